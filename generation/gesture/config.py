@@ -1,0 +1,39 @@
+"""Paths and defaults of the gesture network (seed 003)."""
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+PACKAGE_DIR = Path(__file__).resolve().parent
+GENERATION_DIR = PACKAGE_DIR.parent
+PROJECT_DIR = GENERATION_DIR.parent
+
+SENTENCES_CSV = GENERATION_DIR / "data" / "sentences_synthetic.csv"
+DEFAULT_WEIGHTS = GENERATION_DIR / "data" / "weights" / "gesture_net_default.pt"
+# Caches and checkpoints live under var/ (git-ignored); override with GESTURE_VAR_DIR.
+VAR_DIR = Path(os.environ.get("GESTURE_VAR_DIR", PROJECT_DIR / "var" / "gesture"))
+
+TASKS = ("narration", "conversation")
+GENDERS = ("female", "male")
+HANDEDNESS = ("left", "right")
+
+# The network runs at a low frame rate (the 2-core CPU budget) and output is resampled (slerp).
+TRAIN_FPS = 10.0
+# Gesture length follows the sentence: seconds per word, plus rest lead-in and lead-out.
+SECONDS_PER_WORD = 0.4
+LEAD_IN_S = 0.5
+LEAD_OUT_S = 1.0
+MAX_SECONDS = 12.0
+MIN_SECONDS = 2.5
+
+
+def gesture_seconds(n_words: int) -> float:
+    """Duration in seconds of the gesture for a sentence of ``n_words`` words (rest lead-in/out included)."""
+    if n_words < 1:
+        raise ValueError(f"a sentence needs at least one word, got {n_words}")
+    return float(min(MAX_SECONDS, max(MIN_SECONDS, LEAD_IN_S + SECONDS_PER_WORD * n_words + LEAD_OUT_S)))
+
+
+def gesture_frames(n_words: int, fps: float = TRAIN_FPS) -> int:
+    """Number of frames at ``fps`` of the gesture for a sentence of ``n_words`` words."""
+    return int(round(gesture_seconds(n_words) * fps))

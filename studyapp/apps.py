@@ -1,0 +1,7 @@
+from django.apps import AppConfig
+
+
+class StudyAppConfig(AppConfig):
+    name = "studyapp"
+    verbose_name = "Perceptual studies"
+    default_auto_field = "django.db.models.BigAutoField"
