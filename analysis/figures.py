@@ -1,0 +1,218 @@
+"""Report figures (matplotlib, Agg backend), each built from one tidy analysis table.
+
+Every ``fig_*`` function takes the DataFrame of the matching analysis and returns a matplotlib Figure (or None when
+the table is empty); :func:`save_figure` writes it as PNG and SVG.
+"""
+
+from __future__ import annotations
+
+import os
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+import pandas as pd  # noqa: E402
+
+from .lexicon import GAIT_EMOTIONS, LIKERT_FEATURES, THEMES, VAD_DIMENSIONS  # noqa: E402
+
+plt.rcParams.update({"svg.hashsalt": "analysis", "svg.fonttype": "none", "font.size": 9, "axes.titlesize": 9,
+                     "figure.dpi": 100})
+INTENDED_COLOR, PERCEIVED_COLOR = "#4C72B0", "#DD8452"
+EMOTION_COLORS = {"happy": "#E1A100", "sad": "#4C72B0", "angry": "#C44E52", "neutral": "#8C8C8C"}
+
+
+def save_figure(fig, out_dir: str, name: str, dpi: int = 110) -> dict[str, str]:
+    """Write ``fig`` as ``<name>.png`` and ``<name>.svg`` into out_dir, close it, return {"png": path, "svg": path}."""
+    paths = {"png": os.path.join(out_dir, f"{name}.png"), "svg": os.path.join(out_dir, f"{name}.svg")}
+    fig.savefig(paths["png"], dpi=dpi, metadata={"Software": None})
+    fig.savefig(paths["svg"], metadata={"Date": None, "Creator": None})
+    plt.close(fig)
+    return paths
+
+
+def _grid(n: int, ncols: int, w: float, h: float, **kw):
+    ncols = max(1, min(ncols, n))
+    nrows = int(np.ceil(n / ncols))
+    fig, axes = plt.subplots(nrows, ncols, figsize=(w * ncols, h * nrows), squeeze=False, **kw)
+    for ax in axes.ravel()[n:]:
+        ax.set_visible(False)
+    return fig, axes.ravel()
+
+
+def fig_emotion_vectors(table: pd.DataFrame, title: str = "Intended vs perceived gait emotions"):
+    """Seed 000 Fig. 9: per clip, intended and mean perceived (l1-normalised) emotion vectors as paired bars.
+    ``table``: gait_emotion_ad or transition_ad (then one panel per clip and phase)."""
+    if table.empty:
+        return None
+    fig, axes = _grid(len(table), 4, 2.6, 2.1, sharey=True)
+    x = np.arange(len(GAIT_EMOTIONS))
+    for ax, (_, row) in zip(axes, table.iterrows()):
+        want = [row[f"intended_{e}"] for e in GAIT_EMOTIONS]
+        got = [row[f"perceived_{e}"] for e in GAIT_EMOTIONS]
+        ax.bar(x - 0.2, want, 0.4, color=INTENDED_COLOR, label="intended")
+        ax.bar(x + 0.2, got, 0.4, color=PERCEIVED_COLOR, label="perceived")
+        ax.set_xticks(x, [e[:3] for e in GAIT_EMOTIONS])
+        ax.set_ylim(0, 1.05)
+        phase = f" ({row['phase']})" if "phase" in row else ""
+        verdict = "reject" if row["reject"] else "not rejected"
+        ax.set_title(f"{row['clip_id']}{phase}\nA = {row['statistic']:.2f}, p {_p(row)} ({verdict})", fontsize=8)
+    axes[0].legend(loc="upper right", fontsize=7, frameon=False)
+    fig.suptitle(title)
+    fig.tight_layout()
+    return fig
+
+
+def fig_transitions(table: pd.DataFrame):
+    """Seed 000 section 6.3.2: per transition clip, intended and perceived vectors of the initial (left group) and
+    final (right group) emotion. ``table``: transition_ad."""
+    if table.empty:
+        return None
+    clips = list(dict.fromkeys(table["clip_id"]))
+    fig, axes = _grid(len(clips), 4, 3.0, 2.1, sharey=True)
+    x = np.arange(len(GAIT_EMOTIONS))
+    for ax, clip in zip(axes, clips):
+        title = [clip]
+        for offset, phase in ((0, "initial"), (5, "final")):
+            r = table[(table["clip_id"] == clip) & (table["phase"] == phase)]
+            if r.empty:
+                continue
+            row = r.iloc[0]
+            ax.bar(x + offset - 0.2, [row[f"intended_{e}"] for e in GAIT_EMOTIONS], 0.4, color=INTENDED_COLOR,
+                   label="intended")
+            ax.bar(x + offset + 0.2, [row[f"perceived_{e}"] for e in GAIT_EMOTIONS], 0.4, color=PERCEIVED_COLOR,
+                   label="perceived")
+            title.append(f"{phase[:3]}: p {_p(row)}{' *' if row['reject'] else ''}")
+        ax.axvline(4, color="#bbb", lw=0.8)
+        ax.set_xticks(np.r_[x, x + 5], [e[:2] for e in GAIT_EMOTIONS] * 2, fontsize=7)
+        ax.set_ylim(0, 1.05)
+        ax.set_title("\n".join([title[0], ", ".join(title[1:])]), fontsize=8)
+    h, lab = axes[0].get_legend_handles_labels()
+    axes[0].legend(h[:2], lab[:2], loc="upper center", fontsize=7, frameon=False)
+    fig.suptitle("Emotion transitions: initial (left) and final (right), intended vs perceived (* rejected)")
+    fig.tight_layout()
+    return fig
+
+
+def _p(row) -> str:
+    d = row.get("p_display", "")
+    return d if d.startswith(("<", ">")) else f"= {row['p_value']:.3f}"
+
+
+def fig_likert(dist: pd.DataFrame):
+    """Seed 000 Fig. 8: share of each Likert value 0..4, one panel per feature (rows) and emotion (columns)."""
+    if dist.empty:
+        return None
+    emotions = [e for e in GAIT_EMOTIONS if e in set(dist["emotion"])]
+    features = [f for f in LIKERT_FEATURES if f in set(dist["feature"])]
+    fig, axes = plt.subplots(len(features), len(emotions), figsize=(2.2 * len(emotions), 1.6 * len(features)),
+                             squeeze=False, sharex=True, sharey=True)
+    for i, f in enumerate(features):
+        for j, e in enumerate(emotions):
+            d = dist[(dist["emotion"] == e) & (dist["feature"] == f)].sort_values("value")
+            ax = axes[i, j]
+            ax.bar(d["value"], d["share"], color=EMOTION_COLORS.get(e, "#555"))
+            ax.set_xticks(range(5))
+            ax.set_ylim(0, 1)
+            if i == 0:
+                ax.set_title(e)
+            if j == 0:
+                ax.set_ylabel(f"{f}\nshare")
+            if i == len(features) - 1:
+                ax.set_xlabel("Likert value")
+    fig.suptitle("Pose affective features by intended emotion (share of answers)")
+    fig.tight_layout()
+    return fig
+
+
+def fig_vad(pairs: pd.DataFrame, pearson: pd.DataFrame):
+    """Seed 003 Fig. 7: intended vs perceived value per VAD dimension; each distinct pair is one bubble, its area
+    proportional to the number of answers."""
+    if pairs.empty:
+        return None
+    fig, axes = plt.subplots(1, 3, figsize=(10, 3.4))
+    for ax, d in zip(axes, VAD_DIMENSIONS):
+        counts = pairs.groupby([f"intended_{d}", f"perceived_{d}"]).size().reset_index(name="n")
+        size = 400 * counts["n"] / counts["n"].max()
+        ax.scatter(counts[f"intended_{d}"], counts[f"perceived_{d}"], s=size, alpha=0.5, color=INTENDED_COLOR,
+                   edgecolor="k", linewidth=0.3)
+        ax.plot([0, 1], [0, 1], color="#999", lw=0.8, ls="--")
+        ax.set_xlim(-0.05, 1.05)
+        ax.set_ylim(-0.05, 1.05)
+        ax.set_xlabel(f"intended {d}")
+        ax.set_ylabel(f"perceived {d}")
+        r = pearson.set_index("dimension").get("r", pd.Series(dtype=float)).get(d, np.nan)
+        ax.set_title(f"{d}: Pearson r = {r:.2f} (n = {len(pairs)})")
+        ax.set_aspect("equal")
+    fig.suptitle("Intended vs perceived gesture emotion in NRC-VAD space (bubble area = answers)")
+    fig.tight_layout()
+    return fig
+
+
+def fig_naturalness(nat: pd.DataFrame):
+    """Share of each naturalness rating 1..5, generated vs source, one panel per modality."""
+    if nat.empty:
+        return None
+    modalities = sorted(nat["modality"].unique())
+    fig, axes = plt.subplots(1, len(modalities), figsize=(4.2 * len(modalities), 3), squeeze=False, sharey=True)
+    x = np.arange(1, 6)
+    for ax, mod in zip(axes[0], modalities):
+        for k, (origin, color) in enumerate((("generated", PERCEIVED_COLOR), ("source", INTENDED_COLOR))):
+            r = nat[(nat["modality"] == mod) & (nat["origin"] == origin)]
+            if r.empty:
+                continue
+            r = r.iloc[0]
+            shares = [r[f"share_{v}"] for v in x]
+            ax.bar(x + (k - 0.5) * 0.4, shares, 0.4, color=color,
+                   label=f"{origin} ({r['share_at_least_3']:.0%} >= 3, n = {int(r['n'])})")
+        ax.set_xticks(x)
+        ax.set_xlabel("naturalness rating (1 not natural .. 5 very natural)")
+        ax.set_title(mod)
+        ax.legend(fontsize=7, frameon=False, loc="upper left")
+    axes[0, 0].set_ylabel("share of answers")
+    fig.suptitle("Naturalness of generated and source motion")
+    fig.tight_layout()
+    return fig
+
+
+def fig_theme_ratings(desc: pd.DataFrame):
+    """Seed 004 Fig. 7: normalised theme rating (0..1) against number of features, one line per weight, error
+    bars = standard error, one panel per theme."""
+    if desc.empty:
+        return None
+    themes = [t for t in THEMES if t in set(desc["theme"])] + sorted(set(desc["theme"]) - set(THEMES))
+    fig, axes = _grid(len(themes), 3, 3.2, 2.6, sharey=True)
+    weights = sorted(desc["weight"].unique())
+    cmap = plt.get_cmap("viridis")
+    for ax, theme in zip(axes, themes):
+        d = desc[desc["theme"] == theme]
+        for i, w in enumerate(weights):
+            e = d[d["weight"] == w].sort_values("n_features")
+            ax.errorbar(e["n_features"], e["mean"], yerr=e["se"], marker="o", ms=3, capsize=2, lw=1,
+                        color=cmap(i / max(1, len(weights) - 1)), label=f"w = {w:g}")
+        ax.set_title(theme)
+        ax.set_ylim(0, 1)
+        ax.set_xlabel("number of features")
+        ax.set_xticks(sorted(d["n_features"].unique()))
+    axes[0].set_ylabel("rating (normalised 0..1)")
+    axes[0].legend(fontsize=7, frameon=False)
+    fig.suptitle("Theme ratings by weight and number of features (mean ± SE)")
+    fig.tight_layout()
+    return fig
+
+
+def fig_inversion(inv: pd.DataFrame):
+    """Seed 004 Fig. 8: mean inversion rating per theme (-7 opposite theme .. +7 original theme), error bars SE."""
+    if inv.empty:
+        return None
+    fig, ax = plt.subplots(figsize=(5.5, 3))
+    x = np.arange(len(inv))
+    ax.bar(x, inv["mean"], yerr=inv["se"], capsize=3, color=INTENDED_COLOR)
+    ax.axhline(0, color="k", lw=0.8)
+    ax.set_xticks(x, inv["theme"])
+    ax.set_ylim(-7, 7)
+    ax.set_ylabel("rating (-7 opposite .. +7 original)")
+    ax.set_title("Ratings of inverted themes (w = -0.7), mean ± SE")
+    fig.tight_layout()
+    return fig

@@ -1,0 +1,264 @@
+"""The researcher report: every analysis of the three papers from the three study exports.
+
+:func:`write_report` reads and validates responses.csv, clips.csv and participants.csv, runs each analysis, and
+writes into ``out_dir``:
+- ``report.json`` (top-level keys of DESIGN.md plus ``transition_ad``-style extras, see :data:`TABLE_KEYS`),
+- one CSV per table (``<key>.csv``), ``participants_summary.json``,
+- figures ``fig_<name>.png`` and ``.svg``,
+- ``report.html``, self-contained (CSS inline, figures as inline SVG).
+Methods are described in docs/analysis.md and in each function's docstring.
+"""
+
+from __future__ import annotations
+
+import datetime as _dt
+import html
+import json
+import math
+import os
+import re
+
+import numpy as np
+import pandas as pd
+
+from . import emotion, figures, likert, naturalness, participants, themes, vad
+from .io import StudyData, load_study
+
+TABLE_KEYS = ("gait_emotion_ad", "transition_ad", "likert_consistency_ad", "likert_distribution", "naturalness",
+              "naturalness_test", "vad_pearson", "theme_anova", "theme_descriptives", "theme_inversion",
+              "neutral_validation", "demographic_differences")
+"""Keys of report.json holding a list of records (one CSV each). ``participants`` and ``meta`` are objects."""
+
+TITLES = {
+    "gait_emotion_ad": "Single gait emotions: intended vs perceived, 2-sample Anderson-Darling (seed 000 6.3.1)",
+    "transition_ad": "Emotion transitions: initial and final, 2-sample Anderson-Darling (seed 000 6.3.2)",
+    "likert_consistency_ad": "Pose affective features: consistency across participants, k-sample Anderson-Darling "
+                             "(seed 000 6.3.3)",
+    "likert_distribution": "Pose affective features: share of each Likert value (seed 000 Fig. 8)",
+    "naturalness": "Naturalness ratings by origin and modality (seed 000 6.3.4, seed 003 6.3.2)",
+    "naturalness_test": "Naturalness: generated vs source",
+    "vad_pearson": "Gesture emotions: intended vs perceived VAD, Pearson r (seed 003 6.3.1)",
+    "theme_anova": "Theme ratings: two-way RM-ANOVA weight x number of features (seed 004 Table IV)",
+    "theme_descriptives": "Theme ratings: normalised mean and SE per cell (seed 004 Fig. 7)",
+    "theme_inversion": "Inverted themes: mean, SE and one-sample t-test against 0 (seed 004 Fig. 8)",
+    "neutral_validation": "Neutral input walk: 7-way forced choice (seed 004 Table I)",
+    "demographic_differences": "Perceived emotions across gender and age group, chi-square (seed 000 6.2)",
+}
+
+
+def analyse(data: StudyData, alpha: float = 0.05, permutations: int = 0) -> tuple[dict, dict]:
+    """Run every analysis on validated data. Returns (tables: key -> DataFrame, extras: participants summary,
+    VAD pairs for the figure)."""
+    r, c, p = data.responses, data.clips, data.participants
+    tables = {
+        "gait_emotion_ad": emotion.gait_emotion_ad(r, c, alpha, permutations),
+        "transition_ad": emotion.transition_ad(r, c, alpha, permutations),
+        "likert_consistency_ad": likert.likert_consistency_ad(r, c, alpha),
+        "likert_distribution": likert.likert_distribution(r, c),
+        "naturalness": naturalness.naturalness(r, c),
+        "naturalness_test": naturalness.naturalness_test(r, c, alpha),
+        "vad_pearson": vad.vad_pearson(r, c),
+        "theme_anova": themes.theme_anova(r, c),
+        "theme_descriptives": themes.theme_descriptives(r, c),
+        "theme_inversion": themes.theme_inversion(r, c, alpha),
+        "neutral_validation": themes.neutral_validation(r),
+        "demographic_differences": participants.demographic_differences(r, p, alpha),
+    }
+    extras = {"participants": participants.participant_summary(p, r), "vad_pairs": vad.vad_pairs(r, c)}
+    return tables, extras
+
+
+def _clean(v):
+    """numpy/pandas scalars -> JSON types; NaN/inf/NaT -> None."""
+    if isinstance(v, dict):
+        return {str(k): _clean(x) for k, x in v.items()}
+    if isinstance(v, (list, tuple)):
+        return [_clean(x) for x in v]
+    if isinstance(v, (np.bool_, bool)):
+        return bool(v)
+    if isinstance(v, (np.integer,)):
+        return int(v)
+    if isinstance(v, (float, np.floating)):
+        return None if not math.isfinite(float(v)) else float(v)
+    if v is pd.NaT or v is None:
+        return None
+    return v
+
+
+def _records(df: pd.DataFrame, key: str) -> list[dict]:
+    recs = df.to_dict("records")
+    if key == "naturalness":
+        for rec in recs:
+            rec["counts"] = {str(k): int(rec[f"count_{k}"]) for k in naturalness.RATINGS}
+        order = ["origin", "modality", "counts", "share_at_least_3", "n"]
+        recs = [{**{k: rec[k] for k in order}, **{k: v for k, v in rec.items() if k not in order}} for rec in recs]
+    return _clean(recs)
+
+
+def _summary(tables: dict, parts: dict, alpha: float) -> list[str]:
+    """Plain-language headline findings."""
+    out = []
+    g = tables["gait_emotion_ad"]
+    if len(g):
+        out.append(f"Single emotions: for {int((~g['reject']).sum())} of {len(g)} gaits the null hypothesis "
+                   f"(intended and perceived emotion vectors from the same distribution) is not rejected at "
+                   f"alpha = {alpha}.")
+    t = tables["transition_ad"]
+    if len(t):
+        ok = t.groupby("clip_id")["reject"].any()
+        out.append(f"Transitions: not rejected for {int((~ok).sum())} of {len(ok)} gaits (initial and final).")
+    lc = tables["likert_consistency_ad"]
+    if len(lc):
+        out.append(f"Pose affective features: consistency across participants rejected in {int(lc['reject'].sum())} "
+                   f"of {len(lc)} emotion x feature tests.")
+    n = tables["naturalness"]
+    for _, row in n.iterrows():
+        out.append(f"Naturalness, {row['modality']} {row['origin']}: {row['share_at_least_3']:.1%} of {int(row['n'])}"
+                   f" ratings >= 3.")
+    v = tables["vad_pearson"]
+    if len(v):
+        out.append("Gesture VAD correlation: " + ", ".join(f"{r['dimension']} r = {r['r']:.2f}"
+                                                            for _, r in v.iterrows()) + ".")
+    a = tables["theme_anova"]
+    if len(a):
+        sig = a[a["p_gg"] < alpha]
+        out.append(f"Theme RM-ANOVA: {len(sig)} of {len(a)} effects significant (Greenhouse-Geisser p < {alpha}).")
+    inv = tables["theme_inversion"]
+    if len(inv):
+        out.append(f"Inversion: mean rating below 0 with p < {alpha} for "
+                   f"{int(((inv['mean'] < 0) & inv['reject']).sum())} of {len(inv)} themes.")
+    if parts.get("synthetic"):
+        out.insert(0, "SYNTHETIC DATA: every participant is simulated (ids 'sim-'); these are not findings.")
+    return out
+
+
+def build_report(data: StudyData, alpha: float = 0.05, permutations: int = 0) -> tuple[dict, dict, dict]:
+    """Analyse and assemble the report dict. Returns (report, tables, extras)."""
+    if not 0 < alpha < 1:
+        raise ValueError(f"alpha must be in (0, 1), not {alpha}")
+    if permutations < 0:
+        raise ValueError(f"permutations must be >= 0, not {permutations}")
+    tables, extras = analyse(data, alpha, permutations)
+    report = {k: _records(tables[k], k) for k in TABLE_KEYS}
+    report["participants"] = _clean(extras["participants"])
+    notes = []
+    a = tables["theme_anova"]
+    if len(a) and a["n_dropped"].max() > 0:
+        notes.append(f"Theme RM-ANOVA: participants with missing cells were dropped per theme "
+                     f"(up to {int(a['n_dropped'].max())} per theme).")
+    for k in TABLE_KEYS:
+        if tables[k].empty:
+            notes.append(f"{k}: no data for this analysis in responses.csv.")
+    synthetic = bool(extras["participants"].get("synthetic"))
+    if synthetic:
+        notes.insert(0, "synthetic: all participants are simulated by analysis.simulate; not data from people.")
+    report["meta"] = _clean({
+        "generated_at": _dt.datetime.now(_dt.UTC).strftime("%Y-%m-%dT%H:%M:%SZ"),
+        "alpha": alpha, "permutations": permutations, "synthetic": synthetic,
+        "n_responses": len(data.responses), "n_clips": len(data.clips), "n_participants": len(data.participants),
+        "summary": _summary(tables, extras["participants"], alpha), "notes": notes,
+        "methods": "docs/analysis.md",
+    })
+    return report, tables, extras
+
+
+FIGURES = ("fig_emotion_vectors", "fig_transitions", "fig_likert", "fig_vad", "fig_naturalness",
+           "fig_theme_ratings", "fig_inversion")
+
+
+def _make_figures(tables: dict, extras: dict) -> dict:
+    return {
+        "fig_emotion_vectors": figures.fig_emotion_vectors(tables["gait_emotion_ad"]),
+        "fig_transitions": figures.fig_transitions(tables["transition_ad"]),
+        "fig_likert": figures.fig_likert(tables["likert_distribution"]),
+        "fig_vad": figures.fig_vad(extras["vad_pairs"], tables["vad_pearson"]),
+        "fig_naturalness": figures.fig_naturalness(tables["naturalness"]),
+        "fig_theme_ratings": figures.fig_theme_ratings(tables["theme_descriptives"]),
+        "fig_inversion": figures.fig_inversion(tables["theme_inversion"]),
+    }
+
+
+def write_report(responses_csv, clips_csv, participants_csv, out_dir, alpha: float = 0.05,
+                 permutations: int = 0) -> dict:
+    """Validate the three exports (paths or text file objects), analyse, and write the report folder.
+
+    Raises :class:`analysis.io.ValidationError` (listing file, line and column of each problem) on invalid input.
+    Returns the report dict (also written as ``out_dir/report.json``).
+    """
+    data = load_study(responses_csv, clips_csv, participants_csv)
+    report, tables, extras = build_report(data, alpha, permutations)
+    os.makedirs(out_dir, exist_ok=True)
+    for k in TABLE_KEYS:
+        tables[k].to_csv(os.path.join(out_dir, f"{k}.csv"), index=False)
+    with open(os.path.join(out_dir, "participants_summary.json"), "w") as f:
+        json.dump(report["participants"], f, indent=2)
+    figs = {}
+    for name, fig in _make_figures(tables, extras).items():
+        if fig is not None:
+            figs[name] = figures.save_figure(fig, out_dir, name)
+    report["meta"]["figures"] = {k: {t: os.path.basename(p) for t, p in v.items()} for k, v in figs.items()}
+    with open(os.path.join(out_dir, "report.json"), "w") as f:
+        json.dump(report, f, indent=1, allow_nan=False)
+    with open(os.path.join(out_dir, "report.html"), "w", encoding="utf-8") as f:
+        f.write(render_html(report, tables, figs))
+    return report
+
+
+CSS = """body{font-family:system-ui,sans-serif;max-width:1100px;margin:2em auto;padding:0 1em;color:#222}
+h1{font-size:1.5em}h2{font-size:1.15em;margin-top:2em;border-bottom:1px solid #ccc}
+table{border-collapse:collapse;font-size:.8em;margin:.5em 0}td,th{border:1px solid #ddd;padding:2px 6px;
+text-align:right}th{background:#f3f3f3}.banner{background:#fff3cd;border:1px solid #e0c36a;padding:.6em 1em;
+font-weight:bold}.fig svg{max-width:100%;height:auto}details{margin:.3em 0}ul.summary li{margin:.2em 0}"""
+
+FIG_FOR_TABLE = {"gait_emotion_ad": "fig_emotion_vectors", "transition_ad": "fig_transitions",
+                 "likert_distribution": "fig_likert", "vad_pearson": "fig_vad", "naturalness": "fig_naturalness",
+                 "theme_descriptives": "fig_theme_ratings", "theme_inversion": "fig_inversion"}
+MAX_HTML_ROWS = 60
+
+
+def _inline_svg(path: str) -> str:
+    with open(path, encoding="utf-8") as f:
+        svg = f.read()
+    svg = re.sub(r"^<\?xml[^>]*>\s*", "", svg)
+    return re.sub(r"^<!DOCTYPE[^>]*>\s*", "", svg)
+
+
+def _table_html(df: pd.DataFrame) -> str:
+    shown = df.head(MAX_HTML_ROWS)
+    body = shown.to_html(index=False, na_rep="", float_format=lambda x: f"{x:.4g}", border=0)
+    if len(df) > MAX_HTML_ROWS:
+        body = (f"<details><summary>{len(df)} rows (first {MAX_HTML_ROWS} shown; all in the CSV)</summary>"
+                f"{body}</details>")
+    return body
+
+
+def render_html(report: dict, tables: dict, figs: dict) -> str:
+    """A self-contained HTML page: summary, participants, each table with its figure inline (SVG)."""
+    meta = report["meta"]
+    h = html.escape
+    parts = [f"<!DOCTYPE html><html lang='en'><head><meta charset='utf-8'><title>Study report</title>"
+             f"<style>{CSS}</style></head><body><h1>Perceptual study report</h1>"]
+    if meta.get("synthetic"):
+        parts.append("<p class='banner'>SYNTHETIC DATA: all participants were simulated (analysis.simulate). "
+                     "Nothing here describes real people.</p>")
+    parts.append(f"<p>Generated {h(meta['generated_at'])}; alpha = {meta['alpha']}; permutations = "
+                 f"{meta['permutations']}; {meta['n_participants']} participants, {meta['n_responses']} answers, "
+                 f"{meta['n_clips']} clips. Methods: docs/analysis.md.</p>")
+    parts.append("<h2>Summary</h2><ul class='summary'>" + "".join(f"<li>{h(s)}</li>" for s in meta["summary"])
+                 + "</ul>")
+    if meta["notes"]:
+        parts.append("<h2>Notes</h2><ul>" + "".join(f"<li>{h(s)}</li>" for s in meta["notes"]) + "</ul>")
+    ps = report["participants"]
+    parts.append("<h2>Participants</h2><pre>" + h(json.dumps(ps, indent=1)) + "</pre>")
+    for k in TABLE_KEYS:
+        parts.append(f"<h2 id='{k}'>{h(TITLES[k])}</h2>")
+        df = tables[k]
+        if df.empty:
+            parts.append("<p>No data.</p>")
+            continue
+        fig = FIG_FOR_TABLE.get(k)
+        if fig in figs:
+            parts.append(f"<div class='fig'>{_inline_svg(figs[fig]['svg'])}</div>")
+        parts.append(_table_html(df))
+    parts.append("</body></html>")
+    return "\n".join(parts)

@@ -1,0 +1,119 @@
+"""The clip catalogue file ``clips.csv`` (DESIGN.md "Interchange formats"): write, read, check against files.
+
+One row per clip, columns exactly :data:`CLIP_COLUMNS`; blank cells are missing values. ``clip_id`` is the
+clip's content hash, which is also the stem of its files ``clips/<clip_id>.mp4|.webm|.png``.
+"""
+from __future__ import annotations
+
+import csv
+import math
+import os
+from collections.abc import Iterable
+from pathlib import Path
+
+CLIP_COLUMNS = ("clip_id", "modality", "origin", "happy", "sad", "angry", "neutral", "final_happy", "final_sad",
+                "final_angry", "final_neutral", "emotion_label", "valence", "arousal", "dominance", "theme", "weight",
+                "n_features", "duration_s")
+FLOAT_COLUMNS = ("happy", "sad", "angry", "neutral", "final_happy", "final_sad", "final_angry", "final_neutral",
+                 "valence", "arousal", "dominance", "weight", "duration_s")
+INT_COLUMNS = ("n_features",)
+
+
+class CatalogueFormatError(ValueError):
+    """A clips.csv that cannot be read; the message names the file, line and field."""
+
+
+def _cell(value) -> str:
+    if value is None or (isinstance(value, float) and math.isnan(value)):
+        return ""
+    if isinstance(value, float):
+        return f"{value:.6g}"
+    return str(value)
+
+
+def read_clips_csv(path: str | Path) -> list[dict]:
+    """Rows of a clips.csv as dicts with floats/ints/None; CatalogueFormatError names file, line and field."""
+    path = Path(path)
+    try:
+        f = path.open(newline="", encoding="utf-8")
+    except OSError as exc:
+        raise CatalogueFormatError(f"{path}: cannot open ({exc})") from None
+    rows = []
+    with f:
+        reader = csv.DictReader(f)
+        missing = [c for c in CLIP_COLUMNS if c not in (reader.fieldnames or [])]
+        if missing:
+            raise CatalogueFormatError(f"{path}: line 1: missing column(s) {missing}")
+        for line_no, raw in enumerate(reader, start=2):
+            row: dict = {}
+            for col in CLIP_COLUMNS:
+                text = (raw.get(col) or "").strip()
+                if col in FLOAT_COLUMNS or col in INT_COLUMNS:
+                    if not text:
+                        row[col] = None
+                        continue
+                    try:
+                        row[col] = int(text) if col in INT_COLUMNS else float(text)
+                    except ValueError:
+                        kind = "an integer" if col in INT_COLUMNS else "a number"
+                        raise CatalogueFormatError(
+                            f"{path}: line {line_no}: field {col!r}: expected {kind} or blank, got {text!r}") from None
+                else:
+                    row[col] = text
+            if not row["clip_id"]:
+                raise CatalogueFormatError(f"{path}: line {line_no}: field 'clip_id' is empty")
+            if row["modality"] not in ("gait", "gesture"):
+                raise CatalogueFormatError(
+                    f"{path}: line {line_no}: field 'modality': expected gait or gesture, got {row['modality']!r}")
+            if row["origin"] not in ("generated", "source"):
+                raise CatalogueFormatError(
+                    f"{path}: line {line_no}: field 'origin': expected generated or source, got {row['origin']!r}")
+            rows.append(row)
+    return rows
+
+
+def write_clips_csv(records: Iterable[dict], path: str | Path, merge: bool = True) -> list[dict]:
+    """Write clip records (dicts with at least the CLIP_COLUMNS keys) to ``path`` atomically.
+
+    With ``merge``, rows already in the file whose clip_id is not among ``records`` are kept (the
+    catalogue collects every plan rendered into this media folder); rows with the same clip_id are
+    replaced. Rows are sorted by clip_id. Returns the rows written.
+    """
+    path = Path(path)
+    rows: dict[str, dict] = {}
+    if merge and path.exists():
+        for row in read_clips_csv(path):
+            rows[row["clip_id"]] = row
+    for rec in records:
+        rows[str(rec["clip_id"])] = {c: rec.get(c) for c in CLIP_COLUMNS}
+    path.parent.mkdir(parents=True, exist_ok=True)
+    tmp = path.with_name(f".{path.name}.tmp{os.getpid()}")
+    with tmp.open("w", newline="", encoding="utf-8") as f:
+        writer = csv.writer(f)
+        writer.writerow(CLIP_COLUMNS)
+        for clip_id in sorted(rows):
+            writer.writerow([_cell(rows[clip_id].get(c)) for c in CLIP_COLUMNS])
+    os.replace(tmp, path)
+    return [rows[k] for k in sorted(rows)]
+
+
+def check_catalogue(csv_path: str | Path, clips_dir: str | Path, webm: bool = False) -> list[str]:
+    """Problems between a clips.csv and the clip files: rows without files, files without rows.
+
+    Returns human-readable problems (empty when they match).
+    """
+    clips_dir = Path(clips_dir)
+    rows = read_clips_csv(csv_path)
+    problems = []
+    ids = set()
+    for row in rows:
+        cid = row["clip_id"]
+        ids.add(cid)
+        for ext in ("mp4", "png") + (("webm",) if webm else ()):
+            f = clips_dir / f"{cid}.{ext}"
+            if not f.is_file() or f.stat().st_size == 0:
+                problems.append(f"clip {cid}: {f.name} missing or empty")
+    for f in sorted(clips_dir.glob("*.mp4")):
+        if not f.name.startswith(".") and f.stem not in ids:
+            problems.append(f"{f.name}: no row in {Path(csv_path).name}")
+    return problems

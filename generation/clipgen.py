@@ -1,0 +1,343 @@
+"""Turn a validated plan entry into a Motion by calling the right generator.
+
+Generators are imported lazily, inside the function that needs them, so a missing or broken generator
+fails only the entries that use it, with a message naming the entry (:class:`ClipGenerationError`).
+
+A network generator whose weights are not there yet may be replaced by the entry's ``fallback``
+(procedural_walk for gait_net, procedural_gesture for gesture_net). The clip is then recorded with the
+generator that really made it, ``metadata["fallback_for"]`` and ``synthetic: True``; it is never passed off
+as the network's output. Its content hash differs, so once the weights exist the clip is rendered anew.
+"""
+from __future__ import annotations
+
+import dataclasses
+import functools
+import hashlib
+import importlib
+import math
+from pathlib import Path
+
+import numpy as np
+
+from .motion import Motion
+from .plan import ClipEntry
+
+#: Bump a generator's version when its output for the same inputs changes (forces re-rendering).
+GENERATOR_VERSIONS = {
+    "gait_net": "1",
+    "procedural_walk": "1",
+    "captured": "1",
+    "neutral_walk": "1",
+    "rbf": "1",
+    "gesture_net": "1",
+    "procedural_gesture": "1",
+}
+#: Modules each generator needs (checked before rendering starts).
+GENERATOR_MODULES = {
+    "gait_net": ("generation.gait.generate", "generation.paths"),
+    "procedural_walk": ("generation.procedural_walk", "generation.emotion", "generation.paths"),
+    "captured": ("generation.captured",),
+    "neutral_walk": ("generation.neutral_base", "generation.stylise"),
+    "rbf": ("generation.neutral_base", "generation.stylise"),
+    "gesture_net": ("generation.gesture.generate",),
+    "procedural_gesture": ("generation.procedural_gesture", "generation.emotion"),
+}
+WEIGHTS_DIR = Path(__file__).resolve().parent / "data" / "weights"
+#: Weights files of the network generators (shipped defaults).
+GENERATOR_WEIGHTS = {
+    "gait_net": WEIGHTS_DIR / "gait_net_default.pt",
+    "gesture_net": WEIGHTS_DIR / "gesture_net_default.pt",
+}
+
+
+class ClipGenerationError(RuntimeError):
+    """A plan entry could not be turned into motion; the message names the entry and the cause."""
+
+
+def availability(generator: str) -> str | None:
+    """None when ``generator`` can run here, else the reason it cannot (missing module or weights)."""
+    for mod in GENERATOR_MODULES[generator]:
+        try:
+            importlib.import_module(mod)
+        except Exception as exc:  # noqa: BLE001 - any import failure makes the generator unavailable
+            return f"module {mod} cannot be imported ({type(exc).__name__}: {exc})"
+    weights = GENERATOR_WEIGHTS.get(generator)
+    if weights is not None and not weights.is_file():
+        return f"weights file {weights} is missing"
+    return None
+
+
+@functools.lru_cache(maxsize=None)
+def _file_digest(path: str, size: int, mtime_ns: int) -> str:
+    h = hashlib.sha256()
+    with open(path, "rb") as f:
+        for block in iter(lambda: f.read(1 << 20), b""):
+            h.update(block)
+    return h.hexdigest()[:12]
+
+
+def generator_version(generator: str) -> str:
+    """Version string that goes into the clip hash: the code version plus the weights' digest for networks."""
+    version = GENERATOR_VERSIONS[generator]
+    weights = GENERATOR_WEIGHTS.get(generator)
+    if weights is not None and weights.is_file():
+        st = weights.stat()
+        version += "+" + _file_digest(str(weights), st.st_size, st.st_mtime_ns)
+    return version
+
+
+def resolve(entry: ClipEntry) -> tuple[ClipEntry, str | None]:
+    """The entry as it will be made: itself, or its fallback when the generator is unavailable.
+
+    Returns (entry, reason the requested generator was replaced or None). Raises ClipGenerationError when
+    neither the generator nor a fallback can run.
+    """
+    reason = availability(entry.generator)
+    if reason is None:
+        return entry, None
+    if entry.fallback is None:
+        raise ClipGenerationError(f"{entry.where}: generator {entry.generator!r} is not available: {reason}")
+    fb_reason = availability(entry.fallback)
+    if fb_reason is not None:
+        raise ClipGenerationError(f"{entry.where}: generator {entry.generator!r} is not available ({reason}) "
+                                  f"and its fallback {entry.fallback!r} neither ({fb_reason})")
+    return fallback_entry(entry), f"{entry.generator} unavailable: {reason}"
+
+
+def fallback_entry(entry: ClipEntry) -> ClipEntry:
+    """The entry re-expressed for its fallback generator (inputs mapped; the intent is unchanged)."""
+    fb = entry.with_generator(entry.fallback)
+    if entry.generator == "gesture_net":
+        inp = entry.inputs
+        n_words = len(inp["sentence"].split())
+        try:
+            from .gesture.config import gesture_seconds
+
+            seconds = float(gesture_seconds(n_words))
+        except Exception:  # noqa: BLE001 - the network's package may be the thing that is missing
+            seconds = 2.0 + 0.4 * n_words
+        inputs = {"emotion_label": inp["emotion_label"], "kind": None, "gender": inp["gender"],
+                  "handedness": inp["handedness"], "duration_s": round(min(max(seconds, 2.0), 60.0), 3)}
+        fb = dataclasses.replace(fb, inputs=inputs)
+    return fb
+
+
+# ---- paths -------------------------------------------------------------------------------------
+def make_path(trajectory: dict):
+    """A GroundPath from a normalised plan trajectory (metres; angles in degrees in the plan)."""
+    from . import paths
+
+    kind, length = trajectory["kind"], trajectory["length_m"]
+    if kind == "straight":
+        return paths.straight(length)
+    if kind == "curved":
+        return paths.curved(trajectory["radius_m"], math.radians(trajectory["angle_deg"]), length)
+    return paths.sharp_turn(math.radians(trajectory["angle_deg"]), length, trajectory["at_fraction"])
+
+
+# ---- generators --------------------------------------------------------------------------------
+def _gait_net(entry: ClipEntry, fps: float) -> Motion:
+    from .gait.generate import emotion_transition, generate_gaits, load_default_model
+
+    net = load_default_model()
+    inp = entry.inputs
+    steps = int(math.ceil(inp["duration_s"] * net.fps)) + 1
+    if "transition" in inp:
+        emotions = emotion_transition(inp["transition"]["initial"], inp["transition"]["final"], steps)[None]
+    else:
+        emotions = np.asarray([inp["emotion"]])
+    return generate_gaits(None, [make_path(inp["trajectory"])], emotions, steps=steps, fps_out=fps, model=net,
+                          rng_seed=entry.seed)[0]
+
+
+def _procedural_walk(entry: ClipEntry, fps: float) -> Motion:
+    from .emotion import gait_params_for_emotion
+    from .procedural_walk import walk
+
+    inp = entry.inputs
+    rng = np.random.default_rng(entry.seed)
+    n_frames = int(round(inp["duration_s"] * fps)) + 1
+    path = make_path(inp["trajectory"])
+    if "transition" in inp:
+        a = gait_params_for_emotion(inp["transition"]["initial"], rng)
+        b = gait_params_for_emotion(inp["transition"]["final"], rng)
+        motion = transition_walk(a, b, path, n_frames, fps, seed=entry.seed)
+        motion.metadata["final_emotion"] = inp["transition"]["final"]
+        motion.metadata["emotion"] = inp["transition"]["initial"]
+    else:
+        params = gait_params_for_emotion(inp["emotion"], rng)
+        motion = walk(params, path, n_frames, fps, seed=entry.seed)
+        motion.metadata["emotion"] = inp["emotion"]
+    return motion
+
+
+def transition_walk(a, b, path, n_frames: int, fps: float, seed: int | None = None, hold: float = 0.3,
+                    n_blend: int = 3, overlap_s: float = 0.4) -> Motion:
+    """A procedural walk whose parameters change from ``a`` to ``b`` (WalkParams) along ``path``.
+
+    ``procedural_walk.walk`` keeps its parameters constant, so the walk is made of segments: pure ``a`` for
+    the first ``hold`` of the time, ``n_blend`` segments with parameters blended linearly in between, pure
+    ``b`` for the last ``hold``. Each segment starts where the previous one stood at that moment (arc
+    length along the path and gait phase carried over), and consecutive segments are cross-faded over
+    ``overlap_s`` seconds (slerp of rotations, lerp of root positions), so there is no jump. Feet may slide
+    slightly during a cross-fade. Synthetic, like every procedural walk (used as the clearly marked
+    fallback for gait_net transitions).
+
+    Returns a Motion of ``n_frames`` frames at ``fps`` on the gait skeleton.
+    """
+    from .paths import GroundPath
+    from .procedural_walk import walk
+    from .quaternion import np_qfix, np_qslerp
+
+    T = int(n_frames)
+    weights = [0.0] + [(k + 1) / (n_blend + 1) for k in range(n_blend)] + [1.0]
+    mid = (1.0 - 2 * hold) / n_blend
+    fractions = [hold] + [mid] * n_blend + [hold]
+    bounds = np.round(np.cumsum([0.0] + fractions) * (T - 1)).astype(int)
+    overlap = max(1, int(round(overlap_s * fps)))
+    arc, phase = 0.0, 0.0
+    rot = np.zeros((T, 21, 4))
+    root = np.zeros((T, 3))
+    done = 0
+    segments_meta = []
+    for k, w in enumerate(weights):
+        params = a.blend(b, w).validate()
+        start, stop = int(bounds[k]), (T if k == len(weights) - 1 else int(bounds[k + 1]) + overlap)
+        stop = min(stop, T)
+        n = stop - start
+        if n < 2:
+            continue
+        # The rest of the path from where this segment starts (the walker continues straight past its end).
+        sub = GroundPath(path.point_at(np.arange(arc, arc + params.speed_mps * n / fps + 3.0, 0.02)), path.kind)
+        m = walk(params, sub, n, fps, phase=phase, seed=None if seed is None else seed + k)
+        seg_rot, seg_root = np_qfix(m.rotations), m.root_positions
+        if k == 0:
+            rot[start:stop], root[start:stop] = seg_rot, seg_root
+        else:
+            n_fade = min(overlap, done - start, n)
+            if n_fade > 0:
+                ramp = (np.arange(1, n_fade + 1) / (n_fade + 1))
+                prev = rot[start:start + n_fade]
+                cur = seg_rot[:n_fade]
+                cur = np.where((prev * cur).sum(-1, keepdims=True) < 0, -cur, cur)
+                rot[start:start + n_fade] = np_qslerp(prev, cur, np.broadcast_to(ramp[:, None], prev.shape[:-1]))
+                root[start:start + n_fade] = (1 - ramp[:, None]) * root[start:start + n_fade] + \
+                    ramp[:, None] * seg_root[:n_fade]
+            rot[start + n_fade:stop], root[start + n_fade:stop] = seg_rot[n_fade:], seg_root[n_fade:]
+        done = stop
+        seg_len = (int(bounds[k + 1]) - start) if k < len(weights) - 1 else n
+        arc += params.speed_mps * (m.skeleton.height / 1.75) * seg_len / fps
+        phase += seg_len / fps * params.cadence_spm / 120.0
+        segments_meta.append({"blend": round(w, 4), "start_frame": start, "params": params.to_dict()})
+    meta = {"origin": "procedural", "synthetic": True, "path_kind": path.kind, "transition_segments": segments_meta,
+            "transition_method": "segmented procedural walk with cross-fades (clipgen.transition_walk)"}
+    from .skeleton import gait_skeleton
+
+    return Motion(gait_skeleton(), np_qfix(rot), root, fps, meta)
+
+
+def _captured(entry: ClipEntry, fps: float) -> Motion:
+    from .captured import WALK_FILES, captured_walks, repeat_cycle
+
+    names = [name for name, _ in WALK_FILES]
+    clip = entry.inputs["clip"]
+    if clip not in names:
+        raise ClipGenerationError(f"{entry.where}: captured clip {clip!r} not shipped (have {names})")
+    motion = captured_walks()[names.index(clip)]
+    if entry.inputs["cycles"] > 1:
+        motion = repeat_cycle(motion, entry.inputs["cycles"])
+    return motion
+
+
+@functools.lru_cache(maxsize=1)
+def _neutral_cycle() -> Motion:
+    from .neutral_base import neutral_cycle
+
+    return neutral_cycle()
+
+
+def _neutral_walk(entry: ClipEntry, fps: float) -> Motion:
+    from .stylise import cycle_stride, repeat_cycle
+
+    base = _neutral_cycle()
+    inp = entry.inputs
+    rot, root = repeat_cycle(base.rotations, base.root_positions, cycle_stride(base), base.duration, inp["speed"],
+                             inp["n_cycles"], fps)
+    meta = dict(base.metadata)
+    meta.update({"generator": "neutral_walk", "n_cycles": inp["n_cycles"], "speed": inp["speed"]})
+    return Motion(base.skeleton, rot, root, fps, meta)
+
+
+def _rbf(entry: ClipEntry, fps: float) -> Motion:
+    from .stylise import stylise
+
+    inp = entry.inputs
+    return stylise(_neutral_cycle(), inp["theme"], inp["weight"], inp["n_features"], speed=inp["speed"],
+                   n_cycles=inp["n_cycles"], fps=fps)
+
+
+def _gesture_net(entry: ClipEntry, fps: float) -> Motion:
+    from .gesture.generate import generate_gesture
+
+    inp = entry.inputs
+    return generate_gesture(inp["sentence"], inp["task"], inp["emotion_label"], inp["gender"], inp["handedness"],
+                            fps=fps, seed=entry.seed, noise=inp["noise"])
+
+
+def _procedural_gesture(entry: ClipEntry, fps: float) -> Motion:
+    from .emotion import NRC_VAD, gesture_params_for_vad
+    from .procedural_gesture import seated_gesture
+    from .skeleton import gesture_skeleton
+
+    inp = entry.inputs
+    v, a, d = NRC_VAD[inp["emotion_label"]] if "emotion_label" in inp else inp["vad"]
+    rng = np.random.default_rng(entry.seed)
+    params = gesture_params_for_vad(v, a, d, rng, kind=inp["kind"], handedness=inp["handedness"])
+    n_frames = int(round(inp["duration_s"] * fps))
+    motion = seated_gesture(params, n_frames, fps, gesture_skeleton(build=inp["gender"]), seed=entry.seed)
+    motion.metadata.update({"emotion_label": inp.get("emotion_label"), "valence": v, "arousal": a, "dominance": d,
+                            "gender": inp["gender"], "handedness": inp["handedness"]})
+    return motion
+
+
+MAKERS = {
+    "gait_net": _gait_net,
+    "procedural_walk": _procedural_walk,
+    "captured": _captured,
+    "neutral_walk": _neutral_walk,
+    "rbf": _rbf,
+    "gesture_net": _gesture_net,
+    "procedural_gesture": _procedural_gesture,
+}
+
+
+def make_motion(entry: ClipEntry, fps: float | None = None, requested: str | None = None,
+                fallback_reason: str | None = None) -> Motion:
+    """Generate the motion of a (resolved) entry at ``fps`` (default: the entry's render fps).
+
+    Args:
+        entry: a validated entry, after :func:`resolve` (its ``generator`` is the one that runs).
+        requested: the generator the plan asked for, when a fallback replaced it.
+        fallback_reason: why, for the metadata.
+    Returns the Motion with metadata naming the entry, the generator that made it, origin and whether it
+    is synthetic. ClipGenerationError names the entry when the generator fails.
+    """
+    fps = fps or entry.render.fps
+    try:
+        motion = MAKERS[entry.generator](entry, fps)
+    except ClipGenerationError:
+        raise
+    except Exception as exc:  # noqa: BLE001 - reported with the entry's name, original traceback chained
+        raise ClipGenerationError(f"{entry.where}: generator {entry.generator!r} failed: "
+                                  f"{type(exc).__name__}: {exc}") from exc
+    meta = motion.metadata
+    meta.setdefault("synthetic", meta.get("origin") in ("procedural", "generated") and entry.generator != "captured")
+    meta["generator_module_origin"] = meta.get("origin")
+    meta["origin"] = entry.origin
+    meta["generator"] = entry.generator
+    meta["entry_id"] = entry.id
+    if requested and requested != entry.generator:
+        meta["fallback_for"] = requested
+        meta["fallback_reason"] = fallback_reason or ""
+        meta["synthetic"] = True
+    return motion

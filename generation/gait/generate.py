@@ -1,0 +1,307 @@
+"""Emotive gait generation with the trained network (seed 000 sections 5.4.1-5.4.2).
+
+``generate_gaits`` continues a seed gait (at least 18 network steps of 1/7.5 s, i.e. 2.4 s at 30 fps)
+along a desired ground path with a desired emotion, constant or changing per step, for many agents in
+one batch. Each step the network predicts the next pose (joint rotations, the root's rotation relative
+to the path heading) and the root features h, s, delta and the phase increment omega; the root is then
+moved by s along the predicted travel direction (facing + delta) and its height set to mean + h. The
+path enters through the heading frame: its direction is the direction from the agent to a look-ahead
+point ``lookahead_m`` ahead on the path (pure pursuit), and kappa is computed from it. The agent is thus
+steered but not placed on the path: an agent whose predicted delta or speed is off drifts from it, which
+is what the trajectory-following benchmark measures.
+
+Output frames are interpolated from the network rate to ``fps_out`` (Motion.resample).
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+import torch
+
+from ..motion import Motion
+from ..paths import GroundPath, straight
+from ..skeleton import Skeleton
+from .data import (SBAR_ALPHA, Normalizer, affective_features, facing_yaw, heading_frame_positions,
+                   prepare_sequences, world_rotations, wrap)
+from .model import GaitNet
+from .train import DEFAULT_WEIGHTS, load_checkpoint
+
+EMOTIONS = ("happy", "sad", "angry", "neutral")
+
+
+@dataclass
+class LoadedGaitNet:
+    """A trained network with its normaliser and the information saved with it."""
+
+    model: GaitNet
+    normalizer: Normalizer
+    path: str
+    info: dict = field(default_factory=dict)
+
+    @property
+    def config(self):
+        return self.model.config
+
+    @property
+    def fps(self) -> float:
+        """Network rate in steps per second (30 fps corpus / frame_step)."""
+        return 30.0 / self.model.config.frame_step
+
+
+_DEFAULT: LoadedGaitNet | None = None
+
+
+def load_model(path: str | Path) -> LoadedGaitNet:
+    """Load weights written by the training command."""
+    model, norm, payload = load_checkpoint(path)
+    info = {k: payload[k] for k in ("trained_on", "num_parameters") if k in payload}
+    info["epochs"] = len(payload.get("history", []))
+    return LoadedGaitNet(model, norm, str(path), info)
+
+
+def load_default_model() -> LoadedGaitNet:
+    """The shipped weights ``generation/data/weights/gait_net_default.pt`` (cached after the first call)."""
+    global _DEFAULT
+    if _DEFAULT is None:
+        if not DEFAULT_WEIGHTS.exists():
+            raise FileNotFoundError(
+                f"default gait weights missing: {DEFAULT_WEIGHTS}; train them with `python -m generation.gait.train`")
+        _DEFAULT = load_model(DEFAULT_WEIGHTS)
+    return _DEFAULT
+
+
+# ---- emotions --------------------------------------------------------------------------------
+def normalize_emotion(e) -> np.ndarray:
+    """l1-normalise emotion vectors (..., 4); negative entries are an error."""
+    e = np.asarray(e, dtype=np.float64)
+    if e.shape[-1] != 4:
+        raise ValueError(f"emotion vectors must have 4 entries (happy, sad, angry, neutral), got shape {e.shape}")
+    if (e < 0).any() or not np.isfinite(e).all():
+        raise ValueError("emotion vectors must be finite and non-negative")
+    total = e.sum(-1, keepdims=True)
+    if (total <= 0).any():
+        raise ValueError("an emotion vector sums to zero")
+    return e / total
+
+
+def emotion_transition(initial, final, steps: int) -> np.ndarray:
+    """(steps, 4) per-step emotions from ``initial`` to ``final`` (section 5.4.2): each component linearly
+    interpolated over the steps, then each step's vector normalised to sum to one."""
+    a, b = normalize_emotion(initial), normalize_emotion(final)
+    w = np.linspace(0.0, 1.0, steps)[:, None]
+    return normalize_emotion((1 - w) * a + w * b)
+
+
+# ---- seeds -----------------------------------------------------------------------------------
+def _seed_motion(seed, emotion0: np.ndarray, n_frames: int, rng: np.random.Generator) -> Motion:
+    """A Motion from a seed given as Motion, WalkParams, a params dict, or None (procedural seed)."""
+    if isinstance(seed, Motion):
+        return seed
+    from ..procedural_walk import WalkParams, walk
+    if seed is None:
+        from ..emotion import gait_params_for_emotion  # another helper's module
+        params = gait_params_for_emotion(emotion0, rng)
+    elif isinstance(seed, WalkParams):
+        params = seed
+    elif isinstance(seed, dict):
+        params = WalkParams.from_dict(seed)
+    else:
+        raise TypeError(f"a seed must be a Motion, WalkParams, a params dict or None, got {type(seed).__name__}")
+    return walk(params, straight(30.0), n_frames, 30.0, phase=float(rng.random()))
+
+
+def _seed_sequence(motion: Motion, frame_step: int, max_steps: int, min_steps: int, index: int):
+    if motion.skeleton.num_joints != 21:
+        raise ValueError(f"seed gait {index}: needs the 21-joint gait skeleton, got {motion.skeleton.num_joints} joints")
+    m = motion.resample(30.0)
+    steps = (m.num_frames - 1) // frame_step + 1
+    if steps < min_steps:
+        raise ValueError(f"seed gait {index}: {motion.num_frames} frames at {motion.fps} fps give {steps} network "
+                         f"steps; at least {min_steps} are needed ({(min_steps - 1) * frame_step + 1} frames at 30 fps)")
+    steps = min(steps, max_steps)
+    need = frame_step * (steps - 1) + 1
+    m = m.slice(m.num_frames - need)
+    return prepare_sequences(m.rotations[None], m.root_positions[None], np.full((1, 4), 0.25), np.array(["seed"]),
+                             np.array([m.skeleton.height]), np.array([m.skeleton.build]), fps=30.0,
+                             frame_step=frame_step, seq_len=steps, skeletons=[m.skeleton])
+
+
+# ---- path following --------------------------------------------------------------------------
+class _PathTracker:
+    """Projection of an agent onto a path and the pure-pursuit heading."""
+
+    def __init__(self, path: GroundPath, extra_m: float, spacing: float = 0.05):
+        self.s = np.arange(-2.0, path.length + extra_m, spacing)
+        self.pts = path.point_at(self.s)
+        self.i = int(np.searchsorted(self.s, 0.0))
+
+    def project(self, xz: np.ndarray) -> tuple[float, float]:
+        """(arc length, distance) of the nearest path point, searched near the previous projection."""
+        lo = max(0, self.i - 20)
+        hi = min(len(self.s), self.i + 60)
+        d = np.linalg.norm(self.pts[lo:hi] - xz, axis=-1)
+        k = int(np.argmin(d))
+        self.i = lo + k
+        return float(self.s[self.i]), float(d[k])
+
+    def pursuit_heading(self, xz: np.ndarray, lookahead_m: float) -> float:
+        s, _ = self.project(xz)
+        j = min(len(self.s) - 1, int(np.searchsorted(self.s, s + lookahead_m)))
+        d = self.pts[j] - xz
+        return float(np.arctan2(d[0], d[1]))
+
+
+def distance_to_path(path: GroundPath, xz: np.ndarray, spacing: float = 0.02) -> np.ndarray:
+    """(T,) distance in metres of ground points (T, 2) from the path (its straight extensions included)."""
+    s = np.arange(-1.0, path.length + 1.0, spacing)
+    pts = path.point_at(s)
+    out = np.empty(len(xz))
+    for i, p in enumerate(xz):
+        out[i] = np.linalg.norm(pts - p, axis=-1).min()
+    return out
+
+
+# ---- generation ------------------------------------------------------------------------------
+def generate_gaits(seeds, paths: list[GroundPath], emotions, steps: int = 200, fps_out: float = 30.0,
+                   model: LoadedGaitNet | None = None, lookahead_m: float = 1.0, include_seed: bool = False,
+                   rng_seed: int = 0) -> list[Motion]:
+    """Generate emotive gaits for N agents in one batch.
+
+    Args:
+        seeds: list of N seed gaits: a :class:`Motion` on the 21-joint skeleton with at least 18 network steps
+            (69 frames at 30 fps, any frame rate is resampled), a ``WalkParams`` / params dict (a procedural
+            seed walk is made), or None (procedural seed from ``generation.emotion.gait_params_for_emotion``).
+        paths: N desired ground paths; the seed is moved and turned rigidly so that its last frame stands at
+            the path start facing the path.
+        emotions: (N, 4) constant emotion per agent, or (N, steps, 4) per step (e.g. from
+            :func:`emotion_transition`); l1-normalised here.
+        steps: number of network steps to generate (1/7.5 s each with the default frame step of 4).
+        fps_out: frame rate of the returned motions (interpolated).
+        model: a :class:`LoadedGaitNet`; default :func:`load_default_model`.
+        lookahead_m: pure-pursuit look-ahead along the path, metres.
+        include_seed: prepend the (moved) seed steps to the output.
+
+    Returns:
+        N Motions on each seed's skeleton, metadata {"origin": "generated", "generator": "gait_net", "emotion",
+        "final_emotion" (None unless the emotion changes), "trained_on", "path_kind", "steps", "network_fps"}.
+    """
+    net = model if model is not None else load_default_model()
+    cfg, norm = net.config, net.normalizer
+    N = len(paths)
+    if seeds is None:
+        seeds = [None] * N
+    if len(seeds) != N:
+        raise ValueError(f"got {len(seeds)} seeds for {N} paths")
+    if steps < 1:
+        raise ValueError(f"steps must be positive, got {steps}")
+    emotions = np.asarray(emotions, dtype=np.float64)
+    if emotions.ndim == 2:
+        emotions = np.repeat(emotions[:, None], steps, axis=1)
+    if emotions.shape != (N, steps, 4):
+        raise ValueError(f"emotions must be ({N}, 4) or ({N}, {steps}, 4), got {emotions.shape}")
+    emotions = normalize_emotion(emotions)
+    rng = np.random.default_rng(rng_seed)
+
+    seed_motions = [_seed_motion(s, emotions[i, 0], cfg.frame_step * (cfg.seq_len - 1) + 1, rng)
+                    for i, s in enumerate(seeds)]
+    seqs = [_seed_sequence(m, cfg.frame_step, cfg.seq_len, cfg.prefix_len, i) for i, m in enumerate(seed_motions)]
+    L = min(s.q.shape[1] for s in seqs)       # common seed length (the last L steps of each)
+    cat = {k: torch.cat([getattr(s, k)[:, -L:] if getattr(s, k).dim() > 1 and k not in ("offsets",)
+                         else getattr(s, k) for s in seqs]) for k in
+           ("q", "root", "theta", "omega", "sbar", "kappa", "ref", "aff", "offsets", "mean_height", "root_pos")}
+
+    # Rigid move of each seed: last root ground point -> path start, last heading -> path heading at 0.
+    rot_yaw = np.array([p.heading_at(0.0) for p in paths]) - cat["ref"][:, -1].double().numpy()
+    last_xz = cat["root_pos"][:, -1][:, [0, 2]].double().numpy()
+    start = np.stack([p.point_at(0.0) for p in paths])
+
+    def move(xz, i):
+        c, s = math.cos(rot_yaw[i]), math.sin(rot_yaw[i])
+        d = xz - last_xz[i]
+        # rotation about +y by yaw maps (x, z) -> (x cos + z sin, -x sin + z cos)
+        return np.stack((d[..., 0] * c + d[..., 1] * s, -d[..., 0] * s + d[..., 1] * c), -1) + start[i]
+
+    speed_guess = float(norm.root_mean[1])  # metres per network step
+    trackers = [_PathTracker(p, extra_m=steps * max(speed_guess, 0.1) * 3 + 10.0) for p in paths]
+    em_seed = torch.as_tensor(emotions[:, :1], dtype=torch.float32).expand(N, L, 4)
+    offsets, mean_h = cat["offsets"], cat["mean_height"]
+
+    model_ = net.model
+    model_.eval()
+    out_rot = np.zeros((N, steps, 21, 4))
+    out_root = np.zeros((N, steps, 3))
+    with torch.no_grad():
+        out = model_(cat["q"], norm.aff(cat["aff"]), norm.step(cat["theta"], cat["omega"], cat["sbar"], cat["kappa"]),
+                     norm.root(cat["root"]), em_seed)
+        hidden = out["hidden"]
+        pred = {k: v[:, -1] for k, v in out.items() if k != "hidden"}
+        theta, sbar = cat["theta"][:, -1].double(), cat["sbar"][:, -1].double()
+        ref_prev = torch.as_tensor(rot_yaw) + cat["ref"][:, -1].double()
+        xz = start.copy()
+        em_all = torch.as_tensor(emotions, dtype=torch.float32)
+        for k in range(steps):
+            root_raw = norm.root_inv(pred["root"]).double()
+            h, s_step, delta = root_raw[:, 0], root_raw[:, 1].clamp_min(0.0), root_raw[:, 2]
+            omega = norm.omega_inv(pred["omega"]).double().clamp(0.0, math.pi)
+            ref = torch.tensor([trackers[i].pursuit_heading(xz[i], lookahead_m) for i in range(N)],
+                               dtype=torch.float64)
+            q = pred["q"]
+            world = world_rotations(q.double(), ref).numpy()
+            alpha = facing_yaw(world[:, 0])
+            travel = alpha + delta.numpy()
+            xz = xz + s_step.numpy()[:, None] * np.stack((np.sin(travel), np.cos(travel)), -1)
+            out_rot[:, k] = world
+            out_root[:, k, 0], out_root[:, k, 2] = xz[:, 0], xz[:, 1]
+            out_root[:, k, 1] = (mean_h.double() + h).numpy()
+            if k == steps - 1:
+                break
+            # Inputs for the next step.
+            theta = torch.remainder(theta + omega, 2 * math.pi)
+            sbar_new = (1 - SBAR_ALPHA) * sbar + SBAR_ALPHA * s_step
+            u = torch.stack((sbar_new * torch.sin(ref), sbar_new * torch.cos(ref)), -1)
+            u0 = torch.stack((sbar * torch.sin(ref_prev), sbar * torch.cos(ref_prev)), -1)
+            kappa = (u - u0).norm(dim=-1)
+            sbar, ref_prev = sbar_new, ref
+            pos = heading_frame_positions(q, mean_h + h.float(), offsets)
+            step_in = norm.step(theta.float(), omega.float(), sbar.float(), kappa.float())
+            out = model_.step(q, norm.aff(affective_features(pos)), step_in, pred["root"], em_all[:, k + 1], hidden)
+            hidden = out["hidden"]
+            pred = {kk: v for kk, v in out.items() if kk != "hidden"}
+
+    motions = []
+    net_fps = 30.0 / cfg.frame_step
+    for i in range(N):
+        rot, root = out_rot[i], out_root[i]
+        if include_seed:
+            seed_rot = world_rotations(cat["q"][i].double(), cat["ref"][i].double() + rot_yaw[i]).numpy()
+            seed_root = cat["root_pos"][i].double().numpy().copy()
+            seed_root[:, [0, 2]] = move(seed_root[:, [0, 2]], i)
+            rot, root = np.concatenate((seed_rot, rot)), np.concatenate((seed_root, root))
+        first, last = emotions[i, 0], emotions[i, -1]
+        meta = {
+            "origin": "generated", "generator": "gait_net",
+            "emotion": [round(float(v), 6) for v in first],
+            "final_emotion": None if np.allclose(first, last, atol=1e-6) else [round(float(v), 6) for v in last],
+            "trained_on": "synthetic procedural corpus",
+            "synthetic": True,
+            "path_kind": paths[i].kind, "steps": steps, "network_fps": net_fps,
+            "seed_origin": seed_motions[i].metadata.get("origin", "unknown"),
+            "weights": Path(net.path).name,
+        }
+        skel: Skeleton = seed_motions[i].skeleton
+        m = Motion(skel, wrap_quaternions(rot), root, net_fps, meta)
+        motions.append(m.resample(fps_out))
+    return motions
+
+
+def wrap_quaternions(q: np.ndarray) -> np.ndarray:
+    """Unit-normalise and make sign-continuous along time (T, J, 4)."""
+    from ..quaternion import np_qfix, np_qnormalize
+    return np_qfix(np_qnormalize(q))
+
+
+__all__ = ["EMOTIONS", "LoadedGaitNet", "distance_to_path", "emotion_transition", "generate_gaits",
+           "load_default_model", "load_model", "normalize_emotion", "wrap"]

@@ -1,0 +1,95 @@
+"""Training losses of seed 000, equations 8-13.
+
+All terms are means over their elements (the paper writes sums; a mean only rescales the weights and
+keeps the terms comparable across batch sizes). Features are standardised by the training-set statistics
+before they enter a loss, and positions are measured in units of ``config.pos_scale_m`` metres, so the
+paper's weights of 1.0 give terms of similar size.
+
+Shapes: N batch, L predicted steps, J joints.
+"""
+from __future__ import annotations
+
+import math
+
+import torch
+
+from ..quaternion import qeuler
+from .config import GaitNetConfig
+
+FOOT_JOINTS = (3, 4, 7, 8)  # left heel, left toe, right heel, right toe (gait skeleton)
+
+
+def wrap_angle(a: torch.Tensor) -> torch.Tensor:
+    """Wrap radians to (-pi, pi]."""
+    return torch.remainder(a + math.pi, 2 * math.pi) - math.pi
+
+
+def motion_loss(q_pred_raw: torch.Tensor, q_true: torch.Tensor, order: str = "zyx",
+                lambda_versor: float = 1.0) -> torch.Tensor:
+    """Eq. 8: squared Euler-angle differences plus the unit-norm penalty on the raw predicted versors.
+
+    Args:
+        q_pred_raw: (N, L, J, 4) predicted quaternions before normalisation.
+        q_true: (N, L, J, 4) ground-truth unit quaternions.
+    Angle differences are wrapped to (-pi, pi] so that 359 degrees and 1 degree are 2 degrees apart.
+    """
+    norm = q_pred_raw.norm(dim=-1)
+    q_pred = q_pred_raw / norm.unsqueeze(-1).clamp_min(1e-8)
+    diff = wrap_angle(qeuler(q_pred, order) - qeuler(q_true, order))
+    return (diff ** 2).mean() + lambda_versor * ((norm - 1.0) ** 2).mean()
+
+
+def pose_loss(pos_pred: torch.Tensor, pos_true: torch.Tensor, scale_m: float = 0.1) -> torch.Tensor:
+    """Eq. 9: squared distance of root-relative joint positions (N, L, J, 3), in units of ``scale_m``."""
+    rel_pred = pos_pred[..., 1:, :] - pos_pred[..., :1, :]
+    rel_true = pos_true[..., 1:, :] - pos_true[..., :1, :]
+    return (((rel_pred - rel_true) / scale_m) ** 2).sum(-1).mean()
+
+
+def affective_loss(aff_pred: torch.Tensor, aff_true: torch.Tensor) -> torch.Tensor:
+    """Eq. 10: squared difference of standardised affective features (N, L, 18)."""
+    return ((aff_pred - aff_true) ** 2).sum(-1).mean() / aff_pred.shape[-1]
+
+
+def root_loss(root_pred: torch.Tensor, root_true: torch.Tensor) -> torch.Tensor:
+    """Eq. 11: L1 difference of standardised root features [h, s, delta] (N, L, 3)."""
+    return (root_pred - root_true).abs().mean()
+
+
+def foot_contact_loss(pos_pred: torch.Tensor, pos_true: torch.Tensor, scale_m: float = 0.1) -> torch.Tensor:
+    """Eq. 12: L1 difference of heel and toe positions (N, L, J, 3) in units of ``scale_m``.
+
+    The positions carry the root height (prediction: mean height + predicted deviation), so this term
+    also keeps the feet on the ground.
+    """
+    idx = list(FOOT_JOINTS)
+    return ((pos_pred[..., idx, :] - pos_true[..., idx, :]) / scale_m).abs().mean()
+
+
+def phase_loss(omega_pred: torch.Tensor, omega_true: torch.Tensor) -> torch.Tensor:
+    """L1 on the standardised step-phase increment (N, L); supervises the extra omega head (model.py)."""
+    return (omega_pred - omega_true).abs().mean()
+
+
+def total_loss(pred: dict, true: dict, config: GaitNetConfig) -> tuple[torch.Tensor, dict]:
+    """Eq. 13 plus the phase term.
+
+    ``pred`` and ``true`` hold ``q`` ((N, L, J, 4); ``pred["q_raw"]`` unnormalised), ``pos`` (N, L, J, 3) with
+    root height, ``aff`` (N, L, 18), ``root`` (N, L, 3) and ``omega`` (N, L), all for the same target steps.
+    Returns the weighted total and a dict of floats per term.
+    """
+    c = config
+    terms = {
+        "motion": motion_loss(pred["q_raw"], true["q"], c.euler_order, c.lambda_versor),
+        "pose": pose_loss(pred["pos"], true["pos"], c.pos_scale_m),
+        "root": root_loss(pred["root"], true["root"]),
+        "fctc": foot_contact_loss(pred["pos"], true["pos"], c.pos_scale_m),
+        "phase": phase_loss(pred["omega"], true["omega"]),
+    }
+    weights = {"motion": c.lambda_motion, "pose": c.lambda_pose, "root": c.lambda_root, "fctc": c.lambda_fctc,
+               "phase": c.lambda_phase}
+    if c.use_affective:
+        terms["aff"] = affective_loss(pred["aff"], true["aff"])
+        weights["aff"] = c.lambda_aff
+    total = sum(weights[k] * v for k, v in terms.items() if weights[k] != 0.0)
+    return total, {k: float(v.detach()) for k, v in terms.items()}

@@ -1,0 +1,346 @@
+"""The gesture network's SYNTHETIC training corpus: project-written sentences paired with procedural gestures.
+
+Seed 003 trains on the MPI Emotional Body Expressions database (captured motion, 1,447 sequences), which is not
+available offline. In its place, each sentence of ``generation/data/sentences_synthetic.csv`` (330 sentences
+written for this project: 11 MPI emotions x 15 narration + 15 conversation lines) is paired with procedural
+seated gestures from :func:`generation.procedural_gesture.seated_gesture`, whose affective traits follow the
+intended emotion's arousal (speed) and dominance (expansion) as in seed 003 section 4.3. The gesture lasts as long
+as the sentence takes to say (:func:`generation.gesture.config.gesture_seconds`), starts and ends at the seated
+rest pose, is performed by a female or male body (``gesture_skeleton(build=gender)``) and leads with the dominant
+hand. Everything here is synthetic and labelled so in metadata; none of it is captured motion.
+
+Splits are by sentence (80/10/10, stratified by emotion), so every variant of a sentence lands in one split.
+"""
+from __future__ import annotations
+
+import csv
+import hashlib
+import json
+import re
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+import torch
+
+from ..motion import Motion
+from ..quaternion import np_qfix, np_qnormalize
+from ..skeleton import gesture_skeleton
+from . import config
+from .text import EMBED_DIM, cached_encodings, count_words
+
+SYNTHETIC_LABEL = "synthetic procedural gestures"
+SPLITS = ("train", "val", "test")
+
+
+class CorpusFormatError(ValueError):
+    """The sentence CSV is malformed; the message names the file, line and field."""
+
+
+@dataclass(frozen=True)
+class SentenceRow:
+    sentence_id: str
+    emotion: str
+    task: str
+    sentence: str
+
+
+def nrc_vad(emotion: str) -> tuple[float, float, float]:
+    """(valence, arousal, dominance) in [0, 1] of an emotion word from the NRC-VAD table (Mohammad, ACL 2018)."""
+    from ..emotion import NRC_VAD
+
+    key = emotion.strip().lower()
+    if key not in NRC_VAD:
+        raise ValueError(f"emotion {emotion!r} is not in the NRC-VAD table; known: {', '.join(sorted(NRC_VAD))}")
+    v, a, d = NRC_VAD[key]
+    return float(v), float(a), float(d)
+
+
+def load_sentences(path: str | Path = config.SENTENCES_CSV) -> list[SentenceRow]:
+    """Rows of the sentence corpus CSV (columns sentence_id, emotion, task, sentence)."""
+    from ..emotion import NRC_VAD
+
+    path = Path(path)
+    if not path.is_file():
+        raise CorpusFormatError(f"{path}: sentence corpus not found")
+    rows: list[SentenceRow] = []
+    seen: set[str] = set()
+    with path.open(newline="", encoding="utf-8") as fh:
+        reader = csv.DictReader(fh)
+        expected = ["sentence_id", "emotion", "task", "sentence"]
+        if reader.fieldnames != expected:
+            raise CorpusFormatError(f"{path}: line 1: header must be {','.join(expected)}, got {reader.fieldnames}")
+        for line, rec in enumerate(reader, start=2):
+            sid, emo, task, text = (rec.get(k) or "" for k in expected)
+            if not sid or sid in seen:
+                raise CorpusFormatError(f"{path}: line {line}: field sentence_id is empty or repeated ({sid!r})")
+            if emo not in NRC_VAD:
+                raise CorpusFormatError(f"{path}: line {line}: field emotion {emo!r} is not an NRC-VAD word")
+            if task not in config.TASKS:
+                raise CorpusFormatError(f"{path}: line {line}: field task must be one of {config.TASKS}, got {task!r}")
+            if count_words(text) == 0:
+                raise CorpusFormatError(f"{path}: line {line}: field sentence has no words")
+            seen.add(sid)
+            rows.append(SentenceRow(sid, emo, task, text.strip()))
+    if not rows:
+        raise CorpusFormatError(f"{path}: no sentences")
+    return rows
+
+
+def one_hot(value: str, vocabulary: tuple[str, ...], field: str) -> np.ndarray:
+    if value not in vocabulary:
+        raise ValueError(f"{field} must be one of {vocabulary}, got {value!r}")
+    out = np.zeros(len(vocabulary), dtype=np.float32)
+    out[vocabulary.index(value)] = 1.0
+    return out
+
+
+def attribute_vector(task: str, vad: tuple[float, float, float], gender: str, handedness: str) -> np.ndarray:
+    """The agent attributes of seed 003 section 3.3: [A (2), E = VAD (3), G (2), H (2)] -> (9,) float32."""
+    vad = np.asarray(vad, dtype=np.float32)
+    if vad.shape != (3,) or not np.all((vad >= 0) & (vad <= 1)):
+        raise ValueError(f"VAD must be three values in [0, 1], got {vad}")
+    return np.concatenate([one_hot(task, config.TASKS, "task"), vad, one_hot(gender, config.GENDERS, "gender"),
+                           one_hot(handedness, config.HANDEDNESS, "handedness")])
+
+
+def split_sentences(rows: list[SentenceRow], seed: int = 0) -> dict[str, str]:
+    """sentence_id -> "train" | "val" | "test": 80/10/10 within each emotion (rounded), fixed seed."""
+    rng = np.random.default_rng(seed)
+    out: dict[str, str] = {}
+    by_emotion: dict[str, list[str]] = {}
+    for r in rows:
+        by_emotion.setdefault(r.emotion, []).append(r.sentence_id)
+    for emo in sorted(by_emotion):
+        ids = list(by_emotion[emo])
+        rng.shuffle(ids)
+        n_val = n_test = max(1, int(round(0.1 * len(ids)))) if len(ids) >= 3 else 0
+        for i, sid in enumerate(ids):
+            out[sid] = "test" if i < n_test else "val" if i < n_test + n_val else "train"
+    return out
+
+
+def rest_rotations(gender: str) -> tuple[np.ndarray, np.ndarray]:
+    """Seated rest (start- and end-of-sequence) pose of the gender's body: (23, 4) rotations, (3,) root metres."""
+    from ..procedural_gesture import seated_rest_pose
+
+    rot, root = seated_rest_pose(gesture_skeleton(build=gender))
+    return np.asarray(rot, dtype=np.float64), np.asarray(root, dtype=np.float64)
+
+
+DEICTIC_WORDS = frozenset("you your yours yourself this that these those there here look".split())
+
+
+def gesture_kind_for(sentence: str, arousal: float) -> str:
+    """The procedural gesture kind a sentence gets, so the words matter to the gesture, not only its length.
+
+    Deictic words (you, this, there, look, ...) -> "pointing"; otherwise high arousal (>= 0.6) or an exclamation
+    -> "beat" (seed 003: beats go with aroused speech); otherwise "descriptive".
+    """
+    words = {w.lower() for w in re.findall(r"[A-Za-z']+", sentence)}
+    if words & DEICTIC_WORDS:
+        return "pointing"
+    if arousal >= 0.6 or sentence.rstrip().endswith("!"):
+        return "beat"
+    return "descriptive"
+
+
+MAX_PHRASES = 3
+
+
+def phrases(sentence: str) -> list[str]:
+    """The sentence cut at , ; : ? ! . (up to MAX_PHRASES; extra phrases are merged into the last one)."""
+    parts = [p.strip() for p in re.split(r"[,;:?!.]+", sentence) if count_words(p) > 0]
+    parts = parts or [sentence]
+    if len(parts) > MAX_PHRASES:
+        parts = parts[: MAX_PHRASES - 1] + [" ".join(parts[MAX_PHRASES - 1:])]
+    return parts
+
+
+def procedural_gesture(row: SentenceRow, gender: str, handedness: str, seed: int,
+                       fps: float = config.TRAIN_FPS) -> Motion:
+    """One SYNTHETIC training gesture for a sentence: procedural, seated, emotion-driven, at ``fps``.
+
+    One gesture per phrase of the sentence (:func:`phrases`), its kind from the phrase's words
+    (:func:`gesture_kind_for`), its style from the emotion's VAD (``gesture_params_for_vad``, with individual
+    variation from ``seed``) and the acting task (:func:`_task_style`); the length follows the word count.
+    """
+    from ..emotion import gesture_params_for_vad
+    from ..procedural_gesture import seated_gesture
+
+    v, a, d = nrc_vad(row.emotion)
+    rng = np.random.default_rng(seed)
+    ending = row.sentence.rstrip()[-1:]
+    params = [_task_style(gesture_params_for_vad(v, a, d, rng, kind=gesture_kind_for(p + ending, a),
+                                                 handedness=handedness), row.task)
+              for p in phrases(row.sentence)]
+    n_frames = config.gesture_frames(count_words(row.sentence), fps)
+    motion = seated_gesture(params, n_frames, fps, gesture_skeleton(build=gender), seed)
+    motion.metadata.update({"synthetic": True, "origin": "procedural", "sentence_id": row.sentence_id,
+                            "task": row.task, "emotion_label": row.emotion, "kinds": [p.kind for p in params]})
+    return motion
+
+
+def _task_style(params, task: str):
+    """Narration is more exaggerated and theatrical, conversation subtler (seed 003 section 3.3.1)."""
+    import dataclasses
+
+    scale = {"narration": 1.2, "conversation": 0.8}[task]
+    return dataclasses.replace(params, amplitude=float(np.clip(params.amplitude * scale, 0.2, 1.6)),
+                               head_motion=float(np.clip(params.head_motion * scale, 0.0, 0.4))).validate()
+
+
+@dataclass
+class GestureDataset:
+    """Padded arrays of paired examples (N examples, S tokens, T frames at ``fps``, J = 23 joints).
+
+    Attributes:
+        tokens: (N, S, 384) float32 token vectors; token_lengths (N,) int64.
+        rotations: (N, T, J, 4) float32 unit quaternions, padded past each length with the rest pose.
+        lengths: (N,) int64 frames. attributes: (N, 9) float32. offsets: (N, J, 3) float32 metres.
+        rest: (N, J, 4) float32 seated rest pose. root: (N, 3) float32 seated root position, metres.
+        vad: (N, 3) float32. sentence_index: (N,) index into ``rows``. split: (N,) "train"/"val"/"test".
+        gender, handedness: (N,) str. rows: the sentence rows. fps: frame rate.
+    """
+
+    tokens: np.ndarray
+    token_lengths: np.ndarray
+    rotations: np.ndarray
+    lengths: np.ndarray
+    attributes: np.ndarray
+    offsets: np.ndarray
+    rest: np.ndarray
+    root: np.ndarray
+    vad: np.ndarray
+    sentence_index: np.ndarray
+    split: np.ndarray
+    gender: np.ndarray
+    handedness: np.ndarray
+    rows: list[SentenceRow]
+    fps: float
+
+    def __len__(self) -> int:
+        return len(self.lengths)
+
+    def indices(self, split: str) -> np.ndarray:
+        if split not in SPLITS:
+            raise ValueError(f"split must be one of {SPLITS}, got {split!r}")
+        return np.flatnonzero(self.split == split)
+
+    def row(self, i: int) -> SentenceRow:
+        return self.rows[int(self.sentence_index[i])]
+
+    def batch(self, idx, noise: float = 0.0, generator: torch.Generator | None = None) -> dict[str, torch.Tensor]:
+        """Teacher-forcing batch for examples ``idx``, cropped to their longest sequence.
+
+        Returns tensors: tokens (B, S, 384), token_mask (B, S) bool, attributes (B, 9), inputs (B, T, J, 4) (the rest
+        pose then frames 0..T-2, plus Gaussian ``noise`` before normalising), targets (B, T, J, 4), positions (B, T),
+        progress (B, T, 2), mask (B, T) bool, offsets (B, J, 3), rest (B, J, 4).
+        """
+        idx = np.asarray(idx)
+        T = int(self.lengths[idx].max())
+        S = int(self.token_lengths[idx].max())
+        targets = torch.from_numpy(self.rotations[idx, :T])
+        rest = torch.from_numpy(self.rest[idx])[:, None]
+        inputs = torch.cat((rest, targets[:, :-1]), dim=1)
+        if noise > 0:
+            inputs = inputs + noise * torch.randn(inputs.shape, generator=generator)
+            inputs = inputs / inputs.norm(dim=-1, keepdim=True)
+        lengths = torch.from_numpy(self.lengths[idx])
+        positions = torch.arange(T)[None].expand(len(idx), T)
+        return {
+            "tokens": torch.from_numpy(self.tokens[idx, :S]),
+            "token_mask": torch.arange(S)[None] < torch.from_numpy(self.token_lengths[idx])[:, None],
+            "attributes": torch.from_numpy(self.attributes[idx]),
+            "inputs": inputs,
+            "targets": targets,
+            "positions": positions,
+            "progress": progress_features(positions, lengths, self.fps),
+            "mask": positions < lengths[:, None],
+            "offsets": torch.from_numpy(self.offsets[idx]),
+            "rest": torch.from_numpy(self.rest[idx]),
+        }
+
+
+def progress_features(frames: torch.Tensor, lengths: torch.Tensor, fps: float) -> torch.Tensor:
+    """Where frames (B, T) sit in gestures of ``lengths`` (B,) frames -> (B, T, 2): fraction done, seconds left / 10."""
+    last = (lengths[:, None] - 1).clamp_min(1).to(torch.float32)
+    t = frames.to(torch.float32)
+    return torch.stack(((t / last).clamp(0, 1), ((last - t).clamp_min(0) / fps) / 10.0), dim=-1)
+
+
+def _generator_fingerprint() -> str:
+    """Hash of the procedural generator's source, so cached pairs are rebuilt when it changes."""
+    base = Path(__file__).resolve().parent.parent
+    digest = hashlib.sha1()
+    for name in ("procedural_gesture.py", "emotion.py", "gesture/data.py", "gesture/config.py"):
+        f = base / name
+        if f.is_file():
+            digest.update(f.read_bytes())
+    return digest.hexdigest()
+
+
+def build_dataset(variants: int = 2, seed: int = 0, fps: float = config.TRAIN_FPS,
+                  sentences_csv: str | Path = config.SENTENCES_CSV, cache_dir: str | Path | None = None,
+                  rows: list[SentenceRow] | None = None) -> GestureDataset:
+    """Pair every sentence with ``variants`` procedural gestures (random gender and handedness per variant).
+
+    Token vectors are cached in ``cache_dir/sentence_tokens.npz``, the paired gestures in a second npz keyed by
+    the corpus content and the arguments, so a second call is fast.
+    """
+    cache_dir = Path(cache_dir) if cache_dir is not None else config.VAR_DIR
+    rows = rows if rows is not None else load_sentences(sentences_csv)
+    split = split_sentences(rows, seed)
+    encodings = cached_encodings([r.sentence for r in rows], cache_dir / "sentence_tokens.npz")
+
+    key_src = json.dumps([[r.sentence_id, r.emotion, r.task, r.sentence] for r in rows]) + f"|{variants}|{seed}|{fps}"
+    key_src += _generator_fingerprint()
+    key = hashlib.sha1(key_src.encode()).hexdigest()[:12]
+    motion_cache = cache_dir / f"gesture_pairs_{key}.npz"
+    rest_cache = {g: rest_rotations(g) for g in config.GENDERS}
+    if motion_cache.is_file():
+        with np.load(motion_cache, allow_pickle=False) as data:
+            sentence_index, gender, hand = data["sentence_index"], data["gender"], data["handedness"]
+            lengths = data["lengths"]
+            rotations = data["rotations"]
+    else:
+        rng = np.random.default_rng(seed)
+        motions, sentence_index, gender, hand = [], [], [], []
+        for i, row in enumerate(rows):
+            for k in range(variants):
+                g = config.GENDERS[int(rng.integers(2))]
+                h = config.HANDEDNESS[int(rng.integers(2))] if k % 2 == 0 else ("left" if hand[-1] == "right"
+                                                                                 else "right")
+                m = procedural_gesture(row, g, h, seed=seed * 100_003 + i * variants + k, fps=fps)
+                motions.append(np_qfix(np_qnormalize(m.rotations)).astype(np.float32))
+                sentence_index.append(i)
+                gender.append(g)
+                hand.append(h)
+        lengths = np.array([len(m) for m in motions], dtype=np.int64)
+        rotations = np.zeros((len(motions), int(lengths.max()), 23, 4), dtype=np.float32)
+        for n, m in enumerate(motions):
+            rotations[n, : len(m)] = m
+            rotations[n, len(m):] = m[-1]
+        sentence_index, gender, hand = np.array(sentence_index), np.array(gender), np.array(hand)
+        motion_cache.parent.mkdir(parents=True, exist_ok=True)
+        np.savez_compressed(motion_cache, sentence_index=sentence_index, gender=gender, handedness=hand,
+                            lengths=lengths, rotations=rotations)
+
+    tokens_list = [encodings[i] for i in sentence_index]
+    for e in tokens_list:
+        assert e.shape[1] == EMBED_DIM
+    from .text import pad_tokens
+
+    tokens, token_lengths = pad_tokens(tokens_list)
+    vad = np.array([nrc_vad(rows[i].emotion) for i in sentence_index], dtype=np.float32)
+    attributes = np.stack([attribute_vector(rows[i].task, vad[n], gender[n], hand[n])
+                           for n, i in enumerate(sentence_index)])
+    offsets = np.stack([gesture_skeleton(build=str(g)).offsets for g in gender]).astype(np.float32)
+    rest = np.stack([rest_cache[str(g)][0] for g in gender]).astype(np.float32)
+    root = np.stack([rest_cache[str(g)][1] for g in gender]).astype(np.float32)
+    return GestureDataset(tokens=tokens, token_lengths=token_lengths, rotations=rotations, lengths=lengths,
+                          attributes=attributes, offsets=offsets, rest=rest, root=root, vad=vad,
+                          sentence_index=np.asarray(sentence_index), split=np.array([split[rows[i].sentence_id]
+                                                                                     for i in sentence_index]),
+                          gender=np.asarray(gender).astype(str), handedness=np.asarray(hand).astype(str),
+                          rows=rows, fps=fps)

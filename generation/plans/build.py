@@ -1,0 +1,161 @@
+"""Write the built-in paper plans (seed000.yaml, seed003.yaml, seed004.yaml) from their specifications.
+
+    python -m generation.plans.build            # rewrites the three files next to this module
+
+The plans are plain YAML afterwards; researchers copy and edit them. What each reproduces:
+
+- seed000 (ISMAR 2020, section 6): single-emotion gaits (pure and mixed emotion vectors, straight, curved
+  and sharp-turn paths), emotion-transition gaits (all 12 ordered pairs of the four emotions, each
+  "predominantly" one emotion as in section 6.3.2) and the source motions (the captured DeepMimic walks).
+  Ten-second clips, fixed camera (section 6.3.4).
+- seed003 (IEEE VR 2021, section 6): generated gestures over the 11 MPI emotion categories for narration and
+  conversation sentences, and one "source" gesture per generated one (seed 003's were motion-captured; ours
+  are procedural, marked synthetic) paired through ``pair`` so the study never shows both to one person.
+- seed004 (THMS 2016, section V): the neutral input walk, 6 themes x weights (0.4, 0.7, 1.0, 1.3) x feature
+  counts (1, 4, 7, 10), and the inversions at w = -0.7 with all ten features; short looping clips.
+"""
+from __future__ import annotations
+
+import csv
+from pathlib import Path
+
+import yaml
+
+HERE = Path(__file__).resolve().parent
+SENTENCES = HERE.parent / "data" / "sentences_synthetic.csv"
+GAIT_EMOTIONS = ("happy", "sad", "angry", "neutral")
+GESTURE_EMOTIONS = ("afraid", "amused", "angry", "ashamed", "disgusted", "joyous", "neutral", "proud", "relieved",
+                    "sad", "surprised")
+THEMES = ("happy", "sad", "energetic", "tired", "feminine", "masculine")
+WEIGHTS = (0.4, 0.7, 1.0, 1.3)
+FEATURE_COUNTS = (1, 4, 7, 10)
+INVERSION_WEIGHT = -0.7
+RENDER = {"width": 640, "height": 480, "fps": 30, "duration_s": 10, "camera": "fixed", "anti_aliasing": "fxaa"}
+
+
+def _predominant(emotion: str, share: float = 0.8) -> list[float]:
+    """``share`` of one emotion and the rest neutral (pure neutral for neutral)."""
+    vec = [0.0] * 4
+    vec[GAIT_EMOTIONS.index(emotion)] = share
+    vec[3] += 1.0 - share
+    return [round(v, 3) for v in vec]
+
+
+def seed000() -> dict:
+    clips = []
+    trajectories = [{"kind": "straight", "length_m": 14}, {"kind": "curved", "radius_m": 6, "angle_deg": 90,
+                                                          "length_m": 14}]
+    seed = 0
+    for emotion in GAIT_EMOTIONS:           # pure emotions on a straight and a curved path
+        for k, traj in enumerate(trajectories):
+            seed += 1
+            clips.append({"id": f"single_{emotion}_{traj['kind']}", "generator": "gait_net",
+                          "fallback": "procedural_walk", "origin": "generated",
+                          "emotion": [1.0 if e == emotion else 0.0 for e in GAIT_EMOTIONS], "trajectory": traj,
+                          "seed": seed, "sections": ["emotion_choice", "affect_likert", "naturalness"]})
+    mixtures = {
+        "happy_neutral": [0.6, 0.0, 0.0, 0.4], "sad_neutral": [0.0, 0.7, 0.0, 0.3],
+        "angry_neutral": [0.0, 0.0, 0.6, 0.4], "happy_angry": [0.5, 0.0, 0.5, 0.0],
+        "sad_angry": [0.0, 0.5, 0.5, 0.0], "happy_sad_neutral": [0.3, 0.3, 0.0, 0.4],
+        "mostly_happy": [0.8, 0.0, 0.1, 0.1], "mostly_sad": [0.0, 0.8, 0.0, 0.2],
+    }
+    turns = [{"kind": "sharp_turn", "angle_deg": 70, "length_m": 14},
+             {"kind": "curved", "radius_m": 5, "angle_deg": -120, "length_m": 14},
+             {"kind": "straight", "length_m": 14}]
+    for k, (name, vec) in enumerate(mixtures.items()):
+        seed += 1
+        clips.append({"id": f"single_{name}", "generator": "gait_net", "fallback": "procedural_walk",
+                      "origin": "generated", "emotion": vec, "trajectory": turns[k % len(turns)], "seed": seed,
+                      "sections": ["emotion_choice", "affect_likert", "naturalness"]})
+    for a in GAIT_EMOTIONS:                 # all 12 ordered transitions
+        for b in GAIT_EMOTIONS:
+            if a == b:
+                continue
+            seed += 1
+            clips.append({"id": f"transition_{a}_to_{b}", "generator": "gait_net", "fallback": "procedural_walk",
+                          "origin": "generated",
+                          "transition": {"initial": _predominant(a), "final": _predominant(b)},
+                          "trajectory": turns[seed % len(turns)], "seed": seed, "sections": ["emotion_transition"]})
+    for name, cycles in (("humanoid3d_walk.txt", 8), ("0walk_forward.txt", 8), ("turn_left0.txt", 8),
+                         ("turn_left1.txt", 8), ("turn_right0.txt", 8), ("turn_right1.txt", 8)):
+        clips.append({"id": f"source_{name.removesuffix('.txt')}", "generator": "captured", "origin": "source",
+                      "clip": name, "cycles": cycles, "sections": ["naturalness"],
+                      "note": "captured walk (DeepMimic, CMU/SFU mocap), no emotion label"})
+    return {"name": "seed000", "description": "Seed 000 (Bhattacharya et al., ISMAR 2020) web study stimuli: "
+            "single-emotion gaits, transition gaits, source motions; 10 s clips, fixed camera.",
+            "render": dict(RENDER), "clips": clips}
+
+
+def _sentences(per_emotion_narration: int, per_emotion_conversation: int) -> list[dict]:
+    rows = list(csv.DictReader(SENTENCES.open(encoding="utf-8")))
+    out = []
+    for emotion in GESTURE_EMOTIONS:
+        for task, n in (("narration", per_emotion_narration), ("conversation", per_emotion_conversation)):
+            pool = [r for r in rows if r["emotion"] == emotion and r["task"] == task]
+            out.extend(pool[-n:])           # the last sentences of each group
+    return out
+
+
+def _gesture_seconds(sentence: str) -> float:
+    try:
+        from generation.gesture.config import gesture_seconds
+        from generation.gesture.text import count_words
+
+        return round(float(gesture_seconds(count_words(sentence))), 2)
+    except ImportError:
+        return round(min(12.0, max(2.5, 1.5 + 0.4 * len(sentence.split()))), 2)
+
+
+def seed003(narration: int = 3, conversation: int = 2) -> dict:
+    clips = []
+    for k, row in enumerate(_sentences(narration, conversation)):
+        gender = "female" if k % 2 == 0 else "male"
+        handedness = "left" if k % 7 == 3 else "right"
+        sid = row["sentence_id"]
+        clips.append({"id": f"source_{sid}", "generator": "procedural_gesture", "origin": "source",
+                      "emotion_label": row["emotion"], "gender": gender, "handedness": handedness,
+                      "duration_s": _gesture_seconds(row["sentence"]), "seed": k + 1, "sections": ["naturalness"],
+                      "note": "synthetic stand-in for the motion-captured MPI sequence of this sentence"})
+        clips.append({"id": f"generated_{sid}", "generator": "gesture_net", "fallback": "procedural_gesture",
+                      "origin": "generated", "sentence": row["sentence"], "task": row["task"],
+                      "emotion_label": row["emotion"], "gender": gender, "handedness": handedness, "seed": k + 1,
+                      "pair": f"source_{sid}", "sections": ["gesture_emotion", "naturalness"]})
+    return {"name": "seed003", "description": "Seed 003 (Bhattacharya et al., IEEE VR 2021) web study stimuli: "
+            "generated gestures over the 11 MPI emotions, each paired with a source gesture (procedural, "
+            "synthetic); seated agent on a chair, fixed camera.",
+            "render": dict(RENDER, duration_s=12), "clips": clips}
+
+
+def seed004(n_cycles: int = 3) -> dict:
+    clips = [{"id": "neutral_walk", "generator": "neutral_walk", "origin": "source", "n_cycles": n_cycles,
+              "sections": ["neutral_validation"], "loop": True}]
+    for theme in THEMES:
+        for w in WEIGHTS:
+            for n in FEATURE_COUNTS:
+                clips.append({"id": f"{theme}_w{w}_n{n}", "generator": "rbf", "origin": "generated", "theme": theme,
+                              "weight": w, "n_features": n, "n_cycles": n_cycles, "sections": ["theme_rating"],
+                              "loop": True})
+    for theme in THEMES:
+        clips.append({"id": f"{theme}_inverted", "generator": "rbf", "origin": "generated", "theme": theme,
+                      "weight": INVERSION_WEIGHT, "n_features": 10, "n_cycles": n_cycles,
+                      "sections": ["theme_inversion"], "loop": True})
+    return {"name": "seed004", "description": "Seed 004 (Etemad & Arya, THMS 2016) perception study stimuli: "
+            "neutral input walk, 6 themes x 4 weights x 4 feature counts, inversions at w = -0.7; short walk "
+            "cycles the player loops.", "render": dict(RENDER), "clips": clips}
+
+
+def write_all(out_dir: Path = HERE) -> list[Path]:
+    written = []
+    for name, data in (("seed000", seed000()), ("seed003", seed003()), ("seed004", seed004())):
+        path = out_dir / f"{name}.yaml"
+        header = (f"# Built-in plan {name}; written by `python -m generation.plans.build` (edit a copy, or change\n"
+                  f"# build.py and rerun). {len(data['clips'])} clips.\n")
+        path.write_text(header + yaml.safe_dump(data, sort_keys=False, width=118, allow_unicode=True),
+                        encoding="utf-8")
+        written.append(path)
+    return written
+
+
+if __name__ == "__main__":
+    for p in write_all():
+        print(p)

@@ -1,0 +1,506 @@
+"""Procedural (synthetic) walking on the 21-joint gait skeleton, with planted feet.
+
+This is a parametric walk cycle, not captured motion; everything it makes is marked
+``{"origin": "procedural", "synthetic": True}`` in the metadata.
+
+How a walk is made (all in metres, seconds, radians):
+
+1. Timing. The gait cycle phase is ``phi(t) = phase + t * cadence / 120`` cycles (a cycle is two
+   steps). The left heel strikes at integer ``phi``, the right heel half a cycle later. Each foot
+   is on the ground for the first 60 % of its cycle: heel rocker (toe lowering onto the ground,
+   heel joint fixed) for 10 %, foot flat until 35 %, then heel rise about the fixed toe until
+   toe-off at 60 %; the remaining 40 % is swing.
+2. Path. The root moves along a corner-rounded copy of the :class:`~generation.paths.GroundPath`
+   at constant speed ``stride_m * cadence / 120`` m/s (a stride is two steps), facing the path
+   tangent. Footprints are put on the path, half a step width to either side, so the walker
+   follows straight, curved and sharp-turn paths.
+3. Feet. During contact a foot stays exactly on its footprint (heel joint fixed, then toe fixed);
+   in swing it travels to the next footprint on a minimum-jerk curve lifted by the knee lift.
+4. Pelvis. Lateral sway toward the stance foot, vertical bounce (highest at mid-stance), pelvic
+   rotation; its height is then lowered wherever a leg could not reach its foot target.
+5. Legs. Analytic two-bone IK (hip-knee-ankle) with the knee bending toward the foot's facing
+   direction; the foot orientation is set directly. Because every foot target is reachable,
+   the feet land exactly on the footprints and foot skate is limited to numerical error.
+6. Upper body. Torso pitch split over the lower back and spine, thorax counter-rotation, head
+   pitch relative to the world vertical plus an optional nod, arms swinging opposite to the legs
+   with abduction (expansion) and elbow flexion.
+"""
+from __future__ import annotations
+
+import dataclasses
+import json
+from dataclasses import dataclass
+
+import numpy as np
+
+from .ik import matrix_to_quaternion
+from .motion import Motion
+from .paths import GroundPath, straight
+from .quaternion import np_qconj, np_qfrom_axis_angle, np_qmul, np_qrot
+from .skeleton import GAIT_JOINTS, Skeleton, gait_skeleton
+
+# Fractions of the gait cycle for one foot (0 = its heel strike).
+HEEL_ROCKER_END = 0.10
+HEEL_OFF = 0.35
+TOE_OFF = 0.60
+
+_J = {name: i for i, name in enumerate(GAIT_JOINTS)}
+_X = np.array([1.0, 0.0, 0.0])
+_Y = np.array([0.0, 1.0, 0.0])
+_Z = np.array([0.0, 0.0, 1.0])
+
+
+@dataclass
+class WalkParams:
+    """Parameters of a procedural walk. Angles in radians, lengths in metres (for a 1.75 m body;
+    lengths are scaled with the skeleton's height).
+
+    Attributes:
+        cadence_spm: steps per minute (a gait cycle is two steps); 60-160.
+        stride_m: stride length, distance between successive contacts of the same foot; 0.4-2.2.
+        arm_swing_rad: amplitude of the shoulder flexion swing (forward/back) of each arm.
+        elbow_bend_rad: mean elbow flexion; the elbow bends a further 40 % of the arm's forward swing.
+        torso_pitch_rad: forward lean of the trunk from vertical (+ = bowed forward, - = leaning back).
+        head_pitch_rad: head pitch from the world vertical (+ = looking down, - = chin up).
+        shoulder_raise_m: shoulder elevation (+ = raised, tense; - = dropped). The 21-joint skeleton has
+            no clavicle joint, so a raise is realised as the arm elevation it would cause: extra
+            abduction of ``asin(raise / upper_arm_length)`` and a matching extra elbow bend.
+        knee_lift_rad: swing knee flexion scale; sets the swing foot clearance
+            ``0.03 + 0.25 * (1 - cos(knee_lift_rad))`` metres (about 0.14 m at 1.0 rad).
+        lateral_sway_m: amplitude of the pelvis' side-to-side sway toward the stance foot.
+        arm_abduction_rad: arms held out from the body (expansion); 0 = hanging at the sides.
+        bounce_m: peak-to-peak vertical pelvis oscillation (before reach limits).
+        step_width_m: lateral distance between the left and right footprints.
+        toe_out_rad: outward yaw of each foot.
+        pelvis_rotation_rad: amplitude of the pelvis' yaw oscillation (the swinging hip leads).
+        head_nod_rad: amplitude of a head nod at the step frequency.
+        knee_bend_m: how much lower than standing the nominal pelvis height is (crouch).
+    """
+
+    cadence_spm: float = 110.0
+    stride_m: float = 1.40
+    arm_swing_rad: float = 0.30
+    elbow_bend_rad: float = 0.25
+    torso_pitch_rad: float = 0.04
+    head_pitch_rad: float = 0.05
+    shoulder_raise_m: float = 0.0
+    knee_lift_rad: float = 1.0
+    lateral_sway_m: float = 0.025
+    arm_abduction_rad: float = 0.10
+    bounce_m: float = 0.03
+    step_width_m: float = 0.16
+    toe_out_rad: float = 0.10
+    pelvis_rotation_rad: float = 0.06
+    head_nod_rad: float = 0.02
+    knee_bend_m: float = 0.015
+
+    _LIMITS = {
+        "cadence_spm": (60.0, 160.0), "stride_m": (0.4, 2.2), "arm_swing_rad": (0.0, 1.2),
+        "elbow_bend_rad": (0.0, 2.2), "torso_pitch_rad": (-0.4, 0.8), "head_pitch_rad": (-0.6, 1.0),
+        "shoulder_raise_m": (-0.08, 0.08), "knee_lift_rad": (0.2, 2.0), "lateral_sway_m": (0.0, 0.15),
+        "arm_abduction_rad": (-0.1, 1.2), "bounce_m": (0.0, 0.12), "step_width_m": (0.0, 0.5),
+        "toe_out_rad": (-0.3, 0.5), "pelvis_rotation_rad": (0.0, 0.4), "head_nod_rad": (0.0, 0.4),
+        "knee_bend_m": (0.0, 0.2),
+    }
+
+    @classmethod
+    def neutral(cls) -> WalkParams:
+        """An unremarkable walk: 110 steps/min, 1.4 m stride (1.28 m/s)."""
+        return cls()
+
+    @property
+    def speed_mps(self) -> float:
+        """Walking speed in m/s for the reference body height."""
+        return self.stride_m * self.cadence_spm / 120.0
+
+    def validate(self) -> WalkParams:
+        """Raise ValueError naming the field when a value is not finite or outside its range."""
+        for f in dataclasses.fields(self):
+            value = getattr(self, f.name)
+            lo, hi = self._LIMITS[f.name]
+            if not isinstance(value, (int, float, np.floating)) or not np.isfinite(value):
+                raise ValueError(f"WalkParams.{f.name} must be a finite number, got {value!r}")
+            if not lo <= value <= hi:
+                raise ValueError(f"WalkParams.{f.name}={value} outside [{lo}, {hi}]")
+        return self
+
+    def to_dict(self) -> dict:
+        return {f.name: float(getattr(self, f.name)) for f in dataclasses.fields(self)}
+
+    @classmethod
+    def from_dict(cls, data: dict) -> WalkParams:
+        names = {f.name for f in dataclasses.fields(cls)}
+        unknown = set(data) - names
+        if unknown:
+            raise ValueError(f"WalkParams: unknown field(s) {sorted(unknown)}")
+        return cls(**{k: float(v) for k, v in data.items()}).validate()
+
+    def blend(self, other: WalkParams, w: float) -> WalkParams:
+        """Linear mix (1 - w) * self + w * other."""
+        return WalkParams(**{f.name: (1 - w) * getattr(self, f.name) + w * getattr(other, f.name)
+                             for f in dataclasses.fields(self)})
+
+
+# ---------------------------------------------------------------------------------------------
+# small numpy rigging helpers
+def smoothstep(x):
+    """Cubic ease 3x^2 - 2x^3 on [0, 1] (clipped)."""
+    x = np.clip(x, 0.0, 1.0)
+    return x * x * (3.0 - 2.0 * x)
+
+
+def minjerk(x):
+    """Minimum-jerk ease 10x^3 - 15x^4 + 6x^5 on [0, 1] (clipped)."""
+    x = np.clip(x, 0.0, 1.0)
+    return x ** 3 * (10.0 - 15.0 * x + 6.0 * x * x)
+
+
+def axis_angle(axis, angle) -> np.ndarray:
+    """Quaternions (..., 4) for rotations by ``angle`` (...) about a fixed ``axis`` (3,)."""
+    angle = np.asarray(angle, dtype=np.float64)
+    return np_qfrom_axis_angle(np.broadcast_to(np.asarray(axis, dtype=np.float64), angle.shape + (3,)), angle)
+
+
+def yaw_quat(heading) -> np.ndarray:
+    """Rotation about +y by ``heading`` (radians, 0 = facing +z, + toward +x)."""
+    return axis_angle(_Y, heading)
+
+
+def _unit(v: np.ndarray) -> np.ndarray:
+    return v / np.maximum(np.linalg.norm(v, axis=-1, keepdims=True), 1e-12)
+
+
+def frame_rotation(rest_dir, rest_hint, dir_, hint) -> np.ndarray:
+    """Rotation (..., 4) taking the frame (rest_dir, rest_hint) onto (dir_, hint).
+
+    Each frame is the orthonormal basis made of the unit direction, the hint made orthogonal to
+    it, and their cross product; the rotation maps the first basis onto the second.
+    """
+    def basis(a, b):
+        a = _unit(np.asarray(a, dtype=np.float64))
+        b = np.asarray(b, dtype=np.float64)
+        b = _unit(b - (b * a).sum(-1, keepdims=True) * a)
+        return np.stack([a, b, np.cross(a, b)], axis=-1)  # columns
+
+    b0 = basis(rest_dir, rest_hint)
+    b1 = basis(dir_, hint)
+    b0, b1 = np.broadcast_arrays(b0, b1)
+    return matrix_to_quaternion(b1 @ np.swapaxes(b0, -1, -2))
+
+
+def two_bone_ik(root, target, len_upper, len_lower, pole):
+    """Analytic two-bone IK: the middle joint position for a chain root -> mid -> end.
+
+    Args:
+        root: (..., 3) first joint (hip/shoulder) positions.
+        target: (..., 3) desired end (ankle/wrist) positions.
+        len_upper, len_lower: bone lengths in metres.
+        pole: (..., 3) direction the middle joint bends toward (knee forward, elbow back/out).
+
+    Returns:
+        mid (..., 3), end (..., 3) reachable end position (= target when reachable), reach (...)
+        ratio |target - root| / (len_upper + len_lower).
+    """
+    d_vec = target - root
+    dist = np.linalg.norm(d_vec, axis=-1)
+    u = d_vec / np.maximum(dist, 1e-9)[..., None]
+    d = np.clip(dist, abs(len_upper - len_lower) + 1e-6, (len_upper + len_lower) * (1.0 - 1e-9))
+    cos_a = np.clip((len_upper ** 2 + d ** 2 - len_lower ** 2) / (2.0 * len_upper * d), -1.0, 1.0)
+    sin_a = np.sqrt(1.0 - cos_a ** 2)
+    n = pole - (pole * u).sum(-1, keepdims=True) * u
+    n = _unit(n)
+    mid = root + len_upper * (cos_a[..., None] * u + sin_a[..., None] * n)
+    end = root + d[..., None] * u
+    return mid, end, dist / (len_upper + len_lower)
+
+
+def locals_from_globals(global_rot: np.ndarray, parents) -> np.ndarray:
+    """Local rotations (..., J, 4) from global ones: R_local[j] = R_global[parent]^-1 R_global[j]."""
+    local = global_rot.copy()
+    for j, p in enumerate(parents):
+        if p >= 0:
+            local[..., j, :] = np_qmul(np_qconj(global_rot[..., p, :]), global_rot[..., j, :])
+    return local
+
+
+# ---------------------------------------------------------------------------------------------
+@dataclass
+class WalkResult:
+    """A walk and its ground-truth contact labels.
+
+    Attributes:
+        motion: the synthetic Motion.
+        heel_contact: (T, 2) bool, heel joint planted (left, right).
+        toe_contact: (T, 2) bool, toe joint planted (left, right).
+        footprints: list (left, right) of (K, 3) arrays (x, z, yaw) of the planted heel joints.
+    """
+
+    motion: Motion
+    heel_contact: np.ndarray
+    toe_contact: np.ndarray
+    footprints: list
+
+
+def _check_skeleton(skeleton: Skeleton) -> None:
+    if tuple(skeleton.joints) != GAIT_JOINTS:
+        raise ValueError(f"procedural walk needs the 21-joint gait skeleton, got {skeleton.name!r} "
+                         f"with {skeleton.num_joints} joints")
+
+
+def walk_with_contacts(params: WalkParams, path: GroundPath | None = None, n_frames: int = 240, fps: float = 30.0,
+                       skeleton: Skeleton | None = None, phase: float = 0.0, seed: int | None = None,
+                       corner_sigma_m: float = 0.35) -> WalkResult:
+    """Like :func:`walk` but also returns the ground-truth foot contacts and footprints."""
+    params = WalkParams(**dataclasses.asdict(params)).validate()
+    skeleton = skeleton or gait_skeleton()
+    _check_skeleton(skeleton)
+    if int(n_frames) < 2:
+        raise ValueError(f"n_frames must be at least 2, got {n_frames}")
+    if not fps > 0:
+        raise ValueError(f"fps must be positive, got {fps}")
+    n_frames = int(n_frames)
+    rng = np.random.default_rng(seed)
+    off = skeleton.offsets
+    scale = skeleton.height / 1.75
+
+    # ---- timing and path -----------------------------------------------------------------
+    t = np.arange(n_frames) / fps
+    f_cycle = params.cadence_spm / 120.0
+    stride = params.stride_m * scale
+    speed = stride * f_cycle
+    phi = phase + t * f_cycle
+    walked = speed * t[-1]
+    if path is None:
+        path = straight(walked + 1.0)
+    lead = 3.0  # metres of straight extension before the path start, for the earliest footprints
+    smooth = path.smoothed(corner_sigma_m, start=-lead, stop=max(path.length, walked) + 3.0)
+
+    def path_s(time):
+        return lead + speed * time
+
+    def heading(s):
+        # Direction from a central difference over +-5 cm of the smoothed path.
+        d = smooth.point_at(s + 0.05) - smooth.point_at(s - 0.05)
+        return np.arctan2(d[..., 0], d[..., 1])
+
+    def left_normal(h):
+        return np.stack([np.cos(h), -np.sin(h)], axis=-1)
+
+    # ---- footprints -------------------------------------------------------------------------
+    ankle_h = -off[_J["left_toe"], 1]           # heel-joint height when the foot is flat
+    toe_off_vec = off[_J["left_toe"]]            # heel -> toe in the foot frame
+    strike_pitch = 0.25                          # toe-up angle at heel strike
+    pitch_max = float(np.clip(0.85 + 0.4 * (params.stride_m - 1.4), 0.4, 1.2))
+    lift = (0.03 + 0.25 * (1.0 - np.cos(params.knee_lift_rad))) * scale
+    half_width = 0.5 * params.step_width_m * scale
+    footprint_at = 0.18                          # pelvis is over the heel 18 % into stance
+    feet = []
+    for side, foot_offset in ((+1.0, 0.0), (-1.0, 0.5)):
+        k0 = int(np.floor(phi[0] - foot_offset)) - 2
+        k1 = int(np.ceil(phi[-1] - foot_offset)) + 2
+        ks = np.arange(k0, k1 + 1)
+        t_fp = (ks + foot_offset + footprint_at - phase) / f_cycle
+        s_fp = path_s(t_fp)
+        h_fp = heading(s_fp)
+        jitter = rng.normal(0.0, 0.01 * scale, size=(len(ks), 2)) if seed is not None else np.zeros((len(ks), 2))
+        xz = smooth.point_at(s_fp) + side * half_width * left_normal(h_fp) + jitter
+        yaw = h_fp + side * params.toe_out_rad
+        feet.append((ks, xz, yaw, foot_offset))
+
+    T = n_frames
+    ankle = np.zeros((2, T, 3))
+    foot_q = np.zeros((2, T, 4))
+    foot_yaw = np.zeros((2, T))
+    heel_contact = np.zeros((T, 2), dtype=bool)
+    toe_contact = np.zeros((T, 2), dtype=bool)
+    footprints = []
+    for f, (ks, xz, yaw, foot_offset) in enumerate(feet):
+        footprints.append(np.column_stack([xz, yaw]))
+        k = np.floor(phi - foot_offset).astype(int)
+        u = phi - foot_offset - k
+        i = k - ks[0]
+        # Planted foot pose at stance k.
+        fp_xz, fp_yaw = xz[i], yaw[i]
+        nxt_xz, nxt_yaw = xz[i + 1], yaw[i + 1]
+        pitch = np.zeros(T)
+        pos = np.zeros((T, 3))
+        yaw_t = fp_yaw.copy()
+        # heel phase (heel rocker then flat): heel joint on the footprint
+        heel = u < HEEL_OFF
+        pitch[heel] = -strike_pitch * (1.0 - smoothstep(u[heel] / HEEL_ROCKER_END))
+        pos[heel] = np.column_stack([fp_xz[heel, 0], np.full(heel.sum(), ankle_h), fp_xz[heel, 1]])
+        # toe phase: heel rises about the fixed toe
+        toe = (u >= HEEL_OFF) & (u < TOE_OFF)
+        p_toe = pitch_max * smoothstep((u[toe] - HEEL_OFF) / (TOE_OFF - HEEL_OFF))
+        flat_heel = np.column_stack([fp_xz[toe, 0], np.full(toe.sum(), ankle_h), fp_xz[toe, 1]])
+        q_flat = yaw_quat(fp_yaw[toe])
+        toe_pos = flat_heel + np_qrot(q_flat, np.broadcast_to(toe_off_vec, flat_heel.shape))
+        q_p = np_qmul(q_flat, axis_angle(_X, p_toe))
+        pos[toe] = toe_pos - np_qrot(q_p, np.broadcast_to(toe_off_vec, flat_heel.shape))
+        pitch[toe] = p_toe
+        # swing: from the toe-off pose of stance k to the heel strike of stance k+1
+        sw = u >= TOE_OFF
+        w = (u[sw] - TOE_OFF) / (1.0 - TOE_OFF)
+        heel0 = np.column_stack([fp_xz[sw, 0], np.full(sw.sum(), ankle_h), fp_xz[sw, 1]])
+        q0 = np_qmul(yaw_quat(fp_yaw[sw]), axis_angle(_X, np.full(sw.sum(), pitch_max)))
+        toe0 = heel0 + np_qrot(yaw_quat(fp_yaw[sw]), np.broadcast_to(toe_off_vec, heel0.shape))
+        start = toe0 - np_qrot(q0, np.broadcast_to(toe_off_vec, heel0.shape))
+        end = np.column_stack([nxt_xz[sw, 0], np.full(sw.sum(), ankle_h), nxt_xz[sw, 1]])
+        e = minjerk(w)
+        pos[sw] = start + e[:, None] * (end - start)
+        pos[sw, 1] += lift * np.sin(np.pi * w ** 0.7)
+        pitch[sw] = pitch_max + (-strike_pitch - pitch_max) * smoothstep(w * 1.2)
+        dyaw = np.angle(np.exp(1j * (nxt_yaw[sw] - fp_yaw[sw])))
+        yaw_t[sw] = fp_yaw[sw] + dyaw * smoothstep(w)
+        ankle[f] = pos
+        foot_yaw[f] = yaw_t
+        foot_q[f] = np_qmul(yaw_quat(yaw_t), axis_angle(_X, pitch))
+        heel_contact[:, f] = heel
+        toe_contact[:, f] = (u >= HEEL_ROCKER_END) & (u < TOE_OFF)
+
+    # ---- pelvis -------------------------------------------------------------------------------
+    s_t = path_s(t)
+    h_t = heading(s_t)
+    root_xz = smooth.point_at(s_t) + (params.lateral_sway_m * scale * np.sin(2 * np.pi * phi))[:, None] \
+        * left_normal(h_t)
+    pelvis_yaw = -params.pelvis_rotation_rad * np.cos(2 * np.pi * phi)
+    q_root = yaw_quat(h_t + pelvis_yaw)
+    stand = -(off[_J["left_hip"], 1] + off[_J["left_knee"], 1] + off[_J["left_heel"], 1]) + ankle_h
+    nominal = stand - params.knee_bend_m * scale - 0.5 * params.bounce_m * scale * np.cos(
+        4 * np.pi * (phi - 0.05)) - 0.5 * params.bounce_m * scale
+    len_thigh = float(np.linalg.norm(off[_J["left_knee"]]))
+    len_shin = float(np.linalg.norm(off[_J["left_heel"]]))
+    reach = 0.995 * (len_thigh + len_shin)
+    hip_rel = np.stack([np_qrot(q_root, np.broadcast_to(off[_J[n]], (T, 3))) for n in ("left_hip", "right_hip")])
+    # Planted feet limit the pelvis height; a swinging foot that would be out of reach is lifted
+    # instead (the knee flexes more), as in early swing.
+    max_y = np.full(T, np.inf)
+    horiz = [np.linalg.norm((root_xz + hip_rel[f][:, [0, 2]]) - ankle[f][:, [0, 2]], axis=-1) for f in range(2)]
+    for f in range(2):
+        stance = heel_contact[:, f] | toe_contact[:, f] | (ankle[f][:, 1] <= ankle_h + 1e-9)
+        dy = np.sqrt(np.maximum(reach ** 2 - horiz[f] ** 2, 0.0))
+        max_y = np.minimum(max_y, np.where(stance, ankle[f][:, 1] + dy - hip_rel[f][:, 1], np.inf))
+    root_y = np.minimum(nominal, max_y)
+    root_y = _smooth_below(root_y, radius=max(1, int(round(0.08 * fps))))
+    root = np.column_stack([root_xz[:, 0], root_y, root_xz[:, 1]])
+    for f in range(2):
+        swing = ~(heel_contact[:, f] | toe_contact[:, f])
+        dy = np.sqrt(np.maximum(reach ** 2 - horiz[f] ** 2, 0.0))
+        lowest = root_y + hip_rel[f][:, 1] - dy
+        ankle[f][swing, 1] = np.maximum(ankle[f][swing, 1], lowest[swing])
+
+    # ---- legs (global rotations) -----------------------------------------------------------------
+    G = np.zeros((T, 21, 4))
+    G[:, _J["root"]] = q_root
+    for f, (hip, knee, heel_j, toe_j) in enumerate((("left_hip", "left_knee", "left_heel", "left_toe"),
+                                                    ("right_hip", "right_knee", "right_heel", "right_toe"))):
+        hip_pos = root + hip_rel[f]
+        # The knee bends toward the foot's facing direction, mixed with the trunk heading.
+        knee_yaw = h_t + np.angle(np.exp(1j * (foot_yaw[f] - h_t))) * 0.5
+        fwd = np.column_stack([np.sin(knee_yaw), np.zeros(T), np.cos(knee_yaw)])
+        knee_pos, ankle_pos, _ = two_bone_ik(hip_pos, ankle[f], len_thigh, len_shin, fwd)
+        G[:, _J[hip]] = frame_rotation(off[_J[knee]], _Z, knee_pos - hip_pos, fwd)
+        G[:, _J[knee]] = frame_rotation(off[_J[heel_j]], _Z, ankle_pos - knee_pos, fwd)
+        G[:, _J[heel_j]] = foot_q[f]
+        G[:, _J[toe_j]] = foot_q[f]
+
+    # ---- trunk, head, arms -------------------------------------------------------------------------
+    thorax_yaw = 0.5 * params.pelvis_rotation_rad * np.cos(2 * np.pi * phi)
+    q_yaw = yaw_quat(h_t)
+    G[:, _J["lower_back"]] = np_qmul(q_yaw, axis_angle(_X, np.full(T, 0.4 * params.torso_pitch_rad)))
+    q_thorax = np_qmul(yaw_quat(h_t + thorax_yaw), axis_angle(_X, np.full(T, params.torso_pitch_rad)))
+    G[:, _J["spine"]] = q_thorax
+    nod = params.head_nod_rad * np.sin(4 * np.pi * phi)
+    G[:, _J["neck"]] = np_qmul(yaw_quat(h_t + 0.5 * thorax_yaw), axis_angle(_X, params.head_pitch_rad + nod))
+    G[:, _J["head"]] = G[:, _J["neck"]]
+    len_upper_arm = float(np.linalg.norm(off[_J["left_elbow"]]))
+    raise_angle = float(np.arcsin(np.clip(params.shoulder_raise_m * scale / len_upper_arm, -0.5, 0.5)))
+    for side, (sh, el, ha, ix), sign in ((0, ("left_shoulder", "left_elbow", "left_hand", "left_hand_index"), 1.0),
+                                         (1, ("right_shoulder", "right_elbow", "right_hand", "right_hand_index"),
+                                          -1.0)):
+        flex = params.arm_swing_rad * (-np.cos(2 * np.pi * phi)) * (1.0 if side == 0 else -1.0)
+        flex = flex + 0.5 * params.torso_pitch_rad * 0.3  # arms hang slightly ahead of a bowed trunk
+        abd = np.full(T, params.arm_abduction_rad + max(raise_angle, 0.0))
+        q_up = np_qmul(np_qmul(yaw_quat(h_t + thorax_yaw), axis_angle(_Z, sign * abd)), axis_angle(_X, -flex))
+        elbow = params.elbow_bend_rad + 0.4 * np.maximum(flex, 0.0) + abs(raise_angle)
+        q_fore = np_qmul(q_up, axis_angle(_X, -elbow))
+        q_hand = np_qmul(q_fore, axis_angle(_X, np.full(T, -0.1)))
+        G[:, _J[sh]] = q_up
+        G[:, _J[el]] = q_fore
+        G[:, _J[ha]] = q_hand
+        G[:, _J[ix]] = q_hand
+
+    local = locals_from_globals(G, skeleton.parents)
+    metadata = {
+        "origin": "procedural",
+        "synthetic": True,
+        "generator": "generation.procedural_walk",
+        "params": params.to_dict(),
+        "path_kind": path.kind,
+        "phase": float(phase),
+        "seed": seed,
+        "speed_mps": float(speed),
+    }
+    json.dumps(metadata)  # fail early if anything is not JSON-serialisable
+    motion = Motion(skeleton, local, root, fps, metadata)
+    return WalkResult(motion, heel_contact, toe_contact, footprints)
+
+
+def walk(params: WalkParams, path: GroundPath | None = None, n_frames: int = 240, fps: float = 30.0,
+         skeleton: Skeleton | None = None, phase: float = 0.0, seed: int | None = None) -> Motion:
+    """A synthetic walk following ``path`` with planted feet.
+
+    Args:
+        params: gait parameters (validated; ValueError names a bad field).
+        path: ground path to follow from its first point (default: straight along +z). The
+            walker starts at arc length 0 facing the path tangent and walks at constant speed;
+            if the path is too short it continues straight past its end.
+        n_frames: number of frames T.
+        fps: frame rate.
+        skeleton: 21-joint gait skeleton (default 1.75 m male); lengths scale with its height.
+        phase: gait cycle phase at frame 0, in cycles (0 = left heel strike, 0.5 = right).
+        seed: adds small random footprint jitter (1 cm) when given; None is fully deterministic.
+
+    Returns:
+        Motion with rotations (T, 21, 4), root_positions (T, 3); metadata {"origin": "procedural",
+        "synthetic": True, "params": {...}, "path_kind": ...}.
+    """
+    return walk_with_contacts(params, path, n_frames, fps, skeleton, phase, seed).motion
+
+
+def _smooth_below(y: np.ndarray, radius: int) -> np.ndarray:
+    """Smooth a signal without exceeding it anywhere: min filter then a blur of the same support."""
+    pad = np.pad(y, radius, mode="edge")
+    windows = np.lib.stride_tricks.sliding_window_view(pad, 2 * radius + 1)
+    eroded = windows.min(axis=-1)
+    half = radius // 2
+    k2 = np.hanning(2 * half + 3)[1:-1]
+    k2 /= k2.sum()
+    padded = np.pad(eroded, half, mode="edge")
+    return np.convolve(padded, k2, mode="valid")
+
+
+def planted_foot_slide(positions: np.ndarray, heel_contact: np.ndarray, toe_contact: np.ndarray,
+               fps: float = 30.0) -> dict:
+    """Horizontal slide of planted feet.
+
+    Args:
+        positions: (T, 21, 3) joint positions in metres.
+        heel_contact, toe_contact: (T, 2) bool contact labels (left, right).
+
+    Returns:
+        dict with mean_mm_per_frame, max_mm_per_frame (over frame pairs where the joint is in
+        contact in both frames), and n_pairs.
+    """
+    slides = []
+    for f, (heel, toe) in enumerate((("left_heel", "left_toe"), ("right_heel", "right_toe"))):
+        for joint, contact in ((heel, heel_contact[:, f]), (toe, toe_contact[:, f])):
+            p = positions[:, _J[joint]][:, [0, 2]]
+            both = contact[1:] & contact[:-1]
+            d = np.linalg.norm(np.diff(p, axis=0), axis=-1)[both]
+            slides.append(d)
+    all_d = np.concatenate(slides) * 1000.0
+    if all_d.size == 0:
+        return {"mean_mm_per_frame": 0.0, "max_mm_per_frame": 0.0, "n_pairs": 0}
+    return {"mean_mm_per_frame": float(all_d.mean()), "max_mm_per_frame": float(all_d.max()),
+            "n_pairs": int(all_d.size)}

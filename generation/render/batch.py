@@ -1,0 +1,287 @@
+"""Render a whole stimulus plan: resolve generators, hash, skip what exists, render the rest in worker processes.
+
+Resumable: a clip is done when its files (mp4, png, and webm when asked) exist under their final names and
+its record ``<records_dir>/<clip_id>.json`` is there; the record is written last, after the files were
+renamed into place. Clips already done are skipped, so running the same plan twice renders nothing the
+second time, and a crash loses at most the clips in progress.
+
+Records are kept outside the media folder on purpose: they name the condition of a clip, and the media
+folder is served to participants.
+"""
+from __future__ import annotations
+
+import json
+import multiprocessing as mp
+import os
+import queue as queue_mod
+import time
+import traceback
+from collections.abc import Callable
+from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from ..plan import ClipEntry, Plan, clip_hash, intent_fields
+from .clip import clip_files_complete, render_clip
+
+RECORD_VERSION = 1
+
+
+@dataclass
+class Job:
+    """One clip to make: the plan entry, the entry that will run (maybe a fallback) and the clip id."""
+
+    entry: ClipEntry
+    run_entry: ClipEntry
+    clip_id: str
+    generator_version: str
+    fallback_reason: str | None = None
+
+
+@dataclass
+class BatchResult:
+    records: list[dict] = field(default_factory=list)
+    rendered: list[str] = field(default_factory=list)
+    skipped: list[str] = field(default_factory=list)
+    failed: list[tuple[str, str]] = field(default_factory=list)   # (entry label, message)
+    seconds: float = 0.0
+
+
+def plan_jobs(plan: Plan, limit: int | None = None) -> tuple[list[Job], list[tuple[str, str]]]:
+    """Jobs for the plan's entries (first ``limit``), and (entry, message) for entries that cannot run."""
+    from ..clipgen import ClipGenerationError, generator_version, resolve
+
+    jobs, failures = [], []
+    for entry in plan.entries[:limit] if limit else plan.entries:
+        try:
+            run_entry, reason = resolve(entry)
+        except ClipGenerationError as exc:
+            failures.append((entry.where, str(exc)))
+            continue
+        version = generator_version(run_entry.generator)
+        jobs.append(Job(entry, run_entry, clip_hash(run_entry, run_entry.generator, version), version, reason))
+    return jobs, failures
+
+
+def _json_safe(obj):
+    try:
+        return json.loads(json.dumps(obj, default=lambda o: o.tolist() if hasattr(o, "tolist") else str(o)))
+    except (TypeError, ValueError):
+        return str(obj)
+
+
+def base_record(job: Job, plan: Plan, pair_ids: dict[str, str], media_prefix: str, webm: bool) -> dict:
+    """The catalogue record of a job without the rendered facts (duration)."""
+    e, r = job.entry, job.run_entry
+    rec = {"clip_id": job.clip_id, "modality": e.modality, "origin": e.origin, **intent_fields(e),
+           "duration_s": None, "video": f"{media_prefix}{job.clip_id}.mp4",
+           "webm": f"{media_prefix}{job.clip_id}.webm" if webm else "", "poster": f"{media_prefix}{job.clip_id}.png",
+           "plan": plan.name, "loop": e.loop, "source_clip_id": pair_ids.get(e.pair, "") if e.pair else ""}
+    rec["metadata"] = {
+        "entry_id": e.id, "plan": plan.name, "generator": r.generator, "requested_generator": e.generator,
+        "generator_version": job.generator_version, "inputs": _json_safe(r.inputs), "seed": e.seed,
+        "sections": list(e.sections), "render": e.render.content_dict(), "note": e.note,
+        "pair": e.pair, "source_clip_id": rec["source_clip_id"],
+    }
+    if job.fallback_reason:
+        rec["metadata"]["fallback_for"] = e.generator
+        rec["metadata"]["fallback_reason"] = job.fallback_reason
+    return rec
+
+
+def _write_json_atomic(obj: dict, path: Path) -> None:
+    tmp = path.with_name(f".{path.name}.tmp{os.getpid()}")
+    tmp.write_text(json.dumps(obj, indent=1, sort_keys=True), encoding="utf-8")
+    os.replace(tmp, path)
+
+
+def load_done_record(clip_id: str, clips_dir: Path, records_dir: Path, webm: bool) -> dict | None:
+    """The stored record of a complete clip, or None when the clip must be (re)rendered."""
+    rec_path = records_dir / f"{clip_id}.json"
+    if not rec_path.is_file() or not clip_files_complete(clips_dir, clip_id, webm):
+        return None
+    try:
+        rec = json.loads(rec_path.read_text(encoding="utf-8"))
+    except (OSError, ValueError):
+        return None
+    if rec.get("record_version") != RECORD_VERSION or rec.get("clip_id") != clip_id:
+        return None
+    return rec
+
+
+# ---- worker side -------------------------------------------------------------------------------
+_PROGRESS_QUEUE = None
+
+
+def _init_worker(progress_queue, threads: int) -> None:
+    global _PROGRESS_QUEUE
+    _PROGRESS_QUEUE = progress_queue
+    os.environ.setdefault("OMP_NUM_THREADS", str(threads))
+    os.environ.setdefault("MKL_NUM_THREADS", str(threads))
+    try:
+        import torch
+
+        torch.set_num_threads(threads)
+    except ImportError:  # pragma: no cover - torch is a project dependency
+        pass
+
+
+def render_job(job: Job, record: dict, clips_dir: str, records_dir: str) -> dict:
+    """Make the motion, render its files, write the record last. Runs in a worker (or inline)."""
+    from ..clipgen import make_motion
+
+    t0 = time.perf_counter()
+    motion = make_motion(job.run_entry, requested=job.entry.generator, fallback_reason=job.fallback_reason)
+    t_gen = time.perf_counter() - t0
+    q = _PROGRESS_QUEUE
+    progress = None
+    if q is not None:
+        def progress(done, total):
+            if done == total or done % 10 == 0:
+                q.put((job.clip_id, job.entry.id, done, total))
+    result = render_clip(motion, clips_dir, job.clip_id, job.run_entry.render, progress=progress)
+    record = dict(record)
+    record["duration_s"] = round(result.duration_s, 4)
+    record["metadata"] = dict(record["metadata"])
+    record["metadata"]["motion"] = _json_safe({k: v for k, v in motion.metadata.items() if k != "entry_id"})
+    record["metadata"]["synthetic"] = bool(motion.metadata.get("synthetic", False))
+    record["metadata"]["n_frames"] = result.n_frames
+    record["metadata"]["fps"] = result.fps
+    record["metadata"]["timing_s"] = {"generate": round(t_gen, 3), "total": round(time.perf_counter() - t0, 3)}
+    record["record_version"] = RECORD_VERSION
+    _write_json_atomic(record, Path(records_dir) / f"{job.clip_id}.json")
+    return record
+
+
+# ---- orchestration -----------------------------------------------------------------------------
+def run_plan(plan: Plan, clips_dir: str | Path, records_dir: str | Path, media_prefix: str = "clips/",
+             workers: int = 1, webm: bool = False, limit: int | None = None,
+             on_event: Callable[[str, dict], None] | None = None, threads_per_worker: int = 1) -> BatchResult:
+    """Render every entry of ``plan`` that is not already complete.
+
+    Args:
+        plan: a validated plan.
+        clips_dir: folder of the clip files (``<MEDIA_ROOT>/clips``).
+        records_dir: folder of the per-clip records (keep it out of the served media folder).
+        media_prefix: prefix of file paths in records (relative to MEDIA_ROOT).
+        workers: processes (spawned); 1 renders in this process.
+        webm: also write VP9 WebM files.
+        limit: only the first ``limit`` entries.
+        on_event: progress callback ``on_event(kind, info)`` with kind in {"plan", "skip", "start", "frames",
+            "done", "fail"} (the command draws tqdm bars from it).
+    Returns a BatchResult with the records of every clip of the plan that exists now.
+    """
+    t0 = time.perf_counter()
+    clips_dir, records_dir = Path(clips_dir), Path(records_dir)
+    clips_dir.mkdir(parents=True, exist_ok=True)
+    records_dir.mkdir(parents=True, exist_ok=True)
+    emit = on_event or (lambda kind, info: None)
+    jobs, failures = plan_jobs(plan, limit)
+    result = BatchResult(failed=list(failures))
+    for where, msg in failures:
+        emit("fail", {"entry": where, "error": msg})
+    pair_ids = {j.entry.id: j.clip_id for j in jobs}
+    todo = []
+    by_id: dict[str, dict] = {}
+    for job in jobs:
+        if job.clip_id in by_id:      # two entries that render identical files (ids differ only)
+            continue
+        if webm or job.run_entry.render.webm:
+            job.run_entry = _with_webm(job.run_entry)
+        rec = base_record(job, plan, pair_ids, media_prefix, job.run_entry.render.webm)
+        done = load_done_record(job.clip_id, clips_dir, records_dir, job.run_entry.render.webm)
+        if done is not None:
+            # Same files; refresh the plan-dependent fields (another plan may share this clip).
+            for key in ("duration_s",):
+                rec[key] = done.get(key)
+            rec["metadata"] = {**done.get("metadata", {}), **rec["metadata"]}
+            by_id[job.clip_id] = rec
+            result.skipped.append(job.clip_id)
+            emit("skip", {"clip_id": job.clip_id, "entry": job.entry.id})
+        else:
+            by_id[job.clip_id] = rec
+            todo.append(job)
+    emit("plan", {"total": len(by_id), "todo": len(todo), "skipped": len(result.skipped)})
+
+    def finished(job: Job, rec: dict) -> None:
+        by_id[job.clip_id] = rec
+        result.rendered.append(job.clip_id)
+        emit("done", {"clip_id": job.clip_id, "entry": job.entry.id, "duration_s": rec["duration_s"]})
+
+    def failed(job: Job, exc: BaseException) -> None:
+        by_id.pop(job.clip_id, None)
+        msg = f"{job.entry.where}: {type(exc).__name__}: {exc}"
+        result.failed.append((job.entry.where, msg))
+        emit("fail", {"entry": job.entry.where, "error": msg, "traceback": "".join(
+            traceback.format_exception(type(exc), exc, exc.__traceback__))[-2000:]})
+
+    if workers <= 1 or len(todo) <= 1:
+        global _PROGRESS_QUEUE
+        _PROGRESS_QUEUE = _DirectProgress(emit)
+        try:
+            for job in todo:
+                emit("start", {"clip_id": job.clip_id, "entry": job.entry.id})
+                try:
+                    rec = render_job(job, by_id[job.clip_id], str(clips_dir), str(records_dir))
+                except Exception as exc:  # noqa: BLE001 - one bad clip must not stop the plan
+                    failed(job, exc)
+                    continue
+                finished(job, rec)
+        finally:
+            _PROGRESS_QUEUE = None
+    else:
+        ctx = mp.get_context("spawn")
+        manager = ctx.Manager()
+        progress_q = manager.Queue()
+        try:
+            with ProcessPoolExecutor(max_workers=workers, mp_context=ctx, initializer=_init_worker,
+                                     initargs=(progress_q, threads_per_worker)) as pool:
+                pending = {}
+                for job in todo:
+                    fut = pool.submit(render_job, job, by_id[job.clip_id], str(clips_dir), str(records_dir))
+                    pending[fut] = job
+                started: set[str] = set()
+                while pending:
+                    done_set, _ = wait(pending, timeout=0.2, return_when=FIRST_COMPLETED)
+                    _drain(progress_q, emit, started)
+                    for fut in done_set:
+                        job = pending.pop(fut)
+                        try:
+                            finished(job, fut.result())
+                        except Exception as exc:  # noqa: BLE001
+                            failed(job, exc)
+                _drain(progress_q, emit, started)
+        finally:
+            manager.shutdown()
+    result.records = [by_id[k] for k in by_id]
+    result.seconds = time.perf_counter() - t0
+    return result
+
+
+class _DirectProgress:
+    """Queue stand-in for rendering in this process: progress goes straight to the callback."""
+
+    def __init__(self, emit):
+        self.emit = emit
+
+    def put(self, item) -> None:
+        clip_id, entry_id, done, total = item
+        self.emit("frames", {"clip_id": clip_id, "entry": entry_id, "done": done, "total": total})
+
+
+def _drain(q, emit, started: set | None = None) -> None:
+    while True:
+        try:
+            clip_id, entry_id, done, total = q.get_nowait()
+        except (queue_mod.Empty, EOFError, OSError):
+            return
+        if started is not None and clip_id not in started:
+            started.add(clip_id)
+            emit("start", {"clip_id": clip_id, "entry": entry_id})
+        emit("frames", {"clip_id": clip_id, "entry": entry_id, "done": done, "total": total})
+
+
+def _with_webm(entry: ClipEntry) -> ClipEntry:
+    import dataclasses
+
+    return dataclasses.replace(entry, render=dataclasses.replace(entry.render, webm=True))

@@ -1,0 +1,153 @@
+"""Camera placement: a fixed camera that frames a whole motion, or one that tracks the root.
+
+All positions are metres, y-up. A camera is (position, focal_point, view_up) plus VTK's vertical
+view angle in degrees. Pure numpy: no VTK here, so it is quick to test.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+UP = np.array([0.0, 1.0, 0.0])
+
+
+@dataclass(frozen=True)
+class CameraPose:
+    position: np.ndarray   # (3,) metres
+    focal_point: np.ndarray  # (3,) metres
+    view_up: tuple = (0.0, 1.0, 0.0)
+    view_angle: float = 30.0  # vertical field of view, degrees
+
+
+def _unit(v: np.ndarray) -> np.ndarray:
+    n = np.linalg.norm(v)
+    return v / n if n > 1e-12 else v
+
+
+def facing_direction(root_rotation: np.ndarray) -> np.ndarray:
+    """Horizontal unit vector the body faces (+z rotated by the root quaternion w,x,y,z)."""
+    w, x, y, z = root_rotation
+    # Third column of the rotation matrix = R·(0,0,1).
+    fwd = np.array([2 * (x * z + w * y), 2 * (y * z - w * x), 1 - 2 * (x * x + y * y)])
+    fwd[1] = 0.0
+    if np.linalg.norm(fwd) < 1e-6:
+        return np.array([0.0, 0.0, 1.0])
+    return _unit(fwd)
+
+
+def travel_direction(root_xz: np.ndarray) -> np.ndarray | None:
+    """Principal horizontal direction of a root path (T, 2) oriented start->end, or None if it stays put."""
+    if root_xz.shape[0] < 2:
+        return None
+    span = root_xz.max(0) - root_xz.min(0)
+    if np.linalg.norm(span) < 0.5:
+        return None
+    centred = root_xz - root_xz.mean(0)
+    _, _, vt = np.linalg.svd(centred, full_matrices=False)
+    axis = vt[0]
+    if np.dot(root_xz[-1] - root_xz[0], axis) < 0:
+        axis = -axis
+    return _unit(np.array([axis[0], 0.0, axis[1]]))
+
+
+def view_offset(forward: np.ndarray, azimuth_deg: float, elevation_deg: float) -> np.ndarray:
+    """Unit vector from the focal point to the camera.
+
+    ``azimuth_deg`` is measured from the side (perpendicular to ``forward``, on the body's left)
+    towards ``forward``: 0 looks at the left side, 90 looks at the front.
+    """
+    side = _unit(np.cross(UP, forward))  # body's left when forward is +z (left = +x)
+    az, el = np.radians(azimuth_deg), np.radians(elevation_deg)
+    horiz = np.cos(az) * side + np.sin(az) * forward
+    return _unit(np.cos(el) * horiz + np.sin(el) * UP)
+
+
+def fit_distance(points: np.ndarray, focal: np.ndarray, offset: np.ndarray, view_angle_deg: float,
+                 aspect: float, margin: float = 1.08) -> float:
+    """Smallest camera distance along ``offset`` from ``focal`` that keeps all ``points`` (N, 3) in view.
+
+    For a point p relative to the focal point, with view direction d = -offset, right r and up u:
+    depth = dist + (p-f)·d; it is inside when |(p-f)·r| <= depth·tan(hfov/2) and likewise for u.
+    """
+    d = -offset
+    r = _unit(np.cross(d, UP))
+    u = np.cross(r, d)
+    rel = points - focal
+    tv = np.tan(np.radians(view_angle_deg) / 2) / margin
+    th = tv * aspect
+    need = np.maximum(np.abs(rel @ r) / th, np.abs(rel @ u) / tv) - rel @ d
+    return float(max(need.max(), 0.5))
+
+
+def fixed_camera(positions: np.ndarray, root_rotation0: np.ndarray, aspect: float, azimuth_deg: float | None = None,
+                 elevation_deg: float = 8.0, view_angle: float = 30.0, extra_points: np.ndarray | None = None
+                 ) -> CameraPose:
+    """One camera for the whole clip that keeps every joint of every frame in view.
+
+    Args:
+        positions: (T, J, 3) joint positions, metres.
+        root_rotation0: (4,) root quaternion of the first frame (decides the side for in-place motion).
+        aspect: width / height of the video.
+        azimuth_deg: angle from the side view towards the front; by default a walk gets the angle in
+            40..60 that shows the body largest while the whole path is in view (a view from ahead of
+            the path), and in-place motion 65 (from the front-left).
+        extra_points: (N, 3) more points to keep in view (a chair).
+    """
+    pts = positions.reshape(-1, 3)
+    if extra_points is not None:
+        pts = np.concatenate([pts, extra_points.reshape(-1, 3)])
+    focal = (pts.min(0) + pts.max(0)) / 2
+    travel = travel_direction(positions[:, 0, [0, 2]])
+    if travel is None:
+        forward = facing_direction(root_rotation0)
+        offset = view_offset(forward, 65.0 if azimuth_deg is None else azimuth_deg, elevation_deg)
+        dist = fit_distance(pts, focal, offset, view_angle, aspect)
+        return CameraPose(focal + offset * dist, focal, view_angle=view_angle)
+    # A walk: from ahead of the path, at the azimuth that shows the body largest on average while the
+    # whole path stays in view (a long path seen side-on leaves a tiny figure).
+    candidates = [azimuth_deg] if azimuth_deg is not None else list(range(40, 61, 5))
+    body = positions[:, 0]
+    best = None
+    for az in candidates:
+        offset = view_offset(travel, az, elevation_deg)
+        dist = fit_distance(pts, focal, offset, view_angle, aspect)
+        depth = (body - (focal + offset * dist)) @ (-offset)
+        size = float(np.mean(1.0 / np.maximum(depth, 1e-3)))
+        if best is None or size > best[0]:
+            best = (size, offset, dist)
+    _, offset, dist = best
+    return CameraPose(focal + offset * dist, focal, view_angle=view_angle)
+
+
+def tracking_cameras(positions: np.ndarray, fps: float, aspect: float, body_height: float,
+                     azimuth_deg: float = 35.0, elevation_deg: float = 10.0, view_angle: float = 30.0,
+                     smooth_s: float = 0.5) -> list[CameraPose]:
+    """A camera per frame that follows the (low-passed) root at a fixed world-space offset.
+
+    The offset direction comes from the path's first second, the distance frames a box of about
+    two body heights around the root. Returns T poses.
+    """
+    T = positions.shape[0]
+    root = positions[:, 0]
+    n_start = max(2, min(T, int(fps)))
+    travel = travel_direction(root[:n_start, [0, 2]])
+    if travel is None:
+        travel = travel_direction(root[:, [0, 2]])
+    forward = travel if travel is not None else np.array([0.0, 0.0, 1.0])
+    offset = view_offset(forward, azimuth_deg, elevation_deg)
+    half = body_height
+    box = np.array([[sx, sy, sz] for sx in (-half, half) for sy in (0.0, 1.15 * body_height)
+                    for sz in (-half, half)])
+    base_focal = np.array([0.0, 0.55 * body_height, 0.0])
+    dist = fit_distance(box, base_focal, offset, view_angle, aspect, margin=1.0)
+    k = max(1, int(round(smooth_s * fps)))
+    kernel = np.ones(k) / k
+    padded = np.pad(root[:, [0, 2]], ((k // 2, k - 1 - k // 2), (0, 0)), mode="edge")
+    smooth = np.stack([np.convolve(padded[:, i], kernel, mode="valid") for i in range(2)], axis=1)
+    ground = positions[..., 1].min()
+    poses = []
+    for t in range(T):
+        focal = np.array([smooth[t, 0], ground + 0.55 * body_height, smooth[t, 1]])
+        poses.append(CameraPose(focal + offset * dist, focal, view_angle=view_angle))
+    return poses

@@ -1,0 +1,152 @@
+"""Render a Motion into clip files: MP4 (+ optional WebM) and a poster PNG.
+
+The renderer draws what the Motion says and nothing else: it resamples to the video frame rate,
+cuts at ``settings.duration_s`` and never stretches or pads motion.
+"""
+from __future__ import annotations
+
+from collections.abc import Callable, Iterator
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from ..motion import Motion
+from .camera import facing_direction, fixed_camera, tracking_cameras
+from .encode import VideoWriter, write_png_atomic
+from .scene import StickFigureScene, chair_boxes
+from .settings import RenderSettings
+
+GROUND_MARGIN_M = 8.0
+
+
+@dataclass(frozen=True)
+class RenderResult:
+    """Files of one rendered clip; paths are absolute, ``webm`` is None unless asked for."""
+
+    mp4: Path
+    webm: Path | None
+    poster: Path
+    n_frames: int
+    fps: float
+
+    @property
+    def duration_s(self) -> float:
+        return self.n_frames / self.fps
+
+
+def is_seated(motion: Motion) -> bool:
+    """Seated gestures get a chair (seed 003 section 5.6: agents sit on a chair)."""
+    if "seated" in motion.metadata:
+        return bool(motion.metadata["seated"])
+    return motion.skeleton.name == "gesture"
+
+
+def prepare(motion: Motion, settings: RenderSettings) -> tuple[Motion, np.ndarray]:
+    """Motion at the video frame rate, cut to the clip length, and its (T, J, 3) positions."""
+    clip = motion.resample(settings.fps)
+    if clip.num_frames > settings.max_frames:
+        clip = clip.slice(0, settings.max_frames)
+    return clip, clip.positions()
+
+
+def build_scene(motion: Motion, positions: np.ndarray, settings: RenderSettings):
+    """The scene and per-frame camera poses for a prepared clip."""
+    skel = motion.skeleton
+    s = skel.height / 1.75
+    ground_y = float(positions[..., 1].min() - 0.03 * s)
+    aspect = settings.width / settings.height
+    chair = None
+    extra = None
+    if is_seated(motion):
+        facing = facing_direction(motion.rotations[0, 0])
+        chair = chair_boxes(positions, skel, facing, ground_y)
+        extra = np.concatenate([np.stack([c + h * np.array(sgn) for sgn in ((1, 1, 1), (-1, -1, -1))])
+                                for c, h, _ in chair])
+    root = positions[:, 0]
+    extent = (root[:, 0].min() - GROUND_MARGIN_M, root[:, 0].max() + GROUND_MARGIN_M,
+              root[:, 2].min() - GROUND_MARGIN_M, root[:, 2].max() + GROUND_MARGIN_M)
+    scene = StickFigureScene(skel, settings.width, settings.height, settings.anti_aliasing, extent, ground_y, chair)
+    if settings.camera == "tracking":
+        cams = tracking_cameras(positions, settings.fps, aspect, skel.height)
+    else:
+        cam = fixed_camera(positions, motion.rotations[0, 0], aspect, extra_points=extra)
+        cams = [cam] * len(positions)
+    return scene, cams
+
+
+def render_frames(motion: Motion, settings: RenderSettings) -> Iterator[np.ndarray]:
+    """Yield the clip's frames as (height, width, 3) uint8 images."""
+    clip, positions = prepare(motion, settings)
+    scene, cams = build_scene(clip, positions, settings)
+    try:
+        last_cam = None
+        for t in range(len(positions)):
+            if cams[t] is not last_cam:
+                scene.set_camera(cams[t])
+                last_cam = cams[t]
+            scene.set_pose(positions[t])
+            yield scene.frame()
+    finally:
+        scene.close()
+
+
+def render_clip(motion: Motion, out_dir: str | Path, name: str, settings: RenderSettings | None = None,
+                progress: Callable[[int, int], None] | None = None) -> RenderResult:
+    """Render ``motion`` to ``out_dir/name.mp4`` (+ ``.webm``) and ``name.png``.
+
+    Files appear under their final names only when complete (temporary names, then rename); the
+    poster is written last, so a complete set is mp4 [+ webm] + png.
+
+    Args:
+        motion: any skeleton; positions from forward kinematics, metres, y-up.
+        out_dir: folder for the files (created if missing).
+        name: file stem, e.g. the content hash.
+        settings: render settings (defaults: 640x480, 30 fps, at most 10 s, fixed camera, FXAA).
+        progress: called as progress(frames_done, frames_total) after every frame.
+    """
+    settings = settings or RenderSettings()
+    out_dir = Path(out_dir)
+    out_dir.mkdir(parents=True, exist_ok=True)
+    clip, positions = prepare(motion, settings)
+    n = len(positions)
+    poster_index = min(n - 1, int(settings.poster_fraction * (n - 1) + 0.5))
+    writers = [VideoWriter(out_dir / f"{name}.mp4", settings.width, settings.height, settings.fps, settings.crf,
+                           settings.preset, settings.encoder_threads)]
+    if settings.webm:
+        writers.append(VideoWriter(out_dir / f"{name}.webm", settings.width, settings.height, settings.fps,
+                                   settings.crf, settings.preset, settings.encoder_threads))
+    scene, cams = build_scene(clip, positions, settings)
+    poster = None
+    try:
+        last_cam = None
+        for t in range(n):
+            if cams[t] is not last_cam:
+                scene.set_camera(cams[t])
+                last_cam = cams[t]
+            scene.set_pose(positions[t])
+            img = scene.frame()
+            for w in writers:
+                w.write(img)
+            if t == poster_index:
+                poster = img.copy()
+            if progress is not None:
+                progress(t + 1, n)
+        for w in reversed(writers):  # the mp4 is committed last of the videos
+            w.commit()
+    except BaseException:
+        for w in writers:
+            w.abort()
+        raise
+    finally:
+        scene.close()
+    write_png_atomic(poster, out_dir / f"{name}.png")
+    return RenderResult(out_dir / f"{name}.mp4", out_dir / f"{name}.webm" if settings.webm else None,
+                        out_dir / f"{name}.png", n, settings.fps)
+
+
+def clip_files_complete(out_dir: str | Path, name: str, webm: bool) -> bool:
+    """True when every file of a clip exists under its final name and is non-empty."""
+    out_dir = Path(out_dir)
+    needed = [out_dir / f"{name}.mp4", out_dir / f"{name}.png"] + ([out_dir / f"{name}.webm"] if webm else [])
+    return all(p.is_file() and p.stat().st_size > 0 for p in needed)

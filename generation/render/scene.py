@@ -1,0 +1,221 @@
+"""The offscreen PyVista scene: stick figure, ground grid, optional chair, camera.
+
+Built once per clip; each frame only moves actors (``user_matrix``) and re-renders, as PyVista
+0.49 returns stale images otherwise (REFERENCE.md section 8): one ``screenshot()`` during setup,
+then ``render()`` + ``screenshot(return_img=True)`` per frame.
+"""
+from __future__ import annotations
+
+import os
+
+import numpy as np
+
+from ..skeleton import Skeleton
+from .camera import CameraPose
+
+os.environ.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow")
+
+LEFT_COLOUR = (0.16, 0.42, 0.85)    # blue
+RIGHT_COLOUR = (0.90, 0.35, 0.12)   # orange
+MID_COLOUR = (0.55, 0.55, 0.58)     # grey
+CHAIR_COLOUR = (0.55, 0.38, 0.24)   # wood brown
+BACKGROUND = (0.93, 0.95, 0.98)
+GROUND_TILE_M = 0.5
+
+
+def _side_colour(name: str) -> tuple[float, float, float]:
+    if name.startswith("left_"):
+        return LEFT_COLOUR
+    if name.startswith("right_"):
+        return RIGHT_COLOUR
+    return MID_COLOUR
+
+
+def bone_matrices(start: np.ndarray, end: np.ndarray, radius: float | np.ndarray) -> np.ndarray:
+    """(B, 4, 4) transforms mapping a unit cylinder (radius 1, y from 0 to 1) onto bones start->end.
+
+    Args:
+        start, end: (B, 3) metres.
+        radius: scalar or (B,) metres.
+    """
+    vec = end - start
+    length = np.linalg.norm(vec, axis=1)
+    axis = vec / np.maximum(length, 1e-9)[:, None]
+    # A helper vector not parallel to the bone gives the two perpendicular axes.
+    helper = np.where(np.abs(axis[:, [0]]) < 0.9, np.array([[1.0, 0, 0]]), np.array([[0, 0, 1.0]]))
+    e1 = np.cross(axis, helper)
+    e1 /= np.linalg.norm(e1, axis=1, keepdims=True)
+    e2 = np.cross(e1, axis)
+    r = np.broadcast_to(np.asarray(radius, dtype=float), length.shape)
+    m = np.zeros((len(start), 4, 4))
+    m[:, :3, 0] = e1 * r[:, None]
+    m[:, :3, 1] = axis * length[:, None]
+    m[:, :3, 2] = e2 * r[:, None]
+    m[:, :3, 3] = start
+    m[:, 3, 3] = 1.0
+    return m
+
+
+def chair_boxes(positions: np.ndarray, skeleton: Skeleton, facing: np.ndarray, ground_y: float) -> list[tuple]:
+    """Boxes (centre (3,), half-sizes (3,) in the chair frame, yaw rotation) of a simple chair under a seated body.
+
+    The seat top sits just under the lowest hip position over the clip, the backrest behind the
+    pelvis, four legs down to the ground. Metres.
+    """
+    s = skeleton.height / 1.75
+    hips = [j for j, n in enumerate(skeleton.joints) if n.endswith("_hip")]
+    hip_y = positions[:, hips, 1].min()
+    root = positions[0, 0]
+    seat_top = hip_y - 0.07 * s
+    seat_th = 0.04 * s
+    right = np.cross(facing, np.array([0.0, 1.0, 0.0]))  # body's right
+    half_w, depth_back, depth_front = 0.24 * s, 0.20 * s, 0.26 * s
+    centre_z = (depth_front - depth_back) / 2
+    boxes = []
+
+    def add(local_centre, half):
+        x, y, z = local_centre
+        world = root * np.array([1, 0, 1]) + right * x + facing * z + np.array([0, y, 0])
+        boxes.append((world, np.asarray(half, dtype=float)))
+
+    add((0.0, seat_top - seat_th / 2, centre_z), (half_w, seat_th / 2, (depth_back + depth_front) / 2))
+    back_h = 0.50 * s
+    add((0.0, seat_top + back_h / 2, -depth_back - 0.02 * s), (half_w, back_h / 2, 0.02 * s))
+    leg_h = max(seat_top - seat_th - ground_y, 0.0)
+    for sx in (-1, 1):
+        for sz in (-1, 1):
+            z = centre_z + sz * ((depth_back + depth_front) / 2 - 0.03 * s)
+            add((sx * (half_w - 0.03 * s), ground_y + leg_h / 2, z), (0.02 * s, leg_h / 2, 0.02 * s))
+    yaw = np.arctan2(facing[0], facing[2])
+    return [(c, h, yaw) for c, h in boxes]
+
+
+class StickFigureScene:
+    """An offscreen scene for one skeleton: tubes for bones, spheres for joints, ground grid, chair.
+
+    Args:
+        skeleton: the hierarchy (joint names tell left from right).
+        width, height: pixels.
+        anti_aliasing: "none", "fxaa", "ssaa2" or "msaa".
+        ground_extent: (xmin, xmax, zmin, zmax) metres of the ground plane.
+        ground_y: height of the ground, metres.
+        chair: boxes from :func:`chair_boxes`, or None.
+    """
+
+    def __init__(self, skeleton: Skeleton, width: int, height: int, anti_aliasing: str,
+                 ground_extent: tuple[float, float, float, float], ground_y: float = 0.0,
+                 chair: list[tuple] | None = None):
+        import pyvista as pv
+
+        self.skeleton = skeleton
+        self.width, self.height = width, height
+        self.ssaa = 2 if anti_aliasing == "ssaa2" else 1
+        self.plotter = pv.Plotter(off_screen=True, window_size=[width * self.ssaa, height * self.ssaa])
+        self.plotter.disable_anti_aliasing()
+        if anti_aliasing == "fxaa":
+            # VTK's own FXAA pass; PyVista's enable_anti_aliasing("fxaa") swaps in its costly SSAA on EGL builds.
+            self.plotter.renderer.SetUseFXAA(True)
+        elif anti_aliasing == "msaa":
+            self.plotter.enable_anti_aliasing("msaa", multi_samples=4)
+        self.plotter.set_background(BACKGROUND)
+        s = skeleton.height / 1.75
+        self._add_ground(pv, ground_extent, ground_y)
+        if chair:
+            for centre, half, yaw in chair:
+                box = pv.Box(bounds=(-half[0], half[0], -half[1], half[1], -half[2], half[2]))
+                actor = self.plotter.add_mesh(box, color=CHAIR_COLOUR, smooth_shading=False)
+                c, sn = np.cos(yaw), np.sin(yaw)
+                m = np.array([[c, 0, sn, centre[0]], [0, 1, 0, centre[1]], [-sn, 0, c, centre[2]], [0, 0, 0, 1]])
+                actor.user_matrix = m
+        # Bones: every joint with a parent and a non-zero offset.
+        lengths = skeleton.bone_lengths()
+        self.bones = [j for j, p in enumerate(skeleton.parents) if p >= 0 and lengths[j] > 1e-6]
+        unit_cyl = pv.Cylinder(center=(0, 0.5, 0), direction=(0, 1, 0), radius=1.0, height=1.0, resolution=14,
+                               capping=False)
+        unit_sphere = pv.Sphere(radius=1.0, theta_resolution=16, phi_resolution=12)
+        self.bone_actors = []
+        for j in self.bones:
+            actor = self.plotter.add_mesh(unit_cyl, color=_side_colour(skeleton.joints[j]), smooth_shading=True,
+                                          specular=0.2)
+            self.bone_actors.append(actor)
+        self.bone_radius = np.array([0.022 * s] * len(self.bones))
+        self.joint_radius = np.full(skeleton.num_joints, 0.03 * s)
+        self.head = skeleton.joints.index("head") if "head" in skeleton.joints else None
+        self.neck = skeleton.joints.index("neck") if "neck" in skeleton.joints else None
+        if self.head is not None:
+            self.joint_radius[self.head] = 0.10 * s
+        self.joint_actors = []
+        for j, name in enumerate(skeleton.joints):
+            actor = self.plotter.add_mesh(unit_sphere, color=_side_colour(name), smooth_shading=True, specular=0.2)
+            self.joint_actors.append(actor)
+        # A soft shadow disc under the pelvis helps read where the body is over the ground.
+        disc = pv.Disc(center=(0, 0, 0), inner=0.0, outer=1.0, normal=(0, 1, 0), c_res=32)
+        self.shadow = self.plotter.add_mesh(disc, color=(0.2, 0.2, 0.25), opacity=0.25, lighting=False)
+        self.shadow_radius = 0.28 * s
+        self.ground_y = ground_y
+        self._head_lift = max(0.02, 0.20 * s - (lengths[self.head] if self.head is not None else 0.0))
+        self._primed = False
+
+    def _add_ground(self, pv, extent, ground_y):
+        xmin, xmax, zmin, zmax = extent
+        # Snap the plane to whole tiles so the grid lines sit on round coordinates.
+        xmin, zmin = np.floor(xmin / GROUND_TILE_M) * GROUND_TILE_M, np.floor(zmin / GROUND_TILE_M) * GROUND_TILE_M
+        xmax, zmax = np.ceil(xmax / GROUND_TILE_M) * GROUND_TILE_M, np.ceil(zmax / GROUND_TILE_M) * GROUND_TILE_M
+        plane = pv.Plane(center=((xmin + xmax) / 2, ground_y - 0.001, (zmin + zmax) / 2), direction=(0, 1, 0),
+                         i_size=xmax - xmin, j_size=zmax - zmin, i_resolution=1, j_resolution=1)
+        pts = plane.points
+        plane.active_texture_coordinates = np.c_[(pts[:, 0] - xmin) / GROUND_TILE_M, (pts[:, 2] - zmin) / GROUND_TILE_M]
+        # Grid texture: light tile with a darker border; mipmapped so distant lines do not shimmer.
+        size, line = 128, 3
+        img = np.full((size, size, 3), 214, dtype=np.uint8)
+        img[:line] = img[-line:] = 150
+        img[:, :line] = img[:, -line:] = 150
+        tex = pv.Texture(img)
+        tex.repeat = True
+        tex.mipmap = True
+        tex.interpolate = True
+        self.plotter.add_mesh(plane, texture=tex, ambient=0.35, diffuse=0.7, specular=0.0)
+
+    def set_camera(self, pose: CameraPose) -> None:
+        cam = self.plotter.camera
+        cam.position = tuple(pose.position)
+        cam.focal_point = tuple(pose.focal_point)
+        cam.up = tuple(pose.view_up)
+        cam.view_angle = pose.view_angle
+        # Near/far planes from the scene, not from VTK's automatic reset (which lags moving cameras).
+        self.plotter.renderer.ResetCameraClippingRange()
+
+    def set_pose(self, positions: np.ndarray) -> None:
+        """Move the figure to joint positions (J, 3) metres."""
+        parents = self.skeleton.parents
+        start = positions[[parents[j] for j in self.bones]]
+        end = positions[self.bones]
+        mats = bone_matrices(start, end, self.bone_radius)
+        for actor, m in zip(self.bone_actors, mats):
+            actor.user_matrix = m
+        centres = positions.copy()
+        if self.head is not None and self.neck is not None:
+            d = positions[self.head] - positions[self.neck]
+            centres[self.head] = positions[self.head] + d / max(np.linalg.norm(d), 1e-9) * self._head_lift
+        for actor, c, r in zip(self.joint_actors, centres, self.joint_radius):
+            actor.user_matrix = np.array([[r, 0, 0, c[0]], [0, r, 0, c[1]], [0, 0, r, c[2]], [0, 0, 0, 1.0]])
+        rs, root = self.shadow_radius, positions[0]
+        self.shadow.user_matrix = np.array([[rs, 0, 0, root[0]], [0, 1, 0, self.ground_y + 0.002],
+                                            [0, 0, rs, root[2]], [0, 0, 0, 1.0]])
+
+    def frame(self) -> np.ndarray:
+        """Render and return the current image, (height, width, 3) uint8."""
+        if not self._primed:
+            # The first screenshot initialises the offscreen buffers (REFERENCE.md section 8).
+            self.plotter.screenshot(return_img=True)
+            self._primed = True
+        self.plotter.renderer.ResetCameraClippingRange()
+        self.plotter.render()
+        img = np.asarray(self.plotter.screenshot(return_img=True))[..., :3]
+        if self.ssaa > 1:
+            h, w = self.height, self.width
+            img = img.reshape(h, self.ssaa, w, self.ssaa, 3).mean(axis=(1, 3)).round().astype(np.uint8)
+        return np.ascontiguousarray(img)
+
+    def close(self) -> None:
+        self.plotter.close()

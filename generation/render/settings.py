@@ -1,0 +1,100 @@
+"""Render settings: resolution, frame rate, duration, camera, anti-aliasing, codecs.
+
+Settings take part in every clip's content hash (see :mod:`generation.plan`), so a change of
+resolution or camera renders new files instead of silently reusing old ones.
+"""
+from __future__ import annotations
+
+from dataclasses import asdict, dataclass, fields
+
+CAMERAS = ("fixed", "tracking")
+ANTI_ALIASING = ("none", "fxaa", "ssaa2", "msaa")
+
+
+class RenderSettingsError(ValueError):
+    """A render setting is missing or out of range; the message names the field."""
+
+
+@dataclass(frozen=True)
+class RenderSettings:
+    """How a clip is rendered and encoded.
+
+    Attributes:
+        width, height: video size in pixels (even numbers: H.264 yuv420p needs them).
+        fps: video frame rate; motions are resampled to it.
+        duration_s: longest clip in seconds (10 s by default, seed 000's clip length); a shorter
+            motion gives a shorter clip.
+        camera: "fixed" (default; frames the whole path, seed 000 section 6.3.4) or "tracking"
+            (follows the root at a fixed offset, as in seed 000's study videos).
+        anti_aliasing: "fxaa" (default; a screen-space pass, nearly free), "ssaa2" (render at 2x and
+            average 2x2 blocks), "msaa" (VTK multisampling, about 3x slower in software GL) or "none".
+        crf: H.264 constant rate factor (lower is better quality; 23 is x264's default).
+        preset: x264 preset.
+        webm: also write a VP9 WebM.
+        poster_fraction: where in the clip the poster frame is taken (0 = first frame).
+        encoder_threads: threads per ffmpeg encoder (0 = ffmpeg decides).
+    """
+
+    width: int = 640
+    height: int = 480
+    fps: float = 30.0
+    duration_s: float = 10.0
+    camera: str = "fixed"
+    anti_aliasing: str = "fxaa"
+    crf: int = 23
+    preset: str = "veryfast"
+    webm: bool = False
+    poster_fraction: float = 0.5
+    encoder_threads: int = 0
+
+    def __post_init__(self):
+        for name in ("width", "height"):
+            value = getattr(self, name)
+            if not isinstance(value, int) or isinstance(value, bool) or value < 16 or value > 4096 or value % 2:
+                raise RenderSettingsError(f"field {name!r}: expected an even integer in 16..4096, got {value!r}")
+        if not isinstance(self.fps, (int, float)) or isinstance(self.fps, bool) or not 1 <= self.fps <= 240:
+            raise RenderSettingsError(f"field 'fps': expected a number in 1..240, got {self.fps!r}")
+        if (not isinstance(self.duration_s, (int, float)) or isinstance(self.duration_s, bool)
+                or not 0 < self.duration_s <= 600):
+            raise RenderSettingsError(f"field 'duration_s': expected a number in (0, 600], got {self.duration_s!r}")
+        if self.camera not in CAMERAS:
+            raise RenderSettingsError(f"field 'camera': expected one of {list(CAMERAS)}, got {self.camera!r}")
+        if self.anti_aliasing not in ANTI_ALIASING:
+            raise RenderSettingsError(
+                f"field 'anti_aliasing': expected one of {list(ANTI_ALIASING)}, got {self.anti_aliasing!r}")
+        if not isinstance(self.crf, int) or not 0 <= self.crf <= 51:
+            raise RenderSettingsError(f"field 'crf': expected an integer in 0..51, got {self.crf!r}")
+        if not 0 <= self.poster_fraction <= 1:
+            raise RenderSettingsError(f"field 'poster_fraction': expected 0..1, got {self.poster_fraction!r}")
+
+    @property
+    def max_frames(self) -> int:
+        """Frames in a clip of ``duration_s`` seconds."""
+        return max(1, int(round(self.duration_s * self.fps)))
+
+    def to_dict(self) -> dict:
+        """Plain dict (hashable as canonical JSON)."""
+        return asdict(self)
+
+    def content_dict(self) -> dict:
+        """The settings that change what a clip looks like (for content hashes): all but ``webm`` (an extra
+        file of the same frames) and ``encoder_threads``."""
+        d = self.to_dict()
+        d.pop("webm")
+        d.pop("encoder_threads")
+        return d
+
+    @classmethod
+    def from_dict(cls, data: dict | None, base: RenderSettings | None = None) -> RenderSettings:
+        """Settings from a dict of overrides on ``base``; unknown keys are refused by name."""
+        values = (base or cls()).to_dict()
+        known = {f.name for f in fields(cls)}
+        for key, value in (data or {}).items():
+            if key not in known:
+                raise RenderSettingsError(f"field {key!r}: unknown render setting; expected one of {sorted(known)}")
+            values[key] = value
+        if isinstance(values["fps"], int):
+            values["fps"] = float(values["fps"])
+        if isinstance(values["duration_s"], int):
+            values["duration_s"] = float(values["duration_s"])
+        return cls(**values)

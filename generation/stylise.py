@@ -1,0 +1,442 @@
+"""Applying a seed 004 theme to a neutral walk cycle: Y = P + w * S, then back onto the skeleton.
+
+Pipeline (shapes: m cycle frames, J joints):
+
+1. ``P`` (m, J, 3): the neutral cycle's joint positions in the walker's frame, i.e. with the mean forward
+   progression (stride * t / m) removed; the root keeps its sway, bob and surge.
+2. ``S`` (m, J, 3): the theme's secondary features (:func:`theme_rbfs`): for each of the first n features of
+   Table III and each joint of its body part, up to three Gaussian RBFs (eq. 4) on one Cartesian axis,
+   amplitudes = intensity x walker height. Posture features are shape 1; movement features are placed on the
+   extrema of the joint's own neutral trajectory (relative to the root) by :func:`generation.rbf.swing_params`.
+   Joints the paper's 54-DOF model lacks (toes, hand tips) carry their parent's displacement.
+3. ``Y = P + w * S``: the paper's linear model (eq. 1 with r = 1). A negative w inverts only the amplitudes.
+4. The paper edits Cartesian positions and so does not keep bone lengths (its stated limitation). We put
+   ``Y`` back onto the skeleton (:func:`fit_to_skeleton`): legs and arms by analytic two-bone IK that reaches
+   the edited heel/hand position when it is reachable, bending in the plane of the edited knee/elbow; other
+   bones keep the edited direction; joints with several children (pelvis, chest) take the best rotation of
+   their children (Horn's quaternion method). Twist comes from the neutral motion. Bone lengths are then exact.
+5. Uniform time warping for speed (cycle duration / speed) and the cycle repeated n_cycles times along +z.
+"""
+from __future__ import annotations
+
+import numpy as np
+import torch
+
+from .kinematics import forward_kinematics
+from .motion import Motion
+from .quaternion import np_qbetween, np_qconj, np_qfix, np_qmul, np_qrot, np_qslerp
+from .rbf import CYCLE_FRAMES, rbf_sum, shape_params, swing_params
+from .skeleton import Skeleton
+from .themes import AXES, BODY_PARTS, THEME_NAMES, theme_features
+
+_MODELLED = frozenset(name for joints in BODY_PARTS.values() for name in joints)
+PAPER_WEIGHTS = (0.4, 0.7, 1.0, 1.3)  # Fig. 7
+PAPER_FEATURE_COUNTS = (1, 4, 7, 10)  # Fig. 7
+INVERSION_WEIGHT = -0.7  # Fig. 8
+
+# Two-bone chains (root, middle, end) of the 21-joint gait skeleton solved analytically.
+GAIT_LIMB_CHAINS = (
+    ("left_hip", "left_knee", "left_heel"), ("right_hip", "right_knee", "right_heel"),
+    ("left_shoulder", "left_elbow", "left_hand"), ("right_shoulder", "right_elbow", "right_hand"),
+)
+
+
+# --------------------------------------------------------------------------------------------------
+# The neutral cycle in the walker's frame
+# --------------------------------------------------------------------------------------------------
+def cycle_stride(neutral: Motion) -> np.ndarray:
+    """(3,) root displacement over one cycle, metres (metadata ``stride_m`` if present, else estimated).
+
+    The cycle is assumed periodic: frame m would be frame 0 moved by the stride.
+    """
+    stride = neutral.metadata.get("stride_m")
+    if stride is not None:
+        vec = np.asarray(stride, dtype=np.float64).reshape(-1)
+        if vec.shape == (1,):
+            vec = np.array([0.0, 0.0, float(vec[0])])
+        if vec.shape != (3,):
+            raise ValueError(f"neutral cycle metadata 'stride_m' must be a number or 3-vector, got {stride!r}")
+    else:
+        m = neutral.num_frames
+        vec = (neutral.root_positions[-1] - neutral.root_positions[0]) * m / (m - 1)
+        vec[1] = 0.0
+    return vec
+
+
+def walker_frame_positions(neutral: Motion) -> tuple[np.ndarray, np.ndarray]:
+    """Neutral positions with the mean forward progression removed.
+
+    Returns:
+        P: (m, J, 3) metres, the walker's frame (y up, facing +z).
+        progression: (m, 3) the removed offset stride * t / m.
+
+    Raises:
+        ValueError: if the cycle is too short or does not walk along +z (heading more than 15 degrees off).
+    """
+    m = neutral.num_frames
+    if m < 20:
+        raise ValueError(f"a neutral cycle needs at least 20 frames, got {m}")
+    stride = cycle_stride(neutral)
+    horizontal = np.hypot(stride[0], stride[2])
+    if horizontal < 1e-6 or stride[2] < np.cos(np.radians(15.0)) * horizontal:
+        raise ValueError(f"the neutral cycle must walk along +z (stride {np.round(stride, 3).tolist()} m); "
+                         "rotate it first (generation.neutral_base does)")
+    progression = np.arange(m)[:, None] / m * stride[None, :]
+    return neutral.positions() - progression[:, None, :], progression
+
+
+# --------------------------------------------------------------------------------------------------
+# Secondary features S
+# --------------------------------------------------------------------------------------------------
+def theme_rbfs(P: np.ndarray, skeleton: Skeleton, theme: str, n_features: int,
+               height: float | None = None) -> dict[tuple[str, str], np.ndarray]:
+    """RBF parameters per degree of freedom for the first ``n_features`` of a theme.
+
+    Args:
+        P: (m, J, 3) neutral cycle in the walker's frame (:func:`walker_frame_positions`), metres.
+        skeleton: gait skeleton (joint names as in :data:`generation.themes.BODY_PARTS`).
+        theme: one of :data:`generation.themes.THEME_NAMES`.
+        n_features: how many of Table III's features, in frequency order (0..10).
+        height: walker height in metres for de-normalising intensities (default ``skeleton.height``).
+
+    Returns:
+        {(joint name, axis "X"|"Y"|"Z"): (M, 3) rows (alpha metres, mu frames, sigma2 frames^2)}, M <= 3.
+        This is the theme's parameter matrix Q of eq. 5, one entry per DOF.
+    """
+    height = float(skeleton.height if height is None else height)
+    m = P.shape[0]
+    root = skeleton.index("root")
+    dofs: dict[tuple[str, str], np.ndarray] = {}
+    for feat in theme_features(theme, n_features):
+        for joint, sign in feat.joint_signs():
+            j = skeleton.index(joint)
+            a = AXES[feat.axis]
+            alpha = sign * feat.intensity * height
+            if feat.kind == "tilt":
+                params = shape_params(1, alpha, m=m)
+            else:
+                traj = P[:, j, a] if j == root else P[:, j, a] - P[:, root, a]
+                params = swing_params(traj, feat.shape, alpha)
+            key = (joint, feat.axis)
+            dofs[key] = params if key not in dofs else np.concatenate([dofs[key], params])
+            if len(dofs[key]) > 3:
+                raise ValueError(f"theme {theme!r}: DOF {key} would need {len(dofs[key])} RBFs (> 3)")
+    return dofs
+
+
+def theme_displacement(P: np.ndarray, skeleton: Skeleton, theme: str, n_features: int,
+                       height: float | None = None, propagate: bool = True) -> np.ndarray:
+    """Secondary features S of the first ``n_features``: (m, J, 3) metres, for weight 1 (linear in the RBFs).
+
+    The paper moved each marker independently (its bones stretched). With exact bone lengths an isolated knee
+    or elbow edit would be almost cancelled by the limb IK, so with ``propagate`` (default) a joint axis that
+    has no edit of its own follows its parent's displacement on that axis (a tilted neck carries the head, a
+    lifted knee the foot, a dropped shoulder the arm); an axis with its own edit keeps exactly the paper's
+    per-marker displacement. The root's (pelvis) edits are not passed on, as that would only translate the
+    body. Without ``propagate`` only joints outside the paper's model (toes, hand tips) follow their parent.
+    """
+    m, J = P.shape[:2]
+    S = np.zeros((m, J, 3))
+    edited = np.zeros((J, 3), dtype=bool)
+    t = np.arange(m, dtype=np.float64)
+    for (joint, axis), params in theme_rbfs(P, skeleton, theme, n_features, height).items():
+        j, a = skeleton.index(joint), AXES[axis]
+        S[:, j, a] += rbf_sum(t, params, period=m)
+        edited[j, a] = True
+    for j, p in enumerate(skeleton.parents):
+        if p < 0:
+            continue
+        if propagate and p > 0:
+            follow = ~edited[j]  # axes without an edit of their own follow the parent
+        elif skeleton.joints[j] not in _MODELLED:
+            follow = np.ones(3, dtype=bool)  # toes and hand tips always move with their parent
+        else:
+            continue
+        S[:, j, follow] = S[:, p, follow]
+    return S
+
+
+# --------------------------------------------------------------------------------------------------
+# Back onto the skeleton
+# --------------------------------------------------------------------------------------------------
+def _horn_rotation(src: np.ndarray, dst: np.ndarray) -> np.ndarray:
+    """Best rotation (least squares) taking vectors src (T, K, 3) onto dst (T, K, 3): (T, 4) quaternions.
+
+    Horn (1987): the eigenvector of the largest eigenvalue of the 4x4 matrix built from sum_k src_k dst_k^T.
+    """
+    S = np.einsum("tki,tkj->tij", src, dst)
+    Sxx, Sxy, Sxz = S[:, 0, 0], S[:, 0, 1], S[:, 0, 2]
+    Syx, Syy, Syz = S[:, 1, 0], S[:, 1, 1], S[:, 1, 2]
+    Szx, Szy, Szz = S[:, 2, 0], S[:, 2, 1], S[:, 2, 2]
+    N = np.stack([
+        np.stack([Sxx + Syy + Szz, Syz - Szy, Szx - Sxz, Sxy - Syx], -1),
+        np.stack([Syz - Szy, Sxx - Syy - Szz, Sxy + Syx, Szx + Sxz], -1),
+        np.stack([Szx - Sxz, Sxy + Syx, -Sxx + Syy - Szz, Syz + Szy], -1),
+        np.stack([Sxy - Syx, Szx + Sxz, Syz + Szy, -Sxx - Syy + Szz], -1),
+    ], -2)
+    _, vecs = np.linalg.eigh(N)
+    q = vecs[..., -1]
+    return q * np.where(q[:, :1] < 0, -1.0, 1.0)
+
+
+def _two_bone(root: np.ndarray, mid_target: np.ndarray, end_target: np.ndarray, a: float, b: float,
+              fallback_pole: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Analytic two-bone IK per frame: (T, 3) x 3 -> middle and end positions with lengths a, b exactly.
+
+    The end reaches ``end_target`` when it is within reach (otherwise the limb points at it, fully
+    stretched or folded); the middle joint bends towards ``mid_target``.
+    """
+    d = end_target - root
+    dist = np.linalg.norm(d, axis=-1, keepdims=True)
+    u = d / np.maximum(dist, 1e-9)
+    reach = np.clip(dist, abs(a - b) + 1e-6, a + b - 1e-6)
+    pole = mid_target - root
+    pole = pole - (pole * u).sum(-1, keepdims=True) * u
+    pole_norm = np.linalg.norm(pole, axis=-1, keepdims=True)
+    fb = np.broadcast_to(fallback_pole, pole.shape)
+    fb = fb - (fb * u).sum(-1, keepdims=True) * u
+    pole = np.where(pole_norm > 1e-6, pole / np.maximum(pole_norm, 1e-12),
+                    fb / np.maximum(np.linalg.norm(fb, axis=-1, keepdims=True), 1e-12))
+    cos_a = np.clip((a * a + reach * reach - b * b) / (2 * a * reach), -1.0, 1.0)
+    mid = root + a * (cos_a * u + np.sqrt(1.0 - cos_a * cos_a) * pole)
+    end = root + reach * u
+    return mid, end
+
+
+def _keep_height(start: np.ndarray, goal: np.ndarray, length: float) -> np.ndarray:
+    """(T, 3) end points at ``length`` from ``start`` with the goal's height where reachable and its heading."""
+    dy = np.clip(goal[:, 1] - start[:, 1], -length, length)
+    flat = goal - start
+    flat[:, 1] = 0.0
+    n = np.linalg.norm(flat, axis=-1, keepdims=True)
+    heading = np.where(n > 1e-9, flat / np.maximum(n, 1e-12), 0.0)
+    horizontal = np.sqrt(np.maximum(length * length - dy * dy, 0.0))[:, None]
+    out = start + horizontal * heading
+    out[:, 1] = start[:, 1] + dy
+    return out
+
+
+def global_rotations(motion_rotations: np.ndarray, root_positions: np.ndarray, skeleton: Skeleton) -> np.ndarray:
+    """(T, J, 4) global joint rotations from local ones."""
+    with torch.no_grad():
+        _, g = forward_kinematics(torch.as_tensor(motion_rotations), torch.as_tensor(root_positions),
+                                  torch.as_tensor(skeleton.offsets), skeleton.parents, return_global_rotations=True)
+    return g.numpy()
+
+
+def fit_to_skeleton(target: np.ndarray, skeleton: Skeleton, reference_rotations: np.ndarray,
+                    chains: tuple[tuple[str, str, str], ...] | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """Local rotations and root positions whose forward kinematics best follows edited positions.
+
+    Bone lengths are exact by construction (the result is a skeletal motion). This is our local
+    projection (see module docstring); it is analytic and per frame, so it runs in milliseconds.
+
+    Args:
+        target: (T, J, 3) edited joint positions, metres.
+        skeleton: the skeleton to fit.
+        reference_rotations: (T, J, 4) local rotations of the unedited motion; they fix bone twist and the
+            rotation of leaf joints. With ``target`` equal to the reference's positions the result is the
+            reference itself.
+        chains: (root, middle, end) joint names solved by two-bone IK; default :data:`GAIT_LIMB_CHAINS` when
+            the skeleton has those joints, else none.
+
+    Returns:
+        rotations (T, J, 4) local unit quaternions, root_positions (T, 3).
+    """
+    target = np.asarray(target, dtype=np.float64)
+    T, J = target.shape[:2]
+    if target.shape != (T, skeleton.num_joints, 3) or reference_rotations.shape != (T, J, 4):
+        raise ValueError(f"target {target.shape} and reference rotations {reference_rotations.shape} must be "
+                         f"(T, {skeleton.num_joints}, 3) and (T, {skeleton.num_joints}, 4)")
+    if chains is None:
+        chains = GAIT_LIMB_CHAINS if all(n in skeleton.joints for c in GAIT_LIMB_CHAINS for n in c) else ()
+    offsets = skeleton.offsets
+    parents = skeleton.parents
+    kids = skeleton.children()
+    ref_global = global_rotations(reference_rotations, target[:, 0], skeleton)
+    goal = target.copy()  # where each joint should go; limb chains overwrite middle and end joints
+    chain_of = {skeleton.index(c[0]): (skeleton.index(c[1]), skeleton.index(c[2])) for c in chains}
+    chain_ends = {skeleton.index(c[2]) for c in chains}
+    pos = np.zeros_like(target)
+    glob = ref_global.copy()
+    pos[:, 0] = target[:, 0]
+    for p in range(J):
+        if not kids[p]:
+            continue  # leaf: keeps the reference rotation
+        if p in chain_of:
+            mid, end = chain_of[p]
+            fallback = np_qrot(ref_global[:, p], np.tile([0.0, 0.0, 1.0], (T, 1)))
+            goal[:, mid], goal[:, end] = _two_bone(pos[:, p], target[:, mid], target[:, end],
+                                                  float(np.linalg.norm(offsets[mid])),
+                                                  float(np.linalg.norm(offsets[end])), fallback)
+        if p in chain_ends and len(kids[p]) == 1 and not kids[kids[p][0]]:
+            # the foot (heel -> toe) or hand tip: keep the edited height of the tip (a planted toe stays on the
+            # floor) and the edited horizontal heading; the length is the bone's.
+            c = kids[p][0]
+            goal[:, c] = _keep_height(pos[:, p], goal[:, c], float(np.linalg.norm(offsets[c])))
+        if len(kids[p]) == 1:
+            c = kids[p][0]
+            current = np_qrot(ref_global[:, p], np.tile(offsets[c], (T, 1)))
+            wanted = goal[:, c] - pos[:, p]
+            glob[:, p] = np_qmul(np_qbetween(current, wanted), ref_global[:, p])
+        else:
+            src = np.stack([np.tile(offsets[c], (T, 1)) for c in kids[p]], axis=1)
+            dst = np.stack([goal[:, c] - pos[:, p] for c in kids[p]], axis=1)
+            glob[:, p] = _horn_rotation(src, dst)
+        for c in kids[p]:
+            pos[:, c] = pos[:, p] + np_qrot(glob[:, p], np.tile(offsets[c], (T, 1)))
+    local = glob.copy()
+    for j in range(1, J):
+        if kids[j]:
+            local[:, j] = np_qmul(np_qconj(glob[:, parents[j]]), glob[:, j])
+        else:
+            local[:, j] = reference_rotations[:, j]
+    return np_qfix(local), pos[:, 0].copy()
+
+
+def bone_length_error(positions: np.ndarray, skeleton: Skeleton) -> float:
+    """Largest |bone length - skeleton bone length| over frames and bones, metres; positions (T, J, 3)."""
+    lengths = skeleton.bone_lengths()[1:]
+    parents = np.asarray(skeleton.parents[1:])
+    actual = np.linalg.norm(positions[:, 1:] - positions[:, parents], axis=-1)
+    return float(np.abs(actual - lengths).max())
+
+
+# --------------------------------------------------------------------------------------------------
+# Timing and repetition
+# --------------------------------------------------------------------------------------------------
+def _sample_cycle(rotations: np.ndarray, root: np.ndarray, stride: np.ndarray, phase: np.ndarray):
+    """Sample a periodic cycle at continuous phases (cycles, >= 0): slerp rotations, lerp root + stride."""
+    m = rotations.shape[0]
+    f = phase * m
+    i0 = np.floor(f).astype(np.int64)
+    frac = f - i0
+    k0, k1 = i0 % m, (i0 + 1) % m
+    n0, n1 = i0 // m, (i0 + 1) // m  # completed cycles at each end of the interval
+    q0, q1 = rotations[k0], rotations[k1]
+    q1 = np.where(((q0 * q1).sum(-1, keepdims=True) < 0), -q1, q1)
+    rot = np_qslerp(q0, q1, np.ascontiguousarray(np.broadcast_to(frac[:, None], q0.shape[:-1])))
+    r0 = root[k0] + n0[:, None] * stride
+    r1 = root[k1] + n1[:, None] * stride
+    return rot, r0 + frac[:, None] * (r1 - r0)
+
+
+def repeat_cycle(rotations: np.ndarray, root: np.ndarray, stride: np.ndarray, cycle_seconds: float,
+                 speed: float, n_cycles: int, fps: float) -> tuple[np.ndarray, np.ndarray]:
+    """Uniformly time-warp a periodic cycle by ``speed`` and repeat it ``n_cycles`` times at ``fps``.
+
+    Returns rotations (N, J, 4) and root positions (N, 3), N = round(n_cycles * cycle_seconds / speed * fps).
+    """
+    n_out = int(round(n_cycles * cycle_seconds / speed * fps))
+    phase = np.arange(n_out) / fps * speed / cycle_seconds
+    return _sample_cycle(rotations, root, stride, phase)
+
+
+# --------------------------------------------------------------------------------------------------
+# Public entry point
+# --------------------------------------------------------------------------------------------------
+def stylised_cycle(neutral_cycle: Motion, theme: str, weight: float, n_features: int,
+                   keep_ground: bool = True) -> dict:
+    """One stylised cycle on the skeleton, with the intermediate arrays.
+
+    Returns a dict with ``P`` (m, J, 3) neutral walker-frame positions, ``S`` (m, J, 3) secondary
+    features, ``Y`` = P + weight * S, ``rotations`` (m, J, 4) and ``root`` (m, 3) of the fitted cycle (root
+    with the progression added back), ``positions`` (m, J, 3) their forward kinematics in the walker's
+    frame, and the bone-length errors ``before`` (of Y) and ``after`` (of the fit), the largest
+    distance ``residual`` between fitted and edited positions and the largest ``ground_lift`` applied by
+    :func:`keep_feet_above_ground` (when ``keep_ground``), all metres.
+    """
+    if not np.isfinite(weight):
+        raise ValueError(f"weight must be a finite number, got {weight!r}")
+    if theme not in THEME_NAMES:
+        raise ValueError(f"unknown theme {theme!r}; expected one of {list(THEME_NAMES)}")
+    skel = neutral_cycle.skeleton
+    P, progression = walker_frame_positions(neutral_cycle)
+    S = theme_displacement(P, skel, theme, n_features)
+    Y = P + float(weight) * S
+    target, lifted = keep_feet_above_ground(Y, P, skel) if keep_ground else (Y, 0.0)
+    rotations, root = fit_to_skeleton(target, skel, neutral_cycle.rotations)
+    fitted = forward_kinematics_np(rotations, root, skel)
+    return {
+        "P": P, "S": S, "Y": Y, "target": target, "rotations": rotations, "root": root + progression, "positions": fitted,
+        "before": bone_length_error(Y, skel), "after": bone_length_error(fitted, skel),
+        "residual": float(np.linalg.norm(fitted - Y, axis=-1).max()), "ground_lift": lifted,
+    }
+
+
+def keep_feet_above_ground(Y: np.ndarray, P: np.ndarray, skeleton: Skeleton) -> tuple[np.ndarray, float]:
+    """Raise edited foot joints that would go below their lowest neutral height (the floor contact height).
+
+    The Gaussian tails of a foot feature (e.g. a lowered swing foot) reach into the stance phase and would
+    push the planted foot through the floor. Each heel/toe joint's height is clamped to its minimum over the
+    neutral cycle. Returns the clamped copy (m, J, 3) and the largest lift applied (metres).
+    """
+    from .features import foot_joints
+
+    left, right = foot_joints(skeleton)
+    out = Y.copy()
+    feet = left + right
+    floor = P[:, feet, 1].min(axis=0)  # (K,)
+    clamped = np.maximum(out[:, feet, 1], floor[None])
+    lifted = float((clamped - out[:, feet, 1]).max())
+    out[:, feet, 1] = clamped
+    return out, lifted
+
+
+def forward_kinematics_np(rotations: np.ndarray, root: np.ndarray, skeleton: Skeleton) -> np.ndarray:
+    from .kinematics import np_forward_kinematics
+
+    return np_forward_kinematics(rotations, root, skeleton)
+
+
+def stylise(neutral_cycle: Motion, theme: str, weight: float, n_features: int, speed: float = 1.0,
+            n_cycles: int = 4, fps: float = 30.0, keep_ground: bool = True) -> Motion:
+    """Apply a seed 004 theme to a neutral walk cycle and walk it along a straight line.
+
+    Args:
+        neutral_cycle: one periodic neutral cycle (left contact to next left contact, walking along +z), e.g.
+            from :func:`generation.neutral_base.neutral_cycle`; metadata ``stride_m`` and ``synthetic`` are
+            read when present.
+        theme: happy, sad, energetic, tired, feminine or masculine.
+        weight: w of Y = P + w * S; any real (the paper uses 0.4, 0.7, 1.0, 1.3 and -0.7 for inversion).
+        n_features: the first n features of Table III (the paper uses 1, 4, 7, 10).
+        speed: uniform time warp; 1.3 plays the cycle 1.3 times faster (same stride, higher cadence).
+        n_cycles: number of cycles in the result.
+        fps: output frame rate.
+        keep_ground: clamp edited foot joints to their neutral floor height (:func:`keep_feet_above_ground`).
+
+    Returns:
+        Motion on the neutral cycle's skeleton, round(n_cycles * cycle duration / speed * fps) frames, with
+        metadata origin, generator "rbf", theme, weight, n_features, speed, synthetic_base and the
+        bone-length errors before/after the fit (metres).
+    """
+    if not speed > 0 or not np.isfinite(speed):
+        raise ValueError(f"speed must be a positive number, got {speed!r}")
+    if not fps > 0:
+        raise ValueError(f"fps must be positive, got {fps!r}")
+    if isinstance(n_cycles, bool) or not isinstance(n_cycles, int) or n_cycles < 1:
+        raise ValueError(f"n_cycles must be a positive integer, got {n_cycles!r}")
+    result = stylised_cycle(neutral_cycle, theme, weight, n_features, keep_ground)
+    stride = cycle_stride(neutral_cycle)
+    rotations, root = repeat_cycle(result["rotations"], result["root"], stride, neutral_cycle.duration, speed,
+                                   n_cycles, fps)
+    base_meta = neutral_cycle.metadata
+    metadata = {
+        "origin": "generated",
+        "generator": "rbf",
+        "theme": theme,
+        "weight": float(weight),
+        "n_features": int(n_features),
+        "speed": float(speed),
+        "synthetic_base": bool(base_meta.get("synthetic", base_meta.get("synthetic_base", True))),
+        "n_cycles": n_cycles,
+        "bone_length_error_before_m": result["before"],
+        "bone_length_error_after_m": result["after"],
+        "fit_residual_max_m": result["residual"],
+        "ground_lift_max_m": result["ground_lift"],
+    }
+    return Motion(neutral_cycle.skeleton, rotations, root, fps, metadata)
+
+
+__all__ = ["stylise", "stylised_cycle", "theme_rbfs", "theme_displacement", "fit_to_skeleton",
+           "walker_frame_positions", "repeat_cycle", "bone_length_error", "CYCLE_FRAMES"]

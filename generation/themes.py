@@ -1,0 +1,248 @@
+"""The six secondary themes of seed 004 as data: Table III's ten most frequent features per theme.
+
+Each theme is an ordered tuple of :class:`Feature` in the table's frequency order (rank 1 first), so
+"the first n features" of the paper's scalability study (n = 1, 4, 7, 10) is ``THEMES[name][:n]``.
+
+What the table gives and we copy: body part, axis, posture ("tilted along") versus movement
+("increased/decreased swing along"), and the signs (including the per-side signs "R along +X, L along -X").
+What the paper only shows in a figure (Fig. 5: per-cell shape number and normalised intensity as a heat
+map whose numbers did not survive in our copy) and we chose: the ``shape`` (Fig. 4 type 1-4) of each
+movement feature and every ``intensity``. Intensities are amplitudes divided by the walker's height, as in
+Fig. 5; the choices follow the paper's statements (movement features are stronger than posture features;
+happy wrist swing along Z, tired ankle swing along Z and masculine ankle swing along Y are the strongest).
+See docs/rbf.md for the reasoning.
+
+Axes: the paper's X, Y, Z are the walker's left, up and forward (checked against the signed entries:
+feminine ankles/knees/thighs move R along +X and L along -X, i.e. towards the midline; masculine ones
+move outward; sad and tired heads tilt along -Y (down) and +Z (forward)). That is exactly our frame
+(y up, facing +z, left = +x), so paper axis "X" is our x, "Y" our y, "Z" our z.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+THEME_NAMES = ("happy", "sad", "energetic", "tired", "feminine", "masculine")
+AXES = {"X": 0, "Y": 1, "Z": 2}
+
+# The paper's 11 body parts (Fig. 3) on the 21-joint gait skeleton. Paired parts list (left, right).
+BODY_PARTS: dict[str, tuple[str, ...]] = {
+    "hip": ("root",),
+    "thighs": ("left_hip", "right_hip"),
+    "knees": ("left_knee", "right_knee"),
+    "ankles": ("left_heel", "right_heel"),
+    "torso_l": ("lower_back",),
+    "torso_u": ("spine",),
+    "neck": ("neck",),
+    "head": ("head",),
+    "shoulders": ("left_shoulder", "right_shoulder"),
+    "elbows": ("left_elbow", "right_elbow"),
+    "wrists": ("left_hand", "right_hand"),
+}
+PART_LABELS = {"hip": "Hip", "thighs": "Thighs", "knees": "Knees", "ankles": "Ankles", "torso_l": "Torso L",
+               "torso_u": "Torso U", "neck": "Neck", "head": "Head", "shoulders": "Shoulders",
+               "elbows": "Elbows", "wrists": "Wrists"}
+
+
+@dataclass(frozen=True)
+class Feature:
+    """One row of Table III.
+
+    Attributes:
+        rank: 1..10, the table's frequency order.
+        part: key of :data:`BODY_PARTS`.
+        axis: "X", "Y" or "Z" (paper axes; identical to ours, see module docstring).
+        kind: "tilt" (posture, Fig. 4 type 1) or "swing" (movement, types 2-4).
+        sign: tilt: +1/-1 direction along the axis for every joint of the part; swing: +1 increased,
+            -1 decreased.
+        side_signs: tilts given per side ("R along +X, L along -X"): {"left": s, "right": s}; overrides sign.
+        shape: Fig. 4 type (1 for tilts; 2, 3 or 4 for swings). Our choice where Fig. 5 is not legible.
+        intensity: amplitude / walker height (dimensionless, > 0). Our choice (Fig. 5 is a heat map).
+    """
+
+    rank: int
+    part: str
+    axis: str
+    kind: str
+    sign: int
+    shape: int
+    intensity: float
+    side_signs: dict = field(default_factory=dict)
+
+    def __post_init__(self):
+        where = f"feature {self.rank} ({self.part})"
+        if self.part not in BODY_PARTS:
+            raise ValueError(f"{where}: unknown body part; expected one of {sorted(BODY_PARTS)}")
+        if self.axis not in AXES:
+            raise ValueError(f"{where}: axis must be X, Y or Z, got {self.axis!r}")
+        if self.kind not in ("tilt", "swing"):
+            raise ValueError(f"{where}: kind must be 'tilt' or 'swing', got {self.kind!r}")
+        if self.kind == "tilt" and self.shape != 1:
+            raise ValueError(f"{where}: a tilt (posture) feature is shape 1, got {self.shape}")
+        if self.kind == "swing" and self.shape not in (2, 3, 4):
+            raise ValueError(f"{where}: a swing (movement) feature is shape 2, 3 or 4, got {self.shape}")
+        if self.sign not in (-1, 1):
+            raise ValueError(f"{where}: sign must be +1 or -1, got {self.sign}")
+        if not self.intensity > 0:
+            raise ValueError(f"{where}: intensity must be positive, got {self.intensity}")
+        if self.side_signs and set(self.side_signs) != {"left", "right"}:
+            raise ValueError(f"{where}: side_signs needs 'left' and 'right', got {sorted(self.side_signs)}")
+
+    @property
+    def is_posture(self) -> bool:
+        return self.kind == "tilt"
+
+    def joint_signs(self) -> list[tuple[str, int]]:
+        """(joint name, sign) for each joint of the body part."""
+        out = []
+        for joint in BODY_PARTS[self.part]:
+            side = "left" if joint.startswith("left_") else "right" if joint.startswith("right_") else None
+            sign = self.side_signs[side] if (self.side_signs and side) else self.sign
+            out.append((joint, int(sign)))
+        return out
+
+    def describe(self) -> str:
+        """Table III wording, e.g. 'Ankles: tilted, R along +X, L along -X'."""
+        label = PART_LABELS[self.part]
+        if self.kind == "swing":
+            return f"{label}: {'increased' if self.sign > 0 else 'decreased'} swing along {self.axis}"
+        if self.side_signs:
+            r = "+" if self.side_signs["right"] > 0 else "-"
+            l_ = "+" if self.side_signs["left"] > 0 else "-"
+            return f"{label}: tilted, R along {r}{self.axis}, L along {l_}{self.axis}"
+        return f"{label}: tilted along {'+' if self.sign > 0 else '-'}{self.axis}"
+
+
+def _swing(rank, part, axis, shape, intensity, sign=1):
+    return Feature(rank, part, axis, "swing", sign, shape, intensity)
+
+
+def _tilt(rank, part, axis, sign, intensity, right=None, left=None):
+    sides = {"right": right, "left": left} if right is not None else {}
+    return Feature(rank, part, axis, "tilt", sign, 1, intensity, sides)
+
+
+INWARD = {"right": 1, "left": -1}  # "R along +X, L along -X": towards the midline (left = +x)
+OUTWARD = {"right": -1, "left": 1}  # "R along -X, L along +X"
+
+THEMES: dict[str, tuple[Feature, ...]] = {
+    "happy": (
+        _swing(1, "shoulders", "Z", 4, 0.025),
+        _swing(2, "wrists", "Z", 4, 0.070),  # strongest in Fig. 5
+        _swing(3, "knees", "Y", 2, 0.030),
+        _swing(4, "head", "X", 4, 0.012),
+        _swing(5, "wrists", "X", 4, 0.025),
+        _swing(6, "hip", "X", 4, 0.012),
+        _swing(7, "knees", "X", 2, 0.012),
+        _tilt(8, "neck", "Y", +1, 0.010),
+        _tilt(9, "head", "Y", +1, 0.012),
+        _tilt(10, "head", "Z", -1, 0.015),
+    ),
+    "sad": (
+        _tilt(1, "shoulders", "Y", -1, 0.030),
+        _tilt(2, "head", "Y", -1, 0.060),
+        _tilt(3, "neck", "Y", -1, 0.025),
+        _swing(4, "shoulders", "Z", 4, 0.020, sign=-1),
+        _swing(5, "wrists", "Y", 3, 0.015, sign=-1),
+        _tilt(6, "torso_u", "Y", -1, 0.015),
+        _tilt(7, "head", "Z", +1, 0.060),
+        _tilt(8, "neck", "Z", +1, 0.040),
+        _tilt(9, "elbows", "Y", -1, 0.015),
+        _tilt(10, "hip", "Y", -1, 0.015),
+    ),
+    "energetic": (
+        _swing(1, "knees", "Y", 2, 0.040),
+        _tilt(2, "head", "Y", +1, 0.015),
+        _swing(3, "elbows", "X", 4, 0.020),
+        _swing(4, "elbows", "Z", 4, 0.040),
+        _swing(5, "shoulders", "Y", 3, 0.012),
+        _swing(6, "shoulders", "Z", 4, 0.030),
+        _swing(7, "wrists", "Z", 4, 0.050),
+        _swing(8, "wrists", "X", 4, 0.025),
+        _swing(9, "thighs", "Z", 4, 0.012),
+        _swing(10, "thighs", "Y", 2, 0.012),
+    ),
+    "tired": (
+        _tilt(1, "shoulders", "Y", -1, 0.030),
+        _tilt(2, "head", "Y", -1, 0.050),
+        _swing(3, "ankles", "Z", 4, 0.070, sign=-1),  # strongest in Fig. 5
+        _tilt(4, "head", "Z", +1, 0.055),
+        _tilt(5, "wrists", "Y", -1, 0.020),
+        _swing(6, "ankles", "Y", 2, 0.020, sign=-1),
+        _tilt(7, "neck", "Y", -1, 0.020),
+        _tilt(8, "neck", "Z", +1, 0.030),
+        _tilt(9, "torso_l", "Z", +1, 0.015),
+        _tilt(10, "torso_u", "Z", +1, 0.040),
+    ),
+    "feminine": (
+        _swing(1, "hip", "X", 4, 0.025),
+        _tilt(2, "ankles", "X", +1, 0.030, **INWARD),
+        _tilt(3, "knees", "X", +1, 0.025, **INWARD),
+        _swing(4, "torso_l", "X", 4, 0.015),
+        _tilt(5, "thighs", "X", +1, 0.012, **INWARD),
+        _swing(6, "torso_u", "X", 4, 0.015),
+        _swing(7, "thighs", "Y", 2, 0.012),
+        _tilt(8, "shoulders", "Y", -1, 0.012),
+        _swing(9, "elbows", "X", 4, 0.020),
+        _swing(10, "wrists", "X", 4, 0.025),
+    ),
+    "masculine": (
+        _swing(1, "shoulders", "Z", 4, 0.030),
+        _tilt(2, "knees", "X", +1, 0.020, **OUTWARD),
+        _tilt(3, "ankles", "X", +1, 0.025, **OUTWARD),
+        _tilt(4, "elbows", "X", +1, 0.030, **OUTWARD),
+        _swing(5, "ankles", "Y", 2, 0.070),  # strongest in Fig. 5
+        _swing(6, "knees", "Y", 2, 0.030),
+        _swing(7, "head", "Z", 3, 0.012),
+        _swing(8, "neck", "Z", 3, 0.010),
+        # Table III lists "Shoulders: increased swing along Z" twice (ranks 1 and 9). We keep both; the
+        # second is a one-bump feature so the DOF stays within the paper's M <= 3 RBFs (2 + 1).
+        _swing(9, "shoulders", "Z", 2, 0.015),
+        _swing(10, "elbows", "Z", 4, 0.030),
+    ),
+}
+
+# Table III wording, verbatim, to check the data above against (tests compare describe() to these).
+TABLE_III: dict[str, tuple[str, ...]] = {
+    "happy": ("Shoulders: increased swing along Z", "Wrists: increased swing along Z",
+              "Knees: increased swing along Y", "Head: increased swing along X", "Wrists: increased swing along X",
+              "Hip: increased swing along X", "Knees: increased swing along X", "Neck: tilted along +Y",
+              "Head: tilted along +Y", "Head: tilted along -Z"),
+    "sad": ("Shoulders: tilted along -Y", "Head: tilted along -Y", "Neck: tilted along -Y",
+            "Shoulders: decreased swing along Z", "Wrists: decreased swing along Y", "Torso U: tilted along -Y",
+            "Head: tilted along +Z", "Neck: tilted along +Z", "Elbows: tilted along -Y", "Hip: tilted along -Y"),
+    "energetic": ("Knees: increased swing along Y", "Head: tilted along +Y", "Elbows: increased swing along X",
+                  "Elbows: increased swing along Z", "Shoulders: increased swing along Y",
+                  "Shoulders: increased swing along Z", "Wrists: increased swing along Z",
+                  "Wrists: increased swing along X", "Thighs: increased swing along Z",
+                  "Thighs: increased swing along Y"),
+    "tired": ("Shoulders: tilted along -Y", "Head: tilted along -Y", "Ankles: decreased swing along Z",
+              "Head: tilted along +Z", "Wrists: tilted along -Y", "Ankles: decreased swing along Y",
+              "Neck: tilted along -Y", "Neck: tilted along +Z", "Torso L: tilted along +Z",
+              "Torso U: tilted along +Z"),
+    "feminine": ("Hip: increased swing along X", "Ankles: tilted, R along +X, L along -X",
+                 "Knees: tilted, R along +X, L along -X", "Torso L: increased swing along X",
+                 "Thighs: tilted, R along +X, L along -X", "Torso U: increased swing along X",
+                 "Thighs: increased swing along Y", "Shoulders: tilted along -Y", "Elbows: increased swing along X",
+                 "Wrists: increased swing along X"),
+    "masculine": ("Shoulders: increased swing along Z", "Knees: tilted, R along -X, L along +X",
+                  "Ankles: tilted, R along -X, L along +X", "Elbows: tilted, R along -X, L along +X",
+                  "Ankles: increased swing along Y", "Knees: increased swing along Y", "Head: increased swing along Z",
+                  "Neck: increased swing along Z", "Shoulders: increased swing along Z",
+                  "Elbows: increased swing along Z"),
+}
+
+# Table II: share of movement features among all edits per theme (%), for comparison with our top ten.
+TABLE_II_MOVEMENT_PERCENT = {"happy": 71.4, "sad": 24.5, "energetic": 86.0, "tired": 22.9, "feminine": 59.0,
+                             "masculine": 67.3}
+
+
+def theme_features(theme: str, n_features: int | None = None) -> tuple[Feature, ...]:
+    """The first ``n_features`` (1..10, default all) features of a theme, in Table III order."""
+    if theme not in THEMES:
+        raise ValueError(f"unknown theme {theme!r}; expected one of {list(THEME_NAMES)}")
+    feats = THEMES[theme]
+    if n_features is None:
+        return feats
+    if isinstance(n_features, bool) or not isinstance(n_features, int) or not 0 <= n_features <= len(feats):
+        raise ValueError(f"n_features must be an integer in 0..{len(feats)}, got {n_features!r}")
+    return feats[:n_features]

@@ -1,0 +1,127 @@
+"""The clip catalogue: import rendered clips (upsert by clip_id) and select clip pools by catalogue fields.
+
+`upsert_clips(records)` is the interface used by the renderer's `generate_clips` command. A record carries the
+DESIGN.md clips.csv fields plus `video` (MP4 path relative to MEDIA_ROOT), `webm` (or ""), `poster`, `plan`,
+`loop` (bool) and `metadata` (dict); optional `source_clip_id` (the clip_id of the source clip a generated clip was
+made from; also read from `pair` or metadata["source_clip_id"] / metadata["pair"]) and `sections` (the plan's
+section-type hints, a list or comma-separated; also read from metadata["sections"]).
+"""
+from __future__ import annotations
+
+import math
+
+from django.db import transaction
+from django.db.models import Q, QuerySet
+
+from .models import Clip
+
+FLOAT_FIELDS = ("happy", "sad", "angry", "neutral", "final_happy", "final_sad", "final_angry", "final_neutral",
+                "valence", "arousal", "dominance", "weight", "duration_s")
+TEXT_FIELDS = ("emotion_label", "theme", "webm", "poster", "plan", "source_clip_id")
+# Catalogue fields a section pool may filter on, with the lookups allowed on them.
+POOL_FIELDS = {"clip_id", "modality", "origin", "emotion_label", "theme", "weight", "n_features", "plan", "sections",
+               "duration_s", "valence", "arousal", "dominance", "happy", "sad", "angry", "neutral"}
+POOL_LOOKUPS = {"", "in", "lt", "lte", "gt", "gte", "isnull", "startswith", "contains"}
+
+
+class CatalogueError(ValueError):
+    """A clip record or pool filter that cannot be used; the message names the record/field."""
+
+
+def _blank(value) -> bool:
+    return value is None or (isinstance(value, str) and value.strip() == "") or (
+        isinstance(value, float) and math.isnan(value))
+
+
+def _float(rec: dict, name: str, where: str):
+    value = rec.get(name)
+    if _blank(value):
+        return None
+    try:
+        return float(value)
+    except (TypeError, ValueError) as exc:
+        raise CatalogueError(f"{where}: field {name!r} must be a number or blank, got {value!r}") from exc
+
+
+def clean_record(rec: dict, index: int = 0) -> dict:
+    """Validate one clip record -> keyword arguments for Clip."""
+    clip_id = str(rec.get("clip_id") or "").strip()
+    where = f"clip record {index} ({clip_id or 'no clip_id'})"
+    if not clip_id:
+        raise CatalogueError(f"{where}: field 'clip_id' is required")
+    modality = str(rec.get("modality") or "").strip()
+    if modality not in ("gait", "gesture"):
+        raise CatalogueError(f"{where}: field 'modality' must be gait or gesture, got {modality!r}")
+    origin = str(rec.get("origin") or "").strip()
+    if origin not in ("generated", "source"):
+        raise CatalogueError(f"{where}: field 'origin' must be generated or source, got {origin!r}")
+    video = str(rec.get("video") or "").strip()
+    if not video:
+        raise CatalogueError(f"{where}: field 'video' (path relative to MEDIA_ROOT) is required")
+    if video.startswith("/") or ".." in video.split("/"):
+        raise CatalogueError(f"{where}: field 'video' must be relative to MEDIA_ROOT, got {video!r}")
+    metadata = rec.get("metadata") or {}
+    if not isinstance(metadata, dict):
+        raise CatalogueError(f"{where}: field 'metadata' must be a dict")
+    out = {"modality": modality, "origin": origin, "video": video, "metadata": metadata,
+           "loop": bool(rec.get("loop", False))}
+    for name in FLOAT_FIELDS:
+        out[name] = _float(rec, name, where)
+    n = rec.get("n_features")
+    if _blank(n):
+        out["n_features"] = None
+    else:
+        try:
+            out["n_features"] = int(float(n))
+        except (TypeError, ValueError) as exc:
+            raise CatalogueError(f"{where}: field 'n_features' must be an integer or blank, got {n!r}") from exc
+    for name in TEXT_FIELDS:
+        value = rec.get(name)
+        out[name] = "" if _blank(value) else str(value).strip()
+    if not out["source_clip_id"]:
+        for value in (rec.get("pair"), metadata.get("source_clip_id"), metadata.get("pair")):
+            if not _blank(value):
+                out["source_clip_id"] = str(value).strip()
+                break
+    sections = rec.get("sections", metadata.get("sections")) or []
+    if isinstance(sections, str):
+        sections = [s for s in sections.split(",")]
+    out["sections"] = ",".join(str(s).strip() for s in sections if str(s).strip())
+    return out
+
+
+def upsert_clips(records: list[dict]) -> int:
+    """Insert or update clips by clip_id (idempotent). Returns the number of records written.
+
+    All records are validated first; nothing is written if one is bad (CatalogueError names it).
+    """
+    cleaned = [(str(rec.get("clip_id")).strip(), clean_record(rec, i)) for i, rec in enumerate(records)]
+    with transaction.atomic():
+        for clip_id, fields in cleaned:
+            Clip.objects.update_or_create(clip_id=clip_id, defaults=fields)
+    return len(cleaned)
+
+
+def pool_queryset(pool: dict | None) -> QuerySet:
+    """Clips matching a section's pool filter.
+
+    Keys are catalogue fields with an optional Django lookup (`weight__gt`, `theme__in`, ...), plus two
+    shorthands: `transition` (bool: has a final emotion) and `rbf` (bool: has a theme). A list value means `in`.
+    """
+    qs = Clip.objects.all()
+    for key, value in (pool or {}).items():
+        if key in ("generated", "source"):      # naturalness sub-pools, handled by the assignment
+            continue
+        if key == "transition":
+            qs = qs.filter(final_happy__isnull=not bool(value))
+            continue
+        if key == "rbf":
+            qs = qs.exclude(theme="") if value else qs.filter(theme="")
+            continue
+        name, _, lookup = key.partition("__")
+        if name not in POOL_FIELDS or lookup not in POOL_LOOKUPS:
+            raise CatalogueError(f"pool filter {key!r}: unknown field or lookup (fields: {sorted(POOL_FIELDS)})")
+        if isinstance(value, list) and not lookup:
+            key = f"{name}__in"
+        qs = qs.filter(Q(**{key: value}))
+    return qs

@@ -1,0 +1,111 @@
+"""Export a study's data in the public DESIGN.md formats: responses.csv, clips.csv, participants.csv.
+
+Rows are produced by generators over `.iterator()` queries, so a large study streams in constant memory (an
+HTTP StreamingHttpResponse or a file on disk); no export builds the whole file as one string.
+Preview runs record nothing, so every participant row is a real participant.
+"""
+from __future__ import annotations
+
+import csv
+from collections.abc import Iterable, Iterator
+from pathlib import Path
+
+from django.db.models import Q
+
+from .models import Clip, Response, Study
+
+RESPONSE_COLUMNS = ["participant_id", "section_type", "clip_id", "question", "answer", "response_ms"]
+CLIP_COLUMNS = ["clip_id", "modality", "origin", "happy", "sad", "angry", "neutral", "final_happy", "final_sad",
+                "final_angry", "final_neutral", "emotion_label", "valence", "arousal", "dominance", "theme",
+                "weight", "n_features", "duration_s"]
+PARTICIPANT_COLUMNS = ["participant_id", "gender", "age_group", "started_at", "completed_at", "status",
+                       "external_id"]
+CHUNK = 2000
+
+
+class _Echo:
+    """A write-only file object: csv.writer writes a row, we hand the string on."""
+
+    def write(self, value: str) -> str:
+        return value
+
+
+def _csv_lines(header: list[str], rows: Iterable[list]) -> Iterator[str]:
+    writer = csv.writer(_Echo(), lineterminator="\n")
+    yield writer.writerow(header)
+    for row in rows:
+        yield writer.writerow(["" if v is None else v for v in row])
+
+
+def _iso(dt) -> str:
+    return dt.isoformat() if dt else ""
+
+
+def response_rows(study: Study) -> Iterator[list]:
+    qs = (Response.objects.filter(section__study=study)
+          .order_by("participant_id", "section__order", "id")
+          .values_list("participant__public_id", "section__section_type", "clip__clip_id", "question", "answer",
+                       "response_ms"))
+    for row in qs.iterator(chunk_size=CHUNK):
+        yield list(row)
+
+
+def study_clips(study: Study):
+    """Clips assigned in the study plus those in its sections' pools."""
+    from .catalogue import pool_queryset
+
+    q = Q(assignments__section__study=study)
+    for section in study.sections.all():
+        if section.pool:
+            q |= Q(pk__in=pool_queryset(section.pool).values("pk"))
+    return Clip.objects.filter(q).distinct().order_by("clip_id")
+
+
+def clip_rows(study: Study) -> Iterator[list]:
+    for clip in study_clips(study).iterator(chunk_size=CHUNK):
+        yield [getattr(clip, c) for c in CLIP_COLUMNS]
+
+
+def feedback_keys(study: Study) -> list[str]:
+    return [str(q["key"]) for q in study.feedback_questions or []]
+
+
+def participant_rows(study: Study) -> Iterator[list]:
+    keys = feedback_keys(study)
+    for p in study.participants.order_by("id").iterator(chunk_size=CHUNK):
+        yield [p.public_id, p.gender, p.age_group, _iso(p.started_at), _iso(p.completed_at), p.status,
+               p.external_id] + [p.feedback.get(k, "") for k in keys]
+
+
+def stream_csv(study: Study, kind: str) -> Iterator[str]:
+    """Lines of `kind` in responses | clips | participants."""
+    if kind == "responses":
+        return _csv_lines(RESPONSE_COLUMNS, response_rows(study))
+    if kind == "clips":
+        return _csv_lines(CLIP_COLUMNS, clip_rows(study))
+    if kind == "participants":
+        return _csv_lines(PARTICIPANT_COLUMNS + feedback_keys(study), participant_rows(study))
+    raise ValueError(f"unknown export {kind!r}; choose responses, clips or participants")
+
+
+def write_study_csvs(study: Study, out_dir: str | Path) -> dict[str, Path]:
+    """Write responses.csv, clips.csv and participants.csv into out_dir; returns their paths."""
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    paths = {}
+    for kind in ("responses", "clips", "participants"):
+        path = out / f"{kind}.csv"
+        with open(path, "w", newline="", encoding="utf-8") as fh:
+            for line in stream_csv(study, kind):
+                fh.write(line)
+        paths[kind] = path
+    return paths
+
+
+def run_report(study: Study, out_dir: str | Path) -> dict:
+    """Export the CSVs and call the analysis library's report writer (analysis.report.write_report)."""
+    out = Path(out_dir)
+    paths = write_study_csvs(study, out / "data")
+    from analysis.report import write_report  # imported lazily: the analysis library is optional at runtime
+
+    return write_report(paths["responses"], paths["clips"], paths["participants"], out)

@@ -1,0 +1,52 @@
+"""Participant forms (consent, demographics, feedback) and the researcher's create-from-preset form."""
+from __future__ import annotations
+
+from django import forms
+
+from .models import Study
+from .presets import preset_choices
+
+GENDERS = [("female", "Female"), ("male", "Male"), ("non-binary", "Non-binary / another gender"),
+           ("undisclosed", "Prefer not to say")]
+AGE_GROUPS = [("18-24", "18-24"), ("25-34", "25-34"), ("35-44", "35-44"), ("45-54", "45-54"), ("55+", "55 or over"),
+              ("undisclosed", "Prefer not to say")]
+
+
+class ConsentForm(forms.Form):
+    consent = forms.BooleanField(required=True, label="I have read the information above and agree to take part.",
+                                 error_messages={"required": "Please tick the box to agree before starting."})
+    PROLIFIC_PID = forms.CharField(required=False, max_length=100, widget=forms.HiddenInput)
+    STUDY_ID = forms.CharField(required=False, max_length=100, widget=forms.HiddenInput)
+    SESSION_ID = forms.CharField(required=False, max_length=100, widget=forms.HiddenInput)
+
+
+class DemographicsForm(forms.Form):
+    gender = forms.ChoiceField(choices=GENDERS, widget=forms.RadioSelect, label="Gender")
+    age_group = forms.ChoiceField(choices=AGE_GROUPS, widget=forms.RadioSelect, label="Age group")
+
+
+class FeedbackForm(forms.Form):
+    """Built from Study.feedback_questions: yes/no radios or an optional text box."""
+
+    def __init__(self, questions: list[dict], *args, **kwargs):
+        super().__init__(*args, **kwargs)
+        for q in questions:
+            key = str(q["key"])
+            if q.get("kind", "yesno") == "text":
+                self.fields[key] = forms.CharField(label=q["text"], required=False, max_length=2000,
+                                                   widget=forms.Textarea(attrs={"rows": 3}))
+            else:
+                self.fields[key] = forms.ChoiceField(label=q["text"], choices=[("yes", "Yes"), ("no", "No")],
+                                                     widget=forms.RadioSelect)
+
+
+class PresetStudyForm(forms.Form):
+    preset = forms.ChoiceField(choices=preset_choices)
+    slug = forms.SlugField(max_length=80, help_text="Used in the participant URL /s/<slug>/")
+    title = forms.CharField(max_length=200, required=False, help_text="Leave blank for the preset's title")
+
+    def clean_slug(self):
+        slug = self.cleaned_data["slug"]
+        if Study.objects.filter(slug=slug).exists():
+            raise forms.ValidationError(f"A study with slug '{slug}' already exists.")
+        return slug

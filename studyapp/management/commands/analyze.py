@@ -1,0 +1,30 @@
+"""Export a study's CSVs and write the analysis report (analysis.report.write_report) into --out."""
+from django.core.management.base import BaseCommand, CommandError
+
+from studyapp.export import run_report
+from studyapp.models import Study
+
+
+class Command(BaseCommand):
+    help = "Run the statistics of the papers on STUDY (slug): report.json, tables, figures, report.html in --out."
+
+    def add_arguments(self, parser):
+        parser.add_argument("study", help="study slug")
+        parser.add_argument("--out", required=True, help="output folder (created if missing)")
+
+    def handle(self, *args, study, out, **options):
+        obj = Study.objects.filter(slug=study).first()
+        if obj is None:
+            known = list(Study.objects.values_list("slug", flat=True))
+            raise CommandError(f"no study with slug {study!r}; known: {known}")
+        try:
+            result = run_report(obj, out)
+        except ImportError as exc:
+            raise CommandError(f"the analysis library is not available ({exc}); the CSVs are in {out}/data") from exc
+        except ValueError as exc:          # analysis.io.ValidationError lists file, line and column
+            raise CommandError(f"the exports of {study!r} did not validate (CSVs in {out}/data):\n{exc}") from exc
+        self.stdout.write(self.style.SUCCESS(f"Report written to {out} (open {out}/report.html)"))
+        if isinstance(result, dict):
+            for key, value in result.items():
+                size = f"{len(value)} records" if isinstance(value, list) else type(value).__name__
+                self.stdout.write(f"  {key}: {size}")

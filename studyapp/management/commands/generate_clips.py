@@ -1,0 +1,139 @@
+"""Render a stimulus plan into clips, write <MEDIA_ROOT>/clips.csv and the Clip rows.
+
+    python manage.py generate_clips --plan demo [--workers 2] [--webm] [--limit K] [--contact-sheet [PNG]]
+
+Thin wrapper over :mod:`generation.render.batch`: the plan is validated before anything renders, clips whose
+files are complete are skipped (resumable), files are written under temporary names and renamed.
+"""
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+from django.conf import settings
+from django.core.management.base import BaseCommand, CommandError
+
+
+class Command(BaseCommand):
+    help = "Render the clips of a stimulus plan (built-in name or YAML/JSON file) and catalogue them."
+
+    def add_arguments(self, parser):
+        parser.add_argument("--plan", required=True, help="built-in plan (demo, seed000, seed003, seed004) or a file")
+        parser.add_argument("--workers", type=int, default=1, help="worker processes (default 1)")
+        parser.add_argument("--webm", action="store_true", help="also write VP9 WebM files")
+        parser.add_argument("--limit", type=int, default=None, help="only the first K entries of the plan")
+        parser.add_argument("--contact-sheet", nargs="?", const="", default=None, metavar="PNG",
+                            help="write a contact sheet of the plan's posters (default "
+                                 "<DATA_DIR>/contact_sheets/<plan>.png)")
+        parser.add_argument("--records-dir", default=None,
+                            help="per-clip records (default <MEDIA_ROOT>/clip_records)")
+        parser.add_argument("--no-db", action="store_true", help="do not write Clip rows (files and clips.csv only)")
+        parser.add_argument("--no-progress", action="store_true", help="no progress bars")
+
+    def handle(self, *args, **opts):
+        from generation.catalogue import write_clips_csv
+        from generation.plan import PlanError, load_plan
+        from generation.render.batch import run_plan
+
+        if opts["workers"] < 1:
+            raise CommandError(f"--workers must be at least 1, got {opts['workers']}")
+        if opts["limit"] is not None and opts["limit"] < 1:
+            raise CommandError(f"--limit must be at least 1, got {opts['limit']}")
+        try:
+            plan = load_plan(opts["plan"])
+        except PlanError as exc:
+            raise CommandError(str(exc)) from None
+        os.environ.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow")
+        media_root = Path(settings.MEDIA_ROOT)
+        clips_dir = media_root / "clips"
+        records_dir = Path(opts["records_dir"]) if opts["records_dir"] else media_root / "clip_records"
+        bars = _Bars(self.stdout, disabled=opts["no_progress"])
+        try:
+            result = run_plan(plan, clips_dir, records_dir, media_prefix="clips/", workers=opts["workers"],
+                              webm=opts["webm"], limit=opts["limit"], on_event=bars.event)
+        finally:
+            bars.close()
+        for where, msg in result.failed:
+            self.stderr.write(f"FAILED {msg}")
+        records = result.records
+        csv_path = media_root / "clips.csv"
+        if records:
+            write_clips_csv(records, csv_path)
+        if records and not opts["no_db"]:
+            try:
+                from studyapp.catalogue import upsert_clips
+            except ImportError as exc:
+                raise CommandError(f"clips rendered and {csv_path} written, but the database catalogue is not "
+                                   f"available ({exc})") from None
+            upsert_clips(records)
+        self.stdout.write(f"plan {plan.name}: {len(result.rendered)} rendered, {len(result.skipped)} already done, "
+                          f"{len(result.failed)} failed, {result.seconds:.1f} s; catalogue {csv_path}")
+        if opts["contact_sheet"] is not None and records:
+            from generation.render import contact_sheet
+
+            out = Path(opts["contact_sheet"]) if opts["contact_sheet"] else (
+                Path(settings.DATA_DIR) / "contact_sheets" / f"{plan.name}.png")
+            labels = [_label(r) for r in records]
+            contact_sheet([clips_dir / f"{r['clip_id']}.png" for r in records], labels, out)
+            self.stdout.write(f"contact sheet {out}")
+        if result.failed:
+            raise CommandError(f"{len(result.failed)} clip(s) of plan {plan.name} failed (see above); the others "
+                               "are catalogued; rerun to retry only the missing ones")
+
+
+def _label(rec: dict) -> str:
+    meta = rec.get("metadata", {})
+    gen = meta.get("generator", "")
+    if meta.get("fallback_for"):
+        gen = f"{gen} (fallback for {meta['fallback_for']})"
+    parts = [str(meta.get("entry_id", rec["clip_id"])), rec["origin"], gen]
+    return " | ".join(p for p in parts if p)
+
+
+class _Bars:
+    """tqdm bars: one for the plan, one per clip being rendered."""
+
+    def __init__(self, stream, disabled: bool = False):
+        self.disabled = disabled
+        self.overall = None
+        self.clips: dict[str, object] = {}
+        self.positions: dict[str, int] = {}
+        self.free_positions: list[int] = []
+        self.next_position = 1
+
+    def event(self, kind: str, info: dict) -> None:
+        if self.disabled:
+            return
+        from tqdm import tqdm
+
+        if kind == "plan":
+            self.overall = tqdm(total=info["todo"], desc=f"clips ({info['skipped']} already done)", unit="clip",
+                                position=0, leave=True)
+        elif kind == "start":
+            pos = self.free_positions.pop(0) if self.free_positions else self.next_position
+            if pos == self.next_position:
+                self.next_position += 1
+            self.positions[info["clip_id"]] = pos
+            self.clips[info["clip_id"]] = tqdm(total=1, desc=str(info["entry"])[:28], unit="frame", position=pos,
+                                               leave=False)
+        elif kind == "frames":
+            bar = self.clips.get(info["clip_id"])
+            if bar is None:
+                self.event("start", info)
+                bar = self.clips[info["clip_id"]]
+            bar.total = info["total"]
+            bar.n = info["done"]
+            bar.refresh()
+        elif kind in ("done", "fail"):
+            bar = self.clips.pop(info.get("clip_id", ""), None)
+            if bar is not None:
+                self.free_positions.append(self.positions.pop(info["clip_id"]))
+                bar.close()
+            if self.overall is not None:
+                self.overall.update(1)
+
+    def close(self) -> None:
+        for bar in self.clips.values():
+            bar.close()
+        if self.overall is not None:
+            self.overall.close()

@@ -1,0 +1,41 @@
+"""Create (or update) the demo study from the demo preset and print the participant URL. Idempotent."""
+from django.core.management.base import BaseCommand, CommandError
+
+from studyapp.catalogue import pool_queryset
+from studyapp.models import Clip, Study
+from studyapp.presets import create_study_from_preset
+
+
+class Command(BaseCommand):
+    help = "Create the demo study (every section type) from the clips in the database and print its URL."
+
+    def add_arguments(self, parser):
+        parser.add_argument("--slug", default="demo")
+        parser.add_argument("--base-url", default="http://127.0.0.1:8000")
+        parser.add_argument("--preset", default="demo", help="preset to build the study from (default: demo)")
+
+    def handle(self, *args, slug, base_url, preset, **options):
+        if not Clip.objects.exists():
+            raise CommandError("The clip catalogue is empty. Render the demo clips first:\n"
+                               "    python manage.py generate_clips --plan demo\n"
+                               "then run setup_demo again.")
+        study = Study.objects.filter(slug=slug).first()
+        if study is None:
+            study = create_study_from_preset(preset, slug, status=Study.Status.OPEN)
+            self.stdout.write(f"Created study '{study.title}' (slug {slug}) from preset {preset}.")
+        else:
+            if study.status != Study.Status.OPEN:
+                study.status = Study.Status.OPEN
+                study.save(update_fields=["status"])
+            self.stdout.write(f"Study '{study.title}' (slug {slug}) already exists; left as it is (open).")
+        for section in study.sections.order_by("order"):
+            if section.reuse_section_id:
+                continue
+            n = pool_queryset(section.pool).count()
+            if n == 0:
+                self.stdout.write(self.style.WARNING(
+                    f"  section {section.order} ({section.section_type}): no clip matches its pool {section.pool}; "
+                    "participants will skip it"))
+            else:
+                self.stdout.write(f"  section {section.order} ({section.section_type}): {n} clips in the pool")
+        self.stdout.write(self.style.SUCCESS(f"Participant URL: {base_url.rstrip('/')}/s/{study.slug}/"))

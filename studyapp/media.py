@@ -1,0 +1,90 @@
+"""Clip files served with HTTP Range support under opaque URLs.
+
+Django's FileResponse ignores `Range`; Safari will not play an MP4 without byte ranges, and no browser can seek
+without them. `ranged_file_response` answers `Range: bytes=a-b` (single range; suffix and open-ended forms) with
+206 + Content-Range, an unsatisfiable range with 416, and anything else with the whole file (200). The body is
+streamed in 64 KiB blocks.
+"""
+from __future__ import annotations
+
+import mimetypes
+import os
+import re
+from pathlib import Path
+
+from django.conf import settings
+from django.http import Http404, HttpResponse, StreamingHttpResponse
+from django.utils.http import http_date
+
+BLOCK = 64 * 1024
+RANGE_RE = re.compile(r"^bytes=(\d*)-(\d*)$")
+CONTENT_TYPES = {".mp4": "video/mp4", ".webm": "video/webm", ".png": "image/png", ".jpg": "image/jpeg"}
+
+
+def media_path(relative: str) -> Path:
+    """Absolute path of a catalogue media path, refusing anything outside MEDIA_ROOT."""
+    root = Path(settings.MEDIA_ROOT).resolve()
+    path = (root / relative).resolve()
+    if root not in path.parents or not path.is_file():
+        raise Http404("clip file not found")
+    return path
+
+
+def _iter_file(path: Path, start: int, length: int):
+    with open(path, "rb") as fh:
+        fh.seek(start)
+        remaining = length
+        while remaining > 0:
+            chunk = fh.read(min(BLOCK, remaining))
+            if not chunk:
+                break
+            remaining -= len(chunk)
+            yield chunk
+
+
+def parse_range(header: str, size: int) -> tuple[int, int] | None:
+    """(start, end inclusive) for a single byte range, None when the header is absent or not a simple range.
+    Raises ValueError when the range cannot be satisfied."""
+    m = RANGE_RE.match(header.strip()) if header else None
+    if not m or (m.group(1) == "" and m.group(2) == ""):
+        return None
+    first, last = m.group(1), m.group(2)
+    if first == "":                      # suffix: the last N bytes
+        n = int(last)
+        if n == 0:
+            raise ValueError("empty suffix range")
+        return max(0, size - n), size - 1
+    start = int(first)
+    end = size - 1 if last == "" else min(int(last), size - 1)
+    if start >= size or end < start:
+        raise ValueError("range not satisfiable")
+    return start, end
+
+
+def ranged_file_response(request, path: Path, content_type: str | None = None):
+    size = path.stat().st_size
+    content_type = content_type or CONTENT_TYPES.get(path.suffix.lower()) or (
+        mimetypes.guess_type(path.name)[0] or "application/octet-stream")
+    mtime = http_date(os.path.getmtime(path))
+    try:
+        rng = parse_range(request.headers.get("Range", ""), size)
+    except ValueError:
+        response = HttpResponse(status=416)
+        response["Content-Range"] = f"bytes */{size}"
+        return response
+    if request.method == "HEAD":
+        response = HttpResponse(content_type=content_type)
+        response["Content-Length"] = str(size)
+    elif rng is None:
+        response = StreamingHttpResponse(_iter_file(path, 0, size), content_type=content_type)
+        response["Content-Length"] = str(size)
+    else:
+        start, end = rng
+        response = StreamingHttpResponse(_iter_file(path, start, end - start + 1), status=206,
+                                         content_type=content_type)
+        response["Content-Length"] = str(end - start + 1)
+        response["Content-Range"] = f"bytes {start}-{end}/{size}"
+    response["Accept-Ranges"] = "bytes"
+    response["Last-Modified"] = mtime
+    response["Cache-Control"] = "private, max-age=86400"
+    return response

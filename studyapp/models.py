@@ -1,0 +1,256 @@
+"""Database models of the study platform.
+
+Study -> Section (ordered, typed, configured) -> per-participant Assignment (ordered clips, fixed at start)
+-> Response (one row per participant, section, clip and question; unique in the database).
+Clip rows mirror the public `clips.csv` columns of DESIGN.md plus media paths.
+"""
+from __future__ import annotations
+
+import secrets
+
+from django.db import models
+from django.utils import timezone
+
+
+def new_token() -> str:
+    """An unguessable participant credential (URL-safe, 32 random bytes)."""
+    return secrets.token_urlsafe(32)
+
+
+def new_public_id() -> str:
+    """The participant id written to exports: opaque, not a credential."""
+    return "p" + secrets.token_hex(6)
+
+
+def new_media_key() -> str:
+    return secrets.token_hex(16)
+
+
+def new_seed() -> int:
+    return secrets.randbelow(2**31 - 1)
+
+
+def new_completion_code() -> str:
+    return secrets.token_hex(4).upper()
+
+
+class SectionType(models.TextChoices):
+    EMOTION_CHOICE = "emotion_choice", "Perceived gait emotion (multi-select)"
+    EMOTION_TRANSITION = "emotion_transition", "Gait emotion transition (initial and final)"
+    AFFECT_LIKERT = "affect_likert", "Pose affective features (5-point Likert)"
+    NATURALNESS = "naturalness", "Naturalness (1..5)"
+    GESTURE_EMOTION = "gesture_emotion", "Perceived gesture emotion (4 options)"
+    NEUTRAL_VALIDATION = "neutral_validation", "Neutral validation (7-way forced choice)"
+    THEME_RATING = "theme_rating", "Theme rating (1..7)"
+    THEME_INVERSION = "theme_inversion", "Theme inversion (-7..+7)"
+
+
+class Clip(models.Model):
+    """One pre-rendered stimulus; fields follow the `clips.csv` columns of DESIGN.md."""
+
+    MODALITIES = [("gait", "gait"), ("gesture", "gesture")]
+    ORIGINS = [("generated", "generated"), ("source", "source")]
+
+    clip_id = models.CharField(max_length=200, unique=True)
+    modality = models.CharField(max_length=10, choices=MODALITIES)
+    origin = models.CharField(max_length=10, choices=ORIGINS)
+    happy = models.FloatField(null=True, blank=True)
+    sad = models.FloatField(null=True, blank=True)
+    angry = models.FloatField(null=True, blank=True)
+    neutral = models.FloatField(null=True, blank=True)
+    final_happy = models.FloatField(null=True, blank=True)
+    final_sad = models.FloatField(null=True, blank=True)
+    final_angry = models.FloatField(null=True, blank=True)
+    final_neutral = models.FloatField(null=True, blank=True)
+    emotion_label = models.CharField(max_length=40, blank=True)
+    valence = models.FloatField(null=True, blank=True)
+    arousal = models.FloatField(null=True, blank=True)
+    dominance = models.FloatField(null=True, blank=True)
+    theme = models.CharField(max_length=40, blank=True)
+    weight = models.FloatField(null=True, blank=True)
+    n_features = models.IntegerField(null=True, blank=True)
+    duration_s = models.FloatField(null=True, blank=True)
+    # Generated clip -> the clip_id of the source clip it was made from (seed 003: never show both to one person).
+    source_clip_id = models.CharField(max_length=200, blank=True)
+    video = models.CharField(max_length=500, help_text="MP4 path relative to MEDIA_ROOT")
+    webm = models.CharField(max_length=500, blank=True)
+    poster = models.CharField(max_length=500, blank=True)
+    plan = models.CharField(max_length=100, blank=True)
+    # The plan's hint of the section types the clip is meant for, comma-separated (pool filter sections__contains).
+    sections = models.CharField(max_length=300, blank=True)
+    loop = models.BooleanField(default=False)
+    metadata = models.JSONField(default=dict, blank=True)
+    media_key = models.CharField(max_length=32, unique=True, default=new_media_key, editable=False)
+    created_at = models.DateTimeField(auto_now_add=True)
+    updated_at = models.DateTimeField(auto_now=True)
+
+    class Meta:
+        ordering = ["clip_id"]
+
+    def __str__(self) -> str:
+        return self.clip_id
+
+    @property
+    def is_transition(self) -> bool:
+        return self.final_happy is not None
+
+
+class Study(models.Model):
+    class Status(models.TextChoices):
+        DRAFT = "draft", "Draft"
+        OPEN = "open", "Open"
+        CLOSED = "closed", "Closed"
+
+    slug = models.SlugField(max_length=80, unique=True)
+    title = models.CharField(max_length=200)
+    preset = models.CharField(max_length=40, blank=True)
+    status = models.CharField(max_length=10, choices=Status.choices, default=Status.DRAFT)
+    introduction = models.TextField(blank=True)
+    consent_text = models.TextField(blank=True)
+    ask_demographics = models.BooleanField(default=True)
+    feedback_questions = models.JSONField(
+        default=list, blank=True,
+        help_text='List of {"key": "camera", "text": "Were you distracted ...?", "kind": "yesno"|"text"}')
+    max_participants = models.PositiveIntegerField(default=0, help_text="0 = no limit")
+    completion_code = models.CharField(max_length=40, default=new_completion_code)
+    completion_redirect = models.CharField(
+        max_length=500, blank=True,
+        help_text="Optional URL shown/redirected to at the end; {code} is replaced by the completion code, e.g. "
+                  "https://app.prolific.com/submissions/complete?cc={code}")
+    created_at = models.DateTimeField(auto_now_add=True)
+
+    class Meta:
+        verbose_name_plural = "studies"
+        ordering = ["-created_at"]
+
+    def __str__(self) -> str:
+        return self.title
+
+    def completion_url(self) -> str:
+        return self.completion_redirect.replace("{code}", self.completion_code) if self.completion_redirect else ""
+
+
+class Section(models.Model):
+    """A block of clips with one question set; `order` fixes the position in the study."""
+
+    study = models.ForeignKey(Study, on_delete=models.CASCADE, related_name="sections")
+    order = models.PositiveIntegerField(default=0)
+    section_type = models.CharField(max_length=30, choices=SectionType.choices)
+    title = models.CharField(max_length=200, blank=True)
+    instructions = models.TextField(blank=True)
+    pool = models.JSONField(
+        default=dict, blank=True,
+        help_text='Clip pool as catalogue filters, e.g. {"modality": "gait", "origin": "generated", '
+                  '"transition": false, "weight__gt": 0}. For naturalness use "generated" and "source" sub-filters.')
+    clips_per_participant = models.PositiveIntegerField(default=6, help_text="0 = every clip of the pool")
+    reuse_section = models.ForeignKey(
+        "self", null=True, blank=True, on_delete=models.SET_NULL, related_name="reused_by",
+        help_text="Show the clips this participant got in that earlier section (seed 000 section 3).")
+    randomize_order = models.BooleanField(default=True)
+    require_full_play = models.BooleanField(default=True, help_text="Answers are enabled once the clip has played")
+    loop = models.BooleanField(default=False)
+    options = models.JSONField(
+        default=dict, blank=True,
+        help_text='Type-specific options, e.g. naturalness {"anchors": {"1": "not natural at all", ...}, '
+                  '"n_generated": 3, "n_source": 3}; gesture_emotion {"n_options": 4}')
+
+    class Meta:
+        ordering = ["study", "order", "id"]
+
+    def __str__(self) -> str:
+        return f"{self.study.slug} #{self.order} {self.section_type}"
+
+    def clean(self):
+        from django.core.exceptions import ValidationError
+
+        from .catalogue import CatalogueError, pool_queryset
+
+        errors = {}
+        if self.reuse_section_id:
+            other = self.reuse_section
+            if other.study_id != self.study_id:
+                errors["reuse_section"] = "The reused section must belong to the same study."
+            elif (other.order, other.pk or 0) >= (self.order, self.pk or 10**12):
+                errors["reuse_section"] = "The reused section must come before this one."
+        try:
+            pool_queryset(self.pool).exists()
+            for sub in ("generated", "source"):
+                if isinstance(self.pool.get(sub), dict):
+                    pool_queryset(self.pool[sub]).exists()
+        except CatalogueError as exc:
+            errors["pool"] = str(exc)
+        if not isinstance(self.options, dict):
+            errors["options"] = "Options must be a JSON object."
+        if errors:
+            raise ValidationError(errors)
+
+
+class Participant(models.Model):
+    class Status(models.TextChoices):
+        CONSENTED = "consented", "Consented"
+        STARTED = "started", "Started"
+        COMPLETED = "completed", "Completed"
+        WITHDRAWN = "withdrawn", "Withdrawn"
+
+    study = models.ForeignKey(Study, on_delete=models.CASCADE, related_name="participants")
+    token = models.CharField(max_length=64, unique=True, default=new_token, editable=False)
+    public_id = models.CharField(max_length=20, unique=True, default=new_public_id, editable=False)
+    external_id = models.CharField(max_length=100, blank=True, help_text="e.g. Prolific PROLIFIC_PID")
+    external_study_id = models.CharField(max_length=100, blank=True)
+    external_session_id = models.CharField(max_length=100, blank=True)
+    gender = models.CharField(max_length=30, blank=True)
+    age_group = models.CharField(max_length=20, blank=True)
+    demographics_done = models.BooleanField(default=False)
+    feedback = models.JSONField(default=dict, blank=True)
+    feedback_done = models.BooleanField(default=False)
+    status = models.CharField(max_length=10, choices=Status.choices, default=Status.CONSENTED)
+    seed = models.BigIntegerField(default=new_seed)
+    consented_at = models.DateTimeField(default=timezone.now)
+    started_at = models.DateTimeField(null=True, blank=True)
+    completed_at = models.DateTimeField(null=True, blank=True)
+    user_agent = models.CharField(max_length=300, blank=True)
+
+    class Meta:
+        constraints = [
+            models.UniqueConstraint(fields=["study", "external_id"], condition=~models.Q(external_id=""),
+                                    name="unique_external_id_per_study"),
+        ]
+
+    def __str__(self) -> str:
+        return self.public_id
+
+
+class Assignment(models.Model):
+    """Clip `position` of `section` for one participant, fixed when the participant starts."""
+
+    participant = models.ForeignKey(Participant, on_delete=models.CASCADE, related_name="assignments")
+    section = models.ForeignKey(Section, on_delete=models.CASCADE, related_name="assignments")
+    position = models.PositiveIntegerField()
+    clip = models.ForeignKey(Clip, on_delete=models.PROTECT, related_name="assignments")
+    options = models.JSONField(default=list, blank=True, help_text="Answer options shown (gesture_emotion)")
+    shown_at = models.DateTimeField(null=True, blank=True)
+    answered_at = models.DateTimeField(null=True, blank=True)
+
+    class Meta:
+        ordering = ["participant", "section__order", "position"]
+        constraints = [
+            models.UniqueConstraint(fields=["participant", "section", "position"], name="unique_assignment_slot"),
+            models.UniqueConstraint(fields=["participant", "section", "clip"], name="unique_assignment_clip"),
+        ]
+
+
+class Response(models.Model):
+    participant = models.ForeignKey(Participant, on_delete=models.CASCADE, related_name="responses")
+    section = models.ForeignKey(Section, on_delete=models.CASCADE, related_name="responses")
+    clip = models.ForeignKey(Clip, on_delete=models.PROTECT, related_name="responses")
+    question = models.CharField(max_length=20)
+    answer = models.CharField(max_length=200)
+    response_ms = models.PositiveIntegerField(null=True, blank=True)
+    created_at = models.DateTimeField(auto_now_add=True)
+
+    class Meta:
+        ordering = ["id"]
+        constraints = [
+            models.UniqueConstraint(fields=["participant", "section", "clip", "question"],
+                                    name="unique_response"),
+        ]

@@ -1,0 +1,85 @@
+"""Test and benchmark helpers: a small SYNTHETIC clip catalogue covering every section pool.
+
+The clips are placeholders (tiny dummy files, or one real 1-second MP4 when given), marked
+metadata["synthetic"] = True; they are not rendered motion and never presented as such.
+"""
+from __future__ import annotations
+
+import hashlib
+import itertools
+from pathlib import Path
+
+from .catalogue import upsert_clips
+from .questions import GESTURE_EMOTIONS, THEMES
+
+GAIT_VECTORS = [(1, 0, 0, 0), (0, 1, 0, 0), (0, 0, 1, 0), (0, 0, 0, 1), (0.5, 0, 0, 0.5), (0, 0.5, 0.5, 0),
+                (0.6, 0.1, 0, 0.3), (0, 0.7, 0, 0.3), (0.25, 0.25, 0.25, 0.25), (0, 0, 0.8, 0.2)]
+
+
+def write_media(media_root: Path, payload: bytes, suffix: str = ".mp4") -> str:
+    """Write payload under media_root/clips/<sha1>.<suffix> (content-hash name, like the renderer). Returns the
+    path relative to media_root."""
+    name = hashlib.sha1(payload).hexdigest()[:16] + suffix
+    path = Path(media_root) / "clips" / name
+    path.parent.mkdir(parents=True, exist_ok=True)
+    if not path.exists():
+        path.write_bytes(payload)
+    return f"clips/{name}"
+
+
+def tiny_mp4(path: Path, seconds: float = 1.0, fps: int = 10, size: int = 64, shade: int = 0) -> Path:
+    """A real H.264 MP4 (yuv420p, faststart) of a moving grey square, via imageio-ffmpeg."""
+    import imageio_ffmpeg
+    import numpy as np
+
+    path.parent.mkdir(parents=True, exist_ok=True)
+    writer = imageio_ffmpeg.write_frames(str(path), (size, size), fps=fps, codec="libx264", pix_fmt_out="yuv420p",
+                                         output_params=["-movflags", "+faststart"], macro_block_size=16)
+    writer.send(None)
+    for i in range(int(seconds * fps)):
+        frame = np.full((size, size, 3), 30 + shade % 60, dtype=np.uint8)
+        x = (i * 5) % (size - 16)
+        frame[24:40, x:x + 16] = 220
+        writer.send(frame.tobytes())
+    writer.close()
+    return path
+
+
+def make_catalogue(media_root: Path, video_bytes: bytes | None = None, duration_s: float | None = None,
+                   n_gait: int = 10, n_transition: int = 6, n_gait_source: int = 4, n_gesture: int = 12) -> int:
+    """Insert a synthetic catalogue: generated/source gaits, transitions, gestures (each generated gesture made from
+    a source gesture), one neutral RBF input walk and RBF theme clips with positive and negative weights."""
+    records = []
+
+    def media(tag: str) -> str:
+        return write_media(media_root, video_bytes if video_bytes is not None else f"dummy {tag}".encode())
+
+    def base(clip_id: str, modality: str, origin: str, **extra) -> dict:
+        rec = {"clip_id": clip_id, "modality": modality, "origin": origin, "video": media(clip_id), "webm": "",
+               "poster": "", "plan": "test", "loop": False, "duration_s": duration_s,
+               "metadata": {"synthetic": True, "note": "test placeholder, not rendered motion"}}
+        rec.update(extra)
+        return rec
+
+    vectors = itertools.cycle(GAIT_VECTORS)
+    for i in range(n_gait):
+        h, s, a, n = next(vectors)
+        records.append(base(f"gait_gen_{i:02d}", "gait", "generated", happy=h, sad=s, angry=a, neutral=n))
+    for i in range(n_gait_source):
+        records.append(base(f"gait_src_{i:02d}", "gait", "source", neutral=1.0, happy=0, sad=0, angry=0))
+    for i in range(n_transition):
+        h, s, a, n = GAIT_VECTORS[i % 4]
+        fh, fs, fa, fn = GAIT_VECTORS[(i + 1) % 4]
+        records.append(base(f"gait_tr_{i:02d}", "gait", "generated", happy=h, sad=s, angry=a, neutral=n,
+                            final_happy=fh, final_sad=fs, final_angry=fa, final_neutral=fn))
+    for i in range(n_gesture):
+        label = GESTURE_EMOTIONS[i % len(GESTURE_EMOTIONS)]
+        records.append(base(f"gest_src_{i:02d}", "gesture", "source", emotion_label=label))
+        records.append(base(f"gest_gen_{i:02d}", "gesture", "generated", emotion_label=label,
+                            source_clip_id=f"gest_src_{i:02d}", valence=0.5, arousal=0.5, dominance=0.5))
+    records.append(base("rbf_neutral", "gait", "source", theme="neutral", n_features=0))
+    for theme in THEMES:
+        for w in (0.4, 1.0):
+            records.append(base(f"rbf_{theme}_{w}", "gait", "generated", theme=theme, weight=w, n_features=10))
+        records.append(base(f"rbf_{theme}_inv", "gait", "generated", theme=theme, weight=-0.7, n_features=10))
+    return upsert_clips(records)

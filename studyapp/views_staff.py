@@ -1,0 +1,138 @@
+"""Researcher pages (staff only): create from preset, preview without recording, progress, exports, report."""
+from __future__ import annotations
+
+import tempfile
+import zipfile
+from pathlib import Path
+
+from django.contrib import messages
+from django.contrib.admin.views.decorators import staff_member_required
+from django.db.models import Count, Q
+from django.http import FileResponse, Http404, StreamingHttpResponse
+from django.shortcuts import get_object_or_404, redirect, render
+from django.urls import reverse
+from django.views.decorators.http import require_http_methods
+
+from .assignment import plan_study
+from .export import stream_csv
+from .forms import ConsentForm, PresetStudyForm
+from .models import Assignment, Participant, Response, Study
+from .presets import create_study_from_preset
+from .questions import AnswerError, clean_answers, questions_for
+from .views import item_context
+
+
+@staff_member_required
+@require_http_methods(["GET", "POST"])
+def create_from_preset(request):
+    form = PresetStudyForm(request.POST or None)
+    if request.method == "POST" and form.is_valid():
+        d = form.cleaned_data
+        study = create_study_from_preset(d["preset"], d["slug"], d["title"] or None)
+        messages.success(request, f"Created '{study.title}' from preset {d['preset']} (status: draft).")
+        return redirect(reverse("admin:studyapp_study_change", args=[study.pk]))
+    return render(request, "studyapp/staff/create_from_preset.html", {"form": form, "title": "New study from preset"})
+
+
+def _preview_plan(study: Study, seed: int):
+    flat = []
+    for section, items in plan_study(study, seed, balanced=False):
+        flat += [(section, it, i) for i, it in enumerate(items)]
+    return flat
+
+
+@staff_member_required
+def preview_start(request, study_id: int):
+    study = get_object_or_404(Study, pk=study_id)
+    seed = int(request.GET.get("seed", 12345))
+    return render(request, "studyapp/consent.html", {"study": study, "form": ConsentForm(), "preview": True,
+                                                     "seed": seed})
+
+
+@staff_member_required
+@require_http_methods(["GET", "POST"])
+def preview_item(request, study_id: int, n: int):
+    """Clip n of a preview participant with the given seed. Answers are validated, never stored."""
+    study = get_object_or_404(Study, pk=study_id)
+    seed = int(request.GET.get("seed", 12345))
+    flat = _preview_plan(study, seed)
+    if not flat:
+        messages.warning(request, "No section of this study has clips: the catalogue has none matching the pools.")
+        return redirect(reverse("admin:studyapp_study_change", args=[study.pk]))
+    if n < 1 or n > len(flat):
+        return render(request, "studyapp/done.html", {"study": study, "preview": True, "seed": seed})
+    section, it, position = flat[n - 1]
+    error = ""
+    if request.method == "POST":
+        try:
+            clean_answers(questions_for(section.section_type, section.options, it.clip.theme, it.options),
+                          request.POST)
+            return redirect(reverse("studyapp:preview_item", args=[study.pk, n + 1]) + f"?seed={seed}")
+        except AnswerError as exc:
+            error = str(exc)
+    nxt = flat[n][1].clip if n < len(flat) else None
+    ctx = item_context(section, it.clip, n, len(flat), nxt, it.options,
+                       request.POST if request.method == "POST" else None)
+    ctx.update({"study": study, "preview": True, "seed": seed, "error": error, "first_of_section": position == 0,
+                "clip_label": it.clip.clip_id})
+    return render(request, "studyapp/item.html", ctx, status=400 if error else 200)
+
+
+@staff_member_required
+def progress(request, study_id: int):
+    study = get_object_or_404(Study, pk=study_id)
+    counts = {row["status"]: row["n"] for row in study.participants.values("status").annotate(n=Count("id"))}
+    sections = []
+    for section in study.sections.order_by("order", "id"):
+        per_clip = (Assignment.objects.filter(section=section)
+                    .values("clip__clip_id")
+                    .annotate(assigned=Count("id"), answered=Count("id", filter=Q(answered_at__isnull=False)))
+                    .order_by("clip__clip_id"))
+        sections.append({"section": section, "clips": list(per_clip),
+                         "responses": Response.objects.filter(section=section).count()})
+    ctx = {"study": study, "counts": counts, "sections": sections, "title": f"Progress: {study.title}",
+           "started": counts.get(Participant.Status.STARTED, 0),
+           "completed": counts.get(Participant.Status.COMPLETED, 0),
+           "consented": counts.get(Participant.Status.CONSENTED, 0),
+           "participant_url": request.build_absolute_uri(reverse("studyapp:study_entry", args=[study.slug]))}
+    return render(request, "studyapp/staff/progress.html", ctx)
+
+
+@staff_member_required
+def export_csv(request, study_id: int, kind: str):
+    study = get_object_or_404(Study, pk=study_id)
+    if kind not in ("responses", "clips", "participants"):
+        raise Http404("unknown export")
+    response = StreamingHttpResponse(stream_csv(study, kind), content_type="text/csv; charset=utf-8")
+    response["Content-Disposition"] = f'attachment; filename="{study.slug}-{kind}.csv"'
+    return response
+
+
+@staff_member_required
+def report_zip(request, study_id: int):
+    """Run the analysis report on the study's CSVs and send report.html, report.json, tables and figures as a zip."""
+    from .export import run_report
+
+    study = get_object_or_404(Study, pk=study_id)
+    tmp = tempfile.TemporaryDirectory(prefix="study-report-")
+    try:
+        run_report(study, tmp.name)
+    except ImportError:
+        tmp.cleanup()
+        messages.error(request, "The analysis library (analysis.report) is not installed in this deployment.")
+        return redirect(reverse("studyapp:progress", args=[study.pk]))
+    except ValueError as exc:       # analysis.io.ValidationError: names file, line and column
+        tmp.cleanup()
+        messages.error(request, f"The study's exports did not validate: {exc}")
+        return redirect(reverse("studyapp:progress", args=[study.pk]))
+    spool = tempfile.SpooledTemporaryFile(max_size=16 * 1024 * 1024)
+    with zipfile.ZipFile(spool, "w", zipfile.ZIP_DEFLATED) as zf:
+        root = Path(tmp.name)
+        for path in sorted(root.rglob("*")):
+            if path.is_file():
+                zf.write(path, path.relative_to(root).as_posix())
+    tmp.cleanup()
+    spool.seek(0)
+    return FileResponse(spool, as_attachment=True, filename=f"{study.slug}-report.zip",
+                        content_type="application/zip")
+

@@ -1,0 +1,143 @@
+"""End to end in real headless Chromium: take the whole demo study (every section type), reload mid-section, use
+the back button, finish, and check the exported responses.csv holds every answer exactly once.
+
+Set STUDY_SCREENSHOTS=<folder> to save a screenshot of the first clip page of each section type there
+(docs/img/study_<section_type>.png are made this way).
+"""
+from __future__ import annotations
+
+import csv
+import io
+import os
+import time
+from pathlib import Path
+
+import pytest
+from django.urls import reverse
+
+from studyapp.export import stream_csv
+from studyapp.models import Participant, Response, Study
+from studyapp.presets import create_study_from_preset
+from studyapp.questions import questions_for
+from studyapp.testing import make_catalogue, tiny_mp4
+
+pytestmark = [pytest.mark.browser, pytest.mark.slow, pytest.mark.django_db(transaction=True)]
+
+
+def wait_for(driver, condition, timeout=20.0, what="condition"):
+    end = time.time() + timeout
+    while time.time() < end:
+        try:
+            value = condition(driver)
+            if value:
+                return value
+        except Exception:     # element not there yet / stale while navigating
+            pass
+        time.sleep(0.1)
+    raise AssertionError(f"timed out waiting for {what}; at {driver.current_url}")
+
+
+def path_of(driver) -> str:
+    return "/" + driver.current_url.split("/", 3)[3]
+
+
+def pick_answers(driver, choice: int = 0):
+    """Choose option number `choice` (clamped) of every question; for multi-select also the last option."""
+    from selenium.webdriver.common.by import By
+
+    for fs in driver.find_elements(By.CSS_SELECTOR, "#answer-form fieldset.question"):
+        inputs = fs.find_elements(By.CSS_SELECTOR, "input")
+        target = inputs[min(choice, len(inputs) - 1)]
+        if not target.is_selected():
+            target.find_element(By.XPATH, "..").click()        # click the label, as a person would
+        if target.get_attribute("type") == "checkbox" and not inputs[-1].is_selected():
+            inputs[-1].find_element(By.XPATH, "..").click()
+
+
+def test_whole_demo_study_in_chromium(chromium, live_server, settings, tmp_path):
+    from selenium.webdriver.common.by import By
+
+    settings.MEDIA_ROOT = tmp_path / "media"
+    video = tiny_mp4(tmp_path / "clip.mp4", seconds=1.0, size=160)
+    make_catalogue(settings.MEDIA_ROOT, video_bytes=video.read_bytes(), duration_s=1.0)
+    study = create_study_from_preset("demo", "demo", status=Study.Status.OPEN,
+                                     completion_redirect="https://example.org/complete?cc={code}")
+    shots = os.environ.get("STUDY_SCREENSHOTS")
+    if shots:
+        chromium.set_window_size(1100, 1500)
+    driver = chromium
+    driver.get(live_server.url + reverse("studyapp:study_entry", args=[study.slug]) + "?PROLIFIC_PID=e2e-1")
+    if shots:
+        driver.save_screenshot(str(Path(shots) / "study_consent.png"))
+    driver.find_element(By.CSS_SELECTOR, "label.check").click()
+    driver.find_element(By.CSS_SELECTOR, "button[type=submit]").click()
+    wait_for(driver, lambda d: "/about-you/" in d.current_url, what="demographics page")
+    for name in ("gender", "age_group"):
+        driver.find_element(By.CSS_SELECTOR, f"input[name={name}]").find_element(By.XPATH, "..").click()
+    driver.find_element(By.CSS_SELECTOR, "button[type=submit]").click()
+    wait_for(driver, lambda d: "/clip/1/" in d.current_url, what="first clip")
+    participant = Participant.objects.get(external_id="e2e-1")
+    total = participant.assignments.count()
+    seen_types, reloaded, went_back = set(), False, False
+    for n in range(1, total + 1):
+        wait_for(driver, lambda d, n=n: f"/clip/{n}/" in d.current_url, what=f"clip {n}")
+        a = participant.assignments.select_related("section", "clip").order_by("section__order", "position")[n - 1]
+        stype = a.section.section_type
+        # answers are enabled once the clip has played (looping clips: after one full loop)
+        wait_for(driver, lambda d: d.find_element(By.ID, "next").is_enabled(), timeout=15, what="clip played")
+        progress = driver.find_element(By.CSS_SELECTOR, ".progress").get_attribute("aria-valuenow")
+        assert int(progress) == round(100 * (n - 1) / total)
+        if stype not in seen_types:
+            seen_types.add(stype)
+            if shots:
+                pick_answers(driver, 2)
+                driver.save_screenshot(str(Path(shots) / f"study_{stype}.png"))
+        pick_answers(driver, n % 3)
+        if n == 2 and not reloaded:
+            # reload mid-section before answering: same clip again, nothing saved, nothing lost
+            reloaded = True
+            driver.refresh()
+            wait_for(driver, lambda d: d.find_element(By.ID, "next").is_enabled(), timeout=15, what="replayed")
+            assert "/clip/2/" in driver.current_url
+            assert Response.objects.filter(participant=participant).count() == len(
+                questions_for(participant.assignments.order_by("section__order", "position")[0].section.section_type))
+            pick_answers(driver, n % 3)
+        driver.find_element(By.ID, "next").click()
+        wait_for(driver, lambda d, n=n: f"/clip/{n}/" not in d.current_url, what=f"leave clip {n}")
+        if n == 3 and not went_back:
+            went_back = True
+            driver.back()                 # the back button shows where the participant is, not an old clip
+            wait_for(driver, lambda d: "/clip/4/" in d.current_url or "/clip/3/" not in d.current_url,
+                     what="back button redirect")
+            driver.get(live_server.url + reverse("studyapp:resume", args=[participant.token]))
+    assert seen_types == {"emotion_choice", "emotion_transition", "affect_likert", "naturalness", "gesture_emotion",
+                          "neutral_validation", "theme_rating", "theme_inversion"}
+    wait_for(driver, lambda d: "/feedback/" in d.current_url, what="feedback page")
+    for fs in driver.find_elements(By.CSS_SELECTOR, "fieldset.question"):
+        radios = fs.find_elements(By.CSS_SELECTOR, "input[type=radio]")
+        if radios:
+            radios[-1].find_element(By.XPATH, "..").click()
+        else:
+            fs.find_element(By.TAG_NAME, "textarea").send_keys("Clear clips, thanks.")
+    driver.find_element(By.CSS_SELECTOR, "button[type=submit]").click()
+    wait_for(driver, lambda d: "/done/" in d.current_url, what="completion page")
+    if shots:
+        driver.save_screenshot(str(Path(shots) / "study_done.png"))
+    assert driver.find_element(By.ID, "completion-code").text == study.completion_code
+    assert f"cc={study.completion_code}" in driver.find_element(By.ID, "completion-link").get_attribute("href")
+
+    participant.refresh_from_db()
+    assert participant.status == "completed" and participant.feedback["comments"] == "Clear clips, thanks."
+    rows = list(csv.DictReader(io.StringIO("".join(stream_csv(study, "responses")))))
+    expected = {}
+    for a in participant.assignments.select_related("section", "clip"):
+        for q in questions_for(a.section.section_type, a.section.options, a.clip.theme, a.options):
+            expected[(participant.public_id, a.section.section_type, a.clip.clip_id, q.key)] = q
+    got = [(r["participant_id"], r["section_type"], r["clip_id"], r["question"]) for r in rows]
+    assert len(got) == len(set(got)), "an answer was stored twice"
+    assert set(got) == set(expected), "an answer is missing or unexpected"
+    for r in rows:
+        q = expected[(r["participant_id"], r["section_type"], r["clip_id"], r["question"])]
+        allowed = {c[0] for c in q.choices}
+        assert set(r["answer"].split(";")) <= allowed
+        assert int(r["response_ms"]) >= 500           # measured in the browser; clips are 1 s long

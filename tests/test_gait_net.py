@@ -1,0 +1,217 @@
+"""Tests of the seed 000 gait network: model, losses, data features, training, generation, shipped weights."""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+import torch
+
+from generation.gait.config import GaitNetConfig
+from generation.gait.data import (Normalizer, from_heading_frame, prepare_sequences, root_features,
+                                  to_heading_frame)
+from generation.gait.generate import (LoadedGaitNet, emotion_transition, generate_gaits, load_default_model,
+                                      load_model, normalize_emotion)
+from generation.gait.losses import motion_loss, total_loss
+from generation.gait.model import GaitNet
+from generation.gait.train import (DEFAULT_WEIGHTS, fit_normalizer, ground_truth_targets, load_checkpoint,
+                                   rollout, save_checkpoint, train)
+from generation.motion import Motion
+from generation.paths import curved, sharp_turn, straight
+from generation.procedural_walk import WalkParams, walk
+
+torch.set_num_threads(1)
+
+
+@pytest.fixture(scope="module")
+def tiny_data():
+    """Six short synthetic procedural walks (2 per split) with one-hot emotions."""
+    rng = np.random.default_rng(0)
+    rots, roots, emo = [], [], []
+    for i in range(6):
+        params = WalkParams(cadence_spm=rng.uniform(95, 125), stride_m=rng.uniform(1.1, 1.5),
+                            torso_pitch_rad=rng.uniform(-0.05, 0.3))
+        path = curved(5.0, 0.8) if i % 2 else straight(12.0)
+        m = walk(params, path, 240, 30.0, phase=float(rng.random()))
+        rots.append(m.rotations)
+        roots.append(m.root_positions)
+        emo.append(np.eye(4)[i % 4])
+    split = np.array(["train", "train", "val", "val", "test", "test"])
+    return prepare_sequences(np.stack(rots), np.stack(roots), np.stack(emo), split, np.full(6, 1.75),
+                             np.array(["male"] * 6))
+
+
+@pytest.fixture(scope="module")
+def tiny_net(tiny_data):
+    torch.manual_seed(0)
+    cfg = GaitNetConfig.tiny()
+    return LoadedGaitNet(GaitNet(cfg), fit_normalizer(tiny_data.subset("train")), "tiny.pt")
+
+
+def test_model_shapes_and_unit_quaternions():
+    cfg = GaitNetConfig.tiny(residual=False)
+    net = GaitNet(cfg)
+    N, L = 3, 5
+    out = net(torch.randn(N, L, 21, 4), torch.randn(N, L, 18), torch.randn(N, L, 5), torch.randn(N, L, 3),
+              torch.rand(N, L, 4))
+    assert out["q"].shape == (N, L, 21, 4)
+    assert out["root"].shape == (N, L, 3) and out["omega"].shape == (N, L)
+    assert torch.allclose(out["q"].norm(dim=-1), torch.ones(N, L, 21), atol=1e-5)
+    one = net.step(torch.randn(N, 21, 4), torch.randn(N, 18), torch.randn(N, 5), torch.randn(N, 3), torch.rand(N, 4))
+    assert one["q"].shape == (N, 21, 4)
+
+
+def test_paper_config_has_released_size_and_ablation_drops_affective_branch():
+    assert 9.5e6 < GaitNet(GaitNetConfig.paper()).num_parameters() < 10.5e6
+    ablated = GaitNet(GaitNetConfig.tiny(use_affective=False))
+    assert ablated.fc_enc1 is None
+    with pytest.raises(ValueError, match="unknown GaitNetConfig fields"):
+        GaitNetConfig.from_dict({"gru_hiden": 3})
+
+
+def test_motion_loss_is_zero_for_equal_rotations_and_wraps_angles():
+    q = torch.nn.functional.normalize(torch.randn(2, 3, 21, 4), dim=-1)
+    assert motion_loss(q, q).item() < 1e-8
+    assert motion_loss(-q, q).item() < 1e-6       # q and -q are the same rotation
+    assert motion_loss(2 * q, q).item() > 0.5      # the unit-norm term of eq. 8
+
+
+def test_root_features_of_a_straight_walk():
+    params = WalkParams()
+    m = walk(params, straight(20.0, heading=0.7), 240, 30.0)
+    rot, root = m.rotations[::4], m.root_positions[::4]
+    rf = root_features(root, rot[:, 0])
+    speed_per_step = params.speed_mps / 7.5
+    assert abs(np.median(rf["s"]) - speed_per_step) < 0.1 * speed_per_step
+    assert np.allclose(rf["ref"][5:-5], 0.7, atol=0.05)
+    assert np.abs(rf["delta"]).mean() < 0.3
+    back = from_heading_frame(to_heading_frame(rot, rf["ref"]), rf["ref"])
+    assert np.allclose(np.abs((back * rot).sum(-1)), 1.0, atol=1e-9)
+
+
+def test_prepared_sequences(tiny_data):
+    d = tiny_data
+    assert d.q.shape == (6, 60, 21, 4) and d.aff.shape == (6, 60, 18) and d.fps == 7.5
+    assert torch.allclose(d.q.norm(dim=-1), torch.ones(6, 60, 21), atol=1e-5)
+    assert float(d.theta.min()) >= 0 and float(d.theta.max()) < 2 * math.pi
+    # Walks take a step every ~0.55 s: omega near 2 pi / (2 * 0.55 s * 7.5 steps/s) rad per step.
+    assert 0.5 < float(d.omega.median()) < 1.2
+    with pytest.raises(ValueError, match="frames"):
+        prepare_sequences(np.zeros((1, 100, 21, 4)), np.zeros((1, 100, 3)), np.ones((1, 4)), np.array(["train"]),
+                          np.array([1.75]), np.array(["male"]))
+
+
+def test_tiny_network_overfits_a_tiny_batch(tiny_data):
+    torch.manual_seed(0)
+    cfg = GaitNetConfig.tiny(gru_hidden=64, versor_hidden=64)
+    net = GaitNet(cfg)
+    data = tiny_data.subset("train")
+    norm = fit_normalizer(data)
+    batch = data.batch([0, 1])
+    target = ground_truth_targets(batch, norm)
+    opt = torch.optim.Adam(net.parameters(), lr=3e-3)
+    losses = []
+    for _ in range(40):
+        loss, _ = total_loss(rollout(net, norm, batch, 1.0, cfg.prefix_len), target, cfg)
+        opt.zero_grad()
+        loss.backward()
+        opt.step()
+        losses.append(loss.item())
+    assert losses[-1] < 0.6 * losses[0], losses[::10]
+
+
+def test_training_writes_checkpoint_and_resumes(tiny_data, tmp_path):
+    cfg = GaitNetConfig.tiny(epochs=1, batch_size=2)
+    out = tmp_path / "w.pt"
+    train(cfg, tiny_data, out, progress=False, log=lambda *_: None)
+    assert out.exists() and (tmp_path / "w.pt.ckpt").exists()
+    cfg2 = GaitNetConfig.tiny(epochs=2, batch_size=2)
+    res = train(cfg2, tiny_data, out, resume=True, progress=False, log=lambda *_: None)
+    assert [h["epoch"] for h in res["history"]] == [1, 2]
+    model, norm, payload = load_checkpoint(out)
+    assert payload["trained_on"] == "synthetic procedural corpus"
+    bad = tmp_path / "bad.pt"
+    bad.write_bytes(b"not a checkpoint")
+    with pytest.raises(ValueError, match="bad.pt"):
+        load_checkpoint(bad)
+
+
+def test_emotion_transition_interpolates_and_normalises():
+    tr = emotion_transition([1, 0, 0, 0], [0, 2, 0, 0], 11)
+    assert tr.shape == (11, 4)
+    assert np.allclose(tr.sum(-1), 1.0)
+    assert np.allclose(tr[0], [1, 0, 0, 0]) and np.allclose(tr[-1], [0, 1, 0, 0])
+    assert np.allclose(tr[5], [0.5, 0.5, 0, 0])
+    assert np.all(np.diff(tr[:, 1]) > 0)
+    with pytest.raises(ValueError):
+        normalize_emotion([0, 0, 0, 0])
+
+
+def test_generation_two_agents_twenty_steps(tiny_net):
+    seed = walk(WalkParams(), straight(10.0), 80, 30.0)
+    emotions = np.stack([emotion_transition([1, 0, 0, 0], [0, 1, 0, 0], 20), np.tile([0, 0, 1, 0], (20, 1))])
+    paths = [curved(4.0, 1.2, 12.0), sharp_turn(1.0, 10.0)]
+    motions = generate_gaits([seed, seed], paths, emotions, steps=20, fps_out=30.0, model=tiny_net)
+    assert len(motions) == 2
+    for m in motions:
+        assert isinstance(m, Motion) and m.fps == 30.0 and m.num_frames == 19 * 4 + 1
+        assert np.allclose(np.linalg.norm(m.rotations, axis=-1), 1.0, atol=1e-6)
+        assert m.metadata["origin"] == "generated" and m.metadata["generator"] == "gait_net"
+        assert m.metadata["trained_on"] == "synthetic procedural corpus"
+    assert motions[0].metadata["final_emotion"] == [0.0, 1.0, 0.0, 0.0]
+    assert motions[1].metadata["final_emotion"] is None
+    # The generated walk starts at the path start.
+    assert np.linalg.norm(motions[0].root_positions[0, [0, 2]]) < 0.5
+
+
+def test_generation_uses_the_emotion_input(tiny_net):
+    seed = walk(WalkParams(), straight(10.0), 80, 30.0)
+    a, b = generate_gaits([seed, seed], [straight(10.0)] * 2, np.array([[1, 0, 0, 0], [0, 1, 0, 0]]), steps=10,
+                          model=tiny_net)
+    assert not np.allclose(a.rotations, b.rotations)
+
+
+def test_generation_rejects_short_seed_and_bad_emotions(tiny_net):
+    short = walk(WalkParams(), straight(5.0), 40, 30.0)
+    with pytest.raises(ValueError, match="seed gait 0"):
+        generate_gaits([short], [straight(5.0)], np.array([[1, 0, 0, 0]]), steps=5, model=tiny_net)
+    seed = walk(WalkParams(), straight(10.0), 80, 30.0)
+    with pytest.raises(ValueError, match="emotions must be"):
+        generate_gaits([seed], [straight(5.0)], np.ones((2, 4)), steps=5, model=tiny_net)
+
+
+def test_generated_motion_exports_to_bvh(tiny_net, tmp_path):
+    bvh = pytest.importorskip("generation.bvh")
+    seed = walk(WalkParams(), straight(10.0), 80, 30.0)
+    (m,) = generate_gaits([seed], [straight(10.0)], np.array([[0, 0, 0, 1.0]]), steps=8, model=tiny_net)
+    bvh.write_bvh(m, tmp_path / "g.bvh")
+    back = bvh.read_bvh(tmp_path / "g.bvh")
+    assert back.num_frames == m.num_frames
+
+
+def test_normalizer_round_trip():
+    rng = np.random.default_rng(1)
+    n = Normalizer.fit(rng.normal(size=(50, 18)), rng.normal(size=(50, 3)), rng.normal(size=(50, 3)))
+    n2 = Normalizer.from_dict(n.to_dict())
+    r = torch.randn(4, 3)
+    assert torch.allclose(n2.root_inv(n2.root(r)), r, atol=1e-5)
+
+
+def test_save_and_load_model(tiny_net, tmp_path):
+    path = tmp_path / "m.pt"
+    save_checkpoint(path, tiny_net.model, tiny_net.normalizer, tiny_net.config)
+    loaded = load_model(path)
+    for p, q in zip(loaded.model.parameters(), tiny_net.model.parameters()):
+        assert torch.equal(p, q)
+
+
+def test_shipped_weights_load_and_generate():
+    if not DEFAULT_WEIGHTS.exists():
+        pytest.skip(f"shipped weights absent: {DEFAULT_WEIGHTS} (train with `python -m generation.gait.train`)")
+    assert DEFAULT_WEIGHTS.stat().st_size < 10 * 2 ** 20
+    net = load_default_model()
+    seed = walk(WalkParams(), straight(10.0), 80, 30.0)
+    (m,) = generate_gaits([seed], [curved(5.0, 1.0, 15.0)], np.array([[0.7, 0.1, 0.1, 0.1]]), steps=30, model=net)
+    assert m.num_frames == 29 * 4 + 1
+    # It walks: the root covers ground.
+    assert np.linalg.norm(m.root_positions[-1, [0, 2]] - m.root_positions[0, [0, 2]]) > 1.0

