@@ -147,7 +147,7 @@ def _gait_answers(rng, intended: np.ndarray, m: PerceptionModel) -> np.ndarray:
     """(N, 4) intended vectors -> (N,) answer strings like "happy;neutral"."""
     p = (1 - m.emotion_noise) * intended + m.emotion_noise / E
     first = _categorical(rng, p)
-    p2 = p.copy()
+    p2 = p + 1e-9  # a second label is possible even when the intended vector has one non-zero component
     p2[np.arange(len(p)), first] = 0
     second = _categorical(rng, p2 / p2.sum(axis=1, keepdims=True))
     two = rng.random(len(p)) < m.multi_select_prob

@@ -56,8 +56,10 @@ def main(out: Path) -> None:
         for side, color, joint in ((0, "tab:blue", "left_toe"), (1, "tab:red", "right_toe")):
             j = sk.index(joint)
             ax.plot(P[contacts[:, side], j, 0], P[contacts[:, side], j, 2], ".", color=color, ms=4)
+        xc, half = P[:, 0, 0].mean(), max(0.5, np.ptp(P[:, 0, 2]) / 2)
+        ax.set_xlim(xc + half, xc - half)   # +x (left) drawn on the left when looking along +z
         ax.set_aspect("equal")
-        ax.invert_xaxis()  # +x (left) drawn on the left when looking along +z
+        ax.tick_params(labelsize=6)
         ax.set_title("top: root, contacts", fontsize=8)
         axes[row, 0].set_ylabel(Path(motion.metadata["source"]).stem, fontsize=8)
     fig.suptitle("Captured DeepMimic walks on the 21-joint gait skeleton (side view, blue = left, red = right)",

@@ -80,7 +80,8 @@ def main() -> None:
     P = walk.positions()
     n = walk.num_frames
     t = best_of(lambda: movement_features(P, walk.fps, sk, root_rotations=walk.rotations[:, 0]))
-    rows.append((f"movement features incl. contacts ({n}-frame captured walk)", f"{t * 1e3 * 1000 / n:.1f} ms / 1000 frames"))
+    rows.append((f"movement features incl. contacts ({n}-frame captured walk)",
+                 f"{t * 1e3 * 1000 / n:.1f} ms / 1000 frames"))
     t = best_of(lambda: detect_foot_contacts(P, walk.fps, sk))
     rows.append(("foot contact detection", f"{t * 1e3 * 1000 / n:.2f} ms / 1000 frames"))
     t = best_of(lambda: np_gait_affective_features(P))

@@ -355,7 +355,7 @@ GAIT_NAME_CANDIDATES: dict[str, tuple[str, ...]] = {
     "lower_back": ("LowerBack", "Spine", "spine", "lower_back", "chest"),
     "spine": ("Spine2", "Spine1", "Chest", "chest3", "chest4", "spine"),
     "neck": ("Neck", "neck"),
-    "head": ("Head", "head", "Neck1", "neck_end"),
+    "head": ("Head", "head", "Neck1", "Neck_end", "neck_end"),
     "left_shoulder": ("LeftArm", "LeftShoulder", "LeftUpperArm", "left_shoulder"),
     "left_elbow": ("LeftForeArm", "LeftElbow", "LeftLowerArm", "left_elbow"),
     "left_hand": ("LeftHand", "LeftWrist", "left_hand", "left_wrist"),

@@ -7,8 +7,9 @@ clips (straight, two left turns, two right turns), each about 1.3 s at 30 fps.
 
 Retargeting: DeepMimic joints are mapped by name onto the gait skeleton (:data:`DEEPMIMIC_TO_GAIT`); the gait
 skeleton's ``lower_back`` lies on the root-chest line, the hand index tips follow the forearms. Positions are
-scaled by the ratio of hip heights (gait 0.94 m / DeepMimic 0.88 m for a 1.75 m gait body), solved with IK, then
-shifted vertically so the lowest joint over the clip touches y = 0.
+scaled by the ratio of hip heights (gait 0.94 m / DeepMimic 0.88 m for a 1.75 m gait body), solved with IK, the
+legs bent with two-bone IK so the heels land where the source's ankles do (keeps the captured foot contacts; foot
+skate stays at the source's 3-8 cm/s), then shifted vertically so the lowest joint over the clip touches y = 0.
 """
 from __future__ import annotations
 

@@ -169,6 +169,8 @@ def neutral_cycle_from_motions(motions: list[Motion], skeleton: Skeleton | None 
     used: list[dict] = []
     for motion, name in zip(motions, names):
         found = motion_cycles(motion, m, name)
+        limit = motion.metadata.get("max_cycles")
+        found = found[: int(limit)] if limit is not None else found
         cycles += found
         used.append({"name": name, "cycles": len(found), "height": motion.skeleton.height,
                      "build": motion.skeleton.build, "synthetic": bool(motion.metadata.get("synthetic", False))})
@@ -217,17 +219,38 @@ def default_sources(n_frames_s: float = 3.3, fps: float = 100.0, include_capture
     return sources
 
 
+def _is_straight(motion: Motion, max_turn_deg: float = 20.0) -> bool:
+    """True when the root's ground-plane heading changes by less than ``max_turn_deg`` over the clip."""
+    root = motion.root_positions[:, [0, 2]]
+    half = len(root) // 2
+    a, b = root[half] - root[0], root[-1] - root[half]
+    if min(np.linalg.norm(a), np.linalg.norm(b)) < 1e-6:
+        return False
+    cos = float(a @ b / (np.linalg.norm(a) * np.linalg.norm(b)))
+    return cos >= np.cos(np.radians(max_turn_deg))
+
+
 def captured_sources() -> list[Motion]:
-    """Real captured neutral walks on the gait skeleton from :mod:`generation.captured`, or [] if unavailable."""
+    """Real captured straight walks on the gait skeleton from :mod:`generation.captured`, or [] if unavailable.
+
+    Turning clips are left out (the paper averaged straight walks). A loopable clip (``loop == "wrap"``) is
+    repeated three times so a full left-right-left cycle can be cut from it; ``max_cycles`` = 1 in the metadata
+    tells :func:`neutral_cycle_from_motions` to keep only its first cycle, so the repeat does not count twice.
+    """
     try:
-        from .captured import captured_walks
+        from .captured import captured_walks, repeat_cycle
     except ImportError:
         return []
     out = []
     for mo in captured_walks():
-        if tuple(mo.skeleton.joints) == GAIT_JOINTS:
-            mo.metadata.setdefault("source", str(mo.metadata.get("clip", "captured walk")))
-            out.append(mo)
+        if tuple(mo.skeleton.joints) != GAIT_JOINTS or not _is_straight(mo):
+            continue
+        name = str(mo.metadata.get("source", "captured walk"))
+        if mo.metadata.get("loop") == "wrap":
+            mo = repeat_cycle(mo, 3)
+            mo.metadata["max_cycles"] = 1
+        mo.metadata["source"] = name + " (captured)"
+        out.append(mo)
     return out
 
 

@@ -18,7 +18,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .motion import Motion
-from .procedural_walk import axis_angle, frame_rotation, locals_from_globals, smoothstep, two_bone_ik, yaw_quat
+from .procedural_walk import axis_angle, hinge_rotations, locals_from_globals, smoothstep, two_bone_ik, yaw_quat
 from .quaternion import np_qmul, np_qrot
 from .skeleton import GESTURE_JOINTS, Skeleton, gesture_skeleton
 
@@ -150,14 +150,8 @@ def _arm_rotations(shoulder, wrist_target, skeleton: Skeleton, prefix: str, pole
     l1 = float(np.linalg.norm(off[_J[prefix + "elbow"]]))
     l2 = float(np.linalg.norm(off[_J[prefix + "wrist"]]))
     elbow, wrist, _ = two_bone_ik(shoulder, wrist_target, l1, l2, pole)
-    upper_dir = elbow - shoulder
-    fore_dir = wrist - elbow
-    u = upper_dir / np.linalg.norm(upper_dir, axis=-1, keepdims=True)
-    bend = fore_dir - (fore_dir * u).sum(-1, keepdims=True) * u
-    fallback = -pole - (-pole * u).sum(-1, keepdims=True) * u
-    bend = bend + 1e-3 * fallback
-    q_upper = frame_rotation(off[_J[prefix + "elbow"]], _Z, upper_dir, bend)
-    q_fore = frame_rotation(off[_J[prefix + "wrist"]], _Z, fore_dir, bend)
+    q_upper, q_fore = hinge_rotations(shoulder, elbow, wrist, off[_J[prefix + "elbow"]], off[_J[prefix + "wrist"]],
+                                      _Z, -pole)
     return q_upper, q_fore
 
 
@@ -313,9 +307,10 @@ def _pose_frames(skeleton: Skeleton, params_list, n_frames: int, fps: float, rng
     for prefix in ("left_", "right_"):
         targets[prefix] = rest_wrists[prefix] + E[:, None] * (targets[prefix] - rest_wrists[prefix])
 
-    # Arms by IK; elbows point back and out, more out when expanded.
+    # Arms by IK; elbows point down, back and out, more out when expanded
     for side, prefix in ((1.0, "left_"), (-1.0, "right_")):
-        pole = np.stack([side * (0.35 + 0.6 * np.maximum(expansion, -0.3)), -0.3 * np.ones(T), -np.ones(T)], axis=1)
+        # (down and back, so it never lines up with an arm reaching forward or resting on the thigh)
+        pole = np.stack([side * (0.4 + 0.6 * np.maximum(expansion, -0.3)), -np.ones(T), -0.6 * np.ones(T)], axis=1)
         pole = np_qrot(trunk_global, pole)
         q_up, q_fore = _arm_rotations(pos[:, _J[prefix + "shoulder"]], targets[prefix], skeleton, prefix, pole)
         G[:, _J[prefix + "shoulder"]] = q_up

@@ -66,7 +66,7 @@ class WalkParams:
             no clavicle joint, so a raise is realised as the arm elevation it would cause: extra
             abduction of ``asin(raise / upper_arm_length)`` and a matching extra elbow bend.
         knee_lift_rad: swing knee flexion scale; sets the swing foot clearance
-            ``0.03 + 0.25 * (1 - cos(knee_lift_rad))`` metres (about 0.14 m at 1.0 rad).
+            ``0.02 + 0.18 * (1 - cos(knee_lift_rad))`` metres (about 0.10 m at 1.0 rad).
         lateral_sway_m: amplitude of the pelvis' side-to-side sway toward the stance foot.
         arm_abduction_rad: arms held out from the body (expansion); 0 = hanging at the sides.
         bounce_m: peak-to-peak vertical pelvis oscillation (before reach limits).
@@ -92,7 +92,7 @@ class WalkParams:
     toe_out_rad: float = 0.10
     pelvis_rotation_rad: float = 0.06
     head_nod_rad: float = 0.02
-    knee_bend_m: float = 0.015
+    knee_bend_m: float = 0.005
 
     _LIMITS = {
         "cadence_spm": (60.0, 160.0), "stride_m": (0.4, 2.2), "arm_swing_rad": (0.0, 1.2),
@@ -214,6 +214,31 @@ def two_bone_ik(root, target, len_upper, len_lower, pole):
     return mid, end, dist / (len_upper + len_lower)
 
 
+def hinge_rotations(root, mid, end, offset_upper, offset_lower, rest_bend, fallback_bend):
+    """Global rotations (..., 4) of the upper and lower bone of a hinge chain (thigh-shin, upper arm-forearm).
+
+    Args:
+        root, mid, end: (..., 3) joint positions (hip, knee, ankle) from :func:`two_bone_ik`.
+        offset_upper, offset_lower: (3,) rest offsets of ``mid`` and ``end``.
+        rest_bend: (3,) direction, in the rest frame, toward which the lower bone bends (-z for
+            knees, +z for elbows).
+        fallback_bend: (..., 3) bend direction used when the chain is straight.
+
+    The lower bone's frame is the upper one turned about the hinge axis, so there is no twist
+    between them and no flip when the lower bone points along the bend direction.
+    """
+    u = _unit(mid - root)
+    f = _unit(end - mid)
+    b = f - (f * u).sum(-1, keepdims=True) * u
+    fb = fallback_bend - (fallback_bend * u).sum(-1, keepdims=True) * u
+    b = _unit(b + 1e-4 * _unit(fb))
+    ce = (f * u).sum(-1, keepdims=True)
+    se = (f * b).sum(-1, keepdims=True)
+    q_upper = frame_rotation(offset_upper, rest_bend, u, b)
+    q_lower = frame_rotation(offset_lower, rest_bend, f, -se * u + ce * b)
+    return q_upper, q_lower
+
+
 def locals_from_globals(global_rot: np.ndarray, parents) -> np.ndarray:
     """Local rotations (..., J, 4) from global ones: R_local[j] = R_global[parent]^-1 R_global[j]."""
     local = global_rot.copy()
@@ -291,9 +316,37 @@ def walk_with_contacts(params: WalkParams, path: GroundPath | None = None, n_fra
     toe_off_vec = off[_J["left_toe"]]            # heel -> toe in the foot frame
     strike_pitch = 0.25                          # toe-up angle at heel strike
     pitch_max = float(np.clip(0.85 + 0.4 * (params.stride_m - 1.4), 0.4, 1.2))
-    lift = (0.03 + 0.25 * (1.0 - np.cos(params.knee_lift_rad))) * scale
+    lift = (0.02 + 0.18 * (1.0 - np.cos(params.knee_lift_rad))) * scale
     half_width = 0.5 * params.step_width_m * scale
     footprint_at = 0.18                          # pelvis is over the heel 18 % into stance
+    stand = -(off[_J["left_hip"], 1] + off[_J["left_knee"], 1] + off[_J["left_heel"], 1]) + ankle_h
+    len_thigh = float(np.linalg.norm(off[_J["left_knee"]]))
+    len_shin = float(np.linalg.norm(off[_J["left_heel"]]))
+    reach = 0.995 * (len_thigh + len_shin)
+
+    def pelvis_at(time):
+        """Nominal root position (n, 3), root rotation (n, 4) and path heading (n,) at times (n,)."""
+        ph = phase + time * f_cycle
+        s = path_s(time)
+        h = heading(s)
+        xz = smooth.point_at(s) + (params.lateral_sway_m * scale * np.sin(2 * np.pi * ph))[:, None] * left_normal(h)
+        y = stand - params.knee_bend_m * scale - 0.5 * params.bounce_m * scale * (1.0 + np.cos(4 * np.pi * (ph - 0.05)))
+        q = yaw_quat(h - params.pelvis_rotation_rad * np.cos(2 * np.pi * ph))
+        return np.column_stack([xz[:, 0], y, xz[:, 1]]), q, h
+
+    pitch_grid = np.linspace(0.0, 1.3, 66)
+
+    def required_pitch(time, hip_name, toe_pos, yaw):
+        """Smallest heel-rise pitch (n,) that brings the ankle within 97 % of the leg's reach of the
+        nominal hip when the foot pivots about its planted toe (so the trailing leg, not the pelvis, gives way)."""
+        root_n, q_n, _ = pelvis_at(time)
+        hip = root_n + np_qrot(q_n, np.broadcast_to(off[_J[hip_name]], root_n.shape))
+        q = np_qmul(yaw_quat(yaw)[:, None], axis_angle(_X, np.broadcast_to(pitch_grid, (len(time), len(pitch_grid)))))
+        ankles = toe_pos[:, None] - np_qrot(q, np.broadcast_to(toe_off_vec, q.shape[:-1] + (3,)))
+        ok = np.linalg.norm(ankles - hip[:, None], axis=-1) <= 0.97 * (len_thigh + len_shin)
+        first = np.where(ok.any(1), ok.argmax(1), len(pitch_grid) - 1)
+        return pitch_grid[first]
+
     feet = []
     for side, foot_offset in ((+1.0, 0.0), (-1.0, 0.5)):
         k0 = int(np.floor(phi[0] - foot_offset)) - 2
@@ -305,7 +358,12 @@ def walk_with_contacts(params: WalkParams, path: GroundPath | None = None, n_fra
         jitter = rng.normal(0.0, 0.01 * scale, size=(len(ks), 2)) if seed is not None else np.zeros((len(ks), 2))
         xz = smooth.point_at(s_fp) + side * half_width * left_normal(h_fp) + jitter
         yaw = h_fp + side * params.toe_out_rad
-        feet.append((ks, xz, yaw, foot_offset))
+        # heel-rise pitch at each toe-off, raised where the hip has already moved far ahead
+        t_off = (ks + foot_offset + TOE_OFF - phase) / f_cycle
+        flat = np.column_stack([xz[:, 0], np.full(len(ks), ankle_h), xz[:, 1]])
+        toe_fp = flat + np_qrot(yaw_quat(yaw), np.broadcast_to(toe_off_vec, flat.shape))
+        p_off = np.maximum(pitch_max, required_pitch(t_off, "left_hip" if side > 0 else "right_hip", toe_fp, yaw))
+        feet.append((ks, xz, yaw, foot_offset, p_off))
 
     T = n_frames
     ankle = np.zeros((2, T, 3))
@@ -314,7 +372,7 @@ def walk_with_contacts(params: WalkParams, path: GroundPath | None = None, n_fra
     heel_contact = np.zeros((T, 2), dtype=bool)
     toe_contact = np.zeros((T, 2), dtype=bool)
     footprints = []
-    for f, (ks, xz, yaw, foot_offset) in enumerate(feet):
+    for f, (ks, xz, yaw, foot_offset, p_off) in enumerate(feet):
         footprints.append(np.column_stack([xz, yaw]))
         k = np.floor(phi - foot_offset).astype(int)
         u = phi - foot_offset - k
@@ -331,10 +389,13 @@ def walk_with_contacts(params: WalkParams, path: GroundPath | None = None, n_fra
         pos[heel] = np.column_stack([fp_xz[heel, 0], np.full(heel.sum(), ankle_h), fp_xz[heel, 1]])
         # toe phase: heel rises about the fixed toe
         toe = (u >= HEEL_OFF) & (u < TOE_OFF)
-        p_toe = pitch_max * smoothstep((u[toe] - HEEL_OFF) / (TOE_OFF - HEEL_OFF))
         flat_heel = np.column_stack([fp_xz[toe, 0], np.full(toe.sum(), ankle_h), fp_xz[toe, 1]])
         q_flat = yaw_quat(fp_yaw[toe])
         toe_pos = flat_heel + np_qrot(q_flat, np.broadcast_to(toe_off_vec, flat_heel.shape))
+        ramp = smoothstep((u[toe] - HEEL_OFF) / (TOE_OFF - HEEL_OFF))
+        p_toe = np.maximum(p_off[i[toe]] * ramp,
+                           required_pitch(t[toe], "left_hip" if f == 0 else "right_hip", toe_pos, fp_yaw[toe]))
+        p_toe = np.minimum(p_toe, p_off[i[toe]])   # reach p_off exactly at toe-off, continuous into swing
         q_p = np_qmul(q_flat, axis_angle(_X, p_toe))
         pos[toe] = toe_pos - np_qrot(q_p, np.broadcast_to(toe_off_vec, flat_heel.shape))
         pitch[toe] = p_toe
@@ -342,14 +403,15 @@ def walk_with_contacts(params: WalkParams, path: GroundPath | None = None, n_fra
         sw = u >= TOE_OFF
         w = (u[sw] - TOE_OFF) / (1.0 - TOE_OFF)
         heel0 = np.column_stack([fp_xz[sw, 0], np.full(sw.sum(), ankle_h), fp_xz[sw, 1]])
-        q0 = np_qmul(yaw_quat(fp_yaw[sw]), axis_angle(_X, np.full(sw.sum(), pitch_max)))
+        p0 = p_off[i[sw]]
+        q0 = np_qmul(yaw_quat(fp_yaw[sw]), axis_angle(_X, p0))
         toe0 = heel0 + np_qrot(yaw_quat(fp_yaw[sw]), np.broadcast_to(toe_off_vec, heel0.shape))
         start = toe0 - np_qrot(q0, np.broadcast_to(toe_off_vec, heel0.shape))
         end = np.column_stack([nxt_xz[sw, 0], np.full(sw.sum(), ankle_h), nxt_xz[sw, 1]])
         e = minjerk(w)
         pos[sw] = start + e[:, None] * (end - start)
         pos[sw, 1] += lift * np.sin(np.pi * w ** 0.7)
-        pitch[sw] = pitch_max + (-strike_pitch - pitch_max) * smoothstep(w * 1.2)
+        pitch[sw] = p0 + (-strike_pitch - p0) * smoothstep(w * 1.2)
         dyaw = np.angle(np.exp(1j * (nxt_yaw[sw] - fp_yaw[sw])))
         yaw_t[sw] = fp_yaw[sw] + dyaw * smoothstep(w)
         ankle[f] = pos
@@ -359,18 +421,9 @@ def walk_with_contacts(params: WalkParams, path: GroundPath | None = None, n_fra
         toe_contact[:, f] = (u >= HEEL_ROCKER_END) & (u < TOE_OFF)
 
     # ---- pelvis -------------------------------------------------------------------------------
-    s_t = path_s(t)
-    h_t = heading(s_t)
-    root_xz = smooth.point_at(s_t) + (params.lateral_sway_m * scale * np.sin(2 * np.pi * phi))[:, None] \
-        * left_normal(h_t)
-    pelvis_yaw = -params.pelvis_rotation_rad * np.cos(2 * np.pi * phi)
-    q_root = yaw_quat(h_t + pelvis_yaw)
-    stand = -(off[_J["left_hip"], 1] + off[_J["left_knee"], 1] + off[_J["left_heel"], 1]) + ankle_h
-    nominal = stand - params.knee_bend_m * scale - 0.5 * params.bounce_m * scale * np.cos(
-        4 * np.pi * (phi - 0.05)) - 0.5 * params.bounce_m * scale
-    len_thigh = float(np.linalg.norm(off[_J["left_knee"]]))
-    len_shin = float(np.linalg.norm(off[_J["left_heel"]]))
-    reach = 0.995 * (len_thigh + len_shin)
+    nominal_root, q_root, h_t = pelvis_at(t)
+    root_xz = nominal_root[:, [0, 2]]
+    nominal = nominal_root[:, 1]
     hip_rel = np.stack([np_qrot(q_root, np.broadcast_to(off[_J[n]], (T, 3))) for n in ("left_hip", "right_hip")])
     # Planted feet limit the pelvis height; a swinging foot that would be out of reach is lifted
     # instead (the knee flexes more), as in early swing.
@@ -399,8 +452,8 @@ def walk_with_contacts(params: WalkParams, path: GroundPath | None = None, n_fra
         knee_yaw = h_t + np.angle(np.exp(1j * (foot_yaw[f] - h_t))) * 0.5
         fwd = np.column_stack([np.sin(knee_yaw), np.zeros(T), np.cos(knee_yaw)])
         knee_pos, ankle_pos, _ = two_bone_ik(hip_pos, ankle[f], len_thigh, len_shin, fwd)
-        G[:, _J[hip]] = frame_rotation(off[_J[knee]], _Z, knee_pos - hip_pos, fwd)
-        G[:, _J[knee]] = frame_rotation(off[_J[heel_j]], _Z, ankle_pos - knee_pos, fwd)
+        G[:, _J[hip]], G[:, _J[knee]] = hinge_rotations(hip_pos, knee_pos, ankle_pos, off[_J[knee]],
+                                                        off[_J[heel_j]], -_Z, -fwd)
         G[:, _J[heel_j]] = foot_q[f]
         G[:, _J[toe_j]] = foot_q[f]
 

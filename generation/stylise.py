@@ -179,28 +179,46 @@ def _horn_rotation(src: np.ndarray, dst: np.ndarray) -> np.ndarray:
     return q * np.where(q[:, :1] < 0, -1.0, 1.0)
 
 
-def _two_bone(root: np.ndarray, mid_target: np.ndarray, end_target: np.ndarray, a: float, b: float,
-              fallback_pole: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def _two_bone(root: np.ndarray, pole_hint: np.ndarray, end_target: np.ndarray, a: float,
+              b: float) -> tuple[np.ndarray, np.ndarray]:
     """Analytic two-bone IK per frame: (T, 3) x 3 -> middle and end positions with lengths a, b exactly.
 
     The end reaches ``end_target`` when it is within reach (otherwise the limb points at it, fully
-    stretched or folded); the middle joint bends towards ``mid_target``.
+    stretched or folded); the middle joint bends towards ``pole_hint`` (a direction, (T, 3), not parallel
+    to the limb).
     """
     d = end_target - root
     dist = np.linalg.norm(d, axis=-1, keepdims=True)
     u = d / np.maximum(dist, 1e-9)
     reach = np.clip(dist, abs(a - b) + 1e-6, a + b - 1e-6)
-    pole = mid_target - root
-    pole = pole - (pole * u).sum(-1, keepdims=True) * u
-    pole_norm = np.linalg.norm(pole, axis=-1, keepdims=True)
-    fb = np.broadcast_to(fallback_pole, pole.shape)
-    fb = fb - (fb * u).sum(-1, keepdims=True) * u
-    pole = np.where(pole_norm > 1e-6, pole / np.maximum(pole_norm, 1e-12),
-                    fb / np.maximum(np.linalg.norm(fb, axis=-1, keepdims=True), 1e-12))
+    pole = pole_hint - (pole_hint * u).sum(-1, keepdims=True) * u
+    pole = pole / np.maximum(np.linalg.norm(pole, axis=-1, keepdims=True), 1e-12)
     cos_a = np.clip((a * a + reach * reach - b * b) / (2 * a * reach), -1.0, 1.0)
     mid = root + a * (cos_a * u + np.sqrt(1.0 - cos_a * cos_a) * pole)
     end = root + reach * u
     return mid, end
+
+
+def _bend_hint(ref_pos: np.ndarray, target: np.ndarray, r: int, m: int, e: int, a: float) -> np.ndarray:
+    """Direction (T, 3) the middle joint of chain (r, m, e) should bend towards.
+
+    The reference (neutral) bend: the middle joint's offset from the root-end line, at least 10 % of the
+    upper bone long (a nearly straight reference limb still has a side to bend to), plus the edit of the
+    middle joint itself (relative to the root). Keeping the reference bend stops a knee or elbow from
+    flipping backwards when only the foot or hand was moved.
+    """
+    u0 = ref_pos[:, e] - ref_pos[:, r]
+    u0 = u0 / np.maximum(np.linalg.norm(u0, axis=-1, keepdims=True), 1e-12)
+    v = ref_pos[:, m] - ref_pos[:, r]
+    v = v - (v * u0).sum(-1, keepdims=True) * u0
+    mean_dir = v.mean(axis=0)
+    mean_dir = mean_dir / max(float(np.linalg.norm(mean_dir)), 1e-12)
+    edit = (target[:, m] - target[:, r]) - (ref_pos[:, m] - ref_pos[:, r])
+    # A floor on the reference bend's size, along its own direction (so the bend plane, and an unedited limb,
+    # are reproduced exactly); only a limb that is exactly straight in the reference borrows the mean direction.
+    size = np.linalg.norm(v, axis=-1, keepdims=True)
+    direction = np.where(size > 1e-9 * a, v / np.maximum(size, 1e-300), mean_dir)
+    return np.maximum(size, 0.1 * a) * direction + edit
 
 
 def _keep_height(start: np.ndarray, goal: np.ndarray, length: float) -> np.ndarray:
@@ -254,6 +272,7 @@ def fit_to_skeleton(target: np.ndarray, skeleton: Skeleton, reference_rotations:
     parents = skeleton.parents
     kids = skeleton.children()
     ref_global = global_rotations(reference_rotations, target[:, 0], skeleton)
+    ref_pos = forward_kinematics_np(reference_rotations, target[:, 0], skeleton)
     goal = target.copy()  # where each joint should go; limb chains overwrite middle and end joints
     chain_of = {skeleton.index(c[0]): (skeleton.index(c[1]), skeleton.index(c[2])) for c in chains}
     chain_ends = {skeleton.index(c[2]) for c in chains}
@@ -265,10 +284,10 @@ def fit_to_skeleton(target: np.ndarray, skeleton: Skeleton, reference_rotations:
             continue  # leaf: keeps the reference rotation
         if p in chain_of:
             mid, end = chain_of[p]
-            fallback = np_qrot(ref_global[:, p], np.tile([0.0, 0.0, 1.0], (T, 1)))
-            goal[:, mid], goal[:, end] = _two_bone(pos[:, p], target[:, mid], target[:, end],
-                                                  float(np.linalg.norm(offsets[mid])),
-                                                  float(np.linalg.norm(offsets[end])), fallback)
+            a = float(np.linalg.norm(offsets[mid]))
+            hint = _bend_hint(ref_pos, target, p, mid, end, a)
+            goal[:, mid], goal[:, end] = _two_bone(pos[:, p], hint, target[:, end], a,
+                                                  float(np.linalg.norm(offsets[end])))
         if p in chain_ends and len(kids[p]) == 1 and not kids[kids[p][0]]:
             # the foot (heel -> toe) or hand tip: keep the edited height of the tip (a planted toe stays on the
             # floor) and the edited horizontal heading; the length is the bone's.

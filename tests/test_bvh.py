@@ -171,6 +171,18 @@ def test_retarget_scales_to_target_and_fills_unmapped(tmp_path):
     d_out = out.positions()[:, knee] - out.positions()[:, 0]
     cos = (d_src * d_out).sum(-1) / np.linalg.norm(d_src, axis=-1) / np.linalg.norm(d_out, axis=-1)
     assert cos.min() > 0.99
+    # foot IK puts the heels exactly on the scaled source heels (the random poses keep them reachable here
+    # wherever the hip-heel distance fits the target leg)
+    for side in ("left", "right"):
+        heel, hip = src.index(f"{side}_heel"), src.index(f"{side}_hip")
+        want = m.positions()[:, heel] * scale
+        reach = np.linalg.norm(want - out.positions()[:, hip], axis=-1)
+        ok = reach < tgt.bone_lengths()[heel] + tgt.bone_lengths()[src.index(f"{side}_knee")] - 1e-3
+        assert ok.sum() > 5
+        np.testing.assert_allclose(out.positions()[ok, heel], want[ok], atol=1e-9)
+    plain = retarget(m, tgt, mapping, foot_ik=False)
+    assert np.abs(plain.positions()[:, src.index("left_heel")] - m.positions()[:, src.index("left_heel")] * scale
+                  ).max() > 1e-3
     with pytest.raises(ValueError, match="root"):
         retarget(m, tgt, {"left_knee": "left_knee"})
     with pytest.raises(KeyError, match="no joint"):
@@ -189,3 +201,25 @@ def test_default_joint_map_for_mixamo_names():
     gesture = default_joint_map(src, gesture_skeleton())
     assert gesture["left_collar"] == "LeftShoulder" and gesture["left_wrist"] == "LeftHand"
     assert "chest4" not in gesture
+
+
+def test_mixamo_named_bvh_retargets_onto_gait_with_default_map(tmp_path):
+    sk = gait_skeleton()
+    m = random_motion(sk, seed=6)
+    path = tmp_path / "mixamo.bvh"
+    write_bvh(m, path, scale=100.0)
+    rename = {"root": "Hips", "lower_back": "Spine", "spine": "Spine2", "neck": "Neck"}
+    for side, Side in (("left", "Left"), ("right", "Right")):
+        rename.update({f"{side}_hip": f"{Side}UpLeg", f"{side}_knee": f"{Side}Leg", f"{side}_heel": f"{Side}Foot",
+                       f"{side}_shoulder": f"{Side}Arm", f"{side}_elbow": f"{Side}ForeArm",
+                       f"{side}_hand": f"{Side}Hand"})
+    text = path.read_text()
+    for ours, theirs in rename.items():
+        text = text.replace(f"ROOT {ours}\n", f"ROOT {theirs}\n").replace(f"JOINT {ours}\n", f"JOINT {theirs}\n")
+    path.write_text(text)
+    src = read_bvh(path)
+    assert "LeftUpLeg" in src.skeleton.joints and src.metadata["bvh_scale"] == 0.01
+    out = retarget(src, gait_skeleton())
+    mapping = out.metadata["retarget"]["joint_map"]
+    assert len(mapping) == 21 and mapping["left_toe"] == "LeftFoot_end" and mapping["head"] == "Neck_end"
+    np.testing.assert_allclose(out.positions(), m.positions(), atol=1e-6)

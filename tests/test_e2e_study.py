@@ -2,7 +2,8 @@
 the back button, finish, and check the exported responses.csv holds every answer exactly once.
 
 Set STUDY_SCREENSHOTS=<folder> to save a screenshot of the first clip page of each section type there
-(docs/img/study_<section_type>.png are made this way).
+(docs/img/study_<section_type>.png are made this way); STUDY_SCREENSHOT_VIDEO=<mp4> (and STUDY_SCREENSHOT_SECONDS)
+uses a rendered clip instead of the 1-second test pattern.
 """
 from __future__ import annotations
 
@@ -41,6 +42,21 @@ def path_of(driver) -> str:
     return "/" + driver.current_url.split("/", 3)[3]
 
 
+def full_shot(driver, path: Path, width: int = 1000):
+    """Screenshot of the whole page: the window is made as tall as the document first."""
+    driver.set_window_size(width, 900)
+    for _ in range(3):
+        inner, height = driver.execute_script(
+            "return [window.innerHeight, document.documentElement.scrollHeight]")
+        if inner >= height:
+            break
+        driver.set_window_size(width, min(900 + int(height) - int(inner) + 4, 4000))
+    driver.execute_script("window.scrollTo(0, 0); document.activeElement && document.activeElement.blur()")
+    time.sleep(0.3)
+    driver.save_screenshot(str(path))
+    driver.set_window_size(1280, 900)
+
+
 def pick_answers(driver, choice: int = 0):
     """Choose option number `choice` (clamped) of every question; for multi-select also the last option."""
     from selenium.webdriver.common.by import By
@@ -58,17 +74,19 @@ def test_whole_demo_study_in_chromium(chromium, live_server, settings, tmp_path)
     from selenium.webdriver.common.by import By
 
     settings.MEDIA_ROOT = tmp_path / "media"
-    video = tiny_mp4(tmp_path / "clip.mp4", seconds=1.0, size=160)
-    make_catalogue(settings.MEDIA_ROOT, video_bytes=video.read_bytes(), duration_s=1.0)
+    shots = os.environ.get("STUDY_SCREENSHOTS")
+    if shots and os.environ.get("STUDY_SCREENSHOT_VIDEO"):
+        video = Path(os.environ["STUDY_SCREENSHOT_VIDEO"])
+        seconds = float(os.environ.get("STUDY_SCREENSHOT_SECONDS", "3"))
+    else:
+        video, seconds = tiny_mp4(tmp_path / "clip.mp4", seconds=1.0, size=160), 1.0
+    make_catalogue(settings.MEDIA_ROOT, video_bytes=video.read_bytes(), duration_s=seconds)
     study = create_study_from_preset("demo", "demo", status=Study.Status.OPEN,
                                      completion_redirect="https://example.org/complete?cc={code}")
-    shots = os.environ.get("STUDY_SCREENSHOTS")
-    if shots:
-        chromium.set_window_size(1100, 1500)
     driver = chromium
     driver.get(live_server.url + reverse("studyapp:study_entry", args=[study.slug]) + "?PROLIFIC_PID=e2e-1")
     if shots:
-        driver.save_screenshot(str(Path(shots) / "study_consent.png"))
+        full_shot(driver, Path(shots) / "study_consent.png")
     driver.find_element(By.CSS_SELECTOR, "label.check").click()
     driver.find_element(By.CSS_SELECTOR, "button[type=submit]").click()
     wait_for(driver, lambda d: "/about-you/" in d.current_url, what="demographics page")
@@ -84,20 +102,22 @@ def test_whole_demo_study_in_chromium(chromium, live_server, settings, tmp_path)
         a = participant.assignments.select_related("section", "clip").order_by("section__order", "position")[n - 1]
         stype = a.section.section_type
         # answers are enabled once the clip has played (looping clips: after one full loop)
-        wait_for(driver, lambda d: d.find_element(By.ID, "next").is_enabled(), timeout=15, what="clip played")
+        wait_for(driver, lambda d: d.find_element(By.ID, "next").is_enabled(), timeout=10 + 3 * seconds,
+                 what="clip played")
         progress = driver.find_element(By.CSS_SELECTOR, ".progress").get_attribute("aria-valuenow")
         assert int(progress) == round(100 * (n - 1) / total)
         if stype not in seen_types:
             seen_types.add(stype)
             if shots:
                 pick_answers(driver, 2)
-                driver.save_screenshot(str(Path(shots) / f"study_{stype}.png"))
+                full_shot(driver, Path(shots) / f"study_{stype}.png")
         pick_answers(driver, n % 3)
         if n == 2 and not reloaded:
             # reload mid-section before answering: same clip again, nothing saved, nothing lost
             reloaded = True
             driver.refresh()
-            wait_for(driver, lambda d: d.find_element(By.ID, "next").is_enabled(), timeout=15, what="replayed")
+            wait_for(driver, lambda d: d.find_element(By.ID, "next").is_enabled(), timeout=10 + 3 * seconds,
+                     what="replayed")
             assert "/clip/2/" in driver.current_url
             assert Response.objects.filter(participant=participant).count() == len(
                 questions_for(participant.assignments.order_by("section__order", "position")[0].section.section_type))
@@ -122,7 +142,7 @@ def test_whole_demo_study_in_chromium(chromium, live_server, settings, tmp_path)
     driver.find_element(By.CSS_SELECTOR, "button[type=submit]").click()
     wait_for(driver, lambda d: "/done/" in d.current_url, what="completion page")
     if shots:
-        driver.save_screenshot(str(Path(shots) / "study_done.png"))
+        full_shot(driver, Path(shots) / "study_done.png")
     assert driver.find_element(By.ID, "completion-code").text == study.completion_code
     assert f"cc={study.completion_code}" in driver.find_element(By.ID, "completion-link").get_attribute("href")
 

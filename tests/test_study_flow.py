@@ -292,3 +292,19 @@ def test_csrf_enforced(study):
     token = re.search(r'name="csrfmiddlewaretoken" value="([^"]+)"', page).group(1)
     r = c.post(reverse("studyapp:study_entry", args=[study.slug]), {"consent": "on", "csrfmiddlewaretoken": token})
     assert r.status_code == 302
+
+
+def test_pages_not_cached_so_back_button_asks_the_server(client, study):
+    p = consent(client, study)
+    r = client.get(reverse("studyapp:demographics", args=[p.token]))
+    assert "no-store" in r["Cache-Control"]
+
+
+def test_started_participant_can_finish_after_study_closes(client, study):
+    p = consent(client, study)
+    demographics(client, p)
+    client.get(reverse("studyapp:resume", args=[p.token]))
+    Study.objects.filter(pk=study.pk).update(status=Study.Status.CLOSED)
+    step = cur(p)
+    assert client.post(reverse("studyapp:item", args=[p.token, 1]), answer_for(step.assignment)).status_code == 302
+    assert cur(p).index == 2

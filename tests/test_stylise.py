@@ -1,8 +1,6 @@
 """Neutral base cycle and applying seed 004 themes: Y = P + w S, bone lengths, timing, metadata."""
 from __future__ import annotations
 
-import warnings
-
 import numpy as np
 import pytest
 
@@ -15,7 +13,7 @@ from generation.stylise import (_horn_rotation, bone_length_error, fit_to_skelet
                                 theme_rbfs, walker_frame_positions)
 from generation.themes import THEME_NAMES, THEMES
 
-warnings.filterwarnings("ignore", message="The given NumPy array is not writable")
+pytestmark = pytest.mark.filterwarnings("ignore:The given NumPy array is not writable")
 
 
 @pytest.fixture(scope="module")
@@ -66,7 +64,7 @@ def test_weight_zero_returns_the_neutral_walk(neutral):
     for theme in THEME_NAMES:
         out = stylise(neutral, theme, 0.0, 10, n_cycles=1, fps=neutral.fps)
         assert out.num_frames == neutral.num_frames
-        np.testing.assert_allclose(out.positions(), neutral.positions(), atol=1e-9)
+        np.testing.assert_allclose(out.positions(), neutral.positions(), atol=1e-5)  # 0.01 mm
 
 
 def test_displacement_scales_linearly_with_weight(neutral):
@@ -178,10 +176,10 @@ def test_speed_warps_time_uniformly_and_walks_forward(neutral):
         assert z[-1] - z[0] == pytest.approx(4 * stride, rel=0.03)
         assert np.all(np.diff(z) > 0)
         assert np.abs(clip.root_positions[:, 0]).max() < 0.1  # straight path
-    # uniform time warp: speed 1.25 at 30 fps shows the same poses as speed 1 sampled at 37.5 fps
-    dense = stylise(neutral, "tired", 0.7, 10, speed=1.0, n_cycles=4, fps=37.5)
-    assert dense.num_frames == fast.num_frames
-    np.testing.assert_allclose(fast.positions(), dense.positions(), atol=1e-9)
+    # uniform time warp: speed 1.25 at 30 fps shows the same poses as speed 1 sampled at 30 / 1.25 = 24 fps
+    sparse = stylise(neutral, "tired", 0.7, 10, speed=1.0, n_cycles=4, fps=24.0)
+    assert sparse.num_frames == fast.num_frames
+    np.testing.assert_allclose(fast.positions(), sparse.positions(), atol=1e-9)
 
 
 def test_metadata(neutral):

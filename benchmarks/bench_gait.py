@@ -1,0 +1,447 @@
+"""Benchmarks of the seed 000 gait network (docs/benchmarks/gait.md).
+
+Measures, on the held-out test split of the synthetic gait corpus:
+1. prediction error (seed 000 Table 1 layout): first 18 of 60 steps given, 42 predicted on the ground-truth
+   trajectory; mean joint position error relative to the body's bounding-box diagonal and mean joint rotation
+   error, for the network, its ablations (no affective inputs/loss = QuaterNet-like; no root loss) and two
+   trivial baselines (last pose held; nearest neighbour continuation from the training split);
+2. emotion expressiveness: a synthetic observer (logistic regression on the 18 affective features averaged
+   over time, trained on the corpus training split) classifies 200-step generated gaits: own emotion, other
+   (unseen, fixed) mixtures, transitions;
+3. trajectory following on unseen paths, with and without the root loss;
+4. long horizon (400 steps): root speed, pose variance and path distance per window; foot skate;
+5. speed in ms per agent per step / per 30 fps frame for 1 and 10 agents;
+6. the contact sheet docs/img/gait_contact_sheet.png and docs/img/gait_trajectories.png.
+
+Usage: python benchmarks/bench_gait.py [--full W.pt] [--no-affect W.pt] [--no-root W.pt] [--quick]
+Results go to var/gait_runs/bench_gait.json and are printed as markdown.
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import torch
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+
+from generation.features import detect_foot_contacts, np_gait_affective_features  # noqa: E402
+from generation.gait.data import load_corpus_sequences, world_rotations  # noqa: E402
+from generation.gait.generate import (EMOTIONS, distance_to_path, emotion_transition, generate_gaits,  # noqa: E402
+                                      load_model)
+from generation.gait.train import DEFAULT_WEIGHTS, rollout  # noqa: E402
+from generation.kinematics import forward_kinematics  # noqa: E402
+from generation.motion import Motion  # noqa: E402
+from generation.paths import random_path, straight  # noqa: E402
+from generation.quaternion import qangle  # noqa: E402
+from generation.skeleton import GAIT_PARENTS, gait_skeleton  # noqa: E402
+
+PREFIX, HORIZON = 18, 42
+
+
+# ---- 1. prediction error ------------------------------------------------------------------------
+def world_positions(q_heading, ref, root_xz, root_y, offsets):
+    """(N, L, J, 3) world positions from heading-frame rotations and a given ground track."""
+    rot = world_rotations(q_heading, ref)
+    root = torch.stack((root_xz[..., 0], root_y, root_xz[..., 1]), dim=-1)
+    return forward_kinematics(rot, root, offsets[:, None], GAIT_PARENTS), rot
+
+
+def pose_rotation_errors(q_pred, h_pred, test) -> dict:
+    """Errors over the 42 predicted steps. q_pred (N, 42, J, 4) heading frame; h_pred (N, 42) metres."""
+    sl = slice(PREFIX, PREFIX + HORIZON)
+    ref = test.ref[:, sl]
+    xz = test.root_pos[:, sl][..., [0, 2]]
+    pos_p, rot_p = world_positions(q_pred, ref, xz, test.mean_height[:, None] + h_pred, test.offsets)
+    pos_t, rot_t = world_positions(test.q[:, sl], ref, xz, test.root_pos[:, sl, 1], test.offsets)
+    err = (pos_p - pos_t).norm(dim=-1).mean(-1)                       # (N, 42) metres
+    span = pos_t.amax(-2) - pos_t.amin(-2)                             # per-frame body box
+    diag = span.norm(dim=-1)                                           # (N, 42)
+    clip_span = pos_t.reshape(len(pos_t), -1, 3)
+    clip_diag = (clip_span.amax(1) - clip_span.amin(1)).norm(dim=-1)    # (N,) whole 42-step clip
+    ang = qangle(rot_p, rot_t)                                         # (N, 42, J) radians
+    return {"pose_error_body_diag": float((err / diag).mean()), "pose_error_clip_diag": float(
+        (err.mean(1) / clip_diag).mean()), "pose_error_cm": float(100 * err.mean()),
+            "rotation_error_deg": float(torch.rad2deg(ang).mean()), "rotation_error_rad": float(ang.mean()),
+            "pose_error_first10_cm": float(100 * err[:, :10].mean()), "pose_error_last10_cm": float(100 * err[:, -10:].mean())}
+
+
+def network_errors(net, test) -> dict:
+    with torch.no_grad():
+        pred = rollout(net.model, net.normalizer, test.batch(np.arange(len(test))), 0.0, PREFIX)
+    return pose_rotation_errors(pred["q"][:, PREFIX - 1:], pred["h"][:, PREFIX - 1:], test)
+
+
+def zero_velocity_errors(test) -> dict:
+    q = test.q[:, PREFIX - 1:PREFIX].expand(-1, HORIZON, -1, -1)
+    h = test.root[:, PREFIX - 1:PREFIX, 0].expand(-1, HORIZON)
+    return pose_rotation_errors(q, h, test)
+
+
+def nearest_neighbour_errors(train, test, window: int = 6) -> dict:
+    """Continue each test prefix with the training sequence window whose last ``window`` poses match best."""
+    T = train.q.shape[1]
+    ends = list(range(window - 1, T - HORIZON))                        # window end index j, copy j+1..j+42
+    lib = torch.stack([train.q[:, j - window + 1:j + 1].reshape(len(train), -1) for j in ends], 1)  # (M, E, D)
+    lib = lib.reshape(-1, lib.shape[-1])
+    qs, hs = [], []
+    for i in range(len(test)):
+        key = test.q[i, PREFIX - window:PREFIX].reshape(-1)
+        # quaternion sign: compare absolute dot products per joint via squared distance of both signs
+        d = torch.minimum(((lib - key) ** 2).sum(-1), ((lib + key) ** 2).sum(-1))
+        k = int(d.argmin())
+        m, e = divmod(k, len(ends))
+        j = ends[e]
+        qs.append(train.q[m, j + 1:j + 1 + HORIZON])
+        hs.append(train.root[m, j + 1:j + 1 + HORIZON, 0])
+    return pose_rotation_errors(torch.stack(qs), torch.stack(hs), test)
+
+
+# ---- 2. emotion expressiveness --------------------------------------------------------------------
+class Observer:
+    """Logistic regression on the 18 affective features averaged over time (synthetic observer)."""
+
+    def __init__(self, train):
+        from sklearn.linear_model import LogisticRegression
+        from sklearn.pipeline import make_pipeline
+        from sklearn.preprocessing import StandardScaler
+        X = self.summarise_seq(train.aff.numpy())
+        y = train.emotion.numpy().argmax(1)
+        self.clf = make_pipeline(StandardScaler(), LogisticRegression(max_iter=2000, C=1.0)).fit(X, y)
+
+    @staticmethod
+    def summarise_seq(aff: np.ndarray) -> np.ndarray:
+        a = np.clip(aff, -10, 10)
+        return a.mean(-2)
+
+    def predict_motions(self, motions: list[Motion], frames: slice = slice(None)) -> np.ndarray:
+        X = np.stack([np_gait_affective_features(m.positions()[frames]).mean(0) for m in motions])
+        return self.clf.predict(np.clip(X, -10, 10))
+
+
+def test_seeds(corpus, test_rows, n_frames=PREFIX * 4 - 3):
+    """Seed Motions: the first 18 network steps (69 frames at 30 fps) of test sequences."""
+    return [corpus.motion(int(i)).slice(0, n_frames) for i in test_rows]
+
+
+def fixed_mixtures() -> np.ndarray:
+    """Four emotion mixtures not in the corpus (dominant 0.55, the rest 0.15 each)."""
+    m = np.full((4, 4), 0.15)
+    np.fill_diagonal(m, 0.55)
+    return m
+
+
+def accuracy_table(pred: np.ndarray, intended: np.ndarray) -> dict:
+    out = {"overall": float((pred == intended).mean()), "n": int(len(pred))}
+    for k, e in enumerate(EMOTIONS):
+        sel = intended == k
+        out[e] = float((pred[sel] == k).mean()) if sel.any() else None
+    return out
+
+
+def expressiveness(net, observer, corpus, test_rows, test_emotion, steps, rng) -> dict:
+    seeds = test_seeds(corpus, test_rows)
+    N = len(seeds)
+    paths = [straight(60.0) for _ in range(N)]
+    res = {}
+    own = generate_gaits(seeds, paths, test_emotion, steps=steps, model=net)
+    res["own_emotion"] = accuracy_table(observer.predict_motions(own), test_emotion.argmax(1))
+    # Other emotions: each seed gets a fixed mixture whose dominant emotion differs from the seed's.
+    mix = fixed_mixtures()
+    target = np.array([(int(e.argmax()) + 1 + int(rng.integers(3))) % 4 for e in test_emotion])
+    other = generate_gaits(seeds, paths, mix[target], steps=steps, model=net)
+    res["other_mixture"] = accuracy_table(observer.predict_motions(other), target)
+    res["other_mixture_last_third"] = accuracy_table(
+        observer.predict_motions(other, slice(-(steps * 4) // 3, None)), target)
+    # Transitions: seed emotion -> a different pure emotion over the steps; classify the first and last 50 steps.
+    final = np.eye(4)[target]
+    sched = np.stack([emotion_transition(test_emotion[i], final[i], steps) for i in range(N)])
+    trans = generate_gaits(seeds, paths, sched, steps=steps, model=net)
+    res["transition_end"] = accuracy_table(observer.predict_motions(trans, slice(-200, None)), target)
+    res["transition_start"] = accuracy_table(observer.predict_motions(trans, slice(0, 200)),
+                                             test_emotion.argmax(1))
+    res["_motions"] = {"own": own, "trans": trans, "other": other}
+    return res
+
+
+# ---- 3/4. trajectories, long horizon, foot skate ---------------------------------------------------
+def foot_skate_cm_s(m: Motion, height_thr: float = 0.03) -> float:
+    """Mean ground-plane speed (cm/s) of heel and toe joints while within ``height_thr`` m of their lowest height."""
+    P = m.positions()
+    speeds = []
+    for j in (3, 4, 7, 8):
+        y = P[:, j, 1]
+        low = (y - y.min()) < height_thr
+        v = np.linalg.norm(np.diff(P[:, j][:, [0, 2]], axis=0), axis=-1) * m.fps
+        both = low[1:] & low[:-1]
+        speeds.append(v[both])
+    s = np.concatenate(speeds)
+    return float(100 * s.mean()) if s.size else float("nan")
+
+
+def trajectory_following(net, seeds, emotions, paths, steps) -> dict:
+    ms = generate_gaits(seeds, paths, emotions, steps=steps, model=net)
+    d_all, face = [], []
+    for m, p in zip(ms, paths):
+        xz = m.root_positions[:, [0, 2]]
+        d_all.append(distance_to_path(p, xz[::2]))
+        fwd = m.positions()[:, 0]  # root
+        del fwd
+    d = np.concatenate(d_all)
+    end = np.array([x[-1] for x in d_all])
+    # facing vs travel direction (the paper's observation on the ablation: "not facing the direction of motion")
+    for m in ms:
+        from generation.gait.data import facing_yaw
+        alpha = facing_yaw(m.rotations[::4, 0])
+        dxz = np.diff(m.root_positions[::4][:, [0, 2]], axis=0)
+        travel = np.arctan2(dxz[:, 0], dxz[:, 1])
+        face.append(np.abs((travel - alpha[1:] + np.pi) % (2 * np.pi) - np.pi))
+    return {"mean_m": float(d.mean()), "p95_m": float(np.percentile(d, 95)), "max_m": float(d.max()),
+            "end_mean_m": float(end.mean()), "facing_vs_travel_deg": float(np.degrees(np.concatenate(face).mean())),
+            "n": len(ms), "_motions": ms}
+
+
+def long_horizon(net, seeds, emotions, steps, window=50) -> dict:
+    paths = [straight(120.0) for _ in seeds]
+    ms = generate_gaits(seeds, paths, emotions, steps=steps, model=net)
+    rows = []
+    for w0 in range(0, steps, window):
+        sl = slice(w0 * 4, (w0 + window) * 4)
+        sp, var, dist, h = [], [], [], []
+        for m, p in zip(ms, paths):
+            r = m.root_positions[sl]
+            sp.append(np.linalg.norm(np.diff(r[:, [0, 2]], axis=0), axis=-1).mean() * m.fps)
+            P = m.positions()[sl]
+            rel = P - P[:, :1]
+            var.append(1e4 * rel.var(0).sum(-1).mean())
+            dist.append(distance_to_path(p, r[::4, [0, 2]]).mean())
+            h.append(r[:, 1].mean())
+        rows.append({"steps": f"{w0}-{w0 + window}", "root_speed_m_s": float(np.mean(sp)),
+                     "pose_variance_cm2": float(np.mean(var)), "path_distance_m": float(np.mean(dist)),
+                     "root_height_m": float(np.mean(h))})
+    skate = [foot_skate_cm_s(m) for m in ms]
+    return {"windows": rows, "foot_skate_cm_s": float(np.mean(skate))}
+
+
+# ---- 5. speed ----------------------------------------------------------------------------------------
+def speed(net, seed, steps=100, repeats=3) -> dict:
+    out = {}
+    for n in (1, 10):
+        times = []
+        for _ in range(repeats):
+            t0 = time.perf_counter()
+            ms = generate_gaits([seed] * n, [straight(40.0)] * n, np.tile([0.25, 0.25, 0.25, 0.25], (n, 1)),
+                                steps=steps, model=net)
+            times.append(time.perf_counter() - t0)
+        t = min(times)
+        frames = ms[0].num_frames
+        out[f"{n}_agents"] = {"ms_per_agent_per_step": 1000 * t / (n * steps),
+                              "ms_per_agent_per_frame_30fps": 1000 * t / (n * frames),
+                              "ms_per_frame_all_agents_30fps": 1000 * t / frames, "steps": steps, "frames": frames}
+    return out
+
+
+# ---- 6. figures ----------------------------------------------------------------------------------
+def side_view(ax, P, color):
+    """Stick figure (J, 3) in a side view: forward (z after yaw removal) right, up."""
+    for j, p in enumerate(GAIT_PARENTS):
+        if p >= 0:
+            ax.plot([P[p, 2], P[j, 2]], [P[p, 1], P[j, 1]], color=color, lw=1.6)
+    ax.plot(P[12, 2], P[12, 1], "o", color=color, ms=4)
+
+
+def body_frame(m: Motion, t: int) -> np.ndarray:
+    """Positions at frame t with the root's ground point at the origin and its facing along +z."""
+    from generation.gait.data import facing_yaw
+    P = m.positions()[t]
+    a = facing_yaw(m.rotations[t, 0])
+    c, s = math.cos(-a), math.sin(-a)
+    x, z = P[:, 0] - P[0, 0], P[:, 2] - P[0, 2]
+    out = P.copy()
+    out[:, 0], out[:, 2] = x * c + z * s, -x * s + z * c
+    out[:, 1] = P[:, 1] - P[:, 1].min() + 0.0
+    return out
+
+
+def contact_sheet(rows: list[tuple[str, Motion]], path: Path, n_cols: int = 6):
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    colors = {"happy": "#d08c00", "sad": "#3366aa", "angry": "#c0392b", "neutral": "#555555"}
+    fig, axes = plt.subplots(len(rows), n_cols, figsize=(1.6 * n_cols, 2.2 * len(rows)))
+    for r, (label, m) in enumerate(rows):
+        T = m.num_frames
+        for c in range(n_cols):
+            t = int((c + 0.5) * T / n_cols)
+            ax = axes[r, c]
+            key = label.split()[0] if label.split()[0] in colors else "neutral"
+            if label.startswith("transition"):
+                key = "sad" if c < n_cols // 2 else "happy"
+            side_view(ax, body_frame(m, t), colors[key])
+            ax.set_xlim(-0.7, 0.7)
+            ax.set_ylim(-0.05, 1.95)
+            ax.set_aspect("equal")
+            ax.set_xticks([])
+            ax.set_yticks([])
+            ax.set_title(f"t={t / m.fps:.1f}s", fontsize=7)
+            if c == 0:
+                ax.set_ylabel(label, fontsize=8)
+    fig.suptitle("Generated gaits (gait net trained on a SYNTHETIC procedural corpus), side view, facing right",
+                 fontsize=8)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+def trajectory_figure(paths, runs: dict, path: Path):
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    n = len(paths)
+    fig, axes = plt.subplots(1, n, figsize=(3.2 * n, 3.4))
+    for i, p in enumerate(paths):
+        ax = axes[i]
+        pts = p.point_at(np.linspace(0, p.length, 200))
+        ax.plot(pts[:, 0], pts[:, 1], "k--", lw=1, label="desired path")
+        for (name, ms), col in zip(runs.items(), ("#1f77b4", "#d62728", "#2ca02c")):
+            r = ms[i].root_positions
+            ax.plot(r[:, 0], r[:, 2], color=col, lw=1.2, label=name)
+        ax.set_aspect("equal")
+        ax.set_title(p.kind, fontsize=8)
+        ax.tick_params(labelsize=6)
+    axes[0].legend(fontsize=6)
+    fig.suptitle("Root tracks of generated gaits on unseen paths (metres, top view)", fontsize=8)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--full", default=str(DEFAULT_WEIGHTS))
+    ap.add_argument("--no-affect", default="var/gait_runs/no_affect.pt")
+    ap.add_argument("--no-root", default="var/gait_runs/no_root.pt")
+    ap.add_argument("--steps", type=int, default=200)
+    ap.add_argument("--quick", action="store_true", help="fewer sequences (smoke run)")
+    ap.add_argument("--out", default="var/gait_runs/bench_gait.json")
+    args = ap.parse_args(argv)
+    torch.set_num_threads(1)
+    rng = np.random.default_rng(7)
+    t_start = time.time()
+
+    from generation.corpus import GaitCorpus
+    corpus = GaitCorpus.load("var/corpus/gait_corpus_synthetic.npz")
+    data = load_corpus_sequences()
+    train = data.subset((data.split == "train") & (data.offset == 0))
+    test = data.subset((data.split == "test") & (data.offset == 0))
+    if args.quick:
+        test = test.subset(np.arange(12))
+    test_rows = test.base_index
+    nets = {"full": args.full, "no affective (QuaterNet-like)": args.no_affect, "no root loss": args.no_root}
+    nets = {k: load_model(v) for k, v in nets.items() if Path(v).exists()}
+    results: dict = {"models": {k: {"path": n.path, "epochs": n.info.get("epochs"),
+                                    "parameters": n.model.num_parameters()} for k, n in nets.items()}}
+
+    # 1. prediction error
+    table = {name: network_errors(net, test) for name, net in nets.items()}
+    table["last pose held"] = zero_velocity_errors(test)
+    table["nearest neighbour (train)"] = nearest_neighbour_errors(train, test)
+    results["prediction"] = table
+    print("## prediction (18 given, 42 predicted), test split n =", len(test))
+    print("| method | pose err / body diag | pose err cm | first 10 / last 10 steps cm | rot err deg (rad) |")
+    print("|---|---|---|---|---|")
+    for k, v in table.items():
+        print(f"| {k} | {v['pose_error_body_diag']:.3f} | {v['pose_error_cm']:.1f} | {v['pose_error_first10_cm']:.1f}"
+              f" / {v['pose_error_last10_cm']:.1f} | {v['rotation_error_deg']:.1f} ({v['rotation_error_rad']:.3f}) |")
+
+    # 2. expressiveness
+    observer = Observer(train)
+    gt_pred = observer.clf.predict(Observer.summarise_seq(test.aff.numpy()))
+    results["observer_on_test_corpus"] = accuracy_table(gt_pred, test.emotion.numpy().argmax(1))
+    test_emotion = test.emotion.numpy().astype(np.float64)
+    expr, motions = {}, {}
+    for name, net in nets.items():
+        if name == "no root loss":
+            continue
+        r = expressiveness(net, observer, corpus, test_rows, test_emotion, args.steps, np.random.default_rng(3))
+        motions[name] = r.pop("_motions")
+        expr[name] = r
+    results["expressiveness"] = expr
+    print("\n## synthetic observer accuracy (chance 0.25); on the test corpus itself:",
+          f"{results['observer_on_test_corpus']['overall']:.2f}")
+    print("| model | own emotion | other mixture (whole / last third) | transition start / end |")
+    print("|---|---|---|---|")
+    for k, v in expr.items():
+        print(f"| {k} | {v['own_emotion']['overall']:.2f} | {v['other_mixture']['overall']:.2f} / "
+              f"{v['other_mixture_last_third']['overall']:.2f} | {v['transition_start']['overall']:.2f} / "
+              f"{v['transition_end']['overall']:.2f} |")
+
+    # 3. trajectory following on unseen paths
+    path_rng = np.random.default_rng(2026)
+    n_traj = 12 if args.quick else 30
+    kinds = ["straight", "curved", "sharp_turn"]
+    tpaths = [random_path(path_rng, 30.0, kinds[i % 3]) for i in range(n_traj)]
+    tseeds = test_seeds(corpus, test_rows[np.arange(n_traj) % len(test_rows)])
+    temo = test_emotion[np.arange(n_traj) % len(test_rows)]
+    traj, traj_motions = {}, {}
+    for name, net in nets.items():
+        r = trajectory_following(net, tseeds, temo, tpaths, args.steps)
+        traj_motions[name] = r.pop("_motions")
+        traj[name] = r
+    results["trajectory"] = traj
+    print("\n## distance of the root from the desired path (unseen random paths, 200 steps)")
+    print("| model | mean m | p95 m | max m | at end m | facing vs travel deg |")
+    print("|---|---|---|---|---|---|")
+    for k, v in traj.items():
+        print(f"| {k} | {v['mean_m']:.3f} | {v['p95_m']:.3f} | {v['max_m']:.3f} | {v['end_mean_m']:.3f} | "
+              f"{v['facing_vs_travel_deg']:.1f} |")
+
+    # 4. long horizon + foot skate
+    n_long = 4 if args.quick else 8
+    lseeds = test_seeds(corpus, test_rows[:n_long])
+    results["long_horizon"] = long_horizon(nets["full"], lseeds, test_emotion[:n_long], 2 * args.steps)
+    corpus_skate = [foot_skate_cm_s(corpus.motion(int(i))) for i in test_rows[:20]]
+    results["foot_skate_corpus_cm_s"] = float(np.mean(corpus_skate))
+    print("\n## long horizon (full model, straight path, 400 steps = 53 s)")
+    print("| steps | root speed m/s | pose variance cm^2 | path distance m | root height m |")
+    print("|---|---|---|---|---|")
+    for row in results["long_horizon"]["windows"]:
+        print(f"| {row['steps']} | {row['root_speed_m_s']:.2f} | {row['pose_variance_cm2']:.0f} | "
+              f"{row['path_distance_m']:.3f} | {row['root_height_m']:.3f} |")
+    print(f"foot skate (low feet ground speed): generated {results['long_horizon']['foot_skate_cm_s']:.1f} cm/s, "
+          f"corpus {results['foot_skate_corpus_cm_s']:.1f} cm/s")
+
+    # 5. speed
+    results["speed"] = speed(nets["full"], lseeds[0])
+    print("\n## speed")
+    for k, v in results["speed"].items():
+        print(k, {kk: round(vv, 2) if isinstance(vv, float) else vv for kk, vv in v.items()})
+
+    # 6. figures
+    full = motions["full"]
+    rows = []
+    for k, e in enumerate(EMOTIONS):
+        idx = int(np.flatnonzero(test_emotion.argmax(1) == k)[np.argmax(test_emotion[test_emotion.argmax(1) == k, k])])
+        rows.append((f"{e} (own)", full["own"][idx]))
+    sad_seed = int(np.flatnonzero(test_emotion.argmax(1) == 1)[0])
+    tr = generate_gaits(test_seeds(corpus, [test_rows[sad_seed]]), [straight(60.0)],
+                        emotion_transition(test_emotion[sad_seed], [1, 0, 0, 0], args.steps)[None], steps=args.steps,
+                        model=nets["full"])[0]
+    rows.append(("transition sad->happy", tr))
+    contact_sheet(rows, Path("docs/img/gait_contact_sheet.png"))
+    trajectory_figure(tpaths[:3], {k: v[:3] for k, v in traj_motions.items()}, Path("docs/img/gait_trajectories.png"))
+
+    results["seconds"] = time.time() - t_start
+    Path(args.out).parent.mkdir(parents=True, exist_ok=True)
+    Path(args.out).write_text(json.dumps(results, indent=1, default=float))
+    print(f"\nwrote {args.out} in {results['seconds']:.0f} s")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

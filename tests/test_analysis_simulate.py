@@ -1,0 +1,110 @@
+"""The simulator's known effects are found by the analyses, and null effects are not (most seeds)."""
+
+import numpy as np
+import pytest
+
+from analysis import participants as parts_mod
+from analysis import themes, vad
+from analysis.io import load_study
+from analysis.simulate import simulate_study
+
+
+def _load(r, c, p):
+    import io
+
+    bufs = []
+    for df in (r, c, p):
+        b = io.StringIO(df.to_csv(index=False))
+        bufs.append(b)
+    return load_study(*bufs)
+
+
+def test_marked_synthetic_and_balanced_design():
+    r, c, p = simulate_study(20, seed=4, completion_rate=0.8)
+    assert p["participant_id"].str.startswith("sim-").all() and c["clip_id"].str.startswith("sim-").all()
+    assert (p["external_id"] == "synthetic").all()
+    assert set(p.loc[p["status"] == "abandoned", "completed_at"]) <= {""}
+    done = p.loc[p["status"] == "completed", "participant_id"]
+    per = r[r["participant_id"].isin(done)].groupby("participant_id").size()
+    assert per.nunique() == 1 and per.iloc[0] == 8 + 12 + 32 + 12 + 6 + 1 + 96 + 6
+    d = _load(r, c, p)
+    assert parts_mod.participant_summary(d.participants, d.responses)["synthetic"] is True
+
+
+def test_same_seed_same_study():
+    a = simulate_study(5, seed=7)[0]
+    b = simulate_study(5, seed=7)[0]
+    assert a.equals(b)
+
+
+def test_theme_effects_found_with_16_participants():
+    """Seed 004 Table IV setting: 16 participants, 4 x 4 design; both main effects found for every theme."""
+    d = _load(*simulate_study(16, seed=11, completion_rate=1.0))
+    a = themes.theme_anova(d.responses, d.clips)
+    main = a[a["effect"] != "weight * n_features"]
+    assert len(main) == 12 and (main["p_gg"] < 1e-4).all()
+    assert (main["df1"] == 3).all() and (main["df2"] == 45).all()
+    desc = themes.theme_descriptives(d.responses, d.clips)
+    lo = desc[(desc.weight == 0.4) & (desc.n_features == 1)]["mean"].mean()
+    hi = desc[(desc.weight == 1.3) & (desc.n_features == 10)]["mean"].mean()
+    assert hi > lo + 0.3
+
+
+def test_no_theme_effect_rarely_significant():
+    """With weight_effect = feature_effect = 0, main effects are significant at 0.05 in about 5% of tests."""
+    rejections, tests = 0, 0
+    for seed in range(12):
+        d = _load(*simulate_study(16, seed=100 + seed, completion_rate=1.0, weight_effect=0.0, feature_effect=0.0))
+        a = themes.theme_anova(d.responses, d.clips)
+        main = a[a["effect"] != "weight * n_features"]
+        rejections += int((main["p_gg"] < 0.05).sum())
+        tests += len(main)
+    assert tests == 144
+    assert rejections / tests < 0.12
+
+
+def test_inversion_found_and_null_not():
+    d = _load(*simulate_study(16, seed=5, completion_rate=1.0))
+    inv = themes.theme_inversion(d.responses, d.clips)
+    assert (inv["mean"] < 0).all() and inv["reject"].all()
+    zero = {t: 0.0 for t in inv["theme"]}
+    rejected = 0
+    for seed in range(8):
+        d = _load(*simulate_study(16, seed=200 + seed, completion_rate=1.0, inversion_mean=zero))
+        rejected += int(themes.theme_inversion(d.responses, d.clips)["reject"].sum())
+    assert rejected / 48 < 0.15
+
+
+def test_vad_correlation_found():
+    d = _load(*simulate_study(50, seed=6))
+    v = vad.vad_pearson(d.responses, d.clips)
+    assert (v["r"] > 0.5).all() and (v["p_value"] < 1e-6).all() and (v["ci_low"] < v["r"]).all()
+
+
+def test_no_demographic_effect_rarely_significant():
+    rejected, tests = 0, 0
+    for seed in range(6):
+        d = _load(*simulate_study(60, seed=300 + seed))
+        t = parts_mod.demographic_differences(d.responses, d.participants)
+        rejected += int(t["reject"].sum())
+        tests += len(t)
+    assert tests >= 12
+    assert rejected / tests < 0.2
+
+
+@pytest.mark.parametrize("noise,expect_reject", [(0.0, False), (0.9, True)])
+def test_gait_emotions_recovered_or_not(noise, expect_reject):
+    """Without perception noise and multi-select, perceived vectors equal the intended ones (no rejection); with
+    heavy noise the perceived vector of a fully happy gait has four non-zero components and the test rejects
+    (seed 000 Table 3, Gait 2)."""
+    from analysis import emotion
+
+    d = _load(*simulate_study(40, seed=8, emotion_noise=noise, multi_select_prob=0.0))
+    g = emotion.gait_emotion_ad(d.responses, d.clips).set_index("clip_id")
+    assert bool(g.loc["sim-gait-01", "reject"]) is expect_reject
+    if noise == 0.0:
+        assert not g["reject"].any()
+        assert g.loc["sim-gait-05", "perceived_happy"] == pytest.approx(0.7, abs=0.15)
+        assert np.isclose(g.loc["sim-gait-01", "perceived_happy"], 1.0)
+    else:
+        assert g.loc["sim-gait-01", "statistic"] > 1.9  # 2.111 without ties among the perceived components
