@@ -1,4 +1,4 @@
-"""CLI: ``python -m analysis RESPONSES CLIPS PARTICIPANTS --out DIR [--alpha A] [--permutations N]``.
+"""CLI: ``python -m analysis RESPONSES CLIPS PARTICIPANTS --out DIR [--alpha A] [--permutations N] [--no-figures]``.
 
 Exit status 0 on success, 2 with a message naming file, line and column on invalid input.
 """
@@ -22,6 +22,7 @@ def main(argv=None) -> int:
     ap.add_argument("--alpha", type=float, default=0.05, help="significance level (default 0.05)")
     ap.add_argument("--permutations", type=int, default=0,
                     help="also compute permutation p-values with N resamples for the 2-sample AD tests")
+    ap.add_argument("--no-figures", action="store_true", help="skip the PNG/SVG figures (tables only)")
     a = ap.parse_args(argv)
     for path in (a.responses, a.clips, a.participants):
         if not os.path.isfile(path):
@@ -33,7 +34,8 @@ def main(argv=None) -> int:
     from .report import write_report  # imported late: matplotlib/pingouin are slow to import
 
     try:
-        report = write_report(a.responses, a.clips, a.participants, a.out, a.alpha, a.permutations)
+        report = write_report(a.responses, a.clips, a.participants, a.out, a.alpha, a.permutations,
+                              figures=not a.no_figures)
     except ValidationError as exc:
         print(f"error: invalid input\n{exc}", file=sys.stderr)
         return 2

@@ -32,10 +32,22 @@ def save_figure(fig, out_dir: str, name: str, dpi: int = 110) -> dict[str, str]:
     return paths
 
 
+def _adjust(fig, top: float = 0.85, bottom: float = 0.45, left: float = 0.55, right: float = 0.15,
+            hgap: float = 0.7, wgap: float = 0.3) -> None:
+    """Fixed margins and gaps in inches (cheaper than tight_layout, which draws the figure once more)."""
+    W, H = fig.get_size_inches()
+    gs = fig.axes[0].get_gridspec()
+    nrows, ncols = gs.nrows, gs.ncols
+    ax_h = (H - top - bottom - hgap * (nrows - 1)) / nrows
+    ax_w = (W - left - right - wgap * (ncols - 1)) / ncols
+    fig.subplots_adjust(left=left / W, right=1 - right / W, bottom=bottom / H, top=1 - top / H,
+                        hspace=hgap / ax_h, wspace=wgap / ax_w)
+
+
 def _grid(n: int, ncols: int, w: float, h: float, **kw):
     ncols = max(1, min(ncols, n))
     nrows = int(np.ceil(n / ncols))
-    fig, axes = plt.subplots(nrows, ncols, figsize=(w * ncols, h * nrows), squeeze=False, **kw)
+    fig, axes = plt.subplots(nrows, ncols, figsize=(w * ncols, h * nrows + 0.3), squeeze=False, **kw)
     for ax in axes.ravel()[n:]:
         ax.set_visible(False)
     return fig, axes.ravel()
@@ -60,7 +72,7 @@ def fig_emotion_vectors(table: pd.DataFrame, title: str = "Intended vs perceived
         ax.set_title(f"{row['clip_id']}{phase}\nA = {row['statistic']:.2f}, p {_p(row)} ({verdict})", fontsize=8)
     axes[0].legend(loc="upper right", fontsize=7, frameon=False)
     fig.suptitle(title)
-    fig.tight_layout()
+    _adjust(fig)
     return fig
 
 
@@ -91,7 +103,7 @@ def fig_transitions(table: pd.DataFrame):
     h, lab = axes[0].get_legend_handles_labels()
     axes[0].legend(h[:2], lab[:2], loc="upper center", fontsize=7, frameon=False)
     fig.suptitle("Emotion transitions: initial (left) and final (right), intended vs perceived (* rejected)")
-    fig.tight_layout()
+    _adjust(fig)
     return fig
 
 
@@ -106,7 +118,7 @@ def fig_likert(dist: pd.DataFrame):
         return None
     emotions = [e for e in GAIT_EMOTIONS if e in set(dist["emotion"])]
     features = [f for f in LIKERT_FEATURES if f in set(dist["feature"])]
-    fig, axes = plt.subplots(len(features), len(emotions), figsize=(2.2 * len(emotions), 1.6 * len(features)),
+    fig, axes = plt.subplots(len(features), len(emotions), figsize=(2.2 * len(emotions), 1.6 * len(features) + 0.6),
                              squeeze=False, sharex=True, sharey=True)
     for i, f in enumerate(features):
         for j, e in enumerate(emotions):
@@ -122,7 +134,7 @@ def fig_likert(dist: pd.DataFrame):
             if i == len(features) - 1:
                 ax.set_xlabel("Likert value")
     fig.suptitle("Pose affective features by intended emotion (share of answers)")
-    fig.tight_layout()
+    _adjust(fig, left=0.7, hgap=0.25, wgap=0.15)
     return fig
 
 
@@ -198,7 +210,7 @@ def fig_theme_ratings(desc: pd.DataFrame):
     axes[0].set_ylabel("rating (normalised 0..1)")
     axes[0].legend(fontsize=7, frameon=False)
     fig.suptitle("Theme ratings by weight and number of features (mean ± SE)")
-    fig.tight_layout()
+    _adjust(fig, hgap=0.75, wgap=0.2)
     return fig
 
 

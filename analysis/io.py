@@ -10,8 +10,8 @@ The checks are vectorised (one boolean mask per rule), so a 1.7-million-row resp
 from __future__ import annotations
 
 import io
-import re
 import os
+import re
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -206,7 +206,9 @@ def read_clips(src) -> pd.DataFrame:
                  lambda v: f"{v!r} is not an NRC-VAD category ({', '.join(NRC_VAD)})")
     if col.total:
         raise ValidationError(col.problems, col.total)
-    return out.set_index("clip_id", drop=False)
+    out = out.set_index("clip_id", drop=False)
+    out.attrs["ignored_columns"] = [c for c in df.columns if c not in CLIP_COLUMNS and c != "_line"]
+    return out
 
 
 def _parse_datetime(s: pd.Series) -> pd.Series:
@@ -425,6 +427,7 @@ def read_responses(src, clips: pd.DataFrame, participants: pd.DataFrame | None =
         "response_ms": ms_u[rms.codes] if n else np.empty(0),
         "_line": raw["_line"].to_numpy(),
     })
+    out.attrs["ignored_columns"] = [c for c in raw.columns if c not in RESPONSE_COLUMNS and c != "_line"]
     return out
 
 
@@ -468,4 +471,6 @@ def load_study(responses_src, clips_src, participants_src) -> StudyData:
         total += exc.total
     if total:
         raise ValidationError(problems[:MAX_LISTED], total)
-    return StudyData(responses, clips, participants)
+    ignored = {name: df.attrs.get("ignored_columns", []) for name, df in (("clips.csv", clips),
+                                                                       ("responses.csv", responses))}
+    return StudyData(responses, clips, participants, {k: v for k, v in ignored.items() if v})

@@ -21,7 +21,8 @@ import re
 import numpy as np
 import pandas as pd
 
-from . import emotion, figures, likert, naturalness, participants, themes, vad
+from . import emotion, likert, naturalness, participants, themes, vad
+from . import figures as figure_mod
 from .io import StudyData, load_study
 
 TABLE_KEYS = ("gait_emotion_ad", "transition_ad", "likert_consistency_ad", "likert_distribution", "naturalness",
@@ -149,6 +150,8 @@ def build_report(data: StudyData, alpha: float = 0.05, permutations: int = 0) ->
     for k in TABLE_KEYS:
         if tables[k].empty:
             notes.append(f"{k}: no data for this analysis in responses.csv.")
+    for name, cols in data.ignored_columns.items():
+        notes.append(f"{name}: unknown column(s) not used: {', '.join(cols)}.")
     synthetic = bool(extras["participants"].get("synthetic"))
     if synthetic:
         notes.insert(0, "synthetic: all participants are simulated by analysis.simulate; not data from people.")
@@ -168,20 +171,21 @@ FIGURES = ("fig_emotion_vectors", "fig_transitions", "fig_likert", "fig_vad", "f
 
 def _make_figures(tables: dict, extras: dict) -> dict:
     return {
-        "fig_emotion_vectors": figures.fig_emotion_vectors(tables["gait_emotion_ad"]),
-        "fig_transitions": figures.fig_transitions(tables["transition_ad"]),
-        "fig_likert": figures.fig_likert(tables["likert_distribution"]),
-        "fig_vad": figures.fig_vad(extras["vad_pairs"], tables["vad_pearson"]),
-        "fig_naturalness": figures.fig_naturalness(tables["naturalness"]),
-        "fig_theme_ratings": figures.fig_theme_ratings(tables["theme_descriptives"]),
-        "fig_inversion": figures.fig_inversion(tables["theme_inversion"]),
+        "fig_emotion_vectors": figure_mod.fig_emotion_vectors(tables["gait_emotion_ad"]),
+        "fig_transitions": figure_mod.fig_transitions(tables["transition_ad"]),
+        "fig_likert": figure_mod.fig_likert(tables["likert_distribution"]),
+        "fig_vad": figure_mod.fig_vad(extras["vad_pairs"], tables["vad_pearson"]),
+        "fig_naturalness": figure_mod.fig_naturalness(tables["naturalness"]),
+        "fig_theme_ratings": figure_mod.fig_theme_ratings(tables["theme_descriptives"]),
+        "fig_inversion": figure_mod.fig_inversion(tables["theme_inversion"]),
     }
 
 
 def write_report(responses_csv, clips_csv, participants_csv, out_dir, alpha: float = 0.05,
-                 permutations: int = 0) -> dict:
+                 permutations: int = 0, *, figures: bool = True) -> dict:
     """Validate the three exports (paths or text file objects), analyse, and write the report folder.
 
+    ``figures=False`` skips the PNG/SVG figures (the HTML then has tables only); the analyses are the same.
     Raises :class:`analysis.io.ValidationError` (listing file, line and column of each problem) on invalid input.
     Returns the report dict (also written as ``out_dir/report.json``).
     """
@@ -193,9 +197,10 @@ def write_report(responses_csv, clips_csv, participants_csv, out_dir, alpha: flo
     with open(os.path.join(out_dir, "participants_summary.json"), "w") as f:
         json.dump(report["participants"], f, indent=2)
     figs = {}
-    for name, fig in _make_figures(tables, extras).items():
-        if fig is not None:
-            figs[name] = figures.save_figure(fig, out_dir, name)
+    if figures:
+        for name, fig in _make_figures(tables, extras).items():
+            if fig is not None:
+                figs[name] = figure_mod.save_figure(fig, out_dir, name)
     report["meta"]["figures"] = {k: {t: os.path.basename(p) for t, p in v.items()} for k, v in figs.items()}
     with open(os.path.join(out_dir, "report.json"), "w") as f:
         json.dump(report, f, indent=1, allow_nan=False)
@@ -208,7 +213,8 @@ CSS = """body{font-family:system-ui,sans-serif;max-width:1100px;margin:2em auto;
 h1{font-size:1.5em}h2{font-size:1.15em;margin-top:2em;border-bottom:1px solid #ccc}
 table{border-collapse:collapse;font-size:.8em;margin:.5em 0}td,th{border:1px solid #ddd;padding:2px 6px;
 text-align:right}th{background:#f3f3f3}.banner{background:#fff3cd;border:1px solid #e0c36a;padding:.6em 1em;
-font-weight:bold}.fig svg{max-width:100%;height:auto}details{margin:.3em 0}ul.summary li{margin:.2em 0}"""
+font-weight:bold}.fig svg{max-width:100%;height:auto}details{margin:.3em 0}ul.summary li{margin:.2em 0}
+.wide{overflow-x:auto}.tables{display:flex;flex-wrap:wrap;gap:1.5em;align-items:flex-start}"""
 
 FIG_FOR_TABLE = {"gait_emotion_ad": "fig_emotion_vectors", "transition_ad": "fig_transitions",
                  "likert_distribution": "fig_likert", "vad_pearson": "fig_vad", "naturalness": "fig_naturalness",
@@ -225,11 +231,38 @@ def _inline_svg(path: str) -> str:
 
 def _table_html(df: pd.DataFrame) -> str:
     shown = df.head(MAX_HTML_ROWS)
-    body = shown.to_html(index=False, na_rep="", float_format=lambda x: f"{x:.4g}", border=0)
+    body = "<div class='wide'>" + shown.to_html(index=False, na_rep="", float_format=lambda x: f"{x:.4g}",
+                                                border=0) + "</div>"
     if len(df) > MAX_HTML_ROWS:
         body = (f"<details><summary>{len(df)} rows (first {MAX_HTML_ROWS} shown; all in the CSV)</summary>"
                 f"{body}</details>")
     return body
+
+
+def _participants_html(ps: dict) -> str:
+    def fmt(v):
+        return "" if v is None else f"{v:.4g}" if isinstance(v, float) else str(v)
+
+    scalars = [(k, ps[k]) for k in ("n_participants", "n_completed", "completion_rate", "n_with_responses",
+                                    "n_responses", "responses_per_participant", "synthetic") if k in ps]
+    dur, ms = ps.get("duration_s", {}), ps.get("response_ms", {})
+    scalars += [("duration_s median (completed)", dur.get("median")), ("duration_s q25..q75",
+                f"{fmt(dur.get('q25'))} .. {fmt(dur.get('q75'))}"), ("response_ms median", ms.get("median"))]
+    out = ["<div class='tables'><table><tbody>"]
+    out += [f"<tr><th>{html.escape(k)}</th><td>{html.escape(fmt(v))}</td></tr>" for k, v in scalars]
+    out.append("</tbody></table>")
+    for key in ("status", "gender", "age_group"):
+        rows = "".join(f"<tr><td>{html.escape(k)}</td><td>{v}</td></tr>" for k, v in ps.get(key, {}).items())
+        out.append(f"<table><thead><tr><th>{key}</th><th>n</th></tr></thead><tbody>{rows}</tbody></table>")
+    cross = ps.get("gender_by_age_group", {})
+    if cross:
+        ages = sorted({a for row in cross.values() for a in row})
+        head = "".join(f"<th>{html.escape(a)}</th>" for a in ages)
+        rows = "".join(f"<tr><th>{html.escape(g)}</th>" + "".join(f"<td>{row.get(a, 0)}</td>" for a in ages)
+                       + "</tr>" for g, row in cross.items())
+        out.append(f"<table><thead><tr><th>gender \\ age</th>{head}</tr></thead><tbody>{rows}</tbody></table>")
+    out.append("</div>")
+    return "".join(out)
 
 
 def render_html(report: dict, tables: dict, figs: dict) -> str:
@@ -248,8 +281,7 @@ def render_html(report: dict, tables: dict, figs: dict) -> str:
                  + "</ul>")
     if meta["notes"]:
         parts.append("<h2>Notes</h2><ul>" + "".join(f"<li>{h(s)}</li>" for s in meta["notes"]) + "</ul>")
-    ps = report["participants"]
-    parts.append("<h2>Participants</h2><pre>" + h(json.dumps(ps, indent=1)) + "</pre>")
+    parts.append("<h2>Participants</h2>" + _participants_html(report["participants"]))
     for k in TABLE_KEYS:
         parts.append(f"<h2 id='{k}'>{h(TITLES[k])}</h2>")
         df = tables[k]

@@ -30,16 +30,15 @@ import torch
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from generation.features import detect_foot_contacts, np_gait_affective_features  # noqa: E402
+from generation.features import np_gait_affective_features  # noqa: E402
 from generation.gait.data import load_corpus_sequences, world_rotations  # noqa: E402
-from generation.gait.generate import (EMOTIONS, distance_to_path, emotion_transition, generate_gaits,  # noqa: E402
-                                      load_model)
+from generation.gait.generate import EMOTIONS, distance_to_path, emotion_transition, generate_gaits, load_model  # noqa: E402
 from generation.gait.train import DEFAULT_WEIGHTS, rollout  # noqa: E402
 from generation.kinematics import forward_kinematics  # noqa: E402
 from generation.motion import Motion  # noqa: E402
 from generation.paths import random_path, straight  # noqa: E402
 from generation.quaternion import qangle  # noqa: E402
-from generation.skeleton import GAIT_PARENTS, gait_skeleton  # noqa: E402
+from generation.skeleton import GAIT_PARENTS  # noqa: E402
 
 PREFIX, HORIZON = 18, 42
 
@@ -65,10 +64,13 @@ def pose_rotation_errors(q_pred, h_pred, test) -> dict:
     clip_span = pos_t.reshape(len(pos_t), -1, 3)
     clip_diag = (clip_span.amax(1) - clip_span.amin(1)).norm(dim=-1)    # (N,) whole 42-step clip
     ang = qangle(rot_p, rot_t)                                         # (N, 42, J) radians
-    return {"pose_error_body_diag": float((err / diag).mean()), "pose_error_clip_diag": float(
-        (err.mean(1) / clip_diag).mean()), "pose_error_cm": float(100 * err.mean()),
+    return {"pose_error_body_diag": float((err / diag).mean()),
+            "pose_error_clip_diag": float((err.mean(1) / clip_diag).mean()),
+            "pose_error_cm": float(100 * err.mean()),
             "rotation_error_deg": float(torch.rad2deg(ang).mean()), "rotation_error_rad": float(ang.mean()),
-            "pose_error_first10_cm": float(100 * err[:, :10].mean()), "pose_error_last10_cm": float(100 * err[:, -10:].mean())}
+            "rotation_error_deg_per_joint": torch.rad2deg(ang).mean((0, 1)).tolist(),
+            "pose_error_first10_cm": float(100 * err[:, :10].mean()),
+            "pose_error_last10_cm": float(100 * err[:, -10:].mean())}
 
 
 def network_errors(net, test) -> dict:
@@ -331,7 +333,6 @@ def main(argv=None) -> int:
     ap.add_argument("--out", default="var/gait_runs/bench_gait.json")
     args = ap.parse_args(argv)
     torch.set_num_threads(1)
-    rng = np.random.default_rng(7)
     t_start = time.time()
 
     from generation.corpus import GaitCorpus

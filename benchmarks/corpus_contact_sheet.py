@@ -103,7 +103,7 @@ def paths_sheet(out: Path):
             toe = pos[:, 4 if f == 0 else 8]
             ax.plot(heel[res.heel_contact[:, f], 0], heel[res.heel_contact[:, f], 2], ".", color=c, ms=3)
             ax.plot(toe[res.toe_contact[:, f], 0], toe[res.toe_contact[:, f], 2], "x", color=c, ms=3)
-        ax.set_aspect("equal")
+        ax.set_aspect("equal", adjustable="datalim")
         ax.set_title(title)
         ax.set_xlabel("x (m)")
         ax.set_ylabel("z (m)")

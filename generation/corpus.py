@@ -306,7 +306,8 @@ class GestureCorpus:
 
     def motion(self, i: int) -> Motion:
         n = int(self.lengths[i])
-        meta = {"origin": "procedural", "synthetic": True, "corpus_index": int(i), "emotion_label": str(self.emotion[i]),
+        meta = {"origin": "procedural", "synthetic": True, "corpus_index": int(i),
+                "emotion_label": str(self.emotion[i]),
                 "vad": [float(x) for x in self.vad[i]], "task": str(self.task[i]), "split": str(self.split[i]),
                 "handedness": str(self.handedness[i]), "params": self.params[i]}
         return Motion(self.skeleton(i), self.rotations[i, :n], self.root_positions[i, :n], self.fps, meta)
@@ -413,7 +414,8 @@ def build_gesture_corpus(specs, seed: int = 0, fps: float = 30.0) -> GestureCorp
                 "vad_source": "NRC-VAD lexicon (Mohammad, ACL 2018)", "kinds": list(GESTURE_KINDS), "fps": fps}
     return GestureCorpus(rotations, roots, lengths, vad.astype(np.float32), emotion,
                          np.asarray([p[1] for p in parsed]), np.asarray([p[2] for p in parsed]),
-                         np.asarray([p[3] for p in parsed]), split, heights, params_out, float(fps), int(seed), metadata)
+                         np.asarray([p[3] for p in parsed]), split, heights, params_out, float(fps), int(seed),
+                         metadata)
 
 
 def default_gesture_specs(n_frames: int = 150) -> list[tuple[str, str, str, str, int]]:

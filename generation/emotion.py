@@ -108,15 +108,15 @@ _GAIT_PROTOTYPES = {
     "neutral": WalkParams.neutral(),
     "happy": WalkParams(cadence_spm=124.0, stride_m=1.52, arm_swing_rad=0.52, elbow_bend_rad=0.40,
                         torso_pitch_rad=-0.03, head_pitch_rad=-0.14, shoulder_raise_m=0.0, knee_lift_rad=1.25,
-                        lateral_sway_m=0.035, arm_abduction_rad=0.24, bounce_m=0.06, step_width_m=0.16,
+                        lateral_sway_m=0.035, arm_abduction_rad=0.24, bounce_m=0.045, step_width_m=0.16,
                         toe_out_rad=0.12, pelvis_rotation_rad=0.09, head_nod_rad=0.05, knee_bend_m=0.005),
     "sad": WalkParams(cadence_spm=86.0, stride_m=1.02, arm_swing_rad=0.08, elbow_bend_rad=0.12,
                       torso_pitch_rad=0.24, head_pitch_rad=0.62, shoulder_raise_m=-0.02, knee_lift_rad=0.75,
-                      lateral_sway_m=0.03, arm_abduction_rad=0.0, bounce_m=0.012, step_width_m=0.14,
+                      lateral_sway_m=0.03, arm_abduction_rad=0.0, bounce_m=0.008, step_width_m=0.14,
                       toe_out_rad=0.08, pelvis_rotation_rad=0.03, head_nod_rad=0.01, knee_bend_m=0.02),
     "angry": WalkParams(cadence_spm=128.0, stride_m=1.58, arm_swing_rad=0.50, elbow_bend_rad=0.85,
                         torso_pitch_rad=0.16, head_pitch_rad=0.08, shoulder_raise_m=0.025, knee_lift_rad=1.1,
-                        lateral_sway_m=0.02, arm_abduction_rad=0.30, bounce_m=0.025, step_width_m=0.20,
+                        lateral_sway_m=0.02, arm_abduction_rad=0.30, bounce_m=0.018, step_width_m=0.20,
                         toe_out_rad=0.10, pelvis_rotation_rad=0.08, head_nod_rad=0.015, knee_bend_m=0.012),
 }
 

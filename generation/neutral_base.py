@@ -8,7 +8,8 @@ result was perceived as neutral by 75 % of viewers (Table I). We do the same wit
    several body sizes and builds, plus the real captured walks of :func:`generation.captured.captured_walks`
    when that module is available and they use the gait skeleton.
 2. Cutting: a cycle runs from a left heel strike to the next one, with one right heel strike between
-   (strikes are the onsets of :func:`generation.features.detect_foot_contacts`).
+   (strikes are the onsets of :func:`generation.features.detect_foot_contacts`). Cycles in which a joint
+   jumps faster than 10 m/s (a capture or rig glitch) are left out and counted in the metadata.
 3. Time normalisation: *contact-based piecewise-linear warping* (not CoTW or DTW): left strike -> frame 0,
    right strike -> frame m/2, next left strike -> frame m, linear in between; positions are interpolated
    linearly at the warped times.
@@ -36,6 +37,7 @@ TIME_WARPING = "contact-based piecewise-linear (left heel strike -> 0, right -> 
 DEFAULT_BODIES = ((1.58, "female"), (1.66, "female"), (1.74, "female"), (1.70, "male"), (1.78, "male"),
                   (1.86, "male"), (1.94, "male"), (1.62, "female"))
 MIN_CYCLE_S, MAX_CYCLE_S = 0.6, 2.5
+MAX_JOINT_SPEED_M_S = 10.0  # for a 1.75 m body; faster joints mean a glitch in the source
 
 
 @dataclass
@@ -113,15 +115,25 @@ def normalise_cycle(positions: np.ndarray, skeleton: Skeleton, fps: float, strik
     return NormalisedCycle(P / h, stride / h, (l1 - l0) / fps, source)
 
 
-def motion_cycles(motion: Motion, m: int = 100, source: str = "") -> list[NormalisedCycle]:
-    """All complete cycles of a walk, normalised (empty if no full cycle is found)."""
+def motion_cycles(motion: Motion, m: int = 100, source: str = "") -> tuple[list[NormalisedCycle], int]:
+    """All complete cycles of a walk, normalised, and how many were rejected as glitches.
+
+    A cycle is rejected when a joint moves faster than :data:`MAX_JOINT_SPEED_M_S` between two frames (a
+    capture or rig glitch; walking peaks at about 6 m/s at the feet).
+    """
     if tuple(motion.skeleton.joints) != GAIT_JOINTS:
         raise ValueError(f"neutral base needs walks on the 21-joint gait skeleton; {source or 'a motion'} uses "
                          f"{motion.skeleton.name!r} with {motion.skeleton.num_joints} joints")
     positions = motion.positions()
     left, right = heel_strikes(positions, motion.fps, motion.skeleton)
-    return [normalise_cycle(positions, motion.skeleton, motion.fps, s, m, source)
-            for s in cut_cycles(left, right, motion.fps)]
+    speed = np.linalg.norm(np.diff(positions, axis=0), axis=-1).max(axis=1) * motion.fps  # (T - 1,)
+    out, rejected = [], 0
+    for s in cut_cycles(left, right, motion.fps):
+        if speed[s[0]:s[2]].max() > MAX_JOINT_SPEED_M_S * motion.skeleton.height / 1.75:
+            rejected += 1
+            continue
+        out.append(normalise_cycle(positions, motion.skeleton, motion.fps, s, m, source))
+    return out, rejected
 
 
 def average_cycles(cycles: list[NormalisedCycle]) -> tuple[np.ndarray, float, float]:
@@ -168,12 +180,17 @@ def neutral_cycle_from_motions(motions: list[Motion], skeleton: Skeleton | None 
     cycles: list[NormalisedCycle] = []
     used: list[dict] = []
     for motion, name in zip(motions, names):
-        found = motion_cycles(motion, m, name)
+        found, rejected = motion_cycles(motion, m, name)
         limit = motion.metadata.get("max_cycles")
         found = found[: int(limit)] if limit is not None else found
         cycles += found
-        used.append({"name": name, "cycles": len(found), "height": motion.skeleton.height,
+        used.append({"name": name, "cycles": len(found), "rejected_cycles": rejected, "height": motion.skeleton.height,
                      "build": motion.skeleton.build, "synthetic": bool(motion.metadata.get("synthetic", False))})
+    if not cycles:
+        rejected = {u["name"]: u["rejected_cycles"] for u in used if u["rejected_cycles"]}
+        raise ValueError("no walk cycles to average: no left-right-left heel strike sequence was found"
+                         + (f"; cycles rejected as glitches (a joint faster than {MAX_JOINT_SPEED_M_S} m/s): "
+                            f"{rejected}" if rejected else ""))
     mean, stride, duration = average_cycles(cycles)
     H = skeleton.height
     positions = mean * H
@@ -233,7 +250,8 @@ def _is_straight(motion: Motion, max_turn_deg: float = 20.0) -> bool:
 def captured_sources() -> list[Motion]:
     """Real captured straight walks on the gait skeleton from :mod:`generation.captured`, or [] if unavailable.
 
-    Turning clips are left out (the paper averaged straight walks). A loopable clip (``loop == "wrap"``) is
+    Turning clips (described as turning, or turning by more than 20 degrees) are left out: the paper averaged
+    straight walks. A loopable clip (``loop == "wrap"``) is
     repeated three times so a full left-right-left cycle can be cut from it; ``max_cycles`` = 1 in the metadata
     tells :func:`neutral_cycle_from_motions` to keep only its first cycle, so the repeat does not count twice.
     """
@@ -243,7 +261,8 @@ def captured_sources() -> list[Motion]:
         return []
     out = []
     for mo in captured_walks():
-        if tuple(mo.skeleton.joints) != GAIT_JOINTS or not _is_straight(mo):
+        turning = "turn" in str(mo.metadata.get("description", "")).lower()
+        if tuple(mo.skeleton.joints) != GAIT_JOINTS or turning or not _is_straight(mo):
             continue
         name = str(mo.metadata.get("source", "captured walk"))
         if mo.metadata.get("loop") == "wrap":

@@ -8,7 +8,7 @@ How a walk is made (all in metres, seconds, radians):
 1. Timing. The gait cycle phase is ``phi(t) = phase + t * cadence / 120`` cycles (a cycle is two
    steps). The left heel strikes at integer ``phi``, the right heel half a cycle later. Each foot
    is on the ground for the first 60 % of its cycle: heel rocker (toe lowering onto the ground,
-   heel joint fixed) for 10 %, foot flat until 35 %, then heel rise about the fixed toe until
+   heel joint fixed) for 10 %, foot flat until 30 %, then heel rise about the fixed toe until
    toe-off at 60 %; the remaining 40 % is swing.
 2. Path. The root moves along a corner-rounded copy of the :class:`~generation.paths.GroundPath`
    at constant speed ``stride_m * cadence / 120`` m/s (a stride is two steps), facing the path
@@ -41,7 +41,7 @@ from .skeleton import GAIT_JOINTS, Skeleton, gait_skeleton
 
 # Fractions of the gait cycle for one foot (0 = its heel strike).
 HEEL_ROCKER_END = 0.10
-HEEL_OFF = 0.35
+HEEL_OFF = 0.30
 TOE_OFF = 0.60
 
 _J = {name: i for i, name in enumerate(GAIT_JOINTS)}
@@ -69,7 +69,7 @@ class WalkParams:
             ``0.02 + 0.18 * (1 - cos(knee_lift_rad))`` metres (about 0.10 m at 1.0 rad).
         lateral_sway_m: amplitude of the pelvis' side-to-side sway toward the stance foot.
         arm_abduction_rad: arms held out from the body (expansion); 0 = hanging at the sides.
-        bounce_m: peak-to-peak vertical pelvis oscillation (before reach limits).
+        bounce_m: peak-to-peak vertical pelvis oscillation, highest at mid-stance (before reach limits).
         step_width_m: lateral distance between the left and right footprints.
         toe_out_rad: outward yaw of each foot.
         pelvis_rotation_rad: amplitude of the pelvis' yaw oscillation (the swinging hip leads).
@@ -87,7 +87,7 @@ class WalkParams:
     knee_lift_rad: float = 1.0
     lateral_sway_m: float = 0.025
     arm_abduction_rad: float = 0.10
-    bounce_m: float = 0.03
+    bounce_m: float = 0.02
     step_width_m: float = 0.16
     toe_out_rad: float = 0.10
     pelvis_rotation_rad: float = 0.06
@@ -318,11 +318,11 @@ def walk_with_contacts(params: WalkParams, path: GroundPath | None = None, n_fra
     pitch_max = float(np.clip(0.85 + 0.4 * (params.stride_m - 1.4), 0.4, 1.2))
     lift = (0.02 + 0.18 * (1.0 - np.cos(params.knee_lift_rad))) * scale
     half_width = 0.5 * params.step_width_m * scale
-    footprint_at = 0.18                          # pelvis is over the heel 18 % into stance
+    footprint_at = 0.16                          # pelvis is over the heel 16 % into stance
     stand = -(off[_J["left_hip"], 1] + off[_J["left_knee"], 1] + off[_J["left_heel"], 1]) + ankle_h
     len_thigh = float(np.linalg.norm(off[_J["left_knee"]]))
     len_shin = float(np.linalg.norm(off[_J["left_heel"]]))
-    reach = 0.995 * (len_thigh + len_shin)
+    reach = 0.998 * (len_thigh + len_shin)
 
     def pelvis_at(time):
         """Nominal root position (n, 3), root rotation (n, 4) and path heading (n,) at times (n,)."""
@@ -330,20 +330,20 @@ def walk_with_contacts(params: WalkParams, path: GroundPath | None = None, n_fra
         s = path_s(time)
         h = heading(s)
         xz = smooth.point_at(s) + (params.lateral_sway_m * scale * np.sin(2 * np.pi * ph))[:, None] * left_normal(h)
-        y = stand - params.knee_bend_m * scale - 0.5 * params.bounce_m * scale * (1.0 + np.cos(4 * np.pi * (ph - 0.05)))
+        y = stand - params.knee_bend_m * scale - 0.5 * params.bounce_m * scale * (1.0 - np.cos(4 * np.pi * (ph - 0.2)))
         q = yaw_quat(h - params.pelvis_rotation_rad * np.cos(2 * np.pi * ph))
         return np.column_stack([xz[:, 0], y, xz[:, 1]]), q, h
 
-    pitch_grid = np.linspace(0.0, 1.3, 66)
+    pitch_grid = np.linspace(0.0, 1.2, 61)
 
     def required_pitch(time, hip_name, toe_pos, yaw):
-        """Smallest heel-rise pitch (n,) that brings the ankle within 97 % of the leg's reach of the
+        """Smallest heel-rise pitch (n,), at most 1.2 rad, that brings the ankle within 95 % of the leg's reach of the
         nominal hip when the foot pivots about its planted toe (so the trailing leg, not the pelvis, gives way)."""
         root_n, q_n, _ = pelvis_at(time)
         hip = root_n + np_qrot(q_n, np.broadcast_to(off[_J[hip_name]], root_n.shape))
         q = np_qmul(yaw_quat(yaw)[:, None], axis_angle(_X, np.broadcast_to(pitch_grid, (len(time), len(pitch_grid)))))
         ankles = toe_pos[:, None] - np_qrot(q, np.broadcast_to(toe_off_vec, q.shape[:-1] + (3,)))
-        ok = np.linalg.norm(ankles - hip[:, None], axis=-1) <= 0.97 * (len_thigh + len_shin)
+        ok = np.linalg.norm(ankles - hip[:, None], axis=-1) <= 0.95 * (len_thigh + len_shin)
         first = np.where(ok.any(1), ok.argmax(1), len(pitch_grid) - 1)
         return pitch_grid[first]
 

@@ -215,6 +215,8 @@ def swing_params(trajectory: np.ndarray, shape: int, alpha: float) -> np.ndarray
     - type 3: two bumps at the two largest peaks of the dominant side (a twice-per-cycle motion);
     - type 4: +alpha at the maximum and -alpha at the minimum (a once-per-cycle oscillation).
 
+    A DOF that is constant in the neutral cycle gets its bumps at the mid-stances (m/4, 3m/4).
+
     Args:
         trajectory: (m,) neutral positions of the DOF over one cycle, metres.
         shape: 2, 3 or 4.
@@ -228,6 +230,13 @@ def swing_params(trajectory: np.ndarray, shape: int, alpha: float) -> np.ndarray
         raise ValueError(f"swing placement needs a (m >= 8,) trajectory, got shape {x.shape}")
     m = x.size
     d = x - x.mean()
+    if np.ptp(d) < 1e-9:
+        # A DOF that does not move in the neutral cycle has no extremum to push: put the bumps at the two
+        # mid-stances (a quarter and three quarters of a left-to-left cycle).
+        mus = {2: (0.25 * m,), 3: (0.25 * m, 0.75 * m), 4: (0.25 * m, 0.75 * m)}
+        if shape not in mus:
+            raise ValueError(f"swing features use shapes 2, 3 or 4, got {shape!r}")
+        return shape_params(shape, alpha, mus[shape], m)
     if shape == 2:
         k = int(np.argmax(np.abs(d)))
         sign = 1.0 if d[k] >= 0 else -1.0

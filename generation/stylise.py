@@ -8,13 +8,16 @@ Pipeline (shapes: m cycle frames, J joints):
    Table III and each joint of its body part, up to three Gaussian RBFs (eq. 4) on one Cartesian axis,
    amplitudes = intensity x walker height. Posture features are shape 1; movement features are placed on the
    extrema of the joint's own neutral trajectory (relative to the root) by :func:`generation.rbf.swing_params`.
-   Joints the paper's 54-DOF model lacks (toes, hand tips) carry their parent's displacement.
+   An axis of a joint with no edit of its own follows its parent's edit (:func:`theme_displacement`), so a
+   lifted knee lifts the foot and the toes and hand tips, which the paper's 54-DOF model lacks, follow.
 3. ``Y = P + w * S``: the paper's linear model (eq. 1 with r = 1). A negative w inverts only the amplitudes.
 4. The paper edits Cartesian positions and so does not keep bone lengths (its stated limitation). We put
-   ``Y`` back onto the skeleton (:func:`fit_to_skeleton`): legs and arms by analytic two-bone IK that reaches
-   the edited heel/hand position when it is reachable, bending in the plane of the edited knee/elbow; other
-   bones keep the edited direction; joints with several children (pelvis, chest) take the best rotation of
-   their children (Horn's quaternion method). Twist comes from the neutral motion. Bone lengths are then exact.
+   ``Y`` back onto the skeleton (:func:`fit_to_skeleton`): foot joints are first kept above their neutral
+   floor height (:func:`keep_feet_above_ground`); legs and arms are solved by analytic two-bone IK that
+   reaches the edited heel/hand position when it is reachable, bending in the neutral bend plane turned by
+   the knee/elbow edit; toes and hand tips keep their edited height; other bones keep the edited direction;
+   joints with several children (pelvis, chest) take the best rotation onto their children (Horn's
+   quaternion method). Twist comes from the neutral motion. Bone lengths are then exact.
 5. Uniform time warping for speed (cycle duration / speed) and the cycle repeated n_cycles times along +z.
 """
 from __future__ import annotations
@@ -22,7 +25,7 @@ from __future__ import annotations
 import numpy as np
 import torch
 
-from .kinematics import forward_kinematics
+from .kinematics import forward_kinematics, np_forward_kinematics
 from .motion import Motion
 from .quaternion import np_qbetween, np_qconj, np_qfix, np_qmul, np_qrot, np_qslerp
 from .rbf import CYCLE_FRAMES, rbf_sum, shape_params, swing_params
@@ -272,7 +275,7 @@ def fit_to_skeleton(target: np.ndarray, skeleton: Skeleton, reference_rotations:
     parents = skeleton.parents
     kids = skeleton.children()
     ref_global = global_rotations(reference_rotations, target[:, 0], skeleton)
-    ref_pos = forward_kinematics_np(reference_rotations, target[:, 0], skeleton)
+    ref_pos = np_forward_kinematics(reference_rotations, target[:, 0], skeleton)
     goal = target.copy()  # where each joint should go; limb chains overwrite middle and end joints
     chain_of = {skeleton.index(c[0]): (skeleton.index(c[1]), skeleton.index(c[2])) for c in chains}
     chain_ends = {skeleton.index(c[2]) for c in chains}
@@ -375,9 +378,10 @@ def stylised_cycle(neutral_cycle: Motion, theme: str, weight: float, n_features:
     Y = P + float(weight) * S
     target, lifted = keep_feet_above_ground(Y, P, skel) if keep_ground else (Y, 0.0)
     rotations, root = fit_to_skeleton(target, skel, neutral_cycle.rotations)
-    fitted = forward_kinematics_np(rotations, root, skel)
+    fitted = np_forward_kinematics(rotations, root, skel)
     return {
-        "P": P, "S": S, "Y": Y, "target": target, "rotations": rotations, "root": root + progression, "positions": fitted,
+        "P": P, "S": S, "Y": Y, "target": target, "rotations": rotations, "root": root + progression,
+        "positions": fitted,
         "before": bone_length_error(Y, skel), "after": bone_length_error(fitted, skel),
         "residual": float(np.linalg.norm(fitted - Y, axis=-1).max()), "ground_lift": lifted,
     }
@@ -400,12 +404,6 @@ def keep_feet_above_ground(Y: np.ndarray, P: np.ndarray, skeleton: Skeleton) -> 
     lifted = float((clamped - out[:, feet, 1]).max())
     out[:, feet, 1] = clamped
     return out, lifted
-
-
-def forward_kinematics_np(rotations: np.ndarray, root: np.ndarray, skeleton: Skeleton) -> np.ndarray:
-    from .kinematics import np_forward_kinematics
-
-    return np_forward_kinematics(rotations, root, skeleton)
 
 
 def stylise(neutral_cycle: Motion, theme: str, weight: float, n_features: int, speed: float = 1.0,
@@ -457,5 +455,26 @@ def stylise(neutral_cycle: Motion, theme: str, weight: float, n_features: int, s
     return Motion(neutral_cycle.skeleton, rotations, root, fps, metadata)
 
 
-__all__ = ["stylise", "stylised_cycle", "theme_rbfs", "theme_displacement", "fit_to_skeleton",
+def neutral_walk(neutral_cycle: Motion, speed: float = 1.0, n_cycles: int = 4, fps: float = 30.0) -> Motion:
+    """The neutral cycle itself walked like a stylised clip (for the neutral-validation section, Table I).
+
+    Same timing and path as :func:`stylise`; metadata origin "generated", generator "neutral_base", theme
+    "neutral", weight 0, n_features 0, speed, synthetic_base.
+    """
+    if not speed > 0 or not np.isfinite(speed):
+        raise ValueError(f"speed must be a positive number, got {speed!r}")
+    if isinstance(n_cycles, bool) or not isinstance(n_cycles, int) or n_cycles < 1:
+        raise ValueError(f"n_cycles must be a positive integer, got {n_cycles!r}")
+    stride = cycle_stride(neutral_cycle)
+    walker_frame_positions(neutral_cycle)  # validates length and heading
+    rotations, root = repeat_cycle(neutral_cycle.rotations, neutral_cycle.root_positions, stride,
+                                   neutral_cycle.duration, speed, n_cycles, fps)
+    meta = neutral_cycle.metadata
+    metadata = {"origin": "generated", "generator": "neutral_base", "theme": "neutral", "weight": 0.0,
+                "n_features": 0, "speed": float(speed), "n_cycles": n_cycles,
+                "synthetic_base": bool(meta.get("synthetic", meta.get("synthetic_base", True)))}
+    return Motion(neutral_cycle.skeleton, rotations, root, fps, metadata)
+
+
+__all__ = ["neutral_walk", "stylise", "stylised_cycle", "theme_rbfs", "theme_displacement", "fit_to_skeleton",
            "walker_frame_positions", "repeat_cycle", "bone_length_error", "CYCLE_FRAMES"]

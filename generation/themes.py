@@ -126,12 +126,12 @@ OUTWARD = {"right": -1, "left": 1}  # "R along -X, L along +X"
 
 THEMES: dict[str, tuple[Feature, ...]] = {
     "happy": (
-        _swing(1, "shoulders", "Z", 4, 0.025),
+        _swing(1, "shoulders", "Z", 4, 0.030),
         _swing(2, "wrists", "Z", 4, 0.070),  # strongest in Fig. 5
-        _swing(3, "knees", "Y", 2, 0.030),
+        _swing(3, "knees", "Y", 2, 0.035),
         _swing(4, "head", "X", 4, 0.012),
-        _swing(5, "wrists", "X", 4, 0.025),
-        _swing(6, "hip", "X", 4, 0.012),
+        _swing(5, "wrists", "X", 4, 0.030),
+        _swing(6, "hip", "X", 4, 0.015),
         _swing(7, "knees", "X", 2, 0.012),
         _tilt(8, "neck", "Y", +1, 0.010),
         _tilt(9, "head", "Y", +1, 0.012),
@@ -139,12 +139,12 @@ THEMES: dict[str, tuple[Feature, ...]] = {
     ),
     "sad": (
         _tilt(1, "shoulders", "Y", -1, 0.030),
-        _tilt(2, "head", "Y", -1, 0.060),
+        _tilt(2, "head", "Y", -1, 0.050),
         _tilt(3, "neck", "Y", -1, 0.025),
         _swing(4, "shoulders", "Z", 4, 0.020, sign=-1),
         _swing(5, "wrists", "Y", 3, 0.015, sign=-1),
         _tilt(6, "torso_u", "Y", -1, 0.015),
-        _tilt(7, "head", "Z", +1, 0.060),
+        _tilt(7, "head", "Z", +1, 0.055),
         _tilt(8, "neck", "Z", +1, 0.040),
         _tilt(9, "elbows", "Y", -1, 0.015),
         _tilt(10, "hip", "Y", -1, 0.015),
@@ -152,9 +152,9 @@ THEMES: dict[str, tuple[Feature, ...]] = {
     "energetic": (
         _swing(1, "knees", "Y", 2, 0.040),
         _tilt(2, "head", "Y", +1, 0.015),
-        _swing(3, "elbows", "X", 4, 0.020),
+        _swing(3, "elbows", "X", 4, 0.025),
         _swing(4, "elbows", "Z", 4, 0.040),
-        _swing(5, "shoulders", "Y", 3, 0.012),
+        _swing(5, "shoulders", "Y", 3, 0.015),
         _swing(6, "shoulders", "Z", 4, 0.030),
         _swing(7, "wrists", "Z", 4, 0.050),
         _swing(8, "wrists", "X", 4, 0.025),
@@ -174,16 +174,16 @@ THEMES: dict[str, tuple[Feature, ...]] = {
         _tilt(10, "torso_u", "Z", +1, 0.040),
     ),
     "feminine": (
-        _swing(1, "hip", "X", 4, 0.025),
+        _swing(1, "hip", "X", 4, 0.030),
         _tilt(2, "ankles", "X", +1, 0.030, **INWARD),
         _tilt(3, "knees", "X", +1, 0.025, **INWARD),
-        _swing(4, "torso_l", "X", 4, 0.015),
+        _swing(4, "torso_l", "X", 4, 0.020),
         _tilt(5, "thighs", "X", +1, 0.012, **INWARD),
-        _swing(6, "torso_u", "X", 4, 0.015),
-        _swing(7, "thighs", "Y", 2, 0.012),
+        _swing(6, "torso_u", "X", 4, 0.020),
+        _swing(7, "thighs", "Y", 2, 0.015),
         _tilt(8, "shoulders", "Y", -1, 0.012),
-        _swing(9, "elbows", "X", 4, 0.020),
-        _swing(10, "wrists", "X", 4, 0.025),
+        _swing(9, "elbows", "X", 4, 0.025),
+        _swing(10, "wrists", "X", 4, 0.030),
     ),
     "masculine": (
         _swing(1, "shoulders", "Z", 4, 0.030),
@@ -192,8 +192,8 @@ THEMES: dict[str, tuple[Feature, ...]] = {
         _tilt(4, "elbows", "X", +1, 0.030, **OUTWARD),
         _swing(5, "ankles", "Y", 2, 0.070),  # strongest in Fig. 5
         _swing(6, "knees", "Y", 2, 0.030),
-        _swing(7, "head", "Z", 3, 0.012),
-        _swing(8, "neck", "Z", 3, 0.010),
+        _swing(7, "head", "Z", 3, 0.015),
+        _swing(8, "neck", "Z", 3, 0.012),
         # Table III lists "Shoulders: increased swing along Z" twice (ranks 1 and 9). We keep both; the
         # second is a one-bump feature so the DOF stays within the paper's M <= 3 RBFs (2 + 1).
         _swing(9, "shoulders", "Z", 2, 0.015),

@@ -107,7 +107,9 @@ PRESETS["demo"] = {
     "sections": [
         dict(PRESETS["gait_ismar2020"]["sections"][0], clips_per_participant=2),
         dict(PRESETS["gait_ismar2020"]["sections"][1], clips_per_participant=1),
-        dict(PRESETS["gait_ismar2020"]["sections"][2]),
+        dict(PRESETS["gait_ismar2020"]["sections"][2],
+             instructions="You will see the walks of the first section again. Rate the torso, the arms, the pace "
+                          "and the flow of each walk."),
         dict(PRESETS["gait_ismar2020"]["sections"][3], clips_per_participant=2,
              options={"anchors": NATURALNESS_ANCHORS_GAIT, "n_generated": 1, "n_source": 1}),
         dict(PRESETS["gestures_ieeevr2021"]["sections"][0], clips_per_participant=2),
@@ -118,6 +120,13 @@ PRESETS["demo"] = {
         dict(PRESETS["rbf_thms2016"]["sections"][2], clips_per_participant=1),
     ],
 }
+
+
+for _sec in PRESETS["demo"]["sections"]:       # the demo mixes the papers' sections: drop their "Section N:" prefixes
+    _title = _sec["title"].split(": ", 1)[-1]
+    _sec["title"] = _title[:1].upper() + _title[1:]
+PRESETS["demo"]["sections"][0]["title"] = "Perceived emotion: walks"
+PRESETS["demo"]["sections"][4]["title"] = "Perceived emotion: gestures"
 
 
 def preset_choices() -> list[tuple[str, str]]:

@@ -46,16 +46,19 @@ def tiny_mp4(path: Path, seconds: float = 1.0, fps: int = 10, size: int = 64, sh
 
 
 def make_catalogue(media_root: Path, video_bytes: bytes | None = None, duration_s: float | None = None,
-                   n_gait: int = 10, n_transition: int = 6, n_gait_source: int = 4, n_gesture: int = 12) -> int:
+                   n_gait: int = 10, n_transition: int = 6, n_gait_source: int = 4, n_gesture: int = 12,
+                   gesture_video_bytes: bytes | None = None) -> int:
     """Insert a synthetic catalogue: generated/source gaits, transitions, gestures (each generated gesture made from
     a source gesture), one neutral RBF input walk and RBF theme clips with positive and negative weights."""
     records = []
 
-    def media(tag: str) -> str:
-        return write_media(media_root, video_bytes if video_bytes is not None else f"dummy {tag}".encode())
+    def media(tag: str, modality: str) -> str:
+        payload = gesture_video_bytes if modality == "gesture" and gesture_video_bytes is not None else video_bytes
+        return write_media(media_root, payload if payload is not None else f"dummy {tag}".encode())
 
     def base(clip_id: str, modality: str, origin: str, **extra) -> dict:
-        rec = {"clip_id": clip_id, "modality": modality, "origin": origin, "video": media(clip_id), "webm": "",
+        rec = {"clip_id": clip_id, "modality": modality, "origin": origin, "video": media(clip_id, modality),
+               "webm": "",
                "poster": "", "plan": "test", "loop": False, "duration_s": duration_s,
                "metadata": {"synthetic": True, "note": "test placeholder, not rendered motion"}}
         rec.update(extra)

@@ -64,7 +64,7 @@ def test_report_files(report_dir):
 def test_write_report_accepts_file_objects(tmp_path):
     r, c, p = simulate_study(8, seed=1)
     bufs = [io.StringIO(df.to_csv(index=False)) for df in (r, c, p)]
-    rep = write_report(*bufs, tmp_path, alpha=0.01, permutations=50)
+    rep = write_report(*bufs, tmp_path, alpha=0.01, permutations=50, figures=False)
     assert rep["meta"]["alpha"] == 0.01
     assert all(rec["p_perm"] is not None for rec in rep["gait_emotion_ad"])
 
@@ -82,10 +82,11 @@ def test_clis(tmp_path):
                          capture_output=True, text=True, timeout=120)
     assert res.returncode == 0, res.stderr
     args = [str(src / "responses.csv"), str(src / "clips.csv"), str(src / "participants.csv")]
-    res = subprocess.run([sys.executable, "-m", "analysis", *args, "--out", str(tmp_path / "rep")],
+    res = subprocess.run([sys.executable, "-m", "analysis", *args, "--out", str(tmp_path / "rep"), "--no-figures"],
                          capture_output=True, text=True, timeout=300)
     assert res.returncode == 0, res.stderr
-    assert (tmp_path / "rep" / "report.html").exists()
+    assert "SYNTHETIC" in res.stdout
+    assert (tmp_path / "rep" / "report.html").exists() and not (tmp_path / "rep" / "fig_vad.png").exists()
     # invalid input: exit status 2 and a message naming file, line and column
     text = (src / "responses.csv").read_text().splitlines()
     text[1] = text[1].replace("emotion_choice", "emotion_choise")

@@ -3,7 +3,7 @@ the back button, finish, and check the exported responses.csv holds every answer
 
 Set STUDY_SCREENSHOTS=<folder> to save a screenshot of the first clip page of each section type there
 (docs/img/study_<section_type>.png are made this way); STUDY_SCREENSHOT_VIDEO=<mp4> (and STUDY_SCREENSHOT_SECONDS)
-uses a rendered clip instead of the 1-second test pattern.
+(and STUDY_SCREENSHOT_GESTURE_VIDEO for gesture clips) use rendered clips instead of the 1-second test pattern.
 """
 from __future__ import annotations
 
@@ -45,12 +45,12 @@ def path_of(driver) -> str:
 def full_shot(driver, path: Path, width: int = 1000):
     """Screenshot of the whole page: the window is made as tall as the document first."""
     driver.set_window_size(width, 900)
-    for _ in range(3):
+    for _ in range(5):
         inner, height = driver.execute_script(
             "return [window.innerHeight, document.documentElement.scrollHeight]")
         if inner >= height:
             break
-        driver.set_window_size(width, min(900 + int(height) - int(inner) + 4, 4000))
+        driver.set_window_size(width, min(driver.get_window_size()["height"] + int(height) - int(inner) + 24, 4000))
     driver.execute_script("window.scrollTo(0, 0); document.activeElement && document.activeElement.blur()")
     time.sleep(0.3)
     driver.save_screenshot(str(path))
@@ -80,7 +80,9 @@ def test_whole_demo_study_in_chromium(chromium, live_server, settings, tmp_path)
         seconds = float(os.environ.get("STUDY_SCREENSHOT_SECONDS", "3"))
     else:
         video, seconds = tiny_mp4(tmp_path / "clip.mp4", seconds=1.0, size=160), 1.0
-    make_catalogue(settings.MEDIA_ROOT, video_bytes=video.read_bytes(), duration_s=seconds)
+    gesture = os.environ.get("STUDY_SCREENSHOT_GESTURE_VIDEO") if shots else None
+    make_catalogue(settings.MEDIA_ROOT, video_bytes=video.read_bytes(), duration_s=seconds,
+                   gesture_video_bytes=Path(gesture).read_bytes() if gesture else None)
     study = create_study_from_preset("demo", "demo", status=Study.Status.OPEN,
                                      completion_redirect="https://example.org/complete?cc={code}")
     driver = chromium
@@ -111,6 +113,8 @@ def test_whole_demo_study_in_chromium(chromium, live_server, settings, tmp_path)
             if shots:
                 pick_answers(driver, 2)
                 full_shot(driver, Path(shots) / f"study_{stype}.png")
+                if stype == "affect_likert":
+                    full_shot(driver, Path(shots) / "study_phone_affect_likert.png", width=390)
         pick_answers(driver, n % 3)
         if n == 2 and not reloaded:
             # reload mid-section before answering: same clip again, nothing saved, nothing lost

@@ -8,14 +8,26 @@ import pytest
 import torch
 
 from generation.gait.config import GaitNetConfig
-from generation.gait.data import (Normalizer, from_heading_frame, prepare_sequences, root_features,
-                                  to_heading_frame)
-from generation.gait.generate import (LoadedGaitNet, emotion_transition, generate_gaits, load_default_model,
-                                      load_model, normalize_emotion)
+from generation.gait.data import Normalizer, from_heading_frame, prepare_sequences, root_features, to_heading_frame
+from generation.gait.generate import (
+    LoadedGaitNet,
+    emotion_transition,
+    generate_gaits,
+    load_default_model,
+    load_model,
+    normalize_emotion,
+)
 from generation.gait.losses import motion_loss, total_loss
 from generation.gait.model import GaitNet
-from generation.gait.train import (DEFAULT_WEIGHTS, fit_normalizer, ground_truth_targets, load_checkpoint,
-                                   rollout, save_checkpoint, train)
+from generation.gait.train import (
+    DEFAULT_WEIGHTS,
+    fit_normalizer,
+    ground_truth_targets,
+    load_checkpoint,
+    rollout,
+    save_checkpoint,
+    train,
+)
 from generation.motion import Motion
 from generation.paths import curved, sharp_turn, straight
 from generation.procedural_walk import WalkParams, walk

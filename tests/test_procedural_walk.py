@@ -7,6 +7,7 @@ import pytest
 from generation import paths
 from generation.features import foot_skate
 from generation.procedural_walk import WalkParams, planted_foot_slide, walk, walk_with_contacts
+from generation.quaternion import np_qrot
 from generation.skeleton import gait_skeleton, gesture_skeleton
 
 PATHS = {
@@ -56,7 +57,7 @@ def test_walk_follows_the_path(walks, kind):
     assert travelled == pytest.approx(WalkParams.neutral().speed_mps * 239 / 30.0, rel=0.1)
     # at the end the body faces along the path
     s_end = WalkParams.neutral().speed_mps * 239 / 30.0
-    fwd = res.motion.positions()[-1, 4] - res.motion.positions()[-1, 3]   # left heel -> toe
+    fwd = np_qrot(res.motion.rotations[-1, 0], np.array([0.0, 0.0, 1.0]))   # root facing direction
     heading = np.arctan2(fwd[0], fwd[2])
     expected = path.heading_at(min(s_end, path.length - 1e-6))
     assert abs(np.angle(np.exp(1j * (heading - expected)))) < np.radians(25)

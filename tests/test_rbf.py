@@ -192,3 +192,9 @@ def test_feature_validation_names_the_feature():
         Feature(1, "head", "Y", "tilt", 1, 2, 0.01)
     with pytest.raises(ValueError, match="axis"):
         Feature(1, "head", "W", "tilt", 1, 1, 0.01)
+
+
+def test_swing_on_a_still_dof_uses_the_mid_stances():
+    p = R.swing_params(np.zeros(100), 4, 0.02)
+    np.testing.assert_allclose(p[:, :2], [[0.02, 25.0], [-0.02, 75.0]])
+    assert R.swing_params(np.ones(100), 3, 0.02)[:, 1].tolist() == [25.0, 75.0]

@@ -107,7 +107,7 @@ def test_double_submit_and_back_button_store_one_answer(client, study):
     assert Response.objects.filter(participant=p, clip=a.clip).count() == len(data)
     # back button: the old page redirects to where the participant is
     r = client.get(url)
-    assert r.status_code == 302 and r["Location"].endswith("/p/%s/" % p.token)
+    assert r.status_code == 302 and r["Location"].endswith(f"/p/{p.token}/")
     assert client.get(r["Location"])["Location"].endswith("/clip/2/")
 
 

@@ -5,21 +5,69 @@ import numpy as np
 import pytest
 
 from generation.motion import Motion
-from generation.neutral_base import (cut_cycles, default_sources, neutral_cycle_from_motions, warp_times)
+from generation.neutral_base import (
+    average_cycles,
+    cut_cycles,
+    default_sources,
+    neutral_cycle_from_motions,
+    normalise_cycle,
+    warp_times,
+)
 from generation.quaternion import np_qfrom_axis_angle, np_qrot
 from generation.rbf import mirrored
 from generation.skeleton import gait_skeleton
-from generation.stylise import (_horn_rotation, bone_length_error, fit_to_skeleton, stylise, stylised_cycle,
-                                theme_rbfs, walker_frame_positions)
+from generation.stylise import (
+    _horn_rotation,
+    bone_length_error,
+    fit_to_skeleton,
+    stylise,
+    stylised_cycle,
+    theme_rbfs,
+    walker_frame_positions,
+)
 from generation.themes import THEME_NAMES, THEMES
 
 pytestmark = pytest.mark.filterwarnings("ignore:The given NumPy array is not writable")
 
 
+def tiny_cycle(height: float = 1.75, build: str = "male", m: int = 100, stride: float = 1.4,
+               duration: float = 1.1) -> Motion:
+    """A small analytic walk cycle of our own (synthetic): sinusoidal hip, knee, arm and elbow angles.
+
+    Periodic over m frames, walking along +z by ``stride`` per cycle, lowest foot joint on y = 0. Its feet are
+    not planted; it exists so these tests do not depend on the procedural walker's current state.
+    """
+    skel = gait_skeleton(height, build)
+    J = skel.num_joints
+    phi = np.arange(m) / m * 2 * np.pi  # left heel strike at 0, right at pi
+    x_axis = np.array([1.0, 0.0, 0.0])
+    rot = np.tile([1.0, 0.0, 0.0, 0.0], (m, J, 1))
+
+    def about_x(angle):
+        return np_qfrom_axis_angle(np.tile(x_axis, (m, 1)), angle)
+
+    for side, shift in (("left", 0.0), ("right", np.pi)):
+        hip_flex = 0.35 * np.cos(phi - shift)  # leg forward at its own heel strike
+        knee = 0.15 + 0.5 * np.clip(np.sin(phi - shift - 1.2 * np.pi) * 1.5, 0.0, None) ** 1.5  # swing flexion
+        rot[:, skel.index(f"{side}_hip")] = about_x(-hip_flex)  # -x rotation swings the leg to +z
+        rot[:, skel.index(f"{side}_knee")] = about_x(knee)
+        rot[:, skel.index(f"{side}_shoulder")] = about_x(0.3 * np.cos(phi - shift))  # arm opposite to its leg
+        rot[:, skel.index(f"{side}_elbow")] = about_x(-0.3 - 0.1 * np.cos(phi - shift))
+    # thorax counter-rotation: the right shoulder leads when the left leg does
+    rot[:, skel.index("spine")] = np_qfrom_axis_angle(np.tile([0.0, 1.0, 0.0], (m, 1)), 0.08 * np.cos(phi))
+    root = np.zeros((m, 3))
+    root[:, 1] = 0.02 * height / 1.75 * np.cos(2 * phi)
+    root[:, 2] = stride * np.arange(m) / m
+    motion = Motion(skel, rot, root, m / duration, {"synthetic": True, "stride_m": [0.0, 0.0, stride]})
+    root[:, 1] -= motion.positions()[:, [3, 4, 7, 8], 1].min()
+    return Motion(skel, rot, root, m / duration, {"synthetic": True, "stride_m": [0.0, 0.0, stride],
+                                                  "origin": "tiny test walk (synthetic)"})
+
+
 @pytest.fixture(scope="module")
 def neutral() -> Motion:
-    """The neutral base averaged from the procedural walks only (deterministic, no captured data needed)."""
-    return neutral_cycle_from_motions(default_sources(include_captured=False))
+    """Our tiny analytic cycle, independent of the procedural walker."""
+    return tiny_cycle()
 
 
 # ---- neutral base -----------------------------------------------------------------------------------
@@ -34,20 +82,41 @@ def test_cut_cycles_needs_one_right_strike_between_left_strikes():
     assert cycles == [(0, 16, 33), (66, 83, 99)]  # the middle cycle has two right strikes
 
 
-def test_neutral_base_is_one_averaged_periodic_cycle(neutral):
+def test_normalise_and_average_remove_body_size():
+    # the same walk at two sizes: after height normalisation the cycles agree and the average reproduces it
+    cycles = []
+    for height in (1.6, 1.9):
+        c = tiny_cycle(height, stride=1.4 * height / 1.75)
+        walk = Motion(c.skeleton, np.concatenate([c.rotations] * 3),
+                      np.concatenate([c.root_positions + [0, 0, k * 1.4 * height / 1.75] for k in range(3)]),
+                      c.fps)  # three cycles, stride scaled with the body
+        cycles.append(normalise_cycle(walk.positions(), walk.skeleton, walk.fps, (100, 150, 200), m=100))
+    np.testing.assert_allclose(cycles[0].positions, cycles[1].positions, atol=1e-9)
+    assert cycles[0].stride == pytest.approx(1.4 / 1.75)
+    mean, stride, duration = average_cycles(cycles)
+    assert mean.shape == (100, 21, 3) and duration == pytest.approx(1.1)
+    P, _ = walker_frame_positions(tiny_cycle())
+    np.testing.assert_allclose(mean * 1.75, P - [0, P[:, [3, 4, 7, 8], 1].min(), 0], atol=1e-9)
+    with pytest.raises(ValueError, match="no walk cycles"):
+        average_cycles([])
+
+
+def test_neutral_base_from_procedural_walks():
+    """Integration with generation.procedural_walk: several body sizes averaged into one periodic cycle."""
+    neutral = neutral_cycle_from_motions(default_sources(include_captured=False))
     meta = neutral.metadata
     assert neutral.num_frames == 100 and meta["cycle_frames"] == 100
-    assert meta["n_cycles"] >= 12  # 8 bodies x about 2 cycles (the paper averaged 16)
+    assert meta["n_cycles"] >= 8  # 8 bodies x about 2 cycles (the paper averaged 16)
     assert meta["synthetic"] is True and meta["generator"] == "neutral_base"
-    assert len({(s["height"], s["build"]) for s in meta["sources"]}) >= 6  # several body sizes
+    assert len({(s["height"], s["build"]) for s in meta["sources"] if s["cycles"]}) >= 4  # several body sizes
     stride = meta["stride_m"][2]
     assert 1.2 < stride < 1.6 and neutral.duration == pytest.approx(meta["cycle_duration_s"])
     P, _ = walker_frame_positions(neutral)
-    # periodic: the first frame continues the last one (loop closed)
-    step = np.abs(P[0] - P[-1]).max()
-    typical = np.abs(np.diff(P, axis=0)).max()
-    assert step <= 1.5 * typical
+    step = np.abs(P[0] - P[-1]).max()  # loop closed: the first frame continues the last one
+    assert step <= 1.5 * np.abs(np.diff(P, axis=0)).max()
     assert neutral.positions()[:, [3, 4, 7, 8], 1].min() == pytest.approx(0.0, abs=1e-9)  # feet on the floor
+    out = stylise(neutral, "sad", 0.7, 10)
+    assert bone_length_error(out.positions(), neutral.skeleton) < 1e-3
 
 
 def test_neutral_base_rejects_other_skeletons():
@@ -180,6 +249,15 @@ def test_speed_warps_time_uniformly_and_walks_forward(neutral):
     sparse = stylise(neutral, "tired", 0.7, 10, speed=1.0, n_cycles=4, fps=24.0)
     assert sparse.num_frames == fast.num_frames
     np.testing.assert_allclose(fast.positions(), sparse.positions(), atol=1e-9)
+
+
+def test_neutral_walk_equals_weight_zero(neutral):
+    from generation.stylise import neutral_walk
+
+    base = neutral_walk(neutral, speed=1.1, n_cycles=3)
+    zero = stylise(neutral, "sad", 0.0, 10, speed=1.1, n_cycles=3)
+    np.testing.assert_allclose(base.positions(), zero.positions(), atol=1e-5)
+    assert base.metadata["theme"] == "neutral" and base.metadata["generator"] == "neutral_base"
 
 
 def test_metadata(neutral):

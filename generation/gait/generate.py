@@ -24,8 +24,16 @@ import torch
 from ..motion import Motion
 from ..paths import GroundPath, straight
 from ..skeleton import Skeleton
-from .data import (SBAR_ALPHA, Normalizer, affective_features, facing_yaw, heading_frame_positions,
-                   prepare_sequences, world_rotations, wrap)
+from .data import (
+    SBAR_ALPHA,
+    Normalizer,
+    affective_features,
+    facing_yaw,
+    heading_frame_positions,
+    prepare_sequences,
+    world_rotations,
+    wrap,
+)
 from .model import GaitNet
 from .train import DEFAULT_WEIGHTS, load_checkpoint
 
@@ -115,12 +123,14 @@ def _seed_motion(seed, emotion0: np.ndarray, n_frames: int, rng: np.random.Gener
 
 def _seed_sequence(motion: Motion, frame_step: int, max_steps: int, min_steps: int, index: int):
     if motion.skeleton.num_joints != 21:
-        raise ValueError(f"seed gait {index}: needs the 21-joint gait skeleton, got {motion.skeleton.num_joints} joints")
+        raise ValueError(f"seed gait {index}: needs the 21-joint gait skeleton, "
+                         f"got {motion.skeleton.num_joints} joints")
     m = motion.resample(30.0)
     steps = (m.num_frames - 1) // frame_step + 1
     if steps < min_steps:
         raise ValueError(f"seed gait {index}: {motion.num_frames} frames at {motion.fps} fps give {steps} network "
-                         f"steps; at least {min_steps} are needed ({(min_steps - 1) * frame_step + 1} frames at 30 fps)")
+                         f"steps; at least {min_steps} are needed "
+                         f"({(min_steps - 1) * frame_step + 1} frames at 30 fps)")
     steps = min(steps, max_steps)
     need = frame_step * (steps - 1) + 1
     m = m.slice(m.num_frames - need)

@@ -21,8 +21,14 @@ import numpy as np
 import torch
 
 from .config import GaitNetConfig
-from .data import (SBAR_ALPHA, GaitSequences, Normalizer, affective_features, heading_frame_positions,
-                   load_corpus_sequences)
+from .data import (
+    SBAR_ALPHA,
+    GaitSequences,
+    Normalizer,
+    affective_features,
+    heading_frame_positions,
+    load_corpus_sequences,
+)
 from .losses import total_loss
 from .model import GaitNet
 

@@ -75,7 +75,9 @@ def rollout(net: GestureNet, tokens: torch.Tensor, token_mask: torch.Tensor, att
     memory = net.encode(tokens, token_mask, attributes)
     B = tokens.shape[0]
     T = int(lengths.max())
-    W = net.cfg.window
+    # Each self-attention layer looks back ``window`` steps, so the stacked decoder's output depends on the last
+    # n_layer * (window - 1) + 1 inputs; feeding exactly those reproduces the teacher-forced computation.
+    W = net.receptive_field
     rest = rest.to(torch.float32)
     history = [rest]  # input poses at positions 0, 1, ...; position 0 is the SoS pose
     outputs = []

@@ -165,6 +165,11 @@ class GestureNet(nn.Module):
             nn.init.zeros_(self.head.weight)
             nn.init.zeros_(self.head.bias)
 
+    @property
+    def receptive_field(self) -> int:
+        """How many past input poses the stacked decoder's output depends on: n_layer * (window - 1) + 1."""
+        return self.cfg.n_layer * (self.cfg.window - 1) + 1
+
     def num_parameters(self) -> int:
         return sum(p.numel() for p in self.parameters())
 

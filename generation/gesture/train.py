@@ -32,7 +32,7 @@ from .model import GestureNet, GestureNetConfig
 class TrainConfig:
     """Training options; the defaults train the shipped weights in about 15 minutes on one CPU thread."""
 
-    epochs: int = 300
+    epochs: int = 400
     batch_size: int = 16
     lr: float = 1e-3
     lr_decay: float = 0.999  # per epoch
@@ -41,11 +41,11 @@ class TrainConfig:
     # Parallel scheduled sampling (Duckworth et al. 2019): this share of the teacher-forced inputs is replaced
     # by the network's own (no-grad) predictions, ramped up linearly over the first ``sampling_ramp`` epochs.
     sampling: float = 0.5
-    sampling_ramp: int = 40
+    sampling_ramp: int = 15
     sampling_passes: int = 1
     seed: int = 0
     variants: int = 2
-    max_minutes: float | None = None  # stop (and keep the best model) after this wall-clock time
+    max_minutes: float | None = 18.0  # stop (and keep the best model) after this wall-clock time
     loss: LossWeights = field(default_factory=LossWeights)
     model: GestureNetConfig = field(default_factory=GestureNetConfig)
     out: str = str(config.DEFAULT_WEIGHTS)
@@ -185,7 +185,11 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--weight-decay", type=float, default=d.weight_decay)
     p.add_argument("--seed", type=int, default=d.seed)
     p.add_argument("--variants", type=int, default=d.variants, help="procedural gestures per sentence")
-    p.add_argument("--max-minutes", type=float, default=None, help="wall-clock budget; keeps the best model")
+    p.add_argument("--max-minutes", type=float, default=d.max_minutes,
+                   help="wall-clock budget in minutes (0 = none); keeps the best model")
+    p.add_argument("--sampling", type=float, default=d.sampling, help="share of self-fed decoder inputs")
+    p.add_argument("--input-noise", type=float, default=d.input_noise)
+    p.add_argument("--residual", choices=("previous", "rest", "none"), default=d.model.residual)
     p.add_argument("--no-angle-loss", action="store_true")
     p.add_argument("--no-pose-loss", action="store_true")
     p.add_argument("--no-affective-loss", action="store_true")
@@ -203,8 +207,10 @@ def config_from_args(args: argparse.Namespace) -> TrainConfig:
     loss = LossWeights(angle=0.0 if args.no_angle_loss else base.angle, pose=0.0 if args.no_pose_loss else base.pose,
                        affective=0.0 if args.no_affective_loss else base.affective)
     return TrainConfig(epochs=args.epochs, batch_size=args.batch_size, lr=args.lr, weight_decay=args.weight_decay,
-                       seed=args.seed, variants=args.variants, max_minutes=args.max_minutes, loss=loss,
-                       model=GestureNetConfig(d_model=args.d_model), out=args.out, checkpoint=args.checkpoint,
+                       seed=args.seed, variants=args.variants, max_minutes=args.max_minutes or None, loss=loss,
+                       sampling=args.sampling, input_noise=args.input_noise,
+                       model=GestureNetConfig(d_model=args.d_model, residual=args.residual), out=args.out,
+                       checkpoint=args.checkpoint,
                        resume=args.resume, threads=args.threads)
 
 
