@@ -158,7 +158,7 @@ def fig_vad(pairs: pd.DataFrame, pearson: pd.DataFrame):
         ax.set_title(f"{d}: Pearson r = {r:.2f} (n = {len(pairs)})")
         ax.set_aspect("equal")
     fig.suptitle("Intended vs perceived gesture emotion in NRC-VAD space (bubble area = answers)")
-    fig.tight_layout()
+    fig.tight_layout(rect=(0, 0, 1, 0.95))
     return fig
 
 

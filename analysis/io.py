@@ -324,7 +324,7 @@ def read_responses(src, clips: pd.DataFrame, participants: pd.DataFrame | None =
 
     add(pid.mask(pid.values == ""), "participant_id", "participant_id is empty", pid)
     if participants is not None:
-        unknown = (pid.values != "") & ~np.isin(pid.values, participants.index.to_numpy(dtype=object))
+        unknown = (pid.values != "") & ~pd.Index(pid.values).isin(participants.index)
         add(pid.mask(unknown), "participant_id", lambda v: f"unknown participant {v!r} (not in participants.csv)",
             pid)
     sections = list(SECTION_QUESTIONS)
@@ -393,7 +393,7 @@ def read_responses(src, clips: pd.DataFrame, participants: pd.DataFrame | None =
             col.problems.append(Problem(name, int(i) + 2, "answer", str(pair_msg[pair_inv[i]])))
 
     # Clips: known, and carrying what the section needs.
-    clip_known_u = np.isin(clip.values, clips.index.to_numpy(dtype=object))
+    clip_known_u = pd.Index(clip.values).isin(clips.index)
     add(clip.mask(~clip_known_u), "clip_id", lambda v: f"unknown clip {v!r} (not in clips.csv)", clip)
     cu = clips.reindex(clip.values)
     no_theme = cu["theme"].isin(["", None]).to_numpy() | cu["theme"].isna().to_numpy()

@@ -96,8 +96,9 @@ def likert_distribution(responses: pd.DataFrame, clips: pd.DataFrame) -> pd.Data
     if d.empty:
         return pd.DataFrame(columns=cols)
     counts = d.groupby(["emotion", "feature", "value"]).size()
-    emotions = [e for e in GAIT_EMOTIONS if e in set(d["emotion"])]
-    features = [f for f in LIKERT_FEATURES if f in set(d["feature"])]
+    present_e, present_f = set(d["emotion"].unique()), set(d["feature"].unique())
+    emotions = [e for e in GAIT_EMOTIONS if e in present_e]
+    features = [f for f in LIKERT_FEATURES if f in present_f]
     full = pd.MultiIndex.from_product([emotions, features, [float(v) for v in LIKERT_VALUES]],
                                       names=["emotion", "feature", "value"])
     counts = counts.reindex(full, fill_value=0)

@@ -75,7 +75,10 @@ def demographic_differences(responses: pd.DataFrame, participants: pd.DataFrame,
     ``min_count`` = 5 selections are left out and listed. Selections are treated as independent although one
     participant answers several clips; clips are assigned at random, so groups see the same clips on average.
 
-    Returns section, factor, chi2, dof, p_value, cramers_v, n, groups, left_out, reject.
+    ``share_expected_below_5`` is the share of cells with an expected count below 5 (Cochran's rule asks for at
+    most 0.2 for the chi-square approximation to hold).
+
+    Returns section, factor, chi2, dof, p_value, cramers_v, n, share_expected_below_5, groups, left_out, reject.
     """
     rows = []
     for section in ("emotion_choice", "gesture_emotion"):
@@ -93,7 +96,8 @@ def demographic_differences(responses: pd.DataFrame, participants: pd.DataFrame,
             v = float(np.sqrt(res.statistic / (n * (min(t.shape) - 1))))
             rows.append({"section": section, "factor": factor, "chi2": float(res.statistic), "dof": int(res.dof),
                          "p_value": float(res.pvalue), "cramers_v": v, "n": n,
+                         "share_expected_below_5": float((res.expected_freq < 5).mean()),
                          "groups": ";".join(map(str, t.index)), "left_out": ";".join(map(str, small)),
                          "reject": bool(res.pvalue < alpha)})
-    return pd.DataFrame(rows, columns=["section", "factor", "chi2", "dof", "p_value", "cramers_v", "n", "groups",
-                                       "left_out", "reject"])
+    return pd.DataFrame(rows, columns=["section", "factor", "chi2", "dof", "p_value", "cramers_v", "n",
+                                       "share_expected_below_5", "groups", "left_out", "reject"])

@@ -13,10 +13,13 @@ from __future__ import annotations
 
 import datetime as _dt
 import html
+import io
 import json
 import math
 import os
 import re
+import tempfile
+import zipfile
 
 import numpy as np
 import pandas as pd
@@ -29,6 +32,28 @@ TABLE_KEYS = ("gait_emotion_ad", "transition_ad", "likert_consistency_ad", "like
               "naturalness_test", "vad_pearson", "theme_anova", "theme_descriptives", "theme_inversion",
               "neutral_validation", "demographic_differences")
 """Keys of report.json holding a list of records (one CSV each). ``participants`` and ``meta`` are objects."""
+
+METHODS = {
+    "gait_emotion_ad": "Each answer -> indicator vector / number of labels; mean over answers, l1-normalised; "
+                       "scipy.stats.anderson_ksamp (midrank) on the 4 intended vs the 4 perceived components; "
+                       "p interpolated and capped to [0.001, 0.25].",
+    "transition_ad": "As above, for question 'initial' vs happy..neutral and 'final' vs final_*.",
+    "likert_consistency_ad": "k samples = participants (each: all their values for gaits of that dominant intended "
+                             "emotion); midrank k-sample Anderson-Darling.",
+    "likert_distribution": "Share of each value 0..4 per dominant intended emotion and feature.",
+    "naturalness": "Counts and shares of ratings 1..5 per origin and modality; share >= 3 = satisfactory.",
+    "naturalness_test": "Mann-Whitney U (two-sided) and chi-square with Yates correction on >= 3 vs < 3 "
+                        "(Fisher's exact when an expected count < 5).",
+    "vad_pearson": "Intended (clip's emotion_label) and perceived words mapped to NRC-VAD; scipy.stats.pearsonr "
+                   "with 95% Fisher-z confidence interval; n = answers.",
+    "theme_anova": "pingouin.rm_anova, within = weight x n_features, subject = participant; Greenhouse-Geisser "
+                   "corrected p; partial eta squared; participants with missing cells dropped.",
+    "theme_descriptives": "Rating normalised (r - 1) / 6; mean and SE = SD/sqrt(n) over participants.",
+    "theme_inversion": "Per-participant mean per theme; mean, SE, one-sample t-test against 0 (two-sided).",
+    "neutral_validation": "Share of each of the seven choices.",
+    "demographic_differences": "Pearson chi-square of group x perceived-label counts (no correction), Cramer's V; "
+                               "groups with < 5 selections left out.",
+}
 
 TITLES = {
     "gait_emotion_ad": "Single gait emotions: intended vs perceived, 2-sample Anderson-Darling (seed 000 6.3.1)",
@@ -150,6 +175,17 @@ def build_report(data: StudyData, alpha: float = 0.05, permutations: int = 0) ->
     for k in TABLE_KEYS:
         if tables[k].empty:
             notes.append(f"{k}: no data for this analysis in responses.csv.")
+    for key in ("gait_emotion_ad", "transition_ad"):
+        t = tables[key]
+        if t.empty:
+            continue
+        intended = t[[c for c in t.columns if c.startswith("intended_")]].to_numpy()
+        pure = t.loc[t["reject"].to_numpy() & ((intended > 0).sum(axis=1) == 1), "clip_id"].unique()
+        if len(pure):
+            notes.append(f"{key}: rejected clip(s) {', '.join(map(str, pure))} have a single intended emotion; "
+                         "against any perceived vector with four non-zero components the 4-value AD test gives about "
+                         "2.1, p ~ 0.04 (2.111 without ties, as seed 000's Gait 2) whatever their size. Judge the "
+                         "vectors in the figure.")
     for name, cols in data.ignored_columns.items():
         notes.append(f"{name}: unknown column(s) not used: {', '.join(cols)}.")
     synthetic = bool(extras["participants"].get("synthetic"))
@@ -209,12 +245,25 @@ def write_report(responses_csv, clips_csv, participants_csv, out_dir, alpha: flo
     return report
 
 
+def report_zip_bytes(responses_csv, clips_csv, participants_csv, alpha: float = 0.05, permutations: int = 0,
+                     *, figures: bool = True) -> tuple[dict, bytes]:
+    """Run :func:`write_report` into a temporary folder and return (report dict, the folder as a zip archive's
+    bytes) -- for a download view. Raises ValidationError like write_report."""
+    with tempfile.TemporaryDirectory() as tmp:
+        report = write_report(responses_csv, clips_csv, participants_csv, tmp, alpha, permutations, figures=figures)
+        buf = io.BytesIO()
+        with zipfile.ZipFile(buf, "w", zipfile.ZIP_DEFLATED) as zf:
+            for name in sorted(os.listdir(tmp)):
+                zf.write(os.path.join(tmp, name), arcname=f"report/{name}")
+    return report, buf.getvalue()
+
+
 CSS = """body{font-family:system-ui,sans-serif;max-width:1100px;margin:2em auto;padding:0 1em;color:#222}
 h1{font-size:1.5em}h2{font-size:1.15em;margin-top:2em;border-bottom:1px solid #ccc}
 table{border-collapse:collapse;font-size:.8em;margin:.5em 0}td,th{border:1px solid #ddd;padding:2px 6px;
 text-align:right}th{background:#f3f3f3}.banner{background:#fff3cd;border:1px solid #e0c36a;padding:.6em 1em;
 font-weight:bold}.fig svg{max-width:100%;height:auto}details{margin:.3em 0}ul.summary li{margin:.2em 0}
-.wide{overflow-x:auto}.tables{display:flex;flex-wrap:wrap;gap:1.5em;align-items:flex-start}"""
+.wide{overflow-x:auto}.method{color:#555;font-size:.85em}.tables{display:flex;flex-wrap:wrap;gap:1.5em;align-items:flex-start}"""
 
 FIG_FOR_TABLE = {"gait_emotion_ad": "fig_emotion_vectors", "transition_ad": "fig_transitions",
                  "likert_distribution": "fig_likert", "vad_pearson": "fig_vad", "naturalness": "fig_naturalness",
@@ -283,7 +332,7 @@ def render_html(report: dict, tables: dict, figs: dict) -> str:
         parts.append("<h2>Notes</h2><ul>" + "".join(f"<li>{h(s)}</li>" for s in meta["notes"]) + "</ul>")
     parts.append("<h2>Participants</h2>" + _participants_html(report["participants"]))
     for k in TABLE_KEYS:
-        parts.append(f"<h2 id='{k}'>{h(TITLES[k])}</h2>")
+        parts.append(f"<h2 id='{k}'>{h(TITLES[k])}</h2><p class='method'>{h(METHODS[k])}</p>")
         df = tables[k]
         if df.empty:
             parts.append("<p>No data.</p>")

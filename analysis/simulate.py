@@ -77,7 +77,7 @@ class PerceptionModel:
         ("gait", "generated"): (0.04, 0.07, 0.24, 0.43, 0.22), ("gait", "source"): (0.0, 0.0, 0.07, 0.35, 0.58),
         ("gesture", "generated"): (0.03, 0.06, 0.30, 0.37, 0.24),
         ("gesture", "source"): (0.04, 0.09, 0.32, 0.35, 0.20)})
-    gesture_temperature: float = 0.15
+    gesture_temperature: float = 0.3
     neutral_probs: tuple = (0.75, 0.05, 0.05, 0.03, 0.05, 0.03, 0.04)  # neutral + THEMES order
     theme_base: float = 2.0
     theme_offsets: dict = field(default_factory=lambda: {"happy": -0.5})

@@ -48,6 +48,8 @@ def vad_pearson(responses: pd.DataFrame, clips: pd.DataFrame, confidence: float 
     """
     pairs = vad_pairs(responses, clips)
     rows = []
+    if pairs.empty:
+        return pd.DataFrame(columns=["dimension", "r", "p_value", "ci_low", "ci_high", "n"])
     for d in VAD_DIMENSIONS:
         x, y = pairs[f"intended_{d}"].to_numpy(float), pairs[f"perceived_{d}"].to_numpy(float)
         n = len(x)

@@ -61,8 +61,8 @@ def main(argv=None) -> int:
         html_kb = os.path.getsize(os.path.join(tmp, "out0", "report.html")) / 1024
 
     n_rows = len(data.responses)
-    print(f"| participants | answers (rows) | responses.csv | import | simulate+write (untimed) | load+validate | "
-          f"analyses | figures | whole write_report | report.html |")
+    print("| participants | answers (rows) | responses.csv | import | simulate+write (untimed) | load+validate | "
+          "analyses | figures | whole write_report | report.html |")
     print("|---|---|---|---|---|---|---|---|---|---|")
     print(f"| {a.participants:,} | {n_rows:,} | {size_mb:.0f} MiB | {t_import:.1f} s | {t_sim:.1f} s | {t_load:.1f} s |"
           f" {t_analyse:.1f} s | {t_fig:.1f} s | {min(totals):.1f} s | {html_kb:.0f} KiB |")

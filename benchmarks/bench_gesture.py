@@ -30,15 +30,15 @@ from generation.gesture import config  # noqa: E402
 from generation.gesture.data import GestureDataset, attribute_vector, build_dataset, nrc_vad  # noqa: E402
 from generation.gesture.generate import decode_examples, generate_gesture, load_model  # noqa: E402
 from generation.gesture.losses import LossWeights  # noqa: E402
+from generation.gesture.metrics import dataset_pose_error  # noqa: E402
 from generation.gesture.model import GestureNetConfig  # noqa: E402
 from generation.gesture.train import TrainConfig, train  # noqa: E402
 from generation.kinematics import np_forward_kinematics  # noqa: E402
-from generation.quaternion import np_qangle, np_qnormalize  # noqa: E402
+from generation.quaternion import np_qnormalize  # noqa: E402
 from generation.skeleton import gesture_skeleton  # noqa: E402
 
 MACHINE = "2-core CI VM, no GPU"
 DATE = "2026-11-27"
-UPPER_BODY = (5, 6, 8, 9, 10, 12, 13, 14)  # neck, head, shoulders, elbows, wrists (the 8 joints of Yoon et al.)
 GESTURE_EMOTIONS = ("afraid", "amused", "angry", "ashamed", "disgusted", "joyous", "neutral", "proud", "relieved",
                     "sad", "surprised")
 ABLATIONS = {
@@ -57,21 +57,8 @@ def positions_of(rotations: np.ndarray, data: GestureDataset, i: int) -> np.ndar
 
 
 def pose_errors(pred: list[np.ndarray], data: GestureDataset, idx: np.ndarray) -> dict[str, float]:
-    """Seed 003 Table 1 metric: per test sequence, the mean over frames of the mean joint distance, divided by the
-    ground truth's bounding-box diagonal; then the mean over sequences. Also the 8 upper-body joints only, and the
-    mean joint rotation error in degrees."""
-    errs, errs_upper, rot_err = [], [], []
-    for p, i in zip(pred, idx):
-        L = int(data.lengths[i])
-        true = data.rotations[i, :L].astype(np.float64)
-        P, G = positions_of(p[:L], data, i), positions_of(true, data, i)
-        diag = float(np.linalg.norm(G.reshape(-1, 3).max(0) - G.reshape(-1, 3).min(0)))
-        d = np.linalg.norm(P - G, axis=-1)  # (T, J)
-        errs.append(d.mean() / diag)
-        errs_upper.append(d[:, UPPER_BODY].mean() / diag)
-        rot_err.append(np.degrees(np_qangle(np_qnormalize(p[:L]), true)).mean())
-    return {"pose_error": float(np.mean(errs)), "pose_error_upper": float(np.mean(errs_upper)),
-            "rotation_error_deg": float(np.mean(rot_err)), "n": len(errs)}
+    """Seed 003 Table 1 metric (:func:`generation.gesture.metrics.dataset_pose_error`)."""
+    return dataset_pose_error(pred, data, idx)
 
 
 def mean_pose_baseline(data: GestureDataset, idx: np.ndarray) -> list[np.ndarray]:

@@ -170,7 +170,7 @@ def qangle(q: torch.Tensor, r: torch.Tensor) -> torch.Tensor:
 
 def _np(fn):
     def wrapper(*arrays, **kwargs):
-        tensors = [torch.as_tensor(np.asarray(a, dtype=np.float64)) if not isinstance(a, (float, int, str))
+        tensors = [torch.from_numpy(np.array(a, dtype=np.float64)) if not isinstance(a, (float, int, str))
                    else a for a in arrays]
         return fn(*tensors, **kwargs).numpy()
 

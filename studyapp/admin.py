@@ -5,15 +5,21 @@ Study pages link to the staff views: preview (records nothing), progress, CSV ex
 from __future__ import annotations
 
 from django.contrib import admin, messages
+from django.db import models
+from django.forms import Textarea
 from django.urls import path, reverse
 from django.utils.html import format_html
 
 from . import views_staff
 from .models import Assignment, Clip, Participant, Response, Section, Study
 
+COMPACT = {models.JSONField: {"widget": Textarea(attrs={"rows": 2, "cols": 90})},
+           models.TextField: {"widget": Textarea(attrs={"rows": 3, "cols": 90})}}
+
 
 class SectionInline(admin.StackedInline):
     model = Section
+    formfield_overrides = COMPACT
     fk_name = "study"
     extra = 0
     ordering = ["order", "id"]
@@ -27,12 +33,14 @@ class StudyAdmin(admin.ModelAdmin):
     list_filter = ["status", "preset"]
     search_fields = ["title", "slug"]
     inlines = [SectionInline]
+    formfield_overrides = COMPACT
     actions = ["open_studies", "close_studies"]
     readonly_fields = ["links", "preset", "created_at"]
     fieldsets = [
         (None, {"fields": ["title", "slug", "status", "preset", "links"]}),
         ("Participant pages", {"fields": ["introduction", "consent_text", "ask_demographics", "feedback_questions"]}),
-        ("Recruitment", {"fields": ["max_participants", "completion_code", "completion_redirect", "created_at"]}),
+        ("Recruitment", {"fields": ["max_participants", "abandon_after_minutes", "completion_code",
+                                    "completion_redirect", "redirect_automatically", "created_at"]}),
     ]
 
     def get_urls(self):

@@ -16,6 +16,7 @@ from __future__ import annotations
 import random
 from collections import Counter
 from dataclasses import dataclass, field
+from datetime import timedelta
 
 from django.db import transaction
 from django.db.models import Count
@@ -148,7 +149,12 @@ def plan_study(study: Study, seed: int, balanced: bool = True) -> list[tuple[Sec
 
 
 def active_count(study: Study) -> int:
-    return study.participants.filter(status__in=[Participant.Status.STARTED, Participant.Status.COMPLETED]).count()
+    """Participants who hold a place: completed ones, and started ones not inactive past the study's timeout."""
+    qs = study.participants.filter(status__in=[Participant.Status.STARTED, Participant.Status.COMPLETED])
+    if study.abandon_after_minutes:
+        cutoff = timezone.now() - timedelta(minutes=study.abandon_after_minutes)
+        qs = qs.exclude(status=Participant.Status.STARTED, last_active_at__lt=cutoff)
+    return qs.count()
 
 
 def check_open(study: Study) -> None:
@@ -175,8 +181,8 @@ def start_participant(participant: Participant) -> bool:
                      for i, it in enumerate(items)]
         Assignment.objects.bulk_create(rows)
         p.status = Participant.Status.STARTED
-        p.started_at = timezone.now()
-        p.save(update_fields=["status", "started_at"])
+        p.started_at = p.last_active_at = timezone.now()
+        p.save(update_fields=["status", "started_at", "last_active_at"])
     participant.refresh_from_db()
     return True
 

@@ -20,6 +20,9 @@ CLIP_COLUMNS = ["clip_id", "modality", "origin", "happy", "sad", "angry", "neutr
                 "weight", "n_features", "duration_s"]
 PARTICIPANT_COLUMNS = ["participant_id", "gender", "age_group", "started_at", "completed_at", "status",
                        "external_id"]
+# Not a DESIGN.md format: what each participant was shown (order, gesture options), for audits.
+ASSIGNMENT_COLUMNS = ["participant_id", "section_type", "section_order", "position", "clip_id", "options",
+                      "shown_at", "answered_at"]
 CHUNK = 2000
 
 
@@ -77,23 +80,36 @@ def participant_rows(study: Study) -> Iterator[list]:
                p.external_id] + [p.feedback.get(k, "") for k in keys]
 
 
+def assignment_rows(study: Study) -> Iterator[list]:
+    from .models import Assignment
+
+    qs = (Assignment.objects.filter(section__study=study).order_by("participant_id", "section__order", "position")
+          .values_list("participant__public_id", "section__section_type", "section__order", "position",
+                       "clip__clip_id", "options", "shown_at", "answered_at"))
+    for pid, stype, order, pos, clip_id, options, shown, answered in qs.iterator(chunk_size=CHUNK):
+        yield [pid, stype, order, pos, clip_id, ";".join(options or []), _iso(shown), _iso(answered)]
+
+
 def stream_csv(study: Study, kind: str) -> Iterator[str]:
-    """Lines of `kind` in responses | clips | participants."""
+    """Lines of `kind` in responses | clips | participants | assignments."""
     if kind == "responses":
         return _csv_lines(RESPONSE_COLUMNS, response_rows(study))
     if kind == "clips":
         return _csv_lines(CLIP_COLUMNS, clip_rows(study))
     if kind == "participants":
         return _csv_lines(PARTICIPANT_COLUMNS + feedback_keys(study), participant_rows(study))
-    raise ValueError(f"unknown export {kind!r}; choose responses, clips or participants")
+    if kind == "assignments":
+        return _csv_lines(ASSIGNMENT_COLUMNS, assignment_rows(study))
+    raise ValueError(f"unknown export {kind!r}; choose responses, clips, participants or assignments")
 
 
 def write_study_csvs(study: Study, out_dir: str | Path) -> dict[str, Path]:
-    """Write responses.csv, clips.csv and participants.csv into out_dir; returns their paths."""
+    """Write responses.csv, clips.csv, participants.csv (DESIGN.md) and assignments.csv into out_dir; returns their
+    paths by kind."""
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     paths = {}
-    for kind in ("responses", "clips", "participants"):
+    for kind in ("responses", "clips", "participants", "assignments"):
         path = out / f"{kind}.csv"
         with open(path, "w", newline="", encoding="utf-8") as fh:
             for line in stream_csv(study, kind):

@@ -112,11 +112,15 @@ class Study(models.Model):
         default=list, blank=True,
         help_text='List of {"key": "camera", "text": "Were you distracted ...?", "kind": "yesno"|"text"}')
     max_participants = models.PositiveIntegerField(default=0, help_text="0 = no limit")
+    abandon_after_minutes = models.PositiveIntegerField(
+        default=0, help_text="A started participant inactive this long stops counting towards the limit (0 = never)")
     completion_code = models.CharField(max_length=40, default=new_completion_code)
     completion_redirect = models.CharField(
         max_length=500, blank=True,
         help_text="Optional URL shown/redirected to at the end; {code} is replaced by the completion code, e.g. "
                   "https://app.prolific.com/submissions/complete?cc={code}")
+    redirect_automatically = models.BooleanField(
+        default=False, help_text="Send participants to the completion URL a few seconds after the last page")
     created_at = models.DateTimeField(auto_now_add=True)
 
     class Meta:
@@ -207,6 +211,7 @@ class Participant(models.Model):
     seed = models.BigIntegerField(default=new_seed)
     consented_at = models.DateTimeField(default=timezone.now)
     started_at = models.DateTimeField(null=True, blank=True)
+    last_active_at = models.DateTimeField(null=True, blank=True)
     completed_at = models.DateTimeField(null=True, blank=True)
     user_agent = models.CharField(max_length=300, blank=True)
 

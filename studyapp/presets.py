@@ -112,7 +112,8 @@ PRESETS["demo"] = {
                           "and the flow of each walk."),
         dict(PRESETS["gait_ismar2020"]["sections"][3], clips_per_participant=2,
              options={"anchors": NATURALNESS_ANCHORS_GAIT, "n_generated": 1, "n_source": 1}),
-        dict(PRESETS["gestures_ieeevr2021"]["sections"][0], clips_per_participant=2),
+        # one gesture here leaves the demo plan's other generated gestures for the naturalness mix below
+        dict(PRESETS["gestures_ieeevr2021"]["sections"][0], clips_per_participant=1),
         dict(PRESETS["gestures_ieeevr2021"]["sections"][1], clips_per_participant=2,
              options=dict(PRESETS["gestures_ieeevr2021"]["sections"][1]["options"], n_generated=1, n_source=1)),
         dict(PRESETS["rbf_thms2016"]["sections"][0]),

@@ -206,6 +206,7 @@ def save_answers(assignment: Assignment, answers: dict[str, str], response_ms: i
                          question=key, answer=value, response_ms=response_ms) for key, value in answers.items()])
             locked.answered_at = timezone.now()
             locked.save(update_fields=["answered_at"])
+            Participant.objects.filter(pk=locked.participant_id).update(last_active_at=locked.answered_at)
     except IntegrityError:      # unique_response caught a concurrent duplicate
         return False
     return True

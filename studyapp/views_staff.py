@@ -101,7 +101,7 @@ def progress(request, study_id: int):
 @staff_member_required
 def export_csv(request, study_id: int, kind: str):
     study = get_object_or_404(Study, pk=study_id)
-    if kind not in ("responses", "clips", "participants"):
+    if kind not in ("responses", "clips", "participants", "assignments"):
         raise Http404("unknown export")
     response = StreamingHttpResponse(stream_csv(study, kind), content_type="text/csv; charset=utf-8")
     response["Content-Disposition"] = f'attachment; filename="{study.slug}-{kind}.csv"'

@@ -98,3 +98,26 @@ def test_clis(tmp_path):
     res = subprocess.run([sys.executable, "-m", "analysis", "nope.csv", *args[1:], "--out", str(tmp_path / "r3")],
                          capture_output=True, text=True, timeout=120)
     assert res.returncode == 2 and "no such file" in res.stderr
+
+
+@pytest.mark.parametrize("sections", [["emotion_choice"], ["theme_rating", "theme_inversion"], []])
+def test_partial_study(tmp_path, sections):
+    """A study with only some sections: the other tables are empty lists and noted, nothing fails."""
+    r, c, p = simulate_study(6, seed=3)
+    r = r[r["section_type"].isin(sections)]
+    rep = write_report(*[io.StringIO(df.to_csv(index=False)) for df in (r, c, p)], tmp_path, figures=False)
+    assert rep["vad_pearson"] == [] and rep["naturalness"] == []
+    assert any("vad_pearson: no data" in n for n in rep["meta"]["notes"])
+    assert bool(rep["gait_emotion_ad"]) == ("emotion_choice" in sections)
+    assert bool(rep["theme_anova"]) == ("theme_rating" in sections)
+
+
+def test_report_zip_bytes():
+    import zipfile
+
+    from analysis.report import report_zip_bytes
+
+    r, c, p = simulate_study(4, seed=2)
+    rep, data = report_zip_bytes(*[io.StringIO(df.to_csv(index=False)) for df in (r, c, p)], figures=False)
+    names = zipfile.ZipFile(io.BytesIO(data)).namelist()
+    assert "report/report.json" in names and "report/report.html" in names and rep["participants"]

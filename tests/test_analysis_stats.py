@@ -12,6 +12,8 @@ from analysis import adtest, emotion, likert, naturalness, participants, themes,
 from analysis.io import read_clips, read_participants, read_responses
 from analysis.lexicon import NRC_VAD
 
+pytestmark = pytest.mark.filterwarnings("ignore:p-value (capped|floored):UserWarning")  # scipy's own calls here
+
 CLIP_HEADER = ("clip_id,modality,origin,happy,sad,angry,neutral,final_happy,final_sad,final_angry,final_neutral,"
                "emotion_label,valence,arousal,dominance,theme,weight,n_features,duration_s\n")
 
@@ -105,6 +107,9 @@ def test_likert_distribution_and_consistency():
     assert bool(c.iloc[0]["reject"]) is True
     ref = stats.anderson_ksamp([np.array([i % 3] * 2, float) for i in range(30)], variant="midrank")
     assert c.iloc[0]["statistic"] == pytest.approx(ref.statistic)
+    by_clip = likert.likert_consistency_ad(r, clips, by="clip")
+    assert len(by_clip) == 2 and by_clip["statistic"].isna().all()  # one value per participant: undefined
+    assert (by_clip["p_display"] == "n/a (every sample has one value)").all()
 
 
 # --- VAD Pearson --------------------------------------------------------------------------------------------------

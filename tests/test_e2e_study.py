@@ -57,6 +57,23 @@ def full_shot(driver, path: Path, width: int = 1000):
     driver.set_window_size(1280, 900)
 
 
+def researcher_shots(driver, base: str, study: Study, folder: Path) -> None:
+    """Screenshots of the researcher pages: the study in the admin and its progress page."""
+    from django.contrib.auth.models import User
+    from selenium.webdriver.common.by import By
+
+    User.objects.create_superuser("researcher", "r@example.org", "screenshot-pw-1")
+    driver.get(base + "/admin/login/")
+    driver.find_element(By.ID, "id_username").send_keys("researcher")
+    driver.find_element(By.ID, "id_password").send_keys("screenshot-pw-1")
+    driver.find_element(By.CSS_SELECTOR, "input[type=submit]").click()
+    wait_for(driver, lambda d: "/admin/login/" not in d.current_url, what="admin login")
+    driver.get(base + reverse("studyapp:progress", args=[study.pk]))
+    full_shot(driver, folder / "study_admin_progress.png", width=1200)
+    driver.get(base + reverse("admin:studyapp_study_change", args=[study.pk]))
+    full_shot(driver, folder / "study_admin_study.png", width=1200)
+
+
 def pick_answers(driver, choice: int = 0):
     """Choose option number `choice` (clamped) of every question; for multi-select also the last option."""
     from selenium.webdriver.common.by import By
@@ -149,6 +166,9 @@ def test_whole_demo_study_in_chromium(chromium, live_server, settings, tmp_path)
         full_shot(driver, Path(shots) / "study_done.png")
     assert driver.find_element(By.ID, "completion-code").text == study.completion_code
     assert f"cc={study.completion_code}" in driver.find_element(By.ID, "completion-link").get_attribute("href")
+
+    if shots:
+        researcher_shots(driver, live_server.url, study, Path(shots))
 
     participant.refresh_from_db()
     assert participant.status == "completed" and participant.feedback["comments"] == "Clear clips, thanks."

@@ -135,10 +135,11 @@ def test_tiny_network_overfits_a_tiny_batch(tiny_data):
 def test_training_writes_checkpoint_and_resumes(tiny_data, tmp_path):
     cfg = GaitNetConfig.tiny(epochs=1, batch_size=2)
     out = tmp_path / "w.pt"
-    train(cfg, tiny_data, out, progress=False, log=lambda *_: None)
-    assert out.exists() and (tmp_path / "w.pt.ckpt").exists()
+    ckpt = tmp_path / "state.ckpt"
+    train(cfg, tiny_data, out, ckpt, progress=False, log=lambda *_: None)
+    assert out.exists() and ckpt.exists()
     cfg2 = GaitNetConfig.tiny(epochs=2, batch_size=2)
-    res = train(cfg2, tiny_data, out, resume=True, progress=False, log=lambda *_: None)
+    res = train(cfg2, tiny_data, out, ckpt, resume=True, progress=False, log=lambda *_: None)
     assert [h["epoch"] for h in res["history"]] == [1, 2]
     model, norm, payload = load_checkpoint(out)
     assert payload["trained_on"] == "synthetic procedural corpus"

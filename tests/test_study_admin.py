@@ -217,3 +217,13 @@ def test_analyze_reports_invalid_exports(gait_study, tmp_path):
     Response.objects.filter(question="torso").update(answer="9")      # out of the Likert range
     with pytest.raises(CommandError, match="did not validate"):
         call_command("analyze", "gaits", "--out", str(tmp_path / "rep"), stdout=io.StringIO())
+
+
+def test_assignments_export_records_options_shown(staff, study):
+    p = Participant.objects.create(study=study)
+    finish(p)
+    rows = read_csv(staff.get(reverse("studyapp:export_csv", args=[study.pk, "assignments"])))
+    assert len(rows) == p.assignments.count()
+    gest = [r for r in rows if r["section_type"] == "gesture_emotion"]
+    assert gest and all(len(r["options"].split(";")) == 4 for r in gest)
+    assert all(r["answered_at"] for r in rows)

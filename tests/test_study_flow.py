@@ -308,3 +308,38 @@ def test_started_participant_can_finish_after_study_closes(client, study):
     step = cur(p)
     assert client.post(reverse("studyapp:item", args=[p.token, 1]), answer_for(step.assignment)).status_code == 302
     assert cur(p).index == 2
+
+
+def test_participant_url_not_sent_as_referrer(client, study):
+    page = client.get(reverse("studyapp:study_entry", args=[study.slug])).content
+    assert b'<meta name="referrer" content="same-origin">' in page
+
+
+def test_abandoned_participant_frees_a_place(client, study):
+    study.max_participants = 1
+    study.abandon_after_minutes = 30
+    study.save()
+    p = consent(client, study)
+    demographics(client, p)
+    client.get(reverse("studyapp:resume", args=[p.token]))
+    assert b"study is full" in Client().get(reverse("studyapp:study_entry", args=[study.slug])).content
+    Participant.objects.filter(pk=p.pk).update(last_active_at=timezone.now() - timedelta(minutes=31))
+    r = Client().get(reverse("studyapp:study_entry", args=[study.slug]))
+    assert b"study is full" not in r.content and b"consent" in r.content
+    # the inactive participant can still come back and go on
+    assert client.get(reverse("studyapp:resume", args=[p.token]))["Location"].endswith("/clip/1/")
+
+
+def test_automatic_completion_redirect(client, study):
+    study.redirect_automatically = True
+    study.save()
+    p = consent(client, study)
+    demographics(client, p)
+    client.get(reverse("studyapp:resume", args=[p.token]))
+    while (step := cur(p)).kind == "item":
+        client.post(reverse("studyapp:item", args=[p.token, step.index]), answer_for(step.assignment))
+    client.post(reverse("studyapp:feedback", args=[p.token]),
+                {q["key"]: "no" if q["kind"] == "yesno" else "" for q in study.feedback_questions})
+    page = client.get(reverse("studyapp:done", args=[p.token])).content.decode()
+    assert f'http-equiv="refresh" content="5; url=https://app.prolific.com/submissions/complete?cc=' \
+           f'{study.completion_code}"' in page

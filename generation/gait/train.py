@@ -33,6 +33,7 @@ from .losses import total_loss
 from .model import GaitNet
 
 DEFAULT_WEIGHTS = Path(__file__).resolve().parent.parent / "data" / "weights" / "gait_net_default.pt"
+CHECKPOINT_DIR = Path("var/gait_runs")
 
 
 def fit_normalizer(data: GaitSequences) -> Normalizer:
@@ -202,7 +203,8 @@ def train(config: GaitNetConfig, data: GaitSequences, out_path: str | Path, chec
     sched = torch.optim.lr_scheduler.ExponentialLR(opt, gamma=config.lr_decay)
     history: list[dict] = []
     start_epoch = 0
-    checkpoint_path = Path(checkpoint_path) if checkpoint_path else Path(str(out_path) + ".ckpt")
+    # Training state lives under var/ (not next to the shipped weights) unless a path is given.
+    checkpoint_path = Path(checkpoint_path) if checkpoint_path else CHECKPOINT_DIR / (Path(out_path).name + ".ckpt")
     if resume and checkpoint_path.exists():
         state = torch.load(checkpoint_path, map_location="cpu", weights_only=False)
         model.load_state_dict(state["model"])
@@ -265,7 +267,8 @@ def build_parser() -> argparse.ArgumentParser:
                                                   "built with --num-sequences when missing)")
     p.add_argument("--num-sequences", type=int, default=1000)
     p.add_argument("--out", default=str(DEFAULT_WEIGHTS), help="weights file to write")
-    p.add_argument("--checkpoint", default=None, help="training-state checkpoint (default OUT.ckpt)")
+    p.add_argument("--checkpoint", default=None,
+                   help="training-state checkpoint for --resume (default var/gait_runs/<OUT name>.ckpt)")
     p.add_argument("--resume", action="store_true", help="continue from the checkpoint")
     p.add_argument("--epochs", type=int, default=None)
     p.add_argument("--batch-size", type=int, default=None)

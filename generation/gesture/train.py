@@ -5,9 +5,11 @@ Seed 003 section 5.2: Adam, learning rate 1e-3 decayed by 0.999 every epoch, bat
 replacement, weight decay (the lambda ||W|| term of eq. 11), 80/10/10 split. Teacher forcing over whole sequences
 with the decoder's self-attention limited to the past ``window`` = 20 steps, which is exactly what autoregressive
 generation sees; small Gaussian noise on the teacher-forced input poses makes the network robust to its own
-errors at generation time. A fixed seed makes runs repeatable; checkpoints (model, optimiser, epoch, history) are
-written every epoch and ``--resume`` continues from the last one. The best model by validation loss is saved as
-plain weights (config + state dict, float32).
+errors at generation time, and so does parallel scheduled sampling (part of the inputs are the network's own
+predictions). Every 5 epochs the validation gestures are generated autoregressively from text and attributes and
+their pose error decides which weights are kept. A fixed seed makes runs repeatable; checkpoints (model,
+optimiser, epoch, history) are written every epoch and ``--resume`` continues from the last one. The best model
+is saved as plain weights (config + state dict, float32).
 """
 from __future__ import annotations
 
@@ -24,7 +26,9 @@ import torch
 from ..skeleton import GESTURE_PARENTS
 from . import config
 from .data import SYNTHETIC_LABEL, GestureDataset, build_dataset
+from .generate import decode_examples
 from .losses import LossWeights, total_loss
+from .metrics import dataset_pose_error
 from .model import GestureNet, GestureNetConfig
 
 
@@ -52,6 +56,9 @@ class TrainConfig:
     checkpoint: str = str(config.VAR_DIR / "checkpoints" / "gesture_net.pt")
     resume: bool = False
     threads: int = 1
+    # Every this many epochs, generate the validation gestures autoregressively and measure their pose error;
+    # the best model is chosen by it (0: choose by the teacher-forced validation loss instead).
+    rollout_every: int = 5
 
 
 def _self_fed_inputs(net, b: dict, share: float, passes: int, generator: torch.Generator) -> torch.Tensor:
@@ -128,7 +135,8 @@ def train(cfg: TrainConfig, data: GestureDataset | None = None, progress: bool =
     scheduler = torch.optim.lr_scheduler.ExponentialLR(optimizer, gamma=cfg.lr_decay)
     generator = torch.Generator().manual_seed(cfg.seed)
     history: list[dict] = []
-    best_val, best_state, start_epoch = float("inf"), None, 0
+    best_val, best_state, start_epoch, best_epoch = float("inf"), None, 0, -1
+    selected_by = "val_rollout_pose_error" if cfg.rollout_every > 0 else "val_loss"
     ckpt_path = Path(cfg.checkpoint)
     if cfg.resume and ckpt_path.is_file():
         ckpt = torch.load(ckpt_path, weights_only=False)
@@ -140,6 +148,9 @@ def train(cfg: TrainConfig, data: GestureDataset | None = None, progress: bool =
         scheduler.load_state_dict(ckpt["scheduler"])
         generator.set_state(ckpt["generator"])
         history, best_val, best_state = ckpt["history"], ckpt["best_val"], ckpt["best_state"]
+        best_epoch = ckpt.get("best_epoch", -1)
+        if ckpt.get("selected_by") != selected_by:  # scores on another scale: start the selection afresh
+            best_val, best_state, best_epoch = float("inf"), None, -1
         start_epoch = ckpt["epoch"] + 1
     t0 = time.time()
     bar = tqdm(range(start_epoch, cfg.epochs), desc="gesture net", disable=not progress, unit="epoch")
@@ -150,22 +161,37 @@ def train(cfg: TrainConfig, data: GestureDataset | None = None, progress: bool =
         scheduler.step()
         with torch.no_grad():
             va = _run_epoch(net, data, val_idx, cfg) if len(val_idx) else tr
-        history.append({"epoch": epoch, "train": tr, "val": va, "lr": scheduler.get_last_lr()[0]})
-        if va["total"] < best_val:
-            best_val = va["total"]
+        entry = {"epoch": epoch, "train": tr, "val": va, "lr": scheduler.get_last_lr()[0]}
+        last_epoch = epoch == cfg.epochs - 1 or (cfg.max_minutes is not None
+                                                 and (time.time() - t0) > 60 * cfg.max_minutes)
+        score = None
+        if cfg.rollout_every > 0 and len(val_idx) and ((epoch + 1) % cfg.rollout_every == 0 or last_epoch):
+            net.eval()
+            entry["val_rollout"] = dataset_pose_error(decode_examples(net, data, val_idx), data, val_idx)
+            score = entry["val_rollout"]["pose_error"]
+        elif cfg.rollout_every <= 0:
+            score = va["total"]
+        history.append(entry)
+        if score is not None and score < best_val:
+            best_val = score
             best_state = {k: v.detach().clone() for k, v in net.state_dict().items()}
+            best_epoch = epoch
         bar.set_postfix(train=f"{tr['total']:.4f}", val=f"{va['total']:.4f}", best=f"{best_val:.4f}")
         ckpt_path.parent.mkdir(parents=True, exist_ok=True)
         torch.save({"epoch": epoch, "state_dict": net.state_dict(), "optimizer": optimizer.state_dict(),
                     "scheduler": scheduler.state_dict(), "generator": generator.get_state(), "history": history,
-                    "best_val": best_val, "best_state": best_state, "model_config": cfg.model.to_dict()},
+                    "best_val": best_val, "best_state": best_state, "best_epoch": best_epoch,
+                    "selected_by": selected_by,
+                    "model_config": cfg.model.to_dict()},
                    ckpt_path)
-        if cfg.max_minutes is not None and (time.time() - t0) > 60 * cfg.max_minutes:
+        if last_epoch:
             break
     seconds = time.time() - t0
     if best_state is not None:
         net.load_state_dict(best_state)
-    summary = {"epochs_run": epoch + 1, "best_val": best_val, "seconds": seconds, "out": cfg.out}
+    summary = {"epochs_run": epoch + 1, "best_val": best_val, "best_epoch": best_epoch,
+               "selected_by": selected_by,
+               "seconds": seconds, "out": cfg.out}
     save_weights(net, cfg.out, {"loss_weights": dataclasses.asdict(cfg.loss), "train_config": _jsonable(cfg),
                                 "history": history, **{k: v for k, v in summary.items() if k != "out"}})
     summary["history"] = history

@@ -118,6 +118,10 @@ def _init_worker(progress_queue, threads: int) -> None:
     _PROGRESS_QUEUE = progress_queue
     os.environ.setdefault("OMP_NUM_THREADS", str(threads))
     os.environ.setdefault("MKL_NUM_THREADS", str(threads))
+    # Mesa's software rasteriser (llvmpipe) starts a thread per core by default; with one worker per core
+    # that oversubscribes the machine.
+    os.environ.setdefault("LP_NUM_THREADS", str(threads))
+    os.environ.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow")
     try:
         import torch
 

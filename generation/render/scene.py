@@ -20,6 +20,9 @@ RIGHT_COLOUR = (0.90, 0.35, 0.12)   # orange
 MID_COLOUR = (0.55, 0.55, 0.58)     # grey
 CHAIR_COLOUR = (0.55, 0.38, 0.24)   # wood brown
 BACKGROUND = (0.93, 0.95, 0.98)
+GROUND_COLOUR = (0.80, 0.80, 0.79)
+GRID_COLOUR = (0.58, 0.58, 0.58)
+SHADOW_COLOUR = (0.62, 0.62, 0.63)
 GROUND_TILE_M = 0.5
 
 
@@ -149,32 +152,37 @@ class StickFigureScene:
             actor = self.plotter.add_mesh(unit_sphere, color=_side_colour(name), smooth_shading=True, specular=0.2)
             self.joint_actors.append(actor)
         # A soft shadow disc under the pelvis helps read where the body is over the ground.
+        # Opaque (a translucent one costs an extra blending pass in software GL).
         disc = pv.Disc(center=(0, 0, 0), inner=0.0, outer=1.0, normal=(0, 1, 0), c_res=32)
-        self.shadow = self.plotter.add_mesh(disc, color=(0.2, 0.2, 0.25), opacity=0.25, lighting=False)
+        self.shadow = self.plotter.add_mesh(disc, color=SHADOW_COLOUR, lighting=False)
         self.shadow_radius = 0.28 * s
         self.ground_y = ground_y
         self._head_lift = max(0.02, 0.20 * s - (lengths[self.head] if self.head is not None else 0.0))
         self._primed = False
 
     def _add_ground(self, pv, extent, ground_y):
+        """Unlit floor with grid lines every GROUND_TILE_M metres.
+
+        Flat colour and line geometry instead of a lit, mipmapped texture: in software GL (llvmpipe)
+        per-pixel lighting and trilinear texture sampling over the whole floor cost more than the figure.
+        """
         xmin, xmax, zmin, zmax = extent
         # Snap the plane to whole tiles so the grid lines sit on round coordinates.
         xmin, zmin = np.floor(xmin / GROUND_TILE_M) * GROUND_TILE_M, np.floor(zmin / GROUND_TILE_M) * GROUND_TILE_M
         xmax, zmax = np.ceil(xmax / GROUND_TILE_M) * GROUND_TILE_M, np.ceil(zmax / GROUND_TILE_M) * GROUND_TILE_M
-        plane = pv.Plane(center=((xmin + xmax) / 2, ground_y - 0.001, (zmin + zmax) / 2), direction=(0, 1, 0),
+        plane = pv.Plane(center=((xmin + xmax) / 2, ground_y - 0.002, (zmin + zmax) / 2), direction=(0, 1, 0),
                          i_size=xmax - xmin, j_size=zmax - zmin, i_resolution=1, j_resolution=1)
-        pts = plane.points
-        plane.active_texture_coordinates = np.c_[(pts[:, 0] - xmin) / GROUND_TILE_M, (pts[:, 2] - zmin) / GROUND_TILE_M]
-        # Grid texture: light tile with a darker border; mipmapped so distant lines do not shimmer.
-        size, line = 128, 3
-        img = np.full((size, size, 3), 214, dtype=np.uint8)
-        img[:line] = img[-line:] = 150
-        img[:, :line] = img[:, -line:] = 150
-        tex = pv.Texture(img)
-        tex.repeat = True
-        tex.mipmap = True
-        tex.interpolate = True
-        self.plotter.add_mesh(plane, texture=tex, ambient=0.35, diffuse=0.7, specular=0.0)
+        self.plotter.add_mesh(plane, color=GROUND_COLOUR, lighting=False)
+        xs = np.arange(xmin, xmax + 1e-6, GROUND_TILE_M)
+        zs = np.arange(zmin, zmax + 1e-6, GROUND_TILE_M)
+        pts = np.concatenate([
+            np.stack([np.repeat(xs, 2), np.full(2 * len(xs), ground_y), np.tile([zmin, zmax], len(xs))], axis=1),
+            np.stack([np.tile([xmin, xmax], len(zs)), np.full(2 * len(zs), ground_y), np.repeat(zs, 2)], axis=1),
+        ])
+        n = len(pts) // 2
+        cells = np.column_stack([np.full(n, 2), 2 * np.arange(n), 2 * np.arange(n) + 1]).ravel()
+        grid = pv.PolyData(pts, lines=cells)
+        self.plotter.add_mesh(grid, color=GRID_COLOUR, line_width=1.5, lighting=False)
 
     def set_camera(self, pose: CameraPose) -> None:
         cam = self.plotter.camera
@@ -200,7 +208,7 @@ class StickFigureScene:
         for actor, c, r in zip(self.joint_actors, centres, self.joint_radius):
             actor.user_matrix = np.array([[r, 0, 0, c[0]], [0, r, 0, c[1]], [0, 0, r, c[2]], [0, 0, 0, 1.0]])
         rs, root = self.shadow_radius, positions[0]
-        self.shadow.user_matrix = np.array([[rs, 0, 0, root[0]], [0, 1, 0, self.ground_y + 0.002],
+        self.shadow.user_matrix = np.array([[rs, 0, 0, root[0]], [0, 1, 0, self.ground_y + 0.001],
                                             [0, 0, rs, root[2]], [0, 0, 0, 1.0]])
 
     def frame(self) -> np.ndarray:

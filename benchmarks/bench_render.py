@@ -1,0 +1,147 @@
+"""Render + encode speed, and wall time of the built-in plans.
+
+    python benchmarks/bench_render.py speed [--frames 300] [--aa none fxaa msaa ssaa2] [--procs 1 2]
+    python benchmarks/bench_render.py plans [--plans demo seed000 seed003 seed004] [--sample 12] [--workers 2]
+
+``speed`` renders a 10 s procedural walk (21 joints) at 640x480 to H.264 and reports frames per second of
+wall time and per CPU-second (the process, its llvmpipe threads and its ffmpeg child together). With
+``--procs 2`` two processes render at once; fps is their total. ``plans`` renders every k-th entry of
+each plan (``--sample`` entries, or all with 0) into a temporary media folder with ``--workers`` processes
+and extrapolates to the whole plan by the entry count; it says so in its output.
+
+CPU-seconds are reported beside wall time because the benchmark machine is shared: wall time measures
+the machine's load as much as the renderer. Writes a JSON summary to ``--json`` when given.
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import multiprocessing as mp
+import os
+import resource
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+os.environ.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow")
+sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
+
+
+def _cpu() -> float:
+    me, kids = resource.getrusage(resource.RUSAGE_SELF), resource.getrusage(resource.RUSAGE_CHILDREN)
+    return me.ru_utime + me.ru_stime + kids.ru_utime + kids.ru_stime
+
+
+def _walk(frames: int, fps: float):
+    from generation.emotion import gait_params_for_emotion
+    from generation.paths import straight
+    from generation.procedural_walk import walk
+
+    params = gait_params_for_emotion([0.2, 0.0, 0.0, 0.8])
+    return walk(params, straight(20.0), frames, fps)
+
+
+def render_once(args: tuple) -> dict:
+    """Render one clip; returns frames, wall and CPU seconds (run in this process or a spawned one)."""
+    aa, frames, width, height, lp_threads, out_dir = args
+    if lp_threads:
+        os.environ["LP_NUM_THREADS"] = str(lp_threads)
+    import torch
+
+    torch.set_num_threads(1)
+    from generation.render import RenderSettings, render_clip
+
+    motion = _walk(frames, 30.0)
+    settings = RenderSettings(width=width, height=height, fps=30.0, duration_s=frames / 30.0, anti_aliasing=aa)
+    c0, t0 = _cpu(), time.perf_counter()
+    result = render_clip(motion, out_dir, f"bench_{aa}_{os.getpid()}", settings)
+    wall, cpu = time.perf_counter() - t0, _cpu() - c0
+    return {"frames": result.n_frames, "wall_s": wall, "cpu_s": cpu, "bytes": result.mp4.stat().st_size}
+
+
+def speed(args) -> list[dict]:
+    rows = []
+    out_dir = tempfile.mkdtemp(prefix="bench_render_")
+    for aa in args.aa:
+        for procs in args.procs:
+            lp = 1 if procs > 1 else 0
+            job = (aa, args.frames, args.width, args.height, lp, out_dir)
+            load = os.getloadavg()[0]
+            if procs == 1:
+                r = [render_once(job)]
+                wall = r[0]["wall_s"]
+            else:
+                ctx = mp.get_context("spawn")
+                with ctx.Pool(procs) as pool:
+                    pool.map(render_once, [(aa, 10, 160, 120, lp, out_dir)] * procs)  # warm the imports
+                    t0 = time.perf_counter()
+                    r = pool.map(render_once, [job] * procs)
+                    wall = time.perf_counter() - t0
+            frames = sum(x["frames"] for x in r)
+            cpu = sum(x["cpu_s"] for x in r)
+            row = {"aa": aa, "procs": procs, "frames": frames, "wall_s": round(wall, 2),
+                   "fps_wall": round(frames / wall, 1), "cpu_s": round(cpu, 2), "fps_per_cpu_s": round(frames / cpu, 1),
+                   "kib_per_10s": round(sum(x["bytes"] for x in r) / len(r) / 1024 * 300 / args.frames),
+                   "load_before": round(load, 2)}
+            rows.append(row)
+            print(json.dumps(row), flush=True)
+    return rows
+
+
+def plans(args) -> list[dict]:
+    from dataclasses import replace
+
+    from generation.plan import load_plan
+    from generation.render.batch import run_plan
+
+    rows = []
+    for name in args.plans:
+        plan = load_plan(name)
+        n = len(plan.entries)
+        k = n if not args.sample or args.sample >= n else args.sample
+        step = n / k
+        picked = tuple(plan.entries[int(i * step)] for i in range(k))
+        sub = replace(plan, entries=picked)
+        with tempfile.TemporaryDirectory(prefix="bench_plan_") as tmp:
+            c0, t0, load = _cpu(), time.perf_counter(), os.getloadavg()[0]
+            result = run_plan(sub, Path(tmp) / "clips", Path(tmp) / "records", workers=args.workers)
+            wall, cpu = time.perf_counter() - t0, _cpu() - c0
+        frames = sum(r["metadata"].get("n_frames", 0) for r in result.records)
+        gen_s = sum(r["metadata"].get("timing_s", {}).get("generate", 0.0) for r in result.records)
+        row = {"plan": name, "entries": n, "rendered": len(result.rendered), "failed": len(result.failed),
+               "workers": args.workers, "frames": frames, "wall_s": round(wall, 1), "cpu_s": round(cpu, 1),
+               "generate_s": round(gen_s, 1), "extrapolated": k < n,
+               "plan_wall_s": round(wall * n / k, 1), "plan_cpu_s": round(cpu * n / k, 1),
+               "plan_frames": round(frames * n / k), "load_before": round(load, 2),
+               "generators": sorted({r["metadata"]["generator"] for r in result.records})}
+        for where, msg in result.failed:
+            print("FAILED", msg, file=sys.stderr)
+        rows.append(row)
+        print(json.dumps(row), flush=True)
+    return rows
+
+
+def main() -> None:
+    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    sub = p.add_subparsers(dest="cmd", required=True)
+    s = sub.add_parser("speed")
+    s.add_argument("--frames", type=int, default=300)
+    s.add_argument("--width", type=int, default=640)
+    s.add_argument("--height", type=int, default=480)
+    s.add_argument("--aa", nargs="+", default=["none", "fxaa", "msaa"])
+    s.add_argument("--procs", nargs="+", type=int, default=[1, 2])
+    q = sub.add_parser("plans")
+    q.add_argument("--plans", nargs="+", default=["demo", "seed000", "seed003", "seed004"])
+    q.add_argument("--sample", type=int, default=12, help="entries rendered per plan (0 = all)")
+    q.add_argument("--workers", type=int, default=2)
+    for x in (s, q):
+        x.add_argument("--json", default=None)
+    args = p.parse_args()
+    rows = speed(args) if args.cmd == "speed" else plans(args)
+    if args.json:
+        Path(args.json).write_text(json.dumps(rows, indent=1))
+
+
+if __name__ == "__main__":
+    main()

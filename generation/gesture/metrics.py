@@ -1,0 +1,43 @@
+"""Quality measures of generated gestures against ground truth (seed 003 section 5.3, Table 1)."""
+from __future__ import annotations
+
+import numpy as np
+
+from ..kinematics import np_forward_kinematics
+from ..quaternion import np_qangle, np_qnormalize
+from ..skeleton import gesture_skeleton
+
+# neck, head, shoulders, elbows, wrists: the 8 upper-body joints seed 003 compares Yoon et al. on
+UPPER_BODY = (5, 6, 8, 9, 10, 12, 13, 14)
+
+
+def sequence_pose_error(pred: np.ndarray, true: np.ndarray, gender: str, root: np.ndarray) -> dict[str, float]:
+    """Normalised pose error of one sequence.
+
+    Args:
+        pred, true: (T, 23, 4) local rotations; gender picks the body; root (3,) the seated root position, metres.
+
+    Returns:
+        {"all": mean over frames and joints of the joint distance / the ground truth's bounding-box diagonal,
+         "upper": the same over the 8 upper-body joints, "rotation_deg": mean geodesic joint-rotation error}.
+    """
+    sk = gesture_skeleton(build=gender)
+    roots = np.repeat(np.asarray(root, dtype=np.float64)[None], len(true), 0)
+    P = np_forward_kinematics(np.asarray(pred, dtype=np.float64), roots, sk)
+    G = np_forward_kinematics(np.asarray(true, dtype=np.float64), roots, sk)
+    flat = G.reshape(-1, 3)
+    diag = float(np.linalg.norm(flat.max(0) - flat.min(0)))
+    d = np.linalg.norm(P - G, axis=-1)
+    return {"all": float(d.mean() / diag), "upper": float(d[:, UPPER_BODY].mean() / diag),
+            "rotation_deg": float(np.degrees(np_qangle(np_qnormalize(pred), true)).mean())}
+
+
+def dataset_pose_error(pred: list[np.ndarray], data, idx) -> dict[str, float]:
+    """Seed 003 Table 1: the mean over sequences ``idx`` of :func:`sequence_pose_error` (pred[k] for idx[k])."""
+    rows = []
+    for p, i in zip(pred, idx):
+        L = int(data.lengths[i])
+        rows.append(sequence_pose_error(p[:L], data.rotations[i, :L], str(data.gender[i]), data.root[i]))
+    return {"pose_error": float(np.mean([r["all"] for r in rows])),
+            "pose_error_upper": float(np.mean([r["upper"] for r in rows])),
+            "rotation_error_deg": float(np.mean([r["rotation_deg"] for r in rows])), "n": len(rows)}
