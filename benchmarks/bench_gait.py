@@ -121,9 +121,14 @@ class Observer:
         a = np.clip(aff, -10, 10)
         return a.mean(-2)
 
+    def features(self, motions: list[Motion], frames: slice = slice(None)) -> np.ndarray:
+        return np.clip(np.stack([np_gait_affective_features(m.positions()[frames]).mean(0) for m in motions]), -10, 10)
+
     def predict_motions(self, motions: list[Motion], frames: slice = slice(None)) -> np.ndarray:
-        X = np.stack([np_gait_affective_features(m.positions()[frames]).mean(0) for m in motions])
-        return self.clf.predict(np.clip(X, -10, 10))
+        return self.clf.predict(self.features(motions, frames))
+
+    def proba_motions(self, motions: list[Motion], frames: slice = slice(None)) -> np.ndarray:
+        return self.clf.predict_proba(self.features(motions, frames))
 
 
 def test_seeds(corpus, test_rows, n_frames=PREFIX * 4 - 3):
@@ -167,6 +172,11 @@ def expressiveness(net, observer, corpus, test_rows, test_emotion, steps, rng) -
     res["transition_end"] = accuracy_table(observer.predict_motions(trans, slice(-200, None)), target)
     res["transition_start"] = accuracy_table(observer.predict_motions(trans, slice(0, 200)),
                                              test_emotion.argmax(1))
+    rows = np.arange(N)
+    res["transition_p_target"] = {
+        "first_50_steps": float(observer.proba_motions(trans, slice(0, 200))[rows, target].mean()),
+        "last_50_steps": float(observer.proba_motions(trans, slice(-200, None))[rows, target].mean()),
+        "constant_seed_emotion_last_50": float(observer.proba_motions(own, slice(-200, None))[rows, target].mean())}
     res["_motions"] = {"own": own, "trans": trans, "other": other}
     return res
 
@@ -375,18 +385,23 @@ def main(argv=None) -> int:
     results["expressiveness"] = expr
     print("\n## synthetic observer accuracy (chance 0.25); on the test corpus itself:",
           f"{results['observer_on_test_corpus']['overall']:.2f}")
-    print("| model | own emotion | other mixture (whole / last third) | transition start / end |")
-    print("|---|---|---|---|")
+    print("| model | own emotion | other mixture (whole / last third) | transition start / end | P(target) "
+          "transition first / last 50 steps (no transition) |")
+    print("|---|---|---|---|---|")
     for k, v in expr.items():
+        pt = v["transition_p_target"]
         print(f"| {k} | {v['own_emotion']['overall']:.2f} | {v['other_mixture']['overall']:.2f} / "
               f"{v['other_mixture_last_third']['overall']:.2f} | {v['transition_start']['overall']:.2f} / "
-              f"{v['transition_end']['overall']:.2f} |")
+              f"{v['transition_end']['overall']:.2f} | {pt['first_50_steps']:.2f} / {pt['last_50_steps']:.2f} "
+              f"({pt['constant_seed_emotion_last_50']:.2f}) |")
+        print("  own emotion per class:", {e: v["own_emotion"][e] for e in EMOTIONS})
 
     # 3. trajectory following on unseen paths
     path_rng = np.random.default_rng(2026)
     n_traj = 12 if args.quick else 30
     kinds = ["straight", "curved", "sharp_turn"]
-    tpaths = [random_path(path_rng, 30.0, kinds[i % 3]) for i in range(n_traj)]
+    # 50 m paths: longer than 200 steps of the fastest gaits, so the walk ends on the path itself.
+    tpaths = [random_path(path_rng, 50.0, kinds[i % 3]) for i in range(n_traj)]
     tseeds = test_seeds(corpus, test_rows[np.arange(n_traj) % len(test_rows)])
     temo = test_emotion[np.arange(n_traj) % len(test_rows)]
     traj, traj_motions = {}, {}

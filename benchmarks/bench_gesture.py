@@ -254,7 +254,8 @@ def main(argv=None):
             out = abl_dir / f"{slug}.pt"
             if not (args.skip_train and out.is_file()):
                 cfg = TrainConfig(epochs=args.ablation_epochs, max_minutes=args.ablation_minutes, loss=weights,
-                                  model=GestureNetConfig(), out=str(out), checkpoint=str(abl_dir / f"{slug}_ckpt.pt"))
+                                  model=GestureNetConfig(**blob["config"]), out=str(out),
+                                  checkpoint=str(abl_dir / f"{slug}_ckpt.pt"))
                 s = train(cfg, data=data, progress=False)
                 print(f"{name}: {s['epochs_run']} epochs in {s['seconds']:.0f} s", flush=True)
             ab = load_model(out)

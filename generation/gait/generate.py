@@ -164,9 +164,11 @@ class _PathTracker:
         return float(np.arctan2(d[0], d[1]))
 
 
-def distance_to_path(path: GroundPath, xz: np.ndarray, spacing: float = 0.02) -> np.ndarray:
-    """(T,) distance in metres of ground points (T, 2) from the path (its straight extensions included)."""
-    s = np.arange(-1.0, path.length + 1.0, spacing)
+def distance_to_path(path: GroundPath, xz: np.ndarray, spacing: float = 0.02, beyond_end_m: float = 100.0
+                     ) -> np.ndarray:
+    """(T,) distance in metres of ground points (T, 2) from the path, including its straight extension
+    ``beyond_end_m`` past the end (where generation keeps walking when the path is shorter than the walk)."""
+    s = np.arange(-1.0, path.length + beyond_end_m, spacing)
     pts = path.point_at(s)
     out = np.empty(len(xz))
     for i, p in enumerate(xz):

@@ -151,3 +151,20 @@ def tracking_cameras(positions: np.ndarray, fps: float, aspect: float, body_heig
         focal = np.array([smooth[t, 0], ground + 0.55 * body_height, smooth[t, 1]])
         poses.append(CameraPose(focal + offset * dist, focal, view_angle=view_angle))
     return poses
+
+
+def project(points: np.ndarray, pose: CameraPose, width: int, height: int) -> tuple[np.ndarray, np.ndarray, float]:
+    """Pixel coordinates of points (N, 3) seen by ``pose`` in a width x height image.
+
+    Returns (N, 2) pixel positions (x to the right, y down, pixel centres at +0.5), (N,) depths in metres
+    along the view direction, and the focal length in pixels.
+    """
+    d = _unit(np.asarray(pose.focal_point, float) - np.asarray(pose.position, float))
+    r = _unit(np.cross(d, np.asarray(pose.view_up, float)))
+    u = np.cross(r, d)
+    rel = points - np.asarray(pose.position, float)
+    depth = rel @ d
+    f = (height / 2) / np.tan(np.radians(pose.view_angle) / 2)
+    safe = np.maximum(depth, 1e-6)
+    px = np.stack([width / 2 + f * (rel @ r) / safe, height / 2 - f * (rel @ u) / safe], axis=1)
+    return px, depth, float(f)

@@ -75,20 +75,32 @@ def build_scene(motion: Motion, positions: np.ndarray, settings: RenderSettings)
     return scene, cams
 
 
-def render_frames(motion: Motion, settings: RenderSettings) -> Iterator[np.ndarray]:
-    """Yield the clip's frames as (height, width, 3) uint8 images."""
-    clip, positions = prepare(motion, settings)
+def _frames(clip: Motion, positions: np.ndarray, settings: RenderSettings, patches: bool = True
+            ) -> Iterator[np.ndarray]:
     scene, cams = build_scene(clip, positions, settings)
     try:
+        fixed = all(c is cams[0] for c in cams)
+        use_patches = patches and fixed and scene.plan_patches(positions, cams[0])
         last_cam = None
         for t in range(len(positions)):
-            if cams[t] is not last_cam:
+            if not use_patches and cams[t] is not last_cam:
                 scene.set_camera(cams[t])
                 last_cam = cams[t]
             scene.set_pose(positions[t])
-            yield scene.frame()
+            yield scene.frame_patch(t) if use_patches else scene.frame()
     finally:
         scene.close()
+
+
+def render_frames(motion: Motion, settings: RenderSettings, patches: bool = True) -> Iterator[np.ndarray]:
+    """Yield the clip's frames as (height, width, 3) uint8 images.
+
+    With a fixed camera and a figure small in the frame, only the figure's patch is re-rendered per frame
+    (:meth:`StickFigureScene.plan_patches`; same pictures, a few differently rasterised pixels);
+    ``patches=False`` renders every frame whole.
+    """
+    clip, positions = prepare(motion, settings)
+    yield from _frames(clip, positions, settings, patches)
 
 
 def render_clip(motion: Motion, out_dir: str | Path, name: str, settings: RenderSettings | None = None,
@@ -116,16 +128,10 @@ def render_clip(motion: Motion, out_dir: str | Path, name: str, settings: Render
     if settings.webm:
         writers.append(VideoWriter(out_dir / f"{name}.webm", settings.width, settings.height, settings.fps,
                                    settings.crf, settings.preset, settings.encoder_threads))
-    scene, cams = build_scene(clip, positions, settings)
     poster = None
+    frames = _frames(clip, positions, settings)
     try:
-        last_cam = None
-        for t in range(n):
-            if cams[t] is not last_cam:
-                scene.set_camera(cams[t])
-                last_cam = cams[t]
-            scene.set_pose(positions[t])
-            img = scene.frame()
+        for t, img in enumerate(frames):
             for w in writers:
                 w.write(img)
             if t == poster_index:
@@ -139,7 +145,7 @@ def render_clip(motion: Motion, out_dir: str | Path, name: str, settings: Render
             w.abort()
         raise
     finally:
-        scene.close()
+        frames.close()  # closes the offscreen window
     write_png_atomic(poster, out_dir / f"{name}.png")
     return RenderResult(out_dir / f"{name}.mp4", out_dir / f"{name}.webm" if settings.webm else None,
                         out_dir / f"{name}.png", n, settings.fps)

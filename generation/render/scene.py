@@ -11,7 +11,7 @@ import os
 import numpy as np
 
 from ..skeleton import Skeleton
-from .camera import CameraPose
+from .camera import CameraPose, project
 
 os.environ.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow")
 
@@ -220,10 +220,106 @@ class StickFigureScene:
         self.plotter.renderer.ResetCameraClippingRange()
         self.plotter.render()
         img = np.asarray(self.plotter.screenshot(return_img=True))[..., :3]
+        return self._downsample(img)
+
+    def _downsample(self, img: np.ndarray) -> np.ndarray:
+        """Average ssaa x ssaa pixel blocks (integer arithmetic, rounded)."""
         if self.ssaa > 1:
-            h, w = self.height, self.width
-            img = img.reshape(h, self.ssaa, w, self.ssaa, 3).mean(axis=(1, 3)).round().astype(np.uint8)
+            k = self.ssaa
+            blocks = img.reshape(self.height, k, self.width, k, 3).sum(axis=(1, 3), dtype=np.uint16)
+            img = ((blocks + (k * k) // 2) // (k * k)).astype(np.uint8)
         return np.ascontiguousarray(img)
+
+    # ---- patch rendering for a fixed camera ----------------------------------------------------
+    def _body_spheres(self, positions: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Bounding spheres (centres (T, K, 3), radii (K,)) of everything that moves: joints, head, shadow."""
+        centres = [positions]
+        radii = [np.maximum(self.joint_radius, self.bone_radius.max()) + 0.01]
+        if self.head is not None and self.neck is not None:
+            d = positions[:, self.head] - positions[:, self.neck]
+            head = positions[:, self.head] + d / np.maximum(np.linalg.norm(d, axis=1, keepdims=True), 1e-9) * \
+                self._head_lift
+            centres.append(head[:, None])
+            radii.append(np.array([self.joint_radius[self.head] + 0.01]))
+        angles = np.linspace(0, 2 * np.pi, 12, endpoint=False)
+        ring = np.stack([np.cos(angles), np.zeros_like(angles), np.sin(angles)], 1) * self.shadow_radius
+        shadow = positions[:, :1] * np.array([1, 0, 1]) + np.array([0, self.ground_y, 0]) + ring[None]
+        centres.append(shadow)
+        radii.append(np.full(len(angles), 0.01))
+        return np.concatenate(centres, axis=1), np.concatenate(radii)
+
+    def plan_patches(self, positions: np.ndarray, pose: CameraPose, margin_px: int = 6,
+                     max_fraction: float = 0.55) -> bool:
+        """Prepare to render only the moving part of each frame (fixed camera only).
+
+        The static scene (floor, grid, chair) is rendered once without the figure; each frame then renders
+        a window just big enough for the figure and its shadow, with the same projection as that region
+        of the full frame (off-axis camera: ``SetWindowCenter`` and a narrower view angle), and pastes it
+        in. Anti-aliasing then only runs over the patch. Returns False (and renders whole frames) when
+        the figure covers more than ``max_fraction`` of the frame, where patches would not save time.
+
+        Args:
+            positions: (T, J, 3) joint positions of the whole clip.
+            pose: the fixed camera.
+        """
+        W, H = self.width * self.ssaa, self.height * self.ssaa
+        centres, radii = self._body_spheres(positions)
+        T, K = centres.shape[:2]
+        px, depth, f = project(centres.reshape(-1, 3), pose, W, H)
+        if (depth <= 0.05).any():
+            return False
+        rpx = (radii[None].repeat(T, 0).ravel() * f / depth)[:, None]
+        lo = (px - rpx).reshape(T, K, 2).min(1) - margin_px * self.ssaa
+        hi = (px + rpx).reshape(T, K, 2).max(1) + margin_px * self.ssaa
+        size = np.ceil((hi - lo).max(0)).astype(int)
+        size += size % 2
+        if size[0] * size[1] > max_fraction * W * H or size[0] >= W or size[1] >= H:
+            return False
+        self._patch_size = (int(size[0]), int(size[1]))
+        centre = (lo + hi) / 2
+        x0 = np.clip(np.round(centre[:, 0] - size[0] / 2), 0, W - size[0]).astype(int)
+        y0 = np.clip(np.round(centre[:, 1] - size[1] / 2), 0, H - size[1]).astype(int)
+        self._patch_origin = np.stack([x0, y0], 1)
+        self._patch_pose = pose
+        self._patch_t = 0
+        # The static background: everything but the figure and its shadow, full size.
+        for actor in (*self.bone_actors, *self.joint_actors, self.shadow):
+            actor.visibility = False
+        self.set_camera(pose)
+        self._background = self._render_full()
+        for actor in (*self.bone_actors, *self.joint_actors, self.shadow):
+            actor.visibility = True
+        self.plotter.render_window.SetSize(*self._patch_size)
+        return True
+
+    def _render_full(self) -> np.ndarray:
+        if not self._primed:
+            # The first screenshot initialises the offscreen buffers (REFERENCE.md section 8).
+            self.plotter.screenshot(return_img=True)
+            self._primed = True
+        self.plotter.renderer.ResetCameraClippingRange()
+        self.plotter.render()
+        return np.asarray(self.plotter.screenshot(return_img=True))[..., :3]
+
+    def frame_patch(self, t: int) -> np.ndarray:
+        """Frame ``t`` of a clip prepared by :meth:`plan_patches` (after :meth:`set_pose`)."""
+        W, H = self.width * self.ssaa, self.height * self.ssaa
+        w, h = self._patch_size
+        x0, y0 = self._patch_origin[t]
+        cam = self.plotter.camera
+        pose = self._patch_pose
+        # Off-axis projection of the patch: same pixel scale as the full frame, centre shifted.
+        cam.view_angle = float(np.degrees(2 * np.arctan(np.tan(np.radians(pose.view_angle) / 2) * h / H)))
+        dx = (x0 + w / 2) - W / 2
+        dy = H / 2 - (y0 + h / 2)
+        cam.SetWindowCenter(dx / (w / 2), dy / (h / 2))
+        self.plotter.renderer.ResetCameraClippingRange()
+        self.plotter.render()
+        patch = np.asarray(self.plotter.screenshot(return_img=True))[..., :3]
+        img = self._background.copy()
+        m = 2 * self.ssaa  # screen-space AA sees the patch edge; keep the background's border pixels
+        img[y0 + m:y0 + h - m, x0 + m:x0 + w - m] = patch[m:h - m, m:w - m]
+        return self._downsample(img)
 
     def close(self) -> None:
         self.plotter.close()
