@@ -197,8 +197,10 @@ def read_clips(src) -> pd.DataFrame:
                  lambda x: f"{x!r} is not an integer >= 0")
     col.add_mask(df, (out["duration_s"] < 0).to_numpy(), "duration_s", lambda x: f"{x!r} is negative")
     has_theme = ~_blank(df["theme"])
-    col.add_mask(df, has_theme & ~df["theme"].isin(THEMES).to_numpy(), "theme",
-                 lambda v: f"{v!r} is not one of {', '.join(THEMES)}")
+    # "neutral" marks the unstyled input walk of seed 004 (weight 0, no features; Table I).
+    clip_themes = (*THEMES, "neutral")
+    col.add_mask(df, has_theme & ~df["theme"].isin(clip_themes).to_numpy(), "theme",
+                 lambda v: f"{v!r} is not one of {', '.join(clip_themes)}")
     col.add_mask(df, has_theme & out["weight"].isna().to_numpy(), "weight", "a theme clip needs a weight")
     label = df["emotion_label"]
     bad_label = (df["modality"] == "gesture").to_numpy() & ~_blank(label) & ~label.isin(list(NRC_VAD)).to_numpy()

@@ -10,8 +10,8 @@ Variables (all optional for the demo):
     MEDIA_ROOT        where rendered clips live (default: DATA_DIR/media)
     PRODUCTION        "1" turns on HTTPS-only cookies, HSTS and the other deploy checks
 """
-from pathlib import Path
 import os
+from pathlib import Path
 
 import dj_database_url
 
@@ -55,6 +55,9 @@ STORAGES = {
     "staticfiles": {"BACKEND": "whitenoise.storage.CompressedManifestStaticFilesStorage"
                     if PRODUCTION else "django.contrib.staticfiles.storage.StaticFilesStorage"},
 }
+
+# Outside production, serve static files straight from the app folders (no collectstatic needed for the demo).
+WHITENOISE_USE_FINDERS = not PRODUCTION
 
 INSTALLED_APPS = [
     "django.contrib.admin",

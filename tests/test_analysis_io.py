@@ -131,3 +131,11 @@ def test_participant_problems():
 def test_empty_file():
     with pytest.raises(ValidationError, match="empty"):
         read_clips(io.StringIO(""))
+
+
+def test_neutral_input_walk_is_a_valid_clip():
+    """The plan writes the unstyled seed 004 walk with theme 'neutral', weight 0 and no features."""
+    header = ("clip_id,modality,origin,happy,sad,angry,neutral,final_happy,final_sad,final_angry,final_neutral,"
+              "emotion_label,valence,arousal,dominance,theme,weight,n_features,duration_s\n")
+    clips = read_clips(io.StringIO(header + "n0,gait,generated,,,,,,,,,,,,,neutral,0,0,10\n"))
+    assert clips.loc["n0", "theme"] == "neutral" and clips.loc["n0", "weight"] == 0

@@ -249,7 +249,7 @@ class StickFigureScene:
         return np.concatenate(centres, axis=1), np.concatenate(radii)
 
     def plan_patches(self, positions: np.ndarray, pose: CameraPose, margin_px: int = 6,
-                     max_fraction: float = 0.55) -> bool:
+                     max_fraction: float = 0.8) -> bool:
         """Prepare to render only the moving part of each frame (fixed camera only).
 
         The static scene (floor, grid, chair) is rendered once without the figure; each frame then renders
