@@ -115,7 +115,7 @@ def plans(args) -> list[dict]:
                "plan_wall_s": round(wall * n / k, 1), "plan_cpu_s": round(cpu * n / k, 1),
                "plan_frames": round(frames * n / k), "load_before": round(load, 2),
                "generators": sorted({r["metadata"]["generator"] for r in result.records})}
-        for where, msg in result.failed:
+        for _where, msg in result.failed:
             print("FAILED", msg, file=sys.stderr)
         rows.append(row)
         print(json.dumps(row), flush=True)

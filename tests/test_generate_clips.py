@@ -91,10 +91,12 @@ def test_resume_renders_only_missing_clips(media, tmp_path):
     rows = read_clips_csv(media / "clips.csv")
     victim = media / "clips" / f"{rows[0]['clip_id']}.mp4"
     victim.unlink()
-    (media / "clips" / f".{rows[0]['clip_id']}.tmp999.mp4").write_bytes(b"half a file")  # a crashed render
+    stale = media / "clips" / f".{rows[0]['clip_id']}.tmp999.mp4"
+    stale.write_bytes(b"half a file")  # what a crashed render leaves
     out = _run("--plan", str(plan), "--no-db")
     assert "1 rendered, 1 already done" in out
-    assert victim.is_file()
+    assert victim.is_file() and not stale.exists()
+    assert check_catalogue(media / "clips.csv", media / "clips") == []
 
 
 @pytest.mark.django_db

@@ -89,7 +89,8 @@ def test_normalisation_and_defaults():
 
 
 def test_gesture_intent_uses_nrc_vad():
-    plan = validate_plan(_plan({"id": "g", "generator": "gesture_net", "sentence": "We won!", "emotion_label": "Proud"}))
+    entry = {"id": "g", "generator": "gesture_net", "sentence": "We won!", "emotion_label": "Proud"}
+    plan = validate_plan(_plan(entry))
     fields = intent_fields(plan.entries[0])
     assert fields["emotion_label"] == "proud"
     assert (fields["valence"], fields["arousal"], fields["dominance"]) == pytest.approx((0.906, 0.700, 0.873))

@@ -187,3 +187,14 @@ def test_patch_rendering_matches_whole_frames():
     for a, b in zip(whole, patched):
         diff = np.abs(a.astype(int) - b.astype(int))
         assert diff.mean() < 0.1 and (diff.max(-1) > 40).sum() < 40
+
+
+def test_patch_rendering_of_a_seated_gesture_matches_whole_frames():
+    """In place (root fixed): the background keeps the still body, the patch covers what moves."""
+    settings = RenderSettings(width=320, height=240, fps=10, duration_s=1.0)
+    whole = list(render_frames(seated(), settings, patches=False))
+    patched = list(render_frames(seated(), settings, patches=True))
+    assert np.abs(whole[-1].astype(int) - whole[0].astype(int)).sum() > 1000  # the arm did move
+    for a, b in zip(whole, patched):
+        diff = np.abs(a.astype(int) - b.astype(int))
+        assert diff.mean() < 0.1 and (diff.max(-1) > 40).sum() < 40

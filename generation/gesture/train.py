@@ -137,6 +137,7 @@ def train(cfg: TrainConfig, data: GestureDataset | None = None, progress: bool =
     history: list[dict] = []
     best_val, best_state, start_epoch, best_epoch = float("inf"), None, 0, -1
     selected_by = "val_rollout_pose_error" if cfg.rollout_every > 0 else "val_loss"
+    seconds_before = 0.0  # wall-clock seconds of earlier (resumed) segments
     ckpt_path = Path(cfg.checkpoint)
     if cfg.resume and ckpt_path.is_file():
         ckpt = torch.load(ckpt_path, weights_only=False)
@@ -152,6 +153,7 @@ def train(cfg: TrainConfig, data: GestureDataset | None = None, progress: bool =
         if ckpt.get("selected_by") != selected_by:  # scores on another scale: start the selection afresh
             best_val, best_state, best_epoch = float("inf"), None, -1
         start_epoch = ckpt["epoch"] + 1
+        seconds_before = float(ckpt.get("seconds", 0.0))
     t0 = time.time()
     bar = tqdm(range(start_epoch, cfg.epochs), desc="gesture net", disable=not progress, unit="epoch")
     epoch = start_epoch - 1
@@ -181,12 +183,12 @@ def train(cfg: TrainConfig, data: GestureDataset | None = None, progress: bool =
         torch.save({"epoch": epoch, "state_dict": net.state_dict(), "optimizer": optimizer.state_dict(),
                     "scheduler": scheduler.state_dict(), "generator": generator.get_state(), "history": history,
                     "best_val": best_val, "best_state": best_state, "best_epoch": best_epoch,
-                    "selected_by": selected_by,
+                    "selected_by": selected_by, "seconds": seconds_before + time.time() - t0,
                     "model_config": cfg.model.to_dict()},
                    ckpt_path)
         if last_epoch:
             break
-    seconds = time.time() - t0
+    seconds = seconds_before + time.time() - t0
     if best_state is not None:
         net.load_state_dict(best_state)
     summary = {"epochs_run": epoch + 1, "best_val": best_val, "best_epoch": best_epoch,

@@ -43,13 +43,15 @@ def _predominant(emotion: str, share: float = 0.8) -> list[float]:
 
 def seed000() -> dict:
     clips = []
-    trajectories = [{"kind": "straight", "length_m": 14}, {"kind": "curved", "radius_m": 6, "angle_deg": 90,
-                                                          "length_m": 14}]
+    # Compact paths (loops and hairpins): a fixed camera has to frame the whole 10 s walk (about 13 m),
+    # and on a long straight the body would be a few dozen pixels tall for most of the clip.
+    trajectories = [{"kind": "curved", "radius_m": 3.0, "angle_deg": 330, "length_m": 14},
+                    {"kind": "sharp_turn", "angle_deg": 150, "length_m": 14}]
     seed = 0
     for emotion in GAIT_EMOTIONS:           # pure emotions on a straight and a curved path
         for k, traj in enumerate(trajectories):
             seed += 1
-            clips.append({"id": f"single_{emotion}_{traj['kind']}", "generator": "gait_net",
+            clips.append({"id": f"single_{emotion}_{('loop', 'hairpin')[k]}", "generator": "gait_net",
                           "fallback": "procedural_walk", "origin": "generated",
                           "emotion": [1.0 if e == emotion else 0.0 for e in GAIT_EMOTIONS], "trajectory": traj,
                           "seed": seed, "sections": ["emotion_choice", "affect_likert", "naturalness"]})
@@ -59,9 +61,9 @@ def seed000() -> dict:
         "sad_angry": [0.0, 0.5, 0.5, 0.0], "happy_sad_neutral": [0.3, 0.3, 0.0, 0.4],
         "mostly_happy": [0.8, 0.0, 0.1, 0.1], "mostly_sad": [0.0, 0.8, 0.0, 0.2],
     }
-    turns = [{"kind": "sharp_turn", "angle_deg": 70, "length_m": 14},
-             {"kind": "curved", "radius_m": 5, "angle_deg": -120, "length_m": 14},
-             {"kind": "straight", "length_m": 14}]
+    turns = [{"kind": "curved", "radius_m": 3.0, "angle_deg": -330, "length_m": 14},
+             {"kind": "sharp_turn", "angle_deg": -150, "length_m": 14},
+             {"kind": "curved", "radius_m": 3.5, "angle_deg": 300, "length_m": 14}]
     for k, (name, vec) in enumerate(mixtures.items()):
         seed += 1
         clips.append({"id": f"single_{name}", "generator": "gait_net", "fallback": "procedural_walk",

@@ -113,9 +113,21 @@ def load_done_record(clip_id: str, clips_dir: Path, records_dir: Path, webm: boo
 _PROGRESS_QUEUE = None
 
 
-def _init_worker(progress_queue, threads: int) -> None:
+def _exit_with_parent(parent_pid: int) -> None:
+    """Stop this worker when the command that started it dies (no orphan renders after a crash)."""
+    while True:
+        time.sleep(1.0)
+        if os.getppid() != parent_pid:
+            os._exit(1)
+
+
+def _init_worker(progress_queue, threads: int, parent_pid: int | None = None) -> None:
     global _PROGRESS_QUEUE
     _PROGRESS_QUEUE = progress_queue
+    if parent_pid is not None:
+        import threading
+
+        threading.Thread(target=_exit_with_parent, args=(parent_pid,), daemon=True).start()
     os.environ.setdefault("OMP_NUM_THREADS", str(threads))
     os.environ.setdefault("MKL_NUM_THREADS", str(threads))
     # Mesa's software rasteriser (llvmpipe) starts a thread per core by default; with one worker per core
@@ -206,6 +218,9 @@ def run_plan(plan: Plan, clips_dir: str | Path, records_dir: str | Path, media_p
             by_id[job.clip_id] = rec
             todo.append(job)
     emit("plan", {"total": len(by_id), "todo": len(todo), "skipped": len(result.skipped)})
+    for job in todo:  # leftovers of a crashed run (hidden temporary names) of the clips about to be made
+        for stale in (*clips_dir.glob(f".{job.clip_id}.tmp*"), *records_dir.glob(f".{job.clip_id}.json.tmp*")):
+            stale.unlink(missing_ok=True)
 
     def finished(job: Job, rec: dict) -> None:
         by_id[job.clip_id] = rec
@@ -239,7 +254,7 @@ def run_plan(plan: Plan, clips_dir: str | Path, records_dir: str | Path, media_p
         progress_q = manager.Queue()
         try:
             with ProcessPoolExecutor(max_workers=workers, mp_context=ctx, initializer=_init_worker,
-                                     initargs=(progress_q, threads_per_worker)) as pool:
+                                     initargs=(progress_q, threads_per_worker, os.getpid())) as pool:
                 pending = {}
                 for job in todo:
                     fut = pool.submit(render_job, job, by_id[job.clip_id], str(clips_dir), str(records_dir))

@@ -95,6 +95,10 @@ def fixed_camera(positions: np.ndarray, root_rotation0: np.ndarray, aspect: floa
         extra_points: (N, 3) more points to keep in view (a chair).
     """
     pts = positions.reshape(-1, 3)
+    # Joints are centres: pad for the head sphere above and the limbs' thickness around.
+    pad = np.array([[0.0, 0.2, 0.0], [0.08, 0.0, 0.0], [-0.08, 0.0, 0.0], [0.0, 0.0, 0.08], [0.0, 0.0, -0.08],
+                    [0.0, -0.05, 0.0]])
+    pts = (pts[:, None, :] + pad[None]).reshape(-1, 3)
     if extra_points is not None:
         pts = np.concatenate([pts, extra_points.reshape(-1, 3)])
     focal = (pts.min(0) + pts.max(0)) / 2
@@ -102,7 +106,7 @@ def fixed_camera(positions: np.ndarray, root_rotation0: np.ndarray, aspect: floa
     if travel is None:
         forward = facing_direction(root_rotation0)
         offset = view_offset(forward, 65.0 if azimuth_deg is None else azimuth_deg, elevation_deg)
-        dist = fit_distance(pts, focal, offset, view_angle, aspect)
+        focal, dist = _centred_fit(pts, focal, offset, view_angle, aspect)
         return CameraPose(focal + offset * dist, focal, view_angle=view_angle)
     # A walk: from ahead of the path, at the azimuth that shows the body largest on average while the
     # whole path stays in view (a long path seen side-on leaves a tiny figure).
@@ -111,13 +115,39 @@ def fixed_camera(positions: np.ndarray, root_rotation0: np.ndarray, aspect: floa
     best = None
     for az in candidates:
         offset = view_offset(travel, az, elevation_deg)
-        dist = fit_distance(pts, focal, offset, view_angle, aspect)
-        depth = (body - (focal + offset * dist)) @ (-offset)
+        f, dist = _centred_fit(pts, focal, offset, view_angle, aspect)
+        depth = (body - (f + offset * dist)) @ (-offset)
         size = float(np.mean(1.0 / np.maximum(depth, 1e-3)))
         if best is None or size > best[0]:
-            best = (size, offset, dist)
-    _, offset, dist = best
+            best = (size, f, offset, dist)
+    _, focal, offset, dist = best
     return CameraPose(focal + offset * dist, focal, view_angle=view_angle)
+
+
+def _centred_fit(points: np.ndarray, focal: np.ndarray, offset: np.ndarray, view_angle: float, aspect: float,
+                 iterations: int = 4) -> tuple[np.ndarray, float]:
+    """Focal point and distance that frame ``points`` with their projection centred in the image.
+
+    The bounding-box centre is not the centre of the projected points under perspective (near parts
+    look bigger), so the focal point is moved across the view until the projected extents are
+    symmetric, refitting the distance each time.
+    """
+    d = -offset
+    r = _unit(np.cross(d, UP))
+    u = np.cross(r, d)
+    tv = np.tan(np.radians(view_angle) / 2)
+    dist = fit_distance(points, focal, offset, view_angle, aspect)
+    for _ in range(iterations):
+        cam = focal + offset * dist
+        rel = points - cam
+        depth = np.maximum(rel @ d, 1e-3)
+        x, y = (rel @ r) / depth, (rel @ u) / depth        # tangent-plane coordinates
+        cx, cy = (x.max() + x.min()) / 2, (y.max() + y.min()) / 2
+        if abs(cx) < 0.002 * tv and abs(cy) < 0.002 * tv:
+            break
+        focal = focal + dist * (cx * r + cy * u)
+        dist = fit_distance(points, focal, offset, view_angle, aspect)
+    return focal, dist
 
 
 def tracking_cameras(positions: np.ndarray, fps: float, aspect: float, body_height: float,

@@ -72,7 +72,8 @@ def chair_boxes(positions: np.ndarray, skeleton: Skeleton, facing: np.ndarray, g
     seat_top = hip_y - 0.07 * s
     seat_th = 0.04 * s
     right = np.cross(facing, np.array([0.0, 1.0, 0.0]))  # body's right
-    half_w, depth_back, depth_front = 0.24 * s, 0.20 * s, 0.26 * s
+    # The backrest sits just behind the pelvis (a seated back touches it), the seat reaches toward the knees.
+    half_w, depth_back, depth_front = 0.23 * s, 0.13 * s, 0.30 * s
     centre_z = (depth_front - depth_back) / 2
     boxes = []
 
@@ -148,7 +149,7 @@ class StickFigureScene:
         if self.head is not None:
             self.joint_radius[self.head] = 0.10 * s
         self.joint_actors = []
-        for j, name in enumerate(skeleton.joints):
+        for name in skeleton.joints:
             actor = self.plotter.add_mesh(unit_sphere, color=_side_colour(name), smooth_shading=True, specular=0.2)
             self.joint_actors.append(actor)
         # A soft shadow disc under the pelvis helps read where the body is over the ground.
@@ -231,47 +232,76 @@ class StickFigureScene:
         return np.ascontiguousarray(img)
 
     # ---- patch rendering for a fixed camera ----------------------------------------------------
-    def _body_spheres(self, positions: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """Bounding spheres (centres (T, K, 3), radii (K,)) of everything that moves: joints, head, shadow."""
-        centres = [positions]
-        radii = [np.maximum(self.joint_radius, self.bone_radius.max()) + 0.01]
-        if self.head is not None and self.neck is not None:
+    def _body_spheres(self, positions: np.ndarray, joints: np.ndarray, shadow: bool
+                      ) -> tuple[np.ndarray, np.ndarray]:
+        """Bounding spheres (centres (T, K, 3), radii (K,)) of the selected joints (J,) bool, the head if
+        selected, and the shadow disc if ``shadow``."""
+        centres = [positions[:, joints]]
+        radii = [np.maximum(self.joint_radius[joints], self.bone_radius.max()) + 0.01]
+        if self.head is not None and self.neck is not None and joints[self.head]:
             d = positions[:, self.head] - positions[:, self.neck]
             head = positions[:, self.head] + d / np.maximum(np.linalg.norm(d, axis=1, keepdims=True), 1e-9) * \
                 self._head_lift
             centres.append(head[:, None])
             radii.append(np.array([self.joint_radius[self.head] + 0.01]))
-        angles = np.linspace(0, 2 * np.pi, 12, endpoint=False)
-        ring = np.stack([np.cos(angles), np.zeros_like(angles), np.sin(angles)], 1) * self.shadow_radius
-        shadow = positions[:, :1] * np.array([1, 0, 1]) + np.array([0, self.ground_y, 0]) + ring[None]
-        centres.append(shadow)
-        radii.append(np.full(len(angles), 0.01))
+        if shadow:
+            angles = np.linspace(0, 2 * np.pi, 12, endpoint=False)
+            ring = np.stack([np.cos(angles), np.zeros_like(angles), np.sin(angles)], 1) * self.shadow_radius
+            centres.append(positions[:, :1] * np.array([1, 0, 1]) + np.array([0, self.ground_y, 0]) + ring[None])
+            radii.append(np.full(len(angles), 0.01))
         return np.concatenate(centres, axis=1), np.concatenate(radii)
+
+    def _screen_boxes(self, centres: np.ndarray, radii: np.ndarray, pose: CameraPose, W: int, H: int):
+        """Per-frame pixel boxes (lo (T, 2), hi (T, 2)) around spheres, or None if one is behind the camera."""
+        T, K = centres.shape[:2]
+        if K == 0:
+            return np.full((T, 2), W / 2), np.full((T, 2), W / 2)
+        px, depth, f = project(centres.reshape(-1, 3), pose, W, H)
+        if (depth <= 0.05).any():
+            return None
+        rpx = (np.tile(radii, T) * f / depth)[:, None]
+        return (px - rpx).reshape(T, K, 2).min(1), (px + rpx).reshape(T, K, 2).max(1)
 
     def plan_patches(self, positions: np.ndarray, pose: CameraPose, margin_px: int = 6,
                      max_fraction: float = 0.8) -> bool:
-        """Prepare to render only the moving part of each frame (fixed camera only).
+        """Prepare to render only the changing part of each frame (fixed camera only).
 
-        The static scene (floor, grid, chair) is rendered once without the figure; each frame then renders
-        a window just big enough for the figure and its shadow, with the same projection as that region
-        of the full frame (off-axis camera: ``SetWindowCenter`` and a narrower view angle), and pastes it
-        in. Anti-aliasing then only runs over the patch. Returns False (and renders whole frames) when
-        the figure covers more than ``max_fraction`` of the frame, where patches would not save time.
+        A background is rendered once; each frame then renders a window just big enough for what moves,
+        with the same projection as that region of the full frame (off-axis camera: ``SetWindowCenter``
+        and a narrower view angle), and pastes it in, so per-pixel work (anti-aliasing above all) only
+        runs over the patch. Two cases:
+
+        - the body travels (a walk): the background is the scene without the figure and its shadow, and
+          the patch covers the whole figure and shadow;
+        - the root stays put (a seated gesture): the background holds the figure in its first pose, and
+          the patch covers the joints that move (and the bones touching them) in the first pose and now.
+
+        Returns False (and renders whole frames) when the patch would cover more than ``max_fraction`` of
+        the frame, where it would not save time.
 
         Args:
             positions: (T, J, 3) joint positions of the whole clip.
             pose: the fixed camera.
         """
         W, H = self.width * self.ssaa, self.height * self.ssaa
-        centres, radii = self._body_spheres(positions)
-        T, K = centres.shape[:2]
-        px, depth, f = project(centres.reshape(-1, 3), pose, W, H)
-        if (depth <= 0.05).any():
+        travels = float(np.ptp(positions[:, 0], axis=0).max()) > 0.01
+        if travels:
+            joints = np.ones(self.skeleton.num_joints, dtype=bool)
+        else:
+            moving = np.linalg.norm(positions - positions[:1], axis=-1).max(0) > 0.002
+            joints = moving.copy()
+            for j, p in enumerate(self.skeleton.parents):
+                if p >= 0 and (moving[j] or moving[p]):
+                    joints[j] = joints[p] = True
+        centres, radii = self._body_spheres(positions, joints, shadow=travels)
+        boxes = self._screen_boxes(centres, radii, pose, W, H)
+        if boxes is None:
             return False
-        rpx = (radii[None].repeat(T, 0).ravel() * f / depth)[:, None]
-        lo = (px - rpx).reshape(T, K, 2).min(1) - margin_px * self.ssaa
-        hi = (px + rpx).reshape(T, K, 2).max(1) + margin_px * self.ssaa
-        size = np.ceil((hi - lo).max(0)).astype(int)
+        lo, hi = boxes
+        if not travels:  # the first pose must be erased from the background too
+            lo, hi = np.minimum(lo, lo[:1]), np.maximum(hi, hi[:1])
+        lo, hi = lo - margin_px * self.ssaa, hi + margin_px * self.ssaa
+        size = np.maximum(np.ceil((hi - lo).max(0)).astype(int), 16)
         size += size % 2
         if size[0] * size[1] > max_fraction * W * H or size[0] >= W or size[1] >= H:
             return False
@@ -281,14 +311,17 @@ class StickFigureScene:
         y0 = np.clip(np.round(centre[:, 1] - size[1] / 2), 0, H - size[1]).astype(int)
         self._patch_origin = np.stack([x0, y0], 1)
         self._patch_pose = pose
-        self._patch_t = 0
-        # The static background: everything but the figure and its shadow, full size.
-        for actor in (*self.bone_actors, *self.joint_actors, self.shadow):
-            actor.visibility = False
         self.set_camera(pose)
-        self._background = self._render_full()
-        for actor in (*self.bone_actors, *self.joint_actors, self.shadow):
-            actor.visibility = True
+        figure = (*self.bone_actors, *self.joint_actors, self.shadow)
+        if travels:
+            for actor in figure:
+                actor.visibility = False
+            self._background = self._render_full()
+            for actor in figure:
+                actor.visibility = True
+        else:
+            self.set_pose(positions[0])
+            self._background = self._render_full()
         self.plotter.render_window.SetSize(*self._patch_size)
         return True
 

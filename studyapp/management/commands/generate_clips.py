@@ -53,7 +53,7 @@ class Command(BaseCommand):
                               webm=opts["webm"], limit=opts["limit"], on_event=bars.event)
         finally:
             bars.close()
-        for where, msg in result.failed:
+        for _where, msg in result.failed:
             self.stderr.write(f"FAILED {msg}")
         records = result.records
         csv_path = media_root / "clips.csv"
