@@ -144,7 +144,10 @@ def fixed_mixtures() -> np.ndarray:
 
 
 def accuracy_table(pred: np.ndarray, intended: np.ndarray) -> dict:
-    out = {"overall": float((pred == intended).mean()), "n": int(len(pred))}
+    """Overall and per-class accuracy, plus the confusion matrix (rows intended, columns predicted)."""
+    out = {"overall": float((pred == intended).mean()), "n": int(len(pred)),
+           "confusion": np.array([[int(((intended == i) & (pred == j)).sum()) for j in range(4)]
+                                  for i in range(4)]).tolist()}
     for k, e in enumerate(EMOTIONS):
         sel = intended == k
         out[e] = float((pred[sel] == k).mean()) if sel.any() else None
@@ -315,14 +318,18 @@ def trajectory_figure(paths, runs: dict, path: Path):
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
     n = len(paths)
-    fig, axes = plt.subplots(1, n, figsize=(3.2 * n, 3.4))
+    fig, axes = plt.subplots(1, n, figsize=(3.0 * n, 3.6))
     for i, p in enumerate(paths):
         ax = axes[i]
         pts = p.point_at(np.linspace(0, p.length, 200))
         ax.plot(pts[:, 0], pts[:, 1], "k--", lw=1, label="desired path")
-        for (name, ms), col in zip(runs.items(), ("#1f77b4", "#d62728", "#2ca02c")):
+        lo, hi = np.full(2, np.inf), np.full(2, -np.inf)
+        for (name, ms), col in zip(runs.items(), ("#1f77b4", "#ff7f0e", "#2ca02c", "#d62728")):
             r = ms[i].root_positions
-            ax.plot(r[:, 0], r[:, 2], color=col, lw=1.2, label=name)
+            ax.plot(r[:, 0], r[:, 2], color=col, lw=1.0, label=name)
+            lo, hi = np.minimum(lo, r[:, [0, 2]].min(0)), np.maximum(hi, r[:, [0, 2]].max(0))
+        ax.set_xlim(lo[0] - 1, hi[0] + 1)
+        ax.set_ylim(lo[1] - 1, hi[1] + 1)
         ax.set_aspect("equal")
         ax.set_title(p.kind, fontsize=8)
         ax.tick_params(labelsize=6)
@@ -336,6 +343,7 @@ def trajectory_figure(paths, runs: dict, path: Path):
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--full", default=str(DEFAULT_WEIGHTS))
+    ap.add_argument("--full-short", default="var/gait_runs/full12.pt", help="full model on the ablations' schedule")
     ap.add_argument("--no-affect", default="var/gait_runs/no_affect.pt")
     ap.add_argument("--no-root", default="var/gait_runs/no_root.pt")
     ap.add_argument("--steps", type=int, default=200)
@@ -353,7 +361,8 @@ def main(argv=None) -> int:
     if args.quick:
         test = test.subset(np.arange(12))
     test_rows = test.base_index
-    nets = {"full": args.full, "no affective (QuaterNet-like)": args.no_affect, "no root loss": args.no_root}
+    nets = {"full": args.full, "full, 12 epochs": args.full_short, "no affective (QuaterNet-like)": args.no_affect,
+            "no root loss": args.no_root}
     nets = {k: load_model(v) for k, v in nets.items() if Path(v).exists()}
     results: dict = {"models": {k: {"path": n.path, "epochs": n.info.get("epochs"),
                                     "parameters": n.model.num_parameters()} for k, n in nets.items()}}
@@ -384,7 +393,7 @@ def main(argv=None) -> int:
         expr[name] = r
     results["expressiveness"] = expr
     print("\n## synthetic observer accuracy (chance 0.25); on the test corpus itself:",
-          f"{results['observer_on_test_corpus']['overall']:.2f}")
+          {k: (round(v, 2) if isinstance(v, float) else v) for k, v in results["observer_on_test_corpus"].items()})
     print("| model | own emotion | other mixture (whole / last third) | transition start / end | P(target) "
           "transition first / last 50 steps (no transition) |")
     print("|---|---|---|---|---|")
@@ -394,7 +403,8 @@ def main(argv=None) -> int:
               f"{v['other_mixture_last_third']['overall']:.2f} | {v['transition_start']['overall']:.2f} / "
               f"{v['transition_end']['overall']:.2f} | {pt['first_50_steps']:.2f} / {pt['last_50_steps']:.2f} "
               f"({pt['constant_seed_emotion_last_50']:.2f}) |")
-        print("  own emotion per class:", {e: v["own_emotion"][e] for e in EMOTIONS})
+        print("  own emotion per class:", {e: round(v["own_emotion"][e], 2) for e in EMOTIONS},
+              "confusion (rows intended h/s/a/n, cols observed):", v["own_emotion"]["confusion"])
 
     # 3. trajectory following on unseen paths
     path_rng = np.random.default_rng(2026)
@@ -410,12 +420,15 @@ def main(argv=None) -> int:
         traj_motions[name] = r.pop("_motions")
         traj[name] = r
     results["trajectory"] = traj
+    d = test.root[:, 1:, 2].abs()
+    results["corpus_facing_vs_travel_deg"] = float(torch.rad2deg(d).mean())
     print("\n## distance of the root from the desired path (unseen random paths, 200 steps)")
     print("| model | mean m | p95 m | max m | at end m | facing vs travel deg |")
     print("|---|---|---|---|---|---|")
     for k, v in traj.items():
         print(f"| {k} | {v['mean_m']:.3f} | {v['p95_m']:.3f} | {v['max_m']:.3f} | {v['end_mean_m']:.3f} | "
               f"{v['facing_vs_travel_deg']:.1f} |")
+    print(f"corpus test walks, facing vs travel: {results['corpus_facing_vs_travel_deg']:.1f} deg")
 
     # 4. long horizon + foot skate
     n_long = 4 if args.quick else 8
@@ -448,9 +461,11 @@ def main(argv=None) -> int:
     tr = generate_gaits(test_seeds(corpus, [test_rows[sad_seed]]), [straight(60.0)],
                         emotion_transition(test_emotion[sad_seed], [1, 0, 0, 0], args.steps)[None], steps=args.steps,
                         model=nets["full"])[0]
-    rows.append(("transition sad->happy", tr))
+    rows.append(("transition sad->happy\n(colour = intended)", tr))
     contact_sheet(rows, Path("docs/img/gait_contact_sheet.png"))
-    trajectory_figure(tpaths[:3], {k: v[:3] for k, v in traj_motions.items()}, Path("docs/img/gait_trajectories.png"))
+    pick = [1, 2, 4, 5]  # two curved and two sharp-turn paths
+    trajectory_figure([tpaths[i] for i in pick], {k: [v[i] for i in pick] for k, v in traj_motions.items()},
+                      Path("docs/img/gait_trajectories.png"))
 
     results["seconds"] = time.time() - t_start
     Path(args.out).parent.mkdir(parents=True, exist_ok=True)

@@ -1,9 +1,11 @@
 """Render + encode speed, and wall time of the built-in plans.
 
     python benchmarks/bench_render.py speed [--frames 300] [--aa none fxaa msaa ssaa2] [--procs 1 2]
+                                            [--motion walk gesture] [--patches 1 0]
     python benchmarks/bench_render.py plans [--plans demo seed000 seed003 seed004] [--sample 12] [--workers 2]
 
-``speed`` renders a 10 s procedural walk (21 joints) at 640x480 to H.264 and reports frames per second of
+``speed`` renders a 10 s procedural walk (21 joints, a loop of 3 m radius) and/or a seated procedural gesture
+(23 joints, on a chair) at 640x480 to H.264 and reports frames per second of
 wall time and per CPU-second (the process, its llvmpipe threads and its ffmpeg child together). With
 ``--procs 2`` two processes render at once; fps is their total. ``plans`` renders every k-th entry of
 each plan (``--sample`` entries, or all with 0) into a temporary media folder with ``--workers`` processes
@@ -33,27 +35,37 @@ def _cpu() -> float:
     return me.ru_utime + me.ru_stime + kids.ru_utime + kids.ru_stime
 
 
-def _walk(frames: int, fps: float):
-    from generation.emotion import gait_params_for_emotion
-    from generation.paths import straight
-    from generation.procedural_walk import walk
+def _motion(kind: str, frames: int, fps: float):
+    """A 'walk' (procedural, 21 joints, a 3 m radius loop) or a seated 'gesture' (procedural, 23 joints)."""
+    import numpy as np
 
-    params = gait_params_for_emotion([0.2, 0.0, 0.0, 0.8])
-    return walk(params, straight(20.0), frames, fps)
+    from generation.emotion import NRC_VAD, gait_params_for_emotion, gesture_params_for_vad
+    if kind == "walk":
+        from generation.paths import curved
+        from generation.procedural_walk import walk
+
+        return walk(gait_params_for_emotion([0.2, 0.0, 0.0, 0.8]), curved(3.0, np.radians(330), 14.0), frames, fps)
+    from generation.procedural_gesture import seated_gesture
+
+    v, a, d = NRC_VAD["proud"]
+    return seated_gesture(gesture_params_for_vad(v, a, d, np.random.default_rng(0)), frames, fps, seed=0)
 
 
 def render_once(args: tuple) -> dict:
     """Render one clip; returns frames, wall and CPU seconds (run in this process or a spawned one)."""
-    aa, frames, width, height, lp_threads, out_dir = args
+    aa, frames, width, height, lp_threads, out_dir, kind, patches = args
     if lp_threads:
         os.environ["LP_NUM_THREADS"] = str(lp_threads)
     import torch
 
     torch.set_num_threads(1)
-    from generation.render import RenderSettings, render_clip
+    from generation.render import RenderSettings, clip, render_clip
 
-    motion = _walk(frames, 30.0)
+    motion = _motion(kind, frames, 30.0)
     settings = RenderSettings(width=width, height=height, fps=30.0, duration_s=frames / 30.0, anti_aliasing=aa)
+    if not patches:  # whole frames every time (the plain PyVista loop), for comparison
+        original = clip._frames
+        clip._frames = lambda c, p, s, patches=True: original(c, p, s, False)
     c0, t0 = _cpu(), time.perf_counter()
     result = render_clip(motion, out_dir, f"bench_{aa}_{os.getpid()}", settings)
     wall, cpu = time.perf_counter() - t0, _cpu() - c0
@@ -63,29 +75,30 @@ def render_once(args: tuple) -> dict:
 def speed(args) -> list[dict]:
     rows = []
     out_dir = tempfile.mkdtemp(prefix="bench_render_")
-    for aa in args.aa:
-        for procs in args.procs:
-            lp = 1 if procs > 1 else 0
-            job = (aa, args.frames, args.width, args.height, lp, out_dir)
-            load = os.getloadavg()[0]
-            if procs == 1:
-                r = [render_once(job)]
-                wall = r[0]["wall_s"]
-            else:
-                ctx = mp.get_context("spawn")
-                with ctx.Pool(procs) as pool:
-                    pool.map(render_once, [(aa, 10, 160, 120, lp, out_dir)] * procs)  # warm the imports
-                    t0 = time.perf_counter()
-                    r = pool.map(render_once, [job] * procs)
-                    wall = time.perf_counter() - t0
-            frames = sum(x["frames"] for x in r)
-            cpu = sum(x["cpu_s"] for x in r)
-            row = {"aa": aa, "procs": procs, "frames": frames, "wall_s": round(wall, 2),
-                   "fps_wall": round(frames / wall, 1), "cpu_s": round(cpu, 2), "fps_per_cpu_s": round(frames / cpu, 1),
-                   "kib_per_10s": round(sum(x["bytes"] for x in r) / len(r) / 1024 * 300 / args.frames),
-                   "load_before": round(load, 2)}
-            rows.append(row)
-            print(json.dumps(row), flush=True)
+    cases = [(k, a, pt, pr) for k in args.motion for a in args.aa for pt in args.patches for pr in args.procs]
+    for kind, aa, patches, procs in cases:
+        lp = 1 if procs > 1 else 0  # one llvmpipe thread per process when several run at once
+        job = (aa, args.frames, args.width, args.height, lp, out_dir, kind, bool(patches))
+        load = os.getloadavg()[0]
+        if procs == 1:
+            r = [render_once(job)]
+            wall = r[0]["wall_s"]
+        else:
+            ctx = mp.get_context("spawn")
+            with ctx.Pool(procs) as pool:
+                pool.map(render_once, [(aa, 10, 160, 120, lp, out_dir, kind, True)] * procs)  # warm the imports
+                t0 = time.perf_counter()
+                r = pool.map(render_once, [job] * procs)
+                wall = time.perf_counter() - t0
+        frames = sum(x["frames"] for x in r)
+        cpu = sum(x["cpu_s"] for x in r)
+        row = {"motion": kind, "aa": aa, "patches": bool(patches), "procs": procs, "frames": frames,
+               "wall_s": round(wall, 2), "fps_wall": round(frames / wall, 1), "cpu_s": round(cpu, 2),
+               "fps_per_cpu_s": round(frames / cpu, 1),
+               "kib_per_10s": round(sum(x["bytes"] for x in r) / len(r) / 1024 * 300 / args.frames),
+               "load_before": round(load, 2)}
+        rows.append(row)
+        print(json.dumps(row), flush=True)
     return rows
 
 
@@ -131,6 +144,8 @@ def main() -> None:
     s.add_argument("--height", type=int, default=480)
     s.add_argument("--aa", nargs="+", default=["none", "fxaa", "msaa"])
     s.add_argument("--procs", nargs="+", type=int, default=[1, 2])
+    s.add_argument("--motion", nargs="+", default=["walk", "gesture"], choices=["walk", "gesture"])
+    s.add_argument("--patches", nargs="+", type=int, default=[1], help="1 = patch rendering, 0 = whole frames")
     q = sub.add_parser("plans")
     q.add_argument("--plans", nargs="+", default=["demo", "seed000", "seed003", "seed004"])
     q.add_argument("--sample", type=int, default=12, help="entries rendered per plan (0 = all)")

@@ -32,7 +32,7 @@ import math
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from .render.settings import RenderSettings, RenderSettingsError
+from .render.settings import RENDERER_VERSION, RenderSettings, RenderSettingsError
 
 PLANS_DIR = Path(__file__).resolve().parent / "plans"
 GAIT_EMOTIONS = ("happy", "sad", "angry", "neutral")
@@ -411,11 +411,12 @@ def _canonical(obj) -> str:
 
 
 def clip_hash(entry: ClipEntry, generator: str, generator_version: str) -> str:
-    """16 hex digits of SHA-256 over the generator actually used, its version, the normalised inputs,
-    origin, seed and the render settings that change the pictures. The entry id, plan name, sections, notes
-    and the WebM option are not part of it."""
+    """16 hex digits of SHA-256 over the generator actually used, its version, the normalised inputs, origin,
+    seed, the render settings that change the pictures and the renderer's version. The entry id, plan name,
+    sections, notes and the WebM option are not part of it."""
     payload = {"generator": generator, "version": generator_version, "inputs": entry.inputs, "seed": entry.seed,
-               "origin": entry.origin, "modality": entry.modality, "render": entry.render.content_dict()}
+               "origin": entry.origin, "modality": entry.modality, "render": entry.render.content_dict(),
+               "renderer": RENDERER_VERSION}
     return hashlib.sha256(_canonical(payload).encode()).hexdigest()[:16]
 
 

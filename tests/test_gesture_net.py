@@ -91,9 +91,15 @@ def _inputs(B=3, S=7, T=25, seed=0):
     return tokens, token_mask, attrs, poses, positions, progress
 
 
+def _rest(B: int) -> torch.Tensor:
+    return _smooth_sequences(B, 1, seed=9)[:, 0]
+
+
 def test_model_defaults_follow_the_paper():
     cfg = GestureNetConfig()
     assert (cfg.n_layer, cfg.n_head, cfg.d_ff, cfg.dropout, cfg.window, cfg.n_joints) == (2, 2, 200, 0.2, 20, 23)
+    with pytest.raises(ValueError, match="rest"):
+        GestureNet(cfg)(*_inputs())  # a rest-offset network needs the rest pose
 
 
 def test_model_output_shapes_and_unit_quaternions():
@@ -101,7 +107,7 @@ def test_model_output_shapes_and_unit_quaternions():
     for p in net.head.parameters():  # make the output depend on the network, not only the residual
         torch.nn.init.normal_(p, std=0.1)
     net.eval()
-    out = net(*_inputs())
+    out = net(*_inputs(), _rest(3))
     assert out.shape == (3, 25, J, 4)
     np.testing.assert_allclose(out.norm(dim=-1).detach().numpy(), 1.0, atol=1e-5)
 
@@ -112,10 +118,10 @@ def test_decoder_attention_is_causal_and_windowed():
         torch.nn.init.normal_(p, std=0.1)
     net.eval()
     tokens, token_mask, attrs, poses, positions, progress = _inputs(T=60)
-    base = net(tokens, token_mask, attrs, poses, positions, progress)
+    base = net(tokens, token_mask, attrs, poses, positions, progress, _rest(3))
     changed = poses.clone()
     changed[:, 10] = qnormalize(changed[:, 10] + 0.5)
-    out = net(tokens, token_mask, attrs, changed, positions, progress)
+    out = net(tokens, token_mask, attrs, changed, positions, progress, _rest(3))
     diff = (out - base).abs().amax(dim=(0, 2, 3))
     reach = net.receptive_field  # 2 layers x 20-step windows: 39 inputs
     assert reach == 39
@@ -132,7 +138,7 @@ def test_rollout_reproduces_the_teacher_forced_computation():
     """Generation feeds the decoder its own outputs; fed the same poses, training and generation agree exactly."""
     from generation.gesture.generate import rollout
 
-    net = GestureNet(GestureNetConfig(dropout=0.0, window=5))
+    net = GestureNet(GestureNetConfig(dropout=0.0, window=5, residual="previous"))
     for p in net.head.parameters():
         torch.nn.init.normal_(p, std=0.05)
     net.eval()
@@ -154,10 +160,10 @@ def test_padded_tokens_are_ignored():
     tokens, token_mask, attrs, poses, positions, progress = _inputs()
     for p in net.head.parameters():
         torch.nn.init.normal_(p, std=0.1)
-    base = net(tokens, token_mask, attrs, poses, positions, progress)
+    base = net(tokens, token_mask, attrs, poses, positions, progress, _rest(3))
     tokens2 = tokens.clone()
     tokens2[0, 5:] = 100.0  # padding of sample 0
-    out = net(tokens2, token_mask, attrs, poses, positions, progress)
+    out = net(tokens2, token_mask, attrs, poses, positions, progress, _rest(3))
     assert torch.allclose(out[0], base[0], atol=1e-5)
 
 
@@ -215,7 +221,7 @@ def test_total_loss_ablation_weights():
 
 def test_tiny_network_overfits_a_tiny_batch():
     torch.manual_seed(0)
-    B, T = 2, 12
+    B, T = 2, 10
     # no residual: the network has to produce the poses itself
     net = GestureNet(GestureNetConfig(d_model=32, d_ff=64, dropout=0.0, residual="none"))
     tokens, token_mask, attrs, _, positions, progress = _inputs(B=B, T=T)
@@ -225,9 +231,9 @@ def test_tiny_network_overfits_a_tiny_batch():
                                           dtype=torch.float32) for s, k in enumerate(("beat", "descriptive"))])
     inputs = torch.cat((target[:, :1], target[:, :-1]), dim=1)
     mask = torch.ones(B, T, dtype=torch.bool)
-    opt = torch.optim.Adam(net.parameters(), lr=3e-3)
+    opt = torch.optim.Adam(net.parameters(), lr=5e-3)
     losses = []
-    for _ in range(120):
+    for _ in range(60):
         pred = net(tokens, token_mask, attrs, inputs, positions, progress)
         loss, _ = total_loss(pred, target, mask, _offsets(B), GESTURE_PARENTS, LossWeights())
         opt.zero_grad()
@@ -235,7 +241,7 @@ def test_tiny_network_overfits_a_tiny_batch():
         torch.nn.utils.clip_grad_norm_(net.parameters(), 1.0)
         opt.step()
         losses.append(float(loss.detach()))
-    assert losses[-1] < 0.1 * losses[0]
+    assert losses[-1] < 0.1 * losses[0]  # about 0.03 after 60 steps
 
 
 # ---- corpus ------------------------------------------------------------------------------------
@@ -339,3 +345,25 @@ def test_generated_gesture_exports_to_bvh(shipped, tmp_path):
     back = bvh.read_bvh(path)
     assert back.num_frames == m.num_frames
     np.testing.assert_allclose(back.positions(), m.positions(), atol=2e-3)
+
+
+# ---- training command ------------------------------------------------------------------------------
+def test_training_writes_weights_and_resumes(tmp_path):
+    from generation.gesture.data import build_dataset, load_sentences
+    from generation.gesture.generate import load_model
+    from generation.gesture.train import TrainConfig, train
+
+    rows = [r for r in load_sentences() if r.emotion in ("sad", "proud")][::6]  # 10 sentences
+    data = build_dataset(variants=1, seed=0, cache_dir=tmp_path, rows=rows)
+    assert set(data.split) <= {"train", "val", "test"} and len(data.indices("train")) >= 6
+    cfg = TrainConfig(epochs=2, batch_size=4, max_minutes=None, rollout_every=1,
+                      model=GestureNetConfig(d_model=16, d_ff=32, residual="rest"),
+                      out=str(tmp_path / "w.pt"), checkpoint=str(tmp_path / "ck.pt"))
+    first = train(cfg, data=data, progress=False)
+    assert first["epochs_run"] == 2 and (tmp_path / "w.pt").is_file()
+    assert "val_rollout" in first["history"][-1]
+    cfg.epochs, cfg.resume = 3, True
+    second = train(cfg, data=data, progress=False)
+    assert [h["epoch"] for h in second["history"]] == [0, 1, 2]
+    net = load_model(tmp_path / "w.pt")
+    assert net.cfg.d_model == 16 and net.cfg.residual == "rest"

@@ -7,6 +7,7 @@ Modules, one job each:
 - ``model``: the transformer encoder-decoder (one nanoGPT-style file with a config dataclass).
 - ``data``: the synthetic training corpus: project-written sentences paired with procedural seated gestures.
 - ``losses``: angle loss with its derivative term (eq. 8), pose loss through FK (eq. 9), affective loss (eq. 10).
+- ``metrics``: the normalised mean pose error of seed 003 Table 1.
 - ``train``: the training command (``python -m generation.gesture.train``).
 - ``generate``: ``generate_gesture(sentence, ...) -> Motion`` and ``load_default_model()``.
 

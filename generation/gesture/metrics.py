@@ -33,11 +33,25 @@ def sequence_pose_error(pred: np.ndarray, true: np.ndarray, gender: str, root: n
 
 
 def dataset_pose_error(pred: list[np.ndarray], data, idx) -> dict[str, float]:
-    """Seed 003 Table 1: the mean over sequences ``idx`` of :func:`sequence_pose_error` (pred[k] for idx[k])."""
-    rows = []
+    """Seed 003 Table 1: the mean over sequences ``idx`` of :func:`sequence_pose_error` (pred[k] for idx[k]),
+    plus the mean :func:`upper_body_acceleration` of the predictions."""
+    rows, accel = [], []
     for p, i in zip(pred, idx):
         L = int(data.lengths[i])
         rows.append(sequence_pose_error(p[:L], data.rotations[i, :L], str(data.gender[i]), data.root[i]))
+        accel.append(upper_body_acceleration(p[:L], str(data.gender[i]), data.root[i], data.fps))
     return {"pose_error": float(np.mean([r["all"] for r in rows])),
             "pose_error_upper": float(np.mean([r["upper"] for r in rows])),
-            "rotation_error_deg": float(np.mean([r["rotation_deg"] for r in rows])), "n": len(rows)}
+            "rotation_error_deg": float(np.mean([r["rotation_deg"] for r in rows])),
+            "acceleration": float(np.mean(accel)), "n": len(rows)}
+
+
+def upper_body_acceleration(rotations: np.ndarray, gender: str, root: np.ndarray, fps: float) -> float:
+    """Mean magnitude (m/s^2) of the second time difference of the 8 upper-body joint positions: a jerkiness
+    measure (seed 003 Fig. 5 reads smoothness off the end-effector trajectories). rotations (T, 23, 4)."""
+    sk = gesture_skeleton(build=gender)
+    roots = np.repeat(np.asarray(root, dtype=np.float64)[None], len(rotations), 0)
+    P = np_forward_kinematics(np.asarray(rotations, dtype=np.float64), roots, sk)[:, UPPER_BODY]
+    if len(P) < 3:
+        return 0.0
+    return float(np.linalg.norm(np.diff(P, n=2, axis=0), axis=-1).mean() * fps * fps)

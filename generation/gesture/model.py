@@ -12,11 +12,14 @@ query from the text and key/value from the poses, which would give one output pe
 Vaswani et al. (and the released code, which uses the standard transformer decoder) the poses give the query and the
 encoded text the keys and values.
 
-Two additions to the paper, both small: (1) the head predicts a residual added to the previous pose before
-normalisation (as in QuaterNet), which keeps autoregressive decoding stable on a small data set; (2) each decoder
-input carries the gesture's progress (fraction of the sentence's gesture elapsed, seconds left), because the model
-only sees a 20-step window and must know when to return to the end-of-sequence rest pose (the paper pads every
-sequence to one length with the EoS pose, so absolute position tells the same thing there).
+Additions to the paper, all small: (1) the head predicts an offset that is added, before normalisation, to the
+rest pose (``residual="rest"``, the shipped setting, chosen over ``"previous"`` (QuaterNet-style, added to the last
+pose) by validation pose error) or to nothing (``"none"``); (2) each decoder input carries the gesture's progress
+(fraction of the sentence's gesture elapsed, seconds left), because the decoder sees a bounded window and must know
+when to return to the end-of-sequence rest pose (the paper pads every sequence to one length with the EoS pose, so
+absolute position tells the same thing there); (3) the attributes are also appended to each decoder input, so the
+pose stream is conditioned directly as well as through the encoded text. With N = 2 layers each looking back 20
+steps, a decoder output depends on the last 2 * 19 + 1 = 39 input poses (:attr:`GestureNet.receptive_field`).
 """
 from __future__ import annotations
 
@@ -44,7 +47,7 @@ class GestureNetConfig:
     dropout: float = 0.2
     window: int = 20
     max_frames: int = 512
-    residual: str = "previous"  # the head's output is added to: "previous" pose, the "rest" pose, or "none"
+    residual: str = "rest"  # the head's output is added to: the "rest" pose, the "previous" pose, or "none"
 
     def to_dict(self) -> dict:
         return asdict(self)

@@ -17,7 +17,7 @@ from .encode import VideoWriter, write_png_atomic
 from .scene import StickFigureScene, chair_boxes
 from .settings import RenderSettings
 
-GROUND_MARGIN_M = 8.0
+GROUND_MARGIN_M = 25.0  # far enough that the floor edge stays out of view
 
 
 @dataclass(frozen=True)

@@ -7,6 +7,9 @@ from __future__ import annotations
 
 from dataclasses import asdict, dataclass, fields
 
+#: Bump when the look of clips changes for the same settings (scene, camera placement): it is part of
+#: every clip's content hash, so changed clips get new files instead of stale ones being reused.
+RENDERER_VERSION = "1"
 CAMERAS = ("fixed", "tracking")
 ANTI_ALIASING = ("none", "fxaa", "ssaa2", "msaa")
 
