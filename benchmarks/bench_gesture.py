@@ -107,24 +107,26 @@ def motion_descriptors(positions: np.ndarray, fps: float) -> dict[str, float]:
         [feats.mean(0), feats.std(0), [speed, float(wrist_speed.mean())]])}
 
 
-def expressiveness(net, data: GestureDataset, idx: np.ndarray) -> dict:
-    """Each held-out sentence said with each of the 11 emotions: Pearson r of speed with arousal and of
-    expansion with dominance; a synthetic observer (logistic regression on affective features, trained on the
-    procedural training gestures) classifies high vs low arousal and dominance (threshold 0.5) of the generated
-    gestures (balanced accuracy)."""
+def fit_observers(data: GestureDataset) -> dict:
+    """Synthetic observers: logistic regressions on :func:`motion_descriptors` features of the procedural training
+    gestures, one for high vs low arousal and one for high vs low dominance (VAD value > 0.5)."""
     from sklearn.linear_model import LogisticRegression
-    from sklearn.metrics import balanced_accuracy_score
     from sklearn.pipeline import make_pipeline
     from sklearn.preprocessing import StandardScaler
 
-    # synthetic observer trained on the procedural (ground-truth) training gestures
     tr = data.indices("train")
     X_tr = np.stack([motion_descriptors(positions_of(data.rotations[i, : data.lengths[i]].astype(np.float64), data,
                                                      i), data.fps)["features"] for i in tr])
-    observers = {}
-    for k, dim in (("arousal", 1), ("dominance", 2)):
-        y = data.vad[tr, dim] > 0.5
-        observers[k] = make_pipeline(StandardScaler(), LogisticRegression(max_iter=2000, C=1.0)).fit(X_tr, y)
+    return {k: make_pipeline(StandardScaler(), LogisticRegression(max_iter=2000, C=1.0)).fit(X_tr,
+                                                                                              data.vad[tr, dim] > 0.5)
+            for k, dim in (("arousal", 1), ("dominance", 2))}
+
+
+def expressiveness(net, data: GestureDataset, idx: np.ndarray, observers: dict) -> dict:
+    """Each held-out sentence said with each of the 11 emotions: Pearson r of speed with arousal and of
+    expansion with dominance; the synthetic observers (:func:`fit_observers`) classify high vs low arousal and
+    dominance (threshold 0.5) of the generated gestures (balanced accuracy)."""
+    from sklearn.metrics import balanced_accuracy_score
 
     # generated: the same held-out sentences with every emotion
     rows = [(i, emo, nrc_vad(emo)) for i in idx for emo in GESTURE_EMOTIONS]
@@ -284,8 +286,21 @@ def main(argv=None):
         upper_body_acceleration(data.rotations[i, : data.lengths[i]], str(data.gender[i]), data.root[i], data.fps)
         for i in test]))
     print(json.dumps(table, indent=1), flush=True)
-    results["expressiveness"] = expressiveness(net, data, test)
+    observers = fit_observers(data)
+    results["expressiveness"] = expressiveness(net, data, test, observers)
     print(json.dumps(results["expressiveness"], indent=1), flush=True)
+    # the ablations' expressiveness on the first 22 held-out examples (x 11 emotions)
+    sub_idx = test[:22]
+    ablation_expr = {"all losses (shipped weights)": expressiveness(net, data, sub_idx, observers)}
+    for name in table:
+        if name in ABLATIONS:
+            slug = name.split(" (")[0].replace(" ", "_")
+            ablation_expr[name] = expressiveness(load_model(config.VAR_DIR / "ablations" / f"{slug}.pt"), data,
+                                                 sub_idx, observers)
+    results["ablation_expressiveness"] = {k: {m: v[m] for m in ("r_speed_arousal", "r_expansion_dominance",
+                                                                 "observer_arousal_generated",
+                                                                 "observer_dominance_generated", "n_generated")}
+                                          for k, v in ablation_expr.items()}
     results["speed"] = speed_benchmark(net)
     print(json.dumps(results["speed"], indent=1), flush=True)
     contact_sheet(net, Path(args.sheet), SHEET_SENTENCE)
@@ -326,6 +341,15 @@ def render_markdown(r: dict) -> str:
                    (f"{sh['epochs']} epochs, {sh['seconds'] / 60:.1f} min" if "shipped" in name else "-"))
         lines.append(f"| {name} | {v['pose_error']:.4f} | {v['pose_error_upper']:.4f} | "
                      f"{v['rotation_error_deg']:.2f} | {v['acceleration']:.3f} | {train_s} |")
+    if r.get("ablation_expressiveness"):
+        n = next(iter(r["ablation_expressiveness"].values()))["n_generated"]
+        lines += ["", f"Expressiveness of each variant ({n} gestures: the first 22 held-out examples x 11 emotions; "
+                  "measures as in the next section):", "",
+                  "| Method | r(speed, arousal) | r(expansion, dominance) | observer arousal | observer dominance |",
+                  "|---|---|---|---|---|"]
+        for name, v in r["ablation_expressiveness"].items():
+            lines.append(f"| {name} | {v['r_speed_arousal']:.3f} | {v['r_expansion_dominance']:.3f} | "
+                         f"{v['observer_arousal_generated']:.3f} | {v['observer_dominance_generated']:.3f} |")
     lines += ["", f"Ground truth (procedural) upper-body acceleration: {r['gt_acceleration']:.3f} m/s^2 (a jerkiness "
               "measure: mean magnitude of the second time difference of the 8 upper-body joints at 10 fps).", "",
               "The ablations (and the short 'all losses' run they are compared with) were trained with the same "

@@ -247,7 +247,11 @@ def benchmark_page(result: dict) -> str:
         f"Neutral base: `generation.neutral_base.neutral_cycle()`, {base['n_cycles']} cycle(s) averaged, "
         f"{rejected} rejected as glitches, cycle {base['cycle_duration_s']:.2f} s, stride "
         f"{base['stride_m'][2]:.2f} m, synthetic: {base['synthetic']}. Sources used: "
-        + "; ".join(f"{u['name']} ({u['cycles']})" for u in used) + ".",
+        + "; ".join(f"{u['name']} ({u['cycles']})" for u in used) + "."
+        + (f" {rejected} cycle(s) were left out because a joint moved faster than 10 m/s between two frames (on "
+           "2026-11-27 `generation.procedural_walk.walk` made each knee jump about 13 cm within one frame once per "
+           "cycle, so every procedural cycle was rejected and the base is the captured cycle alone; rerun this "
+           "benchmark once the walker is fixed)." if rejected else ""),
         "",
         "Every theme uses all ten Table III features. Changes are the stylised cycle (after it is put back on the "
         "skeleton) minus the neutral cycle, over one 100-frame cycle.",

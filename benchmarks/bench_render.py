@@ -63,12 +63,15 @@ def render_once(args: tuple) -> dict:
 
     motion = _motion(kind, frames, 30.0)
     settings = RenderSettings(width=width, height=height, fps=30.0, duration_s=frames / 30.0, anti_aliasing=aa)
+    original = clip._frames
     if not patches:  # whole frames every time (the plain PyVista loop), for comparison
-        original = clip._frames
         clip._frames = lambda c, p, s, patches=True: original(c, p, s, False)
-    c0, t0 = _cpu(), time.perf_counter()
-    result = render_clip(motion, out_dir, f"bench_{aa}_{os.getpid()}", settings)
-    wall, cpu = time.perf_counter() - t0, _cpu() - c0
+    try:
+        c0, t0 = _cpu(), time.perf_counter()
+        result = render_clip(motion, out_dir, f"bench_{aa}_{os.getpid()}", settings)
+        wall, cpu = time.perf_counter() - t0, _cpu() - c0
+    finally:
+        clip._frames = original
     return {"frames": result.n_frames, "wall_s": wall, "cpu_s": cpu, "bytes": result.mp4.stat().st_size}
 
 

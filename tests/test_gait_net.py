@@ -228,3 +228,23 @@ def test_shipped_weights_load_and_generate():
     assert m.num_frames == 29 * 4 + 1
     # It walks: the root covers ground.
     assert np.linalg.norm(m.root_positions[-1, [0, 2]] - m.root_positions[0, [0, 2]]) > 1.0
+
+
+def test_training_is_deterministic_for_a_seed(tiny_data, tmp_path):
+    cfg = GaitNetConfig.tiny(epochs=1, batch_size=2, tf_decay=0.5)
+    a = train(cfg, tiny_data, tmp_path / "a.pt", tmp_path / "a.ckpt", progress=False, log=lambda *_: None)
+    b = train(cfg, tiny_data, tmp_path / "b.pt", tmp_path / "b.ckpt", progress=False, log=lambda *_: None)
+    for p, q in zip(a["model"].parameters(), b["model"].parameters()):
+        assert torch.equal(p, q)
+
+
+def test_command_line_options_build_the_config():
+    from generation.gait.train import build_parser, config_from_args
+    args = build_parser().parse_args(["--no-root-loss", "--no-affective", "--epochs", "3",
+                                      "--set", "gru_hidden=64", "--set", "enc1_sizes=[4, 4]"])
+    cfg = config_from_args(args)
+    assert cfg.lambda_root == 0.0 and not cfg.use_affective and cfg.epochs == 3
+    assert cfg.gru_hidden == 64 and cfg.enc1_sizes == (4, 4)
+    assert build_parser().parse_args(["--paper-size"]).paper_size
+    with pytest.raises(SystemExit):
+        config_from_args(build_parser().parse_args(["--set", "no_such_field=1"]))

@@ -53,6 +53,9 @@ class TextEncoder:
         path = model_dir()
         try:
             from transformers import AutoModel, AutoTokenizer
+            from transformers.utils import logging as hf_logging
+
+            hf_logging.disable_progress_bar()
             self.tokenizer = AutoTokenizer.from_pretrained(path, local_files_only=True)
             self.model = AutoModel.from_pretrained(path, local_files_only=True)
         except Exception as exc:  # noqa: BLE001 - any loader failure gets the same clear message
