@@ -322,7 +322,7 @@ def walk_with_contacts(params: WalkParams, path: GroundPath | None = None, n_fra
     stand = -(off[_J["left_hip"], 1] + off[_J["left_knee"], 1] + off[_J["left_heel"], 1]) + ankle_h
     len_thigh = float(np.linalg.norm(off[_J["left_knee"]]))
     len_shin = float(np.linalg.norm(off[_J["left_heel"]]))
-    reach = 0.998 * (len_thigh + len_shin)
+    reach = 0.97 * (len_thigh + len_shin)
 
     def pelvis_at(time):
         """Nominal root position (n, 3), root rotation (n, 4) and path heading (n,) at times (n,)."""
@@ -383,22 +383,26 @@ def walk_with_contacts(params: WalkParams, path: GroundPath | None = None, n_fra
         pitch = np.zeros(T)
         pos = np.zeros((T, 3))
         yaw_t = fp_yaw.copy()
-        # heel phase (heel rocker then flat): heel joint on the footprint
-        heel = u < HEEL_OFF
+        # heel rocker: the toe lowers onto the ground about the planted heel joint
+        heel = u < HEEL_ROCKER_END
         pitch[heel] = -strike_pitch * (1.0 - smoothstep(u[heel] / HEEL_ROCKER_END))
         pos[heel] = np.column_stack([fp_xz[heel, 0], np.full(heel.sum(), ankle_h), fp_xz[heel, 1]])
-        # toe phase: heel rises about the fixed toe
-        toe = (u >= HEEL_OFF) & (u < TOE_OFF)
+        # flat foot, then the heel rises about the fixed toe. The rise starts at HEEL_OFF, or earlier when the hip
+        # has moved so far ahead that the flat foot would be out of reach; one pivot formula for both keeps the
+        # heel (and so the knee) continuous where the heel leaves the ground.
+        toe = (u >= HEEL_ROCKER_END) & (u < TOE_OFF)
         flat_heel = np.column_stack([fp_xz[toe, 0], np.full(toe.sum(), ankle_h), fp_xz[toe, 1]])
         q_flat = yaw_quat(fp_yaw[toe])
         toe_pos = flat_heel + np_qrot(q_flat, np.broadcast_to(toe_off_vec, flat_heel.shape))
-        ramp = smoothstep((u[toe] - HEEL_OFF) / (TOE_OFF - HEEL_OFF))
+        ramp = smoothstep(np.clip((u[toe] - HEEL_OFF) / (TOE_OFF - HEEL_OFF), 0.0, 1.0))
         p_toe = np.maximum(p_off[i[toe]] * ramp,
                            required_pitch(t[toe], "left_hip" if f == 0 else "right_hip", toe_pos, fp_yaw[toe]))
         p_toe = np.minimum(p_toe, p_off[i[toe]])   # reach p_off exactly at toe-off, continuous into swing
         q_p = np_qmul(q_flat, axis_angle(_X, p_toe))
         pos[toe] = toe_pos - np_qrot(q_p, np.broadcast_to(toe_off_vec, flat_heel.shape))
         pitch[toe] = p_toe
+        heel = heel.copy()
+        heel[toe] = p_toe <= 1e-9
         # swing: from the toe-off pose of stance k to the heel strike of stance k+1
         sw = u >= TOE_OFF
         w = (u[sw] - TOE_OFF) / (1.0 - TOE_OFF)

@@ -132,3 +132,25 @@ def test_two_workers(media, tmp_path):
     out = _run("--plan", str(plan), "--workers", "2", "--no-db")
     assert "4 rendered, 0 already done, 0 failed" in out
     assert check_catalogue(media / "clips.csv", media / "clips") == []
+
+
+@pytest.mark.django_db
+def test_unavailable_generator_fails_only_its_entries(media, tmp_path, monkeypatch):
+    import generation.clipgen as clipgen
+
+    missing = tmp_path / "no_such_weights.pt"
+    monkeypatch.setitem(clipgen.GENERATOR_WEIGHTS, "gesture_net", missing)
+    gesture = {"id": "g", "generator": "gesture_net", "sentence": "I did it.", "emotion_label": "proud"}
+    plan = _write_plan(tmp_path, [gesture, dict(gesture, id="g_fb", fallback="procedural_gesture", seed=1), CLIPS[2]])
+    err = io.StringIO()
+    with pytest.raises(CommandError, match="1 clip\\(s\\) of plan tiny failed"):
+        call_command("generate_clips", "--plan", str(plan), "--no-progress", stdout=io.StringIO(), stderr=err)
+    assert f"entry 1 (id 'g'): generator 'gesture_net' is not available: weights file {missing} is missing" \
+        in err.getvalue()
+    from studyapp.models import Clip
+
+    clips = {c.metadata["entry_id"]: c for c in Clip.objects.all()}
+    assert set(clips) == {"g_fb", "source_walk"}
+    fb = clips["g_fb"]
+    assert fb.metadata["generator"] == "procedural_gesture" and fb.metadata["fallback_for"] == "gesture_net"
+    assert fb.metadata["synthetic"] is True and fb.origin == "generated" and fb.emotion_label == "proud"
