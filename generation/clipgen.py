@@ -10,6 +10,7 @@ as the network's output. Its content hash differs, so once the weights exist the
 """
 from __future__ import annotations
 
+import ast
 import dataclasses
 import functools
 import hashlib
@@ -22,7 +23,9 @@ import numpy as np
 from .motion import Motion
 from .plan import ClipEntry
 
-#: Bump a generator's version when its output for the same inputs changes (forces re-rendering).
+#: Declared generator versions. Clip hashes also carry a digest of each generator's source code and data
+#: (:func:`source_digest`) and of network weights, so code changes re-render by themselves; bump these to
+#: force it (e.g. after a change in a library outside the project).
 GENERATOR_VERSIONS = {
     "gait_net": "1",
     "procedural_walk": "1",
@@ -76,13 +79,70 @@ def _file_digest(path: str, size: int, mtime_ns: int) -> str:
     return h.hexdigest()[:12]
 
 
+PACKAGE_DIR = Path(__file__).resolve().parent
+
+
+def _imported_files(path: Path) -> set[Path]:
+    """Project source files a module imports (relative ``from .x`` and absolute ``generation.x`` imports,
+    including imports inside functions)."""
+    out: set[Path] = set()
+    for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+        if not isinstance(node, ast.ImportFrom):
+            continue
+        if node.level:
+            base = path.parent
+            for _ in range(node.level - 1):
+                base = base.parent
+            parts = node.module.split(".") if node.module else []
+        elif node.module and node.module.split(".")[0] == "generation":
+            base, parts = PACKAGE_DIR, node.module.split(".")[1:]
+        else:
+            continue
+        target = base.joinpath(*parts)
+        candidates = [target.with_suffix(".py"), target / "__init__.py"]
+        candidates += [target / f"{a.name}.py" for a in node.names]
+        out.update(c.resolve() for c in candidates if c.is_file())
+    return out
+
+
+def source_files(generator: str) -> list[Path]:
+    """The files whose content a generator's output depends on: its modules and everything they import
+    from the project (followed transitively), this file, and the small data files under ``generation/data``
+    (weights apart; they have their own digest)."""
+    todo = [PACKAGE_DIR.joinpath(*m.split(".")[1:]).with_suffix(".py") for m in GENERATOR_MODULES[generator]]
+    seen: set[Path] = set()
+    while todo:
+        path = todo.pop().resolve()
+        if path in seen or not path.is_file():
+            continue
+        seen.add(path)
+        todo.extend(_imported_files(path) - seen)
+    seen.add(Path(__file__).resolve())
+    data = PACKAGE_DIR / "data"
+    return sorted(seen) + sorted(p.resolve() for p in data.rglob("*") if p.is_file() and "weights" not in p.parts
+                                 and p.stat().st_size < 5_000_000)
+
+
+@functools.cache
+def source_digest(generator: str) -> str:
+    """Digest of :func:`source_files`. It goes into the clip hash, so a change to a generator's code or data
+    renders its clips anew instead of reusing stale files."""
+    files = source_files(generator)
+    h = hashlib.sha256()
+    for f in files:
+        h.update(str(f.relative_to(PACKAGE_DIR)).encode())
+        h.update(f.read_bytes())
+    return h.hexdigest()[:12]
+
+
 def generator_version(generator: str) -> str:
-    """Version string that goes into the clip hash: the code version plus the weights' digest for networks."""
-    version = GENERATOR_VERSIONS[generator]
+    """Version string that goes into the clip hash: the declared version, the digest of the generator's
+    source code and data (:func:`source_digest`) and, for networks, of the weights file."""
+    version = f"{GENERATOR_VERSIONS[generator]}+src{source_digest(generator)}"
     weights = GENERATOR_WEIGHTS.get(generator)
     if weights is not None and weights.is_file():
         st = weights.stat()
-        version += "+" + _file_digest(str(weights), st.st_size, st.st_mtime_ns)
+        version += "+w" + _file_digest(str(weights), st.st_size, st.st_mtime_ns)
     return version
 
 

@@ -159,3 +159,15 @@ def test_builtin_plans_cover_the_papers():
         (w, n) for w in (0.4, 0.7, 1.0, 1.3) for n in (1, 4, 7, 10)}
     assert len(inverted) == 6 and all(e.inputs["weight"] == -0.7 and e.inputs["n_features"] == 10 for e in inverted)
     assert [e.generator for e in s004.entries].count("neutral_walk") == 1
+
+
+def test_generator_version_follows_the_generator_code():
+    from generation import clipgen
+
+    rbf = {p.name for p in clipgen.source_files("rbf")}
+    assert {"stylise.py", "rbf.py", "themes.py", "neutral_base.py", "motion.py", "clipgen.py"} <= rbf
+    captured = {p.name for p in clipgen.source_files("captured")}
+    assert "deepmimic.py" in captured and "stylise.py" not in captured
+    assert "humanoid3d_walk.txt" in captured  # data files count too
+    assert clipgen.generator_version("rbf").startswith(clipgen.GENERATOR_VERSIONS["rbf"] + "+src")
+    assert clipgen.source_digest("rbf") != clipgen.source_digest("captured")

@@ -344,8 +344,20 @@ def load_corpus_sequences(path: str | Path | None = None, num_sequences: int = 1
         if hasattr(corpus, "save"):
             corpus.save(path)
     fps = float(getattr(corpus, "fps", 30.0))
-    return prepare_sequences(corpus.rotations, corpus.root_positions, corpus.emotion, corpus.split, corpus.height,
+    data = prepare_sequences(corpus.rotations, corpus.root_positions, corpus.emotion, corpus.split, corpus.height,
                              corpus.build, fps=fps, frame_step=frame_step, seq_len=seq_len, offsets=offsets)
+    data.source = {"path": str(path), "sha256": file_sha256(path)}
+    return data
+
+
+def file_sha256(path: str | Path) -> str:
+    """Hex SHA-256 of a file (identifies the corpus version a model was trained on)."""
+    import hashlib
+    h = hashlib.sha256()
+    with open(path, "rb") as f:
+        for chunk in iter(lambda: f.read(1 << 20), b""):
+            h.update(chunk)
+    return h.hexdigest()
 
 
 def quat_torch_yaw(yaw: torch.Tensor) -> torch.Tensor:

@@ -65,7 +65,7 @@ _DEFAULT: LoadedGaitNet | None = None
 def load_model(path: str | Path) -> LoadedGaitNet:
     """Load weights written by the training command."""
     model, norm, payload = load_checkpoint(path)
-    info = {k: payload[k] for k in ("trained_on", "num_parameters") if k in payload}
+    info = {k: payload[k] for k in ("trained_on", "num_parameters", "corpus") if k in payload}
     info["epochs"] = len(payload.get("history", []))
     return LoadedGaitNet(model, norm, str(path), info)
 

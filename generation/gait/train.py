@@ -257,7 +257,8 @@ def train(config: GaitNetConfig, data: GaitSequences, out_path: str | Path, chec
             log(f"stopping after epoch {epoch + 1}: time budget of {max_minutes} min used")
             break
     save_checkpoint(Path(out_path), model, norm, config, history=history,
-                    trained_on="synthetic procedural corpus", num_parameters=model.num_parameters())
+                    trained_on="synthetic procedural corpus", num_parameters=model.num_parameters(),
+                    corpus=getattr(data, "source", None))
     return {"history": history, "model": model, "normalizer": norm}
 
 

@@ -146,6 +146,7 @@ def gesture_kind_for(sentence: str, arousal: float) -> str:
 
 
 MAX_PHRASES = 3
+PROCEDURAL_DETAIL_SEED = 0
 
 
 def phrases(sentence: str) -> list[str]:
@@ -164,6 +165,8 @@ def procedural_gesture(row: SentenceRow, gender: str, handedness: str, seed: int
     One gesture per phrase of the sentence (:func:`phrases`), its kind from the phrase's words
     (:func:`gesture_kind_for`), its style from the emotion's VAD (``gesture_params_for_vad``, with individual
     variation from ``seed``) and the acting task (:func:`_task_style`); the length follows the word count.
+    The procedural generator's own random details (beat phase, pointing aim) use one fixed seed: nothing in the
+    text or the attributes could predict them, so a random draw per example would only add unlearnable noise.
     """
     from ..emotion import gesture_params_for_vad
     from ..procedural_gesture import seated_gesture
@@ -175,7 +178,7 @@ def procedural_gesture(row: SentenceRow, gender: str, handedness: str, seed: int
                                                  handedness=handedness), row.task)
               for p in phrases(row.sentence)]
     n_frames = config.gesture_frames(count_words(row.sentence), fps)
-    motion = seated_gesture(params, n_frames, fps, gesture_skeleton(build=gender), seed)
+    motion = seated_gesture(params, n_frames, fps, gesture_skeleton(build=gender), seed=PROCEDURAL_DETAIL_SEED)
     motion.metadata.update({"synthetic": True, "origin": "procedural", "sentence_id": row.sentence_id,
                             "task": row.task, "emotion_label": row.emotion, "kinds": [p.kind for p in params]})
     return motion

@@ -5,8 +5,9 @@ its record ``<records_dir>/<clip_id>.json`` is there; the record is written last
 renamed into place. Clips already done are skipped, so running the same plan twice renders nothing the
 second time, and a crash loses at most the clips in progress.
 
-Records are kept outside the media folder on purpose: they name the condition of a clip, and the media
-folder is served to participants.
+Records name the condition of a clip: the folder they live in must never be served to participants (the
+command puts them in ``<MEDIA_ROOT>/clip_records``; the study app serves only catalogued clip files, by
+opaque keys).
 """
 from __future__ import annotations
 
@@ -178,7 +179,7 @@ def run_plan(plan: Plan, clips_dir: str | Path, records_dir: str | Path, media_p
     Args:
         plan: a validated plan.
         clips_dir: folder of the clip files (``<MEDIA_ROOT>/clips``).
-        records_dir: folder of the per-clip records (keep it out of the served media folder).
+        records_dir: folder of the per-clip records (never served: they name the conditions).
         media_prefix: prefix of file paths in records (relative to MEDIA_ROOT).
         workers: processes (spawned); 1 renders in this process.
         webm: also write VP9 WebM files.

@@ -10,6 +10,7 @@ from dataclasses import dataclass
 import numpy as np
 
 UP = np.array([0.0, 1.0, 0.0])
+SHORT_PATH_M = 6.0
 
 
 @dataclass(frozen=True)
@@ -89,9 +90,9 @@ def fixed_camera(positions: np.ndarray, root_rotation0: np.ndarray, aspect: floa
         positions: (T, J, 3) joint positions, metres.
         root_rotation0: (4,) root quaternion of the first frame (decides the side for in-place motion).
         aspect: width / height of the video.
-        azimuth_deg: angle from the side view towards the front; by default a walk gets the angle in
-            40..60 that shows the body largest while the whole path is in view (a view from ahead of
-            the path), and in-place motion 65 (from the front-left).
+        azimuth_deg: angle from the side view towards the front; by default a walk shorter than
+            SHORT_PATH_M gets 30 (three-quarter side view), a longer one the angle in 40..60 that shows
+            the body largest while the whole path is in view, and in-place motion 65 (front-left).
         extra_points: (N, 3) more points to keep in view (a chair).
     """
     pts = positions.reshape(-1, 3)
@@ -108,9 +109,16 @@ def fixed_camera(positions: np.ndarray, root_rotation0: np.ndarray, aspect: floa
         offset = view_offset(forward, 65.0 if azimuth_deg is None else azimuth_deg, elevation_deg)
         focal, dist = _centred_fit(pts, focal, offset, view_angle, aspect)
         return CameraPose(focal + offset * dist, focal, view_angle=view_angle)
-    # A walk: from ahead of the path, at the azimuth that shows the body largest on average while the
-    # whole path stays in view (a long path seen side-on leaves a tiny figure).
-    candidates = [azimuth_deg] if azimuth_deg is not None else list(range(40, 61, 5))
+    # A walk: from ahead of the path. A short path (a few walk cycles) is seen three-quarter from the side,
+    # where stride and arm swing read best; on a long path, the azimuth that shows the body largest on
+    # average while the whole path stays in view (a long path seen side-on leaves a tiny figure).
+    extent = float(np.linalg.norm(np.ptp(positions[:, 0, [0, 2]], axis=0)))
+    if azimuth_deg is not None:
+        candidates = [azimuth_deg]
+    elif extent < SHORT_PATH_M:
+        candidates = [30.0]
+    else:
+        candidates = list(range(40, 61, 5))
     body = positions[:, 0]
     best = None
     for az in candidates:
