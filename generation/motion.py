@@ -71,11 +71,11 @@ class Motion:
         pos = self.positions().reshape(-1, 3)
         return float(np.linalg.norm(pos.max(0) - pos.min(0)))
 
-    def slice(self, start: int, stop: int | None = None) -> "Motion":
+    def slice(self, start: int, stop: int | None = None) -> Motion:
         return Motion(self.skeleton, self.rotations[start:stop].copy(), self.root_positions[start:stop].copy(),
                       self.fps, dict(self.metadata))
 
-    def resample(self, fps: float) -> "Motion":
+    def resample(self, fps: float) -> Motion:
         """Motion at another frame rate: slerp for rotations, linear for root positions."""
         if abs(fps - self.fps) < 1e-9:
             return self
@@ -90,7 +90,7 @@ class Motion:
         out_root = self.root_positions[idx] + frac[:, None] * (self.root_positions[nxt] - self.root_positions[idx])
         return Motion(self.skeleton, out_rot, out_root, fps, dict(self.metadata))
 
-    def normalized(self) -> "Motion":
+    def normalized(self) -> Motion:
         """Copy with unit-length, sign-continuous quaternions."""
         return Motion(self.skeleton, np_qfix(np_qnormalize(self.rotations)), self.root_positions.copy(), self.fps,
                       dict(self.metadata))
@@ -112,7 +112,7 @@ class Motion:
         )
 
     @classmethod
-    def load_npz(cls, path: str | Path) -> "Motion":
+    def load_npz(cls, path: str | Path) -> Motion:
         """Read a file written by :meth:`save_npz`; MotionFormatError names a missing or bad field."""
         path = Path(path)
         try:

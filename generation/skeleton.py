@@ -161,7 +161,7 @@ class Skeleton:
         """Height of the root above the lowest joint in the rest pose, metres."""
         return float(-self.rest_positions()[:, 1].min())
 
-    def with_offsets(self, offsets: np.ndarray) -> "Skeleton":
+    def with_offsets(self, offsets: np.ndarray) -> Skeleton:
         return Skeleton(self.name, self.joints, self.parents, offsets, self.height, self.build)
 
 
