@@ -357,6 +357,7 @@ def main(argv=None) -> int:
     ap.add_argument("--full-short", default="var/gait_runs/full12.pt", help="full model on the ablations' schedule")
     ap.add_argument("--no-affect", default="var/gait_runs/no_affect.pt")
     ap.add_argument("--no-root", default="var/gait_runs/no_root.pt")
+    ap.add_argument("--corpus", default="var/corpus/gait_corpus_synthetic.npz")
     ap.add_argument("--steps", type=int, default=200)
     ap.add_argument("--quick", action="store_true", help="fewer sequences (smoke run)")
     ap.add_argument("--out", default="var/gait_runs/bench_gait.json")
@@ -365,18 +366,24 @@ def main(argv=None) -> int:
     t_start = time.time()
 
     from generation.corpus import GaitCorpus
-    corpus = GaitCorpus.load("var/corpus/gait_corpus_synthetic.npz")
-    data = load_corpus_sequences()
-    train = data.subset((data.split == "train") & (data.offset == 0))
-    test = data.subset((data.split == "test") & (data.offset == 0))
-    if args.quick:
-        test = test.subset(np.arange(12))
-    test_rows = test.base_index
     nets = {"full": args.full, "full, 12 epochs": args.full_short, "no affective (QuaterNet-like)": args.no_affect,
             "no root loss": args.no_root}
     nets = {k: load_model(v) for k, v in nets.items() if Path(v).exists()}
     results: dict = {"models": {k: {"path": n.path, "epochs": n.info.get("epochs"),
                                     "parameters": n.model.num_parameters()} for k, n in nets.items()}}
+    corpus = GaitCorpus.load(args.corpus)
+    data = load_corpus_sequences(args.corpus)
+    results["corpus"] = data.source
+    for name, net in nets.items():
+        trained = (net.info.get("corpus") or {}).get("sha256")
+        if trained != data.source["sha256"]:
+            print(f"WARNING: model {name!r} was trained on corpus {str(trained)[:12]}, evaluated on "
+                  f"{data.source['sha256'][:12]}")
+    train = data.subset((data.split == "train") & (data.offset == 0))
+    test = data.subset((data.split == "test") & (data.offset == 0))
+    if args.quick:
+        test = test.subset(np.arange(12))
+    test_rows = test.base_index
 
     # 1. prediction error
     table = {name: network_errors(net, test) for name, net in nets.items()}

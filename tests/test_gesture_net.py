@@ -367,3 +367,16 @@ def test_training_writes_weights_and_resumes(tmp_path):
     assert [h["epoch"] for h in second["history"]] == [0, 1, 2]
     net = load_model(tmp_path / "w.pt")
     assert net.cfg.d_model == 16 and net.cfg.residual == "rest"
+
+
+def test_shipped_network_expands_for_dominant_emotions(shipped):
+    """Seed 003 section 4.3: high dominance (proud) -> spread arms; low dominance (sad) -> arms close to the body."""
+    from generation.features import np_gesture_affective_features
+    from generation.gesture.generate import generate_gesture
+
+    spread = {}
+    for emotion in ("proud", "sad"):
+        m = generate_gesture("We climbed the mountain together and reached the top at noon.", emotion=emotion,
+                             model=shipped, fps=10.0)
+        spread[emotion] = np_gesture_affective_features(m.positions())[:, 11].mean()  # wrist spread / torso
+    assert spread["proud"] > spread["sad"] + 0.1
