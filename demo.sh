@@ -39,12 +39,13 @@ user.save()
 "
 
 echo "==> demo study"
-$PY manage.py setup_demo --base-url "http://$HOST:$PORT"
+PARTICIPANT_URL="$($PY manage.py setup_demo --base-url "http://$HOST:$PORT" | tee /dev/stderr \
+    | sed -n 's/^Participant URL: //p' | tail -1)"
 
 cat <<MSG
 
   Demo study is ready.
-    Participant link:  http://$HOST:$PORT/
+    Participant link:  ${PARTICIPANT_URL:-http://$HOST:$PORT/}
     Admin:             http://$HOST:$PORT/admin/   user: $ADMIN_USER   password: $ADMIN_PASSWORD
   Stop the server with Ctrl-C; run 'bash demo.sh' again to restart (nothing is redone).
 

@@ -241,7 +241,7 @@ def global_rotations(motion_rotations: np.ndarray, root_positions: np.ndarray, s
     """(T, J, 4) global joint rotations from local ones."""
     with torch.no_grad():
         _, g = forward_kinematics(torch.as_tensor(motion_rotations), torch.as_tensor(root_positions),
-                                  torch.as_tensor(skeleton.offsets), skeleton.parents, return_global_rotations=True)
+                                  torch.tensor(skeleton.offsets), skeleton.parents, return_global_rotations=True)
     return g.numpy()
 
 
