@@ -438,11 +438,11 @@ def render_markdown(r: dict) -> str:
         "",
         "### Contact sheet",
         "",
-        "`docs/img/gesture_contact_sheet.png`: one sentence said with seven emotions (sorted by arousal) and with "
-        "left vs right handedness (last two rows: proud).",
+        "`docs/img/gesture_contact_sheet.png`: one sentence said with seven emotions (sad, neutral, relieved, "
+        "afraid, angry, amused, proud) by a right-handed agent, and proud by a left-handed one (last row).",
         "",
-        "Reproduce: `python -m generation.gesture.train` (20 min budget; the shipped weights were trained with "
-        "`--residual rest`, the default, in two segments with `--resume`), the ablations with "
+        "Reproduce: `python -m generation.gesture.train` (the defaults: 20 min budget, seed 0, `--residual rest`; "
+        "the epochs reached depend on the machine's load), the ablations with "
         "`python -m generation.gesture.train --epochs 35 [--no-angle-loss|--no-pose-loss|--no-affective-loss] "
         "--out var/gesture/ablations/<name>.pt --checkpoint var/gesture/ablations/<name>_ckpt.pt`, then "
         "`python benchmarks/bench_gesture.py --skip-train`.",
