@@ -84,11 +84,30 @@ class StudyAdmin(admin.ModelAdmin):
 
 @admin.register(Clip)
 class ClipAdmin(admin.ModelAdmin):
-    list_display = ["clip_id", "modality", "origin", "emotion_label", "theme", "weight", "n_features", "duration_s",
-                    "plan"]
+    list_display = ["thumbnail", "clip_id", "modality", "origin", "emotion_label", "theme", "weight", "n_features",
+                    "duration_s", "plan"]
     list_filter = ["modality", "origin", "plan", "theme", "emotion_label"]
     search_fields = ["clip_id", "plan"]
-    readonly_fields = ["media_key", "created_at", "updated_at"]
+    readonly_fields = ["preview", "media_key", "created_at", "updated_at"]
+    actions = ["download_contact_sheet"]
+
+    @admin.display(description="poster")
+    def thumbnail(self, clip):
+        if not clip.poster:
+            return "-"
+        return format_html('<img src="{}" alt="" style="height:48px">', reverse("studyapp:media", args=[
+            clip.media_key, "png"]))
+
+    @admin.display(description="poster and video")
+    def preview(self, clip):
+        poster = reverse("studyapp:media", args=[clip.media_key, "png"]) if clip.poster else ""
+        return format_html('<video src="{}" poster="{}" controls preload="metadata" {} style="max-width:480px">'
+                           "</video>", reverse("studyapp:media", args=[clip.media_key, "mp4"]), poster,
+                           "loop" if clip.loop else "")
+
+    @admin.action(description="Download a contact sheet (PNG) of the selected clips")
+    def download_contact_sheet(self, request, queryset):
+        return views_staff.contact_sheet_response(request, queryset)
 
 
 class AssignmentInline(admin.TabularInline):

@@ -125,3 +125,13 @@ def pool_queryset(pool: dict | None) -> QuerySet:
             key = f"{name}__in"
         qs = qs.filter(Q(**{key: value}))
     return qs
+
+
+def clip_label(record: dict) -> str:
+    """Caption of a clip on a contact sheet: plan entry id, origin and the generator actually used."""
+    meta = record.get("metadata") or {}
+    gen = meta.get("generator", "")
+    if meta.get("fallback_for"):
+        gen = f"{gen} (fallback for {meta['fallback_for']})"
+    parts = [str(meta.get("entry_id", record["clip_id"])), record["origin"], gen]
+    return " | ".join(p for p in parts if p)

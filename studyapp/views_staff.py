@@ -136,3 +136,30 @@ def report_zip(request, study_id: int):
     return FileResponse(spool, as_attachment=True, filename=f"{study.slug}-report.zip",
                         content_type="application/zip")
 
+
+
+def contact_sheet_response(request, clips):
+    """A PNG grid of the posters of ``clips`` (a Clip queryset), captioned like generate_clips' contact sheets.
+
+    To get a plan's sheet in the admin: filter the clip list by plan, select all, run the action.
+    """
+    from generation.render import contact_sheet
+
+    from .catalogue import clip_label
+    from .media import media_path
+
+    clips = [c for c in clips.order_by("plan", "clip_id") if c.poster]
+    if not clips:
+        messages.error(request, "None of the selected clips has a poster image.")
+        return redirect(reverse("admin:studyapp_clip_changelist"))
+    try:
+        posters = [media_path(c.poster) for c in clips]
+    except Http404:
+        messages.error(request, "Some poster files are missing from MEDIA_ROOT; rerun generate_clips for the plan.")
+        return redirect(reverse("admin:studyapp_clip_changelist"))
+    out = Path(tempfile.mkdtemp(prefix="contact-sheet-")) / "contact_sheet.png"
+    contact_sheet(posters, [clip_label({"clip_id": c.clip_id, "origin": c.origin, "metadata": c.metadata})
+                            for c in clips], out)
+    plans = sorted({c.plan for c in clips if c.plan}) or ["clips"]
+    return FileResponse(open(out, "rb"), as_attachment=True, filename=f"{'-'.join(plans)}-contact-sheet.png",
+                        content_type="image/png")

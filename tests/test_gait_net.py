@@ -26,6 +26,7 @@ from generation.gait.train import (
     load_checkpoint,
     rollout,
     save_checkpoint,
+    splice_histories,
     train,
 )
 from generation.motion import Motion
@@ -130,6 +131,28 @@ def test_tiny_network_overfits_a_tiny_batch(tiny_data):
         opt.step()
         losses.append(loss.item())
     assert losses[-1] < 0.6 * losses[0], losses[::10]
+
+
+def test_splice_histories_switches_history_and_emotion(tiny_data):
+    batch = tiny_data.batch(np.arange(6))
+    P = GaitNetConfig().prefix_len
+    out = splice_histories(batch, P, 1.0, np.random.default_rng(0))
+    em = out["emotion"]
+    assert em.shape == (6, batch["q"].shape[1], 4)
+    assert torch.equal(em[:, P - 1:], batch["emotion"][:, None].expand(-1, em.shape[1] - P + 1, -1))
+    dom = batch["emotion"].argmax(-1)
+    for b in range(6):
+        # The prefix comes from a walk with another dominant emotion, whose label it carries; the rest is b's own.
+        src = next(i for i in range(6) if torch.equal(out["q"][b, :P], batch["q"][i, :P]))
+        assert dom[src] != dom[b] and torch.equal(em[b, 0], batch["emotion"][src])
+        assert torch.equal(out["q"][b, P:], batch["q"][b, P:])
+        assert torch.equal(out["theta"][b, P:], batch["theta"][b, P:])
+    none = splice_histories(batch, P, 0.0, np.random.default_rng(0))
+    assert torch.equal(none["q"], batch["q"]) and torch.equal(none["emotion"][:, 0], batch["emotion"])
+    # Per-step emotions go through the rollout.
+    cfg = GaitNetConfig.tiny()
+    pred = rollout(GaitNet(cfg), fit_normalizer(tiny_data.subset("train")), out, 0.5, P)
+    assert pred["q"].shape == batch["q"][:, 1:].shape
 
 
 def test_training_writes_checkpoint_and_resumes(tiny_data, tmp_path):

@@ -227,3 +227,33 @@ def test_assignments_export_records_options_shown(staff, study):
     gest = [r for r in rows if r["section_type"] == "gesture_emotion"]
     assert gest and all(len(r["options"].split(";")) == 4 for r in gest)
     assert all(r["answered_at"] for r in rows)
+
+
+def test_clip_admin_shows_poster_and_video_and_downloads_a_contact_sheet(staff, study, settings):
+    from PIL import Image
+
+    from studyapp.models import Clip
+
+    clips = list(Clip.objects.order_by("clip_id")[:3])
+    for i, clip in enumerate(clips):
+        Image.new("RGB", (64, 48), (40 * i, 120, 200)).save(settings.MEDIA_ROOT / f"poster{i}.png")
+        clip.poster = f"poster{i}.png"
+        clip.save()
+    page = staff.get(reverse("admin:studyapp_clip_change", args=[clips[0].pk]))
+    assert page.status_code == 200
+    assert reverse("studyapp:media", args=[clips[0].media_key, "mp4"]).encode() in page.content
+    assert b"<video" in page.content
+    listing = staff.get(reverse("admin:studyapp_clip_changelist"))
+    assert reverse("studyapp:media", args=[clips[1].media_key, "png"]).encode() in listing.content
+
+    sheet = staff.post(reverse("admin:studyapp_clip_changelist"),
+                       {"action": "download_contact_sheet", "_selected_action": [c.pk for c in clips]})
+    assert sheet.status_code == 200 and sheet["Content-Type"] == "image/png"
+    image = Image.open(io.BytesIO(b"".join(sheet.streaming_content)))
+    assert image.width >= 64 and image.height >= 48
+
+    no_poster = Clip.objects.exclude(pk__in=[c.pk for c in clips])[:1]
+    refused = staff.post(reverse("admin:studyapp_clip_changelist"),
+                         {"action": "download_contact_sheet", "_selected_action": [c.pk for c in no_poster]},
+                         follow=True)
+    assert b"has a poster image" in refused.content

@@ -38,6 +38,10 @@ class GaitNetConfig:
         lambda_*: loss weights of eq. 13 (1.0 in the paper); lambda_versor is the unit-norm term of eq. 8;
             lambda_phase weights the step-phase head (an addition of this implementation, see losses.py).
         pos_scale_m: positions in the pose and foot losses are measured in units of this many metres.
+        splice_frac: fraction of training sequences whose ground-truth prefix is taken from another walk of a
+            different dominant emotion (phase-aligned); the emotion input switches from that walk's label to the
+            sequence's own label at the splice. Every corpus walk has one emotion throughout, so without this the
+            motion history predicts the style and the network learns to ignore m (see train.splice_histories).
     """
 
     enc1_sizes: tuple[int, ...] = (16, 16, 8)
@@ -69,6 +73,7 @@ class GaitNetConfig:
     lambda_fctc: float = 1.0
     lambda_phase: float = 1.0
     pos_scale_m: float = 0.1
+    splice_frac: float = 0.5
     euler_order: str = "zyx"
     seed: int = 0
     notes: dict = field(default_factory=dict)

@@ -57,12 +57,50 @@ def _kappa(sbar, ref, sbar_prev, ref_prev):
     return (u - u0).norm(dim=-1)
 
 
+def splice_histories(batch: dict, prefix: int, frac: float, rng: np.random.Generator) -> dict:
+    """Give a fraction of the sequences the history of another walk with a different emotion.
+
+    For each chosen sequence B, the inputs and targets of steps 0..prefix-1 are replaced by those of the walk A
+    in the batch (different dominant emotion) whose stepping phase at step prefix - 1 is closest to B's; the
+    emotion input is A's label for steps 0..prefix-2 and B's own label from step prefix - 1 on (the step that
+    predicts B's first step). The network must then turn A's style into B's because the label says so.
+    The skeleton (offsets, mean height) and the path heading stay B's. Returns a new batch whose ``emotion``
+    is per step (B, T, C).
+    """
+    B, T = batch["q"].shape[:2]
+    em = batch["emotion"][:, None].expand(B, T, -1).clone()
+    out = dict(batch, emotion=em)
+    if frac <= 0.0 or B < 2:
+        return out
+    dominant = batch["emotion"].argmax(-1).numpy()
+    theta = batch["theta"][:, prefix - 1].numpy()
+    chosen = np.flatnonzero(rng.random(B) < frac)
+    src = np.arange(B)
+    for b in chosen:
+        cand = np.flatnonzero(dominant != dominant[b])
+        if len(cand):
+            dphase = np.abs(np.remainder(theta[cand] - theta[b] + math.pi, 2 * math.pi) - math.pi)
+            src[b] = cand[np.argmin(dphase)]
+    swap = torch.as_tensor(src != np.arange(B))
+    if not swap.any():
+        return out
+    src_t = torch.as_tensor(src)
+    for k in ("q", "root", "theta", "omega", "sbar", "kappa", "aff"):
+        v = batch[k].clone()
+        w = swap.view((B,) + (1,) * (v.dim() - 1))
+        v[:, :prefix] = torch.where(w, batch[k][src_t, :prefix], v[:, :prefix])
+        out[k] = v
+    em[:, :prefix - 1] = torch.where(swap[:, None, None], batch["emotion"][src_t, None], em[:, :prefix - 1])
+    return out
+
+
 def rollout(model: GaitNet, norm: Normalizer, batch: dict, tf_ratio: float, prefix: int,
             generator: torch.Generator | None = None) -> dict:
     """Run the network over a batch of sequences; returns predictions for steps 1..T-1.
 
     Args:
-        batch: from :meth:`GaitSequences.batch` (B sequences of T steps).
+        batch: from :meth:`GaitSequences.batch` (B sequences of T steps); ``emotion`` is (B, C) or per step
+            (B, T, C).
         tf_ratio: probability of feeding the ground truth (rather than the prediction) after the prefix.
         prefix: number of leading steps always fed from the ground truth (>= 1).
 
@@ -74,7 +112,7 @@ def rollout(model: GaitNet, norm: Normalizer, batch: dict, tf_ratio: float, pref
     B, T = batch["q"].shape[:2]
     # Full teacher forcing is the same as a ground-truth prefix covering the whole sequence (one GRU call).
     prefix = T - 1 if tf_ratio >= 1.0 else max(1, min(prefix, T - 1))
-    em = batch["emotion"][:, None].expand(B, T, -1)
+    em = batch["emotion"] if batch["emotion"].dim() == 3 else batch["emotion"][:, None].expand(B, T, -1)
     aff_z = norm.aff(batch["aff"])
     root_z = norm.root(batch["root"])
     step_z = norm.step(batch["theta"], batch["omega"], batch["sbar"], batch["kappa"])
@@ -230,7 +268,7 @@ def train(config: GaitNetConfig, data: GaitSequences, out_path: str | Path, chec
         bar = tqdm(batches, desc=f"epoch {epoch + 1}/{config.epochs} tf={tf:.2f}", disable=not progress,
                    leave=False)
         for idx in bar:
-            batch = train_set.batch(idx)
+            batch = splice_histories(train_set.batch(idx), config.prefix_len, config.splice_frac, rng)
             pred = rollout(model, norm, batch, tf, config.prefix_len, gen)
             loss, terms = total_loss(pred, ground_truth_targets(batch, norm), config)
             opt.zero_grad()

@@ -70,24 +70,16 @@ class Command(BaseCommand):
                           f"{len(result.failed)} failed, {result.seconds:.1f} s; catalogue {csv_path}")
         if opts["contact_sheet"] is not None and records:
             from generation.render import contact_sheet
+            from studyapp.catalogue import clip_label
 
             out = Path(opts["contact_sheet"]) if opts["contact_sheet"] else (
                 Path(settings.DATA_DIR) / "contact_sheets" / f"{plan.name}.png")
-            labels = [_label(r) for r in records]
+            labels = [clip_label(r) for r in records]
             contact_sheet([clips_dir / f"{r['clip_id']}.png" for r in records], labels, out)
             self.stdout.write(f"contact sheet {out}")
         if result.failed:
             raise CommandError(f"{len(result.failed)} clip(s) of plan {plan.name} failed (see above); the others "
                                "are catalogued; rerun to retry only the missing ones")
-
-
-def _label(rec: dict) -> str:
-    meta = rec.get("metadata", {})
-    gen = meta.get("generator", "")
-    if meta.get("fallback_for"):
-        gen = f"{gen} (fallback for {meta['fallback_for']})"
-    parts = [str(meta.get("entry_id", rec["clip_id"])), rec["origin"], gen]
-    return " | ".join(p for p in parts if p)
 
 
 class _Bars:
