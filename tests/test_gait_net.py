@@ -74,6 +74,17 @@ def test_model_shapes_and_unit_quaternions():
     assert one["q"].shape == (N, 21, 4)
 
 
+def test_emotion_skip_wiring_and_old_configs():
+    old = GaitNetConfig.tiny(emotion_skip=False).to_dict()
+    del old["emotion_skip"]
+    assert GaitNetConfig.from_dict(old).emotion_skip is False   # checkpoints from before the field
+    net = GaitNet(GaitNetConfig.tiny(emotion_skip=True))
+    q, zeros = torch.randn(2, 3, 21, 4), (torch.zeros(2, 3, 18), torch.zeros(2, 3, 5), torch.zeros(2, 3, 3))
+    a = net(q, *zeros, torch.eye(4)[[0, 0]][:, None].expand(2, 3, 4))
+    b = net(q, *zeros, torch.eye(4)[[1, 1]][:, None].expand(2, 3, 4))
+    assert a["q"].shape == (2, 3, 21, 4) and not torch.allclose(a["hidden"], b["hidden"])
+
+
 def test_paper_config_has_released_size_and_ablation_drops_affective_branch():
     assert 9.5e6 < GaitNet(GaitNetConfig.paper()).num_parameters() < 10.5e6
     ablated = GaitNet(GaitNetConfig.tiny(use_affective=False))

@@ -27,6 +27,9 @@ class GaitNetConfig:
         residual: the versor head predicts a change added to the current rotations before normalising
             (QuaterNet-style); False predicts absolute rotations.
         use_affective: False gives the ablation without affective inputs and without L_aff (seed 000 5.6).
+        emotion_skip: the emotion m also enters GRU_versors and FC_versors directly at every step (not only
+            through the 8-unit encoders), so the label can steer the pose; False is the paper's wiring
+            (and that of checkpoints saved before this field existed).
 
     Data and training (section 5.1, 5.3):
         seq_len: T = 60 network steps (240 frames sampled every ``frame_step``-th frame).
@@ -52,6 +55,7 @@ class GaitNetConfig:
     versor_hidden: int = 128
     residual: bool = True
     use_affective: bool = True
+    emotion_skip: bool = True
     num_joints: int = NUM_JOINTS
     num_emotions: int = NUM_EMOTIONS
 
@@ -73,7 +77,7 @@ class GaitNetConfig:
     lambda_fctc: float = 1.0
     lambda_phase: float = 1.0
     pos_scale_m: float = 0.1
-    splice_frac: float = 0.5
+    splice_frac: float = 0.3
     euler_order: str = "zyx"
     seed: int = 0
     notes: dict = field(default_factory=dict)
@@ -122,6 +126,7 @@ class GaitNetConfig:
         if unknown:
             raise ValueError(f"unknown GaitNetConfig fields {unknown}")
         d = dict(d)
+        d.setdefault("emotion_skip", False)  # checkpoints saved before the field existed
         for k in ("enc1_sizes", "enc2_sizes"):
             if k in d:
                 d[k] = tuple(d[k])

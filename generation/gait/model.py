@@ -19,6 +19,7 @@ Differences from the paper, on purpose:
   time no future foot contacts exist).
 - the prediction horizon of each step is one time step (T_pred = 1) and the network is rolled out
   autoregressively, as in QuaterNet and the curriculum of section 5.3.
+With ``emotion_skip`` m is also concatenated to the GRU input and to FC_versors' input at every step.
 The ablation without affective inputs and loss (section 5.6) drops FC_enc1 (``use_affective=False``).
 
 Shapes: N batch, J joints, C emotions. Inputs are standardised by :class:`generation.gait.data.Normalizer`.
@@ -54,9 +55,11 @@ class GaitNet(nn.Module):
             self.fc_enc1 = None
         self.fc_enc2 = mlp([NUM_STEP_FEATURES + C, *config.enc2_sizes])
         gamma = config.h1 + config.h2
-        self.gru_versors = nn.GRU(4 * J + gamma, config.gru_hidden, num_layers=config.gru_layers, batch_first=True)
+        skip = C if config.emotion_skip else 0
+        self.gru_versors = nn.GRU(4 * J + gamma + skip, config.gru_hidden, num_layers=config.gru_layers,
+                                  batch_first=True)
         self.fc_root = mlp([NUM_ROOT_FEATURES + gamma, config.root_hidden])
-        self.fc_versors = mlp([config.gru_hidden, config.versor_hidden, 4 * J], final_activation=False)
+        self.fc_versors = mlp([config.gru_hidden + skip, config.versor_hidden, 4 * J], final_activation=False)
         self.fc_h = nn.Linear(config.root_hidden, 1)
         self.fc_s = nn.Linear(config.root_hidden, 1)
         self.fc_delta = nn.Linear(config.root_hidden, 1)
@@ -92,9 +95,10 @@ class GaitNet(nn.Module):
         parts.append(self.fc_enc2(torch.cat((step_feats, emotion), dim=-1)))
         gamma = torch.cat(parts, dim=-1)
         q_flat = q.reshape(N, L, 4 * J)
-        q_latent, hidden = self.gru_versors(torch.cat((q_flat, gamma), dim=-1), hidden)
+        skip = [emotion] if self.config.emotion_skip else []
+        q_latent, hidden = self.gru_versors(torch.cat((q_flat, gamma, *skip), dim=-1), hidden)
         root_latent = self.fc_root(torch.cat((root_feats, gamma), dim=-1))
-        q_out = self.fc_versors(q_latent)
+        q_out = self.fc_versors(torch.cat((q_latent, *skip), dim=-1))
         if self.config.residual:
             q_out = q_out + q_flat
         q_raw = q_out.reshape(N, L, J, 4)

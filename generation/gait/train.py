@@ -8,6 +8,10 @@ later step each sequence's input is the ground truth with probability ``tf_decay
 teacher-forcing ratio) and the network's own previous prediction otherwise (the curriculum of section 5.3,
 after Pavllo et al.). The network predicts step t + 1 from step t; the losses of eq. 8-13 are taken over
 all predicted steps.
+
+A fraction ``splice_frac`` of each batch gets the ground-truth prefix of a walk with another emotion and a label
+that switches to the sequence's own at the splice (:func:`splice_histories`), so that the emotion input, not the
+motion history, decides the style.
 """
 from __future__ import annotations
 
