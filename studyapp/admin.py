@@ -86,7 +86,7 @@ class StudyAdmin(admin.ModelAdmin):
 class ClipAdmin(admin.ModelAdmin):
     list_display = ["thumbnail", "clip_id", "modality", "origin", "emotion_label", "theme", "weight", "n_features",
                     "duration_s", "plan"]
-    list_filter = ["modality", "origin", "plan", "theme", "emotion_label"]
+    list_filter = ["retired", "modality", "origin", "plan", "theme", "emotion_label"]
     search_fields = ["clip_id", "plan"]
     readonly_fields = ["preview", "media_key", "created_at", "updated_at"]
     actions = ["download_contact_sheet"]

@@ -98,8 +98,23 @@ def upsert_clips(records: list[dict]) -> int:
     cleaned = [(str(rec.get("clip_id")).strip(), clean_record(rec, i)) for i, rec in enumerate(records)]
     with transaction.atomic():
         for clip_id, fields in cleaned:
-            Clip.objects.update_or_create(clip_id=clip_id, defaults=fields)
+            Clip.objects.update_or_create(clip_id=clip_id, defaults={**fields, "retired": False})
     return len(cleaned)
+
+
+def retire_superseded(plan: str, current_clip_ids: set[str], entry_ids: set[str] | None = None) -> int:
+    """Mark clips of ``plan`` that a newer render replaced as retired; returns how many.
+
+    A clip is superseded when it belongs to ``plan``, is not among ``current_clip_ids`` and, if ``entry_ids`` is
+    given, was made for one of those plan entries (``metadata["entry_id"]``). With ``entry_ids=None`` every other
+    clip of the plan is retired (a complete run: entries removed from the plan go too). Retired clips keep their
+    rows and files, so earlier answers stay valid; they are left out of new assignments.
+    """
+    stale = Clip.objects.filter(plan=plan, retired=False).exclude(clip_id__in=current_clip_ids)
+    if entry_ids is not None:
+        stale = [c.pk for c in stale if str((c.metadata or {}).get("entry_id")) in entry_ids]
+        return Clip.objects.filter(pk__in=stale).update(retired=True)
+    return stale.update(retired=True)
 
 
 def pool_queryset(pool: dict | None) -> QuerySet:
@@ -108,7 +123,7 @@ def pool_queryset(pool: dict | None) -> QuerySet:
     Keys are catalogue fields with an optional Django lookup (`weight__gt`, `theme__in`, ...), plus two
     shorthands: `transition` (bool: has a final emotion) and `rbf` (bool: has a theme). A list value means `in`.
     """
-    qs = Clip.objects.all()
+    qs = Clip.objects.filter(retired=False)
     for key, value in (pool or {}).items():
         if key in ("generated", "source"):      # naturalness sub-pools, handled by the assignment
             continue

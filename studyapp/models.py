@@ -80,6 +80,9 @@ class Clip(models.Model):
     sections = models.CharField(max_length=300, blank=True)
     loop = models.BooleanField(default=False)
     metadata = models.JSONField(default=dict, blank=True)
+    retired = models.BooleanField(
+        default=False, help_text="superseded by a newer render of the same plan entry (e.g. after a generator "
+        "changed); kept for the answers that refer to it, left out of new assignments")
     media_key = models.CharField(max_length=32, unique=True, default=new_media_key, editable=False)
     created_at = models.DateTimeField(auto_now_add=True)
     updated_at = models.DateTimeField(auto_now=True)

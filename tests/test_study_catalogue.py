@@ -3,7 +3,7 @@ from __future__ import annotations
 
 import pytest
 
-from studyapp.catalogue import CatalogueError, pool_queryset, upsert_clips
+from studyapp.catalogue import CatalogueError, pool_queryset, retire_superseded, upsert_clips
 from studyapp.models import Clip
 
 pytestmark = pytest.mark.django_db
@@ -64,3 +64,21 @@ def test_pair_and_section_hints():
     assert (a.source_clip_id, b.source_clip_id) == ("src1", "src2")
     assert sorted(pool_queryset({"sections__contains": "gesture_emotion"}).values_list("clip_id", flat=True)) == [
         "gen1"]
+
+
+def test_superseded_renders_are_retired_and_left_out_of_pools():
+    """A generator change re-renders an entry under a new clip id: the old clip stays (answers refer to it) but
+    no new participant is assigned it."""
+    upsert_clips([rec(clip_id="old_a", metadata={"entry_id": "a"}), rec(clip_id="old_b", metadata={"entry_id": "b"}),
+                  rec(clip_id="other_plan", plan="seed000", metadata={"entry_id": "a"})])
+    upsert_clips([rec(clip_id="new_a", metadata={"entry_id": "a"})])
+    # A partial run (one entry) retires only that entry's older render.
+    assert retire_superseded("demo", {"new_a"}, entry_ids={"a"}) == 1
+    assert set(pool_queryset({"modality": "gait"}).values_list("clip_id", flat=True)) == {
+        "new_a", "old_b", "other_plan"}
+    # A complete run retires every clip of the plan it did not produce, and nothing of other plans.
+    assert retire_superseded("demo", {"new_a"}) == 1
+    assert set(Clip.objects.filter(retired=True).values_list("clip_id", flat=True)) == {"old_a", "old_b"}
+    # Rendering an entry again brings its clip back.
+    upsert_clips([rec(clip_id="old_b", metadata={"entry_id": "b"})])
+    assert not Clip.objects.get(clip_id="old_b").retired

@@ -61,11 +61,17 @@ class Command(BaseCommand):
             write_clips_csv(records, csv_path)
         if records and not opts["no_db"]:
             try:
-                from studyapp.catalogue import upsert_clips
+                from studyapp.catalogue import retire_superseded, upsert_clips
             except ImportError as exc:
                 raise CommandError(f"clips rendered and {csv_path} written, but the database catalogue is not "
                                    f"available ({exc})") from None
             upsert_clips(records)
+            complete = opts["limit"] is None and not result.failed
+            entries = None if complete else {str(r.get("metadata", {}).get("entry_id")) for r in records}
+            retired = retire_superseded(plan.name, {r["clip_id"] for r in records}, entries)
+            if retired:
+                self.stdout.write(f"retired {retired} superseded clip(s) of plan {plan.name} (kept for earlier "
+                                  "answers, left out of new assignments)")
         self.stdout.write(f"plan {plan.name}: {len(result.rendered)} rendered, {len(result.skipped)} already done, "
                           f"{len(result.failed)} failed, {result.seconds:.1f} s; catalogue {csv_path}")
         if opts["contact_sheet"] is not None and records:
