@@ -2,7 +2,7 @@
 from django.core.management.base import BaseCommand, CommandError
 
 from studyapp.export import run_report
-from studyapp.models import Study
+from studyapp.management.cli import study_by_slug
 
 
 class Command(BaseCommand):
@@ -13,10 +13,7 @@ class Command(BaseCommand):
         parser.add_argument("--out", required=True, help="output folder (created if missing)")
 
     def handle(self, *args, study, out, **options):
-        obj = Study.objects.filter(slug=study).first()
-        if obj is None:
-            known = list(Study.objects.values_list("slug", flat=True))
-            raise CommandError(f"no study with slug {study!r}; known: {known}")
+        obj = study_by_slug(study)
         try:
             result = run_report(obj, out)
         except ImportError as exc:

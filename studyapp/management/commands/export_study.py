@@ -1,8 +1,8 @@
 """Write a study's responses.csv, clips.csv and participants.csv (DESIGN.md formats) into a folder."""
-from django.core.management.base import BaseCommand, CommandError
+from django.core.management.base import BaseCommand
 
 from studyapp.export import write_study_csvs
-from studyapp.models import Study
+from studyapp.management.cli import study_by_slug
 
 
 class Command(BaseCommand):
@@ -13,9 +13,6 @@ class Command(BaseCommand):
         parser.add_argument("--out", required=True, help="output folder (created if missing)")
 
     def handle(self, *args, study, out, **options):
-        obj = Study.objects.filter(slug=study).first()
-        if obj is None:
-            known = list(Study.objects.values_list("slug", flat=True))
-            raise CommandError(f"no study with slug {study!r}; known: {known}")
+        obj = study_by_slug(study)
         for kind, path in write_study_csvs(obj, out).items():
             self.stdout.write(f"{kind}: {path}")

@@ -1,11 +1,10 @@
 """``manage.py train_gait``: train the seed 000 gait network (thin wrapper over generation.gait.train)."""
 from __future__ import annotations
 
-import argparse
-
 from django.core.management.base import BaseCommand
 
 from generation.gait.train import build_parser, run
+from studyapp.management.cli import mirror_arguments, mirrored_namespace
 
 
 class Command(BaseCommand):
@@ -13,21 +12,10 @@ class Command(BaseCommand):
             "`python -m generation.gait.train`.")
 
     def add_arguments(self, parser):
-        for action in build_parser()._actions:
-            if action.dest == "help":
-                continue
-            kwargs = {"dest": action.dest, "default": action.default, "help": action.help}
-            if action.const is True and action.nargs == 0:
-                kwargs["action"] = "store_true"
-            elif isinstance(action, argparse._AppendAction):
-                kwargs["action"] = "append"
-            else:
-                kwargs["type"] = action.type
-            parser.add_argument(*action.option_strings, **kwargs)
+        mirror_arguments(parser, build_parser())
 
     def handle(self, *args, **options):
-        names = {a.dest for a in build_parser()._actions if a.dest != "help"}
-        ns = argparse.Namespace(**{k: v for k, v in options.items() if k in names})
+        ns = mirrored_namespace(build_parser(), options)
         if ns.set is None:
             ns.set = []
         run(ns, log=lambda msg: self.stdout.write(msg))
