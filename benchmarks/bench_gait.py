@@ -30,15 +30,15 @@ import torch
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from generation.features import np_gait_affective_features  # noqa: E402
+from generation.core.features import np_gait_affective_features  # noqa: E402
+from generation.core.kinematics import forward_kinematics  # noqa: E402
+from generation.core.motion import Motion  # noqa: E402
+from generation.core.paths import random_path, straight  # noqa: E402
+from generation.core.quaternion import qangle  # noqa: E402
+from generation.core.skeleton import GAIT_PARENTS  # noqa: E402
 from generation.gait.data import load_corpus_sequences, world_rotations  # noqa: E402
 from generation.gait.generate import EMOTIONS, distance_to_path, emotion_transition, generate_gaits, load_model  # noqa: E402
 from generation.gait.train import DEFAULT_WEIGHTS, rollout  # noqa: E402
-from generation.kinematics import forward_kinematics  # noqa: E402
-from generation.motion import Motion  # noqa: E402
-from generation.paths import random_path, straight  # noqa: E402
-from generation.quaternion import qangle  # noqa: E402
-from generation.skeleton import GAIT_PARENTS  # noqa: E402
 
 PREFIX, HORIZON = 18, 42
 
@@ -185,8 +185,9 @@ def expressiveness(net, observer, corpus, test_rows, test_emotion, steps, rng) -
 
 
 def expressiveness_procedural_seeds(net, observer, steps, per_class=10) -> dict:
-    """Seeds made from the intended emotion itself (``seeds=None``: generation.emotion.gait_params_for_emotion),
-    for the pure emotions and for four mixtures not in the corpus (dominant 0.55)."""
+    """Seeds made from the intended emotion itself (``seeds=None``:
+    generation.procedural.emotion.gait_params_for_emotion), for the pure emotions and for four mixtures not in
+    the corpus (dominant 0.55)."""
     out = {}
     for name, vecs in (("pure", np.eye(4)), ("unseen_mixture", fixed_mixtures())):
         emo = np.repeat(vecs, per_class, axis=0)
@@ -365,7 +366,7 @@ def main(argv=None) -> int:
     torch.set_num_threads(1)
     t_start = time.time()
 
-    from generation.corpus import GaitCorpus
+    from generation.procedural.corpus import GaitCorpus
     nets = {"full": args.full, "full, 12 epochs": args.full_short, "no affective (QuaterNet-like)": args.no_affect,
             "no root loss": args.no_root}
     nets = {k: load_model(v) for k, v in nets.items() if Path(v).exists()}

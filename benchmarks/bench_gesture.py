@@ -25,7 +25,10 @@ import numpy as np  # noqa: E402
 import torch  # noqa: E402
 from scipy import stats  # noqa: E402
 
-from generation.features import np_gesture_affective_features  # noqa: E402
+from generation.core.features import np_gesture_affective_features  # noqa: E402
+from generation.core.kinematics import np_forward_kinematics  # noqa: E402
+from generation.core.quaternion import np_qnormalize  # noqa: E402
+from generation.core.skeleton import gesture_skeleton  # noqa: E402
 from generation.gesture import config  # noqa: E402
 from generation.gesture.data import GestureDataset, attribute_vector, build_dataset, nrc_vad  # noqa: E402
 from generation.gesture.generate import decode_examples, generate_gesture, load_model  # noqa: E402
@@ -33,9 +36,6 @@ from generation.gesture.losses import LossWeights  # noqa: E402
 from generation.gesture.metrics import dataset_pose_error, upper_body_acceleration  # noqa: E402
 from generation.gesture.model import GestureNetConfig  # noqa: E402
 from generation.gesture.train import TrainConfig, train  # noqa: E402
-from generation.kinematics import np_forward_kinematics  # noqa: E402
-from generation.quaternion import np_qnormalize  # noqa: E402
-from generation.skeleton import gesture_skeleton  # noqa: E402
 
 MACHINE = "2-core CI VM, no GPU"
 DATE = "2026-11-27"

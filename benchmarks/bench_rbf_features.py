@@ -5,10 +5,10 @@ Run:  OMP_NUM_THREADS=1 python benchmarks/bench_rbf_features.py [--out docs/benc
           [--sheet docs/img/rbf_contact_sheet.png] [--shapes docs/img/rbf_shapes.png]
 
 For every theme at w = +0.7 and w = -0.7 (all ten features) it measures, over one cycle, the mean change of
-each gait affective feature (generation.features.np_gait_affective_features) against the neutral base and
+each gait affective feature (generation.core.features.np_gait_affective_features) against the neutral base and
 checks the expected directions listed in EXPECTATIONS. It also records the largest bone-length deviation of the
 edited positions before and after they are put back onto the skeleton, the same numbers for
-generation.ik.fit_positions_to_skeleton (direction-only projection) for comparison, the lowest foot height
+generation.core.ik.fit_positions_to_skeleton (direction-only projection) for comparison, the lowest foot height
 (ground penetration) of both, and the time per stylised clip.
 """
 from __future__ import annotations
@@ -26,10 +26,10 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 import torch  # noqa: E402
 
-from generation.features import GAIT_FEATURE_NAMES, foot_joints, np_gait_affective_features  # noqa: E402
-from generation.neutral_base import neutral_cycle  # noqa: E402
-from generation.stylise import stylise, stylised_cycle  # noqa: E402
-from generation.themes import THEME_NAMES, THEMES  # noqa: E402
+from generation.core.features import GAIT_FEATURE_NAMES, foot_joints, np_gait_affective_features  # noqa: E402
+from generation.rbf.neutral_base import neutral_cycle  # noqa: E402
+from generation.rbf.stylise import stylise, stylised_cycle  # noqa: E402
+from generation.rbf.themes import THEME_NAMES, THEMES  # noqa: E402
 
 WEIGHTS = (0.7, -0.7)
 
@@ -100,7 +100,7 @@ def feature_change(neutral_pos: np.ndarray, styled_pos: np.ndarray) -> dict:
 
 
 def evaluate(nc) -> dict:
-    from generation.ik import fit_positions_to_skeleton
+    from generation.core.ik import fit_positions_to_skeleton
 
     skel = nc.skeleton
     feet = sum(foot_joints(skel), [])
@@ -158,7 +158,7 @@ def timing(nc, repeats: int = 7) -> dict:
 
 def scaling(nc) -> dict:
     """Mean joint displacement from the neutral (cm, fitted skeleton) for the Fig. 7 grid of w x n."""
-    from generation.stylise import PAPER_FEATURE_COUNTS, PAPER_WEIGHTS
+    from generation.rbf.stylise import PAPER_FEATURE_COUNTS, PAPER_WEIGHTS
 
     out = {}
     for theme in THEME_NAMES:
@@ -202,7 +202,7 @@ def markdown_tables(result: dict) -> str:
                          f"{'+' if c['expected_sign'] > 0 else '-'} | {c['change_m'] * 1000:+.1f} | "
                          f"{'yes' if c['holds'] else '**no**'} |")
     lines += ["", "Bone lengths and floor (mm): largest bone-length deviation of the edited positions Y, of our fit, "
-              "of `generation.ik.fit_positions_to_skeleton` (direction-only projection); lowest foot joint "
+              "of `generation.core.ik.fit_positions_to_skeleton` (direction-only projection); lowest foot joint "
               "relative to the neutral floor for ours / the direction-only projection:", "",
               "| theme | w | before | after (ours) | after (ik.fit_positions_to_skeleton) | lowest foot ours | "
               "lowest foot direction-only | max lift by floor clamp |", "|---|---|---|---|---|---|---|---|"]
@@ -244,12 +244,12 @@ def benchmark_page(result: dict) -> str:
         "    --sheet docs/img/rbf_contact_sheet.png --shapes docs/img/rbf_shapes.png",
         "```",
         "",
-        f"Neutral base: `generation.neutral_base.neutral_cycle()`, {base['n_cycles']} cycle(s) averaged, "
+        f"Neutral base: `generation.rbf.neutral_base.neutral_cycle()`, {base['n_cycles']} cycle(s) averaged, "
         f"{rejected} rejected as glitches, cycle {base['cycle_duration_s']:.2f} s, stride "
         f"{base['stride_m'][2]:.2f} m, synthetic: {base['synthetic']}. Sources used: "
         + "; ".join(f"{u['name']} ({u['cycles']})" for u in used) + "."
         + (f" {rejected} cycle(s) were left out because a joint moved faster than 10 m/s between two frames (on "
-           "2026-11-27 `generation.procedural_walk.walk` made each knee jump about 13 cm within one frame once per "
+           "2026-11-27 `generation.procedural.walk.walk` made each knee jump about 13 cm within one frame once per "
            "cycle, so every procedural cycle was rejected and the base is the captured cycle alone; rerun this "
            "benchmark once the walker is fixed)." if rejected else ""),
         "",
@@ -264,7 +264,7 @@ def benchmark_page(result: dict) -> str:
         f"{worst_before * 1000:.0f} mm (the paper's stated limitation); after the fit the largest deviation is "
         f"{worst_after * 1000:.1e} mm.",
         f"- Floor: lowest foot joint {lowest_ours * 1000:+.1f} mm relative to the neutral floor with our fit, "
-        f"{lowest_dir * 1000:+.1f} mm with `generation.ik.fit_positions_to_skeleton` (direction-only).",
+        f"{lowest_dir * 1000:+.1f} mm with `generation.core.ik.fit_positions_to_skeleton` (direction-only).",
         f"- Speed: {t['stylise_clip_s'] * 1000:.0f} ms per 4-cycle clip at 30 fps ({t['clip_frames']} frames, "
         f"median of 7, one core); building the neutral base {t['neutral_base_s']:.2f} s.",
         "- Scaling: the mean joint displacement grows with w and, mostly, with n (last table), as the paper's "
@@ -350,7 +350,7 @@ def shapes_figure(path: Path) -> None:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from generation.rbf import mirrored, rbf, shape_params
+    from generation.rbf.basis import mirrored, rbf, shape_params
 
     t = np.arange(100.0)
     specs = [(1, ()), (2, (40.0,)), (3, (25.0, 75.0)), (4, (25.0, 75.0))]

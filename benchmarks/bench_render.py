@@ -39,13 +39,13 @@ def _motion(kind: str, frames: int, fps: float):
     """A 'walk' (procedural, 21 joints, a 3 m radius loop) or a seated 'gesture' (procedural, 23 joints)."""
     import numpy as np
 
-    from generation.emotion import NRC_VAD, gait_params_for_emotion, gesture_params_for_vad
+    from generation.procedural.emotion import NRC_VAD, gait_params_for_emotion, gesture_params_for_vad
     if kind == "walk":
-        from generation.paths import curved
-        from generation.procedural_walk import walk
+        from generation.core.paths import curved
+        from generation.procedural.walk import walk
 
         return walk(gait_params_for_emotion([0.2, 0.0, 0.0, 0.8]), curved(3.0, np.radians(330), 14.0), frames, fps)
-    from generation.procedural_gesture import seated_gesture
+    from generation.procedural.gesture import seated_gesture
 
     v, a, d = NRC_VAD["proud"]
     return seated_gesture(gesture_params_for_vad(v, a, d, np.random.default_rng(0)), frames, fps, seed=0)
@@ -108,7 +108,7 @@ def speed(args) -> list[dict]:
 def plans(args) -> list[dict]:
     from dataclasses import replace
 
-    from generation.plan import load_plan
+    from generation.plans.schema import load_plan
     from generation.render.batch import run_plan
 
     rows = []

@@ -19,8 +19,8 @@ import numpy as np  # noqa: E402
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-from generation.captured import captured_walks  # noqa: E402
-from generation.features import detect_foot_contacts  # noqa: E402
+from generation.core.features import detect_foot_contacts  # noqa: E402
+from generation.formats.captured import captured_walks  # noqa: E402
 
 
 def main(out: Path) -> None:

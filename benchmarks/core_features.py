@@ -17,9 +17,7 @@ import torch
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-from generation.bvh import read_bvh, write_bvh  # noqa: E402
-from generation.captured import captured_walks, repeat_cycle  # noqa: E402
-from generation.features import (  # noqa: E402
+from generation.core.features import (  # noqa: E402
     detect_foot_contacts,
     foot_skate,
     gait_affective_features,
@@ -27,11 +25,13 @@ from generation.features import (  # noqa: E402
     movement_features,
     np_gait_affective_features,
 )
-from generation.ik import fit_positions_to_skeleton, inverse_kinematics  # noqa: E402
-from generation.kinematics import np_forward_kinematics  # noqa: E402
-from generation.motion import Motion  # noqa: E402
-from generation.quaternion import np_qfrom_axis_angle, np_qnormalize  # noqa: E402
-from generation.skeleton import gait_skeleton, gesture_skeleton  # noqa: E402
+from generation.core.ik import fit_positions_to_skeleton, inverse_kinematics  # noqa: E402
+from generation.core.kinematics import np_forward_kinematics  # noqa: E402
+from generation.core.motion import Motion  # noqa: E402
+from generation.core.quaternion import np_qfrom_axis_angle, np_qnormalize  # noqa: E402
+from generation.core.skeleton import gait_skeleton, gesture_skeleton  # noqa: E402
+from generation.formats.bvh import read_bvh, write_bvh  # noqa: E402
+from generation.formats.captured import captured_walks, repeat_cycle  # noqa: E402
 
 torch.set_num_threads(1)
 

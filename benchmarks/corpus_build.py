@@ -4,7 +4,7 @@ Measures
 1. the time to build (and save) the gait corpus on one core;
 2. foot skate of procedural walks: (a) with the generator's ground-truth contact labels over
    pure emotions x path kinds, (b) with contacts detected from positions by
-   ``generation.features.detect_foot_contacts`` over every corpus sequence;
+   ``generation.core.features.detect_foot_contacts`` over every corpus sequence;
 3. mean gait affective features (seed 000, 18) per pure emotion, with walking speed;
 4. gesture traits vs NRC-VAD on the demo gesture corpus (wrist speed vs arousal, hand spread vs
    dominance, Pearson r).
@@ -28,17 +28,17 @@ import numpy as np  # noqa: E402
 import torch  # noqa: E402
 from scipy.stats import pearsonr  # noqa: E402
 
-from generation import paths  # noqa: E402
-from generation.corpus import build_gait_corpus, build_gesture_corpus, default_gesture_specs  # noqa: E402
-from generation.emotion import GAIT_EMOTIONS, gait_params_for_emotion  # noqa: E402
-from generation.features import (  # noqa: E402
+from generation.core import paths
+from generation.core.features import (  # noqa: E402
     GAIT_FEATURE_NAMES,
     foot_skate,
     np_gait_affective_features,
     np_gesture_affective_features,
 )
-from generation.kinematics import np_forward_kinematics  # noqa: E402
-from generation.procedural_walk import planted_foot_slide, walk_with_contacts  # noqa: E402
+from generation.core.kinematics import np_forward_kinematics  # noqa: E402
+from generation.procedural.corpus import build_gait_corpus, build_gesture_corpus, default_gesture_specs  # noqa: E402
+from generation.procedural.emotion import GAIT_EMOTIONS, gait_params_for_emotion  # noqa: E402
+from generation.procedural.walk import planted_foot_slide, walk_with_contacts  # noqa: E402
 
 torch.set_num_threads(1)
 MACHINE = "2-core CI VM, no GPU"
@@ -117,7 +117,7 @@ def main(argv=None):
     out.append(f"| detected (`features.detect_foot_contacts`, lowest foot joint) | corpus, all kinds | {N} | "
                f"{np.mean(det_mean):.2f} | {np.max(det_max):.2f} |")
     try:
-        from generation.captured import captured_walks
+        from generation.formats.captured import captured_walks
         cap = []
         for m in captured_walks():
             fs = foot_skate(m.positions(), m.fps, m.skeleton)

@@ -23,10 +23,10 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 import torch  # noqa: E402
 
-from generation import paths  # noqa: E402
-from generation.emotion import GAIT_EMOTIONS, NRC_VAD, gait_params_for_emotion, gesture_params_for_vad  # noqa: E402
-from generation.procedural_gesture import seated_gesture  # noqa: E402
-from generation.procedural_walk import walk, walk_with_contacts  # noqa: E402
+from generation.core import paths
+from generation.procedural.emotion import GAIT_EMOTIONS, NRC_VAD, gait_params_for_emotion, gesture_params_for_vad  # noqa: E402
+from generation.procedural.gesture import seated_gesture  # noqa: E402
+from generation.procedural.walk import walk, walk_with_contacts  # noqa: E402
 
 torch.set_num_threads(1)
 

@@ -5,10 +5,10 @@ import numpy as np
 import pytest
 import torch
 
-from generation.bvh import default_joint_map, read_bvh, retarget, write_bvh
-from generation.motion import Motion, MotionFormatError
-from generation.quaternion import np_qangle, np_qfrom_axis_angle, np_qnormalize
-from generation.skeleton import Skeleton, gait_skeleton, gesture_skeleton
+from generation.core.motion import Motion, MotionFormatError
+from generation.core.quaternion import np_qangle, np_qfrom_axis_angle, np_qnormalize
+from generation.core.skeleton import Skeleton, gait_skeleton, gesture_skeleton
+from generation.formats.bvh import default_joint_map, read_bvh, retarget, write_bvh
 
 torch.set_num_threads(1)
 

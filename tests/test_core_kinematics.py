@@ -5,10 +5,10 @@ import numpy as np
 import pytest
 import torch
 
-from generation import quaternion as Q
-from generation.kinematics import forward_kinematics, np_forward_kinematics
-from generation.motion import Motion, MotionFormatError
-from generation.skeleton import gait_skeleton, gesture_skeleton
+from generation.core import quaternion as Q
+from generation.core.kinematics import forward_kinematics, np_forward_kinematics
+from generation.core.motion import Motion, MotionFormatError
+from generation.core.skeleton import gait_skeleton, gesture_skeleton
 
 
 def random_unit_quaternions(shape, seed=0):

@@ -4,7 +4,8 @@ import json
 import numpy as np
 import pytest
 
-from generation.corpus import (
+from generation.core.features import np_gait_affective_features
+from generation.procedural.corpus import (
     CorpusFormatError,
     GaitCorpus,
     GestureCorpus,
@@ -12,7 +13,7 @@ from generation.corpus import (
     build_gesture_corpus,
     sample_true_emotions,
 )
-from generation.emotion import (
+from generation.procedural.emotion import (
     GAIT_EMOTIONS,
     GESTURE_EMOTIONS,
     NRC_VAD,
@@ -22,7 +23,6 @@ from generation.emotion import (
     normalize_emotion,
     simulate_annotators,
 )
-from generation.features import np_gait_affective_features
 
 
 @pytest.fixture(scope="module")
@@ -217,7 +217,7 @@ def test_build_corpus_command(tmp_path):
 
 
 def test_module_entry_point(tmp_path, capsys):
-    from generation.corpus import main
+    from generation.procedural.corpus import main
 
     assert main(["--out", str(tmp_path), "--num", "5", "--frames", "16"]) == 0
     assert "split" in capsys.readouterr().out

@@ -8,11 +8,11 @@ import pytest
 import torch
 from scipy.spatial.transform import Rotation
 
-from generation.captured import WALK_FILES, captured_walks, load_captured_walk, repeat_cycle
-from generation.deepmimic import DATA_DIR, deepmimic_skeleton, read_deepmimic
-from generation.features import detect_foot_contacts, foot_skate, movement_features, np_gait_affective_features
-from generation.motion import MotionFormatError
-from generation.skeleton import GAIT_JOINTS
+from generation.core.features import detect_foot_contacts, foot_skate, movement_features, np_gait_affective_features
+from generation.core.motion import MotionFormatError
+from generation.core.skeleton import GAIT_JOINTS
+from generation.formats.captured import WALK_FILES, captured_walks, load_captured_walk, repeat_cycle
+from generation.formats.deepmimic import DATA_DIR, deepmimic_skeleton, read_deepmimic
 
 torch.set_num_threads(1)
 

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 import torch
 
-from generation.features import (
+from generation.core.features import (
     GAIT_FEATURE_NAMES,
     GESTURE_FEATURE_NAMES,
     detect_foot_contacts,
@@ -18,9 +18,9 @@ from generation.features import (
     np_gait_affective_features,
     np_gesture_affective_features,
 )
-from generation.kinematics import np_forward_kinematics
-from generation.quaternion import np_qfrom_axis_angle, np_qnormalize
-from generation.skeleton import gait_skeleton, gesture_skeleton
+from generation.core.kinematics import np_forward_kinematics
+from generation.core.quaternion import np_qfrom_axis_angle, np_qnormalize
+from generation.core.skeleton import gait_skeleton, gesture_skeleton
 
 torch.set_num_threads(1)
 

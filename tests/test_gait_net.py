@@ -7,6 +7,8 @@ import numpy as np
 import pytest
 import torch
 
+from generation.core.motion import Motion
+from generation.core.paths import curved, sharp_turn, straight
 from generation.gait.config import GaitNetConfig
 from generation.gait.data import Normalizer, from_heading_frame, prepare_sequences, root_features, to_heading_frame
 from generation.gait.generate import (
@@ -29,9 +31,7 @@ from generation.gait.train import (
     splice_histories,
     train,
 )
-from generation.motion import Motion
-from generation.paths import curved, sharp_turn, straight
-from generation.procedural_walk import WalkParams, walk
+from generation.procedural.walk import WalkParams, walk
 
 torch.set_num_threads(1)
 
@@ -228,7 +228,7 @@ def test_generation_rejects_short_seed_and_bad_emotions(tiny_net):
 
 
 def test_generated_motion_exports_to_bvh(tiny_net, tmp_path):
-    bvh = pytest.importorskip("generation.bvh")
+    bvh = pytest.importorskip("generation.formats.bvh")
     seed = walk(WalkParams(), straight(10.0), 80, 30.0)
     (m,) = generate_gaits([seed], [straight(10.0)], np.array([[0, 0, 0, 1.0]]), steps=8, model=tiny_net)
     bvh.write_bvh(m, tmp_path / "g.bvh")

@@ -8,7 +8,7 @@ import pytest
 import yaml
 from django.core.management import CommandError, call_command
 
-from generation.catalogue import CLIP_COLUMNS, check_catalogue, read_clips_csv
+from generation.plans.catalogue import CLIP_COLUMNS, check_catalogue, read_clips_csv
 
 TINY_RENDER = {"width": 160, "height": 120, "fps": 10, "duration_s": 1.0}
 CLIPS = [
@@ -136,7 +136,7 @@ def test_two_workers(media, tmp_path):
 
 @pytest.mark.django_db
 def test_unavailable_generator_fails_only_its_entries(media, tmp_path, monkeypatch):
-    import generation.clipgen as clipgen
+    import generation.plans.clipgen as clipgen
 
     missing = tmp_path / "no_such_weights.pt"
     monkeypatch.setitem(clipgen.GENERATOR_WEIGHTS, "gesture_net", missing)

@@ -8,11 +8,11 @@ import numpy as np
 import pytest
 import torch
 
+from generation.core.quaternion import qfrom_axis_angle, qnormalize
+from generation.core.skeleton import GESTURE_PARENTS, gesture_skeleton
 from generation.gesture import config
 from generation.gesture.losses import LossWeights, affective_loss, angle_loss, pose_loss, total_loss
 from generation.gesture.model import GestureNet, GestureNetConfig, window_mask
-from generation.quaternion import qfrom_axis_angle, qnormalize
-from generation.skeleton import GESTURE_PARENTS, gesture_skeleton
 
 J = 23
 
@@ -193,7 +193,7 @@ def test_angle_loss_derivative_term_penalises_jitter():
     const = qfrom_axis_angle(axis, torch.full((B, T, J), 0.1))
     sign = torch.tensor([1.0 if t % 2 == 0 else -1.0 for t in range(T)])[None, :, None].expand(B, T, J)
     jitter = qfrom_axis_angle(axis, 0.1 * sign)
-    from generation.quaternion import qmul
+    from generation.core.quaternion import qmul
 
     assert angle_loss(qmul(target, jitter), target, mask) > 2 * angle_loss(qmul(target, const), target, mask)
 
@@ -225,7 +225,7 @@ def test_tiny_network_overfits_a_tiny_batch():
     # no residual: the network has to produce the poses itself
     net = GestureNet(GestureNetConfig(d_model=32, d_ff=64, dropout=0.0, residual="none"))
     tokens, token_mask, attrs, _, positions, progress = _inputs(B=B, T=T)
-    from generation.procedural_gesture import GestureParams, seated_gesture
+    from generation.procedural.gesture import GestureParams, seated_gesture
 
     target = torch.stack([torch.as_tensor(seated_gesture(GestureParams(kind=k, speed=1.5), T, 10.0, seed=s).rotations,
                                           dtype=torch.float32) for s, k in enumerate(("beat", "descriptive"))])
@@ -298,9 +298,9 @@ def test_shipped_weights_are_small_and_load(shipped):
 
 
 def test_generation_starts_and_ends_at_rest_and_follows_the_sentence(shipped):
+    from generation.core.quaternion import np_qangle
     from generation.gesture.data import rest_rotations
     from generation.gesture.generate import generate_gesture
-    from generation.quaternion import np_qangle
 
     short = generate_gesture("Hello there.", emotion="joyous", model=shipped, fps=30.0)
     long = generate_gesture("I walked all the way from the station to the old church on the hill in the rain.",
@@ -336,7 +336,7 @@ def test_generation_rejects_unknown_emotion_and_task(shipped):
 
 
 def test_generated_gesture_exports_to_bvh(shipped, tmp_path):
-    bvh = pytest.importorskip("generation.bvh")
+    bvh = pytest.importorskip("generation.formats.bvh")
     from generation.gesture.generate import generate_gesture
 
     m = generate_gesture("Look at that!", emotion="surprised", model=shipped, fps=30.0)
@@ -371,7 +371,7 @@ def test_training_writes_weights_and_resumes(tmp_path):
 
 def test_shipped_network_expands_for_dominant_emotions(shipped):
     """Seed 003 section 4.3: high dominance (proud) -> spread arms; low dominance (sad) -> arms close to the body."""
-    from generation.features import np_gesture_affective_features
+    from generation.core.features import np_gesture_affective_features
     from generation.gesture.generate import generate_gesture
 
     spread = {}

@@ -5,11 +5,11 @@ import numpy as np
 import pytest
 import torch
 
-from generation.ik import fit_positions_to_skeleton, inverse_kinematics, matrix_to_quaternion, two_bone_ik
-from generation.kinematics import np_forward_kinematics
-from generation.motion import MotionFormatError
-from generation.quaternion import np_qangle, np_qnormalize, np_qto_matrix
-from generation.skeleton import gait_skeleton, gesture_skeleton
+from generation.core.ik import fit_positions_to_skeleton, inverse_kinematics, matrix_to_quaternion, two_bone_ik
+from generation.core.kinematics import np_forward_kinematics
+from generation.core.motion import MotionFormatError
+from generation.core.quaternion import np_qangle, np_qnormalize, np_qto_matrix
+from generation.core.skeleton import gait_skeleton, gesture_skeleton
 
 torch.set_num_threads(1)
 
@@ -43,7 +43,7 @@ def test_ik_keeps_twist_continuous_on_smooth_motion():
     # smooth arm and spine motion from slowly varying local rotations
     axis = np.stack([np.sin(t), np.cos(t), 0.3 + 0 * t], -1)
     angle = 0.8 * np.sin(t)
-    from generation.quaternion import np_qfrom_axis_angle
+    from generation.core.quaternion import np_qfrom_axis_angle
     q = np.tile([1.0, 0, 0, 0], (T, sk.num_joints, 1))
     for j in range(1, sk.num_joints):
         q[:, j] = np_qfrom_axis_angle(axis, angle * (0.5 + 0.1 * (j % 5)))

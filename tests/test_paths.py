@@ -2,8 +2,8 @@
 import numpy as np
 import pytest
 
-from generation import paths
-from generation.paths import GroundPath
+from generation.core import paths
+from generation.core.paths import GroundPath
 
 
 def test_straight_length_points_and_heading():

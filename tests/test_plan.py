@@ -5,7 +5,7 @@ import json
 
 import pytest
 
-from generation.plan import PlanError, builtin_plans, clip_hash, intent_fields, load_plan, validate_plan
+from generation.plans.schema import PlanError, builtin_plans, clip_hash, intent_fields, load_plan, validate_plan
 
 
 def _plan(*clips, render=None):
@@ -162,10 +162,10 @@ def test_builtin_plans_cover_the_papers():
 
 
 def test_generator_version_follows_the_generator_code():
-    from generation import clipgen
+    from generation.plans import clipgen
 
     rbf = {p.name for p in clipgen.source_files("rbf")}
-    assert {"stylise.py", "rbf.py", "themes.py", "neutral_base.py", "motion.py", "clipgen.py"} <= rbf
+    assert {"stylise.py", "basis.py", "themes.py", "neutral_base.py", "motion.py", "clipgen.py"} <= rbf
     captured = {p.name for p in clipgen.source_files("captured")}
     assert "deepmimic.py" in captured and "stylise.py" not in captured
     assert "humanoid3d_walk.txt" in captured  # data files count too

@@ -4,11 +4,11 @@ import dataclasses
 import numpy as np
 import pytest
 
-from generation.emotion import gesture_params_for_vad
-from generation.kinematics import np_forward_kinematics
-from generation.procedural_gesture import GestureParams, seat_height, seated_gesture, seated_rest_pose
-from generation.quaternion import np_qangle
-from generation.skeleton import gait_skeleton, gesture_skeleton
+from generation.core.kinematics import np_forward_kinematics
+from generation.core.quaternion import np_qangle
+from generation.core.skeleton import gait_skeleton, gesture_skeleton
+from generation.procedural.emotion import gesture_params_for_vad
+from generation.procedural.gesture import GestureParams, seat_height, seated_gesture, seated_rest_pose
 
 J = {n: i for i, n in enumerate(gesture_skeleton().joints)}
 

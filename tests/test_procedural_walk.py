@@ -4,11 +4,11 @@ import dataclasses
 import numpy as np
 import pytest
 
-from generation import paths
-from generation.features import foot_skate
-from generation.procedural_walk import WalkParams, planted_foot_slide, walk, walk_with_contacts
-from generation.quaternion import np_qrot
-from generation.skeleton import gait_skeleton, gesture_skeleton
+from generation.core import paths
+from generation.core.features import foot_skate
+from generation.core.quaternion import np_qrot
+from generation.core.skeleton import gait_skeleton, gesture_skeleton
+from generation.procedural.walk import WalkParams, planted_foot_slide, walk, walk_with_contacts
 
 PATHS = {
     "straight": lambda: paths.straight(15.0),

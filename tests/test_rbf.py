@@ -4,8 +4,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from generation import rbf as R
-from generation.themes import AXES, BODY_PARTS, TABLE_III, THEME_NAMES, THEMES, Feature, theme_features
+from generation.rbf import basis as R
+from generation.rbf.themes import AXES, BODY_PARTS, TABLE_III, THEME_NAMES, THEMES, Feature, theme_features
 
 
 # ---- equations 3-5 ------------------------------------------------------------------------------------

@@ -4,12 +4,12 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from generation.motion import Motion
+from generation.core.motion import Motion
+from generation.core.skeleton import gait_skeleton, gesture_skeleton
 from generation.render import RenderSettings, RenderSettingsError, contact_sheet, render_clip, render_frames
 from generation.render.camera import fit_distance, fixed_camera, view_offset
 from generation.render.encode import probe_video
 from generation.render.scene import LEFT_COLOUR, RIGHT_COLOUR, bone_matrices
-from generation.skeleton import gait_skeleton, gesture_skeleton
 
 TINY = RenderSettings(width=160, height=120, fps=10, duration_s=1.0)
 

@@ -15,7 +15,7 @@ PAIRS = [("demo", "demo"), ("gait_ismar2020", "seed000"), ("gestures_ieeevr2021"
 
 
 def catalogue_plan(name: str) -> int:
-    plan_mod = pytest.importorskip("generation.plan")
+    plan_mod = pytest.importorskip("generation.plans.schema")
     batch = pytest.importorskip("generation.render.batch")
     plan = plan_mod.load_plan(name)
     jobs, failures = batch.plan_jobs(plan)

@@ -4,8 +4,11 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from generation.motion import Motion
-from generation.neutral_base import (
+from generation.core.motion import Motion
+from generation.core.quaternion import np_qfrom_axis_angle, np_qrot
+from generation.core.skeleton import gait_skeleton
+from generation.rbf.basis import mirrored
+from generation.rbf.neutral_base import (
     MAX_JOINT_SPEED_M_S,
     average_cycles,
     cut_cycles,
@@ -14,10 +17,7 @@ from generation.neutral_base import (
     normalise_cycle,
     warp_times,
 )
-from generation.quaternion import np_qfrom_axis_angle, np_qrot
-from generation.rbf import mirrored
-from generation.skeleton import gait_skeleton
-from generation.stylise import (
+from generation.rbf.stylise import (
     _horn_rotation,
     bone_length_error,
     fit_to_skeleton,
@@ -26,7 +26,7 @@ from generation.stylise import (
     theme_rbfs,
     walker_frame_positions,
 )
-from generation.themes import THEME_NAMES, THEMES
+from generation.rbf.themes import THEME_NAMES, THEMES
 
 pytestmark = pytest.mark.filterwarnings("ignore:The given NumPy array is not writable")
 
@@ -104,7 +104,7 @@ def test_normalise_and_average_remove_body_size():
 
 def test_neutral_base_from_the_captured_walk():
     """Real data path: the DeepMimic straight walks (turns left out), loop repeated but counted once."""
-    from generation.neutral_base import captured_sources
+    from generation.rbf.neutral_base import captured_sources
 
     sources = captured_sources()
     assert sources and all("turn" not in mo.metadata["source"] for mo in sources)
@@ -119,17 +119,17 @@ def test_neutral_base_from_the_captured_walk():
 
 def _procedural_walk_glitch() -> float:
     """Fastest joint speed (m/s) in a 2 s procedural neutral walk at 100 fps (walking peaks near 6 m/s)."""
-    from generation.procedural_walk import WalkParams, walk
+    from generation.procedural.walk import WalkParams, walk
 
     p = walk(WalkParams.neutral(), None, 200, 100.0).positions()
     return float(np.linalg.norm(np.diff(p, axis=0), axis=-1).max() * 100.0)
 
 
 def test_neutral_base_from_procedural_walks():
-    """Integration with generation.procedural_walk: several body sizes averaged into one periodic cycle."""
+    """Integration with generation.procedural.walk: several body sizes averaged into one periodic cycle."""
     fastest = _procedural_walk_glitch()
     if fastest > MAX_JOINT_SPEED_M_S:
-        pytest.xfail(f"generation.procedural_walk: a joint moves {fastest:.1f} m/s between two frames (a knee jumps "
+        pytest.xfail(f"generation.procedural.walk: a joint moves {fastest:.1f} m/s between two frames (a knee jumps "
                      "about 13 cm in one frame each cycle), so neutral_base rejects every procedural cycle")
     neutral = neutral_cycle_from_motions(default_sources(include_captured=False))
     meta = neutral.metadata
@@ -148,7 +148,7 @@ def test_neutral_base_from_procedural_walks():
 
 
 def test_neutral_base_rejects_other_skeletons():
-    from generation.skeleton import gesture_skeleton
+    from generation.core.skeleton import gesture_skeleton
 
     J = gesture_skeleton().num_joints
     motion = Motion(gesture_skeleton(), np.tile([1.0, 0, 0, 0], (40, J, 1)), np.zeros((40, 3)), 30.0)
@@ -280,7 +280,7 @@ def test_speed_warps_time_uniformly_and_walks_forward(neutral):
 
 
 def test_neutral_walk_equals_weight_zero(neutral):
-    from generation.stylise import neutral_walk
+    from generation.rbf.stylise import neutral_walk
 
     base = neutral_walk(neutral, speed=1.1, n_cycles=3)
     zero = stylise(neutral, "sad", 0.0, 10, speed=1.1, n_cycles=3)

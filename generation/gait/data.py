@@ -11,11 +11,11 @@ section 5.1). Per step we compute, on the ground plane (x, z; y-up):
   step, metres per step), delta (signed angle from the root's facing direction to its travel direction
   x_t - x_{t-1}; the paper's unsigned delta is its absolute value; the sign lets generation place the root).
 - stepping features: theta (stepping phase: 0 at left foot contact, pi at right foot contact, linear in
-  between; from ``generation.features``), omega (theta_t - theta_{t-1} modulo 2 pi), s-bar (causal
+  between; from ``generation.core.features``), omega (theta_t - theta_{t-1} modulo 2 pi), s-bar (causal
   exponential low-pass of s, so that generation can compute it the same way), kappa (norm of the change of
   the low-pass tangent s-bar * (sin ref, cos ref) between steps: the curvature term of section 3.2.4 on
   the smoothed trajectory).
-- the 18 pose affective features a_t (``generation.features.gait_affective_features``).
+- the 18 pose affective features a_t (``generation.core.features.gait_affective_features``).
 """
 from __future__ import annotations
 
@@ -26,9 +26,9 @@ from pathlib import Path
 import numpy as np
 import torch
 
-from ..kinematics import forward_kinematics, np_forward_kinematics
-from ..quaternion import np_qfix, np_qmul, np_qrot, qmul
-from ..skeleton import GAIT_PARENTS, gait_skeleton
+from generation.core.kinematics import forward_kinematics, np_forward_kinematics
+from generation.core.quaternion import np_qfix, np_qmul, np_qrot, qmul
+from generation.core.skeleton import GAIT_PARENTS, gait_skeleton
 
 DEFAULT_CORPUS = Path("var/corpus/gait_corpus_synthetic.npz")
 SBAR_ALPHA = 0.3      # low-pass coefficient of s-bar per network step
@@ -123,14 +123,14 @@ def heading_frame_positions(q: torch.Tensor, root_y: torch.Tensor, offsets: torc
 
 
 def affective_features(positions: torch.Tensor) -> torch.Tensor:
-    """The 18 pose affective features (..., 18) of positions (..., 21, 3) (``generation.features``)."""
-    from ..features import gait_affective_features  # another helper's module; imported when used
+    """The 18 pose affective features (..., 18) of positions (..., 21, 3) (``generation.core.features``)."""
+    from generation.core.features import gait_affective_features  # another helper's module; imported when used
     return gait_affective_features(positions)
 
 
 def step_phase(positions_30: np.ndarray, fps: float, skeleton) -> np.ndarray:
-    """Stepping phase theta (..., T) in [0, 2 pi) of (..., T, J, 3) positions (``generation.features``)."""
-    from ..features import movement_features
+    """Stepping phase theta (..., T) in [0, 2 pi) of (..., T, J, 3) positions (``generation.core.features``)."""
+    from generation.core.features import movement_features
     return np.remainder(np.asarray(movement_features(positions_30, fps, skeleton)["step_phase"]), 2 * np.pi)
 
 
@@ -334,7 +334,7 @@ def load_corpus_sequences(path: str | Path | None = None, num_sequences: int = 1
                           frame_step: int = 4, seq_len: int = 60, offsets: tuple[int, ...] = (0,)) -> GaitSequences:
     """Load (or build and save, when missing) the synthetic gait corpus and prepare network sequences
     (one row per corpus sequence and subsampling offset)."""
-    from ..corpus import GaitCorpus, build_gait_corpus  # another helper's module
+    from generation.procedural.corpus import GaitCorpus, build_gait_corpus  # another helper's module
     path = Path(path) if path is not None else DEFAULT_CORPUS
     if path.exists():
         corpus = GaitCorpus.load(path)

@@ -21,9 +21,10 @@ from pathlib import Path
 import numpy as np
 import torch
 
-from ..motion import Motion
-from ..paths import GroundPath, straight
-from ..skeleton import Skeleton
+from generation.core.motion import Motion
+from generation.core.paths import GroundPath, straight
+from generation.core.skeleton import Skeleton
+
 from .data import (
     SBAR_ALPHA,
     Normalizer,
@@ -108,9 +109,9 @@ def _seed_motion(seed, emotion0: np.ndarray, n_frames: int, rng: np.random.Gener
     """A Motion from a seed given as Motion, WalkParams, a params dict, or None (procedural seed)."""
     if isinstance(seed, Motion):
         return seed
-    from ..procedural_walk import WalkParams, walk
+    from generation.procedural.walk import WalkParams, walk
     if seed is None:
-        from ..emotion import gait_params_for_emotion  # another helper's module
+        from generation.procedural.emotion import gait_params_for_emotion  # another helper's module
         params = gait_params_for_emotion(emotion0, rng)
     elif isinstance(seed, WalkParams):
         params = seed
@@ -185,7 +186,8 @@ def generate_gaits(seeds, paths: list[GroundPath], emotions, steps: int = 200, f
     Args:
         seeds: list of N seed gaits: a :class:`Motion` on the 21-joint skeleton with at least 18 network steps
             (69 frames at 30 fps, any frame rate is resampled), a ``WalkParams`` / params dict (a procedural
-            seed walk is made), or None (procedural seed from ``generation.emotion.gait_params_for_emotion``).
+            seed walk is made), or None (procedural seed from
+            ``generation.procedural.emotion.gait_params_for_emotion``).
         paths: N desired ground paths; the seed is moved and turned rigidly so that its last frame stands at
             the path start facing the path.
         emotions: (N, 4) constant emotion per agent, or (N, steps, 4) per step (e.g. from
@@ -311,7 +313,7 @@ def generate_gaits(seeds, paths: list[GroundPath], emotions, steps: int = 200, f
 
 def wrap_quaternions(q: np.ndarray) -> np.ndarray:
     """Unit-normalise and make sign-continuous along time (T, J, 4)."""
-    from ..quaternion import np_qfix, np_qnormalize
+    from generation.core.quaternion import np_qfix, np_qnormalize
     return np_qfix(np_qnormalize(q))
 
 

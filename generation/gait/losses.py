@@ -13,7 +13,8 @@ import math
 
 import torch
 
-from ..quaternion import qeuler
+from generation.core.quaternion import qeuler
+
 from .config import GaitNetConfig
 
 FOOT_JOINTS = (3, 4, 7, 8)  # left heel, left toe, right heel, right toe (gait skeleton)

@@ -3,7 +3,7 @@
 Seed 003 trains on the MPI Emotional Body Expressions database (captured motion, 1,447 sequences), which is not
 available offline. In its place, each sentence of ``generation/data/sentences_synthetic.csv`` (330 sentences
 written for this project: 11 MPI emotions x 15 narration + 15 conversation lines) is paired with procedural
-seated gestures from :func:`generation.procedural_gesture.seated_gesture`, whose affective traits follow the
+seated gestures from :func:`generation.procedural.gesture.seated_gesture`, whose affective traits follow the
 intended emotion's arousal (speed) and dominance (expansion) as in seed 003 section 4.3. The gesture lasts as long
 as the sentence takes to say (:func:`generation.gesture.config.gesture_seconds`), starts and ends at the seated
 rest pose, is performed by a female or male body (``gesture_skeleton(build=gender)``) and leads with the dominant
@@ -23,9 +23,10 @@ from pathlib import Path
 import numpy as np
 import torch
 
-from ..motion import Motion
-from ..quaternion import np_qfix, np_qnormalize
-from ..skeleton import gesture_skeleton
+from generation.core.motion import Motion
+from generation.core.quaternion import np_qfix, np_qnormalize
+from generation.core.skeleton import gesture_skeleton
+
 from . import config
 from .text import EMBED_DIM, cached_encodings, count_words
 
@@ -47,7 +48,7 @@ class SentenceRow:
 
 def nrc_vad(emotion: str) -> tuple[float, float, float]:
     """(valence, arousal, dominance) in [0, 1] of an emotion word from the NRC-VAD table (Mohammad, ACL 2018)."""
-    from ..emotion import NRC_VAD
+    from generation.procedural.emotion import NRC_VAD
 
     key = emotion.strip().lower()
     if key not in NRC_VAD:
@@ -58,7 +59,7 @@ def nrc_vad(emotion: str) -> tuple[float, float, float]:
 
 def load_sentences(path: str | Path = config.SENTENCES_CSV) -> list[SentenceRow]:
     """Rows of the sentence corpus CSV (columns sentence_id, emotion, task, sentence)."""
-    from ..emotion import NRC_VAD
+    from generation.procedural.emotion import NRC_VAD
 
     path = Path(path)
     if not path.is_file():
@@ -122,7 +123,7 @@ def split_sentences(rows: list[SentenceRow], seed: int = 0) -> dict[str, str]:
 
 def rest_rotations(gender: str) -> tuple[np.ndarray, np.ndarray]:
     """Seated rest (start- and end-of-sequence) pose of the gender's body: (23, 4) rotations, (3,) root metres."""
-    from ..procedural_gesture import seated_rest_pose
+    from generation.procedural.gesture import seated_rest_pose
 
     rot, root = seated_rest_pose(gesture_skeleton(build=gender))
     return np.asarray(rot, dtype=np.float64), np.asarray(root, dtype=np.float64)
@@ -168,8 +169,8 @@ def procedural_gesture(row: SentenceRow, gender: str, handedness: str, seed: int
     The procedural generator's own random details (beat phase, pointing aim) use one fixed seed: nothing in the
     text or the attributes could predict them, so a random draw per example would only add unlearnable noise.
     """
-    from ..emotion import gesture_params_for_vad
-    from ..procedural_gesture import seated_gesture
+    from generation.procedural.emotion import gesture_params_for_vad
+    from generation.procedural.gesture import seated_gesture
 
     v, a, d = nrc_vad(row.emotion)
     rng = np.random.default_rng(seed)

@@ -14,9 +14,10 @@ from pathlib import Path
 import numpy as np
 import torch
 
-from ..motion import Motion
-from ..quaternion import qslerp
-from ..skeleton import gesture_skeleton
+from generation.core.motion import Motion
+from generation.core.quaternion import qslerp
+from generation.core.skeleton import gesture_skeleton
+
 from . import config
 from .data import SYNTHETIC_LABEL, attribute_vector, nrc_vad, progress_features, rest_rotations
 from .model import GestureNet, GestureNetConfig

@@ -11,8 +11,8 @@ from dataclasses import dataclass
 
 import torch
 
-from ..kinematics import forward_kinematics
-from ..quaternion import qeuler
+from generation.core.kinematics import forward_kinematics
+from generation.core.quaternion import qeuler
 
 EULER_ORDER = "zyx"
 
@@ -68,7 +68,7 @@ def pose_loss(pred: torch.Tensor, target: torch.Tensor, mask: torch.Tensor, offs
 def affective_loss(pred: torch.Tensor, target: torch.Tensor, mask: torch.Tensor, offsets: torch.Tensor,
                    parents) -> torch.Tensor:
     """Eq. 10: squared distance between the 15 gesture affective features of predicted and true poses."""
-    from ..features import gesture_affective_features
+    from generation.core.features import gesture_affective_features
 
     a_pred = gesture_affective_features(_positions(pred, offsets, parents))
     a_true = gesture_affective_features(_positions(target, offsets, parents))

@@ -3,9 +3,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..kinematics import np_forward_kinematics
-from ..quaternion import np_qangle, np_qnormalize
-from ..skeleton import gesture_skeleton
+from generation.core.kinematics import np_forward_kinematics
+from generation.core.quaternion import np_qangle, np_qnormalize
+from generation.core.skeleton import gesture_skeleton
 
 # neck, head, shoulders, elbows, wrists: the 8 upper-body joints seed 003 compares Yoon et al. on
 UPPER_BODY = (5, 6, 8, 9, 10, 12, 13, 14)

@@ -23,7 +23,8 @@ from pathlib import Path
 import numpy as np
 import torch
 
-from ..skeleton import GESTURE_PARENTS
+from generation.core.skeleton import GESTURE_PARENTS
+
 from . import config
 from .data import SYNTHETIC_LABEL, GestureDataset, build_dataset
 from .generate import decode_examples

@@ -22,7 +22,8 @@ from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from ..plan import ClipEntry, Plan, clip_hash, intent_fields
+from generation.plans.schema import ClipEntry, Plan, clip_hash, intent_fields
+
 from .clip import clip_files_complete, render_clip
 
 RECORD_VERSION = 1
@@ -50,7 +51,7 @@ class BatchResult:
 
 def plan_jobs(plan: Plan, limit: int | None = None) -> tuple[list[Job], list[tuple[str, str]]]:
     """Jobs for the plan's entries (first ``limit``), and (entry, message) for entries that cannot run."""
-    from ..clipgen import ClipGenerationError, generator_version, resolve
+    from generation.plans.clipgen import ClipGenerationError, generator_version, resolve
 
     jobs, failures = [], []
     for entry in plan.entries[:limit] if limit else plan.entries:
@@ -145,7 +146,7 @@ def _init_worker(progress_queue, threads: int, parent_pid: int | None = None) ->
 
 def render_job(job: Job, record: dict, clips_dir: str, records_dir: str) -> dict:
     """Make the motion, render its files, write the record last. Runs in a worker (or inline)."""
-    from ..clipgen import make_motion
+    from generation.plans.clipgen import make_motion
 
     t0 = time.perf_counter()
     motion = make_motion(job.run_entry, requested=job.entry.generator, fallback_reason=job.fallback_reason)

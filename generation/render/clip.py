@@ -11,7 +11,8 @@ from pathlib import Path
 
 import numpy as np
 
-from ..motion import Motion
+from generation.core.motion import Motion
+
 from .camera import facing_direction, fixed_camera, tracking_cameras
 from .encode import VideoWriter, write_png_atomic
 from .scene import StickFigureScene, chair_boxes

@@ -10,7 +10,8 @@ import os
 
 import numpy as np
 
-from ..skeleton import Skeleton
+from generation.core.skeleton import Skeleton
+
 from .camera import CameraPose, project
 
 os.environ.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow")

@@ -1,6 +1,6 @@
 """Render settings: resolution, frame rate, duration, camera, anti-aliasing, codecs.
 
-Settings take part in every clip's content hash (see :mod:`generation.plan`), so a change of
+Settings take part in every clip's content hash (see :mod:`generation.plans.schema`), so a change of
 resolution or camera renders new files instead of silently reusing old ones.
 """
 from __future__ import annotations

@@ -1,14 +1,15 @@
-"""``manage.py build_corpus``: build the SYNTHETIC procedural training corpora (thin wrapper over generation.corpus)."""
+"""``manage.py build_corpus``: build the SYNTHETIC procedural training corpora (thin wrapper over
+``generation.procedural.corpus``)."""
 from __future__ import annotations
 
 from django.core.management.base import BaseCommand, CommandError
 
-from generation.corpus import DEFAULT_DIR, build_and_save
+from generation.procedural.corpus import DEFAULT_DIR, build_and_save
 
 
 class Command(BaseCommand):
     help = ("Build the synthetic (procedural, simulated-annotator) gait training corpus "
-            "var/corpus/gait_corpus_synthetic.npz; the same as `python -m generation.corpus`.")
+            "var/corpus/gait_corpus_synthetic.npz; the same as `python -m generation.procedural.corpus`.")
 
     def add_arguments(self, parser):
         parser.add_argument("--out", default=str(DEFAULT_DIR), help="output folder (default var/corpus)")

@@ -31,8 +31,8 @@ class Command(BaseCommand):
         parser.add_argument("--no-progress", action="store_true", help="no progress bars")
 
     def handle(self, *args, **opts):
-        from generation.catalogue import write_clips_csv
-        from generation.plan import PlanError, load_plan
+        from generation.plans.catalogue import write_clips_csv
+        from generation.plans.schema import PlanError, load_plan
         from generation.render.batch import run_plan
 
         if opts["workers"] < 1:

@@ -11,14 +11,14 @@ Reading (:func:`read_bvh`):
 - units: ``scale`` multiplies file units into metres. ``scale=None`` guesses from the rest-pose height (vertical
   extent of the hierarchy): 0.5..3 -> metres (1), 50..300 -> centimetres (0.01), anything else is normalised to a
   1.7 m body; the guess is recorded in ``metadata["bvh_scale"]`` and ``metadata["bvh_scale_guess"]``.
-Malformed files raise :class:`~generation.motion.MotionFormatError` naming the file and line.
+Malformed files raise :class:`~generation.core.motion.MotionFormatError` naming the file and line.
 
 Writing (:func:`write_bvh`): root with 3 position + 3 rotation channels, other joints 3 rotation channels,
 skeleton leaves written as ``End Site`` (BVH leaves carry no name or rotation, so leaf names come back as
 ``<parent>_end``; positions are kept exactly). Readable by Blender's and Unity's importers.
 
 Retargeting (:func:`retarget`): source FK positions, scaled by the ratio of hip heights, are mapped by joint name
-onto the target and solved with :func:`generation.ik.solve_rotations`.
+onto the target and solved with :func:`generation.core.ik.solve_rotations`.
 """
 from __future__ import annotations
 
@@ -28,11 +28,11 @@ from pathlib import Path
 import numpy as np
 import torch
 
-from .ik import ik_report, solve_rotations, two_bone_ik
-from .kinematics import np_forward_kinematics
-from .motion import Motion, MotionFormatError
-from .quaternion import np_qfix, qeuler, qfrom_euler
-from .skeleton import Skeleton
+from generation.core.ik import ik_report, solve_rotations, two_bone_ik
+from generation.core.kinematics import np_forward_kinematics
+from generation.core.motion import Motion, MotionFormatError
+from generation.core.quaternion import np_qfix, qeuler, qfrom_euler
+from generation.core.skeleton import Skeleton
 
 _CHANNELS = ("Xposition", "Yposition", "Zposition", "Xrotation", "Yrotation", "Zrotation")
 

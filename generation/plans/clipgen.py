@@ -20,8 +20,9 @@ from pathlib import Path
 
 import numpy as np
 
-from .motion import Motion
-from .plan import ClipEntry
+from generation.core.motion import Motion
+
+from .schema import ClipEntry
 
 #: Declared generator versions. Clip hashes also carry a digest of each generator's source code and data
 #: (:func:`source_digest`) and of network weights, so code changes re-render by themselves; bump these to
@@ -37,15 +38,15 @@ GENERATOR_VERSIONS = {
 }
 #: Modules each generator needs (checked before rendering starts).
 GENERATOR_MODULES = {
-    "gait_net": ("generation.gait.generate", "generation.paths"),
-    "procedural_walk": ("generation.procedural_walk", "generation.emotion", "generation.paths"),
-    "captured": ("generation.captured",),
-    "neutral_walk": ("generation.neutral_base", "generation.stylise"),
-    "rbf": ("generation.neutral_base", "generation.stylise"),
+    "gait_net": ("generation.gait.generate", "generation.core.paths"),
+    "procedural_walk": ("generation.procedural.walk", "generation.procedural.emotion", "generation.core.paths"),
+    "captured": ("generation.formats.captured",),
+    "neutral_walk": ("generation.rbf.neutral_base", "generation.rbf.stylise"),
+    "rbf": ("generation.rbf.neutral_base", "generation.rbf.stylise"),
     "gesture_net": ("generation.gesture.generate",),
-    "procedural_gesture": ("generation.procedural_gesture", "generation.emotion"),
+    "procedural_gesture": ("generation.procedural.gesture", "generation.procedural.emotion"),
 }
-WEIGHTS_DIR = Path(__file__).resolve().parent / "data" / "weights"
+WEIGHTS_DIR = Path(__file__).resolve().parent.parent / "data" / "weights"
 #: Weights files of the network generators (shipped defaults).
 GENERATOR_WEIGHTS = {
     "gait_net": WEIGHTS_DIR / "gait_net_default.pt",
@@ -79,7 +80,9 @@ def _file_digest(path: str, size: int, mtime_ns: int) -> str:
     return h.hexdigest()[:12]
 
 
-PACKAGE_DIR = Path(__file__).resolve().parent
+PACKAGE_DIR = Path(__file__).resolve().parent.parent
+#: The shared study protocol (vocabularies); generators that import it depend on it too.
+PROTOCOL_MODULE = PACKAGE_DIR.parent / "study_protocol.py"
 
 
 def _imported_files(path: Path) -> set[Path]:
@@ -96,6 +99,9 @@ def _imported_files(path: Path) -> set[Path]:
             parts = node.module.split(".") if node.module else []
         elif node.module and node.module.split(".")[0] == "generation":
             base, parts = PACKAGE_DIR, node.module.split(".")[1:]
+        elif node.module == PROTOCOL_MODULE.stem:
+            out.add(PROTOCOL_MODULE)
+            continue
         else:
             continue
         target = base.joinpath(*parts)
@@ -130,7 +136,7 @@ def source_digest(generator: str) -> str:
     files = source_files(generator)
     h = hashlib.sha256()
     for f in files:
-        h.update(str(f.relative_to(PACKAGE_DIR)).encode())
+        h.update(str(f.relative_to(PACKAGE_DIR.parent)).encode())
         h.update(f.read_bytes())
     return h.hexdigest()[:12]
 
@@ -171,7 +177,7 @@ def fallback_entry(entry: ClipEntry) -> ClipEntry:
         inp = entry.inputs
         n_words = len(inp["sentence"].split())
         try:
-            from .gesture.config import gesture_seconds
+            from generation.gesture.config import gesture_seconds
 
             seconds = float(gesture_seconds(n_words))
         except Exception:  # noqa: BLE001 - the network's package may be the thing that is missing
@@ -185,7 +191,7 @@ def fallback_entry(entry: ClipEntry) -> ClipEntry:
 # ---- paths -------------------------------------------------------------------------------------
 def make_path(trajectory: dict):
     """A GroundPath from a normalised plan trajectory (metres; angles in degrees in the plan)."""
-    from . import paths
+    from generation.core import paths
 
     kind, length = trajectory["kind"], trajectory["length_m"]
     if kind == "straight":
@@ -197,7 +203,7 @@ def make_path(trajectory: dict):
 
 # ---- generators --------------------------------------------------------------------------------
 def _gait_net(entry: ClipEntry, fps: float) -> Motion:
-    from .gait.generate import emotion_transition, generate_gaits, load_default_model
+    from generation.gait.generate import emotion_transition, generate_gaits, load_default_model
 
     net = load_default_model()
     inp = entry.inputs
@@ -211,8 +217,8 @@ def _gait_net(entry: ClipEntry, fps: float) -> Motion:
 
 
 def _procedural_walk(entry: ClipEntry, fps: float) -> Motion:
-    from .emotion import gait_params_for_emotion
-    from .procedural_walk import walk
+    from generation.procedural.emotion import gait_params_for_emotion
+    from generation.procedural.walk import walk
 
     inp = entry.inputs
     rng = np.random.default_rng(entry.seed)
@@ -245,9 +251,9 @@ def transition_walk(a, b, path, n_frames: int, fps: float, seed: int | None = No
 
     Returns a Motion of ``n_frames`` frames at ``fps`` on the gait skeleton.
     """
-    from .paths import GroundPath
-    from .procedural_walk import walk
-    from .quaternion import np_qfix, np_qslerp
+    from generation.core.paths import GroundPath
+    from generation.core.quaternion import np_qfix, np_qslerp
+    from generation.procedural.walk import walk
 
     T = int(n_frames)
     weights = [0.0] + [(k + 1) / (n_blend + 1) for k in range(n_blend)] + [1.0]
@@ -291,13 +297,13 @@ def transition_walk(a, b, path, n_frames: int, fps: float, seed: int | None = No
         segments_meta.append({"blend": round(w, 4), "start_frame": start, "params": params.to_dict()})
     meta = {"origin": "procedural", "synthetic": True, "path_kind": path.kind, "transition_segments": segments_meta,
             "transition_method": "segmented procedural walk with cross-fades (clipgen.transition_walk)"}
-    from .skeleton import gait_skeleton
+    from generation.core.skeleton import gait_skeleton
 
     return Motion(gait_skeleton(), np_qfix(rot), root, fps, meta)
 
 
 def _captured(entry: ClipEntry, fps: float) -> Motion:
-    from .captured import WALK_FILES, captured_walks, repeat_cycle
+    from generation.formats.captured import WALK_FILES, captured_walks, repeat_cycle
 
     names = [name for name, _ in WALK_FILES]
     clip = entry.inputs["clip"]
@@ -311,13 +317,13 @@ def _captured(entry: ClipEntry, fps: float) -> Motion:
 
 @functools.lru_cache(maxsize=1)
 def _neutral_cycle() -> Motion:
-    from .neutral_base import neutral_cycle
+    from generation.rbf.neutral_base import neutral_cycle
 
     return neutral_cycle()
 
 
 def _neutral_walk(entry: ClipEntry, fps: float) -> Motion:
-    from .stylise import cycle_stride, repeat_cycle
+    from generation.rbf.stylise import cycle_stride, repeat_cycle
 
     base = _neutral_cycle()
     inp = entry.inputs
@@ -329,7 +335,7 @@ def _neutral_walk(entry: ClipEntry, fps: float) -> Motion:
 
 
 def _rbf(entry: ClipEntry, fps: float) -> Motion:
-    from .stylise import stylise
+    from generation.rbf.stylise import stylise
 
     inp = entry.inputs
     return stylise(_neutral_cycle(), inp["theme"], inp["weight"], inp["n_features"], speed=inp["speed"],
@@ -337,7 +343,7 @@ def _rbf(entry: ClipEntry, fps: float) -> Motion:
 
 
 def _gesture_net(entry: ClipEntry, fps: float) -> Motion:
-    from .gesture.generate import generate_gesture
+    from generation.gesture.generate import generate_gesture
 
     inp = entry.inputs
     return generate_gesture(inp["sentence"], inp["task"], inp["emotion_label"], inp["gender"], inp["handedness"],
@@ -345,9 +351,9 @@ def _gesture_net(entry: ClipEntry, fps: float) -> Motion:
 
 
 def _procedural_gesture(entry: ClipEntry, fps: float) -> Motion:
-    from .emotion import NRC_VAD, gesture_params_for_vad
-    from .procedural_gesture import seated_gesture
-    from .skeleton import gesture_skeleton
+    from generation.core.skeleton import gesture_skeleton
+    from generation.procedural.emotion import NRC_VAD, gesture_params_for_vad
+    from generation.procedural.gesture import seated_gesture
 
     inp = entry.inputs
     v, a, d = NRC_VAD[inp["emotion_label"]] if "emotion_label" in inp else inp["vad"]

@@ -17,11 +17,12 @@ from pathlib import Path
 
 import numpy as np
 
+from generation.core.motion import Motion
+from generation.core.quaternion import np_qfrom_axis_angle, np_qmul, np_qrot
+from generation.core.skeleton import REFERENCE_HEIGHT_M, Skeleton, gait_skeleton
+
 from .bvh import retarget
 from .deepmimic import DATA_DIR, read_deepmimic
-from .motion import Motion
-from .quaternion import np_qfrom_axis_angle, np_qmul, np_qrot
-from .skeleton import REFERENCE_HEIGHT_M, Skeleton, gait_skeleton
 
 #: (file, description). All are walks; the turn clips walk along a curve.
 WALK_FILES = (

@@ -4,11 +4,11 @@ Etemad & Arya cut 16 two-step neutral walks from HDM05, aligned them with correl
 warping into 100 frames and averaged them, so that no single actor's style survives (section III-C); the
 result was perceived as neutral by 75 % of viewers (Table I). We do the same with what we have:
 
-1. Sources: procedural neutral walks (:func:`generation.procedural_walk.walk`, marked synthetic) of
-   several body sizes and builds, plus the real captured walks of :func:`generation.captured.captured_walks`
+1. Sources: procedural neutral walks (:func:`generation.procedural.walk.walk`, marked synthetic) of
+   several body sizes and builds, plus the real captured walks of :func:`generation.formats.captured.captured_walks`
    when that module is available and they use the gait skeleton.
 2. Cutting: a cycle runs from a left heel strike to the next one, with one right heel strike between
-   (strikes are the onsets of :func:`generation.features.detect_foot_contacts`). Cycles in which a joint
+   (strikes are the onsets of :func:`generation.core.features.detect_foot_contacts`). Cycles in which a joint
    jumps faster than 10 m/s (a capture or rig glitch) are left out and counted in the metadata.
 3. Time normalisation: *contact-based piecewise-linear warping* (not CoTW or DTW): left strike -> frame 0,
    right strike -> frame m/2, next left strike -> frame m, linear in between; positions are interpolated
@@ -18,10 +18,10 @@ result was perceived as neutral by 75 % of viewers (Table I). We do the same wit
    height, so walkers of different sizes can be averaged (the paper normalises by height too, Fig. 5).
 5. Averaging joint positions (T, J, 3) frame by frame, closing the loop (the end-to-start mismatch is
    removed linearly), scaling to the target skeleton's height and putting the positions back onto the
-   skeleton with :func:`generation.ik.inverse_kinematics` (directions kept, bone lengths exact).
+   skeleton with :func:`generation.core.ik.inverse_kinematics` (directions kept, bone lengths exact).
 
 The result is one periodic cycle of ``m`` frames (default 100) walking along +z, whose metadata carries
-``stride_m`` (the root advance per cycle) for :func:`generation.stylise.stylise`.
+``stride_m`` (the root advance per cycle) for :func:`generation.rbf.stylise.stylise`.
 """
 from __future__ import annotations
 
@@ -29,9 +29,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .features import detect_foot_contacts, foot_joints
-from .motion import Motion
-from .skeleton import GAIT_JOINTS, Skeleton, gait_skeleton
+from generation.core.features import detect_foot_contacts, foot_joints
+from generation.core.motion import Motion
+from generation.core.skeleton import GAIT_JOINTS, Skeleton, gait_skeleton
 
 TIME_WARPING = "contact-based piecewise-linear (left heel strike -> 0, right -> m/2, next left -> m)"
 DEFAULT_BODIES = ((1.58, "female"), (1.66, "female"), (1.74, "female"), (1.70, "male"), (1.78, "male"),
@@ -170,7 +170,7 @@ def neutral_cycle_from_motions(motions: list[Motion], skeleton: Skeleton | None 
         along +z. metadata: origin "generated", generator "neutral_base", synthetic (True if any source is),
         sources, n_cycles, time_warping, ik_error_max_m.
     """
-    from .ik import inverse_kinematics
+    from generation.core.ik import inverse_kinematics
 
     if m < 20:
         raise ValueError(f"m must be at least 20 frames, got {m}")
@@ -220,10 +220,10 @@ def default_sources(n_frames_s: float = 3.3, fps: float = 100.0, include_capture
     """Neutral walks to average: procedural walks of :data:`DEFAULT_BODIES` and the captured walks if any.
 
     Each procedural walk is ``n_frames_s`` seconds long (about two full cycles at the neutral cadence) with
-    a different footprint-jitter seed. Captured walks are included only when ``generation.captured`` exists and
+    a different footprint-jitter seed. Captured walks are included only when ``generation.formats.captured`` exists and
     yields gait-skeleton motions.
     """
-    from .procedural_walk import WalkParams, walk
+    from generation.procedural.walk import WalkParams, walk
 
     sources = []
     for i, (height, build) in enumerate(DEFAULT_BODIES):
@@ -248,7 +248,7 @@ def _is_straight(motion: Motion, max_turn_deg: float = 20.0) -> bool:
 
 
 def captured_sources() -> list[Motion]:
-    """Real captured straight walks on the gait skeleton from :mod:`generation.captured`, or [] if unavailable.
+    """Real captured straight walks on the gait skeleton from :mod:`generation.formats.captured`, or [] if unavailable.
 
     Turning clips (described as turning, or turning by more than 20 degrees) are left out: the paper averaged
     straight walks. A loopable clip (``loop == "wrap"``) is
@@ -256,7 +256,7 @@ def captured_sources() -> list[Motion]:
     tells :func:`neutral_cycle_from_motions` to keep only its first cycle, so the repeat does not count twice.
     """
     try:
-        from .captured import captured_walks, repeat_cycle
+        from generation.formats.captured import captured_walks, repeat_cycle
     except ImportError:
         return []
     out = []

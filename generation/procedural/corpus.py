@@ -2,7 +2,7 @@
 
 No emotion-labelled body-motion data set can be had offline (REFERENCE.md section 7), so the
 networks are trained on procedural motion whose style follows the literature mapping in
-:mod:`generation.emotion`. Everything here is synthetic and says so: file names contain
+:mod:`generation.procedural.emotion`. Everything here is synthetic and says so: file names contain
 "synthetic", each corpus carries ``metadata = {"synthetic": True, "origin": "procedural", ...}``,
 and the gait labels are *simulated* annotator counts (seed 000 section 3.2.2), not human ratings.
 
@@ -11,7 +11,7 @@ and builds, straight / curved / sharp-turn paths, 240 frames at 30 fps by defaul
 subsamples every 4th frame, T = 60). Gesture corpus (:func:`build_gesture_corpus`): one seated
 gesture sequence per spec (emotion word, task, gender, handedness, frames).
 
-Command line: ``python -m generation.corpus [--out DIR] [--seed N] [--num N]`` or
+Command line: ``python -m generation.procedural.corpus [--out DIR] [--seed N] [--num N]`` or
 ``python manage.py build_corpus``.
 """
 from __future__ import annotations
@@ -25,12 +25,13 @@ from pathlib import Path
 
 import numpy as np
 
+from generation.core.motion import Motion
+from generation.core.paths import PATH_KINDS, random_path
+from generation.core.skeleton import gait_skeleton, gesture_skeleton
+
 from .emotion import GAIT_EMOTIONS, gait_params_for_emotion, gesture_params_for_vad, simulate_annotators, vad_for
-from .motion import Motion
-from .paths import PATH_KINDS, random_path
-from .procedural_gesture import GESTURE_KINDS, seated_gesture
-from .procedural_walk import walk
-from .skeleton import gait_skeleton, gesture_skeleton
+from .gesture import GESTURE_KINDS, seated_gesture
+from .walk import walk
 
 DEFAULT_DIR = Path("var/corpus")
 GAIT_CORPUS_FILE = "gait_corpus_synthetic.npz"
@@ -216,10 +217,10 @@ def build_gait_corpus(num_sequences: int = 1000, seed: int = 0, frames: int = 24
     """Build the synthetic gait corpus (deterministic from ``seed``).
 
     Each sequence: a true emotion vector (pure or mixture), walk parameters from
-    :func:`~generation.emotion.gait_params_for_emotion` with individual variation, a random body
+    :func:`~generation.procedural.emotion.gait_params_for_emotion` with individual variation, a random body
     (height, build), a random straight / curved / sharp-turn path long enough for the walk, a random
     starting gait phase; the soft label is the relative count of ``n_annotators`` simulated
-    annotators (:func:`~generation.emotion.simulate_annotators`).
+    annotators (:func:`~generation.procedural.emotion.simulate_annotators`).
 
     Returns a :class:`GaitCorpus`; about 5 ms per 240-frame sequence on one core.
     """
@@ -256,7 +257,8 @@ def build_gait_corpus(num_sequences: int = 1000, seed: int = 0, frames: int = 24
         if progress and (i + 1) % 200 == 0:
             print(f"  {i + 1}/{N} walks")
     split = _stratified_split(np.asarray(GAIT_EMOTIONS)[true.argmax(1)], root_rng)
-    metadata = {"synthetic": True, "origin": "procedural", "generator": "generation.corpus.build_gait_corpus",
+    metadata = {"synthetic": True, "origin": "procedural",
+                "generator": "generation.procedural.corpus.build_gait_corpus",
                 "labels": f"simulated annotators (n={n_annotators}), not human ratings",
                 "emotions": list(GAIT_EMOTIONS), "path_kinds": list(PATH_KINDS), "frames": T, "fps": fps}
     return GaitCorpus(rotations, roots, emotion.astype(np.float32), true.astype(np.float32), split, kinds, heights,
@@ -374,7 +376,7 @@ def build_gesture_corpus(specs, seed: int = 0, fps: float = 30.0) -> GestureCorp
         seed: random seed (body height, gesture kinds, individual variation).
 
     Each sequence has one gesture per ~1.5 s (at least one), kinds drawn by
-    :func:`~generation.emotion.gesture_params_for_vad` from the word's NRC-VAD values; narration is
+    :func:`~generation.procedural.emotion.gesture_params_for_vad` from the word's NRC-VAD values; narration is
     performed larger (amplitude x1.2) than conversation (x0.8), as seed 003 section 3.3.1 describes.
     """
     parsed = [_parse_spec(s, i) for i, s in enumerate(specs)]
@@ -410,7 +412,8 @@ def build_gesture_corpus(specs, seed: int = 0, fps: float = 30.0) -> GestureCorp
         params_out.append([p.to_dict() for p in plist])
     emotion = np.asarray([p[0] for p in parsed])
     split = _stratified_split(emotion, np.random.default_rng(seed))
-    metadata = {"synthetic": True, "origin": "procedural", "generator": "generation.corpus.build_gesture_corpus",
+    metadata = {"synthetic": True, "origin": "procedural",
+                "generator": "generation.procedural.corpus.build_gesture_corpus",
                 "vad_source": "NRC-VAD lexicon (Mohammad, ACL 2018)", "kinds": list(GESTURE_KINDS), "fps": fps}
     return GestureCorpus(rotations, roots, lengths, vad.astype(np.float32), emotion,
                          np.asarray([p[1] for p in parsed]), np.asarray([p[2] for p in parsed]),

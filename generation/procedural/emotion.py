@@ -25,8 +25,8 @@ from pathlib import Path
 
 import numpy as np
 
-from .procedural_gesture import GESTURE_KINDS, GestureParams
-from .procedural_walk import WalkParams
+from .gesture import GESTURE_KINDS, GestureParams
+from .walk import WalkParams
 
 GAIT_EMOTIONS = ("happy", "sad", "angry", "neutral")
 
@@ -34,7 +34,7 @@ GAIT_EMOTIONS = ("happy", "sad", "angry", "neutral")
 GESTURE_EMOTIONS = ("afraid", "amused", "angry", "ashamed", "disgusted", "joyous", "neutral", "proud", "relieved",
                     "sad", "surprised")
 
-NRC_VAD_PATH = Path(__file__).resolve().parent / "data" / "nrc_vad.csv"
+NRC_VAD_PATH = Path(__file__).resolve().parent.parent / "data" / "nrc_vad.csv"
 
 
 def load_nrc_vad(path: str | Path = NRC_VAD_PATH) -> dict[str, tuple[float, float, float]]:

@@ -23,11 +23,11 @@ from pathlib import Path
 
 import numpy as np
 
-from .motion import Motion, MotionFormatError
-from .quaternion import np_qfix, np_qmul, np_qnormalize
-from .skeleton import Skeleton
+from generation.core.motion import Motion, MotionFormatError
+from generation.core.quaternion import np_qfix, np_qmul, np_qnormalize
+from generation.core.skeleton import Skeleton
 
-DATA_DIR = Path(__file__).resolve().parent / "data" / "deepmimic"
+DATA_DIR = Path(__file__).resolve().parent.parent / "data" / "deepmimic"
 URDF_PATH = DATA_DIR / "humanoid.urdf"
 URDF_SCALE = 0.25
 FRAME_LENGTH = 44

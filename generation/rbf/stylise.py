@@ -7,7 +7,7 @@ Pipeline (shapes: m cycle frames, J joints):
 2. ``S`` (m, J, 3): the theme's secondary features (:func:`theme_rbfs`): for each of the first n features of
    Table III and each joint of its body part, up to three Gaussian RBFs (eq. 4) on one Cartesian axis,
    amplitudes = intensity x walker height. Posture features are shape 1; movement features are placed on the
-   extrema of the joint's own neutral trajectory (relative to the root) by :func:`generation.rbf.swing_params`.
+   extrema of the joint's own neutral trajectory (relative to the root) by :func:`generation.rbf.basis.swing_params`.
    An axis of a joint with no edit of its own follows its parent's edit (:func:`theme_displacement`), so a
    lifted knee lifts the foot and the toes and hand tips, which the paper's 54-DOF model lacks, follow.
 3. ``Y = P + w * S``: the paper's linear model (eq. 1 with r = 1). A negative w inverts only the amplitudes.
@@ -25,11 +25,12 @@ from __future__ import annotations
 import numpy as np
 import torch
 
-from .kinematics import forward_kinematics, np_forward_kinematics
-from .motion import Motion
-from .quaternion import np_qbetween, np_qconj, np_qfix, np_qmul, np_qrot, np_qslerp
-from .rbf import CYCLE_FRAMES, rbf_sum, shape_params, swing_params
-from .skeleton import Skeleton
+from generation.core.kinematics import forward_kinematics, np_forward_kinematics
+from generation.core.motion import Motion
+from generation.core.quaternion import np_qbetween, np_qconj, np_qfix, np_qmul, np_qrot, np_qslerp
+from generation.core.skeleton import Skeleton
+
+from .basis import CYCLE_FRAMES, rbf_sum, shape_params, swing_params
 from .themes import AXES, BODY_PARTS, THEME_NAMES, theme_features
 
 _MODELLED = frozenset(name for joints in BODY_PARTS.values() for name in joints)
@@ -83,7 +84,7 @@ def walker_frame_positions(neutral: Motion) -> tuple[np.ndarray, np.ndarray]:
     horizontal = np.hypot(stride[0], stride[2])
     if horizontal < 1e-6 or stride[2] < np.cos(np.radians(15.0)) * horizontal:
         raise ValueError(f"the neutral cycle must walk along +z (stride {np.round(stride, 3).tolist()} m); "
-                         "rotate it first (generation.neutral_base does)")
+                         "rotate it first (generation.rbf.neutral_base does)")
     progression = np.arange(m)[:, None] / m * stride[None, :]
     return neutral.positions() - progression[:, None, :], progression
 
@@ -97,8 +98,8 @@ def theme_rbfs(P: np.ndarray, skeleton: Skeleton, theme: str, n_features: int,
 
     Args:
         P: (m, J, 3) neutral cycle in the walker's frame (:func:`walker_frame_positions`), metres.
-        skeleton: gait skeleton (joint names as in :data:`generation.themes.BODY_PARTS`).
-        theme: one of :data:`generation.themes.THEME_NAMES`.
+        skeleton: gait skeleton (joint names as in :data:`generation.rbf.themes.BODY_PARTS`).
+        theme: one of :data:`generation.rbf.themes.THEME_NAMES`.
         n_features: how many of Table III's features, in frequency order (0..10).
         height: walker height in metres for de-normalising intensities (default ``skeleton.height``).
 
@@ -394,7 +395,7 @@ def keep_feet_above_ground(Y: np.ndarray, P: np.ndarray, skeleton: Skeleton) -> 
     push the planted foot through the floor. Each heel/toe joint's height is clamped to its minimum over the
     neutral cycle. Returns the clamped copy (m, J, 3) and the largest lift applied (metres).
     """
-    from .features import foot_joints
+    from generation.core.features import foot_joints
 
     left, right = foot_joints(skeleton)
     out = Y.copy()
@@ -412,7 +413,7 @@ def stylise(neutral_cycle: Motion, theme: str, weight: float, n_features: int, s
 
     Args:
         neutral_cycle: one periodic neutral cycle (left contact to next left contact, walking along +z), e.g.
-            from :func:`generation.neutral_base.neutral_cycle`; metadata ``stride_m`` and ``synthetic`` are
+            from :func:`generation.rbf.neutral_base.neutral_cycle`; metadata ``stride_m`` and ``synthetic`` are
             read when present.
         theme: happy, sad, energetic, tired, feminine or masculine.
         weight: w of Y = P + w * S; any real (the paper uses 0.4, 0.7, 1.0, 1.3 and -0.7 for inversion).

@@ -10,7 +10,7 @@ How a walk is made (all in metres, seconds, radians):
    is on the ground for the first 60 % of its cycle: heel rocker (toe lowering onto the ground,
    heel joint fixed) for 10 %, foot flat until 30 %, then heel rise about the fixed toe until
    toe-off at 60 %; the remaining 40 % is swing.
-2. Path. The root moves along a corner-rounded copy of the :class:`~generation.paths.GroundPath`
+2. Path. The root moves along a corner-rounded copy of the :class:`~generation.core.paths.GroundPath`
    at constant speed ``stride_m * cadence / 120`` m/s (a stride is two steps), facing the path
    tangent. Footprints are put on the path, half a step width to either side, so the walker
    follows straight, curved and sharp-turn paths.
@@ -33,11 +33,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .ik import matrix_to_quaternion
-from .motion import Motion
-from .paths import GroundPath, straight
-from .quaternion import np_qconj, np_qfrom_axis_angle, np_qmul, np_qrot
-from .skeleton import GAIT_JOINTS, Skeleton, gait_skeleton
+from generation.core.ik import matrix_to_quaternion
+from generation.core.motion import Motion
+from generation.core.paths import GroundPath, straight
+from generation.core.quaternion import np_qconj, np_qfrom_axis_angle, np_qmul, np_qrot
+from generation.core.skeleton import GAIT_JOINTS, Skeleton, gait_skeleton
 
 # Fractions of the gait cycle for one foot (0 = its heel strike).
 HEEL_ROCKER_END = 0.10
@@ -491,7 +491,7 @@ def walk_with_contacts(params: WalkParams, path: GroundPath | None = None, n_fra
     metadata = {
         "origin": "procedural",
         "synthetic": True,
-        "generator": "generation.procedural_walk",
+        "generator": "generation.procedural.walk",
         "params": params.to_dict(),
         "path_kind": path.kind,
         "phase": float(phase),

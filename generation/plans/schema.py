@@ -32,9 +32,9 @@ import math
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from .render.settings import RENDERER_VERSION, RenderSettings, RenderSettingsError
+from generation.render.settings import RENDERER_VERSION, RenderSettings, RenderSettingsError
 
-PLANS_DIR = Path(__file__).resolve().parent / "plans"
+PLANS_DIR = Path(__file__).resolve().parent
 GAIT_EMOTIONS = ("happy", "sad", "angry", "neutral")
 THEMES = ("happy", "sad", "energetic", "tired", "feminine", "masculine")
 TRAJECTORY_KINDS = ("straight", "curved", "sharp_turn")
@@ -206,7 +206,7 @@ def _trajectory(value) -> dict:
 
 
 def _gesture_label(name: str, value) -> str:
-    from .emotion import NRC_VAD
+    from generation.procedural.emotion import NRC_VAD
 
     if not isinstance(value, str) or value.strip().lower() not in NRC_VAD:
         raise _FieldError(name, f"expected an NRC-VAD emotion word ({', '.join(sorted(NRC_VAD))}), got {value!r}")
@@ -435,7 +435,7 @@ def intent_fields(entry: ClipEntry) -> dict:
         out.update(zip(("final_" + e for e in GAIT_EMOTIONS), inp["transition"]["final"]))
     if entry.modality == "gesture":
         if "emotion_label" in inp:
-            from .emotion import NRC_VAD
+            from generation.procedural.emotion import NRC_VAD
 
             out["emotion_label"] = inp["emotion_label"]
             out["valence"], out["arousal"], out["dominance"] = NRC_VAD[inp["emotion_label"]]

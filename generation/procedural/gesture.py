@@ -17,10 +17,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .motion import Motion
-from .procedural_walk import axis_angle, hinge_rotations, locals_from_globals, smoothstep, two_bone_ik, yaw_quat
-from .quaternion import np_qmul, np_qrot
-from .skeleton import GESTURE_JOINTS, Skeleton, gesture_skeleton
+from generation.core.motion import Motion
+from generation.core.quaternion import np_qmul, np_qrot
+from generation.core.skeleton import GESTURE_JOINTS, Skeleton, gesture_skeleton
+
+from .walk import axis_angle, hinge_rotations, locals_from_globals, smoothstep, two_bone_ik, yaw_quat
 
 GESTURE_KINDS = ("beat", "pointing", "descriptive")
 HANDEDNESS = ("left", "right")
@@ -359,7 +360,7 @@ def seated_gesture(params, n_frames: int = 120, fps: float = 30.0, skeleton: Ske
     metadata = {
         "origin": "procedural",
         "synthetic": True,
-        "generator": "generation.procedural_gesture",
+        "generator": "generation.procedural.gesture",
         "params": [p.to_dict() for p in params_list],
         "seat_height_m": seat_height(skeleton),
         "seed": seed,

@@ -1,0 +1,1 @@
+"""Core maths and the Motion type: quaternions, skeletons, kinematics, IK, features, ground paths."""

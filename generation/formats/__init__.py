@@ -1,0 +1,1 @@
+"""Motion file formats: BVH, DeepMimic JSON, and the shipped captured walks."""

@@ -1,0 +1,149 @@
+"""The study protocol: the one definition of the vocabularies, section types, questions' answer domains and
+public CSV columns that generation, studyapp and analysis share.
+
+Plain Python (no numpy, torch or Django), so every library can import it cheaply. Everything else derives from
+these names; ``tests/test_protocol.py`` fails when a second copy of a vocabulary appears anywhere in the code.
+The formats are those of DESIGN.md ("Interchange formats").
+
+NRC-VAD rows (valence, arousal, dominance in 0..1) are copied from the NRC Valence, Arousal, and Dominance
+Lexicon v1:
+
+    Saif M. Mohammad. "Obtaining Reliable Human Ratings of Valence, Arousal, and Dominance for 20,000 English
+    Words." Proceedings of ACL 2018, pages 174-184. doi:10.18653/v1/P18-1017. Free for research and
+    non-commercial use; cite the paper when using it.
+"""
+from __future__ import annotations
+
+# ---- vocabularies ----------------------------------------------------------------------------------------
+GAIT_EMOTIONS = ("happy", "sad", "angry", "neutral")
+"""Components of seed 000's gait emotion vector, in column order (clips.csv, the network's input)."""
+
+THEMES = ("happy", "sad", "energetic", "tired", "feminine", "masculine")
+"""Seed 004's style themes (Table III)."""
+
+OPPOSITE_THEME = {"happy": "sad", "sad": "happy", "energetic": "tired", "tired": "energetic",
+                  "feminine": "masculine", "masculine": "feminine"}
+"""Each theme's opposite: what a negative RBF weight should look like (seed 004 section 5.3)."""
+
+NEUTRAL_THEME = "neutral"
+"""The theme of seed 004's unstyled input walk (weight 0) in clips.csv."""
+
+CLIP_THEMES = (*THEMES, NEUTRAL_THEME)
+"""Values the ``theme`` column of clips.csv may take."""
+
+NEUTRAL_CHOICES = (NEUTRAL_THEME, *THEMES)
+"""The 7-way forced choice of seed 004's neutral validation (Table I)."""
+
+GESTURE_VAD: dict[str, tuple[float, float, float]] = {
+    "afraid": (0.010, 0.775, 0.245),
+    "amused": (0.942, 0.847, 0.596),
+    "angry": (0.122, 0.830, 0.604),
+    "ashamed": (0.156, 0.588, 0.228),
+    "disgusted": (0.051, 0.773, 0.274),
+    "joyous": (0.958, 0.580, 0.728),
+    "neutral": (0.469, 0.184, 0.357),
+    "proud": (0.906, 0.700, 0.873),
+    "relieved": (0.896, 0.314, 0.391),
+    "sad": (0.225, 0.333, 0.149),
+    "surprised": (0.784, 0.855, 0.539),
+}
+"""The 11 categories of the MPI Emotional Body Expressions database (seed 003 section 6.1) -> NRC-VAD
+(valence, arousal, dominance), each in 0..1."""
+
+GESTURE_EMOTIONS = tuple(GESTURE_VAD)
+"""Seed 003's gesture emotion categories, alphabetical."""
+
+VAD_DIMENSIONS = ("valence", "arousal", "dominance")
+
+GENDERS = ("female", "male")
+"""Body builds of the skeletons and agents, in the order of the gesture network's one-hot attribute."""
+
+HANDEDNESS = ("left", "right")
+
+MODALITIES = ("gait", "gesture")
+ORIGINS = ("generated", "source")
+"""``origin`` of a clip: made by a generator, or the source motion a generator started from."""
+
+# ---- sections and their answers ----------------------------------------------------------------------
+SECTION_TYPES = ("emotion_choice", "emotion_transition", "affect_likert", "naturalness", "gesture_emotion",
+                 "neutral_validation", "theme_rating", "theme_inversion")
+
+LIKERT_FEATURES = ("torso", "arms", "pace", "flow")
+"""Seed 000 Table 2's broad pose affective features, each rated 0..4."""
+
+LIKERT_LEVELS = {
+    "torso": ("Torso", ("contracted, bowed", "somewhat contracted", "neither contracted nor expanded",
+                        "somewhat expanded", "expanded, stretched")),
+    "arms": ("Arms", ("contracted, close to the body", "somewhat contracted", "neither contracted nor expanded",
+                      "somewhat expanded", "expanded, away from the body")),
+    "pace": ("Gait pace", ("sustained, leisurely, slow", "somewhat sustained", "neither sustained nor hurried",
+                           "somewhat hurried", "hurried, sudden, fast")),
+    "flow": ("Gait flow", ("free, relaxed, uncontrolled", "somewhat free", "neither free nor bound",
+                           "somewhat bound", "bound, tense, controlled")),
+}
+"""Seed 000 Table 2, verbatim: feature -> (label, the wording of values 0..4)."""
+
+# How the `answer` cell of responses.csv is written for each answer kind.
+GAIT_MULTI = "gait_multi"          # gait emotion labels joined by ';'
+LIKERT = "likert"                  # integer 0..4
+NATURALNESS = "naturalness"        # integer 1..5
+GESTURE_CHOICE = "gesture_choice"  # one gesture emotion category
+NEUTRAL_CHOICE = "neutral_choice"  # neutral or one of the six themes
+THEME_RATING = "theme_rating"      # integer 1..7
+INVERSION = "inversion"            # integer -7..7
+
+INTEGER_RANGES = {LIKERT: (0, 4), NATURALNESS: (1, 5), THEME_RATING: (1, 7), INVERSION: (-7, 7)}
+"""Answer kind -> (lowest, highest) integer, inclusive."""
+
+LABEL_CHOICES = {GAIT_MULTI: GAIT_EMOTIONS, GESTURE_CHOICE: GESTURE_EMOTIONS, NEUTRAL_CHOICE: NEUTRAL_CHOICES}
+"""Answer kind -> the labels it may use."""
+
+MULTI_SELECT_KINDS = (GAIT_MULTI,)
+"""Answer kinds where several labels may be chosen (joined by ';' in the protocol's order)."""
+
+SECTION_QUESTIONS: dict[str, dict[str, str]] = {
+    "emotion_choice": {"perceived": GAIT_MULTI},
+    "emotion_transition": {"initial": GAIT_MULTI, "final": GAIT_MULTI},
+    "affect_likert": {feature: LIKERT for feature in LIKERT_FEATURES},
+    "naturalness": {"naturalness": NATURALNESS},
+    "gesture_emotion": {"perceived": GESTURE_CHOICE},
+    "neutral_validation": {"perceived": NEUTRAL_CHOICE},
+    "theme_rating": {"rating": THEME_RATING},
+    "theme_inversion": {"rating": INVERSION},
+}
+"""section_type -> question key -> answer kind: exactly what the study app writes and the analysis reads."""
+
+SECTION_MODALITY = {"emotion_choice": "gait", "emotion_transition": "gait", "affect_likert": "gait",
+                    "naturalness": None, "gesture_emotion": "gesture", "neutral_validation": "gait",
+                    "theme_rating": "gait", "theme_inversion": "gait"}
+"""The modality of the clips each section shows (None: either)."""
+
+
+def answer_values(kind: str) -> tuple[str, ...]:
+    """Every value one answer of ``kind`` may take, as the strings stored in responses.csv."""
+    if kind in INTEGER_RANGES:
+        lo, hi = INTEGER_RANGES[kind]
+        return tuple(str(v) for v in range(lo, hi + 1))
+    return LABEL_CHOICES[kind]
+
+
+# ---- public CSV columns (DESIGN.md) --------------------------------------------------------------------
+FINAL_EMOTION_COLUMNS = tuple(f"final_{e}" for e in GAIT_EMOTIONS)
+
+CLIP_COLUMNS = ("clip_id", "modality", "origin", *GAIT_EMOTIONS, *FINAL_EMOTION_COLUMNS, "emotion_label",
+                *VAD_DIMENSIONS, "theme", "weight", "n_features", "duration_s")
+"""clips.csv, in order. Readers ignore extra columns after these."""
+
+CLIP_FLOAT_COLUMNS = (*GAIT_EMOTIONS, *FINAL_EMOTION_COLUMNS, *VAD_DIMENSIONS, "weight", "duration_s")
+CLIP_INT_COLUMNS = ("n_features",)
+
+RESPONSE_COLUMNS = ("participant_id", "section_type", "clip_id", "question", "answer", "response_ms")
+"""responses.csv, in order: one row per answer."""
+
+PARTICIPANT_COLUMNS = ("participant_id", "gender", "age_group", "started_at", "completed_at", "status",
+                       "external_id")
+"""participants.csv, in order (feedback columns follow)."""
+
+ASSIGNMENT_COLUMNS = ("participant_id", "section_type", "section_order", "position", "clip_id", "options",
+                      "shown_at", "answered_at")
+"""assignments.csv (an extra export): which clips each participant was given, in order."""
