@@ -60,6 +60,9 @@ GENDERS = ("female", "male")
 
 HANDEDNESS = ("left", "right")
 
+GESTURE_TASKS = ("narration", "conversation")
+"""Seed 003's speaking tasks: a gesture accompanies a narration or a conversation."""
+
 MODALITIES = ("gait", "gesture")
 ORIGINS = ("generated", "source")
 """``origin`` of a clip: made by a generator, or the source motion a generator started from."""

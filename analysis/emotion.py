@@ -23,8 +23,7 @@ import numpy as np
 import pandas as pd
 from scipy import stats
 
-from .io import FINAL_COLUMNS, INTENDED_COLUMNS
-from .lexicon import GAIT_EMOTIONS
+from study_protocol import FINAL_EMOTION_COLUMNS, GAIT_EMOTIONS
 
 P_FLOOR, P_CEIL = 0.001, 0.25
 
@@ -125,7 +124,7 @@ def gait_emotion_ad(responses: pd.DataFrame, clips: pd.DataFrame, alpha: float =
     intended_<e>, perceived_<e> for e in (happy, sad, angry, neutral).
     """
     perceived = perceived_by_clip(responses, "emotion_choice", "perceived")
-    return _ad_table(perceived, clips[list(INTENDED_COLUMNS)], alpha, permutations)
+    return _ad_table(perceived, clips[list(GAIT_EMOTIONS)], alpha, permutations)
 
 
 def transition_ad(responses: pd.DataFrame, clips: pd.DataFrame, alpha: float = 0.05,
@@ -136,7 +135,7 @@ def transition_ad(responses: pd.DataFrame, clips: pd.DataFrame, alpha: float = 0
     Returns the columns of :func:`gait_emotion_ad` plus ``phase`` (initial | final) after clip_id.
     """
     parts = []
-    for phase, cols in (("initial", INTENDED_COLUMNS), ("final", FINAL_COLUMNS)):
+    for phase, cols in (("initial", GAIT_EMOTIONS), ("final", FINAL_EMOTION_COLUMNS)):
         perceived = perceived_by_clip(responses, "emotion_transition", phase)
         intended = clips[list(cols)].set_axis(list(GAIT_EMOTIONS), axis=1)
         t = _ad_table(perceived, intended, alpha, permutations)

@@ -15,12 +15,13 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 import pandas as pd  # noqa: E402
 
-from .lexicon import GAIT_EMOTIONS, LIKERT_FEATURES, THEMES, VAD_DIMENSIONS  # noqa: E402
+from study_protocol import GAIT_EMOTIONS, LIKERT_FEATURES, THEMES, VAD_DIMENSIONS  # noqa: E402
 
 plt.rcParams.update({"svg.hashsalt": "analysis", "svg.fonttype": "none", "font.size": 9, "axes.titlesize": 9,
                      "figure.dpi": 100})
 INTENDED_COLOR, PERCEIVED_COLOR = "#4C72B0", "#DD8452"
-EMOTION_COLORS = {"happy": "#E1A100", "sad": "#4C72B0", "angry": "#C44E52", "neutral": "#8C8C8C"}
+EMOTION_COLORS = dict(zip(GAIT_EMOTIONS, ("#E1A100", "#4C72B0", "#C44E52", "#8C8C8C")))
+"""Bar colour of each gait emotion (happy, sad, angry, neutral)."""
 
 
 def save_figure(fig, out_dir: str, name: str, dpi: int = 110) -> dict[str, str]:

@@ -17,41 +17,27 @@ from dataclasses import dataclass, field
 import numpy as np
 import pandas as pd
 
-from .lexicon import GAIT_EMOTIONS, LIKERT_FEATURES, NEUTRAL_CHOICES, NRC_VAD, THEMES
-
-CLIP_COLUMNS = (
-    "clip_id", "modality", "origin", "happy", "sad", "angry", "neutral",
-    "final_happy", "final_sad", "final_angry", "final_neutral", "emotion_label",
-    "valence", "arousal", "dominance", "theme", "weight", "n_features", "duration_s",
+from study_protocol import (
+    CLIP_COLUMNS,
+    CLIP_THEMES,
+    FINAL_EMOTION_COLUMNS,
+    GAIT_EMOTIONS,
+    GAIT_MULTI,
+    GESTURE_EMOTIONS,
+    INTEGER_RANGES,
+    LABEL_CHOICES,
+    MODALITIES,
+    MULTI_SELECT_KINDS,
+    ORIGINS,
+    PARTICIPANT_COLUMNS,
+    RESPONSE_COLUMNS,
+    SECTION_QUESTIONS,
+    VAD_DIMENSIONS,
 )
-RESPONSE_COLUMNS = ("participant_id", "section_type", "clip_id", "question", "answer", "response_ms")
-PARTICIPANT_COLUMNS = ("participant_id", "gender", "age_group", "started_at", "completed_at", "status", "external_id")
 
-INTENDED_COLUMNS = tuple(GAIT_EMOTIONS)
-FINAL_COLUMNS = tuple("final_" + e for e in GAIT_EMOTIONS)
+ANSWER_KINDS = tuple(dict.fromkeys(kind for questions in SECTION_QUESTIONS.values() for kind in questions.values()))
+"""Every answer kind the sections use (:data:`study_protocol.SECTION_QUESTIONS`), in first-use order."""
 
-# Answer kinds: how the `answer` cell of each (section_type, question) pair is written.
-GAIT_MULTI = "gait_multi"  # gait emotion labels joined by ';'
-LIKERT = "likert"  # integer 0..4
-NATURALNESS = "naturalness"  # integer 1..5
-GESTURE_CHOICE = "gesture_choice"  # one NRC-VAD category
-NEUTRAL_CHOICE = "neutral_choice"  # neutral or one of the six themes
-THEME_RATING = "theme_rating"  # integer 1..7
-INVERSION = "inversion"  # integer -7..7
-
-SECTION_QUESTIONS: dict[str, dict[str, str]] = {
-    "emotion_choice": {"perceived": GAIT_MULTI},
-    "emotion_transition": {"initial": GAIT_MULTI, "final": GAIT_MULTI},
-    "affect_likert": {f: LIKERT for f in LIKERT_FEATURES},
-    "naturalness": {"naturalness": NATURALNESS},
-    "gesture_emotion": {"perceived": GESTURE_CHOICE},
-    "neutral_validation": {"perceived": NEUTRAL_CHOICE},
-    "theme_rating": {"rating": THEME_RATING},
-    "theme_inversion": {"rating": INVERSION},
-}
-"""Allowed (section_type -> question -> answer kind). The study app must write exactly these."""
-
-INTEGER_RANGES = {LIKERT: (0, 4), NATURALNESS: (1, 5), THEME_RATING: (1, 7), INVERSION: (-7, 7)}
 MAX_LISTED = 20
 
 
@@ -161,14 +147,14 @@ def read_clips(src) -> pd.DataFrame:
     col.add_mask(df, _blank(df["clip_id"]), "clip_id", "clip_id is empty")
     dup = df["clip_id"].duplicated(keep="first").to_numpy() & ~_blank(df["clip_id"])
     col.add_mask(df, dup, "clip_id", lambda v: f"duplicate clip_id {v!r}")
-    col.add_mask(df, ~df["modality"].isin(["gait", "gesture"]), "modality",
-                 lambda v: f"{v!r} is not one of gait, gesture")
-    col.add_mask(df, ~df["origin"].isin(["generated", "source"]), "origin",
-                 lambda v: f"{v!r} is not one of generated, source")
+    col.add_mask(df, ~df["modality"].isin(MODALITIES), "modality",
+                 lambda v: f"{v!r} is not one of {', '.join(MODALITIES)}")
+    col.add_mask(df, ~df["origin"].isin(ORIGINS), "origin",
+                 lambda v: f"{v!r} is not one of {', '.join(ORIGINS)}")
 
     out = pd.DataFrame({"clip_id": df["clip_id"], "modality": df["modality"], "origin": df["origin"],
                         "emotion_label": df["emotion_label"], "theme": df["theme"], "_line": df["_line"]})
-    for group in (INTENDED_COLUMNS, FINAL_COLUMNS):
+    for group in (GAIT_EMOTIONS, FINAL_EMOTION_COLUMNS):
         blank = np.column_stack([_blank(df[c]) for c in group])
         values = np.column_stack([_numeric(df[c]).to_numpy() for c in group])
         partial = blank.any(axis=1) & ~blank.all(axis=1)
@@ -184,7 +170,7 @@ def read_clips(src) -> pd.DataFrame:
         normed[~given] = np.nan
         for j, c in enumerate(group):
             out[c] = normed[:, j]
-    for c in ("valence", "arousal", "dominance"):
+    for c in VAD_DIMENSIONS:
         v = _numeric(df[c])
         col.add_mask(df, ~_blank(df[c]) & ~((v >= 0) & (v <= 1)).to_numpy(), c, lambda x: f"{x!r} is not in 0..1")
         out[c] = v.to_numpy()
@@ -198,14 +184,13 @@ def read_clips(src) -> pd.DataFrame:
     col.add_mask(df, (out["duration_s"] < 0).to_numpy(), "duration_s", lambda x: f"{x!r} is negative")
     has_theme = ~_blank(df["theme"])
     # "neutral" marks the unstyled input walk of seed 004 (weight 0, no features; Table I).
-    clip_themes = (*THEMES, "neutral")
-    col.add_mask(df, has_theme & ~df["theme"].isin(clip_themes).to_numpy(), "theme",
-                 lambda v: f"{v!r} is not one of {', '.join(clip_themes)}")
+    col.add_mask(df, has_theme & ~df["theme"].isin(CLIP_THEMES).to_numpy(), "theme",
+                 lambda v: f"{v!r} is not one of {', '.join(CLIP_THEMES)}")
     col.add_mask(df, has_theme & out["weight"].isna().to_numpy(), "weight", "a theme clip needs a weight")
     label = df["emotion_label"]
-    bad_label = (df["modality"] == "gesture").to_numpy() & ~_blank(label) & ~label.isin(list(NRC_VAD)).to_numpy()
+    bad_label = (df["modality"] == "gesture").to_numpy() & ~_blank(label) & ~label.isin(GESTURE_EMOTIONS).to_numpy()
     col.add_mask(df, bad_label, "emotion_label",
-                 lambda v: f"{v!r} is not an NRC-VAD category ({', '.join(NRC_VAD)})")
+                 lambda v: f"{v!r} is not an NRC-VAD category ({', '.join(GESTURE_EMOTIONS)})")
     if col.total:
         raise ValidationError(col.problems, col.total)
     out = out.set_index("clip_id", drop=False)
@@ -272,10 +257,169 @@ class _CodedColumn:
     def rows(self) -> np.ndarray:
         return self.values[self.codes]
 
-    def categorical(self, values=None) -> pd.Categorical:
-        vals = self.values if values is None else values
-        cats, inv = np.unique(np.asarray(vals, dtype=object).astype(str), return_inverse=True)
+    def categorical(self) -> pd.Categorical:
+        cats, inv = np.unique(self.values.astype(str), return_inverse=True)
         return pd.Categorical.from_codes(inv[self.codes], cats)
+
+
+class _RowProblems:
+    """Problems of coded columns: each offending cell is decoded only for the first few rows of a rule."""
+
+    def __init__(self, name: str, lines: pd.Series):
+        self.col = _Collector(name)
+        self.shown = pd.DataFrame({"_line": lines})
+
+    def add(self, mask, column: str, message, coded: _CodedColumn) -> None:
+        mask = np.asarray(mask, dtype=bool)
+        if mask.any():
+            idx = np.flatnonzero(mask)[:MAX_LISTED]
+            self.shown.loc[self.shown.index[idx], column] = coded.values[coded.codes[idx]]
+            self.col.add_mask(self.shown, mask, column, message)
+
+
+_LOWERED = ("section_type", "question")
+"""responses.csv columns compared case-insensitively."""
+
+_MULTI_NOUN = {GAIT_MULTI: "gait emotions"}
+"""What the labels of a multi-select answer kind are called in messages."""
+
+
+def _multi_pattern(choices) -> re.Pattern:
+    alt = "|".join(choices)
+    return re.compile(rf"\s*(?:{alt})\s*(?:;\s*(?:{alt})\s*)*")
+
+
+_MULTI_PATTERNS = {kind: _multi_pattern(LABEL_CHOICES[kind]) for kind in MULTI_SELECT_KINDS}
+
+
+def _read_categorical(src, name: str) -> pd.DataFrame:
+    """Read a CSV with every column categorical (no NA conversion). Adds ``_line`` (file line number of each row)."""
+    if isinstance(src, bytes):
+        src = io.BytesIO(src)
+    try:
+        raw = pd.read_csv(src, dtype="category", keep_default_na=False, na_filter=False)
+    except pd.errors.EmptyDataError as exc:
+        raise ValidationError([Problem(name, 0, "*", "file is empty (no header row)")]) from exc
+    except (pd.errors.ParserError, UnicodeDecodeError) as exc:
+        raise ValidationError([Problem(name, 0, "*", f"not a readable CSV file: {exc}")]) from exc
+    raw.columns = [str(c).strip() for c in raw.columns]
+    if raw.empty and not len(raw.columns):
+        raise ValidationError([Problem(name, 0, "*", "file is empty (no header row)")])
+    raw["_line"] = np.arange(2, len(raw) + 2)
+    return raw
+
+
+def _check_participants(pid: _CodedColumn, participants: pd.DataFrame | None, rows: _RowProblems) -> None:
+    """participant_id set, and known when ``participants`` is given."""
+    rows.add(pid.mask(pid.values == ""), "participant_id", "participant_id is empty", pid)
+    if participants is not None:
+        unknown = (pid.values != "") & ~pd.Index(pid.values).isin(participants.index)
+        rows.add(pid.mask(unknown), "participant_id",
+                 lambda v: f"unknown participant {v!r} (not in participants.csv)", pid)
+
+
+def _answer_kinds(sec: _CodedColumn, qst: _CodedColumn) -> np.ndarray:
+    """Row -> index into :data:`ANSWER_KINDS` of its (section_type, question) pair, -1 where the pair is not in
+    SECTION_QUESTIONS. Looked up once per distinct pair."""
+    table = np.full((len(sec.values), len(qst.values)), -1, dtype=np.int8)
+    for i, section in enumerate(sec.values):
+        for j, question in enumerate(qst.values):
+            kind = SECTION_QUESTIONS.get(section, {}).get(question)
+            if kind is not None:
+                table[i, j] = ANSWER_KINDS.index(kind)
+    return table[sec.codes, qst.codes]
+
+
+def _check_sections(sec: _CodedColumn, qst: _CodedColumn, kind: np.ndarray, rows: _RowProblems) -> None:
+    """A known section_type, and a question of that section."""
+    sections = list(SECTION_QUESTIONS)
+    known = np.isin(sec.values, sections)
+    rows.add(sec.mask(~known), "section_type", lambda v: f"{v!r} is not one of {', '.join(sections)}", sec)
+    bad_q = sec.mask(known) & (kind < 0)
+    if bad_q.any():
+        present = set(sec.rows()[bad_q])
+        listed = "; ".join(f"{s}: {', '.join(qs)}" for s, qs in SECTION_QUESTIONS.items() if s in present)
+        rows.add(bad_q, "question", lambda v: f"{v!r} is not a question of its section_type ({listed})", qst)
+
+
+def _check_answer(kind: str, answer: str) -> tuple[str | None, str, float]:
+    """One answer of one kind -> (problem message or None, cleaned label, value: the integer or NaN)."""
+    if kind in INTEGER_RANGES:
+        lo, hi = INTEGER_RANGES[kind]
+        try:
+            v = float(answer)
+        except ValueError:
+            v = np.nan
+        if not (lo <= v <= hi and v == round(v)):
+            return f"{answer!r} is not an integer in {lo}..{hi}", answer, np.nan
+        return None, answer, v
+    choices = LABEL_CHOICES[kind]
+    if kind in MULTI_SELECT_KINDS:
+        label = re.sub(r"\s+", "", answer.lower())
+        if _MULTI_PATTERNS[kind].fullmatch(answer.lower()) is None:
+            noun = _MULTI_NOUN.get(kind, "labels")
+            return f"{answer!r} is not {noun} ({', '.join(choices)}) joined by ';'", label, np.nan
+        return None, label, np.nan
+    if answer.lower() not in choices:
+        return f"{answer!r} is not one of {', '.join(choices)}", answer.lower(), np.nan
+    return None, answer.lower(), np.nan
+
+
+def _check_answers(kind: np.ndarray, ans: _CodedColumn, col: _Collector):
+    """Validate each distinct (kind, answer) pair once (rows of unknown questions are not checked).
+
+    Returns (per-pair cleaned label, per-pair value, row -> pair index)."""
+    pair = kind.astype(np.int64) * len(ans.values) + ans.codes
+    upair, pair_inv = np.unique(pair, return_inverse=True)
+    pair_value = np.full(len(upair), np.nan)
+    pair_label = np.empty(len(upair), dtype=object)
+    pair_msg = np.empty(len(upair), dtype=object)
+    for u, code in enumerate(upair):
+        k_i, a_i = divmod(int(code), len(ans.values))
+        pair_label[u] = ans.values[a_i]
+        if 0 <= k_i < len(ANSWER_KINDS):
+            pair_msg[u], pair_label[u], pair_value[u] = _check_answer(ANSWER_KINDS[k_i], ans.values[a_i])
+    pair_bad = np.fromiter((m is not None for m in pair_msg), dtype=bool, count=len(pair_msg))
+    bad = np.flatnonzero(pair_bad[pair_inv])
+    col.total += len(bad)
+    for i in bad[:MAX_LISTED]:
+        col.problems.append(Problem(col.file, int(i) + 2, "answer", str(pair_msg[pair_inv[i]])))
+    return pair_label, pair_value, pair_inv
+
+
+def _clip_needs(cu: pd.DataFrame) -> dict[str, tuple[np.ndarray, str]]:
+    """section_type -> (per clip of ``cu``: lacks what the section needs, message)."""
+    first, last = GAIT_EMOTIONS[0], GAIT_EMOTIONS[-1]
+    no_intended = cu[first].isna().to_numpy()
+    no_theme = cu["theme"].isin(["", None]).to_numpy() | cu["theme"].isna().to_numpy()
+    no_vad = cu[list(VAD_DIMENSIONS)].isna().any(axis=1).to_numpy()
+    return {
+        "emotion_choice": (no_intended, f"has no intended emotion vector ({first}..{last}) in clips.csv"),
+        "emotion_transition": (no_intended | cu[FINAL_EMOTION_COLUMNS[0]].isna().to_numpy(),
+                               f"needs initial ({first}..{last}) and final_* emotion vectors in clips.csv"),
+        "theme_rating": (no_theme | (cu["weight"].isna() | cu["n_features"].isna()).to_numpy(),
+                         "needs theme, weight and n_features in clips.csv"),
+        "theme_inversion": (no_theme, "needs a theme in clips.csv"),
+        "gesture_emotion": (~cu["emotion_label"].isin(GESTURE_EMOTIONS).to_numpy() & no_vad,
+                            f"needs an NRC-VAD emotion_label or {'/'.join(VAD_DIMENSIONS)} in clips.csv"),
+    }
+
+
+def _check_clips(clip: _CodedColumn, section_rows: np.ndarray, clips: pd.DataFrame, rows: _RowProblems) -> None:
+    """clip_id known, and the clip carries what its row's section needs."""
+    known = pd.Index(clip.values).isin(clips.index)
+    rows.add(clip.mask(~known), "clip_id", lambda v: f"unknown clip {v!r} (not in clips.csv)", clip)
+    for section, (missing, msg) in _clip_needs(clips.reindex(clip.values)).items():
+        bad = clip.mask(known & missing) & (section_rows == section)
+        rows.add(bad, "clip_id", lambda v, msg=msg: f"clip {v!r} {msg}", clip)
+
+
+def _check_response_ms(rms: _CodedColumn, rows: _RowProblems) -> np.ndarray:
+    """response_ms blank or a number >= 0. Returns the per-distinct-value milliseconds (NaN if blank)."""
+    ms = pd.to_numeric(pd.Series(rms.values, dtype=object), errors="coerce").to_numpy(float)
+    bad = (rms.values != "") & ~(ms >= 0)
+    rows.add(rms.mask(bad), "response_ms", lambda v: f"{v!r} is not a number of milliseconds >= 0", rms)
+    return ms
 
 
 def read_responses(src, clips: pd.DataFrame, participants: pd.DataFrame | None = None) -> pd.DataFrame:
@@ -294,139 +438,25 @@ def read_responses(src, clips: pd.DataFrame, participants: pd.DataFrame | None =
     response_ms (float, NaN if blank) and _line (file line number).
     """
     name = _name(src, "responses.csv")
-    if isinstance(src, bytes):
-        src = io.BytesIO(src)
-    try:
-        raw = pd.read_csv(src, dtype="category", keep_default_na=False, na_filter=False)
-    except pd.errors.EmptyDataError as exc:
-        raise ValidationError([Problem(name, 0, "*", "file is empty (no header row)")]) from exc
-    except (pd.errors.ParserError, UnicodeDecodeError) as exc:
-        raise ValidationError([Problem(name, 0, "*", f"not a readable CSV file: {exc}")]) from exc
-    raw.columns = [str(c).strip() for c in raw.columns]
-    col = _Collector(name)
-    if raw.empty and not len(raw.columns):
-        raise ValidationError([Problem(name, 0, "*", "file is empty (no header row)")])
-    raw["_line"] = np.arange(2, len(raw) + 2)
-    _check_columns(raw, RESPONSE_COLUMNS, col)
+    raw = _read_categorical(src, name)
+    rows = _RowProblems(name, raw["_line"])
+    _check_columns(raw, RESPONSE_COLUMNS, rows.col)
+    coded = {c: _CodedColumn(raw[c], lower=c in _LOWERED) for c in RESPONSE_COLUMNS}
+    sec, qst = coded["section_type"], coded["question"]
+    _check_participants(coded["participant_id"], participants, rows)
+    kind = _answer_kinds(sec, qst)
+    _check_sections(sec, qst, kind, rows)
+    pair_label, pair_value, pair_inv = _check_answers(kind, coded["answer"], rows.col)
+    _check_clips(coded["clip_id"], sec.rows(), clips, rows)
+    ms = _check_response_ms(coded["response_ms"], rows)
+    if rows.col.total:
+        raise ValidationError(sorted(rows.col.problems, key=lambda p: p.line)[:MAX_LISTED], rows.col.total)
     n = len(raw)
-    pid = _CodedColumn(raw["participant_id"])
-    sec = _CodedColumn(raw["section_type"], lower=True)
-    clip = _CodedColumn(raw["clip_id"])
-    qst = _CodedColumn(raw["question"], lower=True)
-    ans = _CodedColumn(raw["answer"])
-    rms = _CodedColumn(raw["response_ms"])
-    shown = pd.DataFrame({"_line": raw["_line"]})
-
-    def add(mask, column, message, coded: _CodedColumn):
-        mask = np.asarray(mask, dtype=bool)
-        if mask.any():
-            idx = np.flatnonzero(mask)[:MAX_LISTED]
-            shown.loc[shown.index[idx], column] = coded.values[coded.codes[idx]]
-            col.add_mask(shown, mask, column, message)
-
-    add(pid.mask(pid.values == ""), "participant_id", "participant_id is empty", pid)
-    if participants is not None:
-        unknown = (pid.values != "") & ~pd.Index(pid.values).isin(participants.index)
-        add(pid.mask(unknown), "participant_id", lambda v: f"unknown participant {v!r} (not in participants.csv)",
-            pid)
-    sections = list(SECTION_QUESTIONS)
-    add(sec.mask(~np.isin(sec.values, sections)), "section_type",
-        lambda v: f"{v!r} is not one of {', '.join(sections)}", sec)
-    # Answer kind per (section, question) pair, computed on the distinct pairs.
-    kinds = [GAIT_MULTI, LIKERT, NATURALNESS, GESTURE_CHOICE, NEUTRAL_CHOICE, THEME_RATING, INVERSION]
-    kind_table = np.full((len(sec.values), len(qst.values)), -1, dtype=np.int8)
-    for i, sv in enumerate(sec.values):
-        for j, qv in enumerate(qst.values):
-            k = SECTION_QUESTIONS.get(sv, {}).get(qv)
-            if k is not None:
-                kind_table[i, j] = kinds.index(k)
-    kind = kind_table[sec.codes, qst.codes]
-    known_sec = sec.mask(np.isin(sec.values, sections))
-    section_rows = sec.rows()
-    bad_q = known_sec & (kind < 0)
-    if bad_q.any():
-        qs_of = {s_: ", ".join(SECTION_QUESTIONS[s_]) for s_ in sections}
-        sec_at = section_rows
-        add(bad_q, "question", lambda v: f"{v!r} is not a question of its section_type "
-            f"({'; '.join(f'{s_}: {q_}' for s_, q_ in qs_of.items() if s_ in set(sec_at[bad_q]))})", qst)
-
-    # Answers: validate each distinct (kind, answer) pair once.
-    pair = kind.astype(np.int64) * len(ans.values) + ans.codes
-    upair, pair_inv = np.unique(pair, return_inverse=True)
-    pair_ok = np.ones(len(upair), dtype=bool)
-    pair_value = np.full(len(upair), np.nan)
-    pair_label = np.empty(len(upair), dtype=object)
-    alt = "|".join(GAIT_EMOTIONS)
-
-    multi_re = re.compile(rf"\s*(?:{alt})\s*(?:;\s*(?:{alt})\s*)*")
-    pair_msg = np.empty(len(upair), dtype=object)
-    for u, code in enumerate(upair):
-        k_i, a_i = divmod(int(code), len(ans.values))
-        a = ans.values[a_i]
-        pair_label[u] = a
-        if k_i < 0 or k_i >= len(kinds):
-            continue
-        k = kinds[k_i]
-        if k in INTEGER_RANGES:
-            lo, hi = INTEGER_RANGES[k]
-            try:
-                v = float(a)
-            except ValueError:
-                v = np.nan
-            if not (lo <= v <= hi and v == round(v)):
-                pair_ok[u], pair_msg[u] = False, f"{a!r} is not an integer in {lo}..{hi}"
-            else:
-                pair_value[u] = v
-        elif k == GAIT_MULTI:
-            if multi_re.fullmatch(a.lower()) is None:
-                pair_ok[u] = False
-                pair_msg[u] = f"{a!r} is not gait emotions ({', '.join(GAIT_EMOTIONS)}) joined by ';'"
-            pair_label[u] = re.sub(r"\s+", "", a.lower())
-        else:
-            allowed = NRC_VAD if k == GESTURE_CHOICE else NEUTRAL_CHOICES
-            if a.lower() not in allowed:
-                pair_ok[u], pair_msg[u] = False, f"{a!r} is not one of {', '.join(allowed)}"
-            pair_label[u] = a.lower()
-    bad_answer = ~pair_ok[pair_inv]
-    if bad_answer.any():
-        idx = np.flatnonzero(bad_answer)
-        col.total += len(idx)
-        for i in idx[:MAX_LISTED]:
-            col.problems.append(Problem(name, int(i) + 2, "answer", str(pair_msg[pair_inv[i]])))
-
-    # Clips: known, and carrying what the section needs.
-    clip_known_u = pd.Index(clip.values).isin(clips.index)
-    add(clip.mask(~clip_known_u), "clip_id", lambda v: f"unknown clip {v!r} (not in clips.csv)", clip)
-    cu = clips.reindex(clip.values)
-    no_theme = cu["theme"].isin(["", None]).to_numpy() | cu["theme"].isna().to_numpy()
-    needs = {
-        "emotion_choice": (cu["happy"].isna().to_numpy(),
-                           "has no intended emotion vector (happy..neutral) in clips.csv"),
-        "emotion_transition": ((cu["happy"].isna() | cu["final_happy"].isna()).to_numpy(),
-                               "needs initial (happy..neutral) and final_* emotion vectors in clips.csv"),
-        "theme_rating": (no_theme | (cu["weight"].isna() | cu["n_features"].isna()).to_numpy(),
-                         "needs theme, weight and n_features in clips.csv"),
-        "theme_inversion": (no_theme, "needs a theme in clips.csv"),
-        "gesture_emotion": ((~cu["emotion_label"].isin(list(NRC_VAD))
-                             & (cu["valence"].isna() | cu["arousal"].isna() | cu["dominance"].isna())).to_numpy(),
-                            "needs an NRC-VAD emotion_label or valence/arousal/dominance in clips.csv"),
-    }
-    for section, (missing_u, msg) in needs.items():
-        bad = clip.mask(clip_known_u & missing_u) & (section_rows == section)
-        add(bad, "clip_id", lambda v, msg=msg: f"clip {v!r} {msg}", clip)
-    ms_u = pd.to_numeric(pd.Series(rms.values, dtype=object), errors="coerce").to_numpy(float)
-    bad_ms_u = (rms.values != "") & ~(ms_u >= 0)
-    add(rms.mask(bad_ms_u), "response_ms", lambda v: f"{v!r} is not a number of milliseconds >= 0", rms)
-    if col.total:
-        raise ValidationError(sorted(col.problems, key=lambda p: p.line)[:MAX_LISTED], col.total)
     out = pd.DataFrame({
-        "participant_id": pid.categorical(),
-        "section_type": sec.categorical(),
-        "clip_id": clip.categorical(),
-        "question": qst.categorical(),
+        **{c: coded[c].categorical() for c in ("participant_id", "section_type", "clip_id", "question")},
         "answer": pd.Categorical.from_codes(*_recode(pair_label, pair_inv)),
         "value": pair_value[pair_inv] if n else np.empty(0),
-        "response_ms": ms_u[rms.codes] if n else np.empty(0),
+        "response_ms": ms[coded["response_ms"].codes] if n else np.empty(0),
         "_line": raw["_line"].to_numpy(),
     })
     out.attrs["ignored_columns"] = [c for c in raw.columns if c not in RESPONSE_COLUMNS and c != "_line"]

@@ -10,17 +10,17 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
+from study_protocol import GAIT_EMOTIONS, LIKERT_FEATURES
+
 from .adtest import anderson_ksamp_groups
 from .emotion import P_CEIL, P_FLOOR, ad_ksamp
-from .io import INTENDED_COLUMNS
-from .lexicon import GAIT_EMOTIONS, LIKERT_FEATURES
 
 LIKERT_VALUES = (0, 1, 2, 3, 4)
 
 
 def dominant_emotion(clips: pd.DataFrame) -> pd.Series:
     """clip_id -> dominant intended gait emotion (argmax of happy..neutral); NaN where a clip has no vector."""
-    v = clips[list(INTENDED_COLUMNS)]
+    v = clips[list(GAIT_EMOTIONS)]
     has = v.notna().all(axis=1)
     lab = pd.Series(np.asarray(GAIT_EMOTIONS, dtype=object)[np.nan_to_num(v.to_numpy(float), nan=-1).argmax(1)],
                     index=clips.index)

@@ -6,8 +6,9 @@ import numpy as np
 import pandas as pd
 from scipy import stats
 
+from study_protocol import GAIT_EMOTIONS
+
 from .emotion import answer_vectors
-from .lexicon import GAIT_EMOTIONS
 
 SYNTHETIC_PREFIX = "sim-"
 

@@ -201,10 +201,6 @@ def build_report(data: StudyData, alpha: float = 0.05, permutations: int = 0) ->
     return report, tables, extras
 
 
-FIGURES = ("fig_emotion_vectors", "fig_transitions", "fig_likert", "fig_vad", "fig_naturalness",
-           "fig_theme_ratings", "fig_inversion")
-
-
 def _make_figures(tables: dict, extras: dict) -> dict:
     return {
         "fig_emotion_vectors": figure_mod.fig_emotion_vectors(tables["gait_emotion_ad"]),

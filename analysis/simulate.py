@@ -37,29 +37,46 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 import pandas as pd
 
-from .io import CLIP_COLUMNS, PARTICIPANT_COLUMNS, RESPONSE_COLUMNS
-from .lexicon import GAIT_EMOTIONS, LIKERT_FEATURES, NEUTRAL_CHOICES, NRC_VAD, THEMES
+from study_protocol import (
+    CLIP_COLUMNS,
+    GAIT_EMOTIONS,
+    GESTURE_VAD,
+    LIKERT_FEATURES,
+    NEUTRAL_CHOICES,
+    PARTICIPANT_COLUMNS,
+    RESPONSE_COLUMNS,
+    THEMES,
+)
 
 E = len(GAIT_EMOTIONS)
-SINGLE_VECTORS = np.array([
+NEUTRAL = GAIT_EMOTIONS.index("neutral")
+SINGLE_VECTORS = np.array([  # columns in GAIT_EMOTIONS order (happy, sad, angry, neutral)
     [1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1],
     [0.7, 0, 0, 0.3], [0, 0.6, 0, 0.4], [0.2, 0, 0.8, 0], [0, 0.3, 0.7, 0],
 ], dtype=float)
 TRANSITIONS = [(0, 1), (1, 0), (0, 2), (2, 0), (1, 2), (2, 1), (3, 0), (0, 3), (3, 1), (1, 3), (3, 2), (2, 3)]
+"""(initial, final) indices into GAIT_EMOTIONS."""
+N_SHOWN_TRANSITIONS = 6
+N_NATURALNESS_PER_GROUP = 3
+N_SHOWN_GESTURES = 6
+N_GESTURE_CHOICES = 4
 WEIGHTS = (0.4, 0.7, 1.0, 1.3)
 N_FEATURES = (1, 4, 7, 10)
+
+
 def _transition_vectors() -> tuple[np.ndarray, np.ndarray]:
     """(12, 4) initial and (12, 4) final intended vectors: 0.85 of the named emotion + 0.15 neutral (pure neutral
     for neutral)."""
     eye = np.eye(E)
 
     def mix(i):
-        return eye[3] if i == 3 else 0.85 * eye[i] + 0.15 * eye[3]
+        return eye[NEUTRAL] if i == NEUTRAL else 0.85 * eye[i] + 0.15 * eye[NEUTRAL]
 
     return np.array([mix(a) for a, _ in TRANSITIONS]), np.array([mix(b) for _, b in TRANSITIONS])
 
 
-GENDERS = (("male", 0.55), ("female", 0.42), ("non-binary", 0.02), ("", 0.01))
+GENDER_SHARES = (("male", 0.55), ("female", 0.42), ("non-binary", 0.02), ("", 0.01))
+"""Self-reported gender of the simulated participants (participants.csv) and its share."""
 AGE_GROUPS = (("18-24", 0.55), ("25-34", 0.38), ("35+", 0.07))
 
 
@@ -69,28 +86,23 @@ class PerceptionModel:
 
     emotion_noise: float = 0.3
     multi_select_prob: float = 0.3
-    likert_means: dict = field(default_factory=lambda: {  # emotion -> (torso, arms, pace, flow), 0..4
-        "happy": (3.4, 3.0, 3.0, 1.2), "sad": (0.5, 0.8, 0.6, 2.0),
-        "angry": (2.6, 2.9, 3.5, 3.3), "neutral": (2.0, 2.0, 2.0, 2.0)})
+    likert_means: dict = field(default_factory=lambda: dict(zip(GAIT_EMOTIONS, (  # (torso, arms, pace, flow), 0..4
+        (3.4, 3.0, 3.0, 1.2), (0.5, 0.8, 0.6, 2.0), (2.6, 2.9, 3.5, 3.3), (2.0, 2.0, 2.0, 2.0)))))
     likert_sd: float = 0.6
     naturalness_probs: dict = field(default_factory=lambda: {  # shares of ratings 1..5
         ("gait", "generated"): (0.04, 0.07, 0.24, 0.43, 0.22), ("gait", "source"): (0.0, 0.0, 0.07, 0.35, 0.58),
         ("gesture", "generated"): (0.03, 0.06, 0.30, 0.37, 0.24),
         ("gesture", "source"): (0.04, 0.09, 0.32, 0.35, 0.20)})
     gesture_temperature: float = 0.3
-    neutral_probs: tuple = (0.75, 0.05, 0.05, 0.03, 0.05, 0.03, 0.04)  # neutral + THEMES order
+    neutral_probs: tuple = (0.75, 0.05, 0.05, 0.03, 0.05, 0.03, 0.04)  # NEUTRAL_CHOICES order
     theme_base: float = 2.0
     theme_offsets: dict = field(default_factory=lambda: {"happy": -0.5})
     weight_effect: float = 1.5
     feature_effect: float = 2.0
     theme_subject_sd: float = 0.6
     theme_noise_sd: float = 0.9
-    inversion_mean: dict = field(default_factory=lambda: {
-        "happy": -3.5, "sad": -2.5, "energetic": -1.8, "tired": -1.6, "feminine": -3.2, "masculine": -3.8})
+    inversion_mean: dict = field(default_factory=lambda: dict(zip(THEMES, (-3.5, -2.5, -1.8, -1.6, -3.2, -3.8))))
     inversion_sd: float = 2.0
-
-
-NULL_THEME_MODEL = PerceptionModel(weight_effect=0.0, feature_effect=0.0)
 
 
 def _blank_clip(**kw) -> dict:
@@ -111,21 +123,18 @@ def make_clips() -> pd.DataFrame:
                                 **vec("", v)))
         rows.append(_blank_clip(clip_id=f"sim-gait-src-{i:02d}", modality="gait", origin="source", duration_s=10.0,
                                 **vec("", v)))
-    eye = np.eye(E)
     starts, finals = _transition_vectors()
     for i, (start, final) in enumerate(zip(starts, finals), 1):
         rows.append(_blank_clip(clip_id=f"sim-trans-{i:02d}", modality="gait", origin="generated", duration_s=10.0,
                                 **vec("", start), **vec("final_", final)))
-    for label, (v, a, d) in NRC_VAD.items():
-        if label == "neutral":
-            continue
+    for label, (v, a, d) in _gesture_vad().items():
         for origin in ("generated", "source"):
             for rep in (1, 2):
                 rows.append(_blank_clip(clip_id=f"sim-gest-{origin[:3]}-{label}-{rep}", modality="gesture",
                                         origin=origin, emotion_label=label, valence=v, arousal=a, dominance=d,
                                         duration_s=8.0))
     rows.append(_blank_clip(clip_id="sim-neutral-walk", modality="gait", origin="source", duration_s=10.0,
-                            **vec("", eye[3])))
+                            **vec("", np.eye(E)[NEUTRAL])))
     for theme in THEMES:
         for w in WEIGHTS:
             for n in N_FEATURES:
@@ -134,6 +143,11 @@ def make_clips() -> pd.DataFrame:
         rows.append(_blank_clip(clip_id=f"sim-invert-{theme}", modality="gait", origin="generated", theme=theme,
                                 weight=-0.7, n_features=10, duration_s=10.0))
     return pd.DataFrame(rows, columns=list(CLIP_COLUMNS))
+
+
+def _gesture_vad() -> dict[str, tuple[float, float, float]]:
+    """The gesture categories the simulated gestures show and offer (every MPI category but neutral) -> NRC-VAD."""
+    return {label: vad for label, vad in GESTURE_VAD.items() if label != "neutral"}
 
 
 def _categorical(rng, probs: np.ndarray) -> np.ndarray:
@@ -163,6 +177,164 @@ def _frame(pids, section, clip_ids, question, answers) -> pd.DataFrame:
                          "question": question, "answer": answers})
 
 
+def _shuffled(rng, n_participants: int, n_items: int, n_shown: int | None = None) -> np.ndarray:
+    """(P, n_shown) indices: each participant's random order of ``n_items`` items, cut to the first n_shown."""
+    return np.argsort(rng.random((n_participants, n_items)), axis=1)[:, :n_shown]
+
+
+def _single_ids() -> np.ndarray:
+    return np.array([f"sim-gait-{i:02d}" for i in range(1, len(SINGLE_VECTORS) + 1)], dtype=object)
+
+
+def _emotion_choice(rng, pid_list, m: PerceptionModel) -> tuple[pd.DataFrame, np.ndarray]:
+    """Section 1: the single-emotion gaits in a random order per participant, multi-select perceived emotion.
+    Returns (answers, the (P, 8) order, which affect_likert reuses)."""
+    order = _shuffled(rng, len(pid_list), len(SINGLE_VECTORS))
+    answers = _gait_answers(rng, SINGLE_VECTORS[order.ravel()], m)
+    return _frame(np.repeat(pid_list, order.shape[1]), "emotion_choice", _single_ids()[order.ravel()], "perceived",
+                  answers), order
+
+
+def _emotion_transition(rng, pid_list, m: PerceptionModel) -> pd.DataFrame:
+    """Section 2: 6 of the 12 transitions, initial and final emotions."""
+    t_order = _shuffled(rng, len(pid_list), len(TRANSITIONS), N_SHOWN_TRANSITIONS).ravel()
+    t_ids = np.array([f"sim-trans-{i:02d}" for i in range(1, len(TRANSITIONS) + 1)], dtype=object)
+    starts, finals = _transition_vectors()
+    tp = np.repeat(pid_list, N_SHOWN_TRANSITIONS)
+    ini = _frame(tp, "emotion_transition", t_ids[t_order], "initial", _gait_answers(rng, starts[t_order], m))
+    fin = _frame(tp, "emotion_transition", t_ids[t_order], "final", _gait_answers(rng, finals[t_order], m))
+    return pd.concat([ini, fin]).sort_index(kind="stable")
+
+
+def _affect_likert(rng, pid_list, order: np.ndarray, m: PerceptionModel) -> pd.DataFrame:
+    """Section 3: the single-emotion gaits in the order of section 1, each feature of LIKERT_FEATURES on 0..4."""
+    P, n = order.shape
+    intended = SINGLE_VECTORS[order.ravel()]
+    means = np.array([m.likert_means[e] for e in GAIT_EMOTIONS])  # (4 emotions, 4 features)
+    mu = intended @ means + rng.normal(0, 0.3, (P, 1, 1)).repeat(n, axis=1).reshape(P * n, 1)
+    lik = np.clip(np.rint(mu + rng.normal(0, m.likert_sd, mu.shape)), 0, 4).astype(int)
+    F = len(LIKERT_FEATURES)
+    return pd.DataFrame({
+        "participant_id": np.repeat(np.repeat(pid_list, n), F), "section_type": "affect_likert",
+        "clip_id": np.repeat(_single_ids()[order.ravel()], F),
+        "question": np.tile(np.array(LIKERT_FEATURES, dtype=object), P * n), "answer": lik.ravel()})
+
+
+def _naturalness(rng, pid_list, clips: pd.DataFrame, m: PerceptionModel) -> pd.DataFrame:
+    """Section 4: 3 generated + 3 source clips per modality, rated 1..5."""
+    P, k = len(pid_list), N_NATURALNESS_PER_GROUP
+    gestures = clips[clips.modality == "gesture"]
+    nat = []
+    for modality, gen_ids, src_ids in (
+            ("gait", _single_ids(),
+             np.array([f"sim-gait-src-{i:02d}" for i in range(1, len(SINGLE_VECTORS) + 1)], dtype=object)),
+            ("gesture", gestures.loc[gestures.origin == "generated", "clip_id"].to_numpy(),
+             gestures.loc[gestures.origin == "source", "clip_id"].to_numpy())):
+        for origin, ids in (("generated", gen_ids), ("source", src_ids)):
+            pick = _shuffled(rng, P, len(ids), k).ravel()
+            probs = np.tile(np.asarray(m.naturalness_probs[(modality, origin)], float), (P * k, 1))
+            nat.append(_frame(np.repeat(pid_list, k), "naturalness", ids[pick], "naturalness",
+                              _categorical(rng, probs) + 1))
+    return pd.concat(nat).sort_values("participant_id", kind="stable")
+
+
+def _gesture_emotion(rng, pid_list, clips: pd.DataFrame, m: PerceptionModel) -> pd.DataFrame:
+    """Section 5: 6 generated gestures; forced choice among the intended and 3 random other categories."""
+    g = clips[(clips.modality == "gesture") & (clips.origin == "generated")]
+    g_ids, g_lab = g["clip_id"].to_numpy(), g["emotion_label"].to_numpy()
+    lexicon = _gesture_vad()
+    cats = np.array(list(lexicon), dtype=object)
+    vad = np.array(list(lexicon.values()))
+    cat_index = {c: i for i, c in enumerate(cats)}
+    pick = _shuffled(rng, len(pid_list), len(g_ids), N_SHOWN_GESTURES).ravel()
+    want = np.array([cat_index[c] for c in g_lab])[pick]
+    noise = rng.random((len(pick), len(cats)))
+    noise[np.arange(len(pick)), want] = np.inf
+    others = np.argsort(noise, axis=1)[:, :N_GESTURE_CHOICES - 1]
+    offered = np.column_stack([want, others])  # (N, 4) category indices
+    dist = np.linalg.norm(vad[offered] - vad[want][:, None, :], axis=2)
+    w = np.exp(-dist / m.gesture_temperature)
+    choice = offered[np.arange(len(pick)), _categorical(rng, w / w.sum(axis=1, keepdims=True))]
+    return _frame(np.repeat(pid_list, N_SHOWN_GESTURES), "gesture_emotion", g_ids[pick], "perceived", cats[choice])
+
+
+def _neutral_validation(rng, pid_list, m: PerceptionModel) -> pd.DataFrame:
+    """Section 6: the neutral input walk, 7-way forced choice."""
+    nv = _categorical(rng, np.tile(np.asarray(m.neutral_probs, float), (len(pid_list), 1)))
+    return _frame(pid_list, "neutral_validation", "sim-neutral-walk", "perceived",
+                  np.asarray(NEUTRAL_CHOICES, dtype=object)[nv])
+
+
+def _theme_rating(rng, pid_list, clips: pd.DataFrame, m: PerceptionModel) -> pd.DataFrame:
+    """Section 7: every theme x weight x feature-count clip in a random order, rated 1..7."""
+    th = clips[clips["theme"].ne("") & (pd.to_numeric(clips["weight"], errors="coerce") > 0)]
+    ids = th["clip_id"].to_numpy()
+    wt = pd.to_numeric(th["weight"]).to_numpy()
+    nf = pd.to_numeric(th["n_features"]).to_numpy()
+    off = np.array([m.theme_offsets.get(t, 0.0) for t in th["theme"]])
+    mean = (m.theme_base + off + m.weight_effect * (wt - 0.4) / 0.9
+            + m.feature_effect * (1 - np.exp(-(nf - 1) / 3)) / (1 - np.exp(-3)))
+    o = _shuffled(rng, len(pid_list), len(ids))
+    subj = rng.normal(0, m.theme_subject_sd, (len(pid_list), 1))
+    lat = mean[o] + subj + rng.normal(0, m.theme_noise_sd, o.shape)
+    return _frame(np.repeat(pid_list, len(ids)), "theme_rating", ids[o.ravel()], "rating",
+                  np.clip(np.rint(lat), 1, 7).astype(int).ravel())
+
+
+def _theme_inversion(rng, pid_list, clips: pd.DataFrame, m: PerceptionModel) -> pd.DataFrame:
+    """Section 8: the negative-weight clip of each theme in a random order, rated -7..7."""
+    inv = clips[pd.to_numeric(clips["weight"], errors="coerce") < 0]
+    inv_ids = inv["clip_id"].to_numpy()
+    inv_mean = np.array([m.inversion_mean[t] for t in inv["theme"]])
+    o = _shuffled(rng, len(pid_list), len(inv_ids))
+    val = np.clip(np.rint(inv_mean[o] + rng.normal(0, m.inversion_sd, o.shape)), -7, 7).astype(int)
+    return _frame(np.repeat(pid_list, len(inv_ids)), "theme_inversion", inv_ids[o.ravel()], "rating", val.ravel())
+
+
+def _all_answers(rng, pid_list, clips: pd.DataFrame, m: PerceptionModel) -> pd.DataFrame:
+    """Every participant's answers to the eight sections, in section order per participant."""
+    choice, order = _emotion_choice(rng, pid_list, m)
+    parts = [choice, _emotion_transition(rng, pid_list, m), _affect_likert(rng, pid_list, order, m),
+             _naturalness(rng, pid_list, clips, m), _gesture_emotion(rng, pid_list, clips, m),
+             _neutral_validation(rng, pid_list, m), _theme_rating(rng, pid_list, clips, m),
+             _theme_inversion(rng, pid_list, clips, m)]
+    responses = pd.concat(parts, ignore_index=True)
+    responses["answer"] = responses["answer"].astype(str)
+    responses["_p"] = responses["participant_id"].str[4:].astype(int)
+    return responses.sort_values("_p", kind="stable").reset_index(drop=True)
+
+
+def _abandon(rng, responses: pd.DataFrame, completion_rate: float) -> tuple[pd.DataFrame, np.ndarray]:
+    """A share 1 - completion_rate of participants keep only a prefix of their answers. Adds response_ms.
+    Returns (responses, per participant: quit)."""
+    per = responses.groupby("_p").size().to_numpy()
+    pos = responses.groupby("_p").cumcount().to_numpy()
+    quits = rng.random(len(per)) >= completion_rate
+    keep_n = np.where(quits, rng.integers(1, per), per)
+    responses = responses[pos < keep_n[responses["_p"].to_numpy() - 1]].drop(columns="_p").reset_index(drop=True)
+    responses["response_ms"] = np.rint(rng.lognormal(np.log(4000), 0.5, len(responses))).astype(int)
+    return responses, quits
+
+
+def _participants(rng, pid_list, quits: np.ndarray) -> pd.DataFrame:
+    """participants.csv rows: start times over two weeks, demographics, abandoned participants without an end."""
+    P = len(pid_list)
+    start = pd.Timestamp("2026-11-02T09:00:00Z") + pd.to_timedelta(rng.integers(0, 14 * 24 * 3600, P), unit="s")
+    dur = pd.to_timedelta(np.rint(rng.lognormal(np.log(600), 0.3, P)), unit="s")
+    gender = np.asarray([g for g, _ in GENDER_SHARES], dtype=object)[
+        _categorical(rng, np.tile([p for _, p in GENDER_SHARES], (P, 1)))]
+    age = np.asarray([a for a, _ in AGE_GROUPS], dtype=object)[
+        _categorical(rng, np.tile([p for _, p in AGE_GROUPS], (P, 1)))]
+    fmt = "%Y-%m-%dT%H:%M:%SZ"
+    participants = pd.DataFrame({
+        "participant_id": pid_list, "gender": gender, "age_group": age,
+        "started_at": start.strftime(fmt),
+        "completed_at": np.where(quits, "", (start + dur).strftime(fmt)),
+        "status": np.where(quits, "abandoned", "completed"),
+        "external_id": "synthetic", "feedback": ""})
+    return participants[[*PARTICIPANT_COLUMNS, "feedback"]]
+
+
 def simulate_study(n_participants: int, seed: int = 0, model: PerceptionModel | None = None,
                    completion_rate: float = 0.95, **overrides):
     """Draw a SYNTHETIC study of ``n_participants`` observers.
@@ -179,113 +351,9 @@ def simulate_study(n_participants: int, seed: int = 0, model: PerceptionModel | 
     m = replace(model or PerceptionModel(), **overrides)
     rng = np.random.default_rng(seed)
     clips = make_clips()
-    P = n_participants
-    pid_list = np.array([f"sim-{i:05d}" for i in range(1, P + 1)], dtype=object)
-    parts = []
-
-    # 1 + 3: the 8 single-emotion gaits, shown in a random order per participant.
-    single_ids = np.array([f"sim-gait-{i:02d}" for i in range(1, 9)], dtype=object)
-    order = np.argsort(rng.random((P, 8)), axis=1)
-    pids = np.repeat(pid_list, 8)
-    intended = SINGLE_VECTORS[order.ravel()]
-    parts.append(_frame(pids, "emotion_choice", single_ids[order.ravel()], "perceived",
-                        _gait_answers(rng, intended, m)))
-    # 2: 6 of 12 transitions, initial and final.
-    t_order = np.argsort(rng.random((P, 12)), axis=1)[:, :6].ravel()
-    t_ids = np.array([f"sim-trans-{i:02d}" for i in range(1, 13)], dtype=object)
-    starts, finals = _transition_vectors()
-    tp = np.repeat(pid_list, 6)
-    ini = _frame(tp, "emotion_transition", t_ids[t_order], "initial", _gait_answers(rng, starts[t_order], m))
-    fin = _frame(tp, "emotion_transition", t_ids[t_order], "final", _gait_answers(rng, finals[t_order], m))
-    parts.append(pd.concat([ini, fin]).sort_index(kind="stable"))
-    # 3: Likert on the same gaits.
-    means = np.array([m.likert_means[e] for e in GAIT_EMOTIONS])  # (4 emotions, 4 features)
-    mu = intended @ means + rng.normal(0, 0.3, (P, 1, 1)).repeat(8, axis=1).reshape(P * 8, 1)
-    lik = np.clip(np.rint(mu + rng.normal(0, m.likert_sd, mu.shape)), 0, 4).astype(int)
-    parts.append(pd.DataFrame({
-        "participant_id": np.repeat(pids, 4), "section_type": "affect_likert",
-        "clip_id": np.repeat(single_ids[order.ravel()], 4),
-        "question": np.tile(np.array(LIKERT_FEATURES, dtype=object), P * 8), "answer": lik.ravel()}))
-    # 4: naturalness, 3 generated + 3 source per modality.
-    nat = []
-    for modality, gen_ids, src_ids in (
-            ("gait", single_ids, np.array([f"sim-gait-src-{i:02d}" for i in range(1, 9)], dtype=object)),
-            ("gesture", clips.loc[(clips.modality == "gesture") & (clips.origin == "generated"), "clip_id"].to_numpy(),
-             clips.loc[(clips.modality == "gesture") & (clips.origin == "source"), "clip_id"].to_numpy())):
-        for origin, ids in (("generated", gen_ids), ("source", src_ids)):
-            pick = np.argsort(rng.random((P, len(ids))), axis=1)[:, :3].ravel()
-            probs = np.tile(np.asarray(m.naturalness_probs[(modality, origin)], float), (P * 3, 1))
-            nat.append(_frame(np.repeat(pid_list, 3), "naturalness", ids[pick], "naturalness",
-                              _categorical(rng, probs) + 1))
-    parts.append(pd.concat(nat).sort_values("participant_id", kind="stable"))
-    # 5: gesture emotion, 6 generated gestures, 4 offered choices.
-    g = clips[(clips.modality == "gesture") & (clips.origin == "generated")]
-    g_ids, g_lab = g["clip_id"].to_numpy(), g["emotion_label"].to_numpy()
-    cats = np.array([c for c in NRC_VAD if c != "neutral"], dtype=object)
-    vad = np.array([NRC_VAD[c] for c in cats])
-    cat_index = {c: i for i, c in enumerate(cats)}
-    pick = np.argsort(rng.random((P, len(g_ids))), axis=1)[:, :6].ravel()
-    want = np.array([cat_index[c] for c in g_lab])[pick]
-    noise = rng.random((len(pick), len(cats)))
-    noise[np.arange(len(pick)), want] = np.inf
-    others = np.argsort(noise, axis=1)[:, :3]
-    offered = np.column_stack([want, others])  # (N, 4) category indices
-    dist = np.linalg.norm(vad[offered] - vad[want][:, None, :], axis=2)
-    w = np.exp(-dist / m.gesture_temperature)
-    choice = offered[np.arange(len(pick)), _categorical(rng, w / w.sum(axis=1, keepdims=True))]
-    parts.append(_frame(np.repeat(pid_list, 6), "gesture_emotion", g_ids[pick], "perceived", cats[choice]))
-    # 6: neutral validation.
-    nv = _categorical(rng, np.tile(np.asarray(m.neutral_probs, float), (P, 1)))
-    parts.append(_frame(pid_list, "neutral_validation", "sim-neutral-walk", "perceived",
-                        np.asarray(NEUTRAL_CHOICES, dtype=object)[nv]))
-    # 7: theme ratings, all 96 cells in random order.
-    th = clips[clips["theme"].ne("") & (pd.to_numeric(clips["weight"], errors="coerce") > 0)]
-    ids = th["clip_id"].to_numpy()
-    wt = pd.to_numeric(th["weight"]).to_numpy()
-    nf = pd.to_numeric(th["n_features"]).to_numpy()
-    off = np.array([m.theme_offsets.get(t, 0.0) for t in th["theme"]])
-    mean = (m.theme_base + off + m.weight_effect * (wt - 0.4) / 0.9
-            + m.feature_effect * (1 - np.exp(-(nf - 1) / 3)) / (1 - np.exp(-3)))
-    o = np.argsort(rng.random((P, len(ids))), axis=1)
-    subj = rng.normal(0, m.theme_subject_sd, (P, 1))
-    lat = mean[o] + subj + rng.normal(0, m.theme_noise_sd, o.shape)
-    parts.append(_frame(np.repeat(pid_list, len(ids)), "theme_rating", ids[o.ravel()], "rating",
-                        np.clip(np.rint(lat), 1, 7).astype(int).ravel()))
-    # 8: inversion.
-    inv = clips[pd.to_numeric(clips["weight"], errors="coerce") < 0]
-    inv_ids = inv["clip_id"].to_numpy()
-    inv_mean = np.array([m.inversion_mean[t] for t in inv["theme"]])
-    o = np.argsort(rng.random((P, len(inv_ids))), axis=1)
-    val = np.clip(np.rint(inv_mean[o] + rng.normal(0, m.inversion_sd, o.shape)), -7, 7).astype(int)
-    parts.append(_frame(np.repeat(pid_list, len(inv_ids)), "theme_inversion", inv_ids[o.ravel()], "rating",
-                        val.ravel()))
-
-    responses = pd.concat(parts, ignore_index=True)
-    responses["answer"] = responses["answer"].astype(str)
-    responses["_p"] = responses["participant_id"].str[4:].astype(int)
-    responses = responses.sort_values("_p", kind="stable").reset_index(drop=True)
-    # Abandoning participants keep only a prefix of their answers.
-    per = responses.groupby("_p").size().to_numpy()
-    pos = responses.groupby("_p").cumcount().to_numpy()
-    quits = rng.random(P) >= completion_rate
-    keep_n = np.where(quits, rng.integers(1, per), per)
-    responses = responses[pos < keep_n[responses["_p"].to_numpy() - 1]].drop(columns="_p").reset_index(drop=True)
-    responses["response_ms"] = np.rint(rng.lognormal(np.log(4000), 0.5, len(responses))).astype(int)
-
-    start = pd.Timestamp("2026-11-02T09:00:00Z") + pd.to_timedelta(rng.integers(0, 14 * 24 * 3600, P), unit="s")
-    dur = pd.to_timedelta(np.rint(rng.lognormal(np.log(600), 0.3, P)), unit="s")
-    gender = np.asarray([g for g, _ in GENDERS], dtype=object)[
-        _categorical(rng, np.tile([p for _, p in GENDERS], (P, 1)))]
-    age = np.asarray([a for a, _ in AGE_GROUPS], dtype=object)[
-        _categorical(rng, np.tile([p for _, p in AGE_GROUPS], (P, 1)))]
-    fmt = "%Y-%m-%dT%H:%M:%SZ"
-    participants = pd.DataFrame({
-        "participant_id": pid_list, "gender": gender, "age_group": age,
-        "started_at": start.strftime(fmt),
-        "completed_at": np.where(quits, "", (start + dur).strftime(fmt)),
-        "status": np.where(quits, "abandoned", "completed"),
-        "external_id": "synthetic", "feedback": ""})
-    return responses[list(RESPONSE_COLUMNS)], clips, participants[[*PARTICIPANT_COLUMNS, "feedback"]]
+    pid_list = np.array([f"sim-{i:05d}" for i in range(1, n_participants + 1)], dtype=object)
+    responses, quits = _abandon(rng, _all_answers(rng, pid_list, clips, m), completion_rate)
+    return responses[list(RESPONSE_COLUMNS)], clips, _participants(rng, pid_list, quits)
 
 
 def write_study(out_dir: str, n_participants: int, seed: int = 0, **overrides) -> dict[str, str]:

@@ -1,7 +1,7 @@
 """Intended vs perceived gesture emotions in VAD space (seed 003 section 6.3.1, Fig. 7).
 
 Section ``gesture_emotion``: each answer is one emotion category (a forced choice among four). The perceived
-category is mapped to (valence, arousal, dominance) with the NRC-VAD lexicon (:data:`analysis.lexicon.NRC_VAD`).
+category is mapped to (valence, arousal, dominance) with the NRC-VAD lexicon (:data:`study_protocol.GESTURE_VAD`).
 The intended VAD of a clip is the NRC-VAD row of its ``emotion_label``; a clip whose label is blank or not in the
 lexicon uses its ``valence, arousal, dominance`` columns. Each answer gives one (intended, perceived) pair.
 """
@@ -12,12 +12,12 @@ import numpy as np
 import pandas as pd
 from scipy import stats
 
-from .lexicon import NRC_VAD, VAD_DIMENSIONS
+from study_protocol import GESTURE_VAD, VAD_DIMENSIONS
 
 
 def intended_vad(clips: pd.DataFrame) -> pd.DataFrame:
     """clip_id -> intended (valence, arousal, dominance): NRC-VAD of emotion_label, else the clip's VAD columns."""
-    lex = pd.DataFrame.from_dict(NRC_VAD, orient="index", columns=list(VAD_DIMENSIONS))
+    lex = pd.DataFrame.from_dict(GESTURE_VAD, orient="index", columns=list(VAD_DIMENSIONS))
     from_label = lex.reindex(clips["emotion_label"]).set_axis(clips.index)
     return from_label.fillna(clips[list(VAD_DIMENSIONS)])
 
@@ -25,7 +25,7 @@ def intended_vad(clips: pd.DataFrame) -> pd.DataFrame:
 def vad_pairs(responses: pd.DataFrame, clips: pd.DataFrame) -> pd.DataFrame:
     """One row per gesture_emotion answer: clip_id, intended_label, perceived_label, intended_<d>, perceived_<d>."""
     r = responses[responses["section_type"] == "gesture_emotion"]
-    lex = pd.DataFrame.from_dict(NRC_VAD, orient="index", columns=list(VAD_DIMENSIONS))
+    lex = pd.DataFrame.from_dict(GESTURE_VAD, orient="index", columns=list(VAD_DIMENSIONS))
     want = intended_vad(clips).reindex(r["clip_id"])
     got = lex.reindex(r["answer"])
     out = pd.DataFrame({"clip_id": r["clip_id"].to_numpy(),

@@ -37,8 +37,9 @@ from generation.core.paths import random_path, straight  # noqa: E402
 from generation.core.quaternion import qangle  # noqa: E402
 from generation.core.skeleton import GAIT_PARENTS  # noqa: E402
 from generation.gait.data import load_corpus_sequences, world_rotations  # noqa: E402
-from generation.gait.generate import EMOTIONS, distance_to_path, emotion_transition, generate_gaits, load_model  # noqa: E402
+from generation.gait.generate import distance_to_path, emotion_transition, generate_gaits, load_model  # noqa: E402
 from generation.gait.train import DEFAULT_WEIGHTS, rollout  # noqa: E402
+from study_protocol import GAIT_EMOTIONS  # noqa: E402
 
 PREFIX, HORIZON = 18, 42
 
@@ -148,7 +149,7 @@ def accuracy_table(pred: np.ndarray, intended: np.ndarray) -> dict:
     out = {"overall": float((pred == intended).mean()), "n": int(len(pred)),
            "confusion": np.array([[int(((intended == i) & (pred == j)).sum()) for j in range(4)]
                                   for i in range(4)]).tolist()}
-    for k, e in enumerate(EMOTIONS):
+    for k, e in enumerate(GAIT_EMOTIONS):
         sel = intended == k
         out[e] = float((pred[sel] == k).mean()) if sel.any() else None
     return out
@@ -299,7 +300,7 @@ def contact_sheet(rows: list[tuple[str, Motion]], path: Path, n_cols: int = 6):
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
-    colors = {"happy": "#d08c00", "sad": "#3366aa", "angry": "#c0392b", "neutral": "#555555"}
+    colors = dict(zip(GAIT_EMOTIONS, ("#d08c00", "#3366aa", "#c0392b", "#555555")))
     fig, axes = plt.subplots(len(rows), n_cols, figsize=(1.6 * n_cols, 2.2 * len(rows)))
     for r, (label, m) in enumerate(rows):
         T = m.num_frames
@@ -425,13 +426,13 @@ def main(argv=None) -> int:
               f"{v['other_mixture_last_third']['overall']:.2f} | {v['transition_start']['overall']:.2f} / "
               f"{v['transition_end']['overall']:.2f} | {pt['first_50_steps']:.2f} / {pt['last_50_steps']:.2f} "
               f"({pt['constant_seed_emotion_last_50']:.2f}) |")
-        print("  own emotion per class:", {e: round(v["own_emotion"][e], 2) for e in EMOTIONS},
+        print("  own emotion per class:", {e: round(v["own_emotion"][e], 2) for e in GAIT_EMOTIONS},
               "confusion (rows intended h/s/a/n, cols observed):", v["own_emotion"]["confusion"])
 
     print("\nseeds made from the intended emotion (seeds=None), observer accuracy:")
     for k, v in results["expressiveness_procedural_seeds"].items():
         for kind, t in v.items():
-            print(f"  {k} {kind}: {t['overall']:.2f}", {e: round(t[e], 2) for e in EMOTIONS}, t["confusion"])
+            print(f"  {k} {kind}: {t['overall']:.2f}", {e: round(t[e], 2) for e in GAIT_EMOTIONS}, t["confusion"])
 
     # 3. trajectory following on unseen paths
     path_rng = np.random.default_rng(2026)
@@ -481,7 +482,7 @@ def main(argv=None) -> int:
     # 6. figures
     full = motions["full"]
     rows = []
-    for k, e in enumerate(EMOTIONS):
+    for k, e in enumerate(GAIT_EMOTIONS):
         idx = int(np.flatnonzero(test_emotion.argmax(1) == k)[np.argmax(test_emotion[test_emotion.argmax(1) == k, k])])
         rows.append((f"{e} (own)", full["own"][idx]))
     sad_seed = int(np.flatnonzero(test_emotion.argmax(1) == 1)[0])

@@ -39,7 +39,8 @@ def _motion(kind: str, frames: int, fps: float):
     """A 'walk' (procedural, 21 joints, a 3 m radius loop) or a seated 'gesture' (procedural, 23 joints)."""
     import numpy as np
 
-    from generation.procedural.emotion import NRC_VAD, gait_params_for_emotion, gesture_params_for_vad
+    from generation.procedural.emotion import gait_params_for_emotion, gesture_params_for_vad
+    from study_protocol import GESTURE_VAD
     if kind == "walk":
         from generation.core.paths import curved
         from generation.procedural.walk import walk
@@ -47,7 +48,7 @@ def _motion(kind: str, frames: int, fps: float):
         return walk(gait_params_for_emotion([0.2, 0.0, 0.0, 0.8]), curved(3.0, np.radians(330), 14.0), frames, fps)
     from generation.procedural.gesture import seated_gesture
 
-    v, a, d = NRC_VAD["proud"]
+    v, a, d = GESTURE_VAD["proud"]
     return seated_gesture(gesture_params_for_vad(v, a, d, np.random.default_rng(0)), frames, fps, seed=0)
 
 

@@ -31,7 +31,7 @@ from generation.core.motion import Motion  # noqa: E402
 from generation.core.quaternion import np_qfrom_axis_angle, np_qnormalize  # noqa: E402
 from generation.core.skeleton import gait_skeleton, gesture_skeleton  # noqa: E402
 from generation.formats.bvh import read_bvh, write_bvh  # noqa: E402
-from generation.formats.captured import captured_walks, repeat_cycle  # noqa: E402
+from generation.formats.captured import captured_walks, chain_clip_repeats  # noqa: E402
 
 torch.set_num_threads(1)
 
@@ -76,7 +76,7 @@ def main() -> None:
                      f"{t * 1e3:.1f} ms / 1000 frames; bone-length deviation {before * 100:.1f} cm -> {after:.0e} m"))
 
     sk = gait_skeleton()
-    walk = repeat_cycle(captured_walks()[0], 27)                                # ~1026 frames
+    walk = chain_clip_repeats(captured_walks()[0], 27)                                # ~1026 frames
     P = walk.positions()
     n = walk.num_frames
     t = best_of(lambda: movement_features(P, walk.fps, sk, root_rotations=walk.rotations[:, 0]))

@@ -11,6 +11,7 @@ from django.urls import path, reverse
 from django.utils.html import format_html
 
 from . import views_staff
+from .forms import SectionForm
 from .models import Assignment, Clip, Participant, Response, Section, Study
 
 COMPACT = {models.JSONField: {"widget": Textarea(attrs={"rows": 2, "cols": 90})},
@@ -19,6 +20,7 @@ COMPACT = {models.JSONField: {"widget": Textarea(attrs={"rows": 2, "cols": 90})}
 
 class SectionInline(admin.StackedInline):
     model = Section
+    form = SectionForm
     formfield_overrides = COMPACT
     fk_name = "study"
     extra = 0

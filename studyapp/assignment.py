@@ -22,9 +22,11 @@ from django.db import transaction
 from django.db.models import Count
 from django.utils import timezone
 
+from study_protocol import GESTURE_EMOTIONS
+
 from .catalogue import pool_queryset
 from .models import Assignment, Clip, Participant, Section, Study
-from .questions import GESTURE_EMOTIONS
+from .pools import DEFAULT_GESTURE_OPTIONS, SUB_POOLS
 
 
 class StudyUnavailable(Exception):
@@ -56,7 +58,7 @@ def _section_counts(section: Section) -> dict[int, int]:
 
 def _gesture_options(rng: random.Random, clip: Clip, section: Section) -> list[str]:
     categories = list(section.options.get("categories") or GESTURE_EMOTIONS)
-    n_options = int(section.options.get("n_options", 4))
+    n_options = int(section.options.get("n_options", DEFAULT_GESTURE_OPTIONS))
     intended = clip.emotion_label or "neutral"
     others = [c for c in categories if c != intended]
     shown = [intended, *rng.sample(others, min(n_options - 1, len(others)))]
@@ -82,7 +84,7 @@ def plan_section(section: Section, seed: int, used: set[int], earlier: dict[int,
         return items
     base = [c for c in pool_queryset(section.pool) if c.pk not in used]
     k = section.clips_per_participant
-    if section.section_type == "naturalness" and ("generated" in section.pool or "source" in section.pool
+    if section.section_type == "naturalness" and (any(key in section.pool for key in SUB_POOLS)
                                                   or "n_source" in section.options):
         n_source = int(section.options.get("n_source", k // 2 if k else 0))
         n_generated = int(section.options.get("n_generated", (k - n_source) if k else 0))

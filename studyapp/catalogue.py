@@ -11,17 +11,14 @@ from __future__ import annotations
 import math
 
 from django.db import transaction
-from django.db.models import Q, QuerySet
+from django.db.models import QuerySet
+
+from study_protocol import CLIP_FLOAT_COLUMNS, CLIP_THEMES, GESTURE_EMOTIONS, MODALITIES, ORIGINS
 
 from .models import Clip
+from .pools import PoolError, pool_lookups
 
-FLOAT_FIELDS = ("happy", "sad", "angry", "neutral", "final_happy", "final_sad", "final_angry", "final_neutral",
-                "valence", "arousal", "dominance", "weight", "duration_s")
 TEXT_FIELDS = ("emotion_label", "theme", "webm", "poster", "plan", "source_clip_id")
-# Catalogue fields a section pool may filter on, with the lookups allowed on them.
-POOL_FIELDS = {"clip_id", "modality", "origin", "emotion_label", "theme", "weight", "n_features", "plan", "sections",
-               "duration_s", "valence", "arousal", "dominance", "happy", "sad", "angry", "neutral"}
-POOL_LOOKUPS = {"", "in", "lt", "lte", "gt", "gte", "isnull", "startswith", "contains"}
 
 
 class CatalogueError(ValueError):
@@ -50,11 +47,11 @@ def clean_record(rec: dict, index: int = 0) -> dict:
     if not clip_id:
         raise CatalogueError(f"{where}: field 'clip_id' is required")
     modality = str(rec.get("modality") or "").strip()
-    if modality not in ("gait", "gesture"):
-        raise CatalogueError(f"{where}: field 'modality' must be gait or gesture, got {modality!r}")
+    if modality not in MODALITIES:
+        raise CatalogueError(f"{where}: field 'modality' must be one of {', '.join(MODALITIES)}, got {modality!r}")
     origin = str(rec.get("origin") or "").strip()
-    if origin not in ("generated", "source"):
-        raise CatalogueError(f"{where}: field 'origin' must be generated or source, got {origin!r}")
+    if origin not in ORIGINS:
+        raise CatalogueError(f"{where}: field 'origin' must be one of {', '.join(ORIGINS)}, got {origin!r}")
     video = str(rec.get("video") or "").strip()
     if not video:
         raise CatalogueError(f"{where}: field 'video' (path relative to MEDIA_ROOT) is required")
@@ -65,7 +62,7 @@ def clean_record(rec: dict, index: int = 0) -> dict:
         raise CatalogueError(f"{where}: field 'metadata' must be a dict")
     out = {"modality": modality, "origin": origin, "video": video, "metadata": metadata,
            "loop": bool(rec.get("loop", False))}
-    for name in FLOAT_FIELDS:
+    for name in CLIP_FLOAT_COLUMNS:
         out[name] = _float(rec, name, where)
     n = rec.get("n_features")
     if _blank(n):
@@ -78,6 +75,14 @@ def clean_record(rec: dict, index: int = 0) -> dict:
     for name in TEXT_FIELDS:
         value = rec.get(name)
         out[name] = "" if _blank(value) else str(value).strip()
+    if out["theme"] and out["theme"] not in CLIP_THEMES:
+        raise CatalogueError(f"{where}: field 'theme' must be blank or one of {', '.join(CLIP_THEMES)}, "
+                             f"got {out['theme']!r}")
+    if out["theme"] and out["weight"] is None:
+        raise CatalogueError(f"{where}: field 'weight' is required for a clip with a theme (0 for the neutral walk)")
+    if modality == "gesture" and out["emotion_label"] and out["emotion_label"] not in GESTURE_EMOTIONS:
+        raise CatalogueError(f"{where}: field 'emotion_label' of a gesture must be one of "
+                             f"{', '.join(GESTURE_EMOTIONS)}, got {out['emotion_label']!r}")
     if not out["source_clip_id"]:
         for value in (rec.get("pair"), metadata.get("source_clip_id"), metadata.get("pair")):
             if not _blank(value):
@@ -118,27 +123,17 @@ def retire_superseded(plan: str, current_clip_ids: set[str], entry_ids: set[str]
 
 
 def pool_queryset(pool: dict | None) -> QuerySet:
-    """Clips matching a section's pool filter.
+    """Clips (not retired) matching a section's pool filter (see studyapp.pools for the filter language).
 
-    Keys are catalogue fields with an optional Django lookup (`weight__gt`, `theme__in`, ...), plus two
-    shorthands: `transition` (bool: has a final emotion) and `rbf` (bool: has a theme). A list value means `in`.
+    Raises CatalogueError naming the filter when the pool is not valid; sub-pools are left to the assignment.
     """
+    try:
+        calls = pool_lookups(pool)
+    except PoolError as exc:
+        raise CatalogueError(f"pool: {'; '.join(exc.errors['pool'])}") from exc
     qs = Clip.objects.filter(retired=False)
-    for key, value in (pool or {}).items():
-        if key in ("generated", "source"):      # naturalness sub-pools, handled by the assignment
-            continue
-        if key == "transition":
-            qs = qs.filter(final_happy__isnull=not bool(value))
-            continue
-        if key == "rbf":
-            qs = qs.exclude(theme="") if value else qs.filter(theme="")
-            continue
-        name, _, lookup = key.partition("__")
-        if name not in POOL_FIELDS or lookup not in POOL_LOOKUPS:
-            raise CatalogueError(f"pool filter {key!r}: unknown field or lookup (fields: {sorted(POOL_FIELDS)})")
-        if isinstance(value, list) and not lookup:
-            key = f"{name}__in"
-        qs = qs.filter(Q(**{key: value}))
+    for method, kwargs in calls:
+        qs = getattr(qs, method)(**kwargs)
     return qs
 
 

@@ -1,4 +1,5 @@
-"""Export a study's data in the public DESIGN.md formats: responses.csv, clips.csv, participants.csv.
+"""Export a study's data in the public DESIGN.md formats: responses.csv, clips.csv, participants.csv (columns:
+study_protocol), plus assignments.csv (what each participant was shown, for audits).
 
 Rows are produced by generators over `.iterator()` queries, so a large study streams in constant memory (an
 HTTP StreamingHttpResponse or a file on disk); no export builds the whole file as one string.
@@ -12,17 +13,14 @@ from pathlib import Path
 
 from django.db.models import Q
 
-from .models import Clip, Response, Study
+from study_protocol import ASSIGNMENT_COLUMNS, CLIP_COLUMNS, PARTICIPANT_COLUMNS, RESPONSE_COLUMNS
 
-RESPONSE_COLUMNS = ["participant_id", "section_type", "clip_id", "question", "answer", "response_ms"]
-CLIP_COLUMNS = ["clip_id", "modality", "origin", "happy", "sad", "angry", "neutral", "final_happy", "final_sad",
-                "final_angry", "final_neutral", "emotion_label", "valence", "arousal", "dominance", "theme",
-                "weight", "n_features", "duration_s"]
-PARTICIPANT_COLUMNS = ["participant_id", "gender", "age_group", "started_at", "completed_at", "status",
-                       "external_id"]
-# Not a DESIGN.md format: what each participant was shown (order, gesture options), for audits.
-ASSIGNMENT_COLUMNS = ["participant_id", "section_type", "section_order", "position", "clip_id", "options",
-                      "shown_at", "answered_at"]
+from .catalogue import pool_queryset
+from .models import Assignment, Clip, Response, Study
+
+__all__ = ["ASSIGNMENT_COLUMNS", "CLIP_COLUMNS", "PARTICIPANT_COLUMNS", "RESPONSE_COLUMNS", "run_report",
+           "stream_csv", "write_study_csvs"]
+
 CHUNK = 2000
 
 
@@ -33,9 +31,9 @@ class _Echo:
         return value
 
 
-def _csv_lines(header: list[str], rows: Iterable[list]) -> Iterator[str]:
+def _csv_lines(header: Iterable[str], rows: Iterable[list]) -> Iterator[str]:
     writer = csv.writer(_Echo(), lineterminator="\n")
-    yield writer.writerow(header)
+    yield writer.writerow(list(header))
     for row in rows:
         yield writer.writerow(["" if v is None else v for v in row])
 
@@ -55,8 +53,6 @@ def response_rows(study: Study) -> Iterator[list]:
 
 def study_clips(study: Study):
     """Clips assigned in the study plus those in its sections' pools."""
-    from .catalogue import pool_queryset
-
     q = Q(assignments__section__study=study)
     for section in study.sections.all():
         if section.pool:
@@ -81,8 +77,6 @@ def participant_rows(study: Study) -> Iterator[list]:
 
 
 def assignment_rows(study: Study) -> Iterator[list]:
-    from .models import Assignment
-
     qs = (Assignment.objects.filter(section__study=study).order_by("participant_id", "section__order", "position")
           .values_list("participant__public_id", "section__section_type", "section__order", "position",
                        "clip__clip_id", "options", "shown_at", "answered_at"))
@@ -97,7 +91,7 @@ def stream_csv(study: Study, kind: str) -> Iterator[str]:
     if kind == "clips":
         return _csv_lines(CLIP_COLUMNS, clip_rows(study))
     if kind == "participants":
-        return _csv_lines(PARTICIPANT_COLUMNS + feedback_keys(study), participant_rows(study))
+        return _csv_lines([*PARTICIPANT_COLUMNS, *feedback_keys(study)], participant_rows(study))
     if kind == "assignments":
         return _csv_lines(ASSIGNMENT_COLUMNS, assignment_rows(study))
     raise ValueError(f"unknown export {kind!r}; choose responses, clips, participants or assignments")

@@ -1,9 +1,11 @@
-"""Participant forms (consent, demographics, feedback) and the researcher's create-from-preset form."""
+"""Participant forms (consent, demographics, feedback), the researcher's create-from-preset form and the admin's
+section form (pool and options checked against the study protocol)."""
 from __future__ import annotations
 
 from django import forms
 
-from .models import Study
+from .models import Section, Study
+from .pools import validate_section
 from .presets import preset_choices
 
 GENDERS = [("female", "Female"), ("male", "Male"), ("non-binary", "Non-binary / another gender"),
@@ -50,3 +52,26 @@ class PresetStudyForm(forms.Form):
         if Study.objects.filter(slug=slug).exists():
             raise forms.ValidationError(f"A study with slug '{slug}' already exists.")
         return slug
+
+
+class SectionForm(forms.ModelForm):
+    """A section in the admin: every bad pool filter, option or count is an error on its field (studyapp.pools),
+    so a study can never reach a participant with a pool or options the assignment cannot use. (A field with an
+    error leaves cleaned_data, so Section.clean, which repeats the check, does not report it twice.)"""
+
+    class Meta:
+        model = Section
+        fields = "__all__"
+
+    def clean(self):
+        data = super().clean()
+        if self.has_error("section_type"):
+            return data
+        section_type = data.get("section_type")
+        fields = {"pool": data.get("pool"), "options": data.get("options"),
+                  "clips_per_participant": data.get("clips_per_participant")}
+        for name, messages in validate_section(section_type, **fields).items():
+            if not self.has_error(name) and name in self.fields:
+                for message in messages:
+                    self.add_error(name, message)
+        return data

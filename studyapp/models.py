@@ -8,8 +8,14 @@ from __future__ import annotations
 
 import secrets
 
+from django.core.exceptions import ValidationError
 from django.db import models
 from django.utils import timezone
+
+from study_protocol import MODALITIES, ORIGINS
+
+from .pools import validate_section
+from .questions import section_type_choices
 
 
 def new_token() -> str:
@@ -34,26 +40,12 @@ def new_completion_code() -> str:
     return secrets.token_hex(4).upper()
 
 
-class SectionType(models.TextChoices):
-    EMOTION_CHOICE = "emotion_choice", "Perceived gait emotion (multi-select)"
-    EMOTION_TRANSITION = "emotion_transition", "Gait emotion transition (initial and final)"
-    AFFECT_LIKERT = "affect_likert", "Pose affective features (5-point Likert)"
-    NATURALNESS = "naturalness", "Naturalness (1..5)"
-    GESTURE_EMOTION = "gesture_emotion", "Perceived gesture emotion (4 options)"
-    NEUTRAL_VALIDATION = "neutral_validation", "Neutral validation (7-way forced choice)"
-    THEME_RATING = "theme_rating", "Theme rating (1..7)"
-    THEME_INVERSION = "theme_inversion", "Theme inversion (-7..+7)"
-
-
 class Clip(models.Model):
     """One pre-rendered stimulus; fields follow the `clips.csv` columns of DESIGN.md."""
 
-    MODALITIES = [("gait", "gait"), ("gesture", "gesture")]
-    ORIGINS = [("generated", "generated"), ("source", "source")]
-
     clip_id = models.CharField(max_length=200, unique=True)
-    modality = models.CharField(max_length=10, choices=MODALITIES)
-    origin = models.CharField(max_length=10, choices=ORIGINS)
+    modality = models.CharField(max_length=10, choices=[(m, m) for m in MODALITIES])
+    origin = models.CharField(max_length=10, choices=[(o, o) for o in ORIGINS])
     happy = models.FloatField(null=True, blank=True)
     sad = models.FloatField(null=True, blank=True)
     angry = models.FloatField(null=True, blank=True)
@@ -142,7 +134,7 @@ class Section(models.Model):
 
     study = models.ForeignKey(Study, on_delete=models.CASCADE, related_name="sections")
     order = models.PositiveIntegerField(default=0)
-    section_type = models.CharField(max_length=30, choices=SectionType.choices)
+    section_type = models.CharField(max_length=30, choices=section_type_choices())
     title = models.CharField(max_length=200, blank=True)
     instructions = models.TextField(blank=True)
     pool = models.JSONField(
@@ -167,27 +159,18 @@ class Section(models.Model):
     def __str__(self) -> str:
         return f"{self.study.slug} #{self.order} {self.section_type}"
 
+    def protocol_errors(self) -> dict[str, list[str]]:
+        """Field -> messages for a bad pool, options or count (studyapp.pools; no database query)."""
+        return validate_section(self.section_type, self.pool, self.options, self.clips_per_participant)
+
     def clean(self):
-        from django.core.exceptions import ValidationError
-
-        from .catalogue import CatalogueError, pool_queryset
-
-        errors = {}
+        errors: dict[str, list[str]] = dict(self.protocol_errors())
         if self.reuse_section_id:
             other = self.reuse_section
             if other.study_id != self.study_id:
-                errors["reuse_section"] = "The reused section must belong to the same study."
+                errors["reuse_section"] = ["The reused section must belong to the same study."]
             elif (other.order, other.pk or 0) >= (self.order, self.pk or 10**12):
-                errors["reuse_section"] = "The reused section must come before this one."
-        try:
-            pool_queryset(self.pool).exists()
-            for sub in ("generated", "source"):
-                if isinstance(self.pool.get(sub), dict):
-                    pool_queryset(self.pool[sub]).exists()
-        except CatalogueError as exc:
-            errors["pool"] = str(exc)
-        if not isinstance(self.options, dict):
-            errors["options"] = "Options must be a JSON object."
+                errors["reuse_section"] = ["The reused section must come before this one."]
         if errors:
             raise ValidationError(errors)
 

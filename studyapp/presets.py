@@ -9,6 +9,8 @@ import copy
 
 from django.db import transaction
 
+from study_protocol import NEUTRAL_THEME
+
 from .questions import NATURALNESS_ANCHORS_GAIT, NATURALNESS_ANCHORS_GESTURE
 
 CONSENT = (
@@ -82,7 +84,7 @@ PRESETS: dict[str, dict] = {
         "sections": [
             {"section_type": "neutral_validation", "title": "The input walk",
              "instructions": "Which of these best describes the walk?",
-             "pool": {"modality": "gait", "theme": "neutral"}, "clips_per_participant": 1},
+             "pool": {"modality": "gait", "theme": NEUTRAL_THEME}, "clips_per_participant": 1},
             {"section_type": "theme_rating", "title": "Theme ratings",
              "instructions": "Rate the amount of the named style in each walk on a seven-point scale.",
              "pool": {"rbf": True, "weight__gt": 0}, "clips_per_participant": 0, "loop": True},

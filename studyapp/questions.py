@@ -1,5 +1,6 @@
 """Questions of each section type: wording (REFERENCE.md section 4, verbatim where the papers give it), answer
-choices, and validation of posted answers. No Django import: views and tests share it.
+choices, and validation of posted answers. No Django import: views and tests share it. The question keys and
+answer values are study_protocol's (SECTION_QUESTIONS, answer_values); only the sentences shown live here.
 
 A question is asked once per (participant, section, clip); its answer is stored as text (DESIGN.md responses.csv):
 emotion labels joined by ";" for multi-select, an integer for scales, a label for forced choice.
@@ -8,25 +9,16 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-GAIT_EMOTIONS = ("happy", "sad", "angry", "neutral")
-THEMES = ("happy", "sad", "energetic", "tired", "feminine", "masculine")
-# The 11 categories of the MPI Emotional Body Expressions database (seed 003 section 6.1).
-GESTURE_EMOTIONS = ("afraid", "amused", "angry", "ashamed", "disgusted", "joyous", "neutral", "proud", "relieved",
-                    "sad", "surprised")
-OPPOSITE_THEME = {"happy": "sad", "sad": "happy", "energetic": "tired", "tired": "energetic",
-                  "feminine": "masculine", "masculine": "feminine"}
-
-# Seed 000 Table 2 (values 0..4), verbatim.
-LIKERT_FEATURES = {
-    "torso": ("Torso", ["contracted, bowed", "somewhat contracted", "neither contracted nor expanded",
-                        "somewhat expanded", "expanded, stretched"]),
-    "arms": ("Arms", ["contracted, close to the body", "somewhat contracted", "neither contracted nor expanded",
-                      "somewhat expanded", "expanded, away from the body"]),
-    "pace": ("Gait pace", ["sustained, leisurely, slow", "somewhat sustained", "neither sustained nor hurried",
-                           "somewhat hurried", "hurried, sudden, fast"]),
-    "flow": ("Gait flow", ["free, relaxed, uncontrolled", "somewhat free", "neither free nor bound",
-                           "somewhat bound", "bound, tense, controlled"]),
-}
+from study_protocol import (
+    GESTURE_EMOTIONS,
+    INTEGER_RANGES,
+    LIKERT_LEVELS,
+    MULTI_SELECT_KINDS,
+    OPPOSITE_THEME,
+    SECTION_QUESTIONS,
+    SECTION_TYPES,
+    answer_values,
+)
 
 # Seed 000 section 6.3.4 anchors and seed 003 Table 2 markers (1..5), verbatim.
 NATURALNESS_ANCHORS_GAIT = {"1": "not natural at all", "3": "satisfactory", "5": "very natural"}
@@ -38,6 +30,42 @@ NATURALNESS_ANCHORS_GESTURE = {
     "5": "Looks great! (the gestures look like they could be from a real person)",
 }
 
+@dataclass(frozen=True)
+class SectionWording:
+    """What a section type says: its name in the admin and, per question key, the (text, help) shown."""
+    label: str
+    questions: dict[str, tuple[str, str]]
+
+
+# The keys and the answers are study_protocol.SECTION_QUESTIONS'; theme sections fill in {theme} and {opposite},
+# naturalness may replace its text (Section.options["question"]).
+WORDING: dict[str, SectionWording] = {
+    "emotion_choice": SectionWording("Perceived gait emotion (multi-select)", {
+        "perceived": ("Which emotion(s) do you perceive from this walk?",
+                      "Select every emotion you perceive; more than one is allowed.")}),
+    "emotion_transition": SectionWording("Gait emotion transition (initial and final)", {
+        "initial": ("Which emotion(s) do you perceive at the start of the clip?", "More than one is allowed."),
+        "final": ("Which emotion(s) do you perceive at the end of the clip?", "More than one is allowed.")}),
+    "affect_likert": SectionWording("Pose affective features (5-point Likert)", {
+        key: (label, "") for key, (label, _levels) in LIKERT_LEVELS.items()}),
+    "naturalness": SectionWording("Naturalness (1..5)", {
+        "naturalness": ("How natural and smooth does this animation look?", "")}),
+    "gesture_emotion": SectionWording("Perceived gesture emotion (4 options)", {
+        "perceived": ("Which emotion do you perceive from the gestures?", "")}),
+    "neutral_validation": SectionWording("Neutral validation (7-way forced choice)", {
+        "perceived": ("Which of these best describes the walk?", "Choose one.")}),
+    "theme_rating": SectionWording("Theme rating (1..7)", {
+        "rating": ("How {theme} does this walk look?", "Seven-point scale; choose one.")}),
+    "theme_inversion": SectionWording("Theme inversion (-7..+7)", {
+        "rating": ("Does this walk look {opposite} or {theme}?",
+                   "From -7 (maximum opposite theme) through 0 (neutral) to +7 (maximum {theme}).")}),
+}
+
+
+def section_type_choices() -> list[tuple[str, str]]:
+    """(section type, admin label) for every study_protocol.SECTION_TYPES entry, in the protocol's order."""
+    return [(t, WORDING[t].label if t in WORDING else t) for t in SECTION_TYPES]
+
 
 class AnswerError(ValueError):
     """A posted answer that is missing or out of range; the message names the question."""
@@ -47,9 +75,10 @@ class AnswerError(ValueError):
 class Question:
     key: str                       # the `question` column of responses.csv
     text: str
-    kind: str                      # "multi" | "single" | "scale"
+    kind: str                      # how it is shown: "multi" | "single" | "scale"
     choices: list[tuple[str, str]] = field(default_factory=list)   # (value, label)
     help: str = ""
+    answer_kind: str = ""          # study_protocol's answer kind (SECTION_QUESTIONS)
 
     def clean(self, raw: list[str]) -> str:
         """Validate the posted values of this question (a list, as from QueryDict.getlist) -> stored answer."""
@@ -68,59 +97,61 @@ class Question:
         return values[0]
 
 
-def _scale(lo: int, hi: int, labels: dict[str, str]) -> list[tuple[str, str]]:
-    return [(str(v), labels.get(str(v), "")) for v in range(lo, hi + 1)]
+def _widget(kind: str) -> str:
+    if kind in MULTI_SELECT_KINDS:
+        return "multi"
+    return "scale" if kind in INTEGER_RANGES else "single"
+
+
+def _value_labels(section_type: str, key: str, options: dict, theme: str, opposite: str) -> dict[str, str]:
+    """Labels of some answer values (a scale's anchors); values without one show no label, choices their name."""
+    if section_type == "affect_likert":
+        return {str(i): text for i, text in enumerate(LIKERT_LEVELS[key][1])}
+    if section_type == "naturalness":
+        return {str(k): v for k, v in (options.get("anchors") or NATURALNESS_ANCHORS_GAIT).items()}
+    if section_type == "theme_rating":
+        return {"1": "not at all", "7": f"maximum {theme}"}
+    if section_type == "theme_inversion":
+        return {"-7": f"maximum {opposite} (opposite theme)", "0": "neutral", "7": f"maximum {theme} (original theme)"}
+    return {}
+
+
+def _values(section_type: str, kind: str, shown_options: list[str] | None) -> tuple[str, ...]:
+    if section_type != "gesture_emotion":
+        return answer_values(kind)
+    if not shown_options:
+        raise ValueError("gesture_emotion needs the options shown to the participant")
+    unknown = [e for e in shown_options if e not in GESTURE_EMOTIONS]
+    if unknown:
+        raise ValueError(f"gesture_emotion options {unknown} are not gesture emotions ({', '.join(GESTURE_EMOTIONS)})")
+    return tuple(shown_options)
 
 
 def questions_for(section_type: str, options: dict | None = None, clip_theme: str = "",
                   shown_options: list[str] | None = None) -> list[Question]:
-    """The questions asked about one clip in a section of `section_type`.
+    """The questions asked about one clip in a section of `section_type`: the keys and answer values of
+    study_protocol.SECTION_QUESTIONS with the wording above.
 
-    options: Section.options (anchors for naturalness, categories...); clip_theme: the clip's RBF theme (theme
-    sections name it); shown_options: the four emotions drawn for this participant and clip (gesture_emotion).
+    options: Section.options (anchors and question for naturalness...); clip_theme: the clip's RBF theme (theme
+    sections name it); shown_options: the emotions drawn for this participant and clip (gesture_emotion).
     """
+    if section_type not in SECTION_QUESTIONS:
+        raise ValueError(f"unknown section_type {section_type!r}")
     options = options or {}
-    emotions = [(e, e.capitalize()) for e in GAIT_EMOTIONS]
-    if section_type == "emotion_choice":
-        return [Question("perceived", "Which emotion(s) do you perceive from this walk?", "multi", emotions,
-                         "Select every emotion you perceive; more than one is allowed.")]
-    if section_type == "emotion_transition":
-        return [
-            Question("initial", "Which emotion(s) do you perceive at the start of the clip?", "multi", emotions,
-                     "More than one is allowed."),
-            Question("final", "Which emotion(s) do you perceive at the end of the clip?", "multi", emotions,
-                     "More than one is allowed."),
-        ]
-    if section_type == "affect_likert":
-        return [Question(key, label, "scale", [(str(i), text) for i, text in enumerate(levels)])
-                for key, (label, levels) in LIKERT_FEATURES.items()]
-    if section_type == "naturalness":
-        anchors = {str(k): v for k, v in (options.get("anchors") or NATURALNESS_ANCHORS_GAIT).items()}
-        text = options.get("question") or "How natural and smooth does this animation look?"
-        return [Question("naturalness", text, "scale", _scale(1, 5, anchors))]
-    if section_type == "gesture_emotion":
-        if not shown_options:
-            raise ValueError("gesture_emotion needs the options shown to the participant")
-        return [Question("perceived", "Which emotion do you perceive from the gestures?", "single",
-                         [(e, e.capitalize()) for e in shown_options])]
-    if section_type == "neutral_validation":
-        labels = ["neutral", *THEMES]
-        return [Question("perceived", "Which of these best describes the walk?", "single",
-                         [(t, t.capitalize()) for t in labels], "Choose one.")]
-    if section_type == "theme_rating":
-        theme = clip_theme or "styled"
-        return [Question("rating", f"How {theme} does this walk look?", "scale",
-                         _scale(1, 7, {"1": "not at all", "7": f"maximum {theme}"}),
-                         "Seven-point scale; choose one.")]
-    if section_type == "theme_inversion":
-        theme = clip_theme or "original theme"
-        opposite = OPPOSITE_THEME.get(clip_theme, "opposite theme")
-        labels = {"-7": f"maximum {opposite} (opposite theme)", "0": "neutral",
-                  "7": f"maximum {theme} (original theme)"}
-        return [Question("rating", f"Does this walk look {opposite} or {theme}?", "scale",
-                         [(str(v), labels.get(str(v), "")) for v in range(-7, 8)],
-                         f"From -7 (maximum opposite theme) through 0 (neutral) to +7 (maximum {theme}).")]
-    raise ValueError(f"unknown section_type {section_type!r}")
+    theme = clip_theme or ("original theme" if section_type == "theme_inversion" else "styled")
+    opposite = OPPOSITE_THEME.get(clip_theme, "opposite theme")
+    questions = []
+    for key, kind in SECTION_QUESTIONS[section_type].items():
+        text, help_text = WORDING[section_type].questions[key]
+        if section_type == "naturalness":
+            text = options.get("question") or text
+        labels = _value_labels(section_type, key, options, theme, opposite)
+        widget = _widget(kind)
+        choices = [(v, labels.get(v, "") if widget == "scale" else labels.get(v, v.capitalize()))
+                   for v in _values(section_type, kind, shown_options)]
+        questions.append(Question(key, text.format(theme=theme, opposite=opposite), widget, choices,
+                                  help_text.format(theme=theme, opposite=opposite), kind))
+    return questions
 
 
 def clean_answers(questions: list[Question], data) -> dict[str, str]:

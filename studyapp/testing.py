@@ -9,11 +9,13 @@ import hashlib
 import itertools
 from pathlib import Path
 
-from .catalogue import upsert_clips
-from .questions import GESTURE_EMOTIONS, THEMES
+from study_protocol import GAIT_EMOTIONS, GESTURE_EMOTIONS, NEUTRAL_THEME, THEMES
 
-GAIT_VECTORS = [(1, 0, 0, 0), (0, 1, 0, 0), (0, 0, 1, 0), (0, 0, 0, 1), (0.5, 0, 0, 0.5), (0, 0.5, 0.5, 0),
-                (0.6, 0.1, 0, 0.3), (0, 0.7, 0, 0.3), (0.25, 0.25, 0.25, 0.25), (0, 0, 0.8, 0.2)]
+from .catalogue import upsert_clips
+
+GAIT_VECTORS = [   # in study_protocol.GAIT_EMOTIONS order; GAIT_VECTORS[3] is pure neutral
+    (1, 0, 0, 0), (0, 1, 0, 0), (0, 0, 1, 0), (0, 0, 0, 1), (0.5, 0, 0, 0.5), (0, 0.5, 0.5, 0),
+    (0.6, 0.1, 0, 0.3), (0, 0.7, 0, 0.3), (0.25, 0.25, 0.25, 0.25), (0, 0, 0.8, 0.2)]
 
 
 def write_media(media_root: Path, payload: bytes, suffix: str = ".mp4") -> str:
@@ -64,25 +66,51 @@ def make_catalogue(media_root: Path, video_bytes: bytes | None = None, duration_
         rec.update(extra)
         return rec
 
+    def gait(vector, prefix: str = "") -> dict:
+        return {f"{prefix}{e}": v for e, v in zip(GAIT_EMOTIONS, vector, strict=True)}
+
     vectors = itertools.cycle(GAIT_VECTORS)
     for i in range(n_gait):
-        h, s, a, n = next(vectors)
-        records.append(base(f"gait_gen_{i:02d}", "gait", "generated", happy=h, sad=s, angry=a, neutral=n))
+        records.append(base(f"gait_gen_{i:02d}", "gait", "generated", **gait(next(vectors))))
     for i in range(n_gait_source):
-        records.append(base(f"gait_src_{i:02d}", "gait", "source", neutral=1.0, happy=0, sad=0, angry=0))
+        records.append(base(f"gait_src_{i:02d}", "gait", "source", **gait(GAIT_VECTORS[3])))
     for i in range(n_transition):
-        h, s, a, n = GAIT_VECTORS[i % 4]
-        fh, fs, fa, fn = GAIT_VECTORS[(i + 1) % 4]
-        records.append(base(f"gait_tr_{i:02d}", "gait", "generated", happy=h, sad=s, angry=a, neutral=n,
-                            final_happy=fh, final_sad=fs, final_angry=fa, final_neutral=fn))
+        records.append(base(f"gait_tr_{i:02d}", "gait", "generated", **gait(GAIT_VECTORS[i % 4]),
+                            **gait(GAIT_VECTORS[(i + 1) % 4], "final_")))
     for i in range(n_gesture):
         label = GESTURE_EMOTIONS[i % len(GESTURE_EMOTIONS)]
         records.append(base(f"gest_src_{i:02d}", "gesture", "source", emotion_label=label))
         records.append(base(f"gest_gen_{i:02d}", "gesture", "generated", emotion_label=label,
                             source_clip_id=f"gest_src_{i:02d}", valence=0.5, arousal=0.5, dominance=0.5))
-    records.append(base("rbf_neutral", "gait", "source", theme="neutral", n_features=0))
+    records.append(base("rbf_neutral", "gait", "source", theme=NEUTRAL_THEME, weight=0.0,
+                        n_features=0))
     for theme in THEMES:
         for w in (0.4, 1.0):
             records.append(base(f"rbf_{theme}_{w}", "gait", "generated", theme=theme, weight=w, n_features=10))
         records.append(base(f"rbf_{theme}_inv", "gait", "generated", theme=theme, weight=-0.7, n_features=10))
     return upsert_clips(records)
+
+
+def admin_form_data(response) -> dict[str, str]:
+    """The POST data an admin change (or add) page would submit unchanged: its main form and every inline
+    formset with its management form, from the page's template context (Django test client response)."""
+    from django import forms
+
+    def fields(form) -> dict[str, str]:
+        data = {}
+        for bound in form:
+            value = bound.value()
+            if isinstance(bound.field, forms.BooleanField):
+                if value:
+                    data[bound.html_name] = "on"
+                continue
+            data[bound.html_name] = "" if value is None else str(value)
+        return data
+
+    data = fields(response.context["adminform"].form)
+    for inline in response.context["inline_admin_formsets"]:
+        formset = inline.formset
+        data.update(fields(formset.management_form))
+        for form in formset.forms:
+            data.update(fields(form))
+    return data

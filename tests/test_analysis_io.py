@@ -5,8 +5,9 @@ import io
 import pandas as pd
 import pytest
 
-from analysis.io import SECTION_QUESTIONS, ValidationError, load_study, read_clips, read_participants
+from analysis.io import ValidationError, load_study, read_clips, read_participants
 from analysis.simulate import simulate_study
+from study_protocol import SECTION_QUESTIONS
 
 
 @pytest.fixture(scope="module")

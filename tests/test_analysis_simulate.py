@@ -1,8 +1,10 @@
 """The simulator's known effects are found by the analyses, and null effects are not (most seeds)."""
 
 import numpy as np
+import pandas as pd
 import pytest
 
+import study_protocol as P
 from analysis import participants as parts_mod
 from analysis import themes, vad
 from analysis.io import load_study
@@ -19,16 +21,66 @@ def _load(r, c, p):
     return load_study(*bufs)
 
 
-def test_marked_synthetic_and_balanced_design():
+def test_marked_synthetic():
     r, c, p = simulate_study(20, seed=4, completion_rate=0.8)
     assert p["participant_id"].str.startswith("sim-").all() and c["clip_id"].str.startswith("sim-").all()
     assert (p["external_id"] == "synthetic").all()
     assert set(p.loc[p["status"] == "abandoned", "completed_at"]) <= {""}
-    done = p.loc[p["status"] == "completed", "participant_id"]
-    per = r[r["participant_id"].isin(done)].groupby("participant_id").size()
-    assert per.nunique() == 1 and per.iloc[0] == 8 + 12 + 32 + 12 + 6 + 1 + 96 + 6
     d = _load(r, c, p)
     assert parts_mod.participant_summary(d.participants, d.responses)["synthetic"] is True
+
+
+def _protocol_violations(r, c, p) -> list[str]:
+    """What in a simulated study breaks the study protocol (study_protocol), checked row by row."""
+    problems = []
+    modality = c.set_index("clip_id")["modality"]
+    for row in r.itertuples(index=False):
+        kind = P.SECTION_QUESTIONS.get(row.section_type, {}).get(row.question)
+        if kind is None:
+            problems.append(f"question {row.question!r} is not asked in {row.section_type!r}")
+            continue
+        answer = str(row.answer)
+        if kind in P.MULTI_SELECT_KINDS:
+            labels = answer.split(";")
+            order = [P.LABEL_CHOICES[kind].index(a) for a in labels if a in P.LABEL_CHOICES[kind]]
+            if len(order) != len(labels) or order != sorted(set(order)):
+                problems.append(f"{answer!r} is not distinct {kind} labels in protocol order")
+        elif answer not in P.answer_values(kind):
+            problems.append(f"{answer!r} is not a {kind} answer")
+        want = P.SECTION_MODALITY[row.section_type]
+        if row.clip_id not in modality.index:
+            problems.append(f"unknown clip {row.clip_id!r}")
+        elif want is not None and modality[row.clip_id] != want:
+            problems.append(f"{row.section_type} shows {row.clip_id!r}, not a {want} clip")
+    if not set(r["participant_id"]) <= set(p["participant_id"]):
+        problems.append("answers of unknown participants")
+    repeated = r.duplicated(["participant_id", "section_type", "clip_id", "question"])
+    problems += [f"{row.participant_id} answers {row.section_type}/{row.clip_id}/{row.question} twice"
+                 for row in r[repeated].itertuples(index=False)]
+    return problems
+
+
+def test_simulated_answers_follow_the_protocol():
+    """Every answer is a question of its section with a value in the protocol's domain, about a known clip of
+    the section's modality; no clip question is answered twice; every completed participant answered every
+    question of every section, and the same number of answers (a balanced design); read_responses accepts it."""
+    r, c, p = simulate_study(20, seed=4, completion_rate=0.8)
+    assert _protocol_violations(r, c, p) == []
+    done = p.loc[p["status"] == "completed", "participant_id"]
+    assert len(done) >= 10
+    completed = r[r["participant_id"].isin(done)]
+    asked = set(zip(completed["section_type"], completed["question"]))
+    for pid, answers in completed.groupby("participant_id"):
+        assert set(zip(answers["section_type"], answers["question"])) == asked, pid
+    assert asked == {(s, q) for s, questions in P.SECTION_QUESTIONS.items() for q in questions}
+    assert completed.groupby("participant_id").size().nunique() == 1
+    # the check can fail: a gesture answer outside the MPI categories, a Likert 5, a repeated answer
+    bad = r.copy()
+    bad.loc[bad.index[bad["section_type"] == "gesture_emotion"][0], "answer"] = "happy"
+    bad.loc[bad.index[bad["section_type"] == "affect_likert"][0], "answer"] = "5"
+    bad = pd.concat([bad, bad.iloc[[0]]])
+    assert len(_protocol_violations(bad, c, p)) == 3
+    assert len(_load(r, c, p).responses) == len(r)
 
 
 def test_same_seed_same_study():

@@ -10,7 +10,7 @@ from scipy import stats
 
 from analysis import adtest, emotion, likert, naturalness, participants, themes, vad
 from analysis.io import read_clips, read_participants, read_responses
-from analysis.lexicon import NRC_VAD
+from study_protocol import GESTURE_VAD
 
 pytestmark = pytest.mark.filterwarnings("ignore:p-value (capped|floored):UserWarning")  # scipy's own calls here
 
@@ -115,7 +115,7 @@ def test_likert_distribution_and_consistency():
 # --- VAD Pearson --------------------------------------------------------------------------------------------------
 
 def test_vad_pearson_against_hand_formula():
-    labels = [lab for lab in NRC_VAD if lab != "neutral"]
+    labels = [lab for lab in GESTURE_VAD if lab != "neutral"]
     clips = _clips([f"c{i},gesture,generated,,,,,,,,,{lab},,,,,,,8" for i, lab in enumerate(labels)])
     rng = np.random.default_rng(0)
     rows = []
@@ -126,8 +126,8 @@ def test_vad_pearson_against_hand_formula():
     r = _responses(rows, clips)
     t = vad.vad_pearson(r, clips).set_index("dimension")
     for d, col in zip(("valence", "arousal", "dominance"), range(3)):
-        x = np.array([NRC_VAD[labels[j % len(labels)]][col] for j in range(60)])
-        y = np.array([NRC_VAD[row[4]][col] for row in rows])
+        x = np.array([GESTURE_VAD[labels[j % len(labels)]][col] for j in range(60)])
+        y = np.array([GESTURE_VAD[row[4]][col] for row in rows])
         xm, ym = x - x.mean(), y - y.mean()
         rr = (xm * ym).sum() / math.sqrt((xm**2).sum() * (ym**2).sum())
         tt = rr * math.sqrt(58) / math.sqrt(1 - rr**2)

@@ -14,15 +14,14 @@ from generation.procedural.corpus import (
     sample_true_emotions,
 )
 from generation.procedural.emotion import (
-    GAIT_EMOTIONS,
-    GESTURE_EMOTIONS,
     NRC_VAD,
     gait_params_for_emotion,
     gesture_params_for_vad,
-    load_nrc_vad,
     normalize_emotion,
     simulate_annotators,
+    vad_for,
 )
+from study_protocol import GAIT_EMOTIONS, GESTURE_EMOTIONS, GESTURE_VAD
 
 
 @pytest.fixture(scope="module")
@@ -32,20 +31,17 @@ def small_corpus():
 
 # ---- emotion ---------------------------------------------------------------------------------------
 def test_nrc_vad_table_and_gesture_emotions():
-    assert len(NRC_VAD) == 12
+    assert NRC_VAD is GESTURE_VAD and len(NRC_VAD) == 11
     assert NRC_VAD["proud"] == pytest.approx((0.906, 0.700, 0.873))
     assert NRC_VAD["sad"] == pytest.approx((0.225, 0.333, 0.149))
-    assert len(GESTURE_EMOTIONS) == 11 and set(GESTURE_EMOTIONS) <= set(NRC_VAD)
+    assert tuple(NRC_VAD) == GESTURE_EMOTIONS
+    assert all(0.0 <= x <= 1.0 for vad in NRC_VAD.values() for x in vad)
 
 
-def test_nrc_vad_loader_reports_file_and_line(tmp_path):
-    bad = tmp_path / "vad.csv"
-    bad.write_text("# comment\nword,valence,arousal,dominance\nhappy,1.0,0.7,0.7\nsad,0.2,1.4,0.1\n")
-    with pytest.raises(ValueError, match=r"vad.csv:4: VAD values"):
-        load_nrc_vad(bad)
-    bad.write_text("word,valence,arousal,dominance\nsad,0.2,x,0.1\n")
-    with pytest.raises(ValueError, match=r"vad.csv:2: non-numeric"):
-        load_nrc_vad(bad)
+def test_vad_for_names_the_known_words():
+    assert vad_for(" Proud ") == NRC_VAD["proud"]
+    with pytest.raises(KeyError, match="known words"):
+        vad_for("happy")  # a gait emotion, not one of the 11 gesture categories
 
 
 def test_normalize_emotion():

@@ -11,7 +11,7 @@ from scipy.spatial.transform import Rotation
 from generation.core.features import detect_foot_contacts, foot_skate, movement_features, np_gait_affective_features
 from generation.core.motion import MotionFormatError
 from generation.core.skeleton import GAIT_JOINTS
-from generation.formats.captured import WALK_FILES, captured_walks, load_captured_walk, repeat_cycle
+from generation.formats.captured import WALK_FILES, captured_walks, chain_clip_repeats, load_captured_walk
 from generation.formats.deepmimic import DATA_DIR, deepmimic_skeleton, read_deepmimic
 
 torch.set_num_threads(1)
@@ -151,7 +151,7 @@ def test_step_phase_of_loopable_cycle_and_repeat():
     mf = movement_features(m.positions(), m.fps, m.skeleton, cyclic=True)
     omega = mf["step_frequency"]
     assert np.all(omega > 0.1) and np.all(omega < 0.25)              # about one stride per 1.3 s
-    long = repeat_cycle(m, 4)
+    long = chain_clip_repeats(m, 4)
     assert long.num_frames == 4 * m.num_frames
     P = long.positions()
     dist = np.linalg.norm(P[-1, 0, [0, 2]] - P[0, 0, [0, 2]])

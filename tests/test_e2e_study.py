@@ -16,6 +16,7 @@ from pathlib import Path
 import pytest
 from django.urls import reverse
 
+from study_protocol import SECTION_TYPES
 from studyapp.export import stream_csv
 from studyapp.models import Participant, Response, Study
 from studyapp.presets import create_study_from_preset
@@ -151,8 +152,7 @@ def test_whole_demo_study_in_chromium(chromium, live_server, settings, tmp_path)
             wait_for(driver, lambda d: "/clip/4/" in d.current_url or "/clip/3/" not in d.current_url,
                      what="back button redirect")
             driver.get(live_server.url + reverse("studyapp:resume", args=[participant.token]))
-    assert seen_types == {"emotion_choice", "emotion_transition", "affect_likert", "naturalness", "gesture_emotion",
-                          "neutral_validation", "theme_rating", "theme_inversion"}
+    assert seen_types == set(SECTION_TYPES)
     wait_for(driver, lambda d: "/feedback/" in d.current_url, what="feedback page")
     for fs in driver.find_elements(By.CSS_SELECTOR, "fieldset.question"):
         radios = fs.find_elements(By.CSS_SELECTOR, "input[type=radio]")

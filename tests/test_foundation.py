@@ -80,7 +80,10 @@ def test_production_settings_pass_check_deploy(tmp_path):
 def test_home_page_through_test_client(client):
     response = client.get("/")
     assert response.status_code == 200
-    assert b"study" in response.content.lower()
+    html = response.content.decode()
+    assert "<h1>Perceptual study of virtual-agent motion</h1>" in html
+    assert "No study is open at the moment." in html          # an empty database lists no study
+    assert 'href="/admin/"' in html
 
 
 def _free_port() -> int:
@@ -111,8 +114,9 @@ def test_real_server_page_in_headless_chromium(chromium, tmp_path):
                     raise AssertionError("gunicorn did not come up") from None
                 time.sleep(0.3)
         chromium.get(url)
-        assert "study" in chromium.page_source.lower()
-        assert chromium.title
+        assert "Perceptual study of virtual-agent motion" in chromium.page_source
+        assert "No study is open at the moment." in chromium.page_source
+        assert chromium.title == "Perceptual study"
     finally:
         server.terminate()
         server.wait(timeout=30)

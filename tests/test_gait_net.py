@@ -9,7 +9,15 @@ import torch
 
 from generation.core.motion import Motion
 from generation.core.paths import curved, sharp_turn, straight
-from generation.gait.config import GaitNetConfig
+from generation.core.rigging import yaw_quat
+from generation.formats import bvh
+from generation.gait.config import (
+    GaitDataConfig,
+    GaitLossWeights,
+    GaitModelConfig,
+    GaitNetConfig,
+    GaitTrainConfig,
+)
 from generation.gait.data import Normalizer, from_heading_frame, prepare_sequences, root_features, to_heading_frame
 from generation.gait.generate import (
     LoadedGaitNet,
@@ -58,12 +66,11 @@ def tiny_data():
 def tiny_net(tiny_data):
     torch.manual_seed(0)
     cfg = GaitNetConfig.tiny()
-    return LoadedGaitNet(GaitNet(cfg), fit_normalizer(tiny_data.subset("train")), "tiny.pt")
+    return LoadedGaitNet(GaitNet(cfg.model), fit_normalizer(tiny_data.subset("train")), "tiny.pt", config=cfg)
 
 
 def test_model_shapes_and_unit_quaternions():
-    cfg = GaitNetConfig.tiny(residual=False)
-    net = GaitNet(cfg)
+    net = GaitNet(GaitModelConfig.tiny(residual=False))
     N, L = 3, 5
     out = net(torch.randn(N, L, 21, 4), torch.randn(N, L, 18), torch.randn(N, L, 5), torch.randn(N, L, 3),
               torch.rand(N, L, 4))
@@ -74,11 +81,57 @@ def test_model_shapes_and_unit_quaternions():
     assert one["q"].shape == (N, 21, 4)
 
 
+# The flat config dict of the shipped weights (format gait_net/1, written before the config was split).
+FLAT_V1 = {"enc1_sizes": [16, 16, 8], "enc2_sizes": [16, 16, 8], "gru_hidden": 256, "gru_layers": 2,
+           "root_hidden": 32, "versor_hidden": 128, "residual": True, "use_affective": True, "emotion_skip": True,
+           "num_joints": 21, "num_emotions": 4, "seq_len": 60, "frame_step": 4, "prefix_frac": 0.3,
+           "batch_size": 64, "epochs": 28, "lr": 0.001, "lr_decay": 0.999, "tf_decay": 0.91, "grad_clip": 1.0,
+           "lambda_motion": 1.0, "lambda_versor": 1.0, "lambda_pose": 1.0, "lambda_aff": 1.0, "lambda_root": 1.0,
+           "lambda_fctc": 1.0, "lambda_phase": 1.0, "pos_scale_m": 0.1, "splice_frac": 0.3, "euler_order": "zyx",
+           "seed": 0, "notes": {}}
+
+
+def test_flat_configs_of_old_checkpoints_map_onto_the_sections():
+    cfg = GaitNetConfig.from_dict(FLAT_V1)
+    assert cfg == GaitNetConfig()   # the shipped weights were trained with the CPU default
+    odd = GaitNetConfig.from_dict({**FLAT_V1, "gru_hidden": 64, "lambda_root": 0.0, "tf_decay": 0.5,
+                                   "frame_step": 2, "pos_scale_m": 0.2, "notes": {"run": "x"}})
+    assert odd.model == GaitModelConfig(gru_hidden=64)
+    assert odd.loss == GaitLossWeights(root=0.0, pos_scale_m=0.2)
+    assert odd.train == GaitTrainConfig(tf_decay=0.5) and odd.data == GaitDataConfig(frame_step=2)
+    assert odd.notes == {"run": "x"}
+    # The split form round-trips, tuples included.
+    assert GaitNetConfig.from_dict(odd.to_dict()) == odd
+    assert set(odd.to_dict()) == {"model", "data", "train", "loss", "notes"}
+    assert GaitNetConfig.from_dict(GaitNetConfig.tiny().to_dict()).model.enc1_sizes == (8, 8)
+    with pytest.raises(ValueError, match="unknown GaitModelConfig fields"):
+        GaitNetConfig.from_dict({"model": {"gru_hiden": 3}})
+    with pytest.raises(ValueError, match="unknown GaitNetConfig fields"):
+        GaitNetConfig.from_dict({"model": {}, "optimiser": {}})
+
+
+def test_config_overrides_take_flat_and_section_names():
+    cfg = GaitNetConfig().with_overrides(gru_hidden=64, lambda_pose=0.5, **{"loss.fctc": 2.0, "train.lr": 0.01,
+                                                                           "model.enc2_sizes": [4, 4]})
+    assert (cfg.model.gru_hidden, cfg.model.enc2_sizes, cfg.loss.pose, cfg.loss.fctc, cfg.train.lr) == \
+        (64, (4, 4), 0.5, 2.0, 0.01)
+    assert GaitNetConfig() == GaitNetConfig()   # the default is not changed in place
+    with pytest.raises(ValueError, match="unknown GaitNetConfig fields"):
+        GaitNetConfig().with_overrides(**{"loss.lambda_pose": 1.0})
+    assert GaitNetConfig.paper(epochs=3).train.epochs == 3
+    assert GaitNetConfig.paper().model == GaitModelConfig.paper()
+    assert GaitNetConfig().prefix_len == GaitDataConfig().prefix_len == 18
+    with pytest.raises(TypeError, match="GaitModelConfig"):
+        GaitNet(GaitNetConfig.tiny())
+
+
 def test_emotion_skip_wiring_and_old_configs():
     old = GaitNetConfig.tiny(emotion_skip=False).to_dict()
-    del old["emotion_skip"]
-    assert GaitNetConfig.from_dict(old).emotion_skip is False   # checkpoints from before the field
-    net = GaitNet(GaitNetConfig.tiny(emotion_skip=True))
+    flat = {**old["model"], **old["data"], **old["train"], **{f"lambda_{k}": v for k, v in old["loss"].items()
+                                                              if k not in ("pos_scale_m", "euler_order")}}
+    del flat["emotion_skip"]
+    assert GaitNetConfig.from_dict(flat).model.emotion_skip is False   # checkpoints from before the field
+    net = GaitNet(GaitModelConfig.tiny(emotion_skip=True))
     q, zeros = torch.randn(2, 3, 21, 4), (torch.zeros(2, 3, 18), torch.zeros(2, 3, 5), torch.zeros(2, 3, 3))
     a = net(q, *zeros, torch.eye(4)[[0, 0]][:, None].expand(2, 3, 4))
     b = net(q, *zeros, torch.eye(4)[[1, 1]][:, None].expand(2, 3, 4))
@@ -86,8 +139,10 @@ def test_emotion_skip_wiring_and_old_configs():
 
 
 def test_paper_config_has_released_size_and_ablation_drops_affective_branch():
-    assert 9.5e6 < GaitNet(GaitNetConfig.paper()).num_parameters() < 10.5e6
-    ablated = GaitNet(GaitNetConfig.tiny(use_affective=False))
+    assert 9.5e6 < GaitNet(GaitNetConfig.paper().model).num_parameters() < 10.5e6
+    assert 9.5e6 < GaitNet(GaitModelConfig.paper()).num_parameters() < 10.5e6
+    assert GaitNet(GaitNetConfig().model).num_parameters() < 1e6   # the CPU default
+    ablated = GaitNet(GaitModelConfig.tiny(use_affective=False))
     assert ablated.fc_enc1 is None
     with pytest.raises(ValueError, match="unknown GaitNetConfig fields"):
         GaitNetConfig.from_dict({"gru_hiden": 3})
@@ -113,6 +168,14 @@ def test_root_features_of_a_straight_walk():
     assert np.allclose(np.abs((back * rot).sum(-1)), 1.0, atol=1e-9)
 
 
+def test_heading_frame_uses_the_yaw_about_plus_y():
+    yaw = np.linspace(-7.0, 7.0, 301).reshape(7, 43)
+    q = yaw_quat(yaw)
+    assert np.allclose(q, np.stack((np.cos(yaw / 2), 0 * yaw, np.sin(yaw / 2), 0 * yaw), -1), atol=1e-15)
+    rot = np.tile([1.0, 0.0, 0.0, 0.0], (7, 43, 21, 1))
+    assert np.array_equal(from_heading_frame(rot, yaw)[..., 0, :], q)
+
+
 def test_prepared_sequences(tiny_data):
     d = tiny_data
     assert d.q.shape == (6, 60, 21, 4) and d.aff.shape == (6, 60, 18) and d.fps == 7.5
@@ -128,7 +191,7 @@ def test_prepared_sequences(tiny_data):
 def test_tiny_network_overfits_a_tiny_batch(tiny_data):
     torch.manual_seed(0)
     cfg = GaitNetConfig.tiny(gru_hidden=64, versor_hidden=64)
-    net = GaitNet(cfg)
+    net = GaitNet(cfg.model)
     data = tiny_data.subset("train")
     norm = fit_normalizer(data)
     batch = data.batch([0, 1])
@@ -136,7 +199,7 @@ def test_tiny_network_overfits_a_tiny_batch(tiny_data):
     opt = torch.optim.Adam(net.parameters(), lr=3e-3)
     losses = []
     for _ in range(40):
-        loss, _ = total_loss(rollout(net, norm, batch, 1.0, cfg.prefix_len), target, cfg)
+        loss, _ = total_loss(rollout(net, norm, batch, 1.0, cfg.prefix_len), target, cfg.loss)
         opt.zero_grad()
         loss.backward()
         opt.step()
@@ -162,7 +225,7 @@ def test_splice_histories_switches_history_and_emotion(tiny_data):
     assert torch.equal(none["q"], batch["q"]) and torch.equal(none["emotion"][:, 0], batch["emotion"])
     # Per-step emotions go through the rollout.
     cfg = GaitNetConfig.tiny()
-    pred = rollout(GaitNet(cfg), fit_normalizer(tiny_data.subset("train")), out, 0.5, P)
+    pred = rollout(GaitNet(cfg.model), fit_normalizer(tiny_data.subset("train")), out, 0.5, P)
     assert pred["q"].shape == batch["q"][:, 1:].shape
 
 
@@ -176,7 +239,8 @@ def test_training_writes_checkpoint_and_resumes(tiny_data, tmp_path):
     res = train(cfg2, tiny_data, out, ckpt, resume=True, progress=False, log=lambda *_: None)
     assert [h["epoch"] for h in res["history"]] == [1, 2]
     model, norm, payload = load_checkpoint(out)
-    assert payload["trained_on"] == "synthetic procedural corpus"
+    assert payload["trained_on"] == "synthetic procedural corpus" and payload["format"] == "gait_net/2"
+    assert GaitNetConfig.from_dict(payload["config"]) == cfg2 and model.config == cfg2.model
     bad = tmp_path / "bad.pt"
     bad.write_bytes(b"not a checkpoint")
     with pytest.raises(ValueError, match="bad.pt"):
@@ -228,7 +292,6 @@ def test_generation_rejects_short_seed_and_bad_emotions(tiny_net):
 
 
 def test_generated_motion_exports_to_bvh(tiny_net, tmp_path):
-    bvh = pytest.importorskip("generation.formats.bvh")
     seed = walk(WalkParams(), straight(10.0), 80, 30.0)
     (m,) = generate_gaits([seed], [straight(10.0)], np.array([[0, 0, 0, 1.0]]), steps=8, model=tiny_net)
     bvh.write_bvh(m, tmp_path / "g.bvh")
@@ -250,6 +313,16 @@ def test_save_and_load_model(tiny_net, tmp_path):
     loaded = load_model(path)
     for p, q in zip(loaded.model.parameters(), tiny_net.model.parameters()):
         assert torch.equal(p, q)
+    assert loaded.config == tiny_net.config
+    # A checkpoint of before the config split (flat config, format gait_net/1) loads the same way.
+    payload = torch.load(path, weights_only=False)
+    c = tiny_net.config
+    flat = {**c.model.to_dict(), **c.data.to_dict(), **c.train.to_dict(), "notes": c.notes,
+            "pos_scale_m": c.loss.pos_scale_m, "euler_order": c.loss.euler_order,
+            **{f"lambda_{k}": v for k, v in c.loss.to_dict().items() if k not in ("pos_scale_m", "euler_order")}}
+    old = tmp_path / "old.pt"
+    torch.save({**payload, "format": "gait_net/1", "config": flat}, old)
+    assert load_model(old).config == tiny_net.config
 
 
 def test_shipped_weights_load_and_generate():
@@ -257,6 +330,7 @@ def test_shipped_weights_load_and_generate():
         pytest.skip(f"shipped weights absent: {DEFAULT_WEIGHTS} (train with `python -m generation.gait.train`)")
     assert DEFAULT_WEIGHTS.stat().st_size < 10 * 2 ** 20
     net = load_default_model()
+    assert net.config == GaitNetConfig.from_dict(FLAT_V1) and net.fps == 7.5   # a gait_net/1 file
     seed = walk(WalkParams(), straight(10.0), 80, 30.0)
     (m,) = generate_gaits([seed], [curved(5.0, 1.0, 15.0)], np.array([[0.7, 0.1, 0.1, 0.1]]), steps=30, model=net)
     assert m.num_frames == 29 * 4 + 1
@@ -277,8 +351,14 @@ def test_command_line_options_build_the_config():
     args = build_parser().parse_args(["--no-root-loss", "--no-affective", "--epochs", "3",
                                       "--set", "gru_hidden=64", "--set", "enc1_sizes=[4, 4]"])
     cfg = config_from_args(args)
-    assert cfg.lambda_root == 0.0 and not cfg.use_affective and cfg.epochs == 3
-    assert cfg.gru_hidden == 64 and cfg.enc1_sizes == (4, 4)
-    assert build_parser().parse_args(["--paper-size"]).paper_size
+    assert cfg.loss.root == 0.0 and not cfg.model.use_affective and cfg.train.epochs == 3
+    assert cfg.model.gru_hidden == 64 and cfg.model.enc1_sizes == (4, 4)
+    assert cfg.loss == GaitLossWeights(root=0.0) and cfg.data == GaitDataConfig()
+    dotted = config_from_args(build_parser().parse_args(["--set", "loss.pose=0.5", "--set", "splice_frac=0",
+                                                         "--set", "emotion_skip=false", "--seed", "2"]))
+    assert dotted.loss.pose == 0.5 and dotted.train.splice_frac == 0 and not dotted.model.emotion_skip
+    assert dotted.train.seed == 2
+    paper = config_from_args(build_parser().parse_args(["--paper-size", "--epochs", "5"]))
+    assert paper.model == GaitModelConfig.paper() and paper.train.epochs == 5
     with pytest.raises(SystemExit):
         config_from_args(build_parser().parse_args(["--set", "no_such_field=1"]))

@@ -268,8 +268,8 @@ def test_bad_corpus_row_names_file_line_and_field(tmp_path):
     with path.open("w", newline="") as fh:
         w = csv.writer(fh)
         w.writerow(["sentence_id", "emotion", "task", "sentence"])
-        w.writerow(["a", "happy", "narration", "Fine words here."])
-        w.writerow(["b", "happy", "singing", "Wrong task."])
+        w.writerow(["a", "joyous", "narration", "Fine words here."])
+        w.writerow(["b", "joyous", "singing", "Wrong task."])
     with pytest.raises(CorpusFormatError, match=r"bad\.csv: line 3: field task"):
         load_sentences(path)
 
@@ -336,7 +336,7 @@ def test_generation_rejects_unknown_emotion_and_task(shipped):
 
 
 def test_generated_gesture_exports_to_bvh(shipped, tmp_path):
-    bvh = pytest.importorskip("generation.formats.bvh")
+    from generation.formats import bvh
     from generation.gesture.generate import generate_gesture
 
     m = generate_gesture("Look at that!", emotion="surprised", model=shipped, fps=30.0)

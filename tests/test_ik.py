@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 import torch
 
-from generation.core.ik import fit_positions_to_skeleton, inverse_kinematics, matrix_to_quaternion, two_bone_ik
+from generation.core.ik import bend_limb_to_target, fit_positions_to_skeleton, inverse_kinematics, matrix_to_quaternion
 from generation.core.kinematics import np_forward_kinematics
 from generation.core.motion import MotionFormatError
 from generation.core.quaternion import np_qangle, np_qnormalize, np_qto_matrix
@@ -103,14 +103,14 @@ def test_matrix_to_quaternion_roundtrip():
     assert np_qangle(back, q).max() < 1e-7
 
 
-def test_two_bone_ik_reaches_target_and_keeps_lengths():
+def test_bend_limb_to_target_reaches_target_and_keeps_lengths():
     sk = gait_skeleton()
     q, root = random_motion(sk, 40, seed=8)
     P = np_forward_kinematics(q, root, sk)
     hip, knee, heel, toe = (sk.index(n) for n in ("left_hip", "left_knee", "left_heel", "left_toe"))
     rng = np.random.default_rng(9)
     target = P[:, hip] + rng.normal(size=(40, 3)) * 0.25
-    out = two_bone_ik(P, sk, "left_heel", target)
+    out = bend_limb_to_target(P, sk, "left_heel", target)
     reach = np.linalg.norm(target - P[:, hip], axis=-1)
     ok = reach < 0.8
     np.testing.assert_allclose(out[ok, heel], target[ok], atol=1e-9)
@@ -120,4 +120,4 @@ def test_two_bone_ik_reaches_target_and_keeps_lengths():
     np.testing.assert_allclose(out[:, toe] - out[:, heel], P[:, toe] - P[:, heel], atol=1e-12)  # foot moved rigidly
     np.testing.assert_allclose(np.delete(out, [knee, heel, toe], 1), np.delete(P, [knee, heel, toe], 1))
     # reaching for where the heel already is changes nothing
-    np.testing.assert_allclose(two_bone_ik(P, sk, "left_heel", P[:, heel]), P, atol=1e-9)
+    np.testing.assert_allclose(bend_limb_to_target(P, sk, "left_heel", P[:, heel]), P, atol=1e-9)

@@ -6,6 +6,7 @@ import json
 import pytest
 
 from generation.plans.schema import PlanError, builtin_plans, clip_hash, intent_fields, load_plan, validate_plan
+from study_protocol import GESTURE_EMOTIONS, SECTION_TYPES
 
 
 def _plan(*clips, render=None):
@@ -131,8 +132,7 @@ def test_builtin_plans_cover_the_papers():
     demo = load_plan("demo")
     assert 12 <= len(demo.entries) <= 16
     sections = {s for e in demo.entries for s in e.sections}
-    assert sections == {"emotion_choice", "emotion_transition", "affect_likert", "naturalness", "gesture_emotion",
-                        "neutral_validation", "theme_rating", "theme_inversion"}
+    assert sections == set(SECTION_TYPES)
 
     s000 = load_plan("seed000")
     singles = [e for e in s000.entries if "emotion" in e.inputs]
@@ -145,9 +145,7 @@ def test_builtin_plans_cover_the_papers():
     s003 = load_plan("seed003")
     generated = [e for e in s003.entries if e.origin == "generated"]
     source = {e.id: e for e in s003.entries if e.origin == "source"}
-    assert {e.inputs["emotion_label"] for e in generated} == {
-        "afraid", "amused", "angry", "ashamed", "disgusted", "joyous", "neutral", "proud", "relieved", "sad",
-        "surprised"}
+    assert {e.inputs["emotion_label"] for e in generated} == set(GESTURE_EMOTIONS)
     assert all(e.pair in source and source[e.pair].inputs["emotion_label"] == e.inputs["emotion_label"]
                for e in generated)
 

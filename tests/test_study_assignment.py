@@ -7,6 +7,7 @@ from collections import Counter
 import pytest
 from django.db import connection
 
+from study_protocol import SECTION_TYPES
 from studyapp.assignment import StudyUnavailable, plan_study, start_participant
 from studyapp.models import Assignment, Participant, Section, Study
 from studyapp.presets import PRESETS, create_study_from_preset
@@ -33,8 +34,7 @@ def started(study: Study, n: int = 1) -> list[Participant]:
 def test_presets_create_every_section_type(catalogue):
     study = create_study_from_preset("demo", "demo", status="open")
     types = list(study.sections.order_by("order").values_list("section_type", flat=True))
-    assert set(types) == {"emotion_choice", "emotion_transition", "affect_likert", "naturalness", "gesture_emotion",
-                          "neutral_validation", "theme_rating", "theme_inversion"}
+    assert set(types) == set(SECTION_TYPES)
     for key in PRESETS:
         s = create_study_from_preset(key, f"s-{key.replace('_', '-')}")
         assert s.sections.exists() and s.status == "draft"

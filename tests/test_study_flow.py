@@ -9,6 +9,7 @@ from django.test import Client
 from django.urls import reverse
 from django.utils import timezone
 
+from study_protocol import SECTION_TYPES
 from studyapp.assignment import current_step
 from studyapp.models import Assignment, Participant, Response, Study
 from studyapp.presets import create_study_from_preset
@@ -53,9 +54,17 @@ def demographics(client, p):
     assert r.status_code == 302
 
 
-def test_home_page_boots(client):
+def test_home_page_lists_open_studies_only(client, study):
+    create_study_from_preset("rbf_thms2016", "draft-study", title="A draft study")
+    create_study_from_preset("rbf_thms2016", "closed-study", title="A closed study", status=Study.Status.CLOSED)
     r = client.get("/")
-    assert r.status_code == 200 and b"study" in r.content.lower()
+    assert r.status_code == 200
+    html = r.content.decode()
+    assert "<h2>Open studies</h2>" in html
+    link = reverse("studyapp:study_entry", args=[study.slug])
+    assert f'href="{link}">{study.title}</a>' in html
+    assert "draft-study" not in html and "A draft study" not in html
+    assert "closed-study" not in html and "No study is open" not in html
 
 
 def test_whole_study_and_one_response_per_question(client, study):
@@ -90,9 +99,7 @@ def test_whole_study_and_one_response_per_question(client, study):
     p.refresh_from_db()
     assert p.status == "completed" and p.completed_at and p.feedback["distracted_camera"] == "yes"
     assert Response.objects.filter(participant=p).count() == expected
-    assert set(Response.objects.values_list("section__section_type", flat=True)) == {
-        "emotion_choice", "emotion_transition", "affect_likert", "naturalness", "gesture_emotion",
-        "neutral_validation", "theme_rating", "theme_inversion"}
+    assert set(Response.objects.values_list("section__section_type", flat=True)) == set(SECTION_TYPES)
 
 
 def test_double_submit_and_back_button_store_one_answer(client, study):

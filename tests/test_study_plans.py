@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import pytest
 
+from generation.plans.schema import load_plan
+from generation.render import batch
 from studyapp.assignment import plan_study
 from studyapp.catalogue import upsert_clips
 from studyapp.presets import create_study_from_preset
@@ -15,9 +17,7 @@ PAIRS = [("demo", "demo"), ("gait_ismar2020", "seed000"), ("gestures_ieeevr2021"
 
 
 def catalogue_plan(name: str) -> int:
-    plan_mod = pytest.importorskip("generation.plans.schema")
-    batch = pytest.importorskip("generation.render.batch")
-    plan = plan_mod.load_plan(name)
+    plan = load_plan(name)
     jobs, failures = batch.plan_jobs(plan)
     assert not failures
     pair_ids = {j.entry.id: j.clip_id for j in jobs}

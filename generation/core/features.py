@@ -10,7 +10,8 @@ Gait (21-joint skeleton, REFERENCE.md section 1): 11 angles in radians, 4 distan
 Gesture (23-joint skeleton, REFERENCE.md section 2): 7 angles divided by pi, 5 distance ratios, 3 area ratios = 15.
 
 The torch functions are differentiable (angles use atan2(|u x v|, u.v), which has finite gradients at 0 and pi;
-distances carry a 1e-12 m^2 epsilon inside the square root). The ``np_`` twins call the torch code in float64.
+distances carry a 1e-12 m^2 epsilon inside the square root). The ``np_`` twins call the torch code in float64;
+torch is imported when a function first runs, not with this module.
 
 Movement features (numpy, over (..., T, J, 3) sequences): root height deviation, root speed and its low-pass,
 root orientation difference, trajectory curvature, stepping phase and foot-step frequency, from foot contacts
@@ -18,11 +19,15 @@ detected with height and speed thresholds. See :func:`movement_features` and :fu
 """
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
-import torch
 from scipy.ndimage import gaussian_filter1d
 
 from .skeleton import GAIT_JOINTS, GESTURE_JOINTS, Skeleton
+
+if TYPE_CHECKING:
+    import torch
 
 # ---- feature tables (joint indices as in REFERENCE.md) ----------------------------------------------
 GAIT_ANGLES = ((17, 9, 13), (19, 9, 15), (13, 14, 15), (17, 18, 19), (12, 11, 13), (12, 11, 17),
@@ -51,14 +56,12 @@ def _names(joints, angles, dists, areas) -> tuple[str, ...]:
 GAIT_FEATURE_NAMES = _names(GAIT_JOINTS, GAIT_ANGLES, GAIT_DISTANCE_RATIOS, GAIT_AREA_RATIOS)
 #: 15 gesture feature names in the same style.
 GESTURE_FEATURE_NAMES = _names(GESTURE_JOINTS, GESTURE_ANGLES, GESTURE_DISTANCE_RATIOS, GESTURE_AREA_RATIOS)
-#: Feature kind per index: "angle", "distance_ratio" or "area_ratio".
-GAIT_FEATURE_KINDS = ("angle",) * 11 + ("distance_ratio",) * 4 + ("area_ratio",) * 3
-GESTURE_FEATURE_KINDS = ("angle",) * 7 + ("distance_ratio",) * 5 + ("area_ratio",) * 3
 
 _EPS2 = 1e-12  # m^2, keeps sqrt differentiable at zero distance
 
 
 def _check(positions: torch.Tensor, num_joints: int, what: str) -> torch.Tensor:
+    import torch
     if not isinstance(positions, torch.Tensor):
         raise TypeError(f"{what}: expected a torch.Tensor, got {type(positions).__name__}; use the np_ function")
     if positions.dim() < 2 or tuple(positions.shape[-2:]) != (num_joints, 3):
@@ -67,6 +70,7 @@ def _check(positions: torch.Tensor, num_joints: int, what: str) -> torch.Tensor:
 
 
 def _angle(P: torch.Tensor, p: int, q: int, r: int) -> torch.Tensor:
+    import torch
     u = P[..., p, :] - P[..., q, :]
     v = P[..., r, :] - P[..., q, :]
     cross = torch.linalg.cross(u, v)
@@ -74,16 +78,19 @@ def _angle(P: torch.Tensor, p: int, q: int, r: int) -> torch.Tensor:
 
 
 def _dist(P: torch.Tensor, a: int, b: int) -> torch.Tensor:
+    import torch
     diff = P[..., a, :] - P[..., b, :]
     return torch.sqrt((diff * diff).sum(-1) + _EPS2)
 
 
 def _area(P: torch.Tensor, p: int, q: int, r: int) -> torch.Tensor:
+    import torch
     cross = torch.linalg.cross(P[..., p, :] - P[..., q, :], P[..., r, :] - P[..., q, :])
     return 0.5 * torch.sqrt((cross * cross).sum(-1) + _EPS2 * _EPS2)
 
 
 def _features(P, angles, dists, areas, angle_scale: float) -> torch.Tensor:
+    import torch
     cols = [_angle(P, *a) * angle_scale for a in angles]
     cols += [_dist(P, *a) / _dist(P, *b) for a, b in dists]
     cols += [_area(P, *a) / _area(P, *b) for a, b in areas]
@@ -120,12 +127,14 @@ def gesture_affective_features(positions: torch.Tensor) -> torch.Tensor:
 
 def np_gait_affective_features(positions: np.ndarray) -> np.ndarray:
     """numpy twin of :func:`gait_affective_features`: (..., 21, 3) -> (..., 18) float64."""
+    import torch
     with torch.no_grad():
         return gait_affective_features(torch.as_tensor(np.asarray(positions, dtype=np.float64))).numpy()
 
 
 def np_gesture_affective_features(positions: np.ndarray) -> np.ndarray:
     """numpy twin of :func:`gesture_affective_features`: (..., 23, 3) -> (..., 15) float64."""
+    import torch
     with torch.no_grad():
         return gesture_affective_features(torch.as_tensor(np.asarray(positions, dtype=np.float64))).numpy()
 
@@ -387,10 +396,6 @@ def movement_features(positions: np.ndarray, fps: float, skeleton: Skeleton,
     omega = np.diff(phase, axis=-1)
     out["step_frequency"] = np.concatenate([omega[..., :1], omega], axis=-1)
     return out
-
-
-MOVEMENT_FEATURE_NAMES = ("root_height_dev", "root_speed", "root_speed_lowpass", "orientation_diff", "curvature",
-                          "step_phase", "step_frequency")
 
 
 def foot_skate(positions: np.ndarray, fps: float, skeleton: Skeleton, contacts: np.ndarray | None = None) -> dict:

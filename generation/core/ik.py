@@ -190,7 +190,7 @@ def _max_length_deviation(P: np.ndarray, skeleton: Skeleton) -> float:
     return float(np.abs(lengths - skeleton.bone_lengths()[1:]).max())
 
 
-def two_bone_ik(positions: np.ndarray, skeleton: Skeleton, end: str, target: np.ndarray) -> np.ndarray:
+def bend_limb_to_target(positions: np.ndarray, skeleton: Skeleton, end: str, target: np.ndarray) -> np.ndarray:
     """Move a two-bone chain (e.g. hip-knee-heel) so its end reaches ``target``, keeping bone lengths.
 
     The upper joint (the end's grandparent) stays where it is; the middle joint bends in the plane through the
@@ -211,7 +211,7 @@ def two_bone_ik(positions: np.ndarray, skeleton: Skeleton, end: str, target: np.
     m = skeleton.parents[e]
     u_idx = skeleton.parents[m] if m >= 0 else -1
     if u_idx < 0:
-        raise ValueError(f"two_bone_ik: {end!r} needs a parent and a grandparent")
+        raise ValueError(f"bend_limb_to_target: {end!r} needs a parent and a grandparent")
     lengths = skeleton.bone_lengths()
     l1, l2 = lengths[m], lengths[e]
     H = P[:, u_idx]

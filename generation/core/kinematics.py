@@ -3,15 +3,20 @@
 Convention (QuaterNet): ``rotations[..., j, :]`` is joint j's local rotation relative to its
 parent; the global rotation of j is ``R_global[parent(j)] * R_local[j]``; the position of j is
 ``X[parent(j)] + R_global[parent(j)] · offset[j]``; the root's local rotation is its global
-orientation and its position is given by ``root_positions``.
+orientation and its position is given by ``root_positions``. torch is imported when a function first runs, not
+with this module.
 """
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
-import torch
 
 from .quaternion import qmul, qrot
 from .skeleton import Skeleton
+
+if TYPE_CHECKING:
+    import torch
 
 
 def forward_kinematics(
@@ -33,6 +38,7 @@ def forward_kinematics(
     Returns:
         (..., J, 3) positions in metres (and global rotations when asked).
     """
+    import torch
     positions: list[torch.Tensor] = []
     global_rot: list[torch.Tensor] = []
     offsets = offsets.to(rotations.dtype)
@@ -51,12 +57,14 @@ def forward_kinematics(
 
 def fk_skeleton(rotations: torch.Tensor, root_positions: torch.Tensor, skeleton: Skeleton) -> torch.Tensor:
     """Torch forward kinematics on a :class:`Skeleton`; shapes as in :func:`forward_kinematics`."""
+    import torch
     offsets = torch.tensor(skeleton.offsets, dtype=rotations.dtype, device=rotations.device)
     return forward_kinematics(rotations, root_positions, offsets, skeleton.parents)
 
 
 def np_forward_kinematics(rotations: np.ndarray, root_positions: np.ndarray, skeleton: Skeleton) -> np.ndarray:
     """numpy forward kinematics: (..., J, 4), (..., 3) -> (..., J, 3) metres, float64."""
+    import torch
     with torch.no_grad():
         pos = fk_skeleton(torch.as_tensor(np.asarray(rotations, dtype=np.float64)),
                           torch.as_tensor(np.asarray(root_positions, dtype=np.float64)), skeleton)

@@ -207,11 +207,3 @@ def gesture_skeleton(height: float = REFERENCE_HEIGHT_M, build: str = "male") ->
     base = _mirror_offsets(_GESTURE_OFFSETS, GESTURE_JOINTS)
     return Skeleton("gesture", GESTURE_JOINTS, GESTURE_PARENTS,
                     _apply_build(base, GESTURE_JOINTS, height, build), height, build)
-
-
-def skeleton_by_name(name: str, height: float = REFERENCE_HEIGHT_M, build: str = "male") -> Skeleton:
-    """``"gait"`` or ``"gesture"`` skeleton."""
-    factories = {"gait": gait_skeleton, "gesture": gesture_skeleton}
-    if name not in factories:
-        raise ValueError(f"unknown skeleton {name!r}; expected one of {sorted(factories)}")
-    return factories[name](height, build)

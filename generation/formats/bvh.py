@@ -26,9 +26,8 @@ import re
 from pathlib import Path
 
 import numpy as np
-import torch
 
-from generation.core.ik import ik_report, solve_rotations, two_bone_ik
+from generation.core.ik import bend_limb_to_target, ik_report, solve_rotations
 from generation.core.kinematics import np_forward_kinematics
 from generation.core.motion import Motion, MotionFormatError
 from generation.core.quaternion import np_qfix, qeuler, qfrom_euler
@@ -153,6 +152,7 @@ def _parse_hierarchy(tk: _Tokens):
 
 def _euler_channels_to_quat(values: np.ndarray, order: str) -> np.ndarray:
     """(T, 3) degrees in channel order ``order`` (e.g. "zxy") to (T, 4) quaternions R = R0 R1 R2."""
+    import torch
     angles = np.zeros_like(values)
     for k, axis in enumerate(order):
         angles[:, "xyz".index(axis)] = values[:, k]
@@ -192,7 +192,29 @@ def read_bvh(path: str | Path, scale: float | None = None) -> Motion:
         raise MotionFormatError(f"{path}: cannot read ({exc.strerror or exc})") from None
     tk = _Tokens(text, path)
     names, parents, offsets, channels, end_site = _parse_hierarchy(tk)
+    values, frame_time = _read_frames(tk, sum(len(c) for c in channels))
 
+    rest = Skeleton(path.stem, tuple(names), tuple(parents), offsets).rest_positions()
+    rest_height = float(rest[:, 1].max() - rest[:, 1].min())
+    guess = "given"
+    if scale is None:
+        scale, guess = _guess_scale(rest_height)
+    if not scale > 0:
+        raise MotionFormatError(f"{path}: scale must be positive, got {scale}")
+
+    rotations, root_pos, offsets, ignored = _apply_channels(values, names, offsets, channels, rest_height)
+    skeleton = Skeleton(path.stem, tuple(names), tuple(parents), offsets * scale,
+                        height=rest_height * scale if rest_height > 0 else 1.0)
+    metadata = {"source": path.name, "format": "bvh", "bvh_scale": scale, "bvh_scale_guess": guess,
+                "bvh_channels": {names[j]: chans for j, chans in enumerate(channels) if not end_site[j]}}
+    if ignored:
+        metadata["ignored_channels"] = [f"{n}: varying position channels (first frame used as offset)"
+                                        for n in ignored]
+    return Motion(skeleton, np_qfix(rotations), root_pos * scale, 1.0 / frame_time, metadata)
+
+
+def _read_frames(tk: _Tokens, n_ch: int) -> tuple[np.ndarray, float]:
+    """The MOTION section: (T, n_ch) channel values, one line per frame, and the frame time in seconds."""
     tk.expect("MOTION")
     tk.expect("Frames:")
     n_frames = tk.integer("the frame count after 'Frames:'")
@@ -203,8 +225,6 @@ def read_bvh(path: str | Path, scale: float | None = None) -> Motion:
         raise tk.error(f"Frame Time must be positive, got {frame_time}", tk.items[tk.pos - 1][1])
     if n_frames == 0:
         raise tk.error("the file has no frames (Frames: 0)", tk.items[tk.pos - 1][1])
-    n_ch = sum(len(c) for c in channels)
-    # frame data: one line per frame
     data_line = tk.items[tk.pos][1] if tk.pos < len(tk.items) else len(tk.lines) + 1
     rows = []
     for ln in range(data_line, len(tk.lines) + 1):
@@ -223,18 +243,14 @@ def read_bvh(path: str | Path, scale: float | None = None) -> Motion:
         rows.append(row)
     if len(rows) != n_frames:
         raise tk.error(f"'Frames: {n_frames}' but the file holds {len(rows)} frame lines")
-    values = np.array(rows, dtype=np.float64).reshape(n_frames, n_ch)
+    return np.array(rows, dtype=np.float64).reshape(n_frames, n_ch), frame_time
 
-    J = len(names)
-    skel_tmp = Skeleton(path.stem, tuple(names), tuple(parents), offsets)
-    rest = skel_tmp.rest_positions()
-    rest_height = float(rest[:, 1].max() - rest[:, 1].min())
-    guess = "given"
-    if scale is None:
-        scale, guess = _guess_scale(rest_height)
-    if not scale > 0:
-        raise MotionFormatError(f"{path}: scale must be positive, got {scale}")
 
+def _apply_channels(values: np.ndarray, names: list[str], offsets: np.ndarray, channels: list[list[str]],
+                    rest_height: float):
+    """Per-joint channel blocks -> local rotations (T, J, 4), root positions (T, 3) and offsets (J, 3), in file
+    units, and the names of non-root joints whose position channels vary (only their first frame is kept)."""
+    n_frames, J = len(values), len(names)
     rotations = np.zeros((n_frames, J, 4))
     rotations[..., 0] = 1.0
     root_pos = np.tile(offsets[0], (n_frames, 1))
@@ -265,14 +281,7 @@ def read_bvh(path: str | Path, scale: float | None = None) -> Motion:
                 order += "".join(missing)
                 vals = np.concatenate([vals, np.zeros((n_frames, 3 - len(rot_idx)))], 1)
             rotations[:, j] = _euler_channels_to_quat(vals, order)
-    skeleton = Skeleton(path.stem, tuple(names), tuple(parents), offsets * scale,
-                        height=rest_height * scale if rest_height > 0 else 1.0)
-    metadata = {"source": path.name, "format": "bvh", "bvh_scale": scale, "bvh_scale_guess": guess,
-                "bvh_channels": {names[j]: chans for j, chans in enumerate(channels) if not end_site[j]}}
-    if ignored:
-        metadata["ignored_channels"] = [f"{n}: varying position channels (first frame used as offset)"
-                                        for n in ignored]
-    return Motion(skeleton, np_qfix(rotations), root_pos * scale, 1.0 / frame_time, metadata)
+    return rotations, root_pos, offsets, ignored
 
 
 def _is_float(v: str) -> bool:
@@ -292,6 +301,7 @@ def write_bvh(motion: Motion, path: str | Path, rotation_order: str = "ZXY", sca
         rotation_order: Euler channel order, a permutation of "XYZ" (e.g. "ZXY", the common mocap order).
         scale: file units per metre (1 writes metres, 100 centimetres).
     """
+    import torch
     order = rotation_order.upper()
     if sorted(order) != ["X", "Y", "Z"]:
         raise ValueError(f"rotation_order must be a permutation of 'XYZ', got {rotation_order!r}")
@@ -492,7 +502,7 @@ def _place_feet(rotations: np.ndarray, P: np.ndarray, known: np.ndarray, tgt: Sk
             e = tgt.index(end)
             if tgt.parents[e] != tgt.index(chain[1]) or tgt.parents[tgt.index(chain[1])] != tgt.index(chain[0]):
                 continue
-            Q = two_bone_ik(Q, tgt, end, P[:, e])
+            Q = bend_limb_to_target(Q, tgt, end, P[:, e])
             for c in children[e]:
                 if known[c] and lengths[c] > 1e-9:
                     d = P[:, c] - P[:, e]

@@ -96,7 +96,7 @@ def captured_walks(skeleton: Skeleton | None = None) -> list[Motion]:
     return [load_captured_walk(name, skeleton) for name, _ in WALK_FILES]
 
 
-def repeat_cycle(motion: Motion, cycles: int) -> Motion:
+def chain_clip_repeats(motion: Motion, cycles: int) -> Motion:
     """Repeat a walk clip ``cycles`` times, chaining root position and heading.
 
     Each repeat starts where the previous one ended: the displacement and yaw between the clip's first frame and

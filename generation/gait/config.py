@@ -1,50 +1,67 @@
 """Configuration of the affect-based autoregression gait network (seed 000, sections 4-5).
 
-All sizes live here so that the default (sized to train in about 20 minutes on one CPU thread)
-and the paper's released sizes (``GaitNetConfig.paper()``) are the same code path.
+As on the gesture side, the settings are split by what they configure:
+
+- :class:`GaitModelConfig`: the network's architecture (what the weights' shapes depend on);
+- :class:`GaitDataConfig`: how corpus walks become network sequences (sequence length, sampling, prefix),
+  which generation needs as well (network rate, seed length);
+- :class:`GaitTrainConfig`: the optimiser, curriculum and augmentation of a training run;
+- :class:`GaitLossWeights`: the weights of the loss terms of eq. 13 and how the terms are measured.
+
+:class:`GaitNetConfig` holds one of each. The default is sized to train in about 20 minutes on one CPU thread;
+``GaitNetConfig.paper()`` (``GaitModelConfig.paper()`` for the network alone) has the paper's released sizes,
+so both are the same code path.
+
+Weights files store ``GaitNetConfig.to_dict()``: {"model": {...}, "data": {...}, "train": {...}, "loss": {...},
+"notes": {...}} (format ``gait_net/2``). Files written before the split (format ``gait_net/1``, such as the
+shipped ``gait_net_default.pt``) store one flat dict; :meth:`GaitNetConfig.from_dict` reads both, mapping the
+flat names with :data:`FLAT_NAMES`. The flat names also serve ``--set FIELD=JSON`` and the keyword overrides of
+:meth:`GaitNetConfig.paper` / :meth:`GaitNetConfig.tiny`.
 """
 from __future__ import annotations
 
-from dataclasses import asdict, dataclass, field, fields
+from dataclasses import asdict, dataclass, field, fields, replace
 
-NUM_JOINTS = 21          # gait skeleton of seed 000 (Fig. 2)
-NUM_EMOTIONS = 4         # happy, sad, angry, neutral (section 3.2.2)
-NUM_AFFECTIVE = 18       # 11 angles, 4 distance ratios, 3 area ratios (section 3.2.3)
-NUM_STEP_FEATURES = 5    # sin theta, cos theta, omega, s-bar, kappa (section 4.1)
-NUM_ROOT_FEATURES = 3    # h, s, delta (section 4.1, eq. 3)
+from study_protocol import GAIT_EMOTIONS
+
+NUM_JOINTS = 21                    # gait skeleton of seed 000 (Fig. 2)
+NUM_EMOTIONS = len(GAIT_EMOTIONS)  # components of the emotion vector m (section 3.2.2)
+NUM_AFFECTIVE = 18                 # 11 angles, 4 distance ratios, 3 area ratios (section 3.2.3)
+NUM_STEP_FEATURES = 5              # sin theta, cos theta, omega, s-bar, kappa (section 4.1)
+NUM_ROOT_FEATURES = 3              # h, s, delta (section 4.1, eq. 3)
+
+
+def _from_dict(cls, d: dict, what: str):
+    """``cls(**d)`` with list values of tuple fields made tuples; unknown keys raise a ValueError naming them."""
+    names = {f.name: f for f in fields(cls)}
+    unknown = sorted(set(d) - set(names))
+    if unknown:
+        raise ValueError(f"unknown {what} fields {unknown}")
+    d = {k: tuple(v) if isinstance(getattr(cls(), k), tuple) else v for k, v in d.items()}
+    return cls(**d)
+
+
+def _to_dict(obj) -> dict:
+    """``asdict`` with tuples written as lists (JSON-like, as stored in checkpoints)."""
+    return {k: list(v) if isinstance(v, tuple) else v for k, v in asdict(obj).items()}
 
 
 @dataclass
-class GaitNetConfig:
-    """Sizes and training settings.
+class GaitModelConfig:
+    """The network's architecture (names follow section 4 of seed 000).
 
-    Network sizes (names follow section 4 of seed 000):
-        enc1_sizes: hidden sizes of FC_enc1 on [affective features a_t, emotion m]; the last is H1.
-        enc2_sizes: hidden sizes of FC_enc2 on [sin theta, cos theta, omega, s-bar, kappa, m]; the last is H2.
-        gru_hidden: H3, hidden units of GRU_versors; gru_layers its depth.
-        root_hidden: H4, units of the FC_root layer on [h, s, delta; gamma].
-        versor_hidden: hidden layer of the 2-layer FC_versors head.
-        residual: the versor head predicts a change added to the current rotations before normalising
-            (QuaterNet-style); False predicts absolute rotations.
-        use_affective: False gives the ablation without affective inputs and without L_aff (seed 000 5.6).
-        emotion_skip: the emotion m also enters GRU_versors and FC_versors directly at every step (not only
-            through the 8-unit encoders), so the label can steer the pose; False is the paper's wiring
-            (and that of checkpoints saved before this field existed).
-
-    Data and training (section 5.1, 5.3):
-        seq_len: T = 60 network steps (240 frames sampled every ``frame_step``-th frame).
-        prefix_frac: 0.3, the fraction of each sequence always given as ground truth (18 of 60 steps).
-        lr, lr_decay: Adam 1e-3 decayed by 0.999 per epoch.
-        tf_decay: teacher-forcing ratio decays as tf_decay ** epoch. The paper uses 0.995 over 500 epochs (final
-            ratio 0.08); the default run has 28 epochs (the ~20 minute budget on a shared CPU), so 0.91 gives about
-            the same final ratio (0.91 ** 27 = 0.08).
-        lambda_*: loss weights of eq. 13 (1.0 in the paper); lambda_versor is the unit-norm term of eq. 8;
-            lambda_phase weights the step-phase head (an addition of this implementation, see losses.py).
-        pos_scale_m: positions in the pose and foot losses are measured in units of this many metres.
-        splice_frac: fraction of training sequences whose ground-truth prefix is taken from another walk of a
-            different dominant emotion (phase-aligned); the emotion input switches from that walk's label to the
-            sequence's own label at the splice. Every corpus walk has one emotion throughout, so without this the
-            motion history predicts the style and the network learns to ignore m (see train.splice_histories).
+    enc1_sizes: hidden sizes of FC_enc1 on [affective features a_t, emotion m]; the last is H1.
+    enc2_sizes: hidden sizes of FC_enc2 on [sin theta, cos theta, omega, s-bar, kappa, m]; the last is H2.
+    gru_hidden: H3, hidden units of GRU_versors; gru_layers: its depth.
+    root_hidden: H4, units of the FC_root layer on [h, s, delta; gamma].
+    versor_hidden: hidden layer of the 2-layer FC_versors head.
+    residual: the versor head predicts a change added to the current rotations before normalising
+        (QuaterNet-style); False predicts absolute rotations.
+    use_affective: False gives the ablation without affective inputs (FC_enc1) and without L_aff (seed 000 5.6).
+    emotion_skip: the emotion m also enters GRU_versors and FC_versors directly at every step (not only
+        through the 8-unit encoders), so the label can steer the pose; False is the paper's wiring (and that of
+        checkpoints saved before this field existed).
+    num_joints: J, joints of the gait skeleton; num_emotions: C, components of m (``GAIT_EMOTIONS``).
     """
 
     enc1_sizes: tuple[int, ...] = (16, 16, 8)
@@ -59,75 +76,215 @@ class GaitNetConfig:
     num_joints: int = NUM_JOINTS
     num_emotions: int = NUM_EMOTIONS
 
+    @property
+    def h1(self) -> int:
+        """Width of FC_enc1's output (0 without the affective branch)."""
+        return self.enc1_sizes[-1] if self.use_affective else 0
+
+    @property
+    def h2(self) -> int:
+        """Width of FC_enc2's output."""
+        return self.enc2_sizes[-1]
+
+    @classmethod
+    def paper(cls, **overrides) -> GaitModelConfig:
+        """The released model's sizes (REFERENCE.md section 1): 2-layer GRU with 1024 units, FC 16-16-8,
+        versor head 1024-128-(J-1)*4; about ten million parameters."""
+        base = dict(enc1_sizes=(16, 16, 8), enc2_sizes=(16, 16, 8), gru_hidden=1024, gru_layers=2,
+                    root_hidden=32, versor_hidden=128)
+        base.update(overrides)
+        return cls(**base)
+
+    @classmethod
+    def tiny(cls, **overrides) -> GaitModelConfig:
+        """A very small network for tests."""
+        base = dict(enc1_sizes=(8, 8), enc2_sizes=(8, 8), gru_hidden=32, gru_layers=1, root_hidden=8,
+                    versor_hidden=32)
+        base.update(overrides)
+        return cls(**base)
+
+    def to_dict(self) -> dict:
+        return _to_dict(self)
+
+    @classmethod
+    def from_dict(cls, d: dict) -> GaitModelConfig:
+        return _from_dict(cls, d, "GaitModelConfig")
+
+
+@dataclass
+class GaitDataConfig:
+    """Network sequences (section 5.1); generation uses the same rate and prefix.
+
+    seq_len: T = 60 network steps per training sequence.
+    frame_step: every ``frame_step``-th frame of the 30 fps corpus is a network step (7.5 steps per second).
+    prefix_frac: 0.3, the fraction of each sequence always given as ground truth (18 of 60 steps); a seed gait
+        for generation needs at least that many steps.
+    """
+
     seq_len: int = 60
     frame_step: int = 4
     prefix_frac: float = 0.3
-    batch_size: int = 64
-    epochs: int = 28
-    lr: float = 1e-3
-    lr_decay: float = 0.999
-    tf_decay: float = 0.91
-    grad_clip: float = 1.0
-
-    lambda_motion: float = 1.0
-    lambda_versor: float = 1.0
-    lambda_pose: float = 1.0
-    lambda_aff: float = 1.0
-    lambda_root: float = 1.0
-    lambda_fctc: float = 1.0
-    lambda_phase: float = 1.0
-    pos_scale_m: float = 0.1
-    splice_frac: float = 0.3
-    euler_order: str = "zyx"
-    seed: int = 0
-    notes: dict = field(default_factory=dict)
 
     @property
     def prefix_len(self) -> int:
         """Number of ground-truth steps given before prediction (18 for T = 60)."""
         return int(round(self.prefix_frac * self.seq_len))
 
-    @property
-    def h1(self) -> int:
-        return self.enc1_sizes[-1] if self.use_affective else 0
+    def to_dict(self) -> dict:
+        return _to_dict(self)
+
+    @classmethod
+    def from_dict(cls, d: dict) -> GaitDataConfig:
+        return _from_dict(cls, d, "GaitDataConfig")
+
+
+@dataclass
+class GaitTrainConfig:
+    """A training run (section 5.3).
+
+    batch_size, epochs: sequences per batch and passes over the training walks.
+    lr, lr_decay: Adam 1e-3 decayed by 0.999 per epoch.
+    tf_decay: the teacher-forcing ratio decays as tf_decay ** epoch. The paper uses 0.995 over 500 epochs (final
+        ratio 0.08); the default run has 28 epochs (the ~20 minute budget on a shared CPU), so 0.91 gives about the
+        same final ratio (0.91 ** 27 = 0.08).
+    grad_clip: maximum gradient norm.
+    splice_frac: fraction of training sequences whose ground-truth prefix is taken from another walk of a different
+        dominant emotion (phase-aligned); the emotion input switches from that walk's label to the sequence's own
+        label at the splice. Every corpus walk has one emotion throughout, so without this the motion history
+        predicts the style and the network learns to ignore m (see train.splice_histories).
+    seed: seeds torch and numpy (runs are repeatable).
+    """
+
+    batch_size: int = 64
+    epochs: int = 28
+    lr: float = 1e-3
+    lr_decay: float = 0.999
+    tf_decay: float = 0.91
+    grad_clip: float = 1.0
+    splice_frac: float = 0.3
+    seed: int = 0
+
+    def to_dict(self) -> dict:
+        return _to_dict(self)
+
+    @classmethod
+    def from_dict(cls, d: dict) -> GaitTrainConfig:
+        return _from_dict(cls, d, "GaitTrainConfig")
+
+
+@dataclass
+class GaitLossWeights:
+    """Weights of the loss terms of eq. 13 (1.0 in the paper) and how the terms are measured (losses.py).
+
+    motion: L_motion (eq. 8, Euler-angle differences); versor: its unit-norm term.
+    pose: L_pose (eq. 9); aff: L_aff (eq. 10; only with ``GaitModelConfig.use_affective``); root: L_root (eq. 11);
+    fctc: L_fctc (eq. 12, foot contact); phase: the step-phase head (an addition of this implementation).
+    pos_scale_m: positions in the pose and foot losses are measured in units of this many metres.
+    euler_order: axis order of the Euler angles compared by L_motion.
+    """
+
+    motion: float = 1.0
+    versor: float = 1.0
+    pose: float = 1.0
+    aff: float = 1.0
+    root: float = 1.0
+    fctc: float = 1.0
+    phase: float = 1.0
+    pos_scale_m: float = 0.1
+    euler_order: str = "zyx"
+
+    def to_dict(self) -> dict:
+        return _to_dict(self)
+
+    @classmethod
+    def from_dict(cls, d: dict) -> GaitLossWeights:
+        return _from_dict(cls, d, "GaitLossWeights")
+
+
+SECTIONS = {"model": GaitModelConfig, "data": GaitDataConfig, "train": GaitTrainConfig, "loss": GaitLossWeights}
+"""GaitNetConfig attribute -> its dataclass."""
+
+FLAT_NAMES: dict[str, tuple[str, str]] = {
+    **{name: ("model", name) for name in ("enc1_sizes", "enc2_sizes", "gru_hidden", "gru_layers", "root_hidden",
+                                          "versor_hidden", "residual", "use_affective", "emotion_skip",
+                                          "num_joints", "num_emotions")},
+    **{name: ("data", name) for name in ("seq_len", "frame_step", "prefix_frac")},
+    **{name: ("train", name) for name in ("batch_size", "epochs", "lr", "lr_decay", "tf_decay", "grad_clip",
+                                          "splice_frac", "seed")},
+    **{f"lambda_{name}": ("loss", name) for name in ("motion", "versor", "pose", "aff", "root", "fctc", "phase")},
+    "pos_scale_m": ("loss", "pos_scale_m"),
+    "euler_order": ("loss", "euler_order"),
+}
+"""Field names of the single flat config used before the split (``gait_net/1`` checkpoints, ``--set``, the
+overrides of ``paper``/``tiny``) -> (section, field). ``notes`` kept its name."""
+
+
+@dataclass
+class GaitNetConfig:
+    """Everything a gait network run is made of: architecture, data, training and loss weights (and free notes).
+
+    ``GaitNetConfig()`` is the CPU default that trained the shipped weights (GRU 2 x 256, 28 epochs).
+    """
+
+    model: GaitModelConfig = field(default_factory=GaitModelConfig)
+    data: GaitDataConfig = field(default_factory=GaitDataConfig)
+    train: GaitTrainConfig = field(default_factory=GaitTrainConfig)
+    loss: GaitLossWeights = field(default_factory=GaitLossWeights)
+    notes: dict = field(default_factory=dict)
 
     @property
-    def h2(self) -> int:
-        return self.enc2_sizes[-1]
+    def prefix_len(self) -> int:
+        """Number of ground-truth steps given before prediction (``data.prefix_len``)."""
+        return self.data.prefix_len
 
     @classmethod
     def paper(cls, **overrides) -> GaitNetConfig:
-        """The released model's sizes (REFERENCE.md section 1): 2-layer GRU with 1024 units, FC 16-16-8,
-        versor head 1024-128-(J-1)*4, 500 epochs; about ten million parameters."""
-        base = dict(enc1_sizes=(16, 16, 8), enc2_sizes=(16, 16, 8), gru_hidden=1024, gru_layers=2,
-                    root_hidden=32, versor_hidden=128, epochs=500)
-        base.update(overrides)
-        return cls(**base)
+        """The released model (:meth:`GaitModelConfig.paper`, about 9.9 M parameters) trained for 500 epochs.
+        ``overrides`` use the flat names (:data:`FLAT_NAMES`), e.g. ``paper(epochs=10)``."""
+        return cls(model=GaitModelConfig.paper(), train=GaitTrainConfig(epochs=500)).with_overrides(**overrides)
 
     @classmethod
     def tiny(cls, **overrides) -> GaitNetConfig:
-        """A very small network for tests."""
-        base = dict(enc1_sizes=(8, 8), enc2_sizes=(8, 8), gru_hidden=32, gru_layers=1, root_hidden=8,
-                    versor_hidden=32, batch_size=4, epochs=2)
-        base.update(overrides)
-        return cls(**base)
+        """A very small network for tests (batches of 4, 2 epochs); flat-name ``overrides`` as in :meth:`paper`."""
+        return cls(model=GaitModelConfig.tiny(), train=GaitTrainConfig(batch_size=4, epochs=2)
+                   ).with_overrides(**overrides)
+
+    def with_overrides(self, **overrides) -> GaitNetConfig:
+        """A copy with fields replaced; keys are flat names (``gru_hidden``, ``lambda_root``) or
+        ``section.field`` (``model.gru_hidden``, ``loss.root``). Unknown names raise a ValueError."""
+        sections = {name: getattr(self, name).to_dict() for name in SECTIONS}
+        notes = dict(self.notes)
+        unknown = []
+        for key, value in overrides.items():
+            if key == "notes":
+                notes = dict(value)
+                continue
+            section, _, name = key.partition(".")
+            if not name:
+                section, name = FLAT_NAMES.get(key, (None, key))
+            if section not in sections or name not in {f.name for f in fields(SECTIONS[section])}:
+                unknown.append(key)
+                continue
+            sections[section][name] = value
+        if unknown:
+            raise ValueError(f"unknown GaitNetConfig fields {sorted(unknown)}")
+        return replace(self, notes=notes, **{k: SECTIONS[k].from_dict(v) for k, v in sections.items()})
 
     def to_dict(self) -> dict:
-        d = asdict(self)
-        for k in ("enc1_sizes", "enc2_sizes"):
-            d[k] = list(d[k])
-        return d
+        """{"model": {...}, "data": {...}, "train": {...}, "loss": {...}, "notes": {...}} (checkpoint format 2)."""
+        return {**{name: getattr(self, name).to_dict() for name in SECTIONS}, "notes": dict(self.notes)}
 
     @classmethod
     def from_dict(cls, d: dict) -> GaitNetConfig:
-        """Rebuild from :meth:`to_dict`; unknown keys raise a ValueError naming them."""
-        names = {f.name for f in fields(cls)}
-        unknown = sorted(set(d) - names)
-        if unknown:
-            raise ValueError(f"unknown GaitNetConfig fields {unknown}")
-        d = dict(d)
-        d.setdefault("emotion_skip", False)  # checkpoints saved before the field existed
-        for k in ("enc1_sizes", "enc2_sizes"):
-            if k in d:
-                d[k] = tuple(d[k])
-        return cls(**d)
+        """Rebuild from :meth:`to_dict`, or from the flat dict of checkpoints saved before the split (unknown
+        keys raise a ValueError naming them; a flat dict without ``emotion_skip`` predates that field and gets the
+        paper's wiring)."""
+        if any(isinstance(d.get(name), dict) for name in SECTIONS):
+            unknown = sorted(set(d) - set(SECTIONS) - {"notes"})
+            if unknown:
+                raise ValueError(f"unknown GaitNetConfig fields {unknown}")
+            return cls(**{name: SECTIONS[name].from_dict(d.get(name, {})) for name in SECTIONS},
+                       notes=dict(d.get("notes", {})))
+        flat = dict(d)
+        flat.setdefault("emotion_skip", False)  # checkpoints saved before the field existed
+        return cls().with_overrides(**flat)

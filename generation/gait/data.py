@@ -19,7 +19,6 @@ section 5.1). Per step we compute, on the ground plane (x, z; y-up):
 """
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -28,6 +27,7 @@ import torch
 
 from generation.core.kinematics import forward_kinematics, np_forward_kinematics
 from generation.core.quaternion import np_qfix, np_qmul, np_qrot, qmul
+from generation.core.rigging import yaw_quat
 from generation.core.skeleton import GAIT_PARENTS, gait_skeleton
 
 DEFAULT_CORPUS = Path("var/corpus/gait_corpus_synthetic.npz")
@@ -39,15 +39,6 @@ REF_HALF_WINDOW = 4   # steps each side for the trajectory tangent
 def wrap(a):
     """Wrap radians to (-pi, pi]."""
     return np.remainder(np.asarray(a) + np.pi, 2 * np.pi) - np.pi
-
-
-def yaw_quat(yaw) -> np.ndarray:
-    """(..., 4) rotation by ``yaw`` radians about +y (maps +z to (sin yaw, 0, cos yaw))."""
-    yaw = np.asarray(yaw, dtype=np.float64)
-    q = np.zeros(yaw.shape + (4,))
-    q[..., 0] = np.cos(yaw / 2)
-    q[..., 2] = np.sin(yaw / 2)
-    return q
 
 
 def facing_yaw(root_rot: np.ndarray) -> np.ndarray:
@@ -79,6 +70,15 @@ def kappa_from(sbar: np.ndarray, ref: np.ndarray) -> np.ndarray:
     k = np.zeros_like(sbar)
     k[..., 1:] = np.linalg.norm(np.diff(u, axis=-2), axis=-1)
     return k
+
+
+def kappa_torch(sbar: torch.Tensor, ref: torch.Tensor, sbar_prev: torch.Tensor, ref_prev: torch.Tensor
+                ) -> torch.Tensor:
+    """One step of :func:`kappa_from` in torch: norm of the change of the low-pass tangent from
+    ``sbar_prev * (sin ref_prev, cos ref_prev)`` to ``sbar * (sin ref, cos ref)`` (training and generation)."""
+    u = torch.stack((sbar * torch.sin(ref), sbar * torch.cos(ref)), -1)
+    u0 = torch.stack((sbar_prev * torch.sin(ref_prev), sbar_prev * torch.cos(ref_prev)), -1)
+    return (u - u0).norm(dim=-1)
 
 
 def root_features(root_pos: np.ndarray, root_rot: np.ndarray) -> dict:
@@ -370,6 +370,3 @@ def world_rotations(q_heading: torch.Tensor, ref: torch.Tensor) -> torch.Tensor:
     """Rotations (..., J, 4) with the root put back from the heading frame ``ref`` (...) to the world."""
     root = qmul(quat_torch_yaw(ref), q_heading[..., 0, :])
     return torch.cat((root[..., None, :], q_heading[..., 1:, :]), dim=-2)
-
-
-TWO_PI = 2 * math.pi

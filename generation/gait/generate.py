@@ -23,14 +23,16 @@ import torch
 
 from generation.core.motion import Motion
 from generation.core.paths import GroundPath, straight
-from generation.core.skeleton import Skeleton
+from study_protocol import GAIT_EMOTIONS
 
+from .config import NUM_EMOTIONS, NUM_JOINTS, GaitDataConfig, GaitNetConfig
 from .data import (
     SBAR_ALPHA,
     Normalizer,
     affective_features,
     facing_yaw,
     heading_frame_positions,
+    kappa_torch,
     prepare_sequences,
     world_rotations,
     wrap,
@@ -38,26 +40,31 @@ from .data import (
 from .model import GaitNet
 from .train import DEFAULT_WEIGHTS, load_checkpoint
 
-EMOTIONS = ("happy", "sad", "angry", "neutral")
-
 
 @dataclass
 class LoadedGaitNet:
-    """A trained network with its normaliser and the information saved with it."""
+    """A trained network with its normaliser, full config and the information saved with it.
+
+    ``config`` defaults to the default data, training and loss settings around the model's own architecture.
+    """
 
     model: GaitNet
     normalizer: Normalizer
     path: str
     info: dict = field(default_factory=dict)
+    config: GaitNetConfig | None = None
 
-    @property
-    def config(self):
-        return self.model.config
+    def __post_init__(self):
+        if self.config is None:
+            self.config = GaitNetConfig(model=self.model.config)
+        elif self.config.model != self.model.config:
+            raise ValueError(f"{self.path}: the config's architecture {self.config.model} is not the model's "
+                             f"{self.model.config}")
 
     @property
     def fps(self) -> float:
         """Network rate in steps per second (30 fps corpus / frame_step)."""
-        return 30.0 / self.model.config.frame_step
+        return 30.0 / self.config.data.frame_step
 
 
 _DEFAULT: LoadedGaitNet | None = None
@@ -68,7 +75,7 @@ def load_model(path: str | Path) -> LoadedGaitNet:
     model, norm, payload = load_checkpoint(path)
     info = {k: payload[k] for k in ("trained_on", "num_parameters", "corpus") if k in payload}
     info["epochs"] = len(payload.get("history", []))
-    return LoadedGaitNet(model, norm, str(path), info)
+    return LoadedGaitNet(model, norm, str(path), info, GaitNetConfig.from_dict(payload["config"]))
 
 
 def load_default_model() -> LoadedGaitNet:
@@ -84,10 +91,11 @@ def load_default_model() -> LoadedGaitNet:
 
 # ---- emotions --------------------------------------------------------------------------------
 def normalize_emotion(e) -> np.ndarray:
-    """l1-normalise emotion vectors (..., 4); negative entries are an error."""
+    """l1-normalise emotion vectors (..., 4) (components ``GAIT_EMOTIONS``); negative entries are an error."""
     e = np.asarray(e, dtype=np.float64)
-    if e.shape[-1] != 4:
-        raise ValueError(f"emotion vectors must have 4 entries (happy, sad, angry, neutral), got shape {e.shape}")
+    if e.shape[-1] != NUM_EMOTIONS:
+        raise ValueError(f"emotion vectors must have {NUM_EMOTIONS} entries ({', '.join(GAIT_EMOTIONS)}), "
+                         f"got shape {e.shape}")
     if (e < 0).any() or not np.isfinite(e).all():
         raise ValueError("emotion vectors must be finite and non-negative")
     total = e.sum(-1, keepdims=True)
@@ -123,7 +131,7 @@ def _seed_motion(seed, emotion0: np.ndarray, n_frames: int, rng: np.random.Gener
 
 
 def _seed_sequence(motion: Motion, frame_step: int, max_steps: int, min_steps: int, index: int):
-    if motion.skeleton.num_joints != 21:
+    if motion.skeleton.num_joints != NUM_JOINTS:
         raise ValueError(f"seed gait {index}: needs the 21-joint gait skeleton, "
                          f"got {motion.skeleton.num_joints} joints")
     m = motion.resample(30.0)
@@ -135,7 +143,8 @@ def _seed_sequence(motion: Motion, frame_step: int, max_steps: int, min_steps: i
     steps = min(steps, max_steps)
     need = frame_step * (steps - 1) + 1
     m = m.slice(m.num_frames - need)
-    return prepare_sequences(m.rotations[None], m.root_positions[None], np.full((1, 4), 0.25), np.array(["seed"]),
+    uniform = np.full((1, NUM_EMOTIONS), 1.0 / NUM_EMOTIONS)  # the seed's label is not used
+    return prepare_sequences(m.rotations[None], m.root_positions[None], uniform, np.array(["seed"]),
                              np.array([m.skeleton.height]), np.array([m.skeleton.build]), fps=30.0,
                              frame_step=frame_step, seq_len=steps, skeletons=[m.skeleton])
 
@@ -178,6 +187,162 @@ def distance_to_path(path: GroundPath, xz: np.ndarray, spacing: float = 0.02, be
 
 
 # ---- generation ------------------------------------------------------------------------------
+def _check_inputs(seeds, paths: list[GroundPath], emotions, steps: int) -> tuple[list, np.ndarray]:
+    """(seeds as a list of N, emotions as l1-normalised (N, steps, 4)); ValueError on inconsistent inputs."""
+    N = len(paths)
+    if seeds is None:
+        seeds = [None] * N
+    if len(seeds) != N:
+        raise ValueError(f"got {len(seeds)} seeds for {N} paths")
+    if steps < 1:
+        raise ValueError(f"steps must be positive, got {steps}")
+    emotions = np.asarray(emotions, dtype=np.float64)
+    if emotions.ndim == 2:
+        emotions = np.repeat(emotions[:, None], steps, axis=1)
+    if emotions.shape != (N, steps, NUM_EMOTIONS):
+        raise ValueError(f"emotions must be ({N}, {NUM_EMOTIONS}) or ({N}, {steps}, {NUM_EMOTIONS}), "
+                         f"got {emotions.shape}")
+    return seeds, normalize_emotion(emotions)
+
+
+_SEED_KEYS = ("q", "root", "theta", "omega", "sbar", "kappa", "ref", "aff", "offsets", "mean_height", "root_pos")
+
+
+def _seed_batch(seeds: list, emotions: np.ndarray, data: GaitDataConfig, rng: np.random.Generator
+                ) -> tuple[list[Motion], dict]:
+    """The seed Motions and one batch of their network-rate features, each cut to the last L steps, L being
+    the shortest seed's length (at most ``data.seq_len``): dict of tensors (N, L, ...) (offsets (N, J, 3),
+    mean_height (N,))."""
+    n_frames = data.frame_step * (data.seq_len - 1) + 1
+    motions = [_seed_motion(s, emotions[i, 0], n_frames, rng) for i, s in enumerate(seeds)]
+    seqs = [_seed_sequence(m, data.frame_step, data.seq_len, data.prefix_len, i) for i, m in enumerate(motions)]
+    L = min(s.q.shape[1] for s in seqs)
+    batch = {k: torch.cat([getattr(s, k)[:, -L:] if getattr(s, k).dim() > 1 and k != "offsets" else getattr(s, k)
+                           for s in seqs]) for k in _SEED_KEYS}
+    return motions, batch
+
+
+@dataclass
+class _Placement:
+    """Rigid move of each seed: its last root ground point onto the path start, its last heading onto the path's
+    heading at arc length 0."""
+
+    rot_yaw: np.ndarray  # (N,) radians added to the seed's headings
+    last_xz: np.ndarray  # (N, 2) the seed's last root ground point
+    start: np.ndarray    # (N, 2) the path starts
+
+    @classmethod
+    def onto_paths(cls, paths: list[GroundPath], seed: dict) -> _Placement:
+        rot_yaw = np.array([p.heading_at(0.0) for p in paths]) - seed["ref"][:, -1].double().numpy()
+        last_xz = seed["root_pos"][:, -1][:, [0, 2]].double().numpy()
+        return cls(rot_yaw, last_xz, np.stack([p.point_at(0.0) for p in paths]))
+
+    def move(self, xz: np.ndarray, i: int) -> np.ndarray:
+        """Ground points (..., 2) of seed ``i`` moved with it."""
+        c, s = math.cos(self.rot_yaw[i]), math.sin(self.rot_yaw[i])
+        d = xz - self.last_xz[i]
+        # rotation about +y by yaw maps (x, z) -> (x cos + z sin, -x sin + z cos)
+        return np.stack((d[..., 0] * c + d[..., 1] * s, -d[..., 0] * s + d[..., 1] * c), -1) + self.start[i]
+
+
+def _path_trackers(paths: list[GroundPath], norm: Normalizer, steps: int) -> list[_PathTracker]:
+    """One tracker per path, sampled far enough beyond its end for ``steps`` steps at (three times) the mean speed."""
+    speed_guess = float(norm.root_mean[1])  # metres per network step
+    return [_PathTracker(p, extra_m=steps * max(speed_guess, 0.1) * 3 + 10.0) for p in paths]
+
+
+def _advance_root(xz: np.ndarray, world: np.ndarray, s_step: torch.Tensor, delta: torch.Tensor) -> np.ndarray:
+    """Move ground points (N, 2) by the predicted step length along the travel direction: the root's facing
+    (from world rotations (N, J, 4)) turned by the predicted delta."""
+    travel = facing_yaw(world[:, 0]) + delta.numpy()
+    return xz + s_step.numpy()[:, None] * np.stack((np.sin(travel), np.cos(travel)), -1)
+
+
+def _predict_seed(net: LoadedGaitNet, seed: dict, emotions: np.ndarray) -> tuple[dict, torch.Tensor]:
+    """Run the network over the seed steps (the seed's emotion is the first step's): (prediction of the step after
+    the seed, GRU state)."""
+    norm = net.normalizer
+    N, L = seed["q"].shape[:2]
+    em_seed = torch.as_tensor(emotions[:, :1], dtype=torch.float32).expand(N, L, NUM_EMOTIONS)
+    out = net.model(seed["q"], norm.aff(seed["aff"]), norm.step(seed["theta"], seed["omega"], seed["sbar"],
+                                                                seed["kappa"]), norm.root(seed["root"]), em_seed)
+    return {k: v[:, -1] for k, v in out.items() if k != "hidden"}, out["hidden"]
+
+
+def _predict_next(net: LoadedGaitNet, seed: dict, pred: dict, hidden: torch.Tensor, h: torch.Tensor,
+                  step_in: torch.Tensor, emotion: torch.Tensor) -> tuple[dict, torch.Tensor]:
+    """One network step fed with its previous prediction ``pred`` (root height deviation ``h``, step features
+    ``step_in``): (the next prediction, GRU state)."""
+    pos = heading_frame_positions(pred["q"], seed["mean_height"] + h.float(), seed["offsets"])
+    out = net.model.step(pred["q"], net.normalizer.aff(affective_features(pos)), step_in, pred["root"], emotion,
+                         hidden)
+    return {k: v for k, v in out.items() if k != "hidden"}, out["hidden"]
+
+
+def _rollout(net: LoadedGaitNet, seed: dict, emotions: np.ndarray, trackers: list[_PathTracker],
+             placement: _Placement, lookahead_m: float) -> tuple[np.ndarray, np.ndarray]:
+    """The autoregressive rollout (section 5.4.1) after the seed, one step per emotion row.
+
+    Each step turns the prediction into world rotations in the heading frame of the pure-pursuit direction,
+    moves the root by the predicted step (its height mean + h), then advances the phase, s-bar and kappa
+    and feeds the prediction back. Returns world rotations (N, steps, J, 4) and root positions (N, steps, 3).
+    """
+    norm, (N, steps) = net.normalizer, emotions.shape[:2]
+    net.model.eval()
+    out_rot = np.zeros((N, steps, NUM_JOINTS, 4))
+    out_root = np.zeros((N, steps, 3))
+    with torch.no_grad():
+        pred, hidden = _predict_seed(net, seed, emotions)
+        theta, sbar = seed["theta"][:, -1].double(), seed["sbar"][:, -1].double()
+        ref_prev = torch.as_tensor(placement.rot_yaw) + seed["ref"][:, -1].double()
+        xz = placement.start.copy()
+        em_all = torch.as_tensor(emotions, dtype=torch.float32)
+        for k in range(steps):
+            root_raw = norm.root_inv(pred["root"]).double()
+            h, s_step, delta = root_raw[:, 0], root_raw[:, 1].clamp_min(0.0), root_raw[:, 2]
+            omega = norm.omega_inv(pred["omega"]).double().clamp(0.0, math.pi)
+            ref = torch.tensor([t.pursuit_heading(xz[i], lookahead_m) for i, t in enumerate(trackers)],
+                               dtype=torch.float64)
+            world = world_rotations(pred["q"].double(), ref).numpy()
+            xz = _advance_root(xz, world, s_step, delta)
+            out_rot[:, k] = world
+            out_root[:, k, 0], out_root[:, k, 2] = xz[:, 0], xz[:, 1]
+            out_root[:, k, 1] = (seed["mean_height"].double() + h).numpy()
+            if k == steps - 1:
+                break
+            theta = torch.remainder(theta + omega, 2 * math.pi)
+            sbar_new = (1 - SBAR_ALPHA) * sbar + SBAR_ALPHA * s_step
+            kappa = kappa_torch(sbar_new, ref, sbar, ref_prev)
+            sbar, ref_prev = sbar_new, ref
+            step_in = norm.step(theta.float(), omega.float(), sbar.float(), kappa.float())
+            pred, hidden = _predict_next(net, seed, pred, hidden, h, step_in, em_all[:, k + 1])
+    return out_rot, out_root
+
+
+def _with_seed(seed: dict, placement: _Placement, i: int, rot: np.ndarray, root: np.ndarray
+               ) -> tuple[np.ndarray, np.ndarray]:
+    """Agent ``i``'s generated rotations and root positions preceded by its (moved) seed steps."""
+    seed_rot = world_rotations(seed["q"][i].double(), seed["ref"][i].double() + placement.rot_yaw[i]).numpy()
+    seed_root = seed["root_pos"][i].double().numpy().copy()
+    seed_root[:, [0, 2]] = placement.move(seed_root[:, [0, 2]], i)
+    return np.concatenate((seed_rot, rot)), np.concatenate((seed_root, root))
+
+
+def _metadata(net: LoadedGaitNet, emotions: np.ndarray, path: GroundPath, seed_motion: Motion) -> dict:
+    """Metadata of one generated gait with per-step emotions (steps, 4)."""
+    first, last = emotions[0], emotions[-1]
+    return {
+        "origin": "generated", "generator": "gait_net",
+        "emotion": [round(float(v), 6) for v in first],
+        "final_emotion": None if np.allclose(first, last, atol=1e-6) else [round(float(v), 6) for v in last],
+        "trained_on": "synthetic procedural corpus",
+        "synthetic": True,
+        "path_kind": path.kind, "steps": len(emotions), "network_fps": net.fps,
+        "seed_origin": seed_motion.metadata.get("origin", "unknown"),
+        "weights": Path(net.path).name,
+    }
+
+
 def generate_gaits(seeds, paths: list[GroundPath], emotions, steps: int = 200, fps_out: float = 30.0,
                    model: LoadedGaitNet | None = None, lookahead_m: float = 1.0, include_seed: bool = False,
                    rng_seed: int = 0) -> list[Motion]:
@@ -197,116 +362,22 @@ def generate_gaits(seeds, paths: list[GroundPath], emotions, steps: int = 200, f
         model: a :class:`LoadedGaitNet`; default :func:`load_default_model`.
         lookahead_m: pure-pursuit look-ahead along the path, metres.
         include_seed: prepend the (moved) seed steps to the output.
+        rng_seed: seeds the procedural seed walks (their parameters and phase).
 
     Returns:
         N Motions on each seed's skeleton, metadata {"origin": "generated", "generator": "gait_net", "emotion",
         "final_emotion" (None unless the emotion changes), "trained_on", "path_kind", "steps", "network_fps"}.
     """
     net = model if model is not None else load_default_model()
-    cfg, norm = net.config, net.normalizer
-    N = len(paths)
-    if seeds is None:
-        seeds = [None] * N
-    if len(seeds) != N:
-        raise ValueError(f"got {len(seeds)} seeds for {N} paths")
-    if steps < 1:
-        raise ValueError(f"steps must be positive, got {steps}")
-    emotions = np.asarray(emotions, dtype=np.float64)
-    if emotions.ndim == 2:
-        emotions = np.repeat(emotions[:, None], steps, axis=1)
-    if emotions.shape != (N, steps, 4):
-        raise ValueError(f"emotions must be ({N}, 4) or ({N}, {steps}, 4), got {emotions.shape}")
-    emotions = normalize_emotion(emotions)
-    rng = np.random.default_rng(rng_seed)
-
-    seed_motions = [_seed_motion(s, emotions[i, 0], cfg.frame_step * (cfg.seq_len - 1) + 1, rng)
-                    for i, s in enumerate(seeds)]
-    seqs = [_seed_sequence(m, cfg.frame_step, cfg.seq_len, cfg.prefix_len, i) for i, m in enumerate(seed_motions)]
-    L = min(s.q.shape[1] for s in seqs)       # common seed length (the last L steps of each)
-    cat = {k: torch.cat([getattr(s, k)[:, -L:] if getattr(s, k).dim() > 1 and k not in ("offsets",)
-                         else getattr(s, k) for s in seqs]) for k in
-           ("q", "root", "theta", "omega", "sbar", "kappa", "ref", "aff", "offsets", "mean_height", "root_pos")}
-
-    # Rigid move of each seed: last root ground point -> path start, last heading -> path heading at 0.
-    rot_yaw = np.array([p.heading_at(0.0) for p in paths]) - cat["ref"][:, -1].double().numpy()
-    last_xz = cat["root_pos"][:, -1][:, [0, 2]].double().numpy()
-    start = np.stack([p.point_at(0.0) for p in paths])
-
-    def move(xz, i):
-        c, s = math.cos(rot_yaw[i]), math.sin(rot_yaw[i])
-        d = xz - last_xz[i]
-        # rotation about +y by yaw maps (x, z) -> (x cos + z sin, -x sin + z cos)
-        return np.stack((d[..., 0] * c + d[..., 1] * s, -d[..., 0] * s + d[..., 1] * c), -1) + start[i]
-
-    speed_guess = float(norm.root_mean[1])  # metres per network step
-    trackers = [_PathTracker(p, extra_m=steps * max(speed_guess, 0.1) * 3 + 10.0) for p in paths]
-    em_seed = torch.as_tensor(emotions[:, :1], dtype=torch.float32).expand(N, L, 4)
-    offsets, mean_h = cat["offsets"], cat["mean_height"]
-
-    model_ = net.model
-    model_.eval()
-    out_rot = np.zeros((N, steps, 21, 4))
-    out_root = np.zeros((N, steps, 3))
-    with torch.no_grad():
-        out = model_(cat["q"], norm.aff(cat["aff"]), norm.step(cat["theta"], cat["omega"], cat["sbar"], cat["kappa"]),
-                     norm.root(cat["root"]), em_seed)
-        hidden = out["hidden"]
-        pred = {k: v[:, -1] for k, v in out.items() if k != "hidden"}
-        theta, sbar = cat["theta"][:, -1].double(), cat["sbar"][:, -1].double()
-        ref_prev = torch.as_tensor(rot_yaw) + cat["ref"][:, -1].double()
-        xz = start.copy()
-        em_all = torch.as_tensor(emotions, dtype=torch.float32)
-        for k in range(steps):
-            root_raw = norm.root_inv(pred["root"]).double()
-            h, s_step, delta = root_raw[:, 0], root_raw[:, 1].clamp_min(0.0), root_raw[:, 2]
-            omega = norm.omega_inv(pred["omega"]).double().clamp(0.0, math.pi)
-            ref = torch.tensor([trackers[i].pursuit_heading(xz[i], lookahead_m) for i in range(N)],
-                               dtype=torch.float64)
-            q = pred["q"]
-            world = world_rotations(q.double(), ref).numpy()
-            alpha = facing_yaw(world[:, 0])
-            travel = alpha + delta.numpy()
-            xz = xz + s_step.numpy()[:, None] * np.stack((np.sin(travel), np.cos(travel)), -1)
-            out_rot[:, k] = world
-            out_root[:, k, 0], out_root[:, k, 2] = xz[:, 0], xz[:, 1]
-            out_root[:, k, 1] = (mean_h.double() + h).numpy()
-            if k == steps - 1:
-                break
-            # Inputs for the next step.
-            theta = torch.remainder(theta + omega, 2 * math.pi)
-            sbar_new = (1 - SBAR_ALPHA) * sbar + SBAR_ALPHA * s_step
-            u = torch.stack((sbar_new * torch.sin(ref), sbar_new * torch.cos(ref)), -1)
-            u0 = torch.stack((sbar * torch.sin(ref_prev), sbar * torch.cos(ref_prev)), -1)
-            kappa = (u - u0).norm(dim=-1)
-            sbar, ref_prev = sbar_new, ref
-            pos = heading_frame_positions(q, mean_h + h.float(), offsets)
-            step_in = norm.step(theta.float(), omega.float(), sbar.float(), kappa.float())
-            out = model_.step(q, norm.aff(affective_features(pos)), step_in, pred["root"], em_all[:, k + 1], hidden)
-            hidden = out["hidden"]
-            pred = {kk: v for kk, v in out.items() if kk != "hidden"}
-
+    seeds, emotions = _check_inputs(seeds, paths, emotions, steps)
+    seed_motions, seed = _seed_batch(seeds, emotions, net.config.data, np.random.default_rng(rng_seed))
+    placement = _Placement.onto_paths(paths, seed)
+    rot, root = _rollout(net, seed, emotions, _path_trackers(paths, net.normalizer, steps), placement, lookahead_m)
     motions = []
-    net_fps = 30.0 / cfg.frame_step
-    for i in range(N):
-        rot, root = out_rot[i], out_root[i]
-        if include_seed:
-            seed_rot = world_rotations(cat["q"][i].double(), cat["ref"][i].double() + rot_yaw[i]).numpy()
-            seed_root = cat["root_pos"][i].double().numpy().copy()
-            seed_root[:, [0, 2]] = move(seed_root[:, [0, 2]], i)
-            rot, root = np.concatenate((seed_rot, rot)), np.concatenate((seed_root, root))
-        first, last = emotions[i, 0], emotions[i, -1]
-        meta = {
-            "origin": "generated", "generator": "gait_net",
-            "emotion": [round(float(v), 6) for v in first],
-            "final_emotion": None if np.allclose(first, last, atol=1e-6) else [round(float(v), 6) for v in last],
-            "trained_on": "synthetic procedural corpus",
-            "synthetic": True,
-            "path_kind": paths[i].kind, "steps": steps, "network_fps": net_fps,
-            "seed_origin": seed_motions[i].metadata.get("origin", "unknown"),
-            "weights": Path(net.path).name,
-        }
-        skel: Skeleton = seed_motions[i].skeleton
-        m = Motion(skel, wrap_quaternions(rot), root, net_fps, meta)
+    for i, path in enumerate(paths):
+        r, rt = _with_seed(seed, placement, i, rot[i], root[i]) if include_seed else (rot[i], root[i])
+        m = Motion(seed_motions[i].skeleton, wrap_quaternions(r), rt, net.fps,
+                   _metadata(net, emotions[i], path, seed_motions[i]))
         motions.append(m.resample(fps_out))
     return motions
 
@@ -317,5 +388,5 @@ def wrap_quaternions(q: np.ndarray) -> np.ndarray:
     return np_qfix(np_qnormalize(q))
 
 
-__all__ = ["EMOTIONS", "LoadedGaitNet", "distance_to_path", "emotion_transition", "generate_gaits",
+__all__ = ["LoadedGaitNet", "distance_to_path", "emotion_transition", "generate_gaits",
            "load_default_model", "load_model", "normalize_emotion", "wrap"]

@@ -2,7 +2,7 @@
 
 All terms are means over their elements (the paper writes sums; a mean only rescales the weights and
 keeps the terms comparable across batch sizes). Features are standardised by the training-set statistics
-before they enter a loss, and positions are measured in units of ``config.pos_scale_m`` metres, so the
+before they enter a loss, and positions are measured in units of ``GaitLossWeights.pos_scale_m`` metres, so the
 paper's weights of 1.0 give terms of similar size.
 
 Shapes: N batch, L predicted steps, J joints.
@@ -15,7 +15,7 @@ import torch
 
 from generation.core.quaternion import qeuler
 
-from .config import GaitNetConfig
+from .config import GaitLossWeights
 
 FOOT_JOINTS = (3, 4, 7, 8)  # left heel, left toe, right heel, right toe (gait skeleton)
 
@@ -72,25 +72,24 @@ def phase_loss(omega_pred: torch.Tensor, omega_true: torch.Tensor) -> torch.Tens
     return (omega_pred - omega_true).abs().mean()
 
 
-def total_loss(pred: dict, true: dict, config: GaitNetConfig) -> tuple[torch.Tensor, dict]:
+def total_loss(pred: dict, true: dict, weights: GaitLossWeights, use_affective: bool = True
+               ) -> tuple[torch.Tensor, dict]:
     """Eq. 13 plus the phase term.
 
     ``pred`` and ``true`` hold ``q`` ((N, L, J, 4); ``pred["q_raw"]`` unnormalised), ``pos`` (N, L, J, 3) with
     root height, ``aff`` (N, L, 18), ``root`` (N, L, 3) and ``omega`` (N, L), all for the same target steps.
-    Returns the weighted total and a dict of floats per term.
+    ``use_affective`` (``GaitModelConfig.use_affective``) adds L_aff. Terms with weight 0 are left out of the
+    total. Returns the weighted total and a dict of floats per term.
     """
-    c = config
+    w = weights
     terms = {
-        "motion": motion_loss(pred["q_raw"], true["q"], c.euler_order, c.lambda_versor),
-        "pose": pose_loss(pred["pos"], true["pos"], c.pos_scale_m),
+        "motion": motion_loss(pred["q_raw"], true["q"], w.euler_order, w.versor),
+        "pose": pose_loss(pred["pos"], true["pos"], w.pos_scale_m),
         "root": root_loss(pred["root"], true["root"]),
-        "fctc": foot_contact_loss(pred["pos"], true["pos"], c.pos_scale_m),
+        "fctc": foot_contact_loss(pred["pos"], true["pos"], w.pos_scale_m),
         "phase": phase_loss(pred["omega"], true["omega"]),
     }
-    weights = {"motion": c.lambda_motion, "pose": c.lambda_pose, "root": c.lambda_root, "fctc": c.lambda_fctc,
-               "phase": c.lambda_phase}
-    if c.use_affective:
+    if use_affective:
         terms["aff"] = affective_loss(pred["aff"], true["aff"])
-        weights["aff"] = c.lambda_aff
-    total = sum(weights[k] * v for k, v in terms.items() if weights[k] != 0.0)
+    total = sum(getattr(w, k) * v for k, v in terms.items() if getattr(w, k) != 0.0)
     return total, {k: float(v.detach()) for k, v in terms.items()}

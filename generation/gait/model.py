@@ -29,7 +29,7 @@ from __future__ import annotations
 import torch
 from torch import nn
 
-from .config import NUM_AFFECTIVE, NUM_ROOT_FEATURES, NUM_STEP_FEATURES, GaitNetConfig
+from .config import NUM_AFFECTIVE, NUM_ROOT_FEATURES, NUM_STEP_FEATURES, GaitModelConfig
 
 
 def mlp(sizes: list[int], final_activation: bool = True) -> nn.Sequential:
@@ -43,10 +43,15 @@ def mlp(sizes: list[int], final_activation: bool = True) -> nn.Sequential:
 
 
 class GaitNet(nn.Module):
-    """Encoder + predictor; call :meth:`step` once per time step (or :meth:`forward` for many steps)."""
+    """Encoder + predictor; call :meth:`step` once per time step (or :meth:`forward` for many steps).
 
-    def __init__(self, config: GaitNetConfig):
+    ``config`` is the architecture (``GaitNetConfig.model``).
+    """
+
+    def __init__(self, config: GaitModelConfig):
         super().__init__()
+        if not isinstance(config, GaitModelConfig):
+            raise TypeError(f"GaitNet takes a GaitModelConfig (GaitNetConfig.model), got {type(config).__name__}")
         self.config = config
         C, J = config.num_emotions, config.num_joints
         if config.use_affective:

@@ -16,6 +16,7 @@ motion history, decides the style.
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import json
 import math
 import time
@@ -31,6 +32,7 @@ from .data import (
     Normalizer,
     affective_features,
     heading_frame_positions,
+    kappa_torch,
     load_corpus_sequences,
 )
 from .losses import total_loss
@@ -38,6 +40,7 @@ from .model import GaitNet
 
 DEFAULT_WEIGHTS = Path(__file__).resolve().parent.parent / "data" / "weights" / "gait_net_default.pt"
 CHECKPOINT_DIR = Path("var/gait_runs")
+CHECKPOINT_FORMAT = "gait_net/2"
 
 
 def fit_normalizer(data: GaitSequences) -> Normalizer:
@@ -53,12 +56,6 @@ def ground_truth_targets(batch: dict, norm: Normalizer) -> dict:
     pos = heading_frame_positions(batch["q"][:, 1:], batch["mean_height"][:, None] + h, batch["offsets"][:, None])
     return {"q": batch["q"][:, 1:], "pos": pos, "aff": norm.aff(batch["aff"][:, 1:]),
             "root": norm.root(batch["root"][:, 1:]), "omega": norm.omega(batch["omega"][:, 1:])}
-
-
-def _kappa(sbar, ref, sbar_prev, ref_prev):
-    u = torch.stack((sbar * torch.sin(ref), sbar * torch.cos(ref)), -1)
-    u0 = torch.stack((sbar_prev * torch.sin(ref_prev), sbar_prev * torch.cos(ref_prev)), -1)
-    return (u - u0).norm(dim=-1)
 
 
 def splice_histories(batch: dict, prefix: int, frac: float, rng: np.random.Generator) -> dict:
@@ -144,7 +141,7 @@ def rollout(model: GaitNet, norm: Normalizer, batch: dict, tf_ratio: float, pref
         omega_p = norm.omega_inv(prev_pred["omega"]).clamp(0.0, math.pi)
         theta_p = torch.remainder(last["theta"] + omega_p, 2 * math.pi)
         sbar_p = (1 - SBAR_ALPHA) * last["sbar"] + SBAR_ALPHA * prev_pred["root_raw"][:, 1]
-        kappa_p = _kappa(sbar_p, batch["ref"][:, t], last["sbar"], batch["ref"][:, t - 1])
+        kappa_p = kappa_torch(sbar_p, batch["ref"][:, t], last["sbar"], batch["ref"][:, t - 1])
         step_p = norm.step(theta_p, omega_p, sbar_p, kappa_p)
         # ... or from the ground truth, per sequence with probability tf_ratio.
         if tf_ratio >= 1.0:
@@ -183,7 +180,7 @@ def evaluate(model: GaitNet, norm: Normalizer, data: GaitSequences, config: Gait
             idx = np.arange(start, min(start + batch_size, len(data)))
             batch = data.batch(idx)
             pred = rollout(model, norm, batch, 0.0, config.prefix_len)
-            loss, terms = total_loss(pred, ground_truth_targets(batch, norm), config)
+            loss, terms = total_loss(pred, ground_truth_targets(batch, norm), config.loss, config.model.use_affective)
             terms["total"] = loss.item()
             for k, v in terms.items():
                 sums[k] = sums.get(k, 0.0) + v * len(idx)
@@ -193,10 +190,14 @@ def evaluate(model: GaitNet, norm: Normalizer, data: GaitSequences, config: Gait
 
 
 def save_checkpoint(path: Path, model: GaitNet, norm: Normalizer, config: GaitNetConfig, **extra) -> None:
-    """Write model weights, config and normaliser (plus any training state in ``extra``)."""
+    """Write model weights, config and normaliser (plus any training state in ``extra``).
+
+    Format ``gait_net/2`` stores the config split by section (``GaitNetConfig.to_dict``); ``gait_net/1`` files
+    (the flat config of before the split) are still read by :func:`load_checkpoint`.
+    """
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    payload = {"format": "gait_net/1", "config": config.to_dict(), "normalizer": norm.to_dict(),
+    payload = {"format": CHECKPOINT_FORMAT, "config": config.to_dict(), "normalizer": norm.to_dict(),
                "model": model.state_dict(), **extra}
     tmp = path.with_suffix(path.suffix + ".tmp")
     torch.save(payload, tmp)
@@ -204,7 +205,8 @@ def save_checkpoint(path: Path, model: GaitNet, norm: Normalizer, config: GaitNe
 
 
 def load_checkpoint(path: str | Path) -> tuple[GaitNet, Normalizer, dict]:
-    """Load a file written by :func:`save_checkpoint`; returns (model in eval mode, normaliser, payload)."""
+    """Load a file written by :func:`save_checkpoint` (either format); returns (model in eval mode, normaliser,
+    payload). ``GaitNetConfig.from_dict(payload["config"])`` is the full config."""
     path = Path(path)
     if not path.exists():
         raise FileNotFoundError(f"gait network weights not found: {path}")
@@ -215,11 +217,38 @@ def load_checkpoint(path: str | Path) -> tuple[GaitNet, Normalizer, dict]:
     for key in ("config", "normalizer", "model"):
         if key not in payload:
             raise ValueError(f"{path}: checkpoint lacks field {key!r}")
-    config = GaitNetConfig.from_dict(payload["config"])
-    model = GaitNet(config)
+    model = GaitNet(GaitNetConfig.from_dict(payload["config"]).model)
     model.load_state_dict(payload["model"])
     model.eval()
     return model, Normalizer.from_dict(payload["normalizer"]), payload
+
+
+def _train_epoch(model: GaitNet, norm: Normalizer, opt, train_set: GaitSequences, config: GaitNetConfig, tf: float,
+                 rng: np.random.Generator, gen: torch.Generator, desc: str, progress: bool) -> dict[str, float]:
+    """One epoch over the training walks with teacher-forcing ratio ``tf``; returns the mean loss terms."""
+    from tqdm import tqdm
+
+    tc = config.train
+    # One row per corpus sequence per epoch, with a random subsampling offset when several exist.
+    rows = rng.permutation(len(train_set))
+    _, first = np.unique(train_set.base_index[rows], return_index=True)
+    order = rows[np.sort(first)]
+    batches = [order[i:i + tc.batch_size] for i in range(0, len(order), tc.batch_size)]
+    sums: dict[str, float] = {}
+    bar = tqdm(batches, desc=desc, disable=not progress, leave=False)
+    for idx in bar:
+        batch = splice_histories(train_set.batch(idx), config.prefix_len, tc.splice_frac, rng)
+        pred = rollout(model, norm, batch, tf, config.prefix_len, gen)
+        loss, terms = total_loss(pred, ground_truth_targets(batch, norm), config.loss, config.model.use_affective)
+        opt.zero_grad()
+        loss.backward()
+        torch.nn.utils.clip_grad_norm_(model.parameters(), tc.grad_clip)
+        opt.step()
+        terms["total"] = loss.item()
+        for k, v in terms.items():
+            sums[k] = sums.get(k, 0.0) + v / len(batches)
+        bar.set_postfix(loss=f"{loss.item():.3f}")
+    return sums
 
 
 def train(config: GaitNetConfig, data: GaitSequences, out_path: str | Path, checkpoint_path: str | Path | None = None,
@@ -230,19 +259,18 @@ def train(config: GaitNetConfig, data: GaitSequences, out_path: str | Path, chec
     ``out_path`` (model, config, normaliser, history). ``resume`` continues from ``checkpoint_path``.
     ``max_minutes`` stops after the epoch that crosses the budget (the history records it).
     """
-    from tqdm import tqdm
-
-    torch.manual_seed(config.seed)
-    rng = np.random.default_rng(config.seed)
-    gen = torch.Generator().manual_seed(config.seed)
+    tc = config.train
+    torch.manual_seed(tc.seed)
+    rng = np.random.default_rng(tc.seed)
+    gen = torch.Generator().manual_seed(tc.seed)
     train_set = data.subset("train")
     val_set = data.subset((data.split == "val") & (data.offset == 0))
     if len(train_set) == 0:
         raise ValueError("the corpus has no 'train' sequences")
     norm = fit_normalizer(train_set)
-    model = GaitNet(config)
-    opt = torch.optim.Adam(model.parameters(), lr=config.lr)
-    sched = torch.optim.lr_scheduler.ExponentialLR(opt, gamma=config.lr_decay)
+    model = GaitNet(config.model)
+    opt = torch.optim.Adam(model.parameters(), lr=tc.lr)
+    sched = torch.optim.lr_scheduler.ExponentialLR(opt, gamma=tc.lr_decay)
     history: list[dict] = []
     start_epoch = 0
     # Training state lives under var/ (not next to the shipped weights) unless a path is given.
@@ -261,28 +289,10 @@ def train(config: GaitNetConfig, data: GaitSequences, out_path: str | Path, chec
         log(f"resumed from {checkpoint_path} at epoch {start_epoch}")
     t0 = time.time()
     elapsed_before = history[-1]["elapsed_s"] if history else 0.0
-    for epoch in range(start_epoch, config.epochs):
-        tf = config.tf_decay ** epoch
-        # One row per corpus sequence per epoch, with a random subsampling offset when several exist.
-        rows = rng.permutation(len(train_set))
-        _, first = np.unique(train_set.base_index[rows], return_index=True)
-        order = rows[np.sort(first)]
-        batches = [order[i:i + config.batch_size] for i in range(0, len(order), config.batch_size)]
-        sums: dict[str, float] = {}
-        bar = tqdm(batches, desc=f"epoch {epoch + 1}/{config.epochs} tf={tf:.2f}", disable=not progress,
-                   leave=False)
-        for idx in bar:
-            batch = splice_histories(train_set.batch(idx), config.prefix_len, config.splice_frac, rng)
-            pred = rollout(model, norm, batch, tf, config.prefix_len, gen)
-            loss, terms = total_loss(pred, ground_truth_targets(batch, norm), config)
-            opt.zero_grad()
-            loss.backward()
-            torch.nn.utils.clip_grad_norm_(model.parameters(), config.grad_clip)
-            opt.step()
-            terms["total"] = loss.item()
-            for k, v in terms.items():
-                sums[k] = sums.get(k, 0.0) + v / len(batches)
-            bar.set_postfix(loss=f"{loss.item():.3f}")
+    for epoch in range(start_epoch, tc.epochs):
+        tf = tc.tf_decay ** epoch
+        sums = _train_epoch(model, norm, opt, train_set, config, tf, rng, gen,
+                            desc=f"epoch {epoch + 1}/{tc.epochs} tf={tf:.2f}", progress=progress)
         sched.step()
         val = evaluate(model, norm, val_set, config) if len(val_set) else {}
         elapsed = elapsed_before + time.time() - t0
@@ -321,7 +331,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--no-affective", action="store_true", help="ablation: no affective inputs and no L_aff")
     p.add_argument("--no-root-loss", action="store_true", help="ablation: lambda_root = 0")
     p.add_argument("--set", action="append", default=[], metavar="FIELD=JSON",
-                   help="override any GaitNetConfig field, e.g. --set gru_hidden=256 --set tf_decay=0.97")
+                   help="override any config field by its flat name or as SECTION.FIELD (sections model, data, "
+                        "train, loss), e.g. --set gru_hidden=256 --set tf_decay=0.97 --set loss.pose=0.5")
     p.add_argument("--offsets", type=int, default=4,
                    help="subsampling offsets per sequence (augmentation; every 4th frame from frame 0..N-1)")
     p.add_argument("--threads", type=int, default=1)
@@ -330,23 +341,26 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def config_from_args(args) -> GaitNetConfig:
+    """The GaitNetConfig of parsed options: default or ``--paper-size``, then ``--set``, then the named options."""
     config = GaitNetConfig.paper() if args.paper_size else GaitNetConfig()
-    d = config.to_dict()
+    overrides = {}
     for item in args.set:
         if "=" not in item:
             raise SystemExit(f"--set expects FIELD=JSON, got {item!r}")
         key, value = item.split("=", 1)
-        if key not in d:
-            raise SystemExit(f"--set: unknown GaitNetConfig field {key!r}")
-        d[key] = json.loads(value)
-    for key, value in (("epochs", args.epochs), ("batch_size", args.batch_size), ("seed", args.seed)):
-        if value is not None:
-            d[key] = value
+        overrides[key] = json.loads(value)
+    try:
+        config = config.with_overrides(**overrides)
+    except ValueError as exc:
+        raise SystemExit(f"--set: {exc}") from None
+    named = {k: v for k, v in (("epochs", args.epochs), ("batch_size", args.batch_size), ("seed", args.seed))
+             if v is not None}
+    config = dataclasses.replace(config, train=dataclasses.replace(config.train, **named))
     if args.no_affective:
-        d["use_affective"] = False
+        config = dataclasses.replace(config, model=dataclasses.replace(config.model, use_affective=False))
     if args.no_root_loss:
-        d["lambda_root"] = 0.0
-    return GaitNetConfig.from_dict(d)
+        config = dataclasses.replace(config, loss=dataclasses.replace(config.loss, root=0.0))
+    return config
 
 
 def run(args, log=print) -> dict:
@@ -354,10 +368,10 @@ def run(args, log=print) -> dict:
     torch.set_num_threads(args.threads)
     config = config_from_args(args)
     data = load_corpus_sequences(args.corpus, num_sequences=args.num_sequences, seed=0,
-                                 frame_step=config.frame_step, seq_len=config.seq_len,
+                                 frame_step=config.data.frame_step, seq_len=config.data.seq_len,
                                  offsets=tuple(range(args.offsets)))
     counts = ", ".join(f"{s}: {int(((data.split == s) & (data.offset == 0)).sum())}" for s in ("train", "val", "test"))
-    log(f"{len(data)} sequences ({counts}), network {GaitNet(config).num_parameters()} parameters")
+    log(f"{len(data)} sequences ({counts}), network {GaitNet(config.model).num_parameters()} parameters")
     result = train(config, data, args.out, args.checkpoint, args.resume, args.max_minutes, progress=not args.quiet,
                    log=log)
     log(f"wrote {args.out}")

@@ -4,6 +4,9 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
+from study_protocol import GENDERS, HANDEDNESS  # noqa: F401 - the attribute one-hot orders
+from study_protocol import GESTURE_TASKS as TASKS  # noqa: F401
+
 PACKAGE_DIR = Path(__file__).resolve().parent
 GENERATION_DIR = PACKAGE_DIR.parent
 PROJECT_DIR = GENERATION_DIR.parent
@@ -13,9 +16,6 @@ DEFAULT_WEIGHTS = GENERATION_DIR / "data" / "weights" / "gesture_net_default.pt"
 # Caches and checkpoints live under var/ (git-ignored); override with GESTURE_VAR_DIR.
 VAR_DIR = Path(os.environ.get("GESTURE_VAR_DIR", PROJECT_DIR / "var" / "gesture"))
 
-TASKS = ("narration", "conversation")
-GENDERS = ("female", "male")
-HANDEDNESS = ("left", "right")
 
 # The network runs at a low frame rate (the 2-core CPU budget) and output is resampled (slerp).
 TRAIN_FPS = 10.0

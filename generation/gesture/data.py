@@ -26,6 +26,7 @@ import torch
 from generation.core.motion import Motion
 from generation.core.quaternion import np_qfix, np_qnormalize
 from generation.core.skeleton import gesture_skeleton
+from study_protocol import GESTURE_VAD
 
 from . import config
 from .text import EMBED_DIM, cached_encodings, count_words
@@ -48,19 +49,15 @@ class SentenceRow:
 
 def nrc_vad(emotion: str) -> tuple[float, float, float]:
     """(valence, arousal, dominance) in [0, 1] of an emotion word from the NRC-VAD table (Mohammad, ACL 2018)."""
-    from generation.procedural.emotion import NRC_VAD
-
     key = emotion.strip().lower()
-    if key not in NRC_VAD:
-        raise ValueError(f"emotion {emotion!r} is not in the NRC-VAD table; known: {', '.join(sorted(NRC_VAD))}")
-    v, a, d = NRC_VAD[key]
+    if key not in GESTURE_VAD:
+        raise ValueError(f"emotion {emotion!r} is not in the NRC-VAD table; known: {', '.join(GESTURE_VAD)}")
+    v, a, d = GESTURE_VAD[key]
     return float(v), float(a), float(d)
 
 
 def load_sentences(path: str | Path = config.SENTENCES_CSV) -> list[SentenceRow]:
     """Rows of the sentence corpus CSV (columns sentence_id, emotion, task, sentence)."""
-    from generation.procedural.emotion import NRC_VAD
-
     path = Path(path)
     if not path.is_file():
         raise CorpusFormatError(f"{path}: sentence corpus not found")
@@ -75,7 +72,7 @@ def load_sentences(path: str | Path = config.SENTENCES_CSV) -> list[SentenceRow]
             sid, emo, task, text = (rec.get(k) or "" for k in expected)
             if not sid or sid in seen:
                 raise CorpusFormatError(f"{path}: line {line}: field sentence_id is empty or repeated ({sid!r})")
-            if emo not in NRC_VAD:
+            if emo not in GESTURE_VAD:
                 raise CorpusFormatError(f"{path}: line {line}: field emotion {emo!r} is not an NRC-VAD word")
             if task not in config.TASKS:
                 raise CorpusFormatError(f"{path}: line {line}: field task must be one of {config.TASKS}, got {task!r}")

@@ -144,14 +144,14 @@ def decode_examples(net: GestureNet, data, idx, batch_size: int = 64) -> list[np
     return out
 
 
-def generate_gesture(sentence: str, task: str = "narration", emotion: str = "happy", gender: str = "female",
+def generate_gesture(sentence: str, task: str = "narration", emotion: str = "joyous", gender: str = "female",
                      handedness: str = "right", fps: float = 30.0, model: GestureNet | None = None, seed: int = 0,
                      noise: float = 0.0) -> Motion:
     """A seated gesture Motion for ``sentence`` on the 23-joint skeleton of the gender's build.
 
     Args:
         sentence: the text the agent says (at least one word).
-        task: "narration" or "conversation". emotion: an NRC-VAD word (e.g. the 11 MPI categories or "happy").
+        task: "narration" or "conversation". emotion: one of the 11 MPI categories (study_protocol.GESTURE_EMOTIONS).
         gender: "female" or "male" (picks the body build). handedness: "left" or "right".
         fps: output frame rate. model: a network (default: the shipped one). seed, noise: the network is
         deterministic; with ``noise`` > 0 the decoder inputs are jittered (seeded) for variations.

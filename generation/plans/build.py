@@ -21,12 +21,12 @@ from pathlib import Path
 
 import yaml
 
+from study_protocol import GAIT_EMOTIONS, GESTURE_EMOTIONS, GESTURE_TASKS, THEMES
+
+from .schema import CAPTURED_CLIPS
+
 HERE = Path(__file__).resolve().parent
 SENTENCES = HERE.parent / "data" / "sentences_synthetic.csv"
-GAIT_EMOTIONS = ("happy", "sad", "angry", "neutral")
-GESTURE_EMOTIONS = ("afraid", "amused", "angry", "ashamed", "disgusted", "joyous", "neutral", "proud", "relieved",
-                    "sad", "surprised")
-THEMES = ("happy", "sad", "energetic", "tired", "feminine", "masculine")
 WEIGHTS = (0.4, 0.7, 1.0, 1.3)
 FEATURE_COUNTS = (1, 4, 7, 10)
 INVERSION_WEIGHT = -0.7
@@ -35,9 +35,9 @@ RENDER = {"width": 640, "height": 480, "fps": 30, "duration_s": 10, "camera": "f
 
 def _predominant(emotion: str, share: float = 0.8) -> list[float]:
     """``share`` of one emotion and the rest neutral (pure neutral for neutral)."""
-    vec = [0.0] * 4
+    vec = [0.0] * len(GAIT_EMOTIONS)
     vec[GAIT_EMOTIONS.index(emotion)] = share
-    vec[3] += 1.0 - share
+    vec[GAIT_EMOTIONS.index("neutral")] += 1.0 - share
     return [round(v, 3) for v in vec]
 
 
@@ -78,10 +78,9 @@ def seed000() -> dict:
                           "origin": "generated",
                           "transition": {"initial": _predominant(a), "final": _predominant(b)},
                           "trajectory": turns[seed % len(turns)], "seed": seed, "sections": ["emotion_transition"]})
-    for name, cycles in (("humanoid3d_walk.txt", 8), ("0walk_forward.txt", 8), ("turn_left0.txt", 8),
-                         ("turn_left1.txt", 8), ("turn_right0.txt", 8), ("turn_right1.txt", 8)):
+    for name in CAPTURED_CLIPS:
         clips.append({"id": f"source_{name.removesuffix('.txt')}", "generator": "captured", "origin": "source",
-                      "clip": name, "cycles": cycles, "sections": ["naturalness"],
+                      "clip": name, "cycles": 8, "sections": ["naturalness"],
                       "note": "captured walk (DeepMimic, CMU/SFU mocap), no emotion label"})
     return {"name": "seed000", "description": "Seed 000 (Bhattacharya et al., ISMAR 2020) web study stimuli: "
             "single-emotion gaits, transition gaits, source motions; 10 s clips, fixed camera.",
@@ -92,7 +91,7 @@ def _sentences(per_emotion_narration: int, per_emotion_conversation: int) -> lis
     rows = list(csv.DictReader(SENTENCES.open(encoding="utf-8")))
     out = []
     for emotion in GESTURE_EMOTIONS:
-        for task, n in (("narration", per_emotion_narration), ("conversation", per_emotion_conversation)):
+        for task, n in zip(GESTURE_TASKS, (per_emotion_narration, per_emotion_conversation)):
             pool = [r for r in rows if r["emotion"] == emotion and r["task"] == task]
             out.extend(pool[-n:])           # the last sentences of each group
     return out

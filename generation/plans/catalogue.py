@@ -11,12 +11,7 @@ import os
 from collections.abc import Iterable
 from pathlib import Path
 
-CLIP_COLUMNS = ("clip_id", "modality", "origin", "happy", "sad", "angry", "neutral", "final_happy", "final_sad",
-                "final_angry", "final_neutral", "emotion_label", "valence", "arousal", "dominance", "theme", "weight",
-                "n_features", "duration_s")
-FLOAT_COLUMNS = ("happy", "sad", "angry", "neutral", "final_happy", "final_sad", "final_angry", "final_neutral",
-                 "valence", "arousal", "dominance", "weight", "duration_s")
-INT_COLUMNS = ("n_features",)
+from study_protocol import CLIP_COLUMNS, CLIP_FLOAT_COLUMNS, CLIP_INT_COLUMNS, MODALITIES, ORIGINS
 
 
 class CatalogueFormatError(ValueError):
@@ -48,26 +43,24 @@ def read_clips_csv(path: str | Path) -> list[dict]:
             row: dict = {}
             for col in CLIP_COLUMNS:
                 text = (raw.get(col) or "").strip()
-                if col in FLOAT_COLUMNS or col in INT_COLUMNS:
+                if col in CLIP_FLOAT_COLUMNS or col in CLIP_INT_COLUMNS:
                     if not text:
                         row[col] = None
                         continue
                     try:
-                        row[col] = int(text) if col in INT_COLUMNS else float(text)
+                        row[col] = int(text) if col in CLIP_INT_COLUMNS else float(text)
                     except ValueError:
-                        kind = "an integer" if col in INT_COLUMNS else "a number"
+                        kind = "an integer" if col in CLIP_INT_COLUMNS else "a number"
                         raise CatalogueFormatError(
                             f"{path}: line {line_no}: field {col!r}: expected {kind} or blank, got {text!r}") from None
                 else:
                     row[col] = text
             if not row["clip_id"]:
                 raise CatalogueFormatError(f"{path}: line {line_no}: field 'clip_id' is empty")
-            if row["modality"] not in ("gait", "gesture"):
-                raise CatalogueFormatError(
-                    f"{path}: line {line_no}: field 'modality': expected gait or gesture, got {row['modality']!r}")
-            if row["origin"] not in ("generated", "source"):
-                raise CatalogueFormatError(
-                    f"{path}: line {line_no}: field 'origin': expected generated or source, got {row['origin']!r}")
+            for col, allowed in (("modality", MODALITIES), ("origin", ORIGINS)):
+                if row[col] not in allowed:
+                    raise CatalogueFormatError(f"{path}: line {line_no}: field {col!r}: expected "
+                                               f"{' or '.join(allowed)}, got {row[col]!r}")
             rows.append(row)
     return rows
 

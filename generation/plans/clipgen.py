@@ -21,6 +21,7 @@ from pathlib import Path
 import numpy as np
 
 from generation.core.motion import Motion
+from study_protocol import GESTURE_VAD
 
 from .schema import ClipEntry
 
@@ -303,7 +304,7 @@ def transition_walk(a, b, path, n_frames: int, fps: float, seed: int | None = No
 
 
 def _captured(entry: ClipEntry, fps: float) -> Motion:
-    from generation.formats.captured import WALK_FILES, captured_walks, repeat_cycle
+    from generation.formats.captured import WALK_FILES, captured_walks, chain_clip_repeats
 
     names = [name for name, _ in WALK_FILES]
     clip = entry.inputs["clip"]
@@ -311,7 +312,7 @@ def _captured(entry: ClipEntry, fps: float) -> Motion:
         raise ClipGenerationError(f"{entry.where}: captured clip {clip!r} not shipped (have {names})")
     motion = captured_walks()[names.index(clip)]
     if entry.inputs["cycles"] > 1:
-        motion = repeat_cycle(motion, entry.inputs["cycles"])
+        motion = chain_clip_repeats(motion, entry.inputs["cycles"])
     return motion
 
 
@@ -323,12 +324,12 @@ def _neutral_cycle() -> Motion:
 
 
 def _neutral_walk(entry: ClipEntry, fps: float) -> Motion:
-    from generation.rbf.stylise import cycle_stride, repeat_cycle
+    from generation.rbf.stylise import cycle_stride, warp_and_repeat_cycle
 
     base = _neutral_cycle()
     inp = entry.inputs
-    rot, root = repeat_cycle(base.rotations, base.root_positions, cycle_stride(base), base.duration, inp["speed"],
-                             inp["n_cycles"], fps)
+    rot, root = warp_and_repeat_cycle(base.rotations, base.root_positions, cycle_stride(base), base.duration,
+                                      inp["speed"], inp["n_cycles"], fps)
     meta = dict(base.metadata)
     meta.update({"generator": "neutral_walk", "n_cycles": inp["n_cycles"], "speed": inp["speed"]})
     return Motion(base.skeleton, rot, root, fps, meta)
@@ -352,11 +353,11 @@ def _gesture_net(entry: ClipEntry, fps: float) -> Motion:
 
 def _procedural_gesture(entry: ClipEntry, fps: float) -> Motion:
     from generation.core.skeleton import gesture_skeleton
-    from generation.procedural.emotion import NRC_VAD, gesture_params_for_vad
+    from generation.procedural.emotion import gesture_params_for_vad
     from generation.procedural.gesture import seated_gesture
 
     inp = entry.inputs
-    v, a, d = NRC_VAD[inp["emotion_label"]] if "emotion_label" in inp else inp["vad"]
+    v, a, d = GESTURE_VAD[inp["emotion_label"]] if "emotion_label" in inp else inp["vad"]
     rng = np.random.default_rng(entry.seed)
     params = gesture_params_for_vad(v, a, d, rng, kind=inp["kind"], handedness=inp["handedness"])
     n_frames = int(round(inp["duration_s"] * fps))

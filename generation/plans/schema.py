@@ -33,13 +33,21 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from generation.render.settings import RENDERER_VERSION, RenderSettings, RenderSettingsError
+from study_protocol import (
+    FINAL_EMOTION_COLUMNS,
+    GAIT_EMOTIONS,
+    GENDERS,
+    GESTURE_TASKS,
+    GESTURE_VAD,
+    HANDEDNESS,
+    NEUTRAL_THEME,
+    SECTION_TYPES,
+    THEMES,
+    VAD_DIMENSIONS,
+)
 
 PLANS_DIR = Path(__file__).resolve().parent
-GAIT_EMOTIONS = ("happy", "sad", "angry", "neutral")
-THEMES = ("happy", "sad", "energetic", "tired", "feminine", "masculine")
 TRAJECTORY_KINDS = ("straight", "curved", "sharp_turn")
-SECTION_TYPES = ("emotion_choice", "emotion_transition", "affect_likert", "naturalness", "gesture_emotion",
-                 "neutral_validation", "theme_rating", "theme_inversion")
 CAPTURED_CLIPS = ("humanoid3d_walk.txt", "0walk_forward.txt", "turn_left0.txt", "turn_left1.txt",
                   "turn_right0.txt", "turn_right1.txt")
 
@@ -164,7 +172,8 @@ def _text(name: str, value) -> str:
 
 
 def _emotion(name: str, value) -> list[float]:
-    """(happy, sad, angry, neutral) as a list of 4 non-negative numbers or a mapping; l1-normalised."""
+    """A gait emotion vector: non-negative numbers in GAIT_EMOTIONS order, a mapping or one emotion name;
+    l1-normalised."""
     if isinstance(value, str) and value in GAIT_EMOTIONS:
         value = [1.0 if e == value else 0.0 for e in GAIT_EMOTIONS]
     if isinstance(value, dict):
@@ -172,8 +181,8 @@ def _emotion(name: str, value) -> list[float]:
         if unknown:
             raise _FieldError(name, f"unknown emotion(s) {sorted(unknown)}; expected keys of {list(GAIT_EMOTIONS)}")
         value = [value.get(e, 0.0) for e in GAIT_EMOTIONS]
-    if not isinstance(value, (list, tuple)) or len(value) != 4:
-        raise _FieldError(name, f"expected 4 numbers (happy, sad, angry, neutral), got {value!r}")
+    if not isinstance(value, (list, tuple)) or len(value) != len(GAIT_EMOTIONS):
+        raise _FieldError(name, f"expected {len(GAIT_EMOTIONS)} numbers ({', '.join(GAIT_EMOTIONS)}), got {value!r}")
     vec = [_number(name, v, 0.0) for v in value]
     total = sum(vec)
     if total <= 0:
@@ -206,10 +215,8 @@ def _trajectory(value) -> dict:
 
 
 def _gesture_label(name: str, value) -> str:
-    from generation.procedural.emotion import NRC_VAD
-
-    if not isinstance(value, str) or value.strip().lower() not in NRC_VAD:
-        raise _FieldError(name, f"expected an NRC-VAD emotion word ({', '.join(sorted(NRC_VAD))}), got {value!r}")
+    if not isinstance(value, str) or value.strip().lower() not in GESTURE_VAD:
+        raise _FieldError(name, f"expected an NRC-VAD emotion word ({', '.join(sorted(GESTURE_VAD))}), got {value!r}")
     return value.strip().lower()
 
 
@@ -249,12 +256,12 @@ def _generator_inputs(gen: str, raw: dict, duration_default: float) -> dict:
         out["speed"] = _number("speed", raw.get("speed", 1.0), 0.2, 3.0)
     elif gen == "gesture_net":
         out["sentence"] = _text("sentence", raw.get("sentence"))
-        out["task"] = _choice("task", raw.get("task", "narration"), ("narration", "conversation"))
+        out["task"] = _choice("task", raw.get("task", GESTURE_TASKS[0]), GESTURE_TASKS)
         if "emotion_label" not in raw:
             raise _FieldError("emotion_label", "required (an NRC-VAD word, e.g. proud)")
         out["emotion_label"] = _gesture_label("emotion_label", raw["emotion_label"])
-        out["gender"] = _choice("gender", raw.get("gender", "female"), ("female", "male"))
-        out["handedness"] = _choice("handedness", raw.get("handedness", "right"), ("right", "left"))
+        out["gender"] = _choice("gender", raw.get("gender", "female"), GENDERS)
+        out["handedness"] = _choice("handedness", raw.get("handedness", "right"), HANDEDNESS)
         out["noise"] = _number("noise", raw.get("noise", 0.0), 0.0, 1.0)
     elif gen == "procedural_gesture":
         if ("emotion_label" in raw) == ("vad" in raw):
@@ -268,8 +275,8 @@ def _generator_inputs(gen: str, raw: dict, duration_default: float) -> dict:
             out["vad"] = [_number("vad", v, 0.0, 1.0) for v in vad]
         kind = raw.get("kind")
         out["kind"] = None if kind is None else _choice("kind", kind, ("beat", "pointing", "descriptive"))
-        out["gender"] = _choice("gender", raw.get("gender", "female"), ("female", "male"))
-        out["handedness"] = _choice("handedness", raw.get("handedness", "right"), ("right", "left"))
+        out["gender"] = _choice("gender", raw.get("gender", "female"), GENDERS)
+        out["handedness"] = _choice("handedness", raw.get("handedness", "right"), HANDEDNESS)
         out["duration_s"] = _number("duration_s", raw.get("duration_s", 6.0), 1.0, 60.0)
     return out
 
@@ -424,26 +431,23 @@ def clip_hash(entry: ClipEntry, generator: str, generator_version: str) -> str:
 def intent_fields(entry: ClipEntry) -> dict:
     """The clips.csv intent columns of an entry (blank = None): emotion vectors, gesture label and VAD,
     RBF theme/weight/feature count. Source motions carry no intended emotion."""
-    out = {k: None for k in ("happy", "sad", "angry", "neutral", "final_happy", "final_sad", "final_angry",
-                             "final_neutral", "emotion_label", "valence", "arousal", "dominance", "theme",
+    out = {k: None for k in (*GAIT_EMOTIONS, *FINAL_EMOTION_COLUMNS, "emotion_label", *VAD_DIMENSIONS, "theme",
                              "weight", "n_features")}
     inp = entry.inputs
     if "emotion" in inp:
         out.update(zip(GAIT_EMOTIONS, inp["emotion"]))
     elif "transition" in inp:
         out.update(zip(GAIT_EMOTIONS, inp["transition"]["initial"]))
-        out.update(zip(("final_" + e for e in GAIT_EMOTIONS), inp["transition"]["final"]))
+        out.update(zip(FINAL_EMOTION_COLUMNS, inp["transition"]["final"]))
     if entry.modality == "gesture":
         if "emotion_label" in inp:
-            from generation.procedural.emotion import NRC_VAD
-
             out["emotion_label"] = inp["emotion_label"]
-            out["valence"], out["arousal"], out["dominance"] = NRC_VAD[inp["emotion_label"]]
+            out.update(zip(VAD_DIMENSIONS, GESTURE_VAD[inp["emotion_label"]]))
         elif "vad" in inp:
-            out["valence"], out["arousal"], out["dominance"] = inp["vad"]
+            out.update(zip(VAD_DIMENSIONS, inp["vad"]))
     if entry.generator == "rbf":
         out["theme"], out["weight"], out["n_features"] = inp["theme"], inp["weight"], inp["n_features"]
     if entry.generator == "neutral_walk":
         # The neutral base walk (seed 004's input sequence): theme "neutral", no features applied.
-        out["theme"], out["weight"], out["n_features"] = "neutral", 0.0, 0
+        out["theme"], out["weight"], out["n_features"] = NEUTRAL_THEME, 0.0, 0
     return out

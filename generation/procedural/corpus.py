@@ -28,8 +28,9 @@ import numpy as np
 from generation.core.motion import Motion
 from generation.core.paths import PATH_KINDS, random_path
 from generation.core.skeleton import gait_skeleton, gesture_skeleton
+from study_protocol import GAIT_EMOTIONS, GENDERS, GESTURE_EMOTIONS, GESTURE_TASKS, HANDEDNESS
 
-from .emotion import GAIT_EMOTIONS, gait_params_for_emotion, gesture_params_for_vad, simulate_annotators, vad_for
+from .emotion import gait_params_for_emotion, gesture_params_for_vad, simulate_annotators, vad_for
 from .gesture import GESTURE_KINDS, seated_gesture
 from .walk import walk
 
@@ -266,10 +267,6 @@ def build_gait_corpus(num_sequences: int = 1000, seed: int = 0, frames: int = 24
 
 
 # ---- gestures ------------------------------------------------------------------------------------
-TASKS = ("narration", "conversation")
-GENDERS = ("male", "female")
-
-
 @dataclass
 class GestureCorpus:
     """N synthetic procedural seated gesture sequences on the 23-joint gesture skeleton.
@@ -356,12 +353,12 @@ def _parse_spec(spec, i: int) -> tuple[str, str, str, str, int]:
         raise ValueError(f"gesture spec {i}: expected (emotion, task, gender, handedness, n_frames), got {spec!r}")
     word, task, gender, hand, n = spec
     vad_for(word)  # KeyError naming the known words
-    if task not in TASKS:
-        raise ValueError(f"gesture spec {i}: task must be one of {TASKS}, got {task!r}")
+    if task not in GESTURE_TASKS:
+        raise ValueError(f"gesture spec {i}: task must be one of {GESTURE_TASKS}, got {task!r}")
     if gender not in GENDERS:
         raise ValueError(f"gesture spec {i}: gender must be one of {GENDERS}, got {gender!r}")
-    if hand not in ("left", "right"):
-        raise ValueError(f"gesture spec {i}: handedness must be 'left' or 'right', got {hand!r}")
+    if hand not in HANDEDNESS:
+        raise ValueError(f"gesture spec {i}: handedness must be one of {HANDEDNESS}, got {hand!r}")
     if int(n) < 8:
         raise ValueError(f"gesture spec {i}: n_frames must be at least 8, got {n}")
     return str(word).lower(), task, gender, hand, int(n)
@@ -423,9 +420,9 @@ def build_gesture_corpus(specs, seed: int = 0, fps: float = 30.0) -> GestureCorp
 
 def default_gesture_specs(n_frames: int = 150) -> list[tuple[str, str, str, str, int]]:
     """Every MPI emotion x task x gender x handedness once (88 specs), for a demo gesture corpus."""
-    from .emotion import GESTURE_EMOTIONS
-
-    return [(e, t, g, h, n_frames) for e in GESTURE_EMOTIONS for t in TASKS for g in GENDERS for h in ("left", "right")]
+    male_first = GENDERS[::-1]  # the order the demo corpus has always been built in (its seeds follow the order)
+    return [(e, t, g, h, n_frames)
+            for e in GESTURE_EMOTIONS for t in GESTURE_TASKS for g in male_first for h in HANDEDNESS]
 
 
 # ---- command line ----------------------------------------------------------------------------------

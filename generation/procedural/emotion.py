@@ -4,8 +4,8 @@ Gait (seed 000, section 3.2.2): an emotion is a vector over (happy, sad, angry, 
 entries are the relative counts of annotators who chose each term (l1-normalised).
 
 Gestures (seed 003, section 3.1): a categorical emotion term is mapped to valence, arousal and
-dominance in [0, 1] with the NRC-VAD lexicon (Mohammad, ACL 2018), stored in
-``generation/data/nrc_vad.csv`` with its citation.
+dominance in [0, 1] with the NRC-VAD lexicon (Mohammad, ACL 2018): :data:`study_protocol.GESTURE_VAD`, which
+cites it.
 
 The parameter mappings are hand-made from the literature the papers cite, not learned:
 - gait: arousal goes with speed, cadence and arm swing; sadness with a bowed head and trunk,
@@ -20,52 +20,15 @@ The parameter mappings are hand-made from the literature the papers cite, not le
 """
 from __future__ import annotations
 
-import csv
-from pathlib import Path
-
 import numpy as np
+
+from study_protocol import GAIT_EMOTIONS, GESTURE_VAD
 
 from .gesture import GESTURE_KINDS, GestureParams
 from .walk import WalkParams
 
-GAIT_EMOTIONS = ("happy", "sad", "angry", "neutral")
-
-# The 11 categories of the MPI Emotional Body Expressions database, as NRC-VAD words.
-GESTURE_EMOTIONS = ("afraid", "amused", "angry", "ashamed", "disgusted", "joyous", "neutral", "proud", "relieved",
-                    "sad", "surprised")
-
-NRC_VAD_PATH = Path(__file__).resolve().parent.parent / "data" / "nrc_vad.csv"
-
-
-def load_nrc_vad(path: str | Path = NRC_VAD_PATH) -> dict[str, tuple[float, float, float]]:
-    """Read ``word,valence,arousal,dominance`` rows ('#' lines are comments) -> {word: (v, a, d)}.
-
-    Raises ValueError naming the file and line for a malformed row or a value outside [0, 1].
-    """
-    path = Path(path)
-    table: dict[str, tuple[float, float, float]] = {}
-    with path.open(newline="", encoding="utf-8") as fh:
-        rows = [(n, line) for n, line in enumerate(fh, start=1) if line.strip() and not line.startswith("#")]
-    if not rows or rows[0][1].strip().split(",") != ["word", "valence", "arousal", "dominance"]:
-        raise ValueError(f"{path}: expected header 'word,valence,arousal,dominance'")
-    for n, line in rows[1:]:
-        fields = next(csv.reader([line]))
-        if len(fields) != 4:
-            raise ValueError(f"{path}:{n}: expected 4 fields, got {len(fields)}")
-        word = fields[0].strip().lower()
-        try:
-            vad = tuple(float(x) for x in fields[1:])
-        except ValueError:
-            raise ValueError(f"{path}:{n}: non-numeric VAD value in {fields[1:]}") from None
-        if not all(0.0 <= x <= 1.0 for x in vad):
-            raise ValueError(f"{path}:{n}: VAD values must lie in [0, 1], got {vad}")
-        if word in table:
-            raise ValueError(f"{path}:{n}: duplicate word {word!r}")
-        table[word] = vad
-    return table
-
-
-NRC_VAD: dict[str, tuple[float, float, float]] = load_nrc_vad()
+NRC_VAD = GESTURE_VAD
+"""Gesture category -> NRC-VAD (valence, arousal, dominance); :data:`study_protocol.GESTURE_VAD` (cited there)."""
 
 
 def vad_for(word: str) -> tuple[float, float, float]:

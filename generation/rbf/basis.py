@@ -123,12 +123,6 @@ def evaluate_q(Q: np.ndarray, m: int = CYCLE_FRAMES, period: float | None = None
     return np.stack([rbf_sum(t, params_from_q_row(row), period) for row in Q], axis=1)
 
 
-def sort_by_mean(params: np.ndarray) -> np.ndarray:
-    """Reorder RBF rows so mu_1 < mu_2 < mu_3 (section V: done before averaging across animators)."""
-    p = validate_params(params)
-    return p[np.argsort(p[:, 1], kind="stable")]
-
-
 def average_q(q_matrices: list[np.ndarray]) -> np.ndarray:
     """Consolidate several animators' Q matrices into one (section V).
 

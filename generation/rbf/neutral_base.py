@@ -256,7 +256,7 @@ def captured_sources() -> list[Motion]:
     tells :func:`neutral_cycle_from_motions` to keep only its first cycle, so the repeat does not count twice.
     """
     try:
-        from generation.formats.captured import captured_walks, repeat_cycle
+        from generation.formats.captured import captured_walks, chain_clip_repeats
     except ImportError:
         return []
     out = []
@@ -266,7 +266,7 @@ def captured_sources() -> list[Motion]:
             continue
         name = str(mo.metadata.get("source", "captured walk"))
         if mo.metadata.get("loop") == "wrap":
-            mo = repeat_cycle(mo, 3)
+            mo = chain_clip_repeats(mo, 3)
             mo.metadata["max_cycles"] = 1
         mo.metadata["source"] = name + " (captured)"
         out.append(mo)

@@ -344,7 +344,7 @@ def _sample_cycle(rotations: np.ndarray, root: np.ndarray, stride: np.ndarray, p
     return rot, r0 + frac[:, None] * (r1 - r0)
 
 
-def repeat_cycle(rotations: np.ndarray, root: np.ndarray, stride: np.ndarray, cycle_seconds: float,
+def warp_and_repeat_cycle(rotations: np.ndarray, root: np.ndarray, stride: np.ndarray, cycle_seconds: float,
                  speed: float, n_cycles: int, fps: float) -> tuple[np.ndarray, np.ndarray]:
     """Uniformly time-warp a periodic cycle by ``speed`` and repeat it ``n_cycles`` times at ``fps``.
 
@@ -353,6 +353,8 @@ def repeat_cycle(rotations: np.ndarray, root: np.ndarray, stride: np.ndarray, cy
     n_out = int(round(n_cycles * cycle_seconds / speed * fps))
     phase = np.arange(n_out) / fps * speed / cycle_seconds
     return _sample_cycle(rotations, root, stride, phase)
+
+
 
 
 # --------------------------------------------------------------------------------------------------
@@ -436,8 +438,8 @@ def stylise(neutral_cycle: Motion, theme: str, weight: float, n_features: int, s
         raise ValueError(f"n_cycles must be a positive integer, got {n_cycles!r}")
     result = stylised_cycle(neutral_cycle, theme, weight, n_features, keep_ground)
     stride = cycle_stride(neutral_cycle)
-    rotations, root = repeat_cycle(result["rotations"], result["root"], stride, neutral_cycle.duration, speed,
-                                   n_cycles, fps)
+    rotations, root = warp_and_repeat_cycle(result["rotations"], result["root"], stride, neutral_cycle.duration,
+                                            speed, n_cycles, fps)
     base_meta = neutral_cycle.metadata
     metadata = {
         "origin": "generated",
@@ -468,8 +470,8 @@ def neutral_walk(neutral_cycle: Motion, speed: float = 1.0, n_cycles: int = 4, f
         raise ValueError(f"n_cycles must be a positive integer, got {n_cycles!r}")
     stride = cycle_stride(neutral_cycle)
     walker_frame_positions(neutral_cycle)  # validates length and heading
-    rotations, root = repeat_cycle(neutral_cycle.rotations, neutral_cycle.root_positions, stride,
-                                   neutral_cycle.duration, speed, n_cycles, fps)
+    rotations, root = warp_and_repeat_cycle(neutral_cycle.rotations, neutral_cycle.root_positions, stride,
+                                            neutral_cycle.duration, speed, n_cycles, fps)
     meta = neutral_cycle.metadata
     metadata = {"origin": "generated", "generator": "neutral_base", "theme": "neutral", "weight": 0.0,
                 "n_features": 0, "speed": float(speed), "n_cycles": n_cycles,
@@ -478,4 +480,4 @@ def neutral_walk(neutral_cycle: Motion, speed: float = 1.0, n_cycles: int = 4, f
 
 
 __all__ = ["neutral_walk", "stylise", "stylised_cycle", "theme_rbfs", "theme_displacement", "fit_to_skeleton",
-           "walker_frame_positions", "repeat_cycle", "bone_length_error", "CYCLE_FRAMES"]
+           "walker_frame_positions", "warp_and_repeat_cycle", "bone_length_error", "CYCLE_FRAMES"]

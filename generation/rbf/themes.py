@@ -21,7 +21,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-THEME_NAMES = ("happy", "sad", "energetic", "tired", "feminine", "masculine")
+from study_protocol import THEMES as THEME_NAMES  # the six theme names; THEMES below is Table III by theme
+
 AXES = {"X": 0, "Y": 1, "Z": 2}
 
 # The paper's 11 body parts (Fig. 3) on the 21-joint gait skeleton. Paired parts list (left, right).
@@ -230,11 +231,6 @@ TABLE_III: dict[str, tuple[str, ...]] = {
                   "Neck: increased swing along Z", "Shoulders: increased swing along Z",
                   "Elbows: increased swing along Z"),
 }
-
-# Table II: share of movement features among all edits per theme (%), for comparison with our top ten.
-TABLE_II_MOVEMENT_PERCENT = {"happy": 71.4, "sad": 24.5, "energetic": 86.0, "tired": 22.9, "feminine": 59.0,
-                             "masculine": 67.3}
-
 
 def theme_features(theme: str, n_features: int | None = None) -> tuple[Feature, ...]:
     """The first ``n_features`` (1..10, default all) features of a theme, in Table III order."""

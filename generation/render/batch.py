@@ -172,6 +172,107 @@ def render_job(job: Job, record: dict, clips_dir: str, records_dir: str) -> dict
 
 
 # ---- orchestration -----------------------------------------------------------------------------
+@dataclass
+class _Batch:
+    """The state of one :func:`run_plan` call: where files go, the records so far (clip id -> record, in plan
+    order) and the outcome."""
+
+    clips_dir: Path
+    records_dir: Path
+    emit: Callable[[str, dict], None]
+    result: BatchResult
+    by_id: dict[str, dict] = field(default_factory=dict)
+
+    def job_args(self, job: Job) -> tuple:
+        """The arguments of :func:`render_job` for ``job``."""
+        return job, self.by_id[job.clip_id], str(self.clips_dir), str(self.records_dir)
+
+    def finished(self, job: Job, rec: dict) -> None:
+        self.by_id[job.clip_id] = rec
+        self.result.rendered.append(job.clip_id)
+        self.emit("done", {"clip_id": job.clip_id, "entry": job.entry.id, "duration_s": rec["duration_s"]})
+
+    def failed(self, job: Job, exc: BaseException) -> None:
+        self.by_id.pop(job.clip_id, None)
+        msg = f"{job.entry.where}: {type(exc).__name__}: {exc}"
+        self.result.failed.append((job.entry.where, msg))
+        self.emit("fail", {"entry": job.entry.where, "error": msg, "traceback": "".join(
+            traceback.format_exception(type(exc), exc, exc.__traceback__))[-2000:]})
+
+
+def _select_todo(batch: _Batch, jobs: list[Job], plan: Plan, media_prefix: str, webm: bool) -> list[Job]:
+    """Record every job in ``batch.by_id``; skip (and report) the clips already complete, return the rest."""
+    pair_ids = {j.entry.id: j.clip_id for j in jobs}
+    todo = []
+    for job in jobs:
+        if job.clip_id in batch.by_id:      # two entries that render identical files (ids differ only)
+            continue
+        if webm or job.run_entry.render.webm:
+            job.run_entry = _with_webm(job.run_entry)
+        rec = base_record(job, plan, pair_ids, media_prefix, job.run_entry.render.webm)
+        done = load_done_record(job.clip_id, batch.clips_dir, batch.records_dir, job.run_entry.render.webm)
+        if done is not None:
+            # Same files; refresh the plan-dependent fields (another plan may share this clip).
+            for key in ("duration_s",):
+                rec[key] = done.get(key)
+            rec["metadata"] = {**done.get("metadata", {}), **rec["metadata"]}
+            batch.by_id[job.clip_id] = rec
+            batch.result.skipped.append(job.clip_id)
+            batch.emit("skip", {"clip_id": job.clip_id, "entry": job.entry.id})
+        else:
+            batch.by_id[job.clip_id] = rec
+            todo.append(job)
+    return todo
+
+
+def _remove_stale(todo: list[Job], clips_dir: Path, records_dir: Path) -> None:
+    """Delete leftovers of a crashed run (hidden temporary names) of the clips about to be made."""
+    for job in todo:
+        for stale in (*clips_dir.glob(f".{job.clip_id}.tmp*"), *records_dir.glob(f".{job.clip_id}.json.tmp*")):
+            stale.unlink(missing_ok=True)
+
+
+def _render_serial(batch: _Batch, todo: list[Job]) -> None:
+    """Render ``todo`` one after another in this process; frame progress goes straight to ``batch.emit``."""
+    global _PROGRESS_QUEUE
+    _PROGRESS_QUEUE = _DirectProgress(batch.emit)
+    try:
+        for job in todo:
+            batch.emit("start", {"clip_id": job.clip_id, "entry": job.entry.id})
+            try:
+                rec = render_job(*batch.job_args(job))
+            except Exception as exc:  # noqa: BLE001 - one bad clip must not stop the plan
+                batch.failed(job, exc)
+                continue
+            batch.finished(job, rec)
+    finally:
+        _PROGRESS_QUEUE = None
+
+
+def _render_pool(batch: _Batch, todo: list[Job], workers: int, threads_per_worker: int) -> None:
+    """Render ``todo`` in ``workers`` spawned processes, relaying their frame progress to ``batch.emit``."""
+    ctx = mp.get_context("spawn")
+    manager = ctx.Manager()
+    progress_q = manager.Queue()
+    try:
+        with ProcessPoolExecutor(max_workers=workers, mp_context=ctx, initializer=_init_worker,
+                                 initargs=(progress_q, threads_per_worker, os.getpid())) as pool:
+            pending = {pool.submit(render_job, *batch.job_args(job)): job for job in todo}
+            started: set[str] = set()
+            while pending:
+                done_set, _ = wait(pending, timeout=0.2, return_when=FIRST_COMPLETED)
+                _drain(progress_q, batch.emit, started)
+                for fut in done_set:
+                    job = pending.pop(fut)
+                    try:
+                        batch.finished(job, fut.result())
+                    except Exception as exc:  # noqa: BLE001
+                        batch.failed(job, exc)
+            _drain(progress_q, batch.emit, started)
+    finally:
+        manager.shutdown()
+
+
 def run_plan(plan: Plan, clips_dir: str | Path, records_dir: str | Path, media_prefix: str = "clips/",
              workers: int = 1, webm: bool = False, limit: int | None = None,
              on_event: Callable[[str, dict], None] | None = None, threads_per_worker: int = 1) -> BatchResult:
@@ -195,88 +296,19 @@ def run_plan(plan: Plan, clips_dir: str | Path, records_dir: str | Path, media_p
     records_dir.mkdir(parents=True, exist_ok=True)
     emit = on_event or (lambda kind, info: None)
     jobs, failures = plan_jobs(plan, limit)
-    result = BatchResult(failed=list(failures))
+    batch = _Batch(clips_dir, records_dir, emit, BatchResult(failed=list(failures)))
     for where, msg in failures:
         emit("fail", {"entry": where, "error": msg})
-    pair_ids = {j.entry.id: j.clip_id for j in jobs}
-    todo = []
-    by_id: dict[str, dict] = {}
-    for job in jobs:
-        if job.clip_id in by_id:      # two entries that render identical files (ids differ only)
-            continue
-        if webm or job.run_entry.render.webm:
-            job.run_entry = _with_webm(job.run_entry)
-        rec = base_record(job, plan, pair_ids, media_prefix, job.run_entry.render.webm)
-        done = load_done_record(job.clip_id, clips_dir, records_dir, job.run_entry.render.webm)
-        if done is not None:
-            # Same files; refresh the plan-dependent fields (another plan may share this clip).
-            for key in ("duration_s",):
-                rec[key] = done.get(key)
-            rec["metadata"] = {**done.get("metadata", {}), **rec["metadata"]}
-            by_id[job.clip_id] = rec
-            result.skipped.append(job.clip_id)
-            emit("skip", {"clip_id": job.clip_id, "entry": job.entry.id})
-        else:
-            by_id[job.clip_id] = rec
-            todo.append(job)
-    emit("plan", {"total": len(by_id), "todo": len(todo), "skipped": len(result.skipped)})
-    for job in todo:  # leftovers of a crashed run (hidden temporary names) of the clips about to be made
-        for stale in (*clips_dir.glob(f".{job.clip_id}.tmp*"), *records_dir.glob(f".{job.clip_id}.json.tmp*")):
-            stale.unlink(missing_ok=True)
-
-    def finished(job: Job, rec: dict) -> None:
-        by_id[job.clip_id] = rec
-        result.rendered.append(job.clip_id)
-        emit("done", {"clip_id": job.clip_id, "entry": job.entry.id, "duration_s": rec["duration_s"]})
-
-    def failed(job: Job, exc: BaseException) -> None:
-        by_id.pop(job.clip_id, None)
-        msg = f"{job.entry.where}: {type(exc).__name__}: {exc}"
-        result.failed.append((job.entry.where, msg))
-        emit("fail", {"entry": job.entry.where, "error": msg, "traceback": "".join(
-            traceback.format_exception(type(exc), exc, exc.__traceback__))[-2000:]})
-
+    todo = _select_todo(batch, jobs, plan, media_prefix, webm)
+    emit("plan", {"total": len(batch.by_id), "todo": len(todo), "skipped": len(batch.result.skipped)})
+    _remove_stale(todo, clips_dir, records_dir)
     if workers <= 1 or len(todo) <= 1:
-        global _PROGRESS_QUEUE
-        _PROGRESS_QUEUE = _DirectProgress(emit)
-        try:
-            for job in todo:
-                emit("start", {"clip_id": job.clip_id, "entry": job.entry.id})
-                try:
-                    rec = render_job(job, by_id[job.clip_id], str(clips_dir), str(records_dir))
-                except Exception as exc:  # noqa: BLE001 - one bad clip must not stop the plan
-                    failed(job, exc)
-                    continue
-                finished(job, rec)
-        finally:
-            _PROGRESS_QUEUE = None
+        _render_serial(batch, todo)
     else:
-        ctx = mp.get_context("spawn")
-        manager = ctx.Manager()
-        progress_q = manager.Queue()
-        try:
-            with ProcessPoolExecutor(max_workers=workers, mp_context=ctx, initializer=_init_worker,
-                                     initargs=(progress_q, threads_per_worker, os.getpid())) as pool:
-                pending = {}
-                for job in todo:
-                    fut = pool.submit(render_job, job, by_id[job.clip_id], str(clips_dir), str(records_dir))
-                    pending[fut] = job
-                started: set[str] = set()
-                while pending:
-                    done_set, _ = wait(pending, timeout=0.2, return_when=FIRST_COMPLETED)
-                    _drain(progress_q, emit, started)
-                    for fut in done_set:
-                        job = pending.pop(fut)
-                        try:
-                            finished(job, fut.result())
-                        except Exception as exc:  # noqa: BLE001
-                            failed(job, exc)
-                _drain(progress_q, emit, started)
-        finally:
-            manager.shutdown()
-    result.records = [by_id[k] for k in by_id]
-    result.seconds = time.perf_counter() - t0
-    return result
+        _render_pool(batch, todo, workers, threads_per_worker)
+    batch.result.records = list(batch.by_id.values())
+    batch.result.seconds = time.perf_counter() - t0
+    return batch.result
 
 
 class _DirectProgress:

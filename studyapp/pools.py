@@ -1,0 +1,233 @@
+"""Section pools and options, checked against the study protocol. No Django import: the admin's SectionForm,
+``Section.clean`` and the catalogue's ``pool_queryset`` share it, and none of them needs the database to know
+whether a pool or an option is well formed.
+
+A pool is a JSON object of catalogue filters: ``field`` or ``field__lookup`` -> value (a list without a lookup
+means ``in``), plus two boolean shorthands, ``transition`` (the clip has a final emotion) and ``rbf`` (the clip
+has a theme). A naturalness section may add ``generated`` and ``source`` sub-pools (filters of the same kind)
+for its two halves. Options are type-specific (``SECTION_OPTIONS``).
+"""
+from __future__ import annotations
+
+from study_protocol import (
+    CLIP_THEMES,
+    FINAL_EMOTION_COLUMNS,
+    GAIT_EMOTIONS,
+    GESTURE_EMOTIONS,
+    MODALITIES,
+    NATURALNESS,
+    ORIGINS,
+    SECTION_MODALITY,
+    SECTION_TYPES,
+    VAD_DIMENSIONS,
+    answer_values,
+)
+
+TEXT_FIELDS: dict[str, tuple[str, ...] | None] = {
+    "clip_id": None, "plan": None, "modality": MODALITIES, "origin": ORIGINS, "emotion_label": GESTURE_EMOTIONS,
+    "theme": CLIP_THEMES, "sections": SECTION_TYPES}
+"""Catalogue text fields a pool may filter on -> the protocol vocabulary of their values (None: free text)."""
+
+NUMBER_FIELDS = (*GAIT_EMOTIONS, *FINAL_EMOTION_COLUMNS, *VAD_DIMENSIONS, "weight", "duration_s")
+INTEGER_FIELDS = ("n_features",)
+POOL_FIELDS = frozenset((*TEXT_FIELDS, *NUMBER_FIELDS, *INTEGER_FIELDS))
+TEXT_LOOKUPS = ("", "in", "startswith", "contains")
+NUMBER_LOOKUPS = ("", "in", "lt", "lte", "gt", "gte", "isnull")
+FLAGS = ("transition", "rbf")
+SUB_POOLS = ("generated", "source")
+"""Sub-pools of a naturalness section: extra filters for its generated and its source clips."""
+
+SECTION_OPTIONS: dict[str, tuple[str, ...]] = {
+    "naturalness": ("anchors", "question", "n_generated", "n_source"),
+    "gesture_emotion": ("n_options", "categories"),
+}
+"""section_type -> the option keys it understands; other section types take no options."""
+
+DEFAULT_GESTURE_OPTIONS = 4
+
+
+class PoolError(ValueError):
+    """A pool or options that cannot be used; ``errors`` maps a Section field to its messages."""
+
+    def __init__(self, errors: dict[str, list[str]]):
+        self.errors = errors
+        super().__init__("; ".join(f"{field}: {msg}" for field, msgs in errors.items() for msg in msgs))
+
+
+def _is_int(value) -> bool:
+    return isinstance(value, int) and not isinstance(value, bool)
+
+
+def _is_number(value) -> bool:
+    return isinstance(value, (int, float)) and not isinstance(value, bool)
+
+
+def _value_error(key: str, name: str, lookup: str, value) -> str | None:
+    """What is wrong with one (non-list) value of filter ``key``, or None."""
+    if lookup == "isnull":
+        return None if isinstance(value, bool) else f"{key!r} takes true or false, got {value!r}"
+    if name in TEXT_FIELDS:
+        if not isinstance(value, str):
+            return f"{key!r} takes text, got {value!r}"
+        vocabulary = TEXT_FIELDS[name]
+        if vocabulary is None or lookup == "startswith" or value == "":
+            return None
+        parts = value.split(",") if name == "sections" and lookup == "" else [value]
+        bad = [p for p in parts if p not in vocabulary]
+        return f"{key!r}: {bad[0]!r} is not one of {', '.join(vocabulary)}" if bad else None
+    if name in INTEGER_FIELDS:
+        return None if _is_int(value) else f"{key!r} takes an integer, got {value!r}"
+    return None if _is_number(value) else f"{key!r} takes a number, got {value!r}"
+
+
+def _filter_errors(key: str, value) -> list[str]:
+    name, _, lookup = key.partition("__")
+    if name not in POOL_FIELDS:
+        return [f"unknown filter {key!r}: {name!r} is not a catalogue field (fields: {', '.join(sorted(POOL_FIELDS))}; "
+                f"shorthands: {', '.join(FLAGS)})"]
+    lookups = TEXT_LOOKUPS if name in TEXT_FIELDS else NUMBER_LOOKUPS
+    if lookup not in lookups:
+        return [f"unknown lookup in {key!r}: {name} takes {', '.join(x or '(exact)' for x in lookups)}"]
+    if isinstance(value, list) or lookup == "in":
+        if lookup not in ("", "in") or not isinstance(value, list) or not value:
+            return [f"{key!r} takes a non-empty list" if lookup == "in" else f"{key!r} takes one value, not a list"]
+        return [msg for item in value if (msg := _value_error(key, name, lookup, item))]
+    msg = _value_error(key, name, lookup, value)
+    return [msg] if msg else []
+
+
+def pool_errors(pool, section_type: str | None = None, sub_pools: bool = True) -> list[str]:
+    """Every problem of a pool filter, each message naming its key; [] when the pool is usable.
+
+    section_type: also check that sub-pools belong to a naturalness section and that a ``modality`` filter agrees
+    with the section type; sub_pools: whether ``generated``/``source`` keys are allowed at all.
+    """
+    if pool is None or pool == {}:
+        return []
+    if not isinstance(pool, dict):
+        return [f"the pool must be a JSON object of filters, got {type(pool).__name__}"]
+    errors = []
+    for key, value in pool.items():
+        if key in FLAGS:
+            if not isinstance(value, bool):
+                errors.append(f"{key!r} takes true or false, got {value!r}")
+        elif key in SUB_POOLS and sub_pools:
+            if section_type not in (None, "naturalness"):
+                errors.append(f"sub-pool {key!r} is only for naturalness sections")
+            elif not isinstance(value, dict):
+                errors.append(f"sub-pool {key!r} must be a JSON object of filters, got {value!r}")
+            else:
+                errors += [f"sub-pool {key!r}: {msg}" for msg in pool_errors(value, None, sub_pools=False)]
+        else:
+            errors += _filter_errors(key, value)
+    wanted = SECTION_MODALITY.get(section_type or "")
+    if wanted and isinstance(pool.get("modality"), str) and pool["modality"] != wanted:
+        errors.append(f"'modality' is {pool['modality']!r} but {section_type} sections show {wanted} clips")
+    return errors
+
+
+def pool_lookups(pool: dict | None) -> list[tuple[str, dict]]:
+    """A valid pool as ORM calls: [("filter" | "exclude", keyword arguments), ...] (sub-pools left out).
+
+    Raises PoolError when the pool is not valid (``pool_errors``)."""
+    errors = pool_errors(pool)
+    if errors:
+        raise PoolError({"pool": errors})
+    calls = []
+    for key, value in (pool or {}).items():
+        if key in SUB_POOLS:
+            continue
+        if key == "transition":
+            calls.append(("filter", {f"{FINAL_EMOTION_COLUMNS[0]}__isnull": not value}))
+        elif key == "rbf":
+            calls.append(("exclude" if value else "filter", {"theme": ""}))
+        elif isinstance(value, list) and "__" not in key:
+            calls.append(("filter", {f"{key}__in": value}))
+        else:
+            calls.append(("filter", {key: value}))
+    return calls
+
+
+def _count_error(options: dict, key: str, low: int, high: int | None = None) -> str | None:
+    value = options[key]
+    if not _is_int(value) or value < low or (high is not None and value > high):
+        bound = f"from {low} to {high}" if high is not None else f"{low} or more"
+        return f"{key!r} must be an integer {bound}, got {value!r}"
+    return None
+
+
+def _naturalness_errors(options: dict, clips_per_participant: int | None) -> list[str]:
+    errors = []
+    anchors = options.get("anchors")
+    scale = answer_values(NATURALNESS)
+    if "anchors" in options:
+        if not isinstance(anchors, dict):
+            errors.append(f"'anchors' must map scale values ({', '.join(scale)}) to labels, got {anchors!r}")
+        else:
+            errors += [f"'anchors': {k!r} is not a value of the naturalness scale ({', '.join(scale)})"
+                       for k in anchors if str(k) not in scale]
+            errors += [f"'anchors': the label of {k!r} must be text" for k, v in anchors.items()
+                       if not isinstance(v, str)]
+    if "question" in options and not (isinstance(options["question"], str) and options["question"].strip()):
+        errors.append(f"'question' must be non-empty text, got {options['question']!r}")
+    counts = [k for k in ("n_generated", "n_source") if k in options]
+    count_errors = [msg for k in counts if (msg := _count_error(options, k, 0))]
+    errors += count_errors
+    if counts and not count_errors:
+        given = {k: options[k] for k in counts}
+        if len(counts) == 1 and not clips_per_participant:
+            errors.append("give both 'n_generated' and 'n_source' when every clip of the pool is shown")
+        elif len(counts) == 2 and clips_per_participant and sum(given.values()) != clips_per_participant:
+            errors.append(f"'n_generated' + 'n_source' = {sum(given.values())} must equal the clips per "
+                          f"participant ({clips_per_participant})")
+        elif len(counts) == 2 and sum(given.values()) == 0:
+            errors.append("'n_generated' + 'n_source' must be at least 1")
+    return errors
+
+
+def _gesture_errors(options: dict) -> list[str]:
+    errors = []
+    categories = options.get("categories", list(GESTURE_EMOTIONS))
+    if not isinstance(categories, list) or not categories or not all(isinstance(c, str) for c in categories):
+        errors.append(f"'categories' must be a non-empty list of gesture emotions, got {categories!r}")
+        categories = list(GESTURE_EMOTIONS)
+    else:
+        errors += [f"'categories': {c!r} is not one of {', '.join(GESTURE_EMOTIONS)}" for c in categories
+                   if c not in GESTURE_EMOTIONS]
+        if len(set(categories)) != len(categories):
+            errors.append("'categories' lists an emotion twice")
+    if "n_options" in options:
+        msg = _count_error(options, "n_options", 2, len(set(categories)))
+        errors += [msg] if msg else []
+    elif len(set(categories)) < DEFAULT_GESTURE_OPTIONS:
+        errors.append(f"'categories' needs at least {DEFAULT_GESTURE_OPTIONS} emotions (or set 'n_options')")
+    return errors
+
+
+def options_errors(section_type: str, options, clips_per_participant: int | None = None) -> list[str]:
+    """Every problem of a section's type-specific options, each message naming its key."""
+    if options is None or options == {}:
+        return []
+    if not isinstance(options, dict):
+        return [f"the options must be a JSON object, got {type(options).__name__}"]
+    known = SECTION_OPTIONS.get(section_type, ())
+    errors = [f"unknown option {key!r} for {section_type} sections"
+              + (f" (options: {', '.join(known)})" if known else " (this section type takes no options)")
+              for key in options if key not in known]
+    if section_type == "naturalness":
+        errors += _naturalness_errors(options, clips_per_participant)
+    elif section_type == "gesture_emotion":
+        errors += _gesture_errors(options)
+    return errors
+
+
+def validate_section(section_type: str, pool, options, clips_per_participant: int | None = None
+                     ) -> dict[str, list[str]]:
+    """Section field -> messages for everything wrong with a section's type, pool and options ({} when none)."""
+    if section_type not in SECTION_TYPES:
+        return {"section_type": [f"{section_type!r} is not a section type ({', '.join(SECTION_TYPES)})"]}
+    errors = {"pool": pool_errors(pool, section_type), "options": options_errors(section_type, options,
+                                                                                  clips_per_participant)}
+    if clips_per_participant is not None and (not _is_int(clips_per_participant) or clips_per_participant < 0):
+        errors["clips_per_participant"] = [f"must be an integer 0 or more, got {clips_per_participant!r}"]
+    return {field: msgs for field, msgs in errors.items() if msgs}
