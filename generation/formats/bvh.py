@@ -3,6 +3,8 @@
 Reading (:func:`read_bvh`):
 - any hierarchy and any per-joint channel order; rotations are intrinsic Euler angles in degrees applied in
   the listed order (``Zrotation Xrotation Yrotation`` means R = Rz Rx Ry acting on column vectors);
+- a joint name is the rest of its ``ROOT``/``JOINT`` line, so names with spaces (3ds Max Biped's
+  ``Bip01 L Thigh``) are kept whole;
 - the root's position channels give its absolute position (as Blender reads them); position channels on other
   joints are taken from the first frame as that joint's offset (their later changes are not representable on a
   fixed skeleton and are recorded in ``metadata["ignored_channels"]``);
@@ -97,6 +99,10 @@ def _parse_hierarchy(tk: _Tokens):
         name, ln = tk.next("a joint name")
         if name in ("{", "}"):
             raise tk.error(f"expected a joint name, got {name!r}", ln)
+        # a name may hold spaces (3ds Max Biped: "Bip01 L Thigh"): the rest of the keyword's line up to "{"
+        while tk.pos < len(tk.items) and tk.items[tk.pos][1] == keyword_line and tk.items[tk.pos][0] != "{":
+            name += " " + tk.items[tk.pos][0]
+            tk.pos += 1
         if name in names:
             raise tk.error(f"duplicate joint name {name!r}", ln)
         idx = len(names)

@@ -1,0 +1,145 @@
+"""``python -m generation.mocap import PATH... --skeleton gait|gesture --out DIR``: files and folders -> Motions;
+``python -m generation.mocap corpus DIR... --out FILE.npz``: labelled gait Motions -> a corpus for train_gait.
+
+Writes ``DIR/<name>.npz`` per input (``Motion.save_npz``; a name used twice gets ``-2``, ``-3``...) and
+``DIR/import_report.csv`` (:data:`~generation.mocap.importer.REPORT_COLUMNS`, one row per input, in input order).
+Exit status 0 when every input imported, 1 when any failed (the others are still written), 2 for bad arguments
+(argparse) or an unreadable labels file / joint map / pattern. ``corpus``: 0 when every Motion was used, 1 when
+some were skipped (listed; the corpus is still written), 2 when none gave a window.
+"""
+from __future__ import annotations
+
+import argparse
+import csv
+import sys
+from pathlib import Path
+
+from study_protocol import GENDERS, MODALITIES
+
+from .importer import REPORT_COLUMNS, SUFFIXES, ImportOptions, import_file
+from .labels import LabelError, compile_pattern, label_for, label_from_pattern, read_labels
+from .positions import LAYOUTS
+from .rigs import JOINT_MAP_HELP, RigMapError, load_joint_map
+
+
+def collect_inputs(paths) -> list[tuple[Path, str]]:
+    """(file, as given or found) for files and, recursively and sorted, supported files in folders."""
+    out = []
+    for given in paths:
+        p = Path(given)
+        if p.is_dir():
+            out += [(f, str(f)) for f in sorted(p.rglob("*")) if f.is_file() and f.suffix.lower() in SUFFIXES]
+        else:
+            out.append((p, str(given)))
+    return out
+
+
+def _parser() -> argparse.ArgumentParser:
+    ap = argparse.ArgumentParser(prog="python -m generation.mocap", description=__doc__.splitlines()[0])
+    sub = ap.add_subparsers(dest="command", required=True)
+    imp = sub.add_parser("import", help="import BVH / joint-position files as Motions",
+                         description="Import .bvh, .csv and .npy motion files (folders are searched recursively) "
+                                     "onto our gait or gesture skeleton.")
+    imp.add_argument("paths", nargs="+", metavar="PATH")
+    imp.add_argument("--skeleton", choices=MODALITIES, required=True)
+    imp.add_argument("--out", required=True, type=Path, help="output folder (created)")
+    imp.add_argument("--labels", type=Path, help="CSV: source + emotion, or source + the gait emotion columns")
+    imp.add_argument("--label-pattern", help="regex with a named group (emotion) searched in each file name")
+    imp.add_argument("--joint-map", type=Path, help=JOINT_MAP_HELP)
+    imp.add_argument("--scale", type=float, help="metres per file unit (default: guessed from the body height)")
+    imp.add_argument("--fps", type=float, help="resample every result to this frame rate")
+    imp.add_argument("--input-fps", type=float, default=30.0, help="frame rate of position files (default 30)")
+    imp.add_argument("--layout", help=f"joint names of position files: {', '.join(LAYOUTS)} or a comma list")
+    imp.add_argument("--up", default="auto", choices=("auto", "+y", "-y", "+z", "-z", "+x", "-x"))
+    imp.add_argument("--height", type=float, default=1.75, help="our skeleton's height in metres (default 1.75)")
+    imp.add_argument("--build", choices=GENDERS, default="male")
+    imp.add_argument("--quiet", action="store_true", help="no progress bar or summary")
+    cor = sub.add_parser("corpus", help="labelled imported gait Motions -> a gait corpus .npz for train_gait",
+                         description="Cut imported, labelled gait Motions (.npz, folders searched recursively) "
+                                     "into fixed-length windows and save them as a gait corpus (train_gait "
+                                     "--corpus FILE).")
+    cor.add_argument("paths", nargs="+", metavar="DIR")
+    cor.add_argument("--out", required=True, type=Path, help="corpus .npz to write")
+    cor.add_argument("--frames", type=int, default=240, help="window length in frames (default 240)")
+    cor.add_argument("--stride", type=int, help="frames between window starts (default: --frames)")
+    cor.add_argument("--fps", type=float, default=30.0, help="corpus frame rate (default 30)")
+    cor.add_argument("--seed", type=int, default=0, help="seed of the train/val/test split by file")
+    return ap
+
+
+def run_corpus(args) -> int:
+    from .corpus import build_captured_gait_corpus, load_motions
+    motions, problems = load_motions(args.paths)
+    try:
+        corpus, skipped = build_captured_gait_corpus(motions, args.frames, args.fps, args.stride, args.seed)
+    except ValueError as exc:
+        print("\n".join(f"error: {p}" for p in problems), file=sys.stderr)
+        print(f"error: {exc}", file=sys.stderr)
+        return 2
+    problems += skipped
+    path = corpus.save(args.out)
+    summary = corpus.summary()
+    print(f"wrote {path}: {summary['sequences']} windows of {summary['frames']} frames from "
+          f"{len(corpus.metadata['sources'])} files; split {summary['split']}", file=sys.stderr)
+    for p in problems:
+        print(f"  skipped: {p}", file=sys.stderr)
+    return 1 if problems else 0
+
+
+def run_import(args) -> int:
+    try:
+        joint_map = load_joint_map(args.joint_map) if args.joint_map else {}
+        labels = read_labels(args.labels) if args.labels else None
+        pattern = compile_pattern(args.label_pattern) if args.label_pattern else None
+    except (RigMapError, LabelError) as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return 2
+    options = ImportOptions(skeleton=args.skeleton, height=args.height, build=args.build, scale=args.scale,
+                            fps=args.fps, input_fps=args.input_fps, layout=args.layout, joint_map=joint_map,
+                            up=args.up)
+    inputs = collect_inputs(args.paths)
+    args.out.mkdir(parents=True, exist_ok=True)
+    rows, used = [], set()
+    from tqdm import tqdm
+    bar = tqdm(inputs, desc="import", unit="file", disable=args.quiet or len(inputs) < 2 or None, file=sys.stderr)
+    for file, given in bar:
+        label = None
+        try:
+            if labels is not None:
+                label = label_for(labels, file, given)
+            if label is None and pattern is not None:
+                label = label_from_pattern(pattern, file)
+        except LabelError as exc:
+            rows.append({**{c: "" for c in REPORT_COLUMNS}, "source": given, "status": "error", "message": str(exc)})
+            continue
+        result = import_file(file, options, label, given)
+        if result.motion is not None:
+            name, k = file.stem, 1
+            while name in used:
+                k += 1
+                name = f"{file.stem}-{k}"
+            used.add(name)
+            result.motion.save_npz(args.out / f"{name}.npz")
+        rows.append(result.row)
+    with open(args.out / "import_report.csv", "w", newline="", encoding="utf-8") as fh:
+        writer = csv.DictWriter(fh, fieldnames=REPORT_COLUMNS)
+        writer.writeheader()
+        writer.writerows(rows)
+    failed = [r for r in rows if r["status"] != "ok"]
+    if not args.quiet:
+        print(f"imported {len(rows) - len(failed)} of {len(rows)} files into {args.out}", file=sys.stderr)
+        for r in failed:
+            print(f"  error: {r['message']}", file=sys.stderr)
+    if not rows:
+        print("error: no .bvh, .csv or .npy files found in the given paths", file=sys.stderr)
+        return 1
+    return 1 if failed else 0
+
+
+def main(argv=None) -> int:
+    args = _parser().parse_args(argv)
+    if args.command == "import":
+        return run_import(args)
+    if args.command == "corpus":
+        return run_corpus(args)
+    return 2  # pragma: no cover - argparse requires a command
