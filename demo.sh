@@ -2,7 +2,10 @@
 # The first command: set everything up on a fresh machine and run the demo study.
 #   bash demo.sh              (idempotent: a second run skips finished work)
 # Environment: DEMO_ADMIN_USER / DEMO_ADMIN_PASSWORD (default admin / a generated password kept in var/),
-#              HOST (127.0.0.1), PORT (8000), DEMO_WORKERS (2).
+#              HOST (127.0.0.1), PORT (8000), DEMO_WORKERS (2),
+#              DEBUG (off; DEBUG=1 bash demo.sh shows Django's debug pages: never on a reachable host).
+# The server's access log leaves out participant tokens and Prolific IDs (studyapp/gunicorn_logging.py); gthread
+# workers let a slow video download never block an answer.
 set -euo pipefail
 cd "$(dirname "$0")"
 bash scripts/bootstrap.sh
@@ -11,6 +14,9 @@ PY=.venv/bin/python
 HOST="${HOST:-127.0.0.1}"
 PORT="${PORT:-8000}"
 mkdir -p var
+# The host the demo is served on is an allowed host (DEBUG is off, so Django checks Host headers).
+export ALLOWED_HOSTS="${ALLOWED_HOSTS:-localhost,127.0.0.1,[::1],$HOST}"
+export DEBUG="${DEBUG:-0}"
 
 echo "==> database migrations"
 $PY manage.py migrate --noinput -v 0
@@ -50,4 +56,5 @@ cat <<MSG
   Stop the server with Ctrl-C; run 'bash demo.sh' again to restart (nothing is redone).
 
 MSG
-exec .venv/bin/gunicorn studyapp.wsgi -b "$HOST:$PORT" -w 2 --access-logfile - --env DEBUG="${DEBUG:-1}"
+exec .venv/bin/gunicorn studyapp.wsgi -b "$HOST:$PORT" -w 2 --worker-class gthread --threads 4 \
+    --access-logfile - --logger-class studyapp.gunicorn_logging.RedactingLogger

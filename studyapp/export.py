@@ -4,10 +4,16 @@ study_protocol), plus assignments.csv (what each participant was shown, for audi
 Rows are produced by generators over `.iterator()` queries, so a large study streams in constant memory (an
 HTTP StreamingHttpResponse or a file on disk); no export builds the whole file as one string.
 Preview runs record nothing, so every participant row is a real participant.
+
+Spreadsheet formula injection: participants type some of these cells (external_id, feedback). Every text cell
+that starts with =, +, -, @, a tab or a carriage return is written with a leading single quote (') so Excel,
+LibreOffice and Google Sheets show it as text instead of running it; plain numbers (e.g. an inversion rating of
+-7 or a response time) are written unchanged. docs/study.md tells researchers.
 """
 from __future__ import annotations
 
 import csv
+import re
 from collections.abc import Iterable, Iterator
 from pathlib import Path
 
@@ -31,11 +37,25 @@ class _Echo:
         return value
 
 
+FORMULA_STARTS = ("=", "+", "-", "@", "\t", "\r")
+PLAIN_NUMBER = re.compile(r"[+-]?(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?")
+
+
+def safe_cell(value):
+    """A CSV cell a spreadsheet will not run as a formula: text starting with one of FORMULA_STARTS gets a
+    leading single quote; numbers and text that is a plain number ("-7", "-0.25") are left as they are."""
+    if value is None:
+        return ""
+    if isinstance(value, str) and value.startswith(FORMULA_STARTS) and not PLAIN_NUMBER.fullmatch(value):
+        return "'" + value
+    return value
+
+
 def _csv_lines(header: Iterable[str], rows: Iterable[list]) -> Iterator[str]:
     writer = csv.writer(_Echo(), lineterminator="\n")
-    yield writer.writerow(list(header))
+    yield writer.writerow([safe_cell(h) for h in header])
     for row in rows:
-        yield writer.writerow(["" if v is None else v for v in row])
+        yield writer.writerow([safe_cell(v) for v in row])
 
 
 def _iso(dt) -> str:

@@ -14,17 +14,37 @@ AGE_GROUPS = [("18-24", "18-24"), ("25-34", "25-34"), ("35-44", "35-44"), ("45-5
               ("undisclosed", "Prefer not to say")]
 
 
+PARAM_MAX_LENGTH = 100
+PARAM_TOO_LONG = ("The study link is not valid: its {name} is longer than 100 characters. Please open the study "
+                  "again from the recruitment site (Prolific); if this keeps happening, contact the researchers.")
+CHOICE_ERRORS = {"invalid_choice": "Please choose one of the answers shown.",   # never repeats the value sent
+                 "required": "Please answer this question."}
+
+
+def _link_param() -> forms.CharField:
+    return forms.CharField(required=False, max_length=PARAM_MAX_LENGTH, widget=forms.HiddenInput)
+
+
 class ConsentForm(forms.Form):
+    """Consent plus the Prolific link parameters (hidden). A too-long parameter is an error the page shows (the
+    message never repeats the value)."""
+
     consent = forms.BooleanField(required=True, label="I have read the information above and agree to take part.",
                                  error_messages={"required": "Please tick the box to agree before starting."})
-    PROLIFIC_PID = forms.CharField(required=False, max_length=100, widget=forms.HiddenInput)
-    STUDY_ID = forms.CharField(required=False, max_length=100, widget=forms.HiddenInput)
-    SESSION_ID = forms.CharField(required=False, max_length=100, widget=forms.HiddenInput)
+    PROLIFIC_PID = _link_param()
+    STUDY_ID = _link_param()
+    SESSION_ID = _link_param()
+
+    def __init__(self, *args, **kwargs):
+        super().__init__(*args, **kwargs)
+        for name in ("PROLIFIC_PID", "STUDY_ID", "SESSION_ID"):
+            self.fields[name].error_messages["max_length"] = PARAM_TOO_LONG.format(name=name)
 
 
 class DemographicsForm(forms.Form):
-    gender = forms.ChoiceField(choices=GENDERS, widget=forms.RadioSelect, label="Gender")
-    age_group = forms.ChoiceField(choices=AGE_GROUPS, widget=forms.RadioSelect, label="Age group")
+    gender = forms.ChoiceField(choices=GENDERS, widget=forms.RadioSelect, label="Gender", error_messages=CHOICE_ERRORS)
+    age_group = forms.ChoiceField(choices=AGE_GROUPS, widget=forms.RadioSelect, label="Age group",
+                                  error_messages=CHOICE_ERRORS)
 
 
 class FeedbackForm(forms.Form):
@@ -39,7 +59,7 @@ class FeedbackForm(forms.Form):
                                                    widget=forms.Textarea(attrs={"rows": 3}))
             else:
                 self.fields[key] = forms.ChoiceField(label=q["text"], choices=[("yes", "Yes"), ("no", "No")],
-                                                     widget=forms.RadioSelect)
+                                                     widget=forms.RadioSelect, error_messages=CHOICE_ERRORS)
 
 
 class PresetStudyForm(forms.Form):

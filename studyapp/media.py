@@ -3,7 +3,9 @@
 Django's FileResponse ignores `Range`; Safari will not play an MP4 without byte ranges, and no browser can seek
 without them. `ranged_file_response` answers `Range: bytes=a-b` (single range; suffix and open-ended forms) with
 206 + Content-Range, an unsatisfiable range with 416, and anything else with the whole file (200). The body is
-streamed in 64 KiB blocks.
+streamed in 64 KiB blocks. Every answer carries an ETag (size and modification time) and Last-Modified: a
+revalidation with a matching If-None-Match (or, without one, an If-Modified-Since not older than the file) gets
+304 with no body, and an If-Range that no longer matches turns a range request into the whole file.
 """
 from __future__ import annotations
 
@@ -14,7 +16,7 @@ from pathlib import Path
 
 from django.conf import settings
 from django.http import Http404, HttpResponse, StreamingHttpResponse
-from django.utils.http import http_date
+from django.utils.http import http_date, parse_http_date_safe
 
 BLOCK = 64 * 1024
 RANGE_RE = re.compile(r"^bytes=(\d*)-(\d*)$")
@@ -61,13 +63,47 @@ def parse_range(header: str, size: int) -> tuple[int, int] | None:
     return start, end
 
 
+def file_etag(stat: os.stat_result) -> str:
+    """A strong validator of a file's version: its size and modification time in nanoseconds."""
+    return f'"{stat.st_size:x}-{stat.st_mtime_ns:x}"'
+
+
+def _etag_matches(header: str, etag: str) -> bool:
+    tags = [t.strip() for t in header.split(",")]
+    return "*" in tags or etag in tags or f"W/{etag}" in tags
+
+
+def not_modified(request, etag: str, mtime: float) -> bool:
+    """True when the client's cached copy is current (RFC 9110: If-None-Match wins over If-Modified-Since)."""
+    inm = request.headers.get("If-None-Match")
+    if inm is not None:
+        return _etag_matches(inm, etag)
+    since = parse_http_date_safe(request.headers.get("If-Modified-Since", ""))
+    return since is not None and int(mtime) <= since
+
+
+def _validators(response, etag: str, last_modified: str):
+    response["ETag"] = etag
+    response["Last-Modified"] = last_modified
+    response["Cache-Control"] = "private, max-age=86400"
+    return response
+
+
 def ranged_file_response(request, path: Path, content_type: str | None = None):
-    size = path.stat().st_size
+    stat = path.stat()
+    size = stat.st_size
     content_type = content_type or CONTENT_TYPES.get(path.suffix.lower()) or (
         mimetypes.guess_type(path.name)[0] or "application/octet-stream")
-    mtime = http_date(os.path.getmtime(path))
+    mtime = http_date(stat.st_mtime)
+    etag = file_etag(stat)
+    if request.method in ("GET", "HEAD") and not_modified(request, etag, stat.st_mtime):
+        return _validators(HttpResponse(status=304), etag, mtime)
+    range_header = request.headers.get("Range", "")
+    if_range = request.headers.get("If-Range", "").strip()
+    if range_header and if_range and if_range != etag and if_range != mtime:
+        range_header = ""                # the file changed since the client's partial copy: send it whole
     try:
-        rng = parse_range(request.headers.get("Range", ""), size)
+        rng = parse_range(range_header, size)
     except ValueError:
         response = HttpResponse(status=416)
         response["Content-Range"] = f"bytes */{size}"
@@ -85,6 +121,4 @@ def ranged_file_response(request, path: Path, content_type: str | None = None):
         response["Content-Length"] = str(end - start + 1)
         response["Content-Range"] = f"bytes {start}-{end}/{size}"
     response["Accept-Ranges"] = "bytes"
-    response["Last-Modified"] = mtime
-    response["Cache-Control"] = "private, max-age=86400"
-    return response
+    return _validators(response, etag, mtime)

@@ -200,11 +200,16 @@ class Participant(models.Model):
     last_active_at = models.DateTimeField(null=True, blank=True)
     completed_at = models.DateTimeField(null=True, blank=True)
     user_agent = models.CharField(max_length=300, blank=True)
+    # SHA-256 of the one-time key the consent page gave this browser session: a second submit of the same
+    # consent form (double click, two requests in flight) finds this participant instead of creating another.
+    consent_key = models.CharField(max_length=64, blank=True, default="", editable=False)
 
     class Meta:
         constraints = [
             models.UniqueConstraint(fields=["study", "external_id"], condition=~models.Q(external_id=""),
                                     name="unique_external_id_per_study"),
+            models.UniqueConstraint(fields=["study", "consent_key"], condition=~models.Q(consent_key=""),
+                                    name="unique_consent_key_per_study"),
         ]
 
     def __str__(self) -> str:

@@ -67,6 +67,15 @@ def section_type_choices() -> list[tuple[str, str]]:
     return [(t, WORDING[t].label if t in WORDING else t) for t in SECTION_TYPES]
 
 
+ECHO_LIMIT = 20
+
+
+def short(value: str, limit: int = ECHO_LIMIT) -> str:
+    """At most `limit` characters of a submitted value, for an error message (never echo a whole submission)."""
+    value = str(value)
+    return value if len(value) <= limit else value[:limit] + "\u2026"
+
+
 class AnswerError(ValueError):
     """A posted answer that is missing or out of range; the message names the question."""
 
@@ -88,7 +97,7 @@ class Question:
             raise AnswerError(f"Please answer: {self.text}")
         for v in values:
             if v not in allowed:
-                raise AnswerError(f"'{v}' is not an allowed answer to: {self.text}")
+                raise AnswerError(f"'{short(v)}' is not an allowed answer to: {self.text}")
         if self.kind == "multi":
             chosen = set(values)
             return ";".join(v for v in allowed if v in chosen)   # canonical order, no duplicates

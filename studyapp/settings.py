@@ -1,7 +1,7 @@
 """Settings read from the environment.
 
 Variables (all optional for the demo):
-    SECRET_KEY        required when DEBUG is off and PRODUCTION is set
+    SECRET_KEY        required when PRODUCTION is set; otherwise generated once into DATA_DIR/secret_key (mode 600)
     DEBUG             "1"/"true" to turn debugging on (off by default)
     ALLOWED_HOSTS     comma-separated host names (default: localhost,127.0.0.1,[::1])
     CSRF_TRUSTED_ORIGINS  comma-separated origins, e.g. https://study.example.org
@@ -32,19 +32,49 @@ def env_list(name: str, default: str) -> list[str]:
 DEBUG = env_bool("DEBUG")
 PRODUCTION = env_bool("PRODUCTION")
 
-_DEV_SECRET = "insecure-development-key-change-me-for-any-real-deployment-0123456789"
+ALLOWED_HOSTS = env_list("ALLOWED_HOSTS", "localhost,127.0.0.1,[::1],testserver")
+CSRF_TRUSTED_ORIGINS = env_list("CSRF_TRUSTED_ORIGINS", "")
+
+DATA_DIR = Path(os.environ.get("DATA_DIR", BASE_DIR / "var"))
+
+
+def local_secret_key(data_dir: Path) -> str:
+    """Outside production without SECRET_KEY: a random key generated once and kept in DATA_DIR/secret_key (mode
+    600), so sessions survive a restart and no key is ever written in the code. The file appears atomically (a
+    finished temporary file hard-linked into place), so concurrent first starts agree on one key."""
+    import secrets
+
+    path = Path(data_dir) / "secret_key"
+    if not path.exists():
+        path.parent.mkdir(parents=True, exist_ok=True)
+        tmp = path.with_name(f".secret_key.{os.getpid()}.{secrets.token_hex(4)}")
+        fd = os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o600)
+        with os.fdopen(fd, "w") as fh:
+            fh.write(secrets.token_urlsafe(64) + "\n")
+        try:
+            os.link(tmp, path)
+        except FileExistsError:
+            pass                 # another process made it first: use theirs
+        finally:
+            tmp.unlink()
+    if path.stat().st_mode & 0o077:
+        path.chmod(0o600)
+    key = path.read_text().strip()
+    if len(key) < 50:
+        from django.core.exceptions import ImproperlyConfigured
+
+        raise ImproperlyConfigured(f"{path} holds no usable secret key: delete it to have a new one generated")
+    return key
+
+
 SECRET_KEY = os.environ.get("SECRET_KEY", "")
 if not SECRET_KEY:
     if PRODUCTION:
         from django.core.exceptions import ImproperlyConfigured
 
         raise ImproperlyConfigured("SECRET_KEY must be set when PRODUCTION=1")
-    SECRET_KEY = _DEV_SECRET
+    SECRET_KEY = local_secret_key(DATA_DIR)
 
-ALLOWED_HOSTS = env_list("ALLOWED_HOSTS", "localhost,127.0.0.1,[::1],testserver")
-CSRF_TRUSTED_ORIGINS = env_list("CSRF_TRUSTED_ORIGINS", "")
-
-DATA_DIR = Path(os.environ.get("DATA_DIR", BASE_DIR / "var"))
 MEDIA_ROOT = Path(os.environ.get("MEDIA_ROOT", DATA_DIR / "media"))
 MEDIA_URL = "/media/"
 STATIC_URL = "/static/"
@@ -73,6 +103,7 @@ INSTALLED_APPS = [
 
 MIDDLEWARE = [
     "django.middleware.security.SecurityMiddleware",
+    "studyapp.security.ContentSecurityPolicyMiddleware",
     "whitenoise.middleware.WhiteNoiseMiddleware",
     "django.contrib.sessions.middleware.SessionMiddleware",
     "django.middleware.common.CommonMiddleware",
@@ -148,6 +179,11 @@ if PRODUCTION:
 LOGGING = {
     "version": 1,
     "disable_existing_loggers": False,
-    "handlers": {"console": {"class": "logging.StreamHandler"}},
+    # Participant tokens and Prolific IDs never reach a log line (e.g. Django's "Not Found: /p/<token>/...").
+    "filters": {"redact_tokens": {"()": "studyapp.security.RedactTokensFilter"}},
+    "handlers": {"console": {"class": "logging.StreamHandler", "filters": ["redact_tokens"]}},
     "root": {"handlers": ["console"], "level": os.environ.get("LOG_LEVEL", "WARNING")},
+    # Django's own "django" handler (console when DEBUG) would log unfiltered: route it through ours instead.
+    "loggers": {"django": {"handlers": ["console"], "level": os.environ.get("LOG_LEVEL", "WARNING"),
+                           "propagate": False}},
 }

@@ -5,23 +5,36 @@ enhances (plays, gates answers until the clip has played, measures response time
 """
 from __future__ import annotations
 
+import hashlib
+import math
+import secrets
+
 from django.db import IntegrityError, transaction
 from django.http import HttpResponse
 from django.shortcuts import get_object_or_404, redirect, render
 from django.urls import reverse
 from django.utils import timezone
+from django.utils.crypto import constant_time_compare
 from django.views.decorators.cache import never_cache
 from django.views.decorators.http import require_http_methods
 
 from .assignment import StudyUnavailable, check_open, current_step, start_participant
-from .forms import ConsentForm, DemographicsForm, FeedbackForm
+from .forms import PARAM_MAX_LENGTH, PARAM_TOO_LONG, ConsentForm, DemographicsForm, FeedbackForm
 from .media import media_path, ranged_file_response
 from .models import Assignment, Clip, Participant, Response, Study
 from .questions import AnswerError, clean_answers, questions_for
 
 SESSION_KEY = "study_tokens"
+CONSENT_KEYS = "consent_keys"
 PROLIFIC_PARAMS = ("PROLIFIC_PID", "STUDY_ID", "SESSION_ID")
+PROLIFIC_CONFLICT = ("This Prolific ID has already started this study in another browser, with a different "
+                     "study or session link. Please continue in the browser where you started, or open the study "
+                     "again from the same Prolific link. If you think this is a mistake, message the researchers "
+                     "on Prolific.")
 MAX_RESPONSE_MS = 3_600_000
+# A client-measured response time may exceed the server's (first display to answer) by at most this much (clock
+# granularity, the time the POST took); anything beyond is not a measurement and the server's is kept.
+RT_SLACK_MS = 5_000
 # Fraction of a clip's duration that must pass between showing a clip and accepting its answer when the section
 # requires the clip to play first (server-side check; JS gates the form on the `ended` event).
 MIN_PLAY_FRACTION = 0.8
@@ -42,22 +55,75 @@ def _unavailable(request, study: Study, message: str, status: int = 200):
     return render(request, "studyapp/unavailable.html", {"study": study, "message": message}, status=status)
 
 
+def _prolific_params(request) -> dict[str, str]:
+    """PROLIFIC_PID, STUDY_ID and SESSION_ID from the form or the URL (not truncated: the form checks lengths)."""
+    return {k: (request.POST.get(k) or request.GET.get(k) or "").strip() for k in PROLIFIC_PARAMS}
+
+
+def _param_errors(params: dict[str, str]) -> list[str]:
+    return [PARAM_TOO_LONG.format(name=k) for k, v in params.items() if len(v) > PARAM_MAX_LENGTH]
+
+
+def prolific_match(participant: Participant, params: dict[str, str]) -> bool:
+    """True when the link's PROLIFIC_PID, STUDY_ID and SESSION_ID all equal the participant's stored ones. A
+    participant stored without a SESSION_ID never matches: a bare PID is not a credential."""
+    stored = (participant.external_id, participant.external_study_id, participant.external_session_id)
+    if not all(stored):
+        return False
+    return all(constant_time_compare(a, params.get(k, "")) for a, k in zip(stored, PROLIFIC_PARAMS, strict=True))
+
+
+def _consent_key(request, study: Study, posted: str, pid: str) -> str:
+    """The stored form of this browser session's one-time consent key ('' if the posted key is not the one the
+    session was given): equal for two submits of the same consent form, so the second finds the first's
+    participant."""
+    issued = request.session.get(CONSENT_KEYS, {}).get(study.slug, "")
+    if not issued or not posted or not constant_time_compare(issued, posted):
+        return ""
+    return hashlib.sha256(f"{issued}\0{pid}".encode()).hexdigest()
+
+
+def _issue_consent_key(request, study: Study) -> str:
+    keys = dict(request.session.get(CONSENT_KEYS, {}))
+    if study.slug not in keys:
+        keys[study.slug] = secrets.token_urlsafe(24)
+        request.session[CONSENT_KEYS] = keys
+    return keys[study.slug]
+
+
+def _retire_consent_key(request, study: Study) -> None:
+    keys = dict(request.session.get(CONSENT_KEYS, {}))
+    if keys.pop(study.slug, None) is not None:
+        request.session[CONSENT_KEYS] = keys
+
+
+def _prolific_conflict(request, study: Study):
+    return _unavailable(request, study, PROLIFIC_CONFLICT, status=403)
+
+
 @never_cache
 @require_http_methods(["GET", "POST"])
 def study_entry(request, slug: str):
-    """Welcome + consent. Resumes a known participant (session, or the same Prolific PID) instead of restarting."""
+    """Welcome + consent. Resumes a known participant instead of restarting: the one this browser session
+    remembers, or the one whose stored PROLIFIC_PID, STUDY_ID and SESSION_ID all equal the link's (a Prolific
+    participant on another device). A PID alone never resumes anyone."""
     study = get_object_or_404(Study, slug=slug)
-    pid = (request.POST.get("PROLIFIC_PID") or request.GET.get("PROLIFIC_PID") or "").strip()[:100]
-    if pid:
+    params = _prolific_params(request)
+    pid = params["PROLIFIC_PID"]
+    remembered = request.session.get(SESSION_KEY, {}).get(study.slug)
+    mine = Participant.objects.filter(study=study, token=remembered).first() if remembered else None
+    if pid and len(pid) <= PARAM_MAX_LENGTH:
         existing = Participant.objects.filter(study=study, external_id=pid).first()
         if existing:
-            _remember(request, existing)
-            return redirect("studyapp:resume", token=existing.token)
-    token = request.session.get(SESSION_KEY, {}).get(study.slug)
-    if token and not pid:
-        existing = Participant.objects.filter(study=study, token=token).first()
-        if existing:
-            return redirect("studyapp:resume", token=existing.token)
+            if mine is not None and mine.pk == existing.pk:
+                _store_missing_ids(existing, params)
+                return redirect("studyapp:resume", token=existing.token)
+            if prolific_match(existing, params):
+                _remember(request, existing)
+                return redirect("studyapp:resume", token=existing.token)
+            return _prolific_conflict(request, study)
+    if mine is not None and not pid:
+        return redirect("studyapp:resume", token=mine.token)
     try:
         check_open(study)
     except StudyUnavailable as exc:
@@ -70,19 +136,46 @@ def study_entry(request, slug: str):
         form = ConsentForm(data)
         if form.is_valid():
             data = form.cleaned_data
+            key = _consent_key(request, study, request.POST.get("consent_key", ""), data["PROLIFIC_PID"])
             try:
                 with transaction.atomic():
                     participant = Participant.objects.create(
                         study=study, external_id=data["PROLIFIC_PID"], external_study_id=data["STUDY_ID"],
-                        external_session_id=data["SESSION_ID"],
+                        external_session_id=data["SESSION_ID"], consent_key=key,
                         user_agent=request.headers.get("User-Agent", "")[:300])
-            except IntegrityError:       # the same Prolific PID consented in another tab a moment ago
-                participant = Participant.objects.get(study=study, external_id=data["PROLIFIC_PID"])
+            except IntegrityError:
+                # The same consent form submitted twice (double click), or the same Prolific PID consenting in
+                # another tab a moment ago: only the same browser session or the same full Prolific triple
+                # gets that participant.
+                participant = Participant.objects.filter(study=study, consent_key=key).first() if key else None
+                if participant is None and data["PROLIFIC_PID"]:
+                    other = Participant.objects.filter(study=study, external_id=data["PROLIFIC_PID"]).first()
+                    if other is not None and prolific_match(other, data):
+                        participant = other
+                if participant is None:
+                    return _prolific_conflict(request, study)
             _remember(request, participant)
+            _retire_consent_key(request, study)
             return redirect("studyapp:resume", token=participant.token)
     else:
-        form = ConsentForm(initial={k: request.GET.get(k, "") for k in PROLIFIC_PARAMS})
-    return render(request, "studyapp/consent.html", {"study": study, "form": form})
+        form = ConsentForm(initial={k: v for k, v in params.items() if len(v) <= PARAM_MAX_LENGTH})
+    errors = _param_errors(params) if request.method == "GET" else [
+        e for f in form.hidden_fields() for e in f.errors]
+    link_params = {k: v for k, v in params.items() if len(v) <= PARAM_MAX_LENGTH}   # never echo an over-long one
+    return render(request, "studyapp/consent.html", {"study": study, "form": form, "param_errors": errors,
+                                                     "link_params": link_params,
+                                                     "consent_key": _issue_consent_key(request, study)})
+
+
+def _store_missing_ids(participant: Participant, params: dict[str, str]) -> None:
+    """Fill in a participant's STUDY_ID / SESSION_ID when they were not stored yet (older participants)."""
+    updates = {}
+    for field, key in (("external_study_id", "STUDY_ID"), ("external_session_id", "SESSION_ID")):
+        value = params.get(key, "")
+        if not getattr(participant, field) and value and len(value) <= PARAM_MAX_LENGTH:
+            updates[field] = value
+    if updates:
+        Participant.objects.filter(pk=participant.pk).update(**updates)
 
 
 def _participant(token: str) -> Participant:
@@ -148,12 +241,17 @@ def item_context(section, clip, index: int, total: int, next_clip: Clip | None, 
             "index": index, "total": total, "percent": int(round(100 * (index - 1) / max(total, 1)))}
 
 
-def _client_ms(request) -> int | None:
+def client_ms(raw, server_ms: int) -> int | None:
+    """The browser's response time (ms) when it is a plausible measurement: finite, 0..MAX_RESPONSE_MS and not
+    longer than the server's own measurement plus RT_SLACK_MS. None (use the server's) otherwise: "inf", "1e400",
+    "nan", "-5", "9e99", text..."""
     try:
-        value = int(float(request.POST.get("rt", "")))
+        value = float(str(raw)[:32])
     except (TypeError, ValueError):
         return None
-    return value if 0 <= value <= MAX_RESPONSE_MS else None
+    if not math.isfinite(value) or not 0 <= value <= min(MAX_RESPONSE_MS, server_ms + RT_SLACK_MS):
+        return None
+    return int(value)
 
 
 @never_cache
@@ -187,9 +285,10 @@ def item(request, token: str, n: int):
             clip.duration_s, 120):
         return _render_item(request, participant, step, status=400,
                             error="Please watch the whole clip before answering.")
-    response_ms = _client_ms(request)
+    server_ms = min(max(int((now - shown).total_seconds() * 1000), 0), 2**31 - 1)
+    response_ms = client_ms(request.POST.get("rt", ""), server_ms)
     if response_ms is None:
-        response_ms = int((now - shown).total_seconds() * 1000)
+        response_ms = server_ms
     save_answers(assignment, answers, response_ms)
     return redirect("studyapp:resume", token=token)
 

@@ -11,6 +11,7 @@ import csv
 import io
 import os
 import time
+import urllib.request
 from pathlib import Path
 
 import pytest
@@ -104,7 +105,10 @@ def test_whole_demo_study_in_chromium(chromium, live_server, settings, tmp_path)
     study = create_study_from_preset("demo", "demo", status=Study.Status.OPEN,
                                      completion_redirect="https://example.org/complete?cc={code}")
     driver = chromium
-    driver.get(live_server.url + reverse("studyapp:study_entry", args=[study.slug]) + "?PROLIFIC_PID=e2e-1")
+    entry_url = live_server.url + reverse("studyapp:study_entry", args=[study.slug]) + "?PROLIFIC_PID=e2e-1"
+    with urllib.request.urlopen(entry_url) as page:        # the pages carry the Content-Security-Policy
+        assert "script-src 'self'" in page.headers["Content-Security-Policy"]
+    driver.get(entry_url)
     if shots:
         full_shot(driver, Path(shots) / "study_consent.png")
     driver.find_element(By.CSS_SELECTOR, "label.check").click()
@@ -126,6 +130,10 @@ def test_whole_demo_study_in_chromium(chromium, live_server, settings, tmp_path)
                  what="clip played")
         progress = driver.find_element(By.CSS_SELECTOR, ".progress").get_attribute("aria-valuenow")
         assert int(progress) == round(100 * (n - 1) / total)
+        if n == 1:
+            # under the Content-Security-Policy (no inline script or style) study.js still runs: it shows Replay
+            assert driver.find_element(By.ID, "replay").is_displayed()
+            assert int(driver.find_element(By.CSS_SELECTOR, "progress.progress").get_attribute("value")) == 0
         if stype not in seen_types:
             seen_types.add(stype)
             if shots:

@@ -1,0 +1,66 @@
+"""Small security pieces that need no extra package:
+
+- `ContentSecurityPolicyMiddleware`: a Content-Security-Policy on every response (no inline script or style: every
+  script and style sheet is a file under static/).
+- `RedactTokensFilter`: a logging filter that blanks participant credentials (the /p/<token>/ path segment and the
+  PROLIFIC_PID / STUDY_ID / SESSION_ID query values) in any log line, e.g. Django's "Not Found: /p/<token>/...".
+- `redact()`: the same rewriting for one string (the gunicorn access logger of studyapp.gunicorn_logging uses it).
+"""
+from __future__ import annotations
+
+import logging
+import re
+
+from django.conf import settings
+
+CONTENT_SECURITY_POLICY = "; ".join([
+    "default-src 'self'",
+    "script-src 'self'",
+    "style-src 'self'",
+    "img-src 'self' data:",
+    "media-src 'self'",
+    "font-src 'self'",
+    "connect-src 'self'",
+    "object-src 'none'",
+    "base-uri 'none'",
+    "frame-ancestors 'none'",
+    "form-action 'self'",
+])
+
+SECRET_PARAMS = ("PROLIFIC_PID", "STUDY_ID", "SESSION_ID", "token")
+_PATH_TOKEN = re.compile(r"(/p/)[^/?#\s\"]+")
+_QUERY_SECRET = re.compile(r"(?i)\b(" + "|".join(SECRET_PARAMS) + r")=[^&#\s\"]*")
+
+
+def redact(text: str) -> str:
+    """`text` with the participant token of /p/<token>/ URLs and the Prolific query values replaced by '***'."""
+    if not text or not isinstance(text, str):
+        return text
+    return _QUERY_SECRET.sub(r"\1=***", _PATH_TOKEN.sub(r"\1***", text))
+
+
+class RedactTokensFilter(logging.Filter):
+    """Rewrites a record's message (and string arguments) with `redact`; never drops a record."""
+
+    def filter(self, record: logging.LogRecord) -> bool:
+        if isinstance(record.msg, str):
+            record.msg = redact(record.msg)
+        if isinstance(record.args, tuple):
+            record.args = tuple(redact(a) if isinstance(a, str) else a for a in record.args)
+        elif isinstance(record.args, dict):
+            record.args = {k: redact(v) if isinstance(v, str) else v for k, v in record.args.items()}
+        return True
+
+
+class ContentSecurityPolicyMiddleware:
+    """Adds settings.CONTENT_SECURITY_POLICY (default above) unless the view already set one."""
+
+    def __init__(self, get_response):
+        self.get_response = get_response
+        self.policy = getattr(settings, "CONTENT_SECURITY_POLICY", CONTENT_SECURITY_POLICY)
+
+    def __call__(self, request):
+        response = self.get_response(request)
+        if self.policy and "Content-Security-Policy" not in response:
+            response["Content-Security-Policy"] = self.policy
+        return response
