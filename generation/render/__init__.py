@@ -1,8 +1,9 @@
-"""PyVista offscreen renderer: stick figures to MP4/WebM clips with a poster, and contact sheets.
+"""PyVista offscreen renderer: a mannequin (or stick figure, or point-lights) to MP4/WebM clips with a poster,
+and contact sheets.
 
 Public interface:
-    RenderSettings        resolution, fps, duration, camera, anti-aliasing, codecs
-    render_clip(motion, out_dir, name, settings, progress) -> RenderResult
+    RenderSettings        resolution (1280x720), fps, duration, body look, camera rule, anti-aliasing, codecs
+    render_clip(motion, out_dir, name, settings, progress) -> RenderResult (.camera: rule and figure fractions)
     render_frames(motion, settings) -> iterator of (H, W, 3) uint8 frames
     clip_files_complete(out_dir, name, webm) -> bool
     contact_sheet(poster_paths, labels, out_png) -> Path

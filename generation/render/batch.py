@@ -165,6 +165,7 @@ def render_job(job: Job, record: dict, clips_dir: str, records_dir: str) -> dict
     record["metadata"]["synthetic"] = bool(motion.metadata.get("synthetic", False))
     record["metadata"]["n_frames"] = result.n_frames
     record["metadata"]["fps"] = result.fps
+    record["metadata"]["camera"] = _json_safe(result.camera)  # rule (fixed/follow), figure height fractions
     record["metadata"]["timing_s"] = {"generate": round(t_gen, 3), "total": round(time.perf_counter() - t0, 3)}
     record["record_version"] = RECORD_VERSION
     _write_json_atomic(record, Path(records_dir) / f"{job.clip_id}.json")

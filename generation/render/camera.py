@@ -206,3 +206,143 @@ def project(points: np.ndarray, pose: CameraPose, width: int, height: int) -> tu
     safe = np.maximum(depth, 1e-6)
     px = np.stack([width / 2 + f * (rel @ r) / safe, height / 2 - f * (rel @ u) / safe], axis=1)
     return px, depth, float(f)
+
+
+#: Smallest figure height as a fraction of the frame height, in every frame (issue 13).
+MIN_FIGURE_FRACTION = {"walk": 0.50, "seated": 0.60}
+#: What the follow camera aims for (the whole body stays in frame first).
+FOLLOW_TARGET_FRACTION = {"walk": 0.70, "seated": 0.78}
+
+
+def figure_fractions(points: np.ndarray, poses: list[CameraPose], width: int, height: int
+                     ) -> tuple[np.ndarray, np.ndarray]:
+    """Per-frame projected figure height / frame height, and per-frame pixel boxes (T, 4) x0, y0, x1, y1.
+
+    Args:
+        points: (T, K, 3) points of the body's outline (joints padded by the body's thickness, head top).
+        poses: T camera poses (or one repeated).
+    """
+    T = points.shape[0]
+    boxes = np.zeros((T, 4))
+    for t in range(T):
+        px, _, _ = project(points[t], poses[t if len(poses) > 1 else 0], width, height)
+        boxes[t] = (px[:, 0].min(), px[:, 1].min(), px[:, 0].max(), px[:, 1].max())
+    return (boxes[:, 3] - boxes[:, 1]) / height, boxes
+
+
+def critically_damped(x: np.ndarray, fps: float, omega: float) -> np.ndarray:
+    """Zero-phase critically damped smoothing of a (T, D) signal.
+
+    A second-order critically damped follower (x'' = w^2 (target - x) - 2 w x') run forward and then
+    backward over the forward result: no overshoot, no jitter, no lag (the backward pass undoes the
+    forward pass's delay).
+    """
+    def run(sig):
+        dt = 1.0 / fps
+        out = np.empty_like(sig)
+        pos = sig[0].copy()
+        vel = (sig[min(1, len(sig) - 1)] - sig[0]) / dt
+        for t in range(len(sig)):
+            acc = omega * omega * (sig[t] - pos) - 2 * omega * vel
+            vel = vel + acc * dt
+            pos = pos + vel * dt
+            out[t] = pos
+        return out
+
+    x = np.asarray(x, dtype=float)
+    if len(x) < 2:
+        return x.copy()
+    # Extend both ends along the local velocity (over half a second) by several time constants, so the
+    # follower has settled onto the motion when the clip starts and ends.
+    n_pad = int(np.ceil(8.0 / omega * fps))
+    k = max(1, min(len(x) - 1, int(round(0.5 * fps))))
+    v0, v1 = (x[k] - x[0]) / k, (x[-1] - x[-1 - k]) / k
+    steps = np.arange(1, n_pad + 1)[:, None]
+    padded = np.concatenate([x[0] - v0 * steps[::-1], x, x[-1] + v1 * steps])
+    return run(run(padded)[::-1])[::-1][n_pad:n_pad + len(x)]
+
+
+def follow_cameras(positions: np.ndarray, outline: np.ndarray, fps: float, width: int, height: int,
+                   kind: str = "walk", azimuth_deg: float = 35.0, elevation_deg: float = 12.0,
+                   view_angle: float = 30.0, omega: float = 2.5, facing: np.ndarray | None = None
+                   ) -> list[CameraPose]:
+    """A camera per frame that follows the body at a fixed world-space offset and distance.
+
+    The look-at point is the root's ground track smoothed by :func:`critically_damped` (zero phase),
+    at a constant height; the view direction comes from the clip's travel direction (or the body's
+    facing for in-place motion), ``azimuth_deg`` from the side towards the front, ``elevation_deg``
+    above the horizon so the floor grid shows the motion over the ground. The distance is the
+    closest that keeps the whole outline in frame (with a margin) in every frame, starting from the
+    one that makes the figure FOLLOW_TARGET_FRACTION of the frame height.
+
+    Args:
+        positions: (T, J, 3) joints; outline: (T, K, 3) body outline points (see :func:`figure_fractions`).
+    """
+    T = positions.shape[0]
+    root = positions[:, 0]
+    travel = travel_direction(root[:, [0, 2]])
+    if travel is None:
+        # In place: from the body's front-left, as the fixed camera does.
+        forward = facing if facing is not None else np.array([0.0, 0.0, 1.0])
+        azimuth_deg = 65.0
+    else:
+        forward = travel
+    offset = view_offset(forward, azimuth_deg, elevation_deg)
+    lo_y, hi_y = outline[..., 1].min(), outline[..., 1].max()
+    track = critically_damped(root[:, [0, 2]], fps, omega)
+    focal = np.stack([track[:, 0], np.full(T, (lo_y + hi_y) / 2), track[:, 1]], 1)
+    body_h = float(np.median(np.ptp(outline[..., 1], axis=1)))
+    tv = np.tan(np.radians(view_angle) / 2)
+    dist = body_h / (2 * tv * FOLLOW_TARGET_FRACTION[kind])
+    margin = 0.04  # of the frame, on every side
+    for _ in range(40):
+        poses = [CameraPose(focal[t] + offset * dist, focal[t], view_angle=view_angle) for t in range(T)]
+        _, boxes = figure_fractions(outline, poses, width, height)
+        inside = (boxes[:, 0] >= margin * width).all() and (boxes[:, 2] <= (1 - margin) * width).all() and \
+            (boxes[:, 1] >= margin * height).all() and (boxes[:, 3] <= (1 - margin) * height).all()
+        if inside:
+            break
+        dist *= 1.05
+    return poses
+
+
+def body_outline(positions: np.ndarray, head_top: np.ndarray | None, thickness: float) -> np.ndarray:
+    """(T, K, 3) points around the body: every joint padded up/down/sideways by ``thickness`` metres,
+    plus the head top when given."""
+    pad = np.array([[0, 0, 0], [0, 1, 0], [0, -1, 0], [1, 0, 0], [-1, 0, 0], [0, 0, 1], [0, 0, -1]],
+                   dtype=float) * thickness
+    pts = (positions[:, :, None, :] + pad[None, None]).reshape(positions.shape[0], -1, 3)
+    if head_top is not None:
+        pts = np.concatenate([pts, head_top[:, None]], axis=1)
+    return pts
+
+
+def choose_cameras(positions: np.ndarray, root_rotation0: np.ndarray, outline: np.ndarray, fps: float,
+                   width: int, height: int, mode: str = "auto", seated: bool = False,
+                   extra_points: np.ndarray | None = None) -> tuple[list[CameraPose], dict]:
+    """The clip's cameras and the rule that chose them.
+
+    ``mode`` "auto": the fixed camera fitted to the whole clip (:func:`fixed_camera`) when the figure is at
+    least MIN_FIGURE_FRACTION (+ 0.03 to spare) of the frame height in every frame, else the follow camera
+    (:func:`follow_cameras`). "fixed" and "tracking" force one. Returns (T poses, info) where info holds
+    ``rule`` ("fixed" or "follow"), ``min_figure_fraction`` and ``max_figure_fraction`` (projected).
+    """
+    T = positions.shape[0]
+    kind = "seated" if seated else "walk"
+    need = MIN_FIGURE_FRACTION[kind]
+    cams = None
+    rule = "follow"
+    if mode in ("auto", "fixed"):
+        pts = outline.reshape(-1, 3)
+        if extra_points is not None:
+            pts = np.concatenate([pts, extra_points.reshape(-1, 3)])
+        cam = fixed_camera(positions, root_rotation0, width / height, extra_points=pts)
+        frac, _ = figure_fractions(outline, [cam], width, height)
+        if mode == "fixed" or frac.min() >= need + 0.03:
+            cams, rule = [cam] * T, "fixed"
+    if cams is None:
+        cams = follow_cameras(positions, outline, fps, width, height, kind,
+                              facing=facing_direction(root_rotation0))
+    frac, _ = figure_fractions(outline, cams, width, height)
+    return cams, {"rule": rule, "min_figure_fraction": round(float(frac.min()), 3),
+                  "max_figure_fraction": round(float(frac.max()), 3), "required_fraction": need}

@@ -5,17 +5,19 @@ cuts at ``settings.duration_s`` and never stretches or pads motion.
 """
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Callable, Iterator
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
 from generation.core.motion import Motion
 
-from .camera import facing_direction, fixed_camera, tracking_cameras
+from .body import head_top
+from .camera import body_outline, choose_cameras, facing_direction
 from .encode import VideoWriter, write_png_atomic
-from .scene import StickFigureScene, chair_boxes
+from .scene import SCENES, chair_boxes
 from .settings import RenderSettings
 
 GROUND_MARGIN_M = 25.0  # far enough that the floor edge stays out of view
@@ -30,6 +32,11 @@ class RenderResult:
     poster: Path
     n_frames: int
     fps: float
+    camera: dict = field(default_factory=dict)  # rule ("fixed"/"follow"), figure height fractions, body
+
+    @property
+    def camera_rule(self) -> str | None:
+        return self.camera.get("rule")
 
     @property
     def duration_s(self) -> float:
@@ -51,34 +58,57 @@ def prepare(motion: Motion, settings: RenderSettings) -> tuple[Motion, np.ndarra
     return clip, clip.positions()
 
 
-def build_scene(motion: Motion, positions: np.ndarray, settings: RenderSettings):
-    """The scene and per-frame camera poses for a prepared clip."""
+def body_skeleton(motion: Motion):
+    """The skeleton whose build shapes the body: the motion's, relabelled when its metadata names another
+    build ("build" or "gender": male/female; the bone lengths stay the motion's own)."""
     skel = motion.skeleton
+    build = motion.metadata.get("build") or motion.metadata.get("gender")
+    if build in ("male", "female") and build != skel.build:
+        skel = dataclasses.replace(skel, build=build)
+    return skel
+
+
+def figure_outline(skel, positions: np.ndarray, body: str) -> np.ndarray:
+    """(T, K, 3) points around the drawn figure (for framing; see :func:`camera.body_outline`)."""
+    s = skel.height / 1.75
+    if body == "points":
+        return body_outline(positions, None, 0.035 * s)
+    return body_outline(positions, head_top(skel, positions), 0.06 * s)
+
+
+def build_scene(motion: Motion, positions: np.ndarray, settings: RenderSettings, info: dict | None = None):
+    """The scene and per-frame camera poses for a prepared clip; ``info`` (when given) receives the camera
+    rule and the projected figure height fractions."""
+    skel = body_skeleton(motion)
     s = skel.height / 1.75
     ground_y = float(positions[..., 1].min() - 0.03 * s)
-    aspect = settings.width / settings.height
     chair = None
     extra = None
-    if is_seated(motion):
+    seated = is_seated(motion)
+    if seated:
         facing = facing_direction(motion.rotations[0, 0])
         chair = chair_boxes(positions, skel, facing, ground_y)
-        extra = np.concatenate([np.stack([c + h * np.array(sgn) for sgn in ((1, 1, 1), (-1, -1, -1))])
-                                for c, h, _ in chair])
+        if settings.body != "points":
+            extra = np.concatenate([np.stack([c + h * np.array(sgn) for sgn in ((1, 1, 1), (-1, -1, -1))])
+                                    for c, h, _ in chair])
     root = positions[:, 0]
     extent = (root[:, 0].min() - GROUND_MARGIN_M, root[:, 0].max() + GROUND_MARGIN_M,
               root[:, 2].min() - GROUND_MARGIN_M, root[:, 2].max() + GROUND_MARGIN_M)
-    scene = StickFigureScene(skel, settings.width, settings.height, settings.anti_aliasing, extent, ground_y, chair)
-    if settings.camera == "tracking":
-        cams = tracking_cameras(positions, settings.fps, aspect, skel.height)
-    else:
-        cam = fixed_camera(positions, motion.rotations[0, 0], aspect, extra_points=extra)
-        cams = [cam] * len(positions)
+    outline = figure_outline(skel, positions, settings.body)
+    cams, cam_info = choose_cameras(positions, motion.rotations[0, 0], outline, settings.fps, settings.width,
+                                    settings.height, settings.camera, seated, extra)
+    scene = SCENES[settings.body](skel, settings.width, settings.height, settings.anti_aliasing, extent, ground_y,
+                                  chair)
+    if info is not None:
+        info.update(cam_info)
+        info["body"] = settings.body
+        info["build"] = skel.build
     return scene, cams
 
 
-def _frames(clip: Motion, positions: np.ndarray, settings: RenderSettings, patches: bool = True
-            ) -> Iterator[np.ndarray]:
-    scene, cams = build_scene(clip, positions, settings)
+def _frames(clip: Motion, positions: np.ndarray, settings: RenderSettings, patches: bool = True,
+            info: dict | None = None) -> Iterator[np.ndarray]:
+    scene, cams = build_scene(clip, positions, settings, info)
     try:
         fixed = all(c is cams[0] for c in cams)
         use_patches = patches and fixed and scene.plan_patches(positions, cams[0])
@@ -115,7 +145,7 @@ def render_clip(motion: Motion, out_dir: str | Path, name: str, settings: Render
         motion: any skeleton; positions from forward kinematics, metres, y-up.
         out_dir: folder for the files (created if missing).
         name: file stem, e.g. the content hash.
-        settings: render settings (defaults: 640x480, 30 fps, at most 10 s, fixed camera, FXAA).
+        settings: render settings (defaults: 1280x720, 30 fps, at most 10 s, mannequin, auto camera, FXAA).
         progress: called as progress(frames_done, frames_total) after every frame.
     """
     settings = settings or RenderSettings()
@@ -130,7 +160,8 @@ def render_clip(motion: Motion, out_dir: str | Path, name: str, settings: Render
         writers.append(VideoWriter(out_dir / f"{name}.webm", settings.width, settings.height, settings.fps,
                                    settings.crf, settings.preset, settings.encoder_threads))
     poster = None
-    frames = _frames(clip, positions, settings)
+    info: dict = {}
+    frames = _frames(clip, positions, settings, info=info)
     try:
         for t, img in enumerate(frames):
             for w in writers:
@@ -149,7 +180,7 @@ def render_clip(motion: Motion, out_dir: str | Path, name: str, settings: Render
         frames.close()  # closes the offscreen window
     write_png_atomic(poster, out_dir / f"{name}.png")
     return RenderResult(out_dir / f"{name}.mp4", out_dir / f"{name}.webm" if settings.webm else None,
-                        out_dir / f"{name}.png", n, settings.fps)
+                        out_dir / f"{name}.png", n, settings.fps, info)
 
 
 def clip_files_complete(out_dir: str | Path, name: str, webm: bool) -> bool:

@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import math
+import textwrap
 from collections.abc import Sequence
 from pathlib import Path
 
@@ -44,10 +45,11 @@ def contact_sheet(poster_paths: Sequence[str | Path], labels: Sequence[str], out
         x, y = pad + c * (thumb_width + pad), pad + r * (th + caption_h + pad)
         sheet.paste(im, (x, y))
         text = str(label)
-        # Two lines at most; long captions are cut with an ellipsis.
-        lines = [text[:52], text[52:104]] if len(text) > 52 else [text]
-        if len(text) > 104:
-            lines[1] = lines[1][:49] + "..."
+        # Two lines at most, broken at spaces; long captions are cut with an ellipsis.
+        per_line = max(20, int(52 * thumb_width / 320))
+        lines = textwrap.wrap(text, per_line) or [""]
+        if len(lines) > 2:
+            lines = [lines[0], lines[1][:per_line - 3] + "..."]
         for k, line in enumerate(lines):
             draw.text((x + 2, y + th + 2 + 13 * k), line, fill=(20, 20, 20), font=font)
     out_png = Path(out_png)

@@ -1,4 +1,4 @@
-"""The offscreen PyVista scene: stick figure, ground grid, optional chair, camera.
+"""The offscreen PyVista scenes: mannequin (default), stick figure or point-lights; ground grid, chair, camera.
 
 Built once per clip; each frame only moves actors (``user_matrix``) and re-renders, as PyVista
 0.49 returns stale images otherwise (REFERENCE.md section 8): one ``screenshot()`` during setup,
@@ -12,6 +12,7 @@ import numpy as np
 
 from generation.core.skeleton import Skeleton
 
+from .body import MANNEQUIN_COLOUR, PartPoser, mannequin_parts, part_mesh
 from .camera import CameraPose, project
 
 os.environ.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow")
@@ -19,7 +20,7 @@ os.environ.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow")
 LEFT_COLOUR = (0.16, 0.42, 0.85)    # blue
 RIGHT_COLOUR = (0.90, 0.35, 0.12)   # orange
 MID_COLOUR = (0.55, 0.55, 0.58)     # grey
-CHAIR_COLOUR = (0.55, 0.38, 0.24)   # wood brown
+CHAIR_COLOUR = (0.46, 0.52, 0.60)   # blue-grey (contrasts with the clay mannequin)
 BACKGROUND = (0.93, 0.95, 0.98)
 GROUND_COLOUR = (0.80, 0.80, 0.79)
 GRID_COLOUR = (0.58, 0.58, 0.58)
@@ -107,6 +108,9 @@ class StickFigureScene:
         chair: boxes from :func:`chair_boxes`, or None.
     """
 
+    background = BACKGROUND
+    show_ground = True  # floor, grid and chair
+
     def __init__(self, skeleton: Skeleton, width: int, height: int, anti_aliasing: str,
                  ground_extent: tuple[float, float, float, float], ground_y: float = 0.0,
                  chair: list[tuple] | None = None):
@@ -122,16 +126,24 @@ class StickFigureScene:
             self.plotter.renderer.SetUseFXAA(True)
         elif anti_aliasing == "msaa":
             self.plotter.enable_anti_aliasing("msaa", multi_samples=4)
-        self.plotter.set_background(BACKGROUND)
+        self.plotter.set_background(self.background)
         s = skeleton.height / 1.75
-        self._add_ground(pv, ground_extent, ground_y)
-        if chair:
+        if self.show_ground:
+            self._add_ground(pv, ground_extent, ground_y)
+        if chair and self.show_ground:
             for centre, half, yaw in chair:
                 box = pv.Box(bounds=(-half[0], half[0], -half[1], half[1], -half[2], half[2]))
                 actor = self.plotter.add_mesh(box, color=CHAIR_COLOUR, smooth_shading=False)
                 c, sn = np.cos(yaw), np.sin(yaw)
                 m = np.array([[c, 0, sn, centre[0]], [0, 1, 0, centre[1]], [-sn, 0, c, centre[2]], [0, 0, 0, 1]])
                 actor.user_matrix = m
+        self.ground_y = ground_y
+        self._build_figure(pv, s)
+        self._primed = False
+
+    def _build_figure(self, pv, s: float) -> None:
+        """Tubes for bones, spheres for joints, an opaque shadow disc."""
+        skeleton = self.skeleton
         # Bones: every joint with a parent and a non-zero offset.
         lengths = skeleton.bone_lengths()
         self.bones = [j for j, p in enumerate(skeleton.parents) if p >= 0 and lengths[j] > 1e-6]
@@ -158,9 +170,11 @@ class StickFigureScene:
         disc = pv.Disc(center=(0, 0, 0), inner=0.0, outer=1.0, normal=(0, 1, 0), c_res=32)
         self.shadow = self.plotter.add_mesh(disc, color=SHADOW_COLOUR, lighting=False)
         self.shadow_radius = 0.28 * s
-        self.ground_y = ground_y
         self._head_lift = max(0.02, 0.20 * s - (lengths[self.head] if self.head is not None else 0.0))
-        self._primed = False
+
+    def figure_actors(self) -> tuple:
+        """The actors that move with the body (hidden for the background of patch rendering)."""
+        return (*self.bone_actors, *self.joint_actors, self.shadow)
 
     def _add_ground(self, pv, extent, ground_y):
         """Unlit floor with grid lines every GROUND_TILE_M metres.
@@ -313,7 +327,7 @@ class StickFigureScene:
         self._patch_origin = np.stack([x0, y0], 1)
         self._patch_pose = pose
         self.set_camera(pose)
-        figure = (*self.bone_actors, *self.joint_actors, self.shadow)
+        figure = self.figure_actors()
         if travels:
             for actor in figure:
                 actor.visibility = False
@@ -357,3 +371,79 @@ class StickFigureScene:
 
     def close(self) -> None:
         self.plotter.close()
+
+
+class MannequinScene(StickFigureScene):
+    """The default look: a low-poly humanoid mannequin (:mod:`generation.render.body`), matte clay colour,
+    a soft dark translucent ellipse as its ground shadow, on the same floor grid (and chair) as the sticks.
+
+    Meshes are built once from the skeleton's bone lengths; each frame sets one rigid transform per part.
+    """
+
+    def _build_figure(self, pv, s: float) -> None:
+        self.parts = mannequin_parts(self.skeleton)
+        self.poser = PartPoser(self.skeleton, self.parts)
+        self.part_actors = []
+        for part in self.parts:
+            actor = self.plotter.add_mesh(part_mesh(part), color=MANNEQUIN_COLOUR, smooth_shading=True,
+                                          specular=0.0, diffuse=0.85, ambient=0.22)
+            self.part_actors.append(actor)
+        disc = pv.Disc(center=(0, 0, 0), inner=0.0, outer=1.0, normal=(0, 1, 0), c_res=32)
+        self.shadow = self.plotter.add_mesh(disc, color=(0.0, 0.0, 0.0), opacity=0.28, lighting=False)
+        self.shadow_radius = 0.32 * s
+        j = self.skeleton.joints
+        self._hips = (j.index("left_hip"), j.index("right_hip")) if "left_hip" in j else None
+        # Bounding radius around every joint for patch planning (trunk half-width, head above its joint, hands).
+        self.bone_radius = np.array([0.21 * s])
+        self.joint_radius = np.full(self.skeleton.num_joints, 0.21 * s)
+        self.head = self.neck = None
+        self.bones, self.bone_actors, self.joint_actors = [], [], []
+
+    def figure_actors(self) -> tuple:
+        return (*self.part_actors, self.shadow)
+
+    def set_pose(self, positions: np.ndarray) -> None:
+        for actor, m in zip(self.part_actors, self.poser.matrices(positions)):
+            actor.user_matrix = m
+        root = positions[0]
+        side = positions[self._hips[0]] - positions[self._hips[1]] if self._hips else np.array([1.0, 0, 0])
+        side = np.array([side[0], 0.0, side[2]])
+        side = side / max(np.linalg.norm(side), 1e-9) if np.linalg.norm(side) > 1e-6 else np.array([1.0, 0, 0])
+        fwd = np.cross(side, [0.0, 1.0, 0.0])
+        rs = self.shadow_radius
+        m = np.eye(4)
+        m[:3, 0], m[:3, 2] = side * rs, fwd * rs * 0.72
+        m[:3, 3] = (root[0], self.ground_y + 0.002, root[2])
+        self.shadow.user_matrix = m
+
+
+POINT_COLOUR = (1.0, 1.0, 1.0)
+
+
+class PointLightScene(StickFigureScene):
+    """A point-light display (Johansson 1973): white dots at the joints on black, no floor, grid or chair."""
+
+    background = (0.0, 0.0, 0.0)
+    show_ground = False
+
+    def _build_figure(self, pv, s: float) -> None:
+        dot = pv.Sphere(radius=1.0, theta_resolution=12, phi_resolution=8)
+        self.dot_radius = 0.03 * s
+        self.joint_actors = [self.plotter.add_mesh(dot, color=POINT_COLOUR, lighting=False)
+                             for _ in self.skeleton.joints]
+        self.bone_radius = np.array([self.dot_radius])
+        self.joint_radius = np.full(self.skeleton.num_joints, self.dot_radius)
+        self.shadow_radius = 0.0
+        self.head = self.neck = None
+        self.bones, self.bone_actors = [], []
+
+    def figure_actors(self) -> tuple:
+        return tuple(self.joint_actors)
+
+    def set_pose(self, positions: np.ndarray) -> None:
+        r = self.dot_radius
+        for actor, c in zip(self.joint_actors, positions):
+            actor.user_matrix = np.array([[r, 0, 0, c[0]], [0, r, 0, c[1]], [0, 0, r, c[2]], [0, 0, 0, 1.0]])
+
+
+SCENES = {"mannequin": MannequinScene, "stick": StickFigureScene, "points": PointLightScene}

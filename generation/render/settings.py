@@ -9,8 +9,9 @@ from dataclasses import asdict, dataclass, fields
 
 #: Bump when the look of clips changes for the same settings (scene, camera placement): it is part of
 #: every clip's content hash, so changed clips get new files instead of stale ones being reused.
-RENDERER_VERSION = "1"
-CAMERAS = ("fixed", "tracking")
+RENDERER_VERSION = "2"
+CAMERAS = ("auto", "fixed", "tracking")
+BODIES = ("mannequin", "stick", "points")
 ANTI_ALIASING = ("none", "fxaa", "ssaa2", "msaa")
 
 
@@ -27,8 +28,13 @@ class RenderSettings:
         fps: video frame rate; motions are resampled to it.
         duration_s: longest clip in seconds (10 s by default, seed 000's clip length); a shorter
             motion gives a shorter clip.
-        camera: "fixed" (default; frames the whole path, seed 000 section 6.3.4) or "tracking"
-            (follows the root at a fixed offset, as in seed 000's study videos).
+        camera: "auto" (default): one camera fitted to the whole clip when the figure stays at least
+            50 % (walks) / 60 % (seated) of the frame height in every frame, else a smooth follow camera;
+            "fixed" (always the fitted camera, seed 000 section 6.3.4) or "tracking" (always the follow
+            camera: critically damped, zero-phase smoothing of the look-at point). The rule used is
+            recorded per clip (:attr:`generation.render.clip.RenderResult.camera_rule`).
+        body: "mannequin" (default; a low-poly humanoid), "stick" (tubes and spheres, left blue, right
+            orange) or "points" (a point-light display: white dots at the joints on black, no floor).
         anti_aliasing: "fxaa" (default; a screen-space pass, nearly free), "ssaa2" (render at 2x and
             average 2x2 blocks), "msaa" (VTK multisampling, about 3x slower in software GL) or "none".
         crf: H.264 constant rate factor (lower is better quality; 23 is x264's default).
@@ -38,11 +44,12 @@ class RenderSettings:
         encoder_threads: threads per ffmpeg encoder (0 = ffmpeg decides).
     """
 
-    width: int = 640
-    height: int = 480
+    width: int = 1280
+    height: int = 720
     fps: float = 30.0
     duration_s: float = 10.0
-    camera: str = "fixed"
+    camera: str = "auto"
+    body: str = "mannequin"
     anti_aliasing: str = "fxaa"
     crf: int = 23
     preset: str = "veryfast"
@@ -62,6 +69,8 @@ class RenderSettings:
             raise RenderSettingsError(f"field 'duration_s': expected a number in (0, 600], got {self.duration_s!r}")
         if self.camera not in CAMERAS:
             raise RenderSettingsError(f"field 'camera': expected one of {list(CAMERAS)}, got {self.camera!r}")
+        if self.body not in BODIES:
+            raise RenderSettingsError(f"field 'body': expected one of {list(BODIES)}, got {self.body!r}")
         if self.anti_aliasing not in ANTI_ALIASING:
             raise RenderSettingsError(
                 f"field 'anti_aliasing': expected one of {list(ANTI_ALIASING)}, got {self.anti_aliasing!r}")
