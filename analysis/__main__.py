@@ -1,4 +1,5 @@
-"""CLI: ``python -m analysis RESPONSES CLIPS PARTICIPANTS --out DIR [--alpha A] [--permutations N] [--no-figures]``.
+"""CLI: ``python -m analysis RESPONSES CLIPS PARTICIPANTS --out DIR [--alpha A] [--permutations N] [--no-figures]
+[--no-exclusions]``.
 
 Exit status 0 on success, 2 with a message naming file, line and column on invalid input.
 """
@@ -23,6 +24,8 @@ def main(argv=None) -> int:
     ap.add_argument("--permutations", type=int, default=0,
                     help="also compute permutation p-values with N resamples for the 2-sample AD tests")
     ap.add_argument("--no-figures", action="store_true", help="skip the PNG/SVG figures (tables only)")
+    ap.add_argument("--no-exclusions", action="store_true",
+                    help="analyse every participant (skip the too-fast and straight-lining exclusion rules)")
     a = ap.parse_args(argv)
     for path in (a.responses, a.clips, a.participants):
         if not os.path.isfile(path):
@@ -35,7 +38,7 @@ def main(argv=None) -> int:
 
     try:
         report = write_report(a.responses, a.clips, a.participants, a.out, a.alpha, a.permutations,
-                              figures=not a.no_figures)
+                              figures=not a.no_figures, exclude=not a.no_exclusions)
     except ValidationError as exc:
         print(f"error: invalid input\n{exc}", file=sys.stderr)
         return 2

@@ -229,3 +229,35 @@ def fig_inversion(inv: pd.DataFrame):
     ax.set_title("Ratings of inverted themes (w = -0.7), mean ± SE")
     fig.tight_layout()
     return fig
+
+
+def fig_confusion(results: dict):
+    """Confusion matrices of emotion recognition (Wagner 1993): one panel per question (gait, gesture), rows
+    intended, columns perceived, each cell the row share (the diagonal is the hit rate), annotated; the title gives
+    Cohen's kappa. ``results``: name -> :func:`analysis.recognition.recognition` dict (empty ones skipped)."""
+    results = {k: v for k, v in results.items() if v and v["n_answers"] > 0}
+    if not results:
+        return None
+    sizes = [len(v["labels"]) for v in results.values()]
+    fig, axes = plt.subplots(1, len(results), figsize=(sum(0.45 * s + 1.6 for s in sizes), 0.45 * max(sizes) + 1.9),
+                             squeeze=False, gridspec_kw={"width_ratios": sizes})
+    for ax, (name, res) in zip(axes.ravel(), results.items()):
+        c = res["confusion"].to_numpy(float)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            share = np.where(c.sum(axis=1, keepdims=True) > 0, c / c.sum(axis=1, keepdims=True), np.nan)
+        ax.imshow(share, vmin=0, vmax=1, cmap="Blues")
+        labels = res["labels"]
+        ax.set_xticks(range(len(labels)), labels, rotation=60, ha="right")
+        ax.set_yticks(range(len(labels)), labels)
+        size = 7 if len(labels) <= 5 else 5.5
+        for i in range(len(labels)):
+            for j in range(len(labels)):
+                if np.isfinite(share[i, j]):
+                    ax.text(j, i, f"{share[i, j]:.2f}".lstrip("0"), ha="center", va="center", fontsize=size,
+                            color="white" if share[i, j] > 0.6 else "#222")
+        ax.set_xlabel("perceived")
+        ax.set_ylabel("intended")
+        ax.set_title(f"{name}: kappa = {res['kappa']:.2f}, n = {res['n_answers']}", fontsize=8)
+    fig.suptitle("Emotion recognition: row shares of the confusion matrix (diagonal = hit rate)")
+    fig.subplots_adjust(left=0.12, right=0.98, bottom=0.28, top=0.86, wspace=0.45)
+    return fig

@@ -24,19 +24,40 @@ import zipfile
 import numpy as np
 import pandas as pd
 
-from . import emotion, likert, naturalness, participants, themes, vad
+from . import agreement, emotion, exclusion, likert, mixed, naturalness, participants, recognition, themes, vad
 from . import figures as figure_mod
 from .io import StudyData, load_study
 
-TABLE_KEYS = ("gait_emotion_ad", "transition_ad", "likert_consistency_ad", "likert_distribution", "naturalness",
-              "naturalness_test", "vad_pearson", "theme_anova", "theme_descriptives", "theme_inversion",
-              "neutral_validation", "demographic_differences")
+TABLE_KEYS = ("exclusions", "gait_emotion_ad", "transition_ad", "likert_consistency_ad", "likert_distribution",
+              "naturalness", "naturalness_test", "vad_pearson", "theme_anova", "theme_descriptives", "theme_inversion",
+              "neutral_validation", "demographic_differences", "agreement",
+              "mixed_models")
 """Keys of report.json holding a list of records (one CSV each). ``participants`` and ``meta`` are objects."""
 
+AD_LABEL_BLIND = ("It is label-blind: it compares two sets of four numbers without which emotion each number "
+                  "belongs to, so intended happy (1,0,0,0) against perceived pure neutral (0,0,0,1) is not rejected; "
+                  "whether emotions were recognised is answered by the recognition section (Wagner's Hu).")
+"""One sentence shown beside seed 000's 4-value Anderson-Darling test wherever the report shows it."""
+
+RECOGNITION_KEYS = {"gait_emotion": "Gait emotion (section emotion_choice)",
+                    "gesture_emotion": "Gesture emotion (section gesture_emotion)"}
+"""Keys of report.json ``recognition`` -> heading."""
+
+RECOGNITION_METHOD = ("Confusion matrix, rows intended, columns perceived; an answer selecting k labels adds 1/k to "
+                      "each. Gait: intended = the clip's dominant intended emotion (unique largest of happy..neutral, "
+                      ">= 0.5; other clips left out); gesture: the clip's emotion_label. Hit rate = C_ii/row_i; "
+                      "unbiased hit rate Hu = C_ii^2/(row_i col_i) and its chance value row_i col_i/N^2 (Wagner "
+                      "1993); Cohen's kappa. Per participant: Hu and chance per emotion, arcsin(sqrt(x)), paired "
+                      "t-test across participants (scipy.stats.ttest_rel), Holm-corrected across emotions.")
+
 METHODS = {
-    "gait_emotion_ad": "Each answer -> indicator vector / number of labels; mean over answers, l1-normalised; "
-                       "scipy.stats.anderson_ksamp (midrank) on the 4 intended vs the 4 perceived components; "
-                       "p interpolated and capped to [0.001, 0.25].",
+    "exclusions": f"Excluded before every analysis: participants with more than {exclusion.MAX_FAST_SHARE:.0%} of "
+                  f"timed answers faster than {exclusion.FAST_FRACTION:g} x the clip duration (too_fast), or with all "
+                  f"of at least {exclusion.MIN_STRAIGHT} answers of a rating-scale section equal (straight_lining). "
+                  "The participants summary describes everyone.",
+    "gait_emotion_ad": "Seed 000's test, kept for fidelity. Each answer -> indicator vector / number of labels; "
+                       "mean over answers, l1-normalised; scipy.stats.anderson_ksamp (midrank) on the 4 intended vs "
+                       "the 4 perceived components; p interpolated and capped to [0.001, 0.25]. " + AD_LABEL_BLIND,
     "transition_ad": "As above, for question 'initial' vs happy..neutral and 'final' vs final_*.",
     "likert_consistency_ad": "k samples = participants (each: all their values for gaits of that dominant intended "
                              "emotion); midrank k-sample Anderson-Darling.",
@@ -53,11 +74,22 @@ METHODS = {
     "neutral_validation": "Share of each of the seven choices.",
     "demographic_differences": "Pearson chi-square of group x perceived-label counts (no correction), Cramer's V; "
                                "groups with < 5 selections left out.",
+    "agreement": "Ratings: ICC(2,1) and ICC(2,k) (two-way random raters, absolute agreement; clips = targets, "
+                 "participants = raters; only participants who rated every clip of the set; F-based 95% CI as "
+                 "pingouin.intraclass_corr). Choices: Fleiss' kappa on the clip x label table (multi-select 1/k), "
+                 "95% CI by bootstrap over clips.",
+    "mixed_models": "statsmodels MixedLM (REML), crossed random intercepts for participant and clip as variance "
+                    "components of a single group. Theme: rating ~ weight * n_features (centred, numeric) per "
+                    "theme; Likert: value ~ dominant intended emotion (reference neutral) per feature. Wald z "
+                    f"tests; at most {mixed.MAX_PARTICIPANTS} participants per model (seeded random sample).",
 }
 
 TITLES = {
-    "gait_emotion_ad": "Single gait emotions: intended vs perceived, 2-sample Anderson-Darling (seed 000 6.3.1)",
-    "transition_ad": "Emotion transitions: initial and final, 2-sample Anderson-Darling (seed 000 6.3.2)",
+    "exclusions": "Excluded participants and why",
+    "gait_emotion_ad": "Single gait emotions: seed 000's test, 2-sample Anderson-Darling of the 4 intended vs the 4 "
+                       "perceived values (seed 000 6.3.1)",
+    "transition_ad": "Emotion transitions: seed 000's test, initial and final, 2-sample Anderson-Darling (seed 000 "
+                     "6.3.2)",
     "likert_consistency_ad": "Pose affective features: consistency across participants, k-sample Anderson-Darling "
                              "(seed 000 6.3.3)",
     "likert_distribution": "Pose affective features: share of each Likert value (seed 000 Fig. 8)",
@@ -69,6 +101,8 @@ TITLES = {
     "theme_inversion": "Inverted themes: mean, SE and one-sample t-test against 0 (seed 004 Fig. 8)",
     "neutral_validation": "Neutral input walk: 7-way forced choice (seed 004 Table I)",
     "demographic_differences": "Perceived emotions across gender and age group, chi-square (seed 000 6.2)",
+    "agreement": "Agreement between participants: ICC of ratings, Fleiss' kappa of choices",
+    "mixed_models": "Mixed models with crossed random intercepts (participant, clip) beside the papers' tests",
 }
 
 
@@ -89,8 +123,12 @@ def analyse(data: StudyData, alpha: float = 0.05, permutations: int = 0) -> tupl
         "theme_inversion": themes.theme_inversion(r, c, alpha),
         "neutral_validation": themes.neutral_validation(r),
         "demographic_differences": participants.demographic_differences(r, p, alpha),
+        "agreement": agreement.agreement(r, c),
+        "mixed_models": mixed.mixed_models(r, c),
     }
-    extras = {"participants": participants.participant_summary(p, r), "vad_pairs": vad.vad_pairs(r, c)}
+    extras = {"participants": participants.participant_summary(p, r), "vad_pairs": vad.vad_pairs(r, c),
+              "recognition": {"gait_emotion": recognition.gait_recognition(r, c, alpha),
+                              "gesture_emotion": recognition.gesture_recognition(r, c, alpha)}}
     return tables, extras
 
 
@@ -121,18 +159,39 @@ def _records(df: pd.DataFrame, key: str) -> list[dict]:
     return _clean(recs)
 
 
-def _summary(tables: dict, parts: dict, alpha: float) -> list[str]:
-    """Plain-language headline findings."""
+def _recognition_summary(name: str, res: dict, alpha: float) -> str | None:
+    if not res or res["n_answers"] == 0:
+        return None
+    rates = res["rates"].set_index("label")
+    tests = res["participant_tests"]
+    above = tests[tests["reject"] & (tests["mean_diff_asin"] > 0)]
+    hits = ", ".join(f"{lab} {rates.loc[lab, 'hit_rate']:.2f}" for lab in res["labels"]
+                     if np.isfinite(rates.loc[lab, "hit_rate"]))
+    hu = ", ".join(f"{lab} {rates.loc[lab, 'unbiased_hit_rate']:.2f} "
+                   f"(chance {rates.loc[lab, 'chance_unbiased_hit_rate']:.2f})"
+                   for lab in res["labels"] if rates.loc[lab, "n"] > 0)
+    return (f"{name} recognition ({res['n_answers']} answers): hit rate {hits}; unbiased hit rate Hu {hu}; Hu above "
+            f"chance (paired t on arcsine, Holm, alpha = {alpha}) for {len(above)} of "
+            f"{int(tests['p_value'].notna().sum())} emotions; Cohen's kappa = {res['kappa']:.2f}.")
+
+
+def _summary(tables: dict, parts: dict, alpha: float, recog: dict | None = None, exclude: bool = True) -> list[str]:
+    """Plain-language headline findings: recognition first, then the papers' tests."""
     out = []
+    for key, res in (recog or {}).items():
+        line = _recognition_summary(RECOGNITION_KEYS[key].split(" (")[0], res, alpha)
+        if line:
+            out.append(line)
     g = tables["gait_emotion_ad"]
     if len(g):
-        out.append(f"Single emotions: for {int((~g['reject']).sum())} of {len(g)} gaits the null hypothesis "
-                   f"(intended and perceived emotion vectors from the same distribution) is not rejected at "
-                   f"alpha = {alpha}.")
+        out.append(f"Seed 000's 4-value Anderson-Darling test, single emotions: for {int((~g['reject']).sum())} of "
+                   f"{len(g)} gaits the null hypothesis (intended and perceived emotion vectors from the same "
+                   f"distribution) is not rejected at alpha = {alpha}. {AD_LABEL_BLIND}")
     t = tables["transition_ad"]
     if len(t):
         ok = t.groupby("clip_id")["reject"].any()
-        out.append(f"Transitions: not rejected for {int((~ok).sum())} of {len(ok)} gaits (initial and final).")
+        out.append(f"Transitions (seed 000's AD test): not rejected for {int((~ok).sum())} of {len(ok)} gaits "
+                   "(initial and final).")
     lc = tables["likert_consistency_ad"]
     if len(lc):
         out.append(f"Pose affective features: consistency across participants rejected in {int(lc['reject'].sum())} "
@@ -153,27 +212,65 @@ def _summary(tables: dict, parts: dict, alpha: float) -> list[str]:
     if len(inv):
         out.append(f"Inversion: mean rating below 0 with p < {alpha} for "
                    f"{int(((inv['mean'] < 0) & inv['reject']).sum())} of {len(inv)} themes.")
+    ag = tables.get("agreement", pd.DataFrame())
+    if len(ag):
+        icc = ag[ag["statistic"] == "ICC2"].dropna(subset=["value"])
+        fk = ag[ag["statistic"] == "fleiss_kappa"].dropna(subset=["value"])
+        bits = []
+        if len(icc):
+            bits.append(f"single-rater ICC(2,1) of ratings {icc['value'].min():.2f} to {icc['value'].max():.2f}")
+        if len(fk):
+            bits.append("Fleiss' kappa " + ", ".join(f"{r['section_type']}/{r['question']} {r['value']:.2f}"
+                                                     for _, r in fk.iterrows()))
+        if bits:
+            out.append("Agreement between participants: " + "; ".join(bits) + ".")
+    mm = tables.get("mixed_models", pd.DataFrame())
+    if len(mm):
+        fx = mm[(mm["kind"] == "fixed") & (mm["term"] != "Intercept")]
+        out.append(f"Mixed models (crossed random participant and clip intercepts): "
+                   f"{int((fx['p_value'] < alpha).sum())} of {len(fx)} fixed effects with p < {alpha}.")
+    ex = tables.get("exclusions", pd.DataFrame())
+    if exclude:
+        by_rule = ex.groupby("rule")["participant_id"].nunique().to_dict() if len(ex) else {}
+        out.append(f"Exclusions: {parts.get('n_excluded', 0)} of {parts.get('n_participants', 0)} participants "
+                   "excluded before the analyses" + (" (" + ", ".join(f"{k}: {v}" for k, v in by_rule.items()) + ")"
+                                                      if by_rule else "") + ".")
+    else:
+        out.append("Exclusions: not applied (--no-exclusions).")
     if parts.get("synthetic"):
         out.insert(0, "SYNTHETIC DATA: every participant is simulated (ids 'sim-'); these are not findings.")
     return out
 
 
-def build_report(data: StudyData, alpha: float = 0.05, permutations: int = 0) -> tuple[dict, dict, dict]:
-    """Analyse and assemble the report dict. Returns (report, tables, extras)."""
+def build_report(data: StudyData, alpha: float = 0.05, permutations: int = 0,
+                 exclude: bool = True) -> tuple[dict, dict, dict]:
+    """Analyse and assemble the report dict. Returns (report, tables, extras).
+
+    ``exclude`` (default True) applies the exclusion rules of :mod:`analysis.exclusion` before every analysis; the
+    table ``exclusions`` lists who was excluded and why, the participants summary still describes everyone."""
     if not 0 < alpha < 1:
         raise ValueError(f"alpha must be in (0, 1), not {alpha}")
     if permutations < 0:
         raise ValueError(f"permutations must be >= 0, not {permutations}")
-    tables, extras = analyse(data, alpha, permutations)
+    excl = (exclusion.exclusions(data.responses, data.clips) if exclude
+            else pd.DataFrame(columns=exclusion.COLUMNS))
+    kept = StudyData(exclusion.apply_exclusions(data.responses, excl), data.clips, data.participants,
+                     data.ignored_columns)
+    tables, extras = analyse(kept, alpha, permutations)
+    tables["exclusions"] = excl
+    if len(excl):
+        extras["participants"] = participants.participant_summary(data.participants, data.responses)
+    extras["participants"]["n_excluded"] = int(excl["participant_id"].nunique())
     report = {k: _records(tables[k], k) for k in TABLE_KEYS}
     report["participants"] = _clean(extras["participants"])
+    report["recognition"] = {k: _clean(recognition.recognition_json(v)) for k, v in extras["recognition"].items()}
     notes = []
     a = tables["theme_anova"]
     if len(a) and a["n_dropped"].max() > 0:
         notes.append(f"Theme RM-ANOVA: participants with missing cells were dropped per theme "
                      f"(up to {int(a['n_dropped'].max())} per theme).")
     for k in TABLE_KEYS:
-        if tables[k].empty:
+        if tables[k].empty and k != "exclusions":
             notes.append(f"{k}: no data for this analysis in responses.csv.")
     for key in ("gait_emotion_ad", "transition_ad"):
         t = tables[key]
@@ -194,8 +291,10 @@ def build_report(data: StudyData, alpha: float = 0.05, permutations: int = 0) ->
     report["meta"] = _clean({
         "generated_at": _dt.datetime.now(_dt.UTC).strftime("%Y-%m-%dT%H:%M:%SZ"),
         "alpha": alpha, "permutations": permutations, "synthetic": synthetic,
+        "exclusion_rules": {"applied": exclude, "fast_fraction": exclusion.FAST_FRACTION,
+                            "max_fast_share": exclusion.MAX_FAST_SHARE, "min_straight": exclusion.MIN_STRAIGHT},
         "n_responses": len(data.responses), "n_clips": len(data.clips), "n_participants": len(data.participants),
-        "summary": _summary(tables, extras["participants"], alpha), "notes": notes,
+        "summary": _summary(tables, extras["participants"], alpha, extras["recognition"], exclude), "notes": notes,
         "methods": "docs/analysis.md",
     })
     return report, tables, extras
@@ -210,22 +309,28 @@ def _make_figures(tables: dict, extras: dict) -> dict:
         "fig_naturalness": figure_mod.fig_naturalness(tables["naturalness"]),
         "fig_theme_ratings": figure_mod.fig_theme_ratings(tables["theme_descriptives"]),
         "fig_inversion": figure_mod.fig_inversion(tables["theme_inversion"]),
+        "fig_confusion": figure_mod.fig_confusion({RECOGNITION_KEYS[k].split(" (")[0]: v
+                                                   for k, v in extras["recognition"].items()}),
     }
 
 
 def write_report(responses_csv, clips_csv, participants_csv, out_dir, alpha: float = 0.05,
-                 permutations: int = 0, *, figures: bool = True) -> dict:
+                 permutations: int = 0, *, figures: bool = True, exclude: bool = True) -> dict:
     """Validate the three exports (paths or text file objects), analyse, and write the report folder.
 
     ``figures=False`` skips the PNG/SVG figures (the HTML then has tables only); the analyses are the same.
+    ``exclude=False`` analyses every participant (no exclusion rules, :mod:`analysis.exclusion`).
     Raises :class:`analysis.io.ValidationError` (listing file, line and column of each problem) on invalid input.
     Returns the report dict (also written as ``out_dir/report.json``).
     """
     data = load_study(responses_csv, clips_csv, participants_csv)
-    report, tables, extras = build_report(data, alpha, permutations)
+    report, tables, extras = build_report(data, alpha, permutations, exclude)
     os.makedirs(out_dir, exist_ok=True)
     for k in TABLE_KEYS:
         tables[k].to_csv(os.path.join(out_dir, f"{k}.csv"), index=False)
+    for k, res in extras["recognition"].items():
+        recognition.recognition_table(res).to_csv(os.path.join(out_dir, f"recognition_{k}.csv"), index=False)
+        res["confusion"].to_csv(os.path.join(out_dir, f"confusion_{k}.csv"))
     with open(os.path.join(out_dir, "participants_summary.json"), "w") as f:
         json.dump(report["participants"], f, indent=2)
     figs = {}
@@ -237,16 +342,17 @@ def write_report(responses_csv, clips_csv, participants_csv, out_dir, alpha: flo
     with open(os.path.join(out_dir, "report.json"), "w") as f:
         json.dump(report, f, indent=1, allow_nan=False)
     with open(os.path.join(out_dir, "report.html"), "w", encoding="utf-8") as f:
-        f.write(render_html(report, tables, figs))
+        f.write(render_html(report, tables, figs, extras))
     return report
 
 
 def report_zip_bytes(responses_csv, clips_csv, participants_csv, alpha: float = 0.05, permutations: int = 0,
-                     *, figures: bool = True) -> tuple[dict, bytes]:
+                     *, figures: bool = True, exclude: bool = True) -> tuple[dict, bytes]:
     """Run :func:`write_report` into a temporary folder and return (report dict, the folder as a zip archive's
     bytes) -- for a download view. Raises ValidationError like write_report."""
     with tempfile.TemporaryDirectory() as tmp:
-        report = write_report(responses_csv, clips_csv, participants_csv, tmp, alpha, permutations, figures=figures)
+        report = write_report(responses_csv, clips_csv, participants_csv, tmp, alpha, permutations, figures=figures,
+                              exclude=exclude)
         buf = io.BytesIO()
         with zipfile.ZipFile(buf, "w", zipfile.ZIP_DEFLATED) as zf:
             for name in sorted(os.listdir(tmp)):
@@ -310,8 +416,27 @@ def _participants_html(ps: dict) -> str:
     return "".join(out)
 
 
-def render_html(report: dict, tables: dict, figs: dict) -> str:
-    """A self-contained HTML page: summary, participants, each table with its figure inline (SVG)."""
+def _recognition_html(extras: dict, figs: dict) -> str:
+    h = html.escape
+    out = ["<h2 id='recognition'>Emotion recognition against chance: hit rate, unbiased hit rate (Wagner 1993), "
+           f"Cohen's kappa</h2><p class='method'>{h(RECOGNITION_METHOD)}</p>"]
+    if "fig_confusion" in figs:
+        out.append(f"<div class='fig'>{_inline_svg(figs['fig_confusion']['svg'])}</div>")
+    for key, res in extras.get("recognition", {}).items():
+        out.append(f"<h3>{h(RECOGNITION_KEYS[key])}</h3>")
+        if not res or res["n_answers"] == 0:
+            out.append("<p>No data.</p>")
+            continue
+        out.append(f"<p>{res['n_answers']} answers ({res.get('n_excluded', 0)} left out: no intended label); "
+                   f"Cohen's kappa = {res['kappa']:.3f}.</p><div class='tables'>")
+        out.append(_table_html(recognition.recognition_table(res)))
+        out.append("<div class='wide'>" + res["confusion"].to_html(float_format=lambda x: f"{x:.4g}", border=0)
+                   + "</div></div>")
+    return "".join(out)
+
+
+def render_html(report: dict, tables: dict, figs: dict, extras: dict | None = None) -> str:
+    """A self-contained HTML page: summary, recognition, participants, each table with its figure inline (SVG)."""
     meta = report["meta"]
     h = html.escape
     parts = [f"<!DOCTYPE html><html lang='en'><head><meta charset='utf-8'><title>Study report</title>"
@@ -326,16 +451,20 @@ def render_html(report: dict, tables: dict, figs: dict) -> str:
                  + "</ul>")
     if meta["notes"]:
         parts.append("<h2>Notes</h2><ul>" + "".join(f"<li>{h(s)}</li>" for s in meta["notes"]) + "</ul>")
+    if extras:
+        parts.append(_recognition_html(extras, figs))
     parts.append("<h2>Participants</h2>" + _participants_html(report["participants"]))
     for k in TABLE_KEYS:
         parts.append(f"<h2 id='{k}'>{h(TITLES[k])}</h2><p class='method'>{h(METHODS[k])}</p>")
         df = tables[k]
         if df.empty:
-            parts.append("<p>No data.</p>")
+            parts.append("<p>No participant excluded.</p>" if k == "exclusions" else "<p>No data.</p>")
             continue
         fig = FIG_FOR_TABLE.get(k)
         if fig in figs:
             parts.append(f"<div class='fig'>{_inline_svg(figs[fig]['svg'])}</div>")
+        if k in ("gait_emotion_ad", "transition_ad"):
+            parts.append(f"<p class='method'><b>Read with care:</b> {h(AD_LABEL_BLIND)}</p>")
         parts.append(_table_html(df))
     parts.append("</body></html>")
     return "\n".join(parts)

@@ -121,3 +121,25 @@ def test_report_zip_bytes():
     rep, data = report_zip_bytes(*[io.StringIO(df.to_csv(index=False)) for df in (r, c, p)], figures=False)
     names = zipfile.ZipFile(io.BytesIO(data)).namelist()
     assert "report/report.json" in names and "report/report.html" in names and rep["participants"]
+
+
+def test_report_recognition_agreement_mixed_models(report_dir):
+    report, out = report_dir
+    for key in ("gait_emotion", "gesture_emotion"):
+        rec = report["recognition"][key]
+        assert {"labels", "confusion", "hit_rate", "unbiased_hit_rate", "chance_unbiased_hit_rate", "kappa",
+                "n_answers", "participant_tests"} <= rec.keys()
+        assert len(rec["confusion"]) == len(rec["labels"]) == len(rec["hit_rate"])
+        assert sum(map(sum, rec["confusion"])) == pytest.approx(rec["n_answers"])
+        assert (out / f"recognition_{key}.csv").exists()
+    assert report["recognition"]["gait_emotion"]["labels"] == ["happy", "sad", "angry", "neutral"]
+    assert report["meta"]["summary"][1].startswith("Gait emotion recognition")
+    fields = {"section_type", "question", "statistic", "value", "ci_low", "ci_high", "n_raters", "n_items"}
+    assert report["agreement"] and all(fields <= r.keys() for r in report["agreement"])
+    assert {r["statistic"] for r in report["agreement"]} >= {"ICC2", "fleiss_kappa"}
+    kinds = {(r["kind"], r["term"]) for r in report["mixed_models"]}
+    assert {("variance", "participant"), ("variance", "clip"), ("variance", "residual"),
+            ("fixed", "weight_c")} <= kinds
+    html = (out / "report.html").read_text()
+    assert html.index("id='recognition'") < html.index("id='gait_emotion_ad'")
+    assert "label-blind" in html and "fig_confusion" not in html or (out / "fig_confusion.svg").exists()
