@@ -132,18 +132,45 @@ PRESETS["demo"]["sections"][0]["title"] = "Perceived emotion: walks"
 PRESETS["demo"]["sections"][4]["title"] = "Perceived emotion: gestures"
 
 
+#: The stimulus plan (generation/plans/<name>.yaml) whose clips each preset's sections draw:
+#: :func:`create_study_from_preset` adds a ``plan`` filter to every section pool, so clips of another plan in the
+#: same catalogue (the demo's, another paper's) never enter a study's pools. A researcher may change the filter in
+#: the admin.
+PRESET_PLANS = {"gait_ismar2020": "seed000", "gestures_ieeevr2021": "seed003", "rbf_thms2016": "seed004",
+                "demo": "demo"}
+_OWN_PLAN = object()
+
+
 def preset_choices() -> list[tuple[str, str]]:
     return [(key, value["title"]) for key, value in PRESETS.items()]
 
 
+def preset_sections(preset: str, plan: str | None = _OWN_PLAN) -> list[dict]:
+    """A deep copy of the preset's sections with ``plan`` (default the preset's own, :data:`PRESET_PLANS`) as a pool
+    filter of every section that has a pool (a reused section shows the clips of the section it repeats);
+    ``plan=None`` leaves the pools unfiltered."""
+    plan = PRESET_PLANS[preset] if plan is _OWN_PLAN else plan
+    sections = copy.deepcopy(PRESETS[preset]["sections"])
+    if plan is not None:
+        for sec in sections:
+            if "reuse" not in sec:
+                sec["pool"] = dict(sec.get("pool") or {}, plan=plan)
+    return sections
+
+
 def create_study_from_preset(preset: str, slug: str, title: str | None = None, status: str = "draft",
-                             **study_fields):
-    """Create a Study and its Sections from a preset. Raises KeyError naming the preset if unknown."""
+                             plan: str | None = _OWN_PLAN, **study_fields):
+    """Create a Study and its Sections from a preset. Raises KeyError naming the preset if unknown.
+
+    Every section pool draws only clips of ``plan``: by default the preset's own plan (:data:`PRESET_PLANS`), so a
+    paper's study never shows demo clips; another plan name for a copy of a paper plan; None for no plan filter.
+    """
     from .models import Section, Study
 
     if preset not in PRESETS:
         raise KeyError(f"unknown preset {preset!r}; choose one of {sorted(PRESETS)}")
     spec = copy.deepcopy(PRESETS[preset])
+    spec["sections"] = preset_sections(preset, plan)
     with transaction.atomic():
         study = Study.objects.create(
             slug=slug, title=title or spec["title"], preset=preset, status=status,

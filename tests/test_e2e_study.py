@@ -102,7 +102,7 @@ def test_whole_demo_study_in_chromium(chromium, live_server, settings, tmp_path)
     gesture = os.environ.get("STUDY_SCREENSHOT_GESTURE_VIDEO") if shots else None
     make_catalogue(settings.MEDIA_ROOT, video_bytes=video.read_bytes(), duration_s=seconds,
                    gesture_video_bytes=Path(gesture).read_bytes() if gesture else None)
-    study = create_study_from_preset("demo", "demo", status=Study.Status.OPEN,
+    study = create_study_from_preset("demo", "demo", plan="test", status=Study.Status.OPEN,
                                      completion_redirect="https://example.org/complete?cc={code}")
     driver = chromium
     entry_url = live_server.url + reverse("studyapp:study_entry", args=[study.slug]) + "?PROLIFIC_PID=e2e-1"

@@ -282,6 +282,25 @@ def test_generation_uses_the_emotion_input(tiny_net):
     assert not np.allclose(a.rotations, b.rotations)
 
 
+def test_generation_plants_feet_by_default(tiny_net):
+    """generate_gaits runs the foot clean-up unless told not to; it only changes the legs and the root height."""
+    from generation.core.features import foot_joints, foot_skate
+
+    seed = walk(WalkParams(), straight(10.0), 80, 30.0)
+    args = ([seed], [straight(10.0)], np.array([[1.0, 0, 0, 0]]))
+    (raw,) = generate_gaits(*args, steps=30, model=tiny_net, foot_cleanup=False)
+    (clean,) = generate_gaits(*args, steps=30, model=tiny_net)
+    assert "foot_cleanup" not in raw.metadata and clean.metadata["foot_cleanup"]["method"]
+    np.testing.assert_allclose(clean.root_positions[:, [0, 2]], raw.root_positions[:, [0, 2]])
+    upper = [clean.skeleton.index(n) for n in ("lower_back", "spine", "neck", "head", "left_elbow", "right_hand")]
+    np.testing.assert_allclose(clean.rotations[:, upper], raw.rotations[:, upper])
+    P = clean.positions()
+    left, right = foot_joints(clean.skeleton)
+    assert P[:, left + right, 1].min() > -0.01
+    assert foot_skate(P, clean.fps, clean.skeleton)["mean_m_s"] <= foot_skate(
+        raw.positions(), raw.fps, raw.skeleton)["mean_m_s"] + 1e-9
+
+
 def test_generation_rejects_short_seed_and_bad_emotions(tiny_net):
     short = walk(WalkParams(), straight(5.0), 40, 30.0)
     with pytest.raises(ValueError, match="seed gait 0"):

@@ -140,7 +140,9 @@ def test_builtin_plans_cover_the_papers():
     sources = [e for e in s000.entries if e.origin == "source"]
     assert len(singles) >= 8 and len(transitions) == 12 and len(sources) == 6
     assert all(e.generator == "gait_net" and e.fallback == "procedural_walk" for e in singles + transitions)
-    assert all(e.render.duration_s == 10 and e.render.camera == "fixed" for e in s000.entries)
+    assert all(e.render.duration_s == 10 and e.render.camera == "auto"
+               and (e.render.width, e.render.height) == (1280, 720)
+               for e in s000.entries)
 
     s003 = load_plan("seed003")
     generated = [e for e in s003.entries if e.origin == "generated"]
@@ -169,3 +171,46 @@ def test_generator_version_follows_the_generator_code():
     assert "humanoid3d_walk.txt" in captured  # data files count too
     assert clipgen.generator_version("rbf").startswith(clipgen.GENERATOR_VERSIONS["rbf"] + "+src")
     assert clipgen.source_digest("rbf") != clipgen.source_digest("captured")
+
+
+def test_seed003_generates_gestures_from_held_out_sentences():
+    """Every gesture_net entry of seed003 uses a sentence of the gesture network's test split and says so."""
+    from generation.gesture.data import load_sentences, split_sentences
+    from generation.gesture.train import TrainConfig
+
+    rows = load_sentences()
+    split = split_sentences(rows, TrainConfig().seed)
+    split_of_text = {r.sentence: split[r.sentence_id] for r in rows}
+    generated = [e for e in load_plan("seed003").entries if e.generator == "gesture_net"]
+    assert generated
+    for e in generated:
+        assert e.inputs["sentence_split"] == "test", e.id
+        assert split_of_text[e.inputs["sentence"]] == "test", e.id
+    # the test split holds 3 sentences per emotion; the plan uses all of them
+    assert len(generated) == 3 * len(GESTURE_EMOTIONS)
+
+
+def test_sentence_split_field():
+    gesture = {"id": "g", "generator": "gesture_net", "sentence": "I did it.", "emotion_label": "proud"}
+    assert "sentence_split" not in validate_plan(_plan(gesture)).entries[0].inputs
+    assert validate_plan(_plan(dict(gesture, sentence_split="test"))).entries[0].inputs["sentence_split"] == "test"
+    with pytest.raises(PlanError, match="field 'sentence_split'"):
+        validate_plan(_plan(dict(gesture, sentence_split="holdout")))
+    with pytest.raises(PlanError, match="field 'sentence_split'"):
+        validate_plan(_plan(dict(WALK, id="w2", sentence_split="test")))
+
+
+def test_motion_kept_as_bvh_per_clip(tmp_path):
+    from generation.formats.bvh import read_bvh
+    from generation.plans.clipgen import make_motion, write_motion_bvh
+
+    entry = validate_plan(_plan(dict(WALK, duration_s=1.0))).entries[0]
+    motion = make_motion(entry)
+    path = write_motion_bvh(motion, tmp_path / "motions", "0123456789abcdef")
+    assert path == tmp_path / "motions" / "0123456789abcdef.bvh"
+    assert [p.name for p in path.parent.iterdir()] == [path.name]
+    back = read_bvh(path)
+    assert back.num_frames == motion.num_frames
+    assert abs(back.positions() - motion.positions()).max() < 1e-4
+    with pytest.raises(ValueError, match="cannot name a file"):
+        write_motion_bvh(motion, tmp_path, "../x")

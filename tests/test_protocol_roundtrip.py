@@ -66,7 +66,7 @@ def take_part(study: Study, seed: int, gender: str) -> Participant:
 def test_demo_study_round_trip(settings, tmp_path):
     settings.MEDIA_ROOT = tmp_path / "media"
     make_catalogue(settings.MEDIA_ROOT)
-    study = create_study_from_preset("demo", "demo", status=Study.Status.OPEN)
+    study = create_study_from_preset("demo", "demo", plan="test", status=Study.Status.OPEN)
     assert {s.section_type for s in study.sections.all()} == set(SECTION_TYPES)
     people = [take_part(study, seed, gender) for seed, gender in ((1, "female"), (2, "male"), (3, "non-binary"))]
     Participant.objects.create(study=study)            # consented, never started: still a participants.csv row

@@ -35,7 +35,7 @@ def staff():
 def study(settings, tmp_path):
     settings.MEDIA_ROOT = tmp_path / "media"
     make_catalogue(settings.MEDIA_ROOT)
-    return create_study_from_preset("demo", "demo", status="open")
+    return create_study_from_preset("demo", "demo", plan="test", status="open")
 
 
 def finish(p: Participant, gender="female") -> int:
@@ -96,7 +96,7 @@ def test_create_from_preset_and_open_close(staff, study):
 
 def test_reorder_sections_in_admin(staff, study):
     """Sections are reordered by their `order` field in the study's admin page (inline formset)."""
-    s = create_study_from_preset("gestures_ieeevr2021", "gest")
+    s = create_study_from_preset("gestures_ieeevr2021", "gest", plan="test")
     url = f"/admin/studyapp/study/{s.pk}/change/"
     data = admin_form_data(staff.get(url))
     assert data["sections-TOTAL_FORMS"] == "2" and data["sections-0-section_type"] == "gesture_emotion"
@@ -192,7 +192,7 @@ def test_setup_demo_without_clips_says_what_to_run():
 
 @pytest.fixture
 def gait_study(study):
-    return create_study_from_preset("gait_ismar2020", "gaits", status="open")
+    return create_study_from_preset("gait_ismar2020", "gaits", plan="test", status="open")
 
 
 def test_analyze_command_and_report_zip(gait_study, staff, tmp_path):

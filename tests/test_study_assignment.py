@@ -32,16 +32,16 @@ def started(study: Study, n: int = 1) -> list[Participant]:
 
 
 def test_presets_create_every_section_type(catalogue):
-    study = create_study_from_preset("demo", "demo", status="open")
+    study = create_study_from_preset("demo", "demo", plan="test", status="open")
     types = list(study.sections.order_by("order").values_list("section_type", flat=True))
     assert set(types) == set(SECTION_TYPES)
     for key in PRESETS:
-        s = create_study_from_preset(key, f"s-{key.replace('_', '-')}")
+        s = create_study_from_preset(key, f"s-{key.replace('_', '-')}", plan="test")
         assert s.sections.exists() and s.status == "draft"
 
 
 def test_seed_recorded_and_no_clip_twice(catalogue):
-    study = create_study_from_preset("demo", "demo", status="open")
+    study = create_study_from_preset("demo", "demo", plan="test", status="open")
     (p,) = started(study)
     assert p.seed is not None
     rows = list(p.assignments.select_related("section"))
@@ -57,7 +57,7 @@ def test_seed_recorded_and_no_clip_twice(catalogue):
 
 
 def test_plan_is_reproducible_from_the_seed(catalogue):
-    study = create_study_from_preset("gait_ismar2020", "g", status="open")
+    study = create_study_from_preset("gait_ismar2020", "g", plan="test", status="open")
     a = [[it.clip.clip_id for it in items] for _, items in plan_study(study, 42, balanced=False)]
     b = [[it.clip.clip_id for it in items] for _, items in plan_study(study, 42, balanced=False)]
     c = [[it.clip.clip_id for it in items] for _, items in plan_study(study, 43, balanced=False)]
@@ -65,7 +65,7 @@ def test_plan_is_reproducible_from_the_seed(catalogue):
 
 
 def test_section_pools_follow_catalogue_fields(catalogue):
-    study = create_study_from_preset("demo", "demo", status="open")
+    study = create_study_from_preset("demo", "demo", plan="test", status="open")
     (p,) = started(study)
     for a in p.assignments.select_related("section", "clip"):
         t, clip = a.section.section_type, a.clip
@@ -84,7 +84,7 @@ def test_section_pools_follow_catalogue_fields(catalogue):
 
 
 def test_naturalness_mixes_sources_without_their_generated_versions(catalogue):
-    study = create_study_from_preset("gestures_ieeevr2021", "gest", status="open")
+    study = create_study_from_preset("gestures_ieeevr2021", "gest", plan="test", status="open")
     for p in started(study, 12):
         nat = list(p.assignments.filter(section__section_type="naturalness").select_related("clip"))
         origins = Counter(a.clip.origin for a in nat)
@@ -101,7 +101,7 @@ def test_naturalness_mixes_sources_without_their_generated_versions(catalogue):
 
 
 def test_balanced_assignment(catalogue):
-    study = create_study_from_preset("gait_ismar2020", "g", status="open")
+    study = create_study_from_preset("gait_ismar2020", "g", plan="test", status="open")
     section = study.sections.get(order=1)
     pool = 10      # gait_gen_00..09, 8 per participant
     started(study, 5)
@@ -111,7 +111,7 @@ def test_balanced_assignment(catalogue):
 
 
 def test_closed_study_refuses_start(catalogue):
-    study = create_study_from_preset("demo", "demo", status="closed")
+    study = create_study_from_preset("demo", "demo", plan="test", status="closed")
     p = Participant.objects.create(study=study, demographics_done=True)
     with pytest.raises(StudyUnavailable, match="closed"):
         start_participant(p)
@@ -120,7 +120,7 @@ def test_closed_study_refuses_start(catalogue):
 def test_reuse_must_come_before(catalogue):
     from django.core.exceptions import ValidationError
 
-    study = create_study_from_preset("gait_ismar2020", "g")
+    study = create_study_from_preset("gait_ismar2020", "g", plan="test")
     first = study.sections.get(order=1)
     first.reuse_section = study.sections.get(order=3)
     with pytest.raises(ValidationError, match="before"):
@@ -138,7 +138,7 @@ def test_concurrent_starts_stay_balanced_and_within_limit(settings, tmp_path):
         pytest.skip("concurrency test needs PostgreSQL (set DATABASE_URL)")
     settings.MEDIA_ROOT = tmp_path / "media"
     make_catalogue(settings.MEDIA_ROOT)
-    study = create_study_from_preset("gait_ismar2020", "conc", status="open", max_participants=7)
+    study = create_study_from_preset("gait_ismar2020", "conc", plan="test", status="open", max_participants=7)
     people = [Participant.objects.create(study=study, demographics_done=True) for _ in range(10)]
     results: list[str] = []
     barrier = threading.Barrier(len(people))

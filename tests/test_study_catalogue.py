@@ -82,3 +82,23 @@ def test_superseded_renders_are_retired_and_left_out_of_pools():
     # Rendering an entry again brings its clip back.
     upsert_clips([rec(clip_id="old_b", metadata={"entry_id": "b"})])
     assert not Clip.objects.get(clip_id="old_b").retired
+
+
+def test_presets_draw_clips_of_their_own_plan_only():
+    """A demo clip in the same catalogue never enters a paper preset's pools, and the demo keeps to its own."""
+    from studyapp.presets import PRESET_PLANS, PRESETS, create_study_from_preset
+
+    assert set(PRESET_PLANS) == set(PRESETS)
+    upsert_clips([rec(clip_id="demo_walk", plan="demo"), rec(clip_id="paper_walk", plan="seed000"),
+                  rec(clip_id="demo_src", plan="demo", origin="source"),
+                  rec(clip_id="paper_src", plan="seed000", origin="source")])
+    for preset, plan in PRESET_PLANS.items():
+        study = create_study_from_preset(preset, f"s-{preset}")
+        for section in study.sections.filter(reuse_section__isnull=True):
+            assert section.pool["plan"] == plan, (preset, section.section_type)
+            pooled = set(pool_queryset(section.pool).values_list("plan", flat=True))
+            assert pooled <= {plan}, (preset, section.section_type, pooled)
+    paper = create_study_from_preset("gait_ismar2020", "paper").sections.get(section_type="emotion_choice")
+    demo = create_study_from_preset("demo", "demo").sections.get(section_type="emotion_choice")
+    assert set(pool_queryset(paper.pool).values_list("clip_id", flat=True)) == {"paper_walk"}
+    assert set(pool_queryset(demo.pool).values_list("clip_id", flat=True)) == {"demo_walk"}

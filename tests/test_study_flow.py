@@ -23,7 +23,7 @@ pytestmark = pytest.mark.django_db
 def study(settings, tmp_path):
     settings.MEDIA_ROOT = tmp_path / "media"
     make_catalogue(settings.MEDIA_ROOT)
-    s = create_study_from_preset("demo", "demo", status=Study.Status.OPEN,
+    s = create_study_from_preset("demo", "demo", plan="test", status=Study.Status.OPEN,
                                  completion_redirect="https://app.prolific.com/submissions/complete?cc={code}")
     s.sections.update(require_full_play=False)
     return s
@@ -55,8 +55,9 @@ def demographics(client, p):
 
 
 def test_home_page_lists_open_studies_only(client, study):
-    create_study_from_preset("rbf_thms2016", "draft-study", title="A draft study")
-    create_study_from_preset("rbf_thms2016", "closed-study", title="A closed study", status=Study.Status.CLOSED)
+    create_study_from_preset("rbf_thms2016", "draft-study", plan="test", title="A draft study")
+    create_study_from_preset("rbf_thms2016", "closed-study", plan="test", title="A closed study",
+                             status=Study.Status.CLOSED)
     r = client.get("/")
     assert r.status_code == 200
     html = r.content.decode()

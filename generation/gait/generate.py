@@ -21,6 +21,7 @@ from pathlib import Path
 import numpy as np
 import torch
 
+from generation.core.foot_contact import plant_feet
 from generation.core.motion import Motion
 from generation.core.paths import GroundPath, straight
 from study_protocol import GAIT_EMOTIONS
@@ -345,7 +346,7 @@ def _metadata(net: LoadedGaitNet, emotions: np.ndarray, path: GroundPath, seed_m
 
 def generate_gaits(seeds, paths: list[GroundPath], emotions, steps: int = 200, fps_out: float = 30.0,
                    model: LoadedGaitNet | None = None, lookahead_m: float = 1.0, include_seed: bool = False,
-                   rng_seed: int = 0) -> list[Motion]:
+                   rng_seed: int = 0, foot_cleanup: bool = True) -> list[Motion]:
     """Generate emotive gaits for N agents in one batch.
 
     Args:
@@ -363,10 +364,14 @@ def generate_gaits(seeds, paths: list[GroundPath], emotions, steps: int = 200, f
         lookahead_m: pure-pursuit look-ahead along the path, metres.
         include_seed: prepend the (moved) seed steps to the output.
         rng_seed: seeds the procedural seed walks (their parameters and phase).
+        foot_cleanup: plant the feet after generation (:func:`generation.core.foot_contact.plant_feet`: contacts
+            detected in the output, the planted foot locked, legs solved with two-bone IK, no floor
+            penetration); False returns the network's raw output (resampled).
 
     Returns:
         N Motions on each seed's skeleton, metadata {"origin": "generated", "generator": "gait_net", "emotion",
-        "final_emotion" (None unless the emotion changes), "trained_on", "path_kind", "steps", "network_fps"}.
+        "final_emotion" (None unless the emotion changes), "trained_on", "path_kind", "steps", "network_fps",
+        "foot_cleanup" (when applied)}.
     """
     net = model if model is not None else load_default_model()
     seeds, emotions = _check_inputs(seeds, paths, emotions, steps)
@@ -378,7 +383,8 @@ def generate_gaits(seeds, paths: list[GroundPath], emotions, steps: int = 200, f
         r, rt = _with_seed(seed, placement, i, rot[i], root[i]) if include_seed else (rot[i], root[i])
         m = Motion(seed_motions[i].skeleton, wrap_quaternions(r), rt, net.fps,
                    _metadata(net, emotions[i], path, seed_motions[i]))
-        motions.append(m.resample(fps_out))
+        m = m.resample(fps_out)
+        motions.append(plant_feet(m) if foot_cleanup else m)
     return motions
 
 

@@ -11,6 +11,8 @@ The plans are plain YAML afterwards; researchers copy and edit them. What each r
 - seed003 (IEEE VR 2021, section 6): generated gestures over the 11 MPI emotion categories for narration and
   conversation sentences, and one "source" gesture per generated one (seed 003's were motion-captured; ours
   are procedural, marked synthetic) paired through ``pair`` so the study never shows both to one person.
+  The generated gestures' sentences come from the gesture network's held-out test split (each entry says
+  ``sentence_split: test``), so the study shows the network on inputs it was not trained on.
 - seed004 (THMS 2016, section V): the neutral input walk, 6 themes x weights (0.4, 0.7, 1.0, 1.3) x feature
   counts (1, 4, 7, 10), and the inversions at w = -0.7 with all ten features; short looping clips.
 """
@@ -30,7 +32,7 @@ SENTENCES = HERE.parent / "data" / "sentences_synthetic.csv"
 WEIGHTS = (0.4, 0.7, 1.0, 1.3)
 FEATURE_COUNTS = (1, 4, 7, 10)
 INVERSION_WEIGHT = -0.7
-RENDER = {"width": 640, "height": 480, "fps": 30, "duration_s": 10, "camera": "fixed", "anti_aliasing": "fxaa"}
+RENDER = {"fps": 30, "duration_s": 10}  # the renderer's defaults: 1280x720 mannequin, camera auto, FXAA
 
 
 def _predominant(emotion: str, share: float = 0.8) -> list[float]:
@@ -87,13 +89,37 @@ def seed000() -> dict:
             "render": dict(RENDER), "clips": clips}
 
 
-def _sentences(per_emotion_narration: int, per_emotion_conversation: int) -> list[dict]:
+def _sentence_splits() -> dict[str, str]:
+    """sentence_id -> "train" | "val" | "test" as the gesture network's training split them
+    (``generation.gesture.data.split_sentences`` with the training seed)."""
+    from generation.gesture.data import load_sentences, split_sentences
+    from generation.gesture.train import TrainConfig
+
+    return split_sentences(load_sentences(SENTENCES), TrainConfig().seed)
+
+
+def _sentences(per_emotion_narration: int, per_emotion_conversation: int,
+               splits: tuple[str, ...] = ("test",)) -> list[dict]:
+    """Per gesture emotion, up to ``per_emotion_narration`` narration and ``per_emotion_conversation`` conversation
+    sentences from the given splits of the gesture network's sentence split (default the held-out test split,
+    so generated gestures are never made from sentences the network was trained on). A task with too few
+    sentences in those splits is topped up from the other task. Each row gets its ``split``."""
     rows = list(csv.DictReader(SENTENCES.open(encoding="utf-8")))
+    split = _sentence_splits()
     out = []
     for emotion in GESTURE_EMOTIONS:
-        for task, n in zip(GESTURE_TASKS, (per_emotion_narration, per_emotion_conversation)):
-            pool = [r for r in rows if r["emotion"] == emotion and r["task"] == task]
-            out.extend(pool[-n:])           # the last sentences of each group
+        wanted = dict(zip(GESTURE_TASKS, (per_emotion_narration, per_emotion_conversation)))
+        pools = {task: [dict(r, split=split[r["sentence_id"]]) for r in rows if r["emotion"] == emotion
+                        and r["task"] == task and split[r["sentence_id"]] in splits] for task in GESTURE_TASKS}
+        picked = {task: pools[task][len(pools[task]) - min(n, len(pools[task])):] for task, n in wanted.items()}
+        missing = sum(wanted.values()) - sum(len(p) for p in picked.values())
+        for task in GESTURE_TASKS:                 # top up from the other task's remaining sentences
+            spare = pools[task][:len(pools[task]) - len(picked[task])]
+            take = spare[len(spare) - min(missing, len(spare)):] if missing > 0 else []
+            picked[task] = take + picked[task]
+            missing -= len(take)
+        for task in GESTURE_TASKS:
+            out.extend(picked[task])
     return out
 
 
@@ -107,9 +133,11 @@ def _gesture_seconds(sentence: str) -> float:
         return round(min(12.0, max(2.5, 1.5 + 0.4 * len(sentence.split()))), 2)
 
 
-def seed003(narration: int = 3, conversation: int = 2) -> dict:
+def seed003(narration: int = 3, conversation: int = 2, splits: tuple[str, ...] = ("test",)) -> dict:
+    """Generated gestures for sentences of the network's held-out test split (``splits``), each entry recording
+    its ``sentence_split``, and one paired source gesture each."""
     clips = []
-    for k, row in enumerate(_sentences(narration, conversation)):
+    for k, row in enumerate(_sentences(narration, conversation, splits)):
         gender = "female" if k % 2 == 0 else "male"
         handedness = "left" if k % 7 == 3 else "right"
         sid = row["sentence_id"]
@@ -118,12 +146,14 @@ def seed003(narration: int = 3, conversation: int = 2) -> dict:
                       "duration_s": _gesture_seconds(row["sentence"]), "seed": k + 1, "sections": ["naturalness"],
                       "note": "synthetic stand-in for the motion-captured MPI sequence of this sentence"})
         clips.append({"id": f"generated_{sid}", "generator": "gesture_net", "fallback": "procedural_gesture",
-                      "origin": "generated", "sentence": row["sentence"], "task": row["task"],
+                      "origin": "generated", "sentence": row["sentence"], "sentence_split": row["split"],
+                      "task": row["task"],
                       "emotion_label": row["emotion"], "gender": gender, "handedness": handedness, "seed": k + 1,
                       "pair": f"source_{sid}", "sections": ["gesture_emotion", "naturalness"]})
     return {"name": "seed003", "description": "Seed 003 (Bhattacharya et al., IEEE VR 2021) web study stimuli: "
-            "generated gestures over the 11 MPI emotions, each paired with a source gesture (procedural, "
-            "synthetic); seated agent on a chair, fixed camera.",
+            "generated gestures over the 11 MPI emotions for sentences held out from the network's training "
+            "(test split), each paired with a source gesture (procedural, synthetic); seated agent on a chair, "
+            "fixed camera.",
             "render": dict(RENDER, duration_s=12), "clips": clips}
 
 

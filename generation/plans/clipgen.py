@@ -408,3 +408,24 @@ def make_motion(entry: ClipEntry, fps: float | None = None, requested: str | Non
         meta["fallback_reason"] = fallback_reason or ""
         meta["synthetic"] = True
     return motion
+
+
+# ---- motion files ------------------------------------------------------------------------------
+def write_motion_bvh(motion: Motion, motions_dir: str | Path, clip_id: str) -> Path:
+    """Keep a clip's motion as ``motions_dir/<clip_id>.bvh`` (DESIGN.md: ``MEDIA_ROOT/motions/<clip_id>.bvh``).
+
+    The file appears under its final name only when complete (temporary name, then rename). Like the clip records,
+    ``motions_dir`` is never served: a motion file names no condition, but its id is the clip's.
+    Returns the path written.
+    """
+    from generation.formats.bvh import write_bvh
+
+    if not clip_id or any(c in clip_id for c in "/\\.") or clip_id.strip() != clip_id:
+        raise ValueError(f"clip id {clip_id!r} cannot name a file")
+    motions_dir = Path(motions_dir)
+    motions_dir.mkdir(parents=True, exist_ok=True)
+    path = motions_dir / f"{clip_id}.bvh"
+    tmp = motions_dir / f".{clip_id}.bvh.tmp"
+    write_bvh(motion, tmp)
+    tmp.replace(path)
+    return path

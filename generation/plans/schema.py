@@ -48,6 +48,9 @@ from study_protocol import (
 
 PLANS_DIR = Path(__file__).resolve().parent
 TRAJECTORY_KINDS = ("straight", "curved", "sharp_turn")
+#: Splits of the gesture network's sentence corpus (generation.gesture.data.split_sentences); a gesture_net
+#: entry may say which one its sentence comes from (a record for the study: held-out inputs are "test").
+SENTENCE_SPLITS = ("train", "val", "test")
 CAPTURED_CLIPS = ("humanoid3d_walk.txt", "0walk_forward.txt", "turn_left0.txt", "turn_left1.txt",
                   "turn_right0.txt", "turn_right1.txt")
 
@@ -69,7 +72,7 @@ GENERATOR_FIELDS: dict[str, set[str]] = {
     "captured": {"clip", "cycles"},
     "neutral_walk": {"n_cycles", "speed"},
     "rbf": {"theme", "weight", "n_features", "n_cycles", "speed"},
-    "gesture_net": {"sentence", "task", "emotion_label", "gender", "handedness", "noise"},
+    "gesture_net": {"sentence", "task", "emotion_label", "gender", "handedness", "noise", "sentence_split"},
     "procedural_gesture": {"emotion_label", "vad", "kind", "gender", "handedness", "duration_s"},
 }
 
@@ -263,6 +266,8 @@ def _generator_inputs(gen: str, raw: dict, duration_default: float) -> dict:
         out["gender"] = _choice("gender", raw.get("gender", "female"), GENDERS)
         out["handedness"] = _choice("handedness", raw.get("handedness", "right"), HANDEDNESS)
         out["noise"] = _number("noise", raw.get("noise", 0.0), 0.0, 1.0)
+        if "sentence_split" in raw:
+            out["sentence_split"] = _choice("sentence_split", raw["sentence_split"], SENTENCE_SPLITS)
     elif gen == "procedural_gesture":
         if ("emotion_label" in raw) == ("vad" in raw):
             raise _FieldError("emotion_label", "give exactly one of 'emotion_label' or 'vad' ([v, a, d] in 0..1)")

@@ -146,10 +146,11 @@ def _init_worker(progress_queue, threads: int, parent_pid: int | None = None) ->
 
 def render_job(job: Job, record: dict, clips_dir: str, records_dir: str) -> dict:
     """Make the motion, render its files, write the record last. Runs in a worker (or inline)."""
-    from generation.plans.clipgen import make_motion
+    from generation.plans.clipgen import make_motion, write_motion_bvh
 
     t0 = time.perf_counter()
     motion = make_motion(job.run_entry, requested=job.entry.generator, fallback_reason=job.fallback_reason)
+    write_motion_bvh(motion, Path(clips_dir).parent / "motions", job.clip_id)
     t_gen = time.perf_counter() - t0
     q = _PROGRESS_QUEUE
     progress = None

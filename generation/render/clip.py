@@ -13,6 +13,7 @@ from pathlib import Path
 import numpy as np
 
 from generation.core.motion import Motion
+from study_protocol import GENDERS
 
 from .body import head_top
 from .camera import body_outline, choose_cameras, facing_direction
@@ -63,7 +64,7 @@ def body_skeleton(motion: Motion):
     build ("build" or "gender": male/female; the bone lengths stay the motion's own)."""
     skel = motion.skeleton
     build = motion.metadata.get("build") or motion.metadata.get("gender")
-    if build in ("male", "female") and build != skel.build:
+    if build in GENDERS and build != skel.build:
         skel = dataclasses.replace(skel, build=build)
     return skel
 
