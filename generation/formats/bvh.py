@@ -479,10 +479,10 @@ def retarget(motion: Motion, target_skeleton: Skeleton, joint_map: dict[str, str
     for t_name, s_name in joint_map.items():
         P[:, tgt.index(t_name)] = src_pos[:, src.index(s_name)]
         known[tgt.index(t_name)] = True
-    _fill_unmapped(P, known, tgt)
+    fill_unmapped_joints(P, known, tgt)
     rotations = solve_rotations(P, tgt, known)
     if foot_ik:
-        rotations = _place_feet(rotations, P, known, tgt, joint_map)
+        rotations = place_feet_on_source(rotations, P, known, tgt, joint_map)
     meta = dict(motion.metadata)
     meta.update(metadata or {})
     out = Motion(tgt, rotations, P[:, 0].copy(), motion.fps, meta)
@@ -493,7 +493,7 @@ def retarget(motion: Motion, target_skeleton: Skeleton, joint_map: dict[str, str
     return out
 
 
-def _place_feet(rotations: np.ndarray, P: np.ndarray, known: np.ndarray, tgt: Skeleton,
+def place_feet_on_source(rotations: np.ndarray, P: np.ndarray, known: np.ndarray, tgt: Skeleton,
                 joint_map: dict[str, str]) -> np.ndarray:
     """Two-bone IK of each mapped leg onto the desired heel/ankle positions; returns new rotations."""
     Q = np_forward_kinematics(rotations, P[:, 0], tgt)
@@ -517,7 +517,7 @@ def _place_feet(rotations: np.ndarray, P: np.ndarray, known: np.ndarray, tgt: Sk
     return solve_rotations(Q, tgt) if changed else rotations
 
 
-def _fill_unmapped(P: np.ndarray, known: np.ndarray, sk: Skeleton) -> None:
+def fill_unmapped_joints(P: np.ndarray, known: np.ndarray, sk: Skeleton) -> None:
     """Place unmapped interior joints between mapped ancestor and descendant (in place; marks them known)."""
     children = sk.children()
     lengths = sk.bone_lengths()

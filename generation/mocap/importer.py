@@ -26,7 +26,7 @@ import numpy as np
 from generation.core.ik import solve_rotations
 from generation.core.motion import Motion, MotionFormatError
 from generation.core.skeleton import REFERENCE_HEIGHT_M, Skeleton, gait_skeleton, gesture_skeleton
-from generation.formats.bvh import _fill_unmapped, _place_feet, read_bvh
+from generation.formats.bvh import fill_unmapped_joints, place_feet_on_source, read_bvh
 
 from .labels import Label
 from .positions import LAYOUT_MAPS, read_positions
@@ -155,8 +155,8 @@ def solve_onto(P_src: np.ndarray, names, target: Skeleton, joint_map: dict[str, 
         P[:, target.index(ours)] = P_src[:, idx[theirs]] * scale
         known[target.index(ours)] = True
     mapped = np.flatnonzero(known)
-    _fill_unmapped(P, known, target)
-    rotations = _place_feet(solve_rotations(P, target, known), P, known, target, joint_map)
+    fill_unmapped_joints(P, known, target)
+    rotations = place_feet_on_source(solve_rotations(P, target, known), P, known, target, joint_map)
     motion = Motion(target, rotations, P[:, 0].copy(), 1.0, {})
     err = np.linalg.norm(motion.positions()[:, mapped] - P[:, mapped], axis=-1)
     return motion, scale, float(err.max())
