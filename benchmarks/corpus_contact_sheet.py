@@ -24,9 +24,10 @@ import numpy as np  # noqa: E402
 import torch  # noqa: E402
 
 from generation.core import paths
-from generation.procedural.emotion import GAIT_EMOTIONS, NRC_VAD, gait_params_for_emotion, gesture_params_for_vad  # noqa: E402
+from generation.procedural.emotion import GAIT_EMOTIONS, gait_params_for_emotion, gesture_params_for_vad  # noqa: E402
 from generation.procedural.gesture import seated_gesture  # noqa: E402
 from generation.procedural.walk import walk, walk_with_contacts  # noqa: E402
+from study_protocol import GESTURE_VAD  # noqa: E402
 
 torch.set_num_threads(1)
 
@@ -121,7 +122,7 @@ def gesture_sheet(out: Path):
     fig, axes = plt.subplots(len(emotions), 2, figsize=(13, 2.4 * len(emotions)),
                              gridspec_kw={"width_ratios": [len(side_frames), 0.85 * len(front_frames)]})
     for row, word in enumerate(emotions):
-        v, a, d = NRC_VAD[word]
+        v, a, d = GESTURE_VAD[word]
         rng = np.random.default_rng(1)
         params = [gesture_params_for_vad(v, a, d, rng, kind=k) for k in ("descriptive", "pointing", "beat")]
         motion = seated_gesture(params, n_frames=120, seed=1)

@@ -14,7 +14,6 @@ from generation.procedural.corpus import (
     sample_true_emotions,
 )
 from generation.procedural.emotion import (
-    NRC_VAD,
     gait_params_for_emotion,
     gesture_params_for_vad,
     normalize_emotion,
@@ -31,15 +30,15 @@ def small_corpus():
 
 # ---- emotion ---------------------------------------------------------------------------------------
 def test_nrc_vad_table_and_gesture_emotions():
-    assert NRC_VAD is GESTURE_VAD and len(NRC_VAD) == 11
-    assert NRC_VAD["proud"] == pytest.approx((0.906, 0.700, 0.873))
-    assert NRC_VAD["sad"] == pytest.approx((0.225, 0.333, 0.149))
-    assert tuple(NRC_VAD) == GESTURE_EMOTIONS
-    assert all(0.0 <= x <= 1.0 for vad in NRC_VAD.values() for x in vad)
+    assert len(GESTURE_VAD) == 11
+    assert GESTURE_VAD["proud"] == pytest.approx((0.906, 0.700, 0.873))
+    assert GESTURE_VAD["sad"] == pytest.approx((0.225, 0.333, 0.149))
+    assert tuple(GESTURE_VAD) == GESTURE_EMOTIONS
+    assert all(0.0 <= x <= 1.0 for vad in GESTURE_VAD.values() for x in vad)
 
 
 def test_vad_for_names_the_known_words():
-    assert vad_for(" Proud ") == NRC_VAD["proud"]
+    assert vad_for(" Proud ") == GESTURE_VAD["proud"]
     with pytest.raises(KeyError, match="known words"):
         vad_for("happy")  # a gait emotion, not one of the 11 gesture categories
 
@@ -85,8 +84,8 @@ def test_gait_params_follow_the_literature_and_vary_continuously():
 
 
 def test_gesture_params_follow_arousal_and_dominance():
-    lo = gesture_params_for_vad(*NRC_VAD["sad"], kind="beat")
-    hi = gesture_params_for_vad(*NRC_VAD["proud"], kind="beat")
+    lo = gesture_params_for_vad(*GESTURE_VAD["sad"], kind="beat")
+    hi = gesture_params_for_vad(*GESTURE_VAD["proud"], kind="beat")
     assert hi.speed > lo.speed and hi.amplitude > lo.amplitude
     assert hi.expansion > 0 > lo.expansion
     assert lo.torso_lean > hi.torso_lean and lo.head_pitch > hi.head_pitch
@@ -174,7 +173,7 @@ def test_gesture_corpus_padding_labels_and_determinism(tmp_path):
     g = build_gesture_corpus(SPECS, seed=4)
     assert g.rotations.shape == (4, 60, 23, 4)
     np.testing.assert_array_equal(g.lengths, [60, 40, 50, 45])
-    np.testing.assert_allclose(g.vad[0], NRC_VAD["proud"], atol=1e-6)
+    np.testing.assert_allclose(g.vad[0], GESTURE_VAD["proud"], atol=1e-6)
     np.testing.assert_array_equal(g.rotations[1, 40:], np.broadcast_to(g.rotations[1, 39], (20, 23, 4)))
     assert list(g.handedness) == ["right", "left", "right", "left"] and g.metadata["synthetic"] is True
     assert g.motion(1).num_frames == 40 and g.motion(1).skeleton.build == "female"

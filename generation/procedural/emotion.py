@@ -27,16 +27,13 @@ from study_protocol import GAIT_EMOTIONS, GESTURE_VAD
 from .gesture import GESTURE_KINDS, GestureParams
 from .walk import WalkParams
 
-NRC_VAD = GESTURE_VAD
-"""Gesture category -> NRC-VAD (valence, arousal, dominance); :data:`study_protocol.GESTURE_VAD` (cited there)."""
-
 
 def vad_for(word: str) -> tuple[float, float, float]:
     """(valence, arousal, dominance) of an emotion word; KeyError listing the known words."""
     key = word.strip().lower()
-    if key not in NRC_VAD:
-        raise KeyError(f"no NRC-VAD entry for {word!r}; known words: {sorted(NRC_VAD)}")
-    return NRC_VAD[key]
+    if key not in GESTURE_VAD:
+        raise KeyError(f"no NRC-VAD entry for {word!r}; known words: {sorted(GESTURE_VAD)}")
+    return GESTURE_VAD[key]
 
 
 # ---- gait --------------------------------------------------------------------------------------
