@@ -72,6 +72,11 @@ class Clip(models.Model):
     sections = models.CharField(max_length=300, blank=True)
     loop = models.BooleanField(default=False)
     metadata = models.JSONField(default=dict, blank=True)
+    # Per-clip quality record (issue 14): the qa_* values of clips.csv without the prefix, e.g.
+    # {"foot_skate_cm_s": 0.4, "figure_height_frac": 0.62, "observed": "sad", "observed_p": 0.91}.
+    qa = models.JSONField(default=dict, blank=True)
+    qa_flag = models.CharField(max_length=300, blank=True, db_index=True,
+                               help_text="failed quality checks joined by ';' (empty = passed)")
     retired = models.BooleanField(
         default=False, help_text="superseded by a newer render of the same plan entry (e.g. after a generator "
         "changed); kept for the answers that refer to it, left out of new assignments")
@@ -116,6 +121,16 @@ class Study(models.Model):
                   "https://app.prolific.com/submissions/complete?cc={code}")
     redirect_automatically = models.BooleanField(
         default=False, help_text="Send participants to the completion URL a few seconds after the last page")
+    language = models.CharField(max_length=8, default="en", choices=[("en", "English"), ("de", "Deutsch")],
+                                help_text="Language of every participant-facing page; exports stay in the "
+                                          "protocol's labels")
+    counterbalance_sections = models.BooleanField(
+        default=False, help_text="Rotate the order of the sections across participants (Latin square); each "
+                                 "participant's order is recorded and exported")
+    exclusion_rules = models.JSONField(
+        default=dict, blank=True,
+        help_text="Rules the analysis applies (raw exports stay unchanged), e.g. "
+                  '{"min_rt_fraction": 0.25, "max_straightline": 0.9, "min_attention_pass": 1.0}')
     created_at = models.DateTimeField(auto_now_add=True)
 
     class Meta:
@@ -200,6 +215,8 @@ class Participant(models.Model):
     last_active_at = models.DateTimeField(null=True, blank=True)
     completed_at = models.DateTimeField(null=True, blank=True)
     user_agent = models.CharField(max_length=300, blank=True)
+    # Section pks in the order this participant takes them (counterbalanced studies); empty = the study's order.
+    section_order = models.JSONField(default=list, blank=True)
     # SHA-256 of the one-time key the consent page gave this browser session: a second submit of the same
     # consent form (double click, two requests in flight) finds this participant instead of creating another.
     consent_key = models.CharField(max_length=64, blank=True, default="", editable=False)
