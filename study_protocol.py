@@ -140,12 +140,54 @@ CLIP_COLUMNS = ("clip_id", "modality", "origin", *GAIT_EMOTIONS, *FINAL_EMOTION_
 CLIP_FLOAT_COLUMNS = (*GAIT_EMOTIONS, *FINAL_EMOTION_COLUMNS, *VAD_DIMENSIONS, "weight", "duration_s")
 CLIP_INT_COLUMNS = ("n_features",)
 
+# ---- per-clip quality record (issue 14): optional extra columns of clips.csv after CLIP_COLUMNS ----------------
+QA_CHECKS = ("foot_skate", "penetration", "jerk", "bone_error", "figure_height", "observer")
+"""Quality checks; a clip's ``qa_flag`` joins the names of those it failed with ';' (empty = passed)."""
+
+QA_COLUMNS = ("qa_foot_skate_cm_s", "qa_penetration_cm", "qa_jerk", "qa_bone_error_mm", "qa_figure_height_frac",
+              "qa_observed", "qa_observed_p", "qa_flag")
+"""The quality columns of clips.csv, in order, after CLIP_COLUMNS (old files without them still read)."""
+
+QA_FLOAT_COLUMNS = ("qa_foot_skate_cm_s", "qa_penetration_cm", "qa_jerk", "qa_bone_error_mm", "qa_figure_height_frac",
+                    "qa_observed_p")
+
+QA_THRESHOLDS = {
+    "foot_skate_cm_s": 10.0,         # max mean foot slide in contact (corpus walks 2.2-2.6, raw network 15-30)
+    "penetration_cm": 1.0,           # max depth of a foot joint below the floor
+    "jerk": 600.0,                   # max mean joint jerk, m/s^3 (walks 70-400 at 30 fps; 5 mm jitter adds ~600)
+    "bone_error_mm": 1.0,            # max bone length deviation
+    "figure_height_frac_walk": 0.50,    # min figure height / frame height in every frame (walks)
+    "figure_height_frac_seated": 0.60,  # the same for seated gestures
+    "observer_mismatch_p": 0.90,     # flag a gait whose observer names another emotion with at least this p
+}
+"""Default thresholds of the quality checks; a plan's ``qa:`` block overrides them by key (null disables one)."""
+
 RESPONSE_COLUMNS = ("participant_id", "section_type", "clip_id", "question", "answer", "response_ms")
 """responses.csv, in order: one row per answer."""
 
+ATTENTION_CHECK = "attention_check"
+"""The ``section_type`` of an attention-check answer in responses.csv (an instructed-response item placed in a
+clip section). Its ``question`` is ``attention_question(key, instructed)``: the section's question key and the
+answer the participant was told to give, e.g. ``perceived=sad``; it passed when the answer equals that."""
+
+ATTENTION_COLUMNS = ("attention_passed", "attention_total")
+"""participants.csv: attention checks the participant passed, and answered in all."""
+
+
+def attention_question(key: str, instructed: str) -> str:
+    """The ``question`` cell of an attention-check answer: ``<question key>=<instructed answer>``."""
+    return f"{key}={instructed}"
+
+
+def attention_passed(question: str, answer: str) -> bool:
+    """Whether an attention-check answer (responses.csv ``question``, ``answer``) is the instructed one."""
+    return question.partition("=")[2] == answer
+
+
 PARTICIPANT_COLUMNS = ("participant_id", "gender", "age_group", "started_at", "completed_at", "status",
-                       "external_id")
-"""participants.csv, in order (feedback columns follow)."""
+                       "external_id", *ATTENTION_COLUMNS, "section_order")
+"""participants.csv, in order (feedback columns follow). ``section_order``: the ``order`` numbers of the sections
+in the order this participant took them, joined by ';' (counterbalanced studies differ per participant)."""
 
 ASSIGNMENT_COLUMNS = ("participant_id", "section_type", "section_order", "position", "clip_id", "options",
                       "shown_at", "answered_at")

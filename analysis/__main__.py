@@ -7,6 +7,7 @@ Exit status 0 on success, 2 with a message naming file, line and column on inval
 from __future__ import annotations
 
 import argparse
+import json
 import os
 import sys
 
@@ -26,6 +27,10 @@ def main(argv=None) -> int:
     ap.add_argument("--no-figures", action="store_true", help="skip the PNG/SVG figures (tables only)")
     ap.add_argument("--no-exclusions", action="store_true",
                     help="analyse every participant (skip the too-fast and straight-lining exclusion rules)")
+    ap.add_argument("--exclusion-rules", metavar="JSON",
+                    help="the study's exclusion thresholds: a JSON object or a .json file, e.g. "
+                         "'{\"min_rt_fraction\": 0.25, \"max_straightline\": 0.9, \"min_attention_pass\": 1.0}' "
+                         "(keys: see analysis.exclusion.RULES)")
     a = ap.parse_args(argv)
     for path in (a.responses, a.clips, a.participants):
         if not os.path.isfile(path):
@@ -34,11 +39,26 @@ def main(argv=None) -> int:
     if not 0 < a.alpha < 1 or a.permutations < 0:
         print("error: --alpha must be in (0, 1) and --permutations >= 0", file=sys.stderr)
         return 2
+    rules = None
+    if a.exclusion_rules:
+        from .exclusion import rule_errors
+
+        text = a.exclusion_rules
+        try:
+            rules = json.loads(open(text, encoding="utf-8").read() if os.path.isfile(text) else text)
+        except (OSError, ValueError) as exc:
+            print(f"error: --exclusion-rules: not a JSON object or .json file ({exc})", file=sys.stderr)
+            return 2
+        errors = rule_errors(rules)
+        if errors:
+            print("error: --exclusion-rules: " + "; ".join(errors), file=sys.stderr)
+            return 2
     from .report import write_report  # imported late: matplotlib/pingouin are slow to import
 
     try:
         report = write_report(a.responses, a.clips, a.participants, a.out, a.alpha, a.permutations,
-                              figures=not a.no_figures, exclude=not a.no_exclusions)
+                              figures=not a.no_figures, exclude=not a.no_exclusions,
+                              exclusion_rules=rules)
     except ValidationError as exc:
         print(f"error: invalid input\n{exc}", file=sys.stderr)
         return 2

@@ -15,6 +15,14 @@ and listed with their reasons in the report (key ``exclusions``):
     A. W. Meade, S. B. Craig. "Identifying careless responses in survey data." Psychological Methods 17(3),
     437-455, 2012.  P. G. Curran. "Methods for the detection of carelessly invalid responses in survey data."
     Journal of Experimental Social Psychology 66, 4-19, 2016.
+
+A study's own thresholds (``Study.exclusion_rules``, a JSON object) replace the defaults; :func:`rule_errors` checks
+such an object (the Study admin form calls it) and :func:`exclusions` applies it. Keys (:data:`RULES`):
+``min_rt_fraction`` (the too-fast factor above), ``max_fast_share``, ``max_straightline`` (a participant is excluded
+when at least this share of their answers in a rating-scale section have one value; 1.0 = all of them),
+``min_straight`` (answers a section needs before straight-lining is judged) and ``min_attention_pass``
+(**Failed attention checks**: excluded when ``attention_passed / attention_total`` of participants.csv is below it;
+when the export has no such columns, or a participant met no check, the rule does not apply and the report says so).
 """
 
 from __future__ import annotations
@@ -22,13 +30,59 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from study_protocol import INTEGER_RANGES, SECTION_QUESTIONS
+from study_protocol import ATTENTION_COLUMNS, INTEGER_RANGES, SECTION_QUESTIONS, attention_passed
 
 SCALE_SECTIONS = tuple(s for s, qs in SECTION_QUESTIONS.items() if all(k in INTEGER_RANGES for k in qs.values()))
 """Sections whose answers are points of a rating scale (study_protocol: every question of an integer kind)."""
 
 FAST_FRACTION, MAX_FAST_SHARE, MIN_STRAIGHT = 0.25, 0.5, 8
+MAX_STRAIGHTLINE, MIN_ATTENTION_PASS = 1.0, 1.0
 COLUMNS = ["participant_id", "rule", "detail", "n_answers"]
+
+
+RULES: dict[str, tuple[type, float, float, float, str]] = {
+    "min_rt_fraction": (float, 0.0, 10.0, FAST_FRACTION, "an answer faster than this x the clip duration is too fast"),
+    "max_fast_share": (float, 0.0, 1.0, MAX_FAST_SHARE, "excluded when more than this share of answers is too fast"),
+    "max_straightline": (float, 0.5, 1.0, MAX_STRAIGHTLINE, "excluded when at least this share of a rating-scale "
+                                                            "section's answers have one value"),
+    "min_straight": (int, 2, 10_000, MIN_STRAIGHT, "answers a section needs before straight-lining is judged"),
+    "min_attention_pass": (float, 0.0, 1.0, MIN_ATTENTION_PASS, "excluded when the share of attention checks "
+                                                                "passed is below this"),
+}
+"""Exclusion rule key -> (type, lowest, highest, default, meaning). ``Study.exclusion_rules`` uses these keys."""
+
+
+def rule_errors(rules) -> list[str]:
+    """Every problem of an exclusion-rules object (``Study.exclusion_rules``), each message naming its key; [] when
+    usable. Keys must be among :data:`RULES`, values numbers (integers for ``min_straight``) within their range;
+    an empty object means the defaults."""
+    if rules is None:
+        return []
+    if not isinstance(rules, dict):
+        return [f"exclusion rules must be a JSON object of rule: number, got {type(rules).__name__}"]
+    errors = []
+    for key, value in rules.items():
+        if key not in RULES:
+            errors.append(f"unknown exclusion rule {key!r} (rules: {', '.join(RULES)})")
+            continue
+        kind, lo, hi, _, meaning = RULES[key]
+        ok_type = (isinstance(value, int) if kind is int else isinstance(value, (int, float))) \
+            and not isinstance(value, bool)
+        if not ok_type:
+            errors.append(f"{key!r} takes {'an integer' if kind is int else 'a number'}, got {value!r} ({meaning})")
+        elif not (lo <= value <= hi) or value != value:
+            errors.append(f"{key!r} must be between {lo:g} and {hi:g}, got {value!r} ({meaning})")
+    return errors
+
+
+def resolve_rules(rules: dict | None = None) -> dict:
+    """The defaults of :data:`RULES` updated with ``rules``; ValueError listing :func:`rule_errors` when invalid."""
+    errors = rule_errors(rules)
+    if errors:
+        raise ValueError("exclusion rules: " + "; ".join(errors))
+    out = {key: spec[3] for key, spec in RULES.items()}
+    out.update({k: RULES[k][0](v) for k, v in (rules or {}).items()})
+    return out
 
 
 def fast_answers(responses: pd.DataFrame, clips: pd.DataFrame, fast_fraction: float = FAST_FRACTION,
@@ -48,30 +102,96 @@ def fast_answers(responses: pd.DataFrame, clips: pd.DataFrame, fast_fraction: fl
                          "n_answers": bad["size"].to_numpy(int)}, columns=COLUMNS)
 
 
-def straight_lining(responses: pd.DataFrame, min_straight: int = MIN_STRAIGHT) -> pd.DataFrame:
-    """Participants who gave one and the same value to all of at least ``min_straight`` answers of a rating-scale
-    section (:data:`SCALE_SECTIONS`). Returns rows participant_id, rule ``straight_lining``, detail, n_answers."""
+def straight_lining(responses: pd.DataFrame, min_straight: int = MIN_STRAIGHT,
+                    max_straightline: float = MAX_STRAIGHTLINE) -> pd.DataFrame:
+    """Participants who gave one and the same value to at least ``max_straightline`` (default 1.0: all) of at least
+    ``min_straight`` answers of a rating-scale section (:data:`SCALE_SECTIONS`). Returns rows participant_id, rule
+    ``straight_lining``, detail, n_answers."""
     r = responses[responses["section_type"].isin(SCALE_SECTIONS)]
     d = pd.DataFrame({"p": r["participant_id"].astype(str).to_numpy(), "s": r["section_type"].astype(str).to_numpy(),
-                      "v": r["value"].to_numpy(float)})
-    g = d.groupby(["p", "s"], sort=True)["v"].agg(["min", "max", "size"])
-    bad = g[(g["size"] >= min_straight) & (g["min"] == g["max"])].reset_index()
+                      "v": r["value"].to_numpy(float)}).dropna(subset=["v"])
+    per_value = d.groupby(["p", "s", "v"], sort=True).size().rename("k").reset_index()
+    modal = per_value.sort_values(["p", "s", "k", "v"], ascending=[True, True, False, True], kind="stable")
+    modal = modal.drop_duplicates(["p", "s"]).set_index(["p", "s"])
+    n = d.groupby(["p", "s"], sort=True).size()
+    g = modal.assign(size=n.reindex(modal.index).to_numpy())
+    bad = g[(g["size"] >= min_straight) & (g["k"] >= max_straightline * g["size"] - 1e-9)].reset_index()
     return pd.DataFrame({"participant_id": bad["p"].to_numpy(dtype=object), "rule": "straight_lining",
-                         "detail": [f"all {int(n)} answers of {s} are {v:g}"
-                                    for s, n, v in zip(bad["s"], bad["size"], bad["min"])],
+                         "detail": [f"all {int(n)} answers of {s} are {v:g}" if k == n else
+                                    f"{int(k)} of {int(n)} answers of {s} are {v:g} (limit {max_straightline:.0%})"
+                                    for s, n, v, k in zip(bad["s"], bad["size"], bad["v"], bad["k"])],
                          "n_answers": bad["size"].to_numpy(int)}, columns=COLUMNS)
 
 
+def attention_counts(checks) -> pd.DataFrame:
+    """Attention-check answers (responses.csv rows of section_type ATTENTION_CHECK: participant_id, question,
+    answer; a DataFrame or a dict of lists as analysis.io keeps them) -> participants.csv-like rows participant_id +
+    :data:`ATTENTION_COLUMNS` (passed, total)."""
+    passed_col, total_col = ATTENTION_COLUMNS
+    checks = pd.DataFrame(checks)
+    ok = [attention_passed(q, a) for q, a in zip(checks["question"].astype(str), checks["answer"].astype(str))]
+    g = pd.DataFrame({"participant_id": checks["participant_id"].astype(str).to_numpy(), "ok": ok}).groupby(
+        "participant_id", sort=True)["ok"].agg(["sum", "size"])
+    return pd.DataFrame({"participant_id": g.index.to_numpy(dtype=object), passed_col: g["sum"].to_numpy(int),
+                         total_col: g["size"].to_numpy(int)})
+
+
+def attention_failures(participants: pd.DataFrame | None, min_attention_pass: float = MIN_ATTENTION_PASS,
+                       checks=None) -> tuple[pd.DataFrame, str]:
+    """Participants who passed less than ``min_attention_pass`` of their attention checks (participants.csv columns
+    :data:`ATTENTION_COLUMNS`: passed, total; without them, counted from the attention-check answers ``checks``).
+    Returns (rows participant_id, rule ``failed_attention``, detail, n_answers = checks met; a sentence saying
+    whether and to whom the rule applied). Without either the rule does not apply; participants with a blank or
+    zero total are not judged."""
+    passed_col, total_col = ATTENTION_COLUMNS
+    if participants is None or passed_col not in participants.columns or total_col not in participants.columns:
+        if checks is not None and len(pd.DataFrame(checks)):
+            participants = attention_counts(checks)
+        else:
+            return pd.DataFrame(columns=COLUMNS), (f"failed_attention: not applicable (participants.csv has no "
+                                                   f"{passed_col}/{total_col} columns)")
+    ids = participants["participant_id"].astype(str).to_numpy() if "participant_id" in participants.columns \
+        else participants.index.astype(str).to_numpy()
+    passed = pd.to_numeric(participants[passed_col], errors="coerce").to_numpy(float)
+    total = pd.to_numeric(participants[total_col], errors="coerce").to_numpy(float)
+    judged = np.isfinite(passed) & np.isfinite(total) & (total > 0)
+    share = np.where(judged, passed / np.where(judged, total, 1.0), np.nan)
+    bad = judged & (share < min_attention_pass - 1e-9)
+    table = pd.DataFrame({"participant_id": ids[bad].astype(object), "rule": "failed_attention",
+                          "detail": [f"passed {int(a)} of {int(t)} attention checks (need {min_attention_pass:.0%})"
+                                     for a, t in zip(passed[bad], total[bad])],
+                          "n_answers": total[bad].astype(int)}, columns=COLUMNS)
+    if not judged.any():
+        return table, "failed_attention: not applicable (no participant met an attention check)"
+    return table, (f"failed_attention: applied to the {int(judged.sum())} of {len(ids)} participants who met an "
+                   f"attention check")
+
+
 def exclusions(responses: pd.DataFrame, clips: pd.DataFrame, fast_fraction: float = FAST_FRACTION,
-               max_fast_share: float = MAX_FAST_SHARE, min_straight: int = MIN_STRAIGHT) -> pd.DataFrame:
+               max_fast_share: float = MAX_FAST_SHARE, min_straight: int = MIN_STRAIGHT, *,
+               participants: pd.DataFrame | None = None, rules: dict | None = None) -> pd.DataFrame:
     """Who is excluded and why: one row per participant and rule that applies (a participant may have several).
-    Columns participant_id, rule (too_fast | straight_lining), detail, n_answers."""
+    Columns participant_id, rule (too_fast | straight_lining | failed_attention), detail, n_answers.
+
+    ``rules`` (a ``Study.exclusion_rules`` object, checked by :func:`rule_errors`; ValueError when invalid) replaces
+    the keyword thresholds; ``participants`` (participants.csv) enables the attention-check rule. The sentence on
+    that rule's applicability is in ``table.attrs["attention"]``."""
+    if rules is not None:
+        r = resolve_rules(rules)
+        fast_fraction, max_fast_share, min_straight = r["min_rt_fraction"], r["max_fast_share"], r["min_straight"]
+        max_straightline, min_attention = r["max_straightline"], r["min_attention_pass"]
+    else:
+        max_straightline, min_attention = MAX_STRAIGHTLINE, MIN_ATTENTION_PASS
+    attention, attention_note = attention_failures(participants, min_attention, responses.attrs.get("attention_checks"))
     parts = [t for t in (fast_answers(responses, clips, fast_fraction, max_fast_share),
-                         straight_lining(responses, min_straight)) if len(t)]
+                         straight_lining(responses, min_straight, max_straightline), attention) if len(t)]
     if not parts:
-        return pd.DataFrame(columns=COLUMNS)
-    return pd.concat(parts, ignore_index=True).sort_values(["participant_id", "rule"], kind="stable").reset_index(
-        drop=True)
+        out = pd.DataFrame(columns=COLUMNS)
+    else:
+        out = pd.concat(parts, ignore_index=True).sort_values(["participant_id", "rule"], kind="stable").reset_index(
+            drop=True)
+    out.attrs["attention"] = attention_note
+    return out
 
 
 def apply_exclusions(responses: pd.DataFrame, table: pd.DataFrame) -> pd.DataFrame:

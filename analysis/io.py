@@ -18,6 +18,8 @@ import numpy as np
 import pandas as pd
 
 from study_protocol import (
+    ATTENTION_CHECK,
+    ATTENTION_COLUMNS,
     CLIP_COLUMNS,
     CLIP_THEMES,
     FINAL_EMOTION_COLUMNS,
@@ -30,6 +32,8 @@ from study_protocol import (
     MULTI_SELECT_KINDS,
     ORIGINS,
     PARTICIPANT_COLUMNS,
+    QA_COLUMNS,
+    QA_FLOAT_COLUMNS,
     RESPONSE_COLUMNS,
     SECTION_QUESTIONS,
     VAD_DIMENSIONS,
@@ -191,19 +195,41 @@ def read_clips(src) -> pd.DataFrame:
     bad_label = (df["modality"] == "gesture").to_numpy() & ~_blank(label) & ~label.isin(GESTURE_EMOTIONS).to_numpy()
     col.add_mask(df, bad_label, "emotion_label",
                  lambda v: f"{v!r} is not an NRC-VAD category ({', '.join(GESTURE_EMOTIONS)})")
+    _read_qa_columns(df, out, col)
     if col.total:
         raise ValidationError(col.problems, col.total)
     out = out.set_index("clip_id", drop=False)
-    out.attrs["ignored_columns"] = [c for c in df.columns if c not in CLIP_COLUMNS and c != "_line"]
+    out.attrs["ignored_columns"] = [c for c in df.columns if c not in CLIP_COLUMNS and c not in QA_COLUMNS
+                                    and c != "_line"]
     return out
+
+
+def _read_qa_columns(df: pd.DataFrame, out: pd.DataFrame, col: _Collector) -> None:
+    """The optional quality columns (QA_COLUMNS, issue 14) into ``out``: numbers as float (NaN where blank), text
+    stripped; a file without them (an older clips.csv) simply has none."""
+    for c in QA_COLUMNS:
+        if c not in df.columns:
+            continue
+        if c in QA_FLOAT_COLUMNS:
+            v = _numeric(df[c])
+            col.add_mask(df, ~_blank(df[c]) & v.isna().to_numpy(), c, lambda x: f"{x!r} is not a number")
+            out[c] = v.to_numpy()
+        else:
+            out[c] = df[c].str.strip().to_numpy()
 
 
 def _parse_datetime(s: pd.Series) -> pd.Series:
     return pd.to_datetime(s.str.strip().replace("", None), format="ISO8601", utc=True, errors="coerce")
 
 
+REQUIRED_PARTICIPANT_COLUMNS = PARTICIPANT_COLUMNS[:PARTICIPANT_COLUMNS.index(ATTENTION_COLUMNS[0])]
+"""participants.csv columns every export has; the later ones of PARTICIPANT_COLUMNS (attention checks, section
+order) are read when present (older exports lack them)."""
+
+
 def read_participants(src) -> pd.DataFrame:
-    """Read and validate participants.csv. Extra columns (e.g. feedback) are kept.
+    """Read and validate participants.csv. Extra columns (e.g. feedback) are kept; the columns after
+    :data:`REQUIRED_PARTICIPANT_COLUMNS` may be missing.
 
     Returns a DataFrame indexed by ``participant_id``; ``started_at``/``completed_at`` become UTC timestamps
     (NaT when blank), blank ``gender``/``age_group`` become ``"undisclosed"``, ``duration_s`` is added (float
@@ -212,7 +238,7 @@ def read_participants(src) -> pd.DataFrame:
     """
     df, name = _read_raw(src, "participants.csv")
     col = _Collector(name)
-    _check_columns(df, PARTICIPANT_COLUMNS, col)
+    _check_columns(df, REQUIRED_PARTICIPANT_COLUMNS, col)
     df["participant_id"] = df["participant_id"].str.strip()
     col.add_mask(df, _blank(df["participant_id"]), "participant_id", "participant_id is empty")
     dup = df["participant_id"].duplicated().to_numpy() & ~_blank(df["participant_id"])
@@ -435,10 +461,21 @@ def read_responses(src, clips: pd.DataFrame, participants: pd.DataFrame | None =
 
     Returns columns participant_id, section_type, clip_id, question, answer (categoricals of cleaned strings;
     labels lower-cased, multi-select labels without spaces), value (float for integer scales, NaN otherwise),
-    response_ms (float, NaN if blank) and _line (file line number).
+    response_ms (float, NaN if blank) and _line (file line number). Attention-check answers (section_type
+    ``study_protocol.ATTENTION_CHECK``) are not answers about clips: they are left out of the table and kept in
+    ``attrs["attention_checks"]`` ({participant_id, question, answer: lists of text}) for the exclusion rules.
     """
     name = _name(src, "responses.csv")
     raw = _read_categorical(src, name)
+    attention = pd.DataFrame(columns=["participant_id", "question", "answer"])
+    if "section_type" in raw.columns:
+        is_check = (raw["section_type"].astype(str).str.strip() == ATTENTION_CHECK).to_numpy()
+        if is_check.any():
+            attention = raw.loc[is_check, [c for c in attention.columns if c in raw.columns]].astype(str)
+            raw = raw[~is_check].reset_index(drop=True)
+            for c in raw.columns:
+                if isinstance(raw[c].dtype, pd.CategoricalDtype):
+                    raw[c] = raw[c].cat.remove_unused_categories()
     rows = _RowProblems(name, raw["_line"])
     _check_columns(raw, RESPONSE_COLUMNS, rows.col)
     coded = {c: _CodedColumn(raw[c], lower=c in _LOWERED) for c in RESPONSE_COLUMNS}
@@ -460,6 +497,8 @@ def read_responses(src, clips: pd.DataFrame, participants: pd.DataFrame | None =
         "_line": raw["_line"].to_numpy(),
     })
     out.attrs["ignored_columns"] = [c for c in raw.columns if c not in RESPONSE_COLUMNS and c != "_line"]
+    out.attrs["attention_checks"] = {c: attention[c].tolist() for c in attention.columns}  # plain lists: attrs
+    # are compared by pandas when frames are combined, which a DataFrame value would break
     return out
 
 

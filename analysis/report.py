@@ -51,10 +51,7 @@ RECOGNITION_METHOD = ("Confusion matrix, rows intended, columns perceived; an an
                       "t-test across participants (scipy.stats.ttest_rel), Holm-corrected across emotions.")
 
 METHODS = {
-    "exclusions": f"Excluded before every analysis: participants with more than {exclusion.MAX_FAST_SHARE:.0%} of "
-                  f"timed answers faster than {exclusion.FAST_FRACTION:g} x the clip duration (too_fast), or with all "
-                  f"of at least {exclusion.MIN_STRAIGHT} answers of a rating-scale section equal (straight_lining). "
-                  "The participants summary describes everyone.",
+    "exclusions": "",  # depends on the rules in force: exclusion_method()
     "gait_emotion_ad": "Seed 000's test, kept for fidelity. Each answer -> indicator vector / number of labels; "
                        "mean over answers, l1-normalised; scipy.stats.anderson_ksamp (midrank) on the 4 intended vs "
                        "the 4 perceived components; p interpolated and capped to [0.001, 0.25]. " + AD_LABEL_BLIND,
@@ -83,6 +80,18 @@ METHODS = {
                     "theme; Likert: value ~ dominant intended emotion (reference neutral) per feature. Wald z "
                     f"tests; at most {mixed.MAX_PARTICIPANTS} participants per model (seeded random sample).",
 }
+
+def exclusion_method(rules: dict) -> str:
+    """The exclusion rules in force (resolved, :func:`analysis.exclusion.resolve_rules`) in one paragraph."""
+    straight = ("all" if rules["max_straightline"] >= 1 else f"at least {rules['max_straightline']:.0%}")
+    return (f"Excluded before every analysis: participants with more than {rules['max_fast_share']:.0%} of timed "
+            f"answers faster than {rules['min_rt_fraction']:g} x the clip duration (too_fast); with {straight} of at "
+            f"least {rules['min_straight']} answers of a rating-scale section equal (straight_lining); who passed "
+            f"less than {rules['min_attention_pass']:.0%} of their attention checks (failed_attention, when "
+            "participants.csv has attention columns). The participants summary describes everyone.")
+
+
+METHODS["exclusions"] = exclusion_method(exclusion.resolve_rules())
 
 TITLES = {
     "exclusions": "Excluded participants and why",
@@ -235,6 +244,8 @@ def _summary(tables: dict, parts: dict, alpha: float, recog: dict | None = None,
         out.append(f"Exclusions: {parts.get('n_excluded', 0)} of {parts.get('n_participants', 0)} participants "
                    "excluded before the analyses" + (" (" + ", ".join(f"{k}: {v}" for k, v in by_rule.items()) + ")"
                                                       if by_rule else "") + ".")
+        if ex.attrs.get("attention", "").startswith("failed_attention: not applicable"):
+            out.append("Attention checks: " + ex.attrs["attention"].split(": ", 1)[1] + ".")
     else:
         out.append("Exclusions: not applied (--no-exclusions).")
     if parts.get("synthetic"):
@@ -242,18 +253,31 @@ def _summary(tables: dict, parts: dict, alpha: float, recog: dict | None = None,
     return out
 
 
+def _exclusion_meta(exclude: bool, given: dict | None, rules: dict, excl: pd.DataFrame) -> dict:
+    """report.json ``meta.exclusion_rules``: applied or not, where the thresholds come from, each threshold, and
+    whether the attention-check rule could apply."""
+    out = {"applied": exclude, "source": "study settings" if given else "defaults", **rules,
+           "given": dict(given or {}), "method": exclusion_method(rules)}
+    if exclude:
+        out["attention"] = excl.attrs.get("attention", "")
+    return out
+
+
 def build_report(data: StudyData, alpha: float = 0.05, permutations: int = 0,
-                 exclude: bool = True) -> tuple[dict, dict, dict]:
+                 exclude: bool = True, exclusion_rules: dict | None = None) -> tuple[dict, dict, dict]:
     """Analyse and assemble the report dict. Returns (report, tables, extras).
 
     ``exclude`` (default True) applies the exclusion rules of :mod:`analysis.exclusion` before every analysis; the
-    table ``exclusions`` lists who was excluded and why, the participants summary still describes everyone."""
+    table ``exclusions`` lists who was excluded and why, the participants summary still describes everyone.
+    ``exclusion_rules`` (a study's ``Study.exclusion_rules``; None or {} = the defaults) sets their thresholds;
+    ValueError naming the key when it is not valid (:func:`analysis.exclusion.rule_errors`)."""
     if not 0 < alpha < 1:
         raise ValueError(f"alpha must be in (0, 1), not {alpha}")
     if permutations < 0:
         raise ValueError(f"permutations must be >= 0, not {permutations}")
-    excl = (exclusion.exclusions(data.responses, data.clips) if exclude
-            else pd.DataFrame(columns=exclusion.COLUMNS))
+    rules = exclusion.resolve_rules(exclusion_rules)
+    excl = (exclusion.exclusions(data.responses, data.clips, participants=data.participants, rules=rules)
+            if exclude else pd.DataFrame(columns=exclusion.COLUMNS))
     kept = StudyData(exclusion.apply_exclusions(data.responses, excl), data.clips, data.participants,
                      data.ignored_columns)
     tables, extras = analyse(kept, alpha, permutations)
@@ -291,8 +315,7 @@ def build_report(data: StudyData, alpha: float = 0.05, permutations: int = 0,
     report["meta"] = _clean({
         "generated_at": _dt.datetime.now(_dt.UTC).strftime("%Y-%m-%dT%H:%M:%SZ"),
         "alpha": alpha, "permutations": permutations, "synthetic": synthetic,
-        "exclusion_rules": {"applied": exclude, "fast_fraction": exclusion.FAST_FRACTION,
-                            "max_fast_share": exclusion.MAX_FAST_SHARE, "min_straight": exclusion.MIN_STRAIGHT},
+        "exclusion_rules": _exclusion_meta(exclude, exclusion_rules, rules, excl),
         "n_responses": len(data.responses), "n_clips": len(data.clips), "n_participants": len(data.participants),
         "summary": _summary(tables, extras["participants"], alpha, extras["recognition"], exclude), "notes": notes,
         "methods": "docs/analysis.md",
@@ -315,16 +338,18 @@ def _make_figures(tables: dict, extras: dict) -> dict:
 
 
 def write_report(responses_csv, clips_csv, participants_csv, out_dir, alpha: float = 0.05,
-                 permutations: int = 0, *, figures: bool = True, exclude: bool = True) -> dict:
+                 permutations: int = 0, *, figures: bool = True, exclude: bool = True,
+                 exclusion_rules: dict | None = None) -> dict:
     """Validate the three exports (paths or text file objects), analyse, and write the report folder.
 
     ``figures=False`` skips the PNG/SVG figures (the HTML then has tables only); the analyses are the same.
-    ``exclude=False`` analyses every participant (no exclusion rules, :mod:`analysis.exclusion`).
+    ``exclude=False`` analyses every participant (no exclusion rules, :mod:`analysis.exclusion`);
+    ``exclusion_rules`` are a study's thresholds (``Study.exclusion_rules``), stated in the report.
     Raises :class:`analysis.io.ValidationError` (listing file, line and column of each problem) on invalid input.
     Returns the report dict (also written as ``out_dir/report.json``).
     """
     data = load_study(responses_csv, clips_csv, participants_csv)
-    report, tables, extras = build_report(data, alpha, permutations, exclude)
+    report, tables, extras = build_report(data, alpha, permutations, exclude, exclusion_rules)
     os.makedirs(out_dir, exist_ok=True)
     for k in TABLE_KEYS:
         tables[k].to_csv(os.path.join(out_dir, f"{k}.csv"), index=False)
@@ -347,12 +372,13 @@ def write_report(responses_csv, clips_csv, participants_csv, out_dir, alpha: flo
 
 
 def report_zip_bytes(responses_csv, clips_csv, participants_csv, alpha: float = 0.05, permutations: int = 0,
-                     *, figures: bool = True, exclude: bool = True) -> tuple[dict, bytes]:
+                     *, figures: bool = True, exclude: bool = True,
+                     exclusion_rules: dict | None = None) -> tuple[dict, bytes]:
     """Run :func:`write_report` into a temporary folder and return (report dict, the folder as a zip archive's
     bytes) -- for a download view. Raises ValidationError like write_report."""
     with tempfile.TemporaryDirectory() as tmp:
         report = write_report(responses_csv, clips_csv, participants_csv, tmp, alpha, permutations, figures=figures,
-                              exclude=exclude)
+                              exclude=exclude, exclusion_rules=exclusion_rules)
         buf = io.BytesIO()
         with zipfile.ZipFile(buf, "w", zipfile.ZIP_DEFLATED) as zf:
             for name in sorted(os.listdir(tmp)):
@@ -455,7 +481,12 @@ def render_html(report: dict, tables: dict, figs: dict, extras: dict | None = No
         parts.append(_recognition_html(extras, figs))
     parts.append("<h2>Participants</h2>" + _participants_html(report["participants"]))
     for k in TABLE_KEYS:
-        parts.append(f"<h2 id='{k}'>{h(TITLES[k])}</h2><p class='method'>{h(METHODS[k])}</p>")
+        method = meta.get("exclusion_rules", {}).get("method") if k == "exclusions" else None
+        parts.append(f"<h2 id='{k}'>{h(TITLES[k])}</h2><p class='method'>{h(method or METHODS[k])}</p>")
+        if k == "exclusions" and meta.get("exclusion_rules", {}).get("applied"):
+            ex_meta = meta["exclusion_rules"]
+            parts.append(f"<p class='method'>Thresholds from the {h(ex_meta['source'])}. "
+                         f"{h(ex_meta.get('attention', ''))}.</p>")
         df = tables[k]
         if df.empty:
             parts.append("<p>No participant excluded.</p>" if k == "exclusions" else "<p>No data.</p>")

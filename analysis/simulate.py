@@ -1,18 +1,16 @@
 """SYNTHETIC participants: response sets drawn from known perception models, for demos and tests.
 
 Nothing here is data from people. Participant ids start with ``sim-``, clip ids with ``sim-``, every participant's
-``external_id`` is ``synthetic`` and the report flags ``synthetic: true``. The simulated study follows the three
-papers' procedures:
+``external_id`` is ``synthetic`` and the report flags ``synthetic: true``.
 
-1. emotion_choice: the 8 single-emotion gait clips, multi-select perceived emotion (seed 000 6.1, section 1);
-2. emotion_transition: 6 of the 12 transition clips, initial and final emotions (section 2);
-3. affect_likert: the same 8 gaits, torso/arms/pace/flow on 0..4 (section 3);
-4. naturalness: 3 generated + 3 source gaits and 3 generated + 3 source gestures, 1..5;
-5. gesture_emotion: 6 generated gesture clips, forced choice among the intended and 3 random other categories
-   (seed 003 6.1);
-6. neutral_validation: the neutral input walk, 7-way forced choice (seed 004 Table I);
-7. theme_rating: all 6 themes x 4 weights x 4 feature counts, 1..7 (seed 004 V-D);
-8. theme_inversion: the 6 themes at w = -0.7 with 10 features, -7..7 (seed 004 V-E).
+The design comes from study presets and their plans (:mod:`analysis.design`): ``simulate_study(n, presets=("demo",))``
+simulates the demo study on the demo plan's clips; the default is the three papers' studies one after the other
+(:data:`analysis.design.PAPER_PRESETS`: seed 000's gait study on plan seed000, seed 003's gesture study on seed003,
+seed 004's RBF study on seed004). Every section is drawn as the study app assigns it (studyapp.assignment): the
+preset's clips per participant from its pool (0 = all), no clip twice for one participant except in a section that
+reuses another's clips, naturalness mixing the given numbers of generated and source clips and never a generated clip
+whose source is shown, gesture_emotion offering the intended and ``n_options - 1`` other categories. Assignment is
+uniformly random rather than balanced.
 
 Perception models (:class:`PerceptionModel`) -- each answer is drawn independently given the clip:
 - gait emotions: label probabilities (1 - emotion_noise) * intended + emotion_noise / 4; one label drawn, and with
@@ -37,8 +35,11 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 import pandas as pd
 
+from generation.plans.schema import PlanError
+from study_presets import PRESETS
 from study_protocol import (
-    CLIP_COLUMNS,
+    ASSIGNMENT_COLUMNS,
+    FINAL_EMOTION_COLUMNS,
     GAIT_EMOTIONS,
     GESTURE_VAD,
     LIKERT_FEATURES,
@@ -48,31 +49,10 @@ from study_protocol import (
     THEMES,
 )
 
+from .design import PAPER_PRESETS, DesignError, SectionDesign, StudyDesign, design_from_presets
+
 E = len(GAIT_EMOTIONS)
 NEUTRAL = GAIT_EMOTIONS.index("neutral")
-SINGLE_VECTORS = np.array([  # columns in GAIT_EMOTIONS order (happy, sad, angry, neutral)
-    [1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1],
-    [0.7, 0, 0, 0.3], [0, 0.6, 0, 0.4], [0.2, 0, 0.8, 0], [0, 0.3, 0.7, 0],
-], dtype=float)
-TRANSITIONS = [(0, 1), (1, 0), (0, 2), (2, 0), (1, 2), (2, 1), (3, 0), (0, 3), (3, 1), (1, 3), (3, 2), (2, 3)]
-"""(initial, final) indices into GAIT_EMOTIONS."""
-N_SHOWN_TRANSITIONS = 6
-N_NATURALNESS_PER_GROUP = 3
-N_SHOWN_GESTURES = 6
-N_GESTURE_CHOICES = 4
-WEIGHTS = (0.4, 0.7, 1.0, 1.3)
-N_FEATURES = (1, 4, 7, 10)
-
-
-def _transition_vectors() -> tuple[np.ndarray, np.ndarray]:
-    """(12, 4) initial and (12, 4) final intended vectors: 0.85 of the named emotion + 0.15 neutral (pure neutral
-    for neutral)."""
-    eye = np.eye(E)
-
-    def mix(i):
-        return eye[NEUTRAL] if i == NEUTRAL else 0.85 * eye[i] + 0.15 * eye[NEUTRAL]
-
-    return np.array([mix(a) for a, _ in TRANSITIONS]), np.array([mix(b) for _, b in TRANSITIONS])
 
 
 GENDER_SHARES = (("male", 0.55), ("female", 0.42), ("non-binary", 0.02), ("", 0.01))
@@ -105,51 +85,6 @@ class PerceptionModel:
     inversion_sd: float = 2.0
 
 
-def _blank_clip(**kw) -> dict:
-    row = {c: "" for c in CLIP_COLUMNS}
-    row.update({k: v for k, v in kw.items()})
-    return row
-
-
-def make_clips() -> pd.DataFrame:
-    """The synthetic catalogue (clips.csv rows, all columns as strings or numbers; blanks as "")."""
-    rows = []
-
-    def vec(prefix, v):
-        return {f"{prefix}{e}": round(float(x), 4) for e, x in zip(GAIT_EMOTIONS, v)}
-
-    for i, v in enumerate(SINGLE_VECTORS, 1):
-        rows.append(_blank_clip(clip_id=f"sim-gait-{i:02d}", modality="gait", origin="generated", duration_s=10.0,
-                                **vec("", v)))
-        rows.append(_blank_clip(clip_id=f"sim-gait-src-{i:02d}", modality="gait", origin="source", duration_s=10.0,
-                                **vec("", v)))
-    starts, finals = _transition_vectors()
-    for i, (start, final) in enumerate(zip(starts, finals), 1):
-        rows.append(_blank_clip(clip_id=f"sim-trans-{i:02d}", modality="gait", origin="generated", duration_s=10.0,
-                                **vec("", start), **vec("final_", final)))
-    for label, (v, a, d) in _gesture_vad().items():
-        for origin in ("generated", "source"):
-            for rep in (1, 2):
-                rows.append(_blank_clip(clip_id=f"sim-gest-{origin[:3]}-{label}-{rep}", modality="gesture",
-                                        origin=origin, emotion_label=label, valence=v, arousal=a, dominance=d,
-                                        duration_s=8.0))
-    rows.append(_blank_clip(clip_id="sim-neutral-walk", modality="gait", origin="source", duration_s=10.0,
-                            **vec("", np.eye(E)[NEUTRAL])))
-    for theme in THEMES:
-        for w in WEIGHTS:
-            for n in N_FEATURES:
-                rows.append(_blank_clip(clip_id=f"sim-theme-{theme}-w{w:.1f}-n{n:02d}", modality="gait",
-                                        origin="generated", theme=theme, weight=w, n_features=n, duration_s=10.0))
-        rows.append(_blank_clip(clip_id=f"sim-invert-{theme}", modality="gait", origin="generated", theme=theme,
-                                weight=-0.7, n_features=10, duration_s=10.0))
-    return pd.DataFrame(rows, columns=list(CLIP_COLUMNS))
-
-
-def _gesture_vad() -> dict[str, tuple[float, float, float]]:
-    """The gesture categories the simulated gestures show and offer (every MPI category but neutral) -> NRC-VAD."""
-    return {label: vad for label, vad in GESTURE_VAD.items() if label != "neutral"}
-
-
 def _categorical(rng, probs: np.ndarray) -> np.ndarray:
     """One draw per row of ``probs`` (N, K) (rows sum to 1) -> (N,) indices."""
     c = np.cumsum(probs, axis=1)
@@ -172,137 +107,199 @@ def _gait_answers(rng, intended: np.ndarray, m: PerceptionModel) -> np.ndarray:
     return np.where(two, table[lo, hi], names[first])
 
 
-def _frame(pids, section, clip_ids, question, answers) -> pd.DataFrame:
-    return pd.DataFrame({"participant_id": pids, "section_type": section, "clip_id": clip_ids,
-                         "question": question, "answer": answers})
+@dataclass
+class _Shown:
+    """The clips one section shows: parallel arrays over shown items (participant index, clip row, 0-based position)
+    and, for gesture_emotion, the offered categories as (N, n_options) indices into ``labels``."""
+
+    p: np.ndarray
+    clip: np.ndarray
+    pos: np.ndarray
+    options: np.ndarray | None = None
+    labels: tuple[str, ...] = ()
 
 
-def _shuffled(rng, n_participants: int, n_items: int, n_shown: int | None = None) -> np.ndarray:
-    """(P, n_shown) indices: each participant's random order of ``n_items`` items, cut to the first n_shown."""
-    return np.argsort(rng.random((n_participants, n_items)), axis=1)[:, :n_shown]
+def _positions(rng, p: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """A random order of the items of each participant: (permutation of the items grouped by participant, the
+    0-based position of each item of that permutation)."""
+    order = np.lexsort((rng.random(len(p)), p))
+    ps = p[order]
+    starts = np.r_[0, np.flatnonzero(np.diff(ps)) + 1]
+    pos = np.arange(len(ps)) - np.repeat(starts, np.diff(np.r_[starts, len(ps)]))
+    return order, pos
 
 
-def _single_ids() -> np.ndarray:
-    return np.array([f"sim-gait-{i:02d}" for i in range(1, len(SINGLE_VECTORS) + 1)], dtype=object)
+def _pick(rng, n_participants: int, candidates: np.ndarray, eligible: np.ndarray, k: int) -> _Shown:
+    """Per participant, ``k`` (0 = all) random clips among ``candidates`` (clip rows) where ``eligible`` (P, n) holds;
+    fewer when fewer are eligible (as the study app)."""
+    n = len(candidates)
+    if n == 0:
+        empty = np.zeros(0, int)
+        return _Shown(empty, empty, empty)
+    k = n if k <= 0 else min(k, n)
+    pri = rng.random((n_participants, n))
+    pri[~eligible] = np.inf
+    order = np.argsort(pri, axis=1)[:, :k]
+    ok = np.isfinite(np.take_along_axis(pri, order, axis=1))
+    p = np.broadcast_to(np.arange(n_participants)[:, None], order.shape)[ok]
+    return _Shown(p, candidates[order][ok], (np.cumsum(ok, axis=1) - 1)[ok])
 
 
-def _emotion_choice(rng, pid_list, m: PerceptionModel) -> tuple[pd.DataFrame, np.ndarray]:
-    """Section 1: the single-emotion gaits in a random order per participant, multi-select perceived emotion.
-    Returns (answers, the (P, 8) order, which affect_likert reuses)."""
-    order = _shuffled(rng, len(pid_list), len(SINGLE_VECTORS))
-    answers = _gait_answers(rng, SINGLE_VECTORS[order.ravel()], m)
-    return _frame(np.repeat(pid_list, order.shape[1]), "emotion_choice", _single_ids()[order.ravel()], "perceived",
-                  answers), order
+def _naturalness_pick(rng, sec: SectionDesign, design: StudyDesign, used: np.ndarray) -> _Shown:
+    """A mixed naturalness section: n_source source clips, then n_generated generated clips whose source is not
+    shown to that participant, in one random order."""
+    P = used.shape[0]
+    n_gen, n_src = sec.naturalness_counts()
+    origin = design.clips["origin"].to_numpy()[sec.pool]
+    src_c = sec.pool[origin == "source"]
+    gen_c = sec.pool[origin == "generated"]
+    if "source" in sec.sub_pools:
+        src_c = np.intersect1d(src_c, sec.sub_pools["source"])
+    if "generated" in sec.sub_pools:
+        gen_c = np.intersect1d(gen_c, sec.sub_pools["generated"])
+    src = _pick(rng, P, src_c, ~used[:, src_c], n_src) if n_src else _pick(rng, P, src_c[:0], used[:, :0], 0)
+    shown_src = np.zeros_like(used)
+    shown_src[src.p, src.clip] = True
+    src_of = design.source_index()[gen_c]
+    blocked = np.where(src_of >= 0, shown_src[:, np.maximum(src_of, 0)], False)
+    gen = _pick(rng, P, gen_c, ~used[:, gen_c] & ~blocked, n_gen) if n_gen else _pick(rng, P, gen_c[:0],
+                                                                                      used[:, :0], 0)
+    p, clip = np.r_[src.p, gen.p], np.r_[src.clip, gen.clip]
+    order, pos = _positions(rng, p)
+    return _Shown(p[order], clip[order], pos)
 
 
-def _emotion_transition(rng, pid_list, m: PerceptionModel) -> pd.DataFrame:
-    """Section 2: 6 of the 12 transitions, initial and final emotions."""
-    t_order = _shuffled(rng, len(pid_list), len(TRANSITIONS), N_SHOWN_TRANSITIONS).ravel()
-    t_ids = np.array([f"sim-trans-{i:02d}" for i in range(1, len(TRANSITIONS) + 1)], dtype=object)
-    starts, finals = _transition_vectors()
-    tp = np.repeat(pid_list, N_SHOWN_TRANSITIONS)
-    ini = _frame(tp, "emotion_transition", t_ids[t_order], "initial", _gait_answers(rng, starts[t_order], m))
-    fin = _frame(tp, "emotion_transition", t_ids[t_order], "final", _gait_answers(rng, finals[t_order], m))
-    return pd.concat([ini, fin]).sort_index(kind="stable")
+def _gesture_options(rng, sec: SectionDesign, design: StudyDesign, shown: _Shown) -> _Shown:
+    """Offered categories of each gesture_emotion item: the intended and ``n_options - 1`` others of the section's
+    categories, in random order (studyapp.assignment)."""
+    intended = design.clips["emotion_label"].fillna("").astype(str).to_numpy()[shown.clip]
+    intended = np.where(intended == "", "neutral", intended)
+    cats = sec.categories()
+    labels = tuple(dict.fromkeys([*cats, *sorted(set(intended))]))
+    index = {c: i for i, c in enumerate(labels)}
+    want = np.array([index[c] for c in intended], dtype=int)
+    noise = rng.random((len(want), len(labels)))
+    noise[:, [i for i, c in enumerate(labels) if c not in cats]] = np.inf
+    noise[np.arange(len(want)), want] = np.inf
+    others = np.argsort(noise, axis=1)[:, :min(sec.n_options() - 1, len(cats) - 1)]
+    offered = np.column_stack([want, others])
+    offered = np.take_along_axis(offered, np.argsort(rng.random(offered.shape), axis=1), axis=1)
+    return _Shown(shown.p, shown.clip, shown.pos, offered, labels)
 
 
-def _affect_likert(rng, pid_list, order: np.ndarray, m: PerceptionModel) -> pd.DataFrame:
-    """Section 3: the single-emotion gaits in the order of section 1, each feature of LIKERT_FEATURES on 0..4."""
-    P, n = order.shape
-    intended = SINGLE_VECTORS[order.ravel()]
-    means = np.array([m.likert_means[e] for e in GAIT_EMOTIONS])  # (4 emotions, 4 features)
-    mu = intended @ means + rng.normal(0, 0.3, (P, 1, 1)).repeat(n, axis=1).reshape(P * n, 1)
-    lik = np.clip(np.rint(mu + rng.normal(0, m.likert_sd, mu.shape)), 0, 4).astype(int)
-    F = len(LIKERT_FEATURES)
-    return pd.DataFrame({
-        "participant_id": np.repeat(np.repeat(pid_list, n), F), "section_type": "affect_likert",
-        "clip_id": np.repeat(_single_ids()[order.ravel()], F),
-        "question": np.tile(np.array(LIKERT_FEATURES, dtype=object), P * n), "answer": lik.ravel()})
+def _assign(rng, sec: SectionDesign, design: StudyDesign, used: np.ndarray, earlier: list[_Shown]) -> _Shown:
+    """The clips (and options) of one section for every participant; marks them used."""
+    if sec.reuse is not None:
+        prev = earlier[sec.reuse]
+        order, pos = _positions(rng, prev.p)
+        return _Shown(prev.p[order], prev.clip[order], pos)
+    if sec.mixed_naturalness:
+        shown = _naturalness_pick(rng, sec, design, used)
+    else:
+        shown = _pick(rng, used.shape[0], sec.pool, ~used[:, sec.pool], sec.n_per_participant)
+        if sec.section_type == "gesture_emotion":
+            shown = _gesture_options(rng, sec, design, shown)
+    used[shown.p, shown.clip] = True
+    return shown
 
 
-def _naturalness(rng, pid_list, clips: pd.DataFrame, m: PerceptionModel) -> pd.DataFrame:
-    """Section 4: 3 generated + 3 source clips per modality, rated 1..5."""
-    P, k = len(pid_list), N_NATURALNESS_PER_GROUP
-    gestures = clips[clips.modality == "gesture"]
-    nat = []
-    for modality, gen_ids, src_ids in (
-            ("gait", _single_ids(),
-             np.array([f"sim-gait-src-{i:02d}" for i in range(1, len(SINGLE_VECTORS) + 1)], dtype=object)),
-            ("gesture", gestures.loc[gestures.origin == "generated", "clip_id"].to_numpy(),
-             gestures.loc[gestures.origin == "source", "clip_id"].to_numpy())):
-        for origin, ids in (("generated", gen_ids), ("source", src_ids)):
-            pick = _shuffled(rng, P, len(ids), k).ravel()
-            probs = np.tile(np.asarray(m.naturalness_probs[(modality, origin)], float), (P * k, 1))
-            nat.append(_frame(np.repeat(pid_list, k), "naturalness", ids[pick], "naturalness",
-                              _categorical(rng, probs) + 1))
-    return pd.concat(nat).sort_values("participant_id", kind="stable")
+# ---- answers -------------------------------------------------------------------------------------------------------
+def _vectors(clips: pd.DataFrame, columns) -> np.ndarray:
+    """(n_clips, 4) intended vectors from ``columns``; a clip without one counts as pure neutral."""
+    v = clips[list(columns)].to_numpy(float)
+    blank = ~np.isfinite(v).all(axis=1) | (np.nan_to_num(v).sum(axis=1) <= 0)
+    v = np.nan_to_num(v)
+    v[blank] = np.eye(E)[NEUTRAL]
+    return v / v.sum(axis=1, keepdims=True)
 
 
-def _gesture_emotion(rng, pid_list, clips: pd.DataFrame, m: PerceptionModel) -> pd.DataFrame:
-    """Section 5: 6 generated gestures; forced choice among the intended and 3 random other categories."""
-    g = clips[(clips.modality == "gesture") & (clips.origin == "generated")]
-    g_ids, g_lab = g["clip_id"].to_numpy(), g["emotion_label"].to_numpy()
-    lexicon = _gesture_vad()
-    cats = np.array(list(lexicon), dtype=object)
-    vad = np.array(list(lexicon.values()))
-    cat_index = {c: i for i, c in enumerate(cats)}
-    pick = _shuffled(rng, len(pid_list), len(g_ids), N_SHOWN_GESTURES).ravel()
-    want = np.array([cat_index[c] for c in g_lab])[pick]
-    noise = rng.random((len(pick), len(cats)))
-    noise[np.arange(len(pick)), want] = np.inf
-    others = np.argsort(noise, axis=1)[:, :N_GESTURE_CHOICES - 1]
-    offered = np.column_stack([want, others])  # (N, 4) category indices
-    dist = np.linalg.norm(vad[offered] - vad[want][:, None, :], axis=2)
-    w = np.exp(-dist / m.gesture_temperature)
-    choice = offered[np.arange(len(pick)), _categorical(rng, w / w.sum(axis=1, keepdims=True))]
-    return _frame(np.repeat(pid_list, N_SHOWN_GESTURES), "gesture_emotion", g_ids[pick], "perceived", cats[choice])
+def _section_answers(rng, sec: SectionDesign, shown: _Shown, clips: pd.DataFrame, m: PerceptionModel,
+                     effects: dict) -> list[np.ndarray]:
+    """One answer array per question of the section (``sec.questions`` order), aligned with ``shown``."""
+    t, n = sec.section_type, len(shown.clip)
+    if t in ("emotion_choice", "emotion_transition"):
+        cols = (GAIT_EMOTIONS, FINAL_EMOTION_COLUMNS)[:len(sec.questions)]
+        return [_gait_answers(rng, _vectors(clips, c)[shown.clip], m) for c in cols]
+    if t == "affect_likert":
+        means = np.array([m.likert_means[e] for e in GAIT_EMOTIONS])  # (emotions, features)
+        mu = _vectors(clips, GAIT_EMOTIONS)[shown.clip] @ means + effects["likert"][shown.p][:, None]
+        lik = np.clip(np.rint(mu + rng.normal(0, m.likert_sd, mu.shape)), 0, 4).astype(int)
+        return [lik[:, LIKERT_FEATURES.index(q)] for q in sec.questions]
+    if t == "naturalness":
+        keys = list(zip(clips["modality"].to_numpy()[shown.clip], clips["origin"].to_numpy()[shown.clip]))
+        probs = np.array([m.naturalness_probs[k] for k in keys], float).reshape(n, -1)
+        return [_categorical(rng, probs) + 1]
+    if t == "gesture_emotion":
+        vad = np.array([GESTURE_VAD[c] for c in shown.labels])
+        intended = clips["emotion_label"].fillna("").astype(str).to_numpy()[shown.clip]
+        want = np.array([shown.labels.index(c or "neutral") for c in intended], dtype=int)
+        w = np.exp(-np.linalg.norm(vad[shown.options] - vad[want][:, None, :], axis=2) / m.gesture_temperature)
+        pick = shown.options[np.arange(n), _categorical(rng, w / w.sum(axis=1, keepdims=True))]
+        return [np.asarray(shown.labels, dtype=object)[pick]]
+    if t == "neutral_validation":
+        nv = _categorical(rng, np.tile(np.asarray(m.neutral_probs, float), (n, 1)))
+        return [np.asarray(NEUTRAL_CHOICES, dtype=object)[nv]]
+    theme = clips["theme"].fillna("").astype(str).to_numpy()[shown.clip]
+    if t == "theme_rating":
+        wt, nf = clips["weight"].to_numpy(float)[shown.clip], clips["n_features"].to_numpy(float)[shown.clip]
+        features = (1 - np.exp(-(nf - 1) / 3)) / (1 - np.exp(-3))
+        mean = (m.theme_base + np.array([m.theme_offsets.get(x, 0.0) for x in theme])
+                + m.weight_effect * (wt - 0.4) / 0.9 + m.feature_effect * features)
+        lat = mean + effects["theme"][shown.p] + rng.normal(0, m.theme_noise_sd, n)
+        return [np.clip(np.rint(lat), 1, 7).astype(int)]
+    if t == "theme_inversion":
+        mean = np.array([m.inversion_mean[x] for x in theme])
+        return [np.clip(np.rint(mean + rng.normal(0, m.inversion_sd, n)), -7, 7).astype(int)]
+    raise ValueError(f"no perception model for section type {t!r}")
 
 
-def _neutral_validation(rng, pid_list, m: PerceptionModel) -> pd.DataFrame:
-    """Section 6: the neutral input walk, 7-way forced choice."""
-    nv = _categorical(rng, np.tile(np.asarray(m.neutral_probs, float), (len(pid_list), 1)))
-    return _frame(pid_list, "neutral_validation", "sim-neutral-walk", "perceived",
-                  np.asarray(NEUTRAL_CHOICES, dtype=object)[nv])
+def _all_answers(rng, design: StudyDesign, n_participants: int, m: PerceptionModel) -> tuple[pd.DataFrame, list]:
+    """Every participant's answers to every section, in study order (columns _p (0-based participant), section_type,
+    clip_id, question, answer), and the :class:`_Shown` of each section."""
+    clips = design.clips
+    clip_ids = clips["clip_id"].to_numpy(dtype=object)
+    used = np.zeros((n_participants, len(clips)), bool)
+    effects = {"likert": rng.normal(0, 0.3, n_participants),
+               "theme": rng.normal(0, m.theme_subject_sd, n_participants)}
+    shown_all: list[_Shown] = []
+    cols: dict[str, list] = {k: [] for k in ("_p", "_s", "_pos", "_q", "section_type", "clip_id", "question",
+                                             "answer")}
+    for k, sec in enumerate(design.sections):
+        shown = _assign(rng, sec, design, used, shown_all)
+        shown_all.append(shown)
+        for qi, (q, ans) in enumerate(zip(sec.questions, _section_answers(rng, sec, shown, clips, m, effects))):
+            n = len(ans)
+            cols["_p"].append(shown.p)
+            cols["_s"].append(np.full(n, k))
+            cols["_pos"].append(shown.pos)
+            cols["_q"].append(np.full(n, qi))
+            cols["section_type"].append(np.full(n, sec.section_type, dtype=object))
+            cols["clip_id"].append(clip_ids[shown.clip])
+            cols["question"].append(np.full(n, q, dtype=object))
+            cols["answer"].append(np.asarray(ans).astype(str).astype(object))
+    flat = {k: np.concatenate(v) for k, v in cols.items()}
+    order = np.lexsort((flat["_q"], flat["_pos"], flat["_s"], flat["_p"]))
+    frame = pd.DataFrame({k: v[order] for k, v in flat.items() if k in ("_p", "section_type", "clip_id", "question",
+                                                                          "answer")})
+    return frame, shown_all
 
 
-def _theme_rating(rng, pid_list, clips: pd.DataFrame, m: PerceptionModel) -> pd.DataFrame:
-    """Section 7: every theme x weight x feature-count clip in a random order, rated 1..7."""
-    th = clips[clips["theme"].ne("") & (pd.to_numeric(clips["weight"], errors="coerce") > 0)]
-    ids = th["clip_id"].to_numpy()
-    wt = pd.to_numeric(th["weight"]).to_numpy()
-    nf = pd.to_numeric(th["n_features"]).to_numpy()
-    off = np.array([m.theme_offsets.get(t, 0.0) for t in th["theme"]])
-    mean = (m.theme_base + off + m.weight_effect * (wt - 0.4) / 0.9
-            + m.feature_effect * (1 - np.exp(-(nf - 1) / 3)) / (1 - np.exp(-3)))
-    o = _shuffled(rng, len(pid_list), len(ids))
-    subj = rng.normal(0, m.theme_subject_sd, (len(pid_list), 1))
-    lat = mean[o] + subj + rng.normal(0, m.theme_noise_sd, o.shape)
-    return _frame(np.repeat(pid_list, len(ids)), "theme_rating", ids[o.ravel()], "rating",
-                  np.clip(np.rint(lat), 1, 7).astype(int).ravel())
-
-
-def _theme_inversion(rng, pid_list, clips: pd.DataFrame, m: PerceptionModel) -> pd.DataFrame:
-    """Section 8: the negative-weight clip of each theme in a random order, rated -7..7."""
-    inv = clips[pd.to_numeric(clips["weight"], errors="coerce") < 0]
-    inv_ids = inv["clip_id"].to_numpy()
-    inv_mean = np.array([m.inversion_mean[t] for t in inv["theme"]])
-    o = _shuffled(rng, len(pid_list), len(inv_ids))
-    val = np.clip(np.rint(inv_mean[o] + rng.normal(0, m.inversion_sd, o.shape)), -7, 7).astype(int)
-    return _frame(np.repeat(pid_list, len(inv_ids)), "theme_inversion", inv_ids[o.ravel()], "rating", val.ravel())
-
-
-def _all_answers(rng, pid_list, clips: pd.DataFrame, m: PerceptionModel) -> pd.DataFrame:
-    """Every participant's answers to the eight sections, in section order per participant."""
-    choice, order = _emotion_choice(rng, pid_list, m)
-    parts = [choice, _emotion_transition(rng, pid_list, m), _affect_likert(rng, pid_list, order, m),
-             _naturalness(rng, pid_list, clips, m), _gesture_emotion(rng, pid_list, clips, m),
-             _neutral_validation(rng, pid_list, m), _theme_rating(rng, pid_list, clips, m),
-             _theme_inversion(rng, pid_list, clips, m)]
-    responses = pd.concat(parts, ignore_index=True)
-    responses["answer"] = responses["answer"].astype(str)
-    responses["_p"] = responses["participant_id"].str[4:].astype(int)
-    return responses.sort_values("_p", kind="stable").reset_index(drop=True)
-
+def _assignments(design: StudyDesign, shown_all: list, pid_list: np.ndarray) -> pd.DataFrame:
+    """assignments.csv rows (study_protocol.ASSIGNMENT_COLUMNS): who was shown which clip where, gesture options
+    joined by ';'; no times (the simulator has no clock per page)."""
+    parts = []
+    clip_ids = design.clips["clip_id"].to_numpy(dtype=object)
+    for sec, shown in zip(design.sections, shown_all):
+        options = np.full(len(shown.p), "", dtype=object)
+        if shown.options is not None and len(shown.p):
+            labels = np.asarray(shown.labels, dtype=object)[shown.options]
+            options = np.array([";".join(row) for row in labels], dtype=object)
+        parts.append(pd.DataFrame({"_p": shown.p, "section_type": sec.section_type, "section_order": sec.order,
+                                   "position": shown.pos, "clip_id": clip_ids[shown.clip], "options": options}))
+    a = pd.concat(parts, ignore_index=True).sort_values(["_p", "section_order", "position"], kind="stable")
+    a.insert(0, "participant_id", pid_list[a.pop("_p").to_numpy()])
+    a["shown_at"] = a["answered_at"] = ""
+    return a[list(ASSIGNMENT_COLUMNS)].reset_index(drop=True)
 
 def _abandon(rng, responses: pd.DataFrame, completion_rate: float) -> tuple[pd.DataFrame, np.ndarray]:
     """A share 1 - completion_rate of participants keep only a prefix of their answers. Adds response_ms.
@@ -311,13 +308,14 @@ def _abandon(rng, responses: pd.DataFrame, completion_rate: float) -> tuple[pd.D
     pos = responses.groupby("_p").cumcount().to_numpy()
     quits = rng.random(len(per)) >= completion_rate
     keep_n = np.where(quits, rng.integers(1, per), per)
-    responses = responses[pos < keep_n[responses["_p"].to_numpy() - 1]].drop(columns="_p").reset_index(drop=True)
+    responses = responses[pos < keep_n[responses["_p"].to_numpy()]].drop(columns="_p").reset_index(drop=True)
     responses["response_ms"] = np.rint(rng.lognormal(np.log(4000), 0.5, len(responses))).astype(int)
     return responses, quits
 
 
-def _participants(rng, pid_list, quits: np.ndarray) -> pd.DataFrame:
-    """participants.csv rows: start times over two weeks, demographics, abandoned participants without an end."""
+def _participants(rng, pid_list, quits: np.ndarray, design: StudyDesign) -> pd.DataFrame:
+    """participants.csv rows: start times over two weeks, demographics, abandoned participants without an end, the
+    sections in study order (no counterbalancing), no attention checks (blank counts: the presets have none)."""
     P = len(pid_list)
     start = pd.Timestamp("2026-11-02T09:00:00Z") + pd.to_timedelta(rng.integers(0, 14 * 24 * 3600, P), unit="s")
     dur = pd.to_timedelta(np.rint(rng.lognormal(np.log(600), 0.3, P)), unit="s")
@@ -332,38 +330,72 @@ def _participants(rng, pid_list, quits: np.ndarray) -> pd.DataFrame:
         "completed_at": np.where(quits, "", (start + dur).strftime(fmt)),
         "status": np.where(quits, "abandoned", "completed"),
         "external_id": "synthetic", "feedback": ""})
-    return participants[[*PARTICIPANT_COLUMNS, "feedback"]]
+    participants = participants.reindex(columns=[*PARTICIPANT_COLUMNS, "feedback"], fill_value="")
+    if "section_order" in participants.columns:
+        participants["section_order"] = ";".join(str(sec.order) for sec in design.sections)
+    return participants
+
+
+@dataclass
+class SimulatedStudy:
+    """A SYNTHETIC study: the three exports (responses.csv, clips.csv, participants.csv columns), assignments.csv
+    (which clips each participant was shown, with gesture options) and the design it was drawn from."""
+
+    responses: pd.DataFrame
+    clips: pd.DataFrame
+    participants: pd.DataFrame
+    assignments: pd.DataFrame
+    design: StudyDesign
+
+
+def simulate_design(n_participants: int, design: StudyDesign, seed: int = 0, model: PerceptionModel | None = None,
+                    completion_rate: float = 0.95, **overrides) -> SimulatedStudy:
+    """Draw ``n_participants`` SYNTHETIC observers through ``design`` (:func:`analysis.design.design_from_presets`);
+    see :func:`simulate_study` for ``model``, ``completion_rate`` and ``overrides``."""
+    if n_participants < 1:
+        raise ValueError("n_participants must be >= 1")
+    if not 0 <= completion_rate <= 1:
+        raise ValueError(f"completion_rate must be in [0, 1], not {completion_rate}")
+    m = replace(model or PerceptionModel(), **overrides)
+    rng = np.random.default_rng(seed)
+    pid_list = np.array([f"sim-{i:05d}" for i in range(1, n_participants + 1)], dtype=object)
+    answers, shown = _all_answers(rng, design, n_participants, m)
+    answers.insert(0, "participant_id", pid_list[answers["_p"].to_numpy()])
+    responses, quits = _abandon(rng, answers, completion_rate)
+    participants = _participants(rng, pid_list, quits, design)
+    return SimulatedStudy(responses[list(RESPONSE_COLUMNS)], design.clips_csv(), participants,
+                          _assignments(design, shown, pid_list), design)
 
 
 def simulate_study(n_participants: int, seed: int = 0, model: PerceptionModel | None = None,
-                   completion_rate: float = 0.95, **overrides):
+                   completion_rate: float = 0.95, presets=PAPER_PRESETS, plans: dict | None = None, **overrides):
     """Draw a SYNTHETIC study of ``n_participants`` observers.
 
-    ``model`` (default :class:`PerceptionModel`) with keyword ``overrides`` of its fields (e.g.
-    ``weight_effect=0, feature_effect=0`` for no theme effect). A share ``1 - completion_rate`` of participants
-    stop part-way (status "abandoned", no completed_at, their answers up to that point kept).
+    ``presets`` (default the three papers' studies, one after the other) and ``plans`` (preset -> plan name or file;
+    default each preset's own plan) give the design (:mod:`analysis.design`). ``model`` (default
+    :class:`PerceptionModel`) with keyword ``overrides`` of its fields (e.g. ``weight_effect=0, feature_effect=0`` for
+    no theme effect). A share ``1 - completion_rate`` of participants stop part-way (status "abandoned", no
+    completed_at, their answers up to that point kept).
 
     Returns (responses_df, clips_df, participants_df) with the columns of responses.csv, clips.csv and
-    participants.csv (DESIGN.md). Vectorised: 10,000 participants (about 1.7 million answers) take a few seconds.
+    participants.csv (DESIGN.md); :func:`simulate_design` also returns the assignments. Vectorised: 10,000
+    participants of the paper studies (about 1.7 million answers) take a few seconds.
     """
-    if n_participants < 1:
-        raise ValueError("n_participants must be >= 1")
-    m = replace(model or PerceptionModel(), **overrides)
-    rng = np.random.default_rng(seed)
-    clips = make_clips()
-    pid_list = np.array([f"sim-{i:05d}" for i in range(1, n_participants + 1)], dtype=object)
-    responses, quits = _abandon(rng, _all_answers(rng, pid_list, clips, m), completion_rate)
-    return responses[list(RESPONSE_COLUMNS)], clips, _participants(rng, pid_list, quits)
+    sim = simulate_design(n_participants, design_from_presets(presets, plans), seed, model, completion_rate,
+                          **overrides)
+    return sim.responses, sim.clips, sim.participants
 
 
-def write_study(out_dir: str, n_participants: int, seed: int = 0, **overrides) -> dict[str, str]:
-    """Simulate and write responses.csv, clips.csv, participants.csv into ``out_dir``; returns their paths."""
+def write_study(out_dir: str, n_participants: int, seed: int = 0, presets=PAPER_PRESETS, plans: dict | None = None,
+                **overrides) -> dict[str, str]:
+    """Simulate and write responses.csv, clips.csv, participants.csv and assignments.csv into ``out_dir``; returns
+    their paths by kind."""
     os.makedirs(out_dir, exist_ok=True)
-    responses, clips, participants = simulate_study(n_participants, seed, **overrides)
-    paths = {name: os.path.join(out_dir, f"{name}.csv") for name in ("responses", "clips", "participants")}
-    responses.to_csv(paths["responses"], index=False)
-    clips.to_csv(paths["clips"], index=False)
-    participants.to_csv(paths["participants"], index=False)
+    sim = simulate_design(n_participants, design_from_presets(presets, plans), seed, **overrides)
+    paths = {}
+    for name in ("responses", "clips", "participants", "assignments"):
+        paths[name] = os.path.join(out_dir, f"{name}.csv")
+        getattr(sim, name).to_csv(paths[name], index=False)
     return paths
 
 
@@ -375,14 +407,26 @@ def main(argv=None) -> int:
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--completion-rate", type=float, default=0.95)
     ap.add_argument("--no-theme-effect", action="store_true", help="theme ratings independent of weight and count")
+    ap.add_argument("--preset", action="append", choices=sorted(PRESETS), metavar="PRESET",
+                    help=f"study preset to simulate (repeat for several, in order; default: {' '.join(PAPER_PRESETS)})")
+    ap.add_argument("--plan", action="append", default=[], metavar="PRESET=PLAN",
+                    help="the plan (built-in name or file) a preset's clips come from (default: the preset's own)")
     a = ap.parse_args(argv)
-    kw = {"completion_rate": a.completion_rate}
+    plans = dict(x.split("=", 1) for x in a.plan if "=" in x)
+    if len(plans) != len(a.plan):
+        print("error: --plan takes PRESET=PLAN", file=sys.stderr)
+        return 2
+    kw = {"completion_rate": a.completion_rate, "presets": tuple(a.preset or PAPER_PRESETS), "plans": plans}
     if a.no_theme_effect:
         kw.update(weight_effect=0.0, feature_effect=0.0)
     if a.participants < 1:
         print("error: --participants must be >= 1", file=sys.stderr)
         return 2
-    paths = write_study(a.out, a.participants, a.seed, **kw)
+    try:
+        paths = write_study(a.out, a.participants, a.seed, **kw)
+    except (DesignError, PlanError) as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return 2
     print("SYNTHETIC study written:", ", ".join(paths.values()))
     return 0
 

@@ -30,7 +30,6 @@ import torch
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from generation.core.features import np_gait_affective_features  # noqa: E402
 from generation.core.kinematics import forward_kinematics  # noqa: E402
 from generation.core.motion import Motion  # noqa: E402
 from generation.core.paths import random_path, straight  # noqa: E402
@@ -40,6 +39,7 @@ from generation.gait.data import load_corpus_sequences, world_rotations  # noqa:
 from generation.gait.generate import distance_to_path, emotion_transition, load_model  # noqa: E402
 from generation.gait.generate import generate_gaits as _generate_gaits  # noqa: E402
 from generation.gait.train import DEFAULT_WEIGHTS, rollout  # noqa: E402
+from generation.quality.observer import GaitObserver  # noqa: E402
 from study_protocol import GAIT_EMOTIONS  # noqa: E402
 
 PREFIX, HORIZON = 18, 42
@@ -113,30 +113,8 @@ def nearest_neighbour_errors(train, test, window: int = 6) -> dict:
 
 
 # ---- 2. emotion expressiveness --------------------------------------------------------------------
-class Observer:
-    """Logistic regression on the 18 affective features averaged over time (synthetic observer)."""
-
-    def __init__(self, train):
-        from sklearn.linear_model import LogisticRegression
-        from sklearn.pipeline import make_pipeline
-        from sklearn.preprocessing import StandardScaler
-        X = self.summarise_seq(train.aff.numpy())
-        y = train.emotion.numpy().argmax(1)
-        self.clf = make_pipeline(StandardScaler(), LogisticRegression(max_iter=2000, C=1.0)).fit(X, y)
-
-    @staticmethod
-    def summarise_seq(aff: np.ndarray) -> np.ndarray:
-        a = np.clip(aff, -10, 10)
-        return a.mean(-2)
-
-    def features(self, motions: list[Motion], frames: slice = slice(None)) -> np.ndarray:
-        return np.clip(np.stack([np_gait_affective_features(m.positions()[frames]).mean(0) for m in motions]), -10, 10)
-
-    def predict_motions(self, motions: list[Motion], frames: slice = slice(None)) -> np.ndarray:
-        return self.clf.predict(self.features(motions, frames))
-
-    def proba_motions(self, motions: list[Motion], frames: slice = slice(None)) -> np.ndarray:
-        return self.clf.predict_proba(self.features(motions, frames))
+# The synthetic observer lives in generation.quality.observer (moved there from this file).
+Observer = GaitObserver
 
 
 def test_seeds(corpus, test_rows, n_frames=PREFIX * 4 - 3):

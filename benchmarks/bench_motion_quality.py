@@ -13,6 +13,10 @@ For every ``gait_net`` entry of the built-in ``seed000`` plan (made as the study
 - bone length error (max, mm) and the largest joint speed (m/s; a pop would raise it).
 
 Usage: ``python benchmarks/bench_motion_quality.py [--json var/motion_quality.json]``
+
+``--qa seed000 seed003 seed004`` instead runs the per-clip quality checks (:mod:`generation.quality`, the record
+``generate_clips`` keeps per clip) over every entry of the plans without rendering video, and prints per plan the
+clips flagged by each check and the range of every measure.
 """
 from __future__ import annotations
 
@@ -137,11 +141,45 @@ def table(result: dict) -> str:
     return "\n".join(lines)
 
 
+QA_MEASURES = ("foot_skate_cm_s", "penetration_cm", "jerk", "bone_error_mm", "figure_height_frac", "observed_p")
+
+
+def qa_table(plans: list[str]) -> tuple[str, dict]:
+    """Per plan: clips, passed, flagged per check, and min / median / max of each measure."""
+    from generation.quality.plan_qa import run as run_qa
+    from generation.quality.plan_qa import summary_counts
+    from study_protocol import QA_CHECKS
+
+    out, lines = {}, ["| plan | clips | passed | " + " | ".join(QA_CHECKS) + " |",
+                      "|---|---|---|" + "---|" * len(QA_CHECKS)]
+    ranges = ["", "| plan | " + " | ".join(QA_MEASURES) + " |", "|---|" + "---|" * len(QA_MEASURES)]
+    for name in plans:
+        rows = run_qa(name, log=lambda _msg: None)
+        out[name] = rows
+        c = summary_counts(r["flag"] for r in rows)
+        lines.append(f"| {name} | {len(rows)} | {c['passed']} | " + " | ".join(str(c[k]) for k in QA_CHECKS) + " |")
+        cells = []
+        for m in QA_MEASURES:
+            v = np.array([r[m] for r in rows if r.get(m) is not None], dtype=float)
+            cells.append(f"{v.min():.3g} / {np.median(v):.3g} / {v.max():.3g}" if v.size else "-")
+        ranges.append(f"| {name} | " + " | ".join(cells) + " |")
+    flagged = [f"- {name} {r['entry']} ({r['generator']}): {r['flag']}" for name, rows in out.items() for r in rows
+               if r["flag"]]
+    return "\n".join(lines + ranges + ["", "Flagged clips:"] + flagged), out
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--plan", default="seed000")
     ap.add_argument("--json", default=None, help="also write the per-clip numbers here")
+    ap.add_argument("--qa", nargs="+", default=None, metavar="PLAN", help="quality checks of these plans' clips")
     args = ap.parse_args(argv)
+    if args.qa:
+        text, rows = qa_table(args.qa)
+        print(text)
+        if args.json:
+            Path(args.json).write_text(json.dumps(rows, indent=1))
+        return 0
     result = run(args.plan)
     print(table(result))
     print(f"\n{len(result['rows'])} clips, {result['seconds']} s (both variants), {result['machine']}, "

@@ -3,18 +3,18 @@
     python benchmarks/bench_render.py speed [--frames 300] [--aa none fxaa msaa ssaa2] [--procs 1 2]
                                             [--motion walk gesture] [--patches 1 0]
                                             [--body mannequin stick points] [--width 1280 --height 720]
-    python benchmarks/bench_render.py sheet [--out docs/img/render_mannequin_sheet.png]
-    python benchmarks/bench_render.py plans [--plans demo seed000 seed003 seed004] [--sample 12] [--workers 2]
+    python benchmarks/bench_render.py sheet [--out docs/img/render_contact_sheet.png]
+    python benchmarks/bench_render.py plans [--plans seed000 seed003 seed004] [--sample 6 10 12] [--workers 2]
 
 ``speed`` renders a 10 s procedural walk (21 joints, a loop of 3 m radius) and/or a seated procedural gesture
 (23 joints, on a chair) at 1280x720 (``--width/--height``) with each ``--body`` to H.264 and reports
 frames per second of wall time and per CPU-second (the process, its llvmpipe threads and its ffmpeg child
 together). With ``--procs 2`` two processes render at once; fps is their total.
 
-``sheet`` renders eight procedural clips (male and female, short and tall, walking and seated) as
-mannequin, stick figure and point-lights and writes one contact sheet of their middle frames (two rows per
-look: walks, then seated gestures) with each clip's camera rule and projected figure height range in the
-labels.
+``sheet`` makes ten motions as plan entries make them (the gait network's happy, sad, angry and neutral walks, two
+RBF themes at w = 1.3 and -0.7, four gesture-network seated gestures), scaled to male and female bodies 1.52-1.95 m
+tall, and writes one contact sheet of the same frame (40 % into each clip) as mannequin, stick figure and
+point-lights, each captioned with its camera rule, anti-aliasing and projected figure height range.
 
 ``plans`` renders every k-th entry of
 each plan (``--sample`` entries, or all with 0) into a temporary media folder with ``--workers`` processes
@@ -120,60 +120,88 @@ def speed(args) -> list[dict]:
     return rows
 
 
-SHEET_CLIPS = [  # (label, modality, build, height m, emotion or gesture label)
-    ("male 1.65 m walk happy", "walk", "male", 1.65, [1.0, 0, 0, 0]),
-    ("male 1.95 m walk sad", "walk", "male", 1.95, [0, 1.0, 0, 0]),
-    ("female 1.52 m walk angry", "walk", "female", 1.52, [0, 0, 1.0, 0]),
-    ("female 1.82 m walk neutral", "walk", "female", 1.82, [0, 0, 0, 1.0]),
-    ("male 1.65 m seated proud", "gesture", "male", 1.65, "proud"),
-    ("male 1.95 m seated angry", "gesture", "male", 1.95, "angry"),
-    ("female 1.52 m seated joyous", "gesture", "female", 1.52, "joyous"),
-    ("female 1.82 m seated sad", "gesture", "female", 1.82, "sad"),
+SHEET_CLIPS = [  # (label, build, height m, plan entry of the generator that makes the motion)
+    ("gait_net happy, male 1.65 m", "male", 1.65, {"generator": "gait_net", "emotion": "happy"}),
+    ("gait_net sad, male 1.95 m", "male", 1.95, {"generator": "gait_net", "emotion": "sad"}),
+    ("gait_net angry, female 1.52 m", "female", 1.52, {"generator": "gait_net", "emotion": "angry"}),
+    ("gait_net neutral, female 1.82 m", "female", 1.82, {"generator": "gait_net", "emotion": "neutral"}),
+    ("rbf {t0} w=1.3, male 1.95 m", "male", 1.95, {"generator": "rbf", "theme": 0, "weight": 1.3}),
+    ("rbf {t1} w=-0.7, female 1.52 m", "female", 1.52, {"generator": "rbf", "theme": 1, "weight": -0.7}),
+    ("gesture_net proud, male 1.65 m", "male", 1.65, {"generator": "gesture_net", "emotion_label": "proud"}),
+    ("gesture_net angry, male 1.95 m", "male", 1.95, {"generator": "gesture_net", "emotion_label": "angry"}),
+    ("gesture_net joyous, female 1.52 m", "female", 1.52, {"generator": "gesture_net", "emotion_label": "joyous"}),
+    ("gesture_net sad, female 1.82 m", "female", 1.82, {"generator": "gesture_net", "emotion_label": "sad"}),
 ]
 
 
-def sheet_motion(modality: str, build: str, height: float, what, frames: int = 90, fps: float = 30.0):
-    import numpy as np
+def _sentence(emotion: str) -> str:
+    import csv
 
-    from generation.core.skeleton import gait_skeleton, gesture_skeleton
-    from generation.procedural.emotion import gait_params_for_emotion, gesture_params_for_vad
-    from study_protocol import GESTURE_VAD
-    if modality == "walk":
-        from generation.core.paths import curved
-        from generation.procedural.walk import walk
+    path = Path(__file__).resolve().parent.parent / "generation" / "data" / "sentences_synthetic.csv"
+    return next(r["sentence"] for r in csv.DictReader(path.open(encoding="utf-8")) if r["emotion"] == emotion)
 
-        return walk(gait_params_for_emotion(what), curved(4.0, np.radians(90), 8.0), frames, fps,
-                    skeleton=gait_skeleton(height, build))
-    from generation.procedural.gesture import seated_gesture
 
-    v, a, d = GESTURE_VAD[what]
-    return seated_gesture(gesture_params_for_vad(v, a, d, np.random.default_rng(0)), frames, fps,
-                          gesture_skeleton(height, build), seed=0)
+def scaled_motion(motion, height: float, build: str):
+    """The motion on a uniformly scaled skeleton ``height`` metres tall (root path scaled too), labelled ``build``."""
+    import dataclasses
+
+    k = height / motion.skeleton.height
+    skel = dataclasses.replace(motion.skeleton, offsets=motion.skeleton.offsets * k, height=height, build=build)
+    meta = {**motion.metadata, "build": build}
+    return dataclasses.replace(motion, skeleton=skel, root_positions=motion.root_positions * k, metadata=meta)
+
+
+def sheet_motion(build: str, height: float, spec: dict, fps: float = 25.0, seconds: float = 4.0):
+    """A motion made as a plan entry makes it (network gait, RBF theme, network gesture), scaled and labelled."""
+    from generation.plans.clipgen import make_motion, resolve
+    from generation.plans.schema import validate_plan
+    from study_protocol import THEMES
+
+    entry = {"id": "x", **spec, "seed": 1}
+    if spec["generator"] == "gait_net":
+        entry.update(trajectory={"kind": "curved", "radius_m": 4.0, "angle_deg": 60, "length_m": 8},
+                     duration_s=seconds)
+    elif spec["generator"] == "rbf":
+        entry.update(theme=THEMES[spec["theme"]], n_features=10, n_cycles=3)
+    else:
+        entry.update(sentence=_sentence(spec["emotion_label"]), gender=build)
+    plan = validate_plan({"name": "sheet", "render": {"fps": fps, "duration_s": seconds}, "clips": [entry]})
+    run_entry, reason = resolve(plan.entries[0])
+    if reason:
+        raise SystemExit(f"{spec['generator']} unavailable: {reason}")
+    return scaled_motion(make_motion(run_entry), height, build)
 
 
 def sheet(args) -> list[dict]:
+    """One contact sheet: every SHEET_CLIPS motion at the same frame (40 % into the clip) as mannequin, stick figure
+    and point-lights (rows of five: walks and themes, then seated gestures, per look)."""
     from PIL import Image
 
     from generation.render import RenderSettings, contact_sheet
     from generation.render import clip as clip_mod
+    from study_protocol import THEMES
 
     rows, paths, labels = [], [], []
     tmp = Path(tempfile.mkdtemp(prefix="render_sheet_"))
+    motions = [sheet_motion(build, height, spec) for _, build, height, spec in SHEET_CLIPS]
     for body in ("mannequin", "stick", "points"):
-        for label, modality, build, height, what in SHEET_CLIPS:
-            motion = sheet_motion(modality, build, height, what)
-            settings = RenderSettings(width=args.width, height=args.height, fps=10.0, duration_s=3.0, body=body)
+        for (label, *_), motion in zip(SHEET_CLIPS, motions):
+            label = label.format(t0=THEMES[0], t1=THEMES[1])
+            settings = RenderSettings(width=args.width, height=args.height, fps=25.0, duration_s=4.0, body=body)
             clip, pos = clip_mod.prepare(motion, settings)
             info: dict = {}
-            frames = list(clip_mod._frames(clip, pos, settings, info=info))
+            t_show = int(0.4 * (len(pos) - 1))
+            frames = clip_mod._frames(clip, pos, settings, info=info)
+            img = next(f for t, f in enumerate(frames) if t == t_show)
+            frames.close()
             p = tmp / f"{body}_{len(paths)}.png"
-            Image.fromarray(frames[len(frames) // 2]).save(p)
+            Image.fromarray(img).save(p)
             paths.append(p)
-            labels.append(f"{body}, {label}, {info['rule']} camera, height "
+            labels.append(f"{body}: {label}; {info['rule']} camera, {info['anti_aliasing']}, figure "
                           f"{info['min_figure_fraction']:.2f}-{info['max_figure_fraction']:.2f}")
-            rows.append({"body": body, "clip": label, **info})
+            rows.append({"body": body, "clip": label, "frame": t_show, **info})
             print(json.dumps(rows[-1]), flush=True)
-    contact_sheet(paths, labels, args.out, columns=4, thumb_width=args.thumb)
+    contact_sheet(paths, labels, args.out, columns=5, thumb_width=args.thumb)
     return rows
 
 
@@ -184,10 +212,11 @@ def plans(args) -> list[dict]:
     from generation.render.batch import run_plan
 
     rows = []
-    for name in args.plans:
+    samples = args.sample * len(args.plans) if len(args.sample) == 1 else args.sample
+    for name, sample in zip(args.plans, samples):
         plan = load_plan(name)
         n = len(plan.entries)
-        k = n if not args.sample or args.sample >= n else args.sample
+        k = n if not sample or sample >= n else sample
         step = n / k
         picked = tuple(plan.entries[int(i * step)] for i in range(k))
         sub = replace(plan, entries=picked)
@@ -223,13 +252,14 @@ def main() -> None:
     s.add_argument("--motion", nargs="+", default=["walk", "gesture"], choices=["walk", "gesture"])
     s.add_argument("--patches", nargs="+", type=int, default=[1], help="1 = patch rendering, 0 = whole frames")
     c = sub.add_parser("sheet")
-    c.add_argument("--out", default="docs/img/render_mannequin_sheet.png")
+    c.add_argument("--out", default="docs/img/render_contact_sheet.png")
     c.add_argument("--width", type=int, default=640)
     c.add_argument("--height", type=int, default=360)
-    c.add_argument("--thumb", type=int, default=480)
+    c.add_argument("--thumb", type=int, default=400)
     q = sub.add_parser("plans")
     q.add_argument("--plans", nargs="+", default=["demo", "seed000", "seed003", "seed004"])
-    q.add_argument("--sample", type=int, default=12, help="entries rendered per plan (0 = all)")
+    q.add_argument("--sample", type=int, nargs="+", default=[12],
+                   help="entries rendered per plan (0 = all), one number for all plans or one per plan")
     q.add_argument("--workers", type=int, default=2)
     for x in (s, c, q):
         x.add_argument("--json", default=None)

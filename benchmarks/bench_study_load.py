@@ -1,15 +1,30 @@
-"""Load test: N simulated participants take the demo study at once over HTTP against gunicorn + PostgreSQL.
+"""Load test: simulated participants take the demo study over HTTP against gunicorn + PostgreSQL.
 
-    python benchmarks/bench_study_load.py --participants 20 --workers 3 [--db-url postgres://postgres@127.0.0.1:5432/postgres]
+    python benchmarks/bench_study_load.py --participants 200 --arrival 30 --workers 2 --threads 8 \
+        [--driver locust|threads] [--viewers 4] [--db-url postgres://postgres@127.0.0.1:5432/postgres]
 
-Loopback only, bounded in participant count (<= 200) and time (--time-limit). It creates a scratch database
-(`<name>_studybench`, dropped and recreated), a SYNTHETIC catalogue (dummy media files, metadata synthetic=True) and
-the demo study with clip playback checks off (no one watches), starts gunicorn, and runs one thread per participant
-with its own cookie session: consent, demographics, every clip (GET page, POST answers), feedback, completion.
-Every 4th answer is posted twice (a double submit) and every 5th clip page is reloaded before answering.
+Loopback only, bounded in participant count (<= 400) and time (--time-limit). It creates its own uniquely named
+scratch database (`<name>_studybench_<pid>_<time>`, dropped at the end unless --keep-db), a SYNTHETIC catalogue
+(dummy media files, metadata synthetic=True) and the demo study with clip playback checks off (no one watches),
+and starts gunicorn (gthread workers). Then:
 
-Reports answers per second (answer POSTs accepted / wall time), p50/p99 latency of answer POSTs and clip pages,
-and lost / duplicated responses found in the database and in the streamed responses.csv (both must be 0).
+1. ceiling (locust driver): `/healthz` (no database, no session) as fast as the generator can for --ceiling-s:
+   the requests/s of the stack itself on this machine;
+2. the study: --participants arrive evenly within --arrival seconds, each with its own cookie session, and take
+   the whole study: consent, demographics, every clip (GET page, POST answers), feedback, completion. Every 4th
+   answer is posted twice (a double submit), every 5th clip page is reloaded before answering; --think pauses on
+   each clip page before answering (default 0: as fast as the server allows). --viewers slow
+   media viewers fetch a clip in 64 KiB Range requests, 4 per second each, meanwhile.
+
+Pages are parsed generically (the post form with the most fields; radios/checkboxes take their first value, hidden
+fields are kept, redirects are followed whatever their target), so the driver does not depend on the exact page
+sequence. The locust driver (benchmarks/locustfile.py: gevent users, so the generator is not the bottleneck)
+is the default; --driver threads runs one Python thread per participant with `requests` (the issue-8 driver).
+
+Reports answers per second (answer POSTs accepted / wall time, and answers stored / wall time), p50/p99 latency
+of answer POSTs and of clip pages (the GETs after an answer, redirects included), the healthz ceiling and the ratio
+of the study's requests/s to it, and lost / duplicated answers found in the database and in the streamed
+responses.csv (all must be 0).
 """
 from __future__ import annotations
 
@@ -17,6 +32,7 @@ import argparse
 import html
 import json
 import os
+import random
 import re
 import signal
 import statistics
@@ -26,14 +42,19 @@ import tempfile
 import threading
 import time
 from pathlib import Path
-from urllib.parse import urlsplit, urlunsplit
+from urllib.parse import urlencode, urljoin, urlsplit, urlunsplit
 
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
+LOCUSTFILE = Path(__file__).resolve().parent / "locustfile.py"
 
-CSRF_RE = re.compile(r'name="csrfmiddlewaretoken" value="([^"]+)"')
-INPUT_RE = re.compile(r'<input type="(checkbox|radio)" name="([^"]+)" id="[^"]*" value="([^"]*)"')
-FEEDBACK_RE = re.compile(r'<(input|textarea)[^>]*name="([^"]+)"[^>]*?(?:value="([^"]*)")?')
+FORM_RE = re.compile(r"<form\b([^>]*)>(.*?)</form>", re.S | re.I)
+FIELD_RE = re.compile(r"<(input|textarea|select|option|/select)\b([^>]*)>", re.I)
+ATTR_RE = re.compile(r'([a-zA-Z_:][-\w:.]*)(?:\s*=\s*"([^"]*)")?')
+TOKEN_RE = re.compile(r"/p/([^/]+)/")
+CLIP_RE = re.compile(r"/clip/(\d+)/")
+MAX_STEPS = 400
+MEDIA_CHUNK = 64 * 1024
 
 
 def percentile(values: list[float], q: float) -> float:
@@ -44,24 +65,189 @@ def percentile(values: list[float], q: float) -> float:
     return v[k]
 
 
+# ----------------------------------------------------------------------------------------------------- forms ---
+
+def _attrs(text: str) -> dict[str, str]:
+    return {k.lower(): html.unescape(v or "") for k, v in ATTR_RE.findall(text)}
+
+
+def fill_form(page: str, url: str) -> tuple[str | None, dict[str, str], list[str]]:
+    """(action URL, data, question names) for the page's main POST form: the one with the most named fields.
+
+    Hidden fields keep their value; a radio group or checkbox takes its first value ("on" without one); a select
+    its first non-empty option; text fields and textareas stay empty; a field named "rt" (response time, set by
+    JavaScript in a browser) gets 1500 ms. (None, {}, []) when the page has no POST form."""
+    best = None
+    for form_attrs, body in FORM_RE.findall(page):
+        attrs = _attrs(form_attrs)
+        if attrs.get("method", "get").lower() != "post":
+            continue
+        data, questions = _form_fields(body)
+        if best is None or len(data) > len(best[1]):
+            best = (urljoin(url, attrs.get("action") or url), data, questions)
+    return best if best is not None else (None, {}, [])
+
+
+def _form_fields(body: str) -> tuple[dict[str, str], list[str]]:
+    data: dict[str, str] = {}
+    questions: list[str] = []
+    select = None
+    for tag, raw in FIELD_RE.findall(body):
+        tag, a = tag.lower(), _attrs(raw)
+        if tag == "/select":
+            select = None
+        elif tag == "option":
+            if select and not data.get(select) and a.get("value"):
+                data[select] = a["value"]
+        elif tag == "select" and a.get("name"):
+            select = a["name"]
+            data.setdefault(select, "")
+            questions.append(select)
+        elif tag == "textarea" and a.get("name"):
+            data.setdefault(a["name"], "")
+        elif tag == "input" and a.get("name"):
+            kind, name = a.get("type", "text").lower(), a["name"]
+            if kind in ("submit", "button", "reset", "image", "file"):
+                continue
+            if kind in ("radio", "checkbox"):
+                if name not in data:
+                    questions.append(name)
+                    data[name] = a.get("value") or "on"
+            else:
+                data.setdefault(name, a.get("value", ""))
+    if "rt" in data:
+        data["rt"] = "1500"
+    return data, [q for q in dict.fromkeys(questions) if q not in ("consent",)]
+
+
+# ------------------------------------------------------------------------------------------ participant flow ---
+
+class Page:
+    def __init__(self, status: int, url: str, text: str, ms: float):
+        self.status, self.url, self.text, self.ms = status, url, text, ms
+
+
+def follow(http, method: str, url: str, data: dict | None, name: str, hops: int = 10) -> Page:
+    """Send one request and follow its redirects with GETs; ms = total time of all hops.
+    http.request(method, url, data, name) -> (status, location or None, text, ms)."""
+    total = 0.0
+    for _ in range(hops):
+        status, location, text, ms = http.request(method, url, data, name)
+        total += ms
+        if not (300 <= status < 400 and location):
+            return Page(status, url, text, total)
+        url, method, data = urljoin(url, location), "GET", None
+        name = name if name.endswith("(redirect)") else name + " (redirect)"
+    return Page(599, url, "too many redirects", total)
+
+
+def new_record(index: int) -> dict:
+    return {"index": index, "token": "", "acknowledged": [], "answer_ms": [], "page_ms": [], "answer_posts": 0,
+            "errors": [], "completed": False, "start": time.time(), "end": None}
+
+
+def take_study(http, base: str, slug: str, index: int, deadline: float, think_s: float = 0.0) -> dict:
+    """One participant from the study link to the completion page, pausing think_s (mean; uniform 0.5x-1.5x) on
+    each clip page before answering. Returns its record (JSON-able)."""
+    rec = new_record(index)
+    acknowledged: set[int] = set()
+    link = {"PROLIFIC_PID": f"bench{index:05d}{os.getpid()}", "STUDY_ID": "bench", "SESSION_ID": f"s{index}"}
+    try:
+        page = follow(http, "GET", f"{base}/s/{slug}/?{urlencode(link)}", None, "consent page")
+        for _ in range(MAX_STEPS):
+            if "/done/" in page.url or time.time() > deadline:
+                break
+            if page.status >= 400:
+                rec["errors"].append(f"HTTP {page.status} on {_path(page.url)}: {_snippet(page.text)}")
+                break
+            if m := TOKEN_RE.search(page.url):
+                rec["token"] = m.group(1)
+            action, data, _questions = fill_form(page.text, page.url)
+            if action is None:
+                rec["errors"].append(f"no form on {_path(page.url)}")
+                break
+            if m := CLIP_RE.search(page.url):
+                if think_s > 0:
+                    time.sleep(think_s * random.uniform(0.5, 1.5))      # gevent-patched under locust
+                page = _answer_clip(http, page, action, data, int(m.group(1)), rec, acknowledged)
+            else:
+                page = follow(http, "POST", action, data, _step_name(page.url) + " POST")
+        rec["completed"] = "/done/" in page.url
+    except Exception as exc:        # reported, never hidden
+        rec["errors"].append(repr(exc)[:300])
+    rec["acknowledged"], rec["end"] = sorted(acknowledged), time.time()
+    return rec
+
+
+def _answer_clip(http, page: Page, action: str, data: dict, n: int, rec: dict, acknowledged: set[int]) -> Page:
+    if n % 5 == 0:                                    # a reload before answering
+        page = follow(http, "GET", page.url, None, "clip page")
+        rec["page_ms"].append(page.ms)
+        action, data, _ = fill_form(page.text, page.url)
+    repeats = 2 if rec["answer_posts"] % 4 == 3 else 1
+    location, status, text = None, 0, ""
+    for _ in range(repeats):
+        status, location, text, ms = http.request("POST", action, data, "answer POST")
+        rec["answer_ms"].append(ms)
+        if not (300 <= status < 400 and location):
+            rec["errors"].append(f"clip {n}: HTTP {status} {_snippet(text)}")
+    rec["answer_posts"] += 1
+    if not (300 <= status < 400 and location):
+        return Page(status or 599, page.url, text, 0.0)
+    acknowledged.add(n)
+    nxt = follow(http, "GET", urljoin(page.url, location), None, "clip page")
+    rec["page_ms"].append(nxt.ms)
+    return nxt
+
+
+def _path(url: str) -> str:
+    return TOKEN_RE.sub("/p/***/", urlsplit(url).path)
+
+
+def _snippet(text: str) -> str:
+    m = re.search(r'class="error"[^>]*>([^<]{0,160})', text or "")
+    return (m.group(1) if m else re.sub(r"\s+", " ", re.sub(r"<[^>]+>", " ", text or ""))[:160]).strip()
+
+
+def _step_name(url: str) -> str:
+    path = _path(url)
+    return "consent" if path.startswith("/s/") else (path.rstrip("/").split("/")[-1] or "page")
+
+
+# ------------------------------------------------------------------------------------ set-up and tear-down ---
+
 def scratch_db_url(base: str) -> tuple[str, str]:
+    """A unique scratch database next to base's: <name>_studybench_<pid>_<time>."""
     parts = urlsplit(base)
-    name = (parts.path.lstrip("/") or "postgres") + "_studybench"
+    name = f"{parts.path.lstrip('/') or 'postgres'}_studybench_{os.getpid()}_{int(time.time())}"
     return urlunsplit(parts._replace(path="/" + name)), name
 
 
-def recreate_db(base_url: str, name: str) -> None:
+def _admin_connection(base_url: str):
     import psycopg
 
     parts = urlsplit(base_url)
-    with psycopg.connect(host=parts.hostname, port=parts.port or 5432, user=parts.username or "postgres",
-                         password=parts.password, dbname=parts.path.lstrip("/") or "postgres",
-                         autocommit=True) as conn:
+    return psycopg.connect(host=parts.hostname, port=parts.port or 5432, user=parts.username or "postgres",
+                           password=parts.password, dbname=parts.path.lstrip("/") or "postgres", autocommit=True)
+
+
+def recreate_db(base_url: str, name: str) -> None:
+    with _admin_connection(base_url) as conn:
         conn.execute(f'DROP DATABASE IF EXISTS "{name}" WITH (FORCE)')
         conn.execute(f'CREATE DATABASE "{name}"')
 
 
+def drop_db(base_url: str, name: str) -> None:
+    from django.db import connections
+
+    connections.close_all()
+    with _admin_connection(base_url) as conn:
+        conn.execute(f'DROP DATABASE IF EXISTS "{name}" WITH (FORCE)')
+
+
 def setup_django(db_url: str, media_root: Path):
+    """Migrate the scratch database, insert the synthetic catalogue (every clip shares one 2 MB synthetic media
+    file, so Range requests have something to read) and open the demo study with playback checks off."""
     os.environ["DATABASE_URL"] = db_url
     os.environ["MEDIA_ROOT"] = str(media_root)
     os.environ.setdefault("DJANGO_SETTINGS_MODULE", "studyapp.settings")
@@ -75,166 +261,332 @@ def setup_django(db_url: str, media_root: Path):
     from studyapp.presets import create_study_from_preset
     from studyapp.testing import make_catalogue
 
-    make_catalogue(media_root, n_gait=40, n_transition=20, n_gait_source=10, n_gesture=40)
-    study = create_study_from_preset("demo", "bench", status=Study.Status.OPEN)
+    synthetic_media = bytes((i * 131 + 7) % 256 for i in range(2 * 1024 * 1024))
+    make_catalogue(media_root, video_bytes=synthetic_media, n_gait=40, n_transition=20, n_gait_source=10,
+                   n_gesture=40)
+    study = create_study_from_preset("demo", "bench", status=Study.Status.OPEN, plan="test")   # make_catalogue's
     study.sections.update(require_full_play=False)
     return study
 
 
-class Participant(threading.Thread):
-    def __init__(self, base: str, slug: str, index: int, start_at: float, deadline: float):
-        super().__init__(daemon=True)
-        self.base, self.slug, self.index, self.start_at, self.deadline = base, slug, index, start_at, deadline
-        self.answer_ms: list[float] = []
-        self.page_ms: list[float] = []
-        self.answered: set[tuple[int, str]] = set()      # (clip number, question) acknowledged by the server
-        self.errors: list[str] = []
-        self.completed = False
+def media_urls(n: int = 4) -> list[str]:
+    from studyapp.models import Clip
 
-    def post(self, s, url, data, referer):
-        return s.post(url, data=data, headers={"Referer": referer}, allow_redirects=True, timeout=30)
+    return [f"/m/{key}.mp4" for key in Clip.objects.order_by("id").values_list("media_key", flat=True)[:n]]
 
-    def run(self):
-        import requests
 
-        s = requests.Session()
-        try:
-            while time.time() < self.start_at:
-                time.sleep(0.001)
-            entry = f"{self.base}/s/{self.slug}/?PROLIFIC_PID=bench-{self.index}"
-            r = s.get(entry, timeout=30)
-            r = self.post(s, entry, {"consent": "on", "csrfmiddlewaretoken": CSRF_RE.search(r.text).group(1)},
-                          entry)
-            if "/about-you/" in r.url:
-                r = self.post(s, r.url, {"gender": "female", "age_group": "25-34",
-                                         "csrfmiddlewaretoken": CSRF_RE.search(r.text).group(1)}, r.url)
-            n_posts = 0
-            while "/clip/" in r.url and time.time() < self.deadline:
-                n = int(r.url.rstrip("/").split("/")[-1])
-                if n % 5 == 0:                       # a reload before answering
-                    t = time.perf_counter()
-                    r = s.get(r.url, timeout=30)
-                    self.page_ms.append(1000 * (time.perf_counter() - t))
-                data: dict[str, str] = {}
-                for _kind, name, value in INPUT_RE.findall(r.text):
-                    data.setdefault(name, html.unescape(value))
-                data["csrfmiddlewaretoken"] = CSRF_RE.search(r.text).group(1)
-                data["rt"] = "1500"
-                url = r.url
-                repeats = 2 if n_posts % 4 == 3 else 1
-                for _ in range(repeats):
-                    t = time.perf_counter()
-                    resp = s.post(url, data=data, headers={"Referer": url}, allow_redirects=False, timeout=30)
-                    self.answer_ms.append(1000 * (time.perf_counter() - t))
-                    if resp.status_code != 302:
-                        self.errors.append(f"clip {n}: HTTP {resp.status_code}")
-                n_posts += 1
-                self.answered.update((n, k) for k in data if k not in ("csrfmiddlewaretoken", "rt"))
-                t = time.perf_counter()
-                r = s.get(self.base + resp.headers["Location"], timeout=30) if resp.status_code == 302 else r
-                self.page_ms.append(1000 * (time.perf_counter() - t))
-            if "/feedback/" in r.url:
-                data = {"csrfmiddlewaretoken": CSRF_RE.search(r.text).group(1)}
-                for tag, name, _v in FEEDBACK_RE.findall(r.text):
-                    if name != "csrfmiddlewaretoken":
-                        data.setdefault(name, "no" if tag == "input" else "")
-                r = self.post(s, r.url, data, r.url)
-            self.completed = "/done/" in r.url
-        except Exception as exc:        # reported, never hidden
-            self.errors.append(repr(exc))
+def start_gunicorn(args, env: dict, log: Path) -> subprocess.Popen:
+    """gunicorn on 127.0.0.1:--port; its stderr (warnings, Django's error tracebacks) goes to ``log``."""
+    cmd = [sys.executable, "-m", "gunicorn", "studyapp.wsgi", "-w", str(args.workers), "-b",
+           f"127.0.0.1:{args.port}", "--log-level", "warning", "--timeout", "60", "--backlog", "2048"]
+    if args.threads > 1:
+        cmd += ["--worker-class", "gthread", "--threads", str(args.threads)]
+    return subprocess.Popen(cmd, cwd=ROOT, env=env, stderr=open(log, "ab"))
+
+
+def start_local_nginx(args, out: Path) -> tuple[str, subprocess.Popen]:
+    """deploy/nginx/study.conf templated to this run (TLS with a self-signed certificate, /protected-media/ ->
+    out/media) in front of gunicorn; returns its https base URL and process."""
+    sys.path.insert(0, str(ROOT / "deploy" / "nginx"))
+    from local_site import free_port, start_nginx, write_local_site
+
+    (out / "static").mkdir(exist_ok=True)
+    https_port = free_port()
+    conf = write_local_site(out / "nginx", out, args.port, free_port(), https_port)
+    return f"https://127.0.0.1:{https_port}", start_nginx(conf)
 
 
 def wait_for_server(base: str, timeout: float = 30) -> None:
     import requests
+    import urllib3
+
+    urllib3.disable_warnings(urllib3.exceptions.InsecureRequestWarning)
 
     end = time.time() + timeout
     while time.time() < end:
         try:
-            if requests.get(base + "/", timeout=2).status_code == 200:
+            if requests.get(base + "/healthz", timeout=2, verify=False).status_code == 200:   # self-signed
                 return
         except requests.RequestException:
             time.sleep(0.2)
     raise SystemExit(f"gunicorn did not answer on {base} within {timeout} s")
 
 
-def main(argv=None) -> dict:
-    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("--participants", type=int, default=20)
-    ap.add_argument("--workers", type=int, default=3, help="gunicorn sync workers")
-    ap.add_argument("--port", type=int, default=8765)
-    ap.add_argument("--db-url", default=os.environ.get("DATABASE_URL") or "postgres://postgres@127.0.0.1:5432/postgres")
-    ap.add_argument("--time-limit", type=float, default=180.0, help="seconds before clients stop")
-    ap.add_argument("--json", default="", help="also write the figures to this JSON file")
-    args = ap.parse_args(argv)
-    if not 1 <= args.participants <= 200:
-        raise SystemExit("--participants must be 1..200 (bounded load test on loopback)")
-    db_url, name = scratch_db_url(args.db_url)
-    recreate_db(args.db_url, name)
-    media_root = Path(tempfile.mkdtemp(prefix="studybench-media-"))
-    study = setup_django(db_url, media_root)
-    env = dict(os.environ, DATABASE_URL=db_url, MEDIA_ROOT=str(media_root), DJANGO_SETTINGS_MODULE="studyapp.settings",
-               OMP_NUM_THREADS="1", MKL_NUM_THREADS="1")
-    gunicorn = subprocess.Popen(
-        [sys.executable, "-m", "gunicorn", "studyapp.wsgi", "-w", str(args.workers), "-b", f"127.0.0.1:{args.port}",
-         "--log-level", "warning", "--timeout", "60"], cwd=ROOT, env=env)
-    base = f"http://127.0.0.1:{args.port}"
-    try:
-        wait_for_server(base)
-        start = time.time() + 0.5
-        clients = [Participant(base, study.slug, i, start, start + args.time_limit) for i in range(args.participants)]
-        for c in clients:
-            c.start()
-        for c in clients:
-            c.join(args.time_limit + 60)
-        wall = time.time() - start
-    finally:
-        gunicorn.send_signal(signal.SIGTERM)
-        gunicorn.wait(30)
+# --------------------------------------------------------------------------------------------- the drivers ---
 
+class RequestsHttp:
+    """The http object of take_study for the threads driver: one requests.Session (its own cookies)."""
+
+    def __init__(self):
+        import requests
+
+        self.session = requests.Session()
+
+    def request(self, method: str, url: str, data: dict | None, name: str):
+        t = time.perf_counter()
+        r = self.session.request(method, url, data=data, headers={"Referer": url}, allow_redirects=False,
+                                 timeout=60, verify=False)       # --nginx: the run's self-signed certificate
+        return r.status_code, r.headers.get("Location"), r.text, 1000 * (time.perf_counter() - t)
+
+
+class DjangoClientHttp:
+    """The http object of take_study in-process (django.test.Client, no network, no gunicorn): records the
+    server-side time and the number of SQL queries of every request by name."""
+
+    def __init__(self):
+        from django.test import Client
+
+        self.client = Client()
+        self.costs: dict[str, list[tuple[float, int]]] = {}
+
+    def request(self, method: str, url: str, data: dict | None, name: str):
+        from django.db import connection
+        from django.test.utils import CaptureQueriesContext
+
+        parts = urlsplit(url)
+        path = parts.path + (f"?{parts.query}" if parts.query else "")
+        with CaptureQueriesContext(connection) as queries:
+            t = time.perf_counter()
+            r = self.client.post(path, data) if method == "POST" else self.client.get(path)
+            ms = 1000 * (time.perf_counter() - t)
+        self.costs.setdefault(name, []).append((ms, len(queries)))
+        return r.status_code, r.get("Location"), r.content.decode(), ms
+
+
+def in_process_costs(slug: str, n: int) -> dict[str, dict]:
+    """Per request kind: median server time (ms) and queries, from n participants taken in-process after the
+    load run (the machine's other load still applies)."""
+    http = DjangoClientHttp()
+    for i in range(n):
+        take_study(http, "http://testserver", slug, 900_000 + i, time.time() + 300)
+    return {name: {"n": len(v), "ms_p50": round(statistics.median(ms for ms, _ in v), 1),
+                   "queries_p50": statistics.median(q for _, q in v)} for name, v in sorted(http.costs.items())}
+
+
+def run_threads(args, base: str, slug: str) -> list[dict]:
+    """The issue-8 driver: one thread per participant, started evenly over --arrival seconds."""
+    start = time.time() + 0.5
+    deadline = start + args.arrival + args.time_limit
+    records: list[dict] = []
+
+    def one(i: int):
+        time.sleep(max(0.0, start + i * args.arrival / args.participants - time.time()))
+        records.append(take_study(RequestsHttp(), base, slug, i, deadline, args.think))
+
+    threads = [threading.Thread(target=one, args=(i,), daemon=True) for i in range(args.participants)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join(args.arrival + args.time_limit + 60)
+    return records
+
+
+def _locust(args, base: str, env: dict, users: list[str], n_users: int, rate: float, run_s: float, csv: str,
+            results: Path | None = None, expected: int = 0) -> None:
+    """Run locust headless on LOCUSTFILE; stops it once `expected` records are in `results` (or at run_s)."""
+    cmd = [sys.executable, "-m", "locust", "-f", str(LOCUSTFILE), "--headless", "--host", base, "-u", str(n_users),
+           "-r", f"{rate:.3f}", "-t", f"{int(run_s)}s", "--csv", csv, "--only-summary", "--loglevel", "WARNING",
+           "--stop-timeout", "5", *users]
+    if args.processes > 1:
+        cmd[3:3] = ["--processes", str(args.processes)]
+    proc = subprocess.Popen(cmd, cwd=ROOT, env=env, start_new_session=True)
+    while proc.poll() is None:
+        if results is not None and expected and results.exists() and \
+                sum(1 for _ in results.open()) >= expected:
+            proc.send_signal(signal.SIGTERM)
+            break
+        time.sleep(0.5)
+    try:
+        proc.wait(30)
+    except subprocess.TimeoutExpired:
+        os.killpg(proc.pid, signal.SIGKILL)
+        proc.wait()
+
+
+def locust_rows(csv_prefix: str) -> dict[str, dict]:
+    import csv
+
+    path = Path(csv_prefix + "_stats.csv")
+    if not path.exists():
+        return {}
+    with open(path) as fh:
+        return {f"{row['Type']} {row['Name']}".strip(): row for row in csv.DictReader(fh)}
+
+
+def run_ceiling(args, base: str, env: dict, out: Path) -> dict:
+    prefix = str(out / "ceiling")
+    _locust(args, base, env, ["HealthUser"], args.ceiling_users, args.ceiling_users, args.ceiling_s, prefix)
+    row = locust_rows(prefix).get("Aggregated", {})
+    return {"healthz_requests_per_s": round(float(row.get("Requests/s", "nan")), 1),
+            "healthz_ms_p50": row.get("50%"), "healthz_ms_p99": row.get("99%"),
+            "healthz_failures": int(row.get("Failure Count", 0) or 0)}
+
+
+def run_locust_study(args, base: str, env: dict, out: Path, slug: str) -> tuple[list[dict], dict]:
+    results = out / "participants.jsonl"
+    env = dict(env, STUDY_BENCH_SLUG=slug, STUDY_BENCH_RESULTS=str(results), STUDY_BENCH_VIEWERS=str(args.viewers),
+               STUDY_BENCH_PARTICIPANTS=str(args.participants), STUDY_BENCH_TICKETS=str(out / "tickets"),
+               STUDY_BENCH_THINK=str(args.think),
+               STUDY_BENCH_MEDIA=",".join(media_urls()), STUDY_BENCH_DEADLINE=str(time.time() + args.arrival +
+                                                                                   args.time_limit + 30))
+    users = ["StudyParticipant"] + (["MediaViewer"] if args.viewers else [])
+    n_users = args.participants + args.viewers
+    _locust(args, base, env, users, n_users, n_users / args.arrival, args.arrival + args.time_limit + 30,
+            str(out / "study"), results, args.participants)
+    records = [json.loads(line) for line in results.open()] if results.exists() else []
+    return records, locust_rows(str(out / "study"))
+
+
+# ------------------------------------------------------------------------------------------------ results ---
+
+def database_checks(study, records: list[dict]) -> dict:
+    """Lost = clips the server acknowledged (3xx after the answer POST) that are not answered in the database;
+    duplicated = (participant, section, clip, question) groups with more than one row, in the DB and the CSV."""
     import csv
     import io
 
     from django.db import connection
-    from django.db.models import Count
+    from django.db.models import Count, Exists, OuterRef
 
     from studyapp.export import stream_csv
-    from studyapp.models import Participant as P
-    from studyapp.models import Response
+    from studyapp.models import Assignment, Participant, Response
 
     connection.close()
-    stored = Response.objects.filter(section__study=study).count()
-    dup_groups = (Response.objects.filter(section__study=study)
-                  .values("participant_id", "section_id", "clip_id", "question").annotate(n=Count("id"))
-                  .filter(n__gt=1).count())
-    expected = sum(len(c.answered) for c in clients)
+    answered = dict(Assignment.objects.filter(section__study=study, answered_at__isnull=False)
+                    .values_list("participant__token").annotate(n=Count("id")))
+    lost = sum(max(0, len(r["acknowledged"]) - answered.get(r["token"], 0)) for r in records)
+    responses = Response.objects.filter(section__study=study)
+    rows_of = Response.objects.filter(participant=OuterRef("participant"), section=OuterRef("section"),
+                                      clip=OuterRef("clip"))
+    silent = Assignment.objects.filter(section__study=study, answered_at__isnull=False).filter(~Exists(rows_of))
+    if hasattr(Assignment, "Kind") and hasattr(Assignment.Kind, "PRACTICE"):
+        silent = silent.exclude(kind=Assignment.Kind.PRACTICE)      # practice items store no answers by design
     rows = list(csv.DictReader(io.StringIO("".join(stream_csv(study, "responses")))))
-    keys = [(r["participant_id"], r["section_type"], r["clip_id"], r["question"]) for r in rows]
-    answer_posts = sum(len(c.answer_ms) for c in clients)
-    all_answer = [x for c in clients for x in c.answer_ms]
-    all_pages = [x for c in clients for x in c.page_ms]
-    result = {
-        "participants": args.participants, "gunicorn_workers": args.workers, "database": "postgresql",
-        "completed": sum(c.completed for c in clients),
-        "completed_in_db": P.objects.filter(study=study, status="completed").count(),
-        "answer_posts": answer_posts, "answers_stored": stored, "answers_expected": expected,
-        "lost": max(0, expected - stored), "duplicated_db": dup_groups, "csv_rows": len(rows),
-        "duplicated_csv": len(keys) - len(set(keys)),
-        "wall_s": round(wall, 2), "answers_per_s": round(answer_posts / wall, 1),
-        "answer_post_ms_p50": round(statistics.median(all_answer), 1) if all_answer else None,
-        "answer_post_ms_p99": round(percentile(all_answer, 99), 1),
-        "clip_page_ms_p50": round(statistics.median(all_pages), 1) if all_pages else None,
-        "clip_page_ms_p99": round(percentile(all_pages, 99), 1),
-        "errors": [e for c in clients for e in c.errors][:10],
+    keys = [(r.get("participant_id"), r.get("section_type"), r.get("clip_id"), r.get("question")) for r in rows]
+    return {
+        "completed_in_db": Participant.objects.filter(study=study, status="completed").count(),
+        "answers_stored": responses.count(), "assignments_answered": sum(answered.values()),
+        "acknowledged_clips": sum(len(r["acknowledged"]) for r in records), "lost": lost,
+        "answered_without_rows": silent.count(),
+        "duplicated_db": responses.values("participant_id", "section_id", "clip_id", "question")
+        .annotate(n=Count("id")).filter(n__gt=1).count(),
+        "csv_rows": len(rows), "duplicated_csv": len(keys) - len(set(keys)),
     }
+
+
+def summarise(args, records: list[dict], checks: dict, ceiling: dict, stats: dict) -> dict:
+    starts = [r["start"] for r in records]
+    ends = [r["end"] for r in records if r.get("end")]
+    wall = (max(ends) - min(starts)) if starts and ends else float("nan")
+    answers = [x for r in records for x in r["answer_ms"]]
+    pages = [x for r in records for x in r["page_ms"]]
+    agg = stats.get("Aggregated", {})
+    total_requests = int(agg.get("Request Count", 0) or 0)
+    study_rps = total_requests / wall if total_requests and wall == wall else None
+    ceiling_rps = ceiling.get("healthz_requests_per_s")
+    media = stats.get("GET media range", {})
+    return {
+        "driver": args.driver, "participants": args.participants, "arrival_s": args.arrival, "think_s": args.think,
+        "gunicorn": f"{args.workers} workers x {args.threads} threads" + (" (gthread)" if args.threads > 1 else ""),
+        "nginx": bool(args.nginx),
+        "locust_processes": args.processes if args.driver == "locust" else None, "viewers": args.viewers,
+        "database": "postgresql", "completed": sum(bool(r["completed"]) for r in records),
+        "records": len(records), "wall_s": round(wall, 2),
+        "answer_posts": len(answers), "answer_posts_per_s": round(len(answers) / wall, 1) if answers else 0,
+        "answers_stored_per_s": round(checks["answers_stored"] / wall, 1) if wall == wall else None,
+        "answer_post_ms_p50": round(statistics.median(answers), 1) if answers else None,
+        "answer_post_ms_p99": round(percentile(answers, 99), 1) if answers else None,
+        "clip_page_ms_p50": round(statistics.median(pages), 1) if pages else None,
+        "clip_page_ms_p99": round(percentile(pages, 99), 1) if pages else None,
+        "media_range_requests": int(media.get("Request Count", 0) or 0),
+        "media_range_ms_p50": media.get("50%"), "media_range_ms_p99": media.get("99%"),
+        "study_requests": total_requests, "study_requests_per_s": round(study_rps, 1) if study_rps else None,
+        **ceiling,
+        "study_to_ceiling_ratio": round(study_rps / ceiling_rps, 2) if study_rps and ceiling_rps else None,
+        **checks,
+        "errors": [e for r in records for e in r["errors"]][:10],
+        "n_errors": sum(len(r["errors"]) for r in records),
+        "load_average_1m": round(os.getloadavg()[0], 1),
+    }
+
+
+def parse_args(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--participants", type=int, default=200)
+    ap.add_argument("--arrival", type=float, default=30.0, help="seconds over which the participants arrive")
+    ap.add_argument("--driver", choices=["locust", "threads"], default="locust")
+    ap.add_argument("--processes", type=int, default=1, help="locust generator processes (--processes)")
+    ap.add_argument("--viewers", type=int, default=4, help="slow media viewers (locust driver)")
+    ap.add_argument("--think", type=float, default=0.0,
+                    help="mean seconds a participant spends on a clip page before answering (0: as fast as possible)")
+    ap.add_argument("--workers", type=int, default=2, help="gunicorn worker processes")
+    ap.add_argument("--threads", type=int, default=8, help="threads per worker (gthread; 1 = sync workers)")
+    ap.add_argument("--ceiling-s", type=float, default=15.0, help="seconds of the /healthz ceiling run")
+    ap.add_argument("--ceiling-users", type=int, default=32)
+    ap.add_argument("--port", type=int, default=8765)
+    ap.add_argument("--nginx", action="store_true",
+                    help="put deploy/nginx/study.conf (TLS, X-Accel-Redirect media) in front of gunicorn")
+    ap.add_argument("--db-url", default=os.environ.get("DATABASE_URL") or "postgres://postgres@127.0.0.1:5432/postgres")
+    ap.add_argument("--time-limit", type=float, default=300.0,
+                    help="seconds after the last arrival before clients stop")
+    ap.add_argument("--keep-db", action="store_true", help="keep the scratch database")
+    ap.add_argument("--in-process", type=int, default=2,
+                    help="afterwards, participants taken in-process to measure each request's server time and queries")
+    ap.add_argument("--json", default="", help="also write the figures to this JSON file")
+    args = ap.parse_args(argv)
+    if not 1 <= args.participants <= 400:
+        raise SystemExit("--participants must be 1..400 (bounded load test on loopback)")
+    return args
+
+
+def main(argv=None) -> dict:
+    args = parse_args(argv)
+    db_url, name = scratch_db_url(args.db_url)
+    recreate_db(args.db_url, name)
+    out = Path(tempfile.mkdtemp(prefix="studybench-"))
+    try:
+        study = setup_django(db_url, out / "media")
+        env = dict(os.environ, DATABASE_URL=db_url, MEDIA_ROOT=str(out / "media"),
+                   DJANGO_SETTINGS_MODULE="studyapp.settings", OMP_NUM_THREADS="1", MKL_NUM_THREADS="1")
+        base, nginx = f"http://127.0.0.1:{args.port}", None
+        if args.nginx:
+            env["MEDIA_ACCEL_REDIRECT"] = "/protected-media/"
+            base, nginx = start_local_nginx(args, out)
+        gunicorn = start_gunicorn(args, env, out / "gunicorn.log")
+        try:
+            wait_for_server(base)
+            ceiling, stats = {}, {}
+            if args.driver == "locust":
+                ceiling = run_ceiling(args, base, env, out)
+                records, stats = run_locust_study(args, base, env, out, study.slug)
+            else:
+                records = run_threads(args, base, study.slug)
+        finally:
+            for proc in (nginx, gunicorn):
+                if proc is not None:
+                    proc.send_signal(signal.SIGTERM)
+                    proc.wait(30)
+        result = summarise(args, records, database_checks(study, records), ceiling, stats)
+        result["gunicorn_log"] = str(out / "gunicorn.log")
+        if args.in_process:
+            result["in_process"] = in_process_costs(study.slug, args.in_process)
+    finally:
+        if not args.keep_db:
+            drop_db(args.db_url, name)
     print(json.dumps(result, indent=1))
     if args.json:
         Path(args.json).write_text(json.dumps(result, indent=1))
-    ok = result["lost"] == 0 and result["duplicated_db"] == 0 and result["duplicated_csv"] == 0 and not result["errors"]
-    if not ok:
-        print("FAILED: lost, duplicated or failed requests", file=sys.stderr)
     return result
+
+
+def passed(result: dict) -> bool:
+    return (result["lost"] == 0 and result["duplicated_db"] == 0 and result["duplicated_csv"] == 0
+            and result["answered_without_rows"] == 0 and not result["errors"]
+            and result["completed"] == result["participants"])
 
 
 if __name__ == "__main__":
     res = main()
-    sys.exit(0 if res["lost"] == 0 and res["duplicated_db"] == 0 and not res["errors"] else 1)
+    if not passed(res):
+        print("FAILED: lost, duplicated, incomplete or failed requests", file=sys.stderr)
+    sys.exit(0 if passed(res) else 1)

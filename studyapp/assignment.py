@@ -6,37 +6,47 @@ Rules (seed 000 section 6.1, seed 003 section 6.1, seed 004 section V):
 - no clip twice for one participant, except in a section that reuses another section's clips on purpose;
 - naturalness mixes generated and source clips, unlabelled, in random order, and never shows a generated clip
   whose source clip is also shown (seed 003);
-- gesture_emotion records four options: the intended emotion and three others drawn from the 11 categories.
-Assignment happens once, inside a transaction that row-locks the study (`select_for_update`; PostgreSQL serialises
-concurrent starters on it, SQLite serialises all writers anyway), so counts stay balanced under concurrent arrivals
-and the participant limit holds.
+- gesture_emotion records four options: the intended emotion and three others drawn from the 11 categories;
+- practice items and attention checks (studyapp.trial_extras) and the counterbalanced section order
+  (studyapp.counterbalance) are fixed at the start too.
+
+Concurrency (issue 16): a start plans without any lock: pools from a per-study cache (studyapp.pool_cache), the
+balancing counts from SectionClipCount (one row per section and pool clip) read plainly. Its transaction then
+claims the participant, locks the count rows of its sections (FOR NO KEY UPDATE on PostgreSQL, in (section, clip)
+order; SQLite runs one writer at a time anyway), plans again only if another start changed the counts meanwhile
+(in memory, from the cached pools), adds its clips with F() updates, inserts its assignments and commits. Starts
+therefore queue only for that short tail, never for another's planning, and the counts every start sees are
+exact: the balance is that of one-at-a-time starts (spread of a section's clips at most 1 where the pool allows;
+a section that draws from clips an earlier section also takes, such as demo naturalness after emotion_choice, can
+reach 2, as with sequential starts). The participant limit is exact: the check runs last, under a row lock on the
+study's counter row (StudyCounter), held only for the count and the commit.
 """
 from __future__ import annotations
 
 import random
+import threading
+import time
 from collections import Counter
-from dataclasses import dataclass, field
+from contextlib import nullcontext
+from dataclasses import dataclass
 from datetime import timedelta
 
-from django.db import transaction
-from django.db.models import Count
+from django.db import OperationalError, connection, transaction
+from django.db.models import F
 from django.utils import timezone
 
-from study_protocol import GESTURE_EMOTIONS
+from .counterbalance import SectionInfo, section_order
+from .models import Assignment, Clip, Participant, Section, SectionClipCount, Study, StudyCounter
+from .pool_cache import SectionPool, load_section_pool, section_pools
+from .pools import SUB_POOLS
+from .trial_extras import PlannedItem, gesture_options, with_extras
 
-from .catalogue import pool_queryset
-from .models import Assignment, Clip, Participant, Section, Study
-from .pools import DEFAULT_GESTURE_OPTIONS, SUB_POOLS
+__all__ = ["PlannedItem", "Step", "StudyUnavailable", "active_count", "check_open", "current_step",
+           "plan_section", "plan_study", "start_participant"]
 
 
 class StudyUnavailable(Exception):
     """The study is closed, or full; the message says which, for the participant."""
-
-
-@dataclass
-class PlannedItem:
-    clip: Clip
-    options: list[str] = field(default_factory=list)
 
 
 def _rng(seed: int, section: Section) -> random.Random:
@@ -51,27 +61,13 @@ def _balanced_pick(rng: random.Random, clips: list[Clip], counts: dict[int, int]
     return clips if k <= 0 else clips[:k]
 
 
-def _section_counts(section: Section) -> dict[int, int]:
-    rows = (Assignment.objects.filter(section=section).values("clip_id").annotate(n=Count("id")))
-    return {r["clip_id"]: r["n"] for r in rows}
-
-
-def _gesture_options(rng: random.Random, clip: Clip, section: Section) -> list[str]:
-    categories = list(section.options.get("categories") or GESTURE_EMOTIONS)
-    n_options = int(section.options.get("n_options", DEFAULT_GESTURE_OPTIONS))
-    intended = clip.emotion_label or "neutral"
-    others = [c for c in categories if c != intended]
-    shown = [intended, *rng.sample(others, min(n_options - 1, len(others)))]
-    rng.shuffle(shown)
-    return shown
-
-
 def plan_section(section: Section, seed: int, used: set[int], earlier: dict[int, list[PlannedItem]],
-                 counts: dict[int, int] | None = None) -> list[PlannedItem]:
-    """The ordered clips of one section for one participant (no DB writes).
+                 counts: dict[int, int] | None = None, pool: SectionPool | None = None) -> list[PlannedItem]:
+    """The ordered clips of one section for one participant (no DB writes; practice and checks not included).
 
     used: pks of clips already given to this participant (excluded); earlier: section pk -> planned items of the
-    sections before this one (for reuse); counts: clip pk -> assignments so far in this section (balancing).
+    sections before this one (for reuse); counts: clip pk -> assignments so far in this section (balancing);
+    pool: the section's cached pool (studyapp.pool_cache; queried when None).
     """
     rng = _rng(seed, section)
     counts = counts or {}
@@ -82,18 +78,12 @@ def plan_section(section: Section, seed: int, used: set[int], earlier: dict[int,
         if section.randomize_order:
             rng.shuffle(items)
         return items
-    base = [c for c in pool_queryset(section.pool) if c.pk not in used]
+    pool = pool if pool is not None else load_section_pool(section)
+    base = [c for c in pool.clips if c.pk not in used]
     k = section.clips_per_participant
     if section.section_type == "naturalness" and (any(key in section.pool for key in SUB_POOLS)
                                                   or "n_source" in section.options):
-        n_source = int(section.options.get("n_source", k // 2 if k else 0))
-        n_generated = int(section.options.get("n_generated", (k - n_source) if k else 0))
-        sources = [c for c in base if c.origin == "source" and _matches(c, section.pool.get("source"))]
-        generated = [c for c in base if c.origin == "generated" and _matches(c, section.pool.get("generated"))]
-        chosen_src = _pick_sources(rng, sources, generated, counts, n_source, n_generated)
-        src_ids = {c.clip_id for c in chosen_src}
-        generated = [c for c in generated if c.source_clip_id not in src_ids]
-        chosen = chosen_src + (_balanced_pick(rng, generated, counts, n_generated) if n_generated else [])
+        chosen = _plan_naturalness(section, rng, base, pool, counts, k)
         rng.shuffle(chosen)          # mixed, unlabelled, random order (seed 003)
         return [PlannedItem(c) for c in chosen]
     chosen = _balanced_pick(rng, base, counts, k)
@@ -104,8 +94,25 @@ def plan_section(section: Section, seed: int, used: set[int], earlier: dict[int,
     items = [PlannedItem(c) for c in chosen]
     if section.section_type == "gesture_emotion":
         for it in items:
-            it.options = _gesture_options(rng, it.clip, section)
+            it.options = gesture_options(rng, section, it.clip.emotion_label or "neutral")
     return items
+
+
+def _in_sub_pool(pool: SectionPool, key: str, clip: Clip) -> bool:
+    return key not in pool.sub_pools or clip.pk in pool.sub_pools[key]
+
+
+def _plan_naturalness(section: Section, rng: random.Random, base: list[Clip], pool: SectionPool,
+                      counts: dict[int, int], k: int) -> list[Clip]:
+    """Balanced source and generated clips of a naturalness section, no generated clip with its source."""
+    n_source = int(section.options.get("n_source", k // 2 if k else 0))
+    n_generated = int(section.options.get("n_generated", (k - n_source) if k else 0))
+    sources = [c for c in base if c.origin == "source" and _in_sub_pool(pool, "source", c)]
+    generated = [c for c in base if c.origin == "generated" and _in_sub_pool(pool, "generated", c)]
+    chosen_src = _pick_sources(rng, sources, generated, counts, n_source, n_generated)
+    src_ids = {c.clip_id for c in chosen_src}
+    generated = [c for c in generated if c.source_clip_id not in src_ids]
+    return chosen_src + (_balanced_pick(rng, generated, counts, n_generated) if n_generated else [])
 
 
 def _pick_sources(rng: random.Random, sources: list[Clip], generated: list[Clip], counts: dict[int, int],
@@ -129,24 +136,44 @@ def _pick_sources(rng: random.Random, sources: list[Clip], generated: list[Clip]
     return chosen + skipped[:n_source - len(chosen)]
 
 
-def _matches(clip: Clip, sub_pool: dict | None) -> bool:
-    if not sub_pool:
-        return True
-    return pool_queryset(sub_pool).filter(pk=clip.pk).exists()
+def read_counts(sections: list[Section], lock: bool = False) -> dict[int, dict[int, int]]:
+    """Section pk -> clip pk -> participants given the clip there so far (one query). lock: row-lock the counts
+    (FOR NO KEY UPDATE, in (section, clip) order so two starts never deadlock) until the transaction ends."""
+    out: dict[int, dict[int, int]] = {s.pk: {} for s in sections}
+    rows = SectionClipCount.objects.filter(section__in=[s.pk for s in sections])
+    if lock:
+        rows = rows.select_for_update(no_key=True).order_by("section_id", "clip_id")
+    for section_id, clip_id, n in rows.values_list("section_id", "clip_id", "n"):
+        out[section_id][clip_id] = n
+    return out
 
 
-def plan_study(study: Study, seed: int, balanced: bool = True) -> list[tuple[Section, list[PlannedItem]]]:
-    """Plan every section of `study` for a participant with `seed` (no writes; previews use balanced=False)."""
+def plan_study(study: Study, seed: int, balanced: bool = True, sections: list[Section] | None = None,
+               pools: dict[int, SectionPool] | None = None, counts: dict[int, dict[int, int]] | None = None,
+               extras: bool = False) -> list[tuple[Section, list[PlannedItem]]]:
+    """Plan every section of `study` for a participant with `seed`, in the study's order (no writes).
+
+    balanced: use the balancing counts (previews pass False); sections/pools/counts: already loaded ones (the
+    start passes them; otherwise they are queried); extras: add practice items and attention checks.
+    """
+    sections = sections if sections is not None else list(study.sections.order_by("order", "id"))
+    pools = pools if pools is not None else {s.pk: load_section_pool(s) for s in sections}
+    if counts is None:
+        counts = read_counts(sections) if balanced else {}
     used: set[int] = set()
     earlier: dict[int, list[PlannedItem]] = {}
     plan = []
-    for section in study.sections.order_by("order", "id"):
-        counts = _section_counts(section) if balanced else {}
-        items = plan_section(section, seed, used, earlier, counts)
+    for section in sections:
+        pool = pools.get(section.pk) or SectionPool()
+        items = plan_section(section, seed, used, earlier, counts.get(section.pk, {}), pool)
         earlier[section.pk] = items
         if not section.reuse_section_id:
             used.update(it.clip.pk for it in items)
         plan.append((section, items))
+    if extras:
+        plan = [(section, with_extras(section, items, pools.get(section.pk, SectionPool()).clips,
+                                      pools.get(section.pk, SectionPool()).practice, used, seed))
+                for section, items in plan]
     return plan
 
 
@@ -159,11 +186,52 @@ def active_count(study: Study) -> int:
     return qs.count()
 
 
+STUDY_CLOSED = "This study is closed and is not accepting participants. Thank you for your interest."
+STUDY_FULL = "This study is full: it has all the participants it needs. Thank you for your interest."
+
+
 def check_open(study: Study) -> None:
     if study.status != Study.Status.OPEN:
-        raise StudyUnavailable("This study is closed and is not accepting participants. Thank you for your interest.")
+        raise StudyUnavailable(STUDY_CLOSED)
     if study.max_participants and active_count(study) >= study.max_participants:
-        raise StudyUnavailable("This study is full: it has all the participants it needs. Thank you for your interest.")
+        raise StudyUnavailable(STUDY_FULL)
+
+
+def _counter(study_id: int):
+    StudyCounter.objects.get_or_create(study_id=study_id)
+    return StudyCounter.objects.filter(study_id=study_id)
+
+
+def next_arrival(study_id: int) -> int:
+    """The 0-based arrival index of the next starting participant (its own short transaction: the counter row
+    is locked for one UPDATE and one SELECT). A start that then fails leaves a gap, which only shifts rows."""
+    with _one_writer(), transaction.atomic():
+        counter = _counter(study_id)
+        counter.update(arrivals=F("arrivals") + 1)
+        return counter.values_list("arrivals", flat=True).get() - 1
+
+
+def participant_order(study: Study, sections: list[Section]) -> list[Section]:
+    """The sections in the order this (next) participant takes them: the study's order, or a Williams row of the
+    rotating sections by arrival index when the study counterbalances (studyapp.counterbalance)."""
+    infos = [SectionInfo(s.pk, s.counterbalance, s.reuse_section_id) for s in sections]
+    if not study.counterbalance_sections or sum(s.counterbalance for s in sections) < 2:
+        return list(sections)
+    by_pk = {s.pk: s for s in sections}
+    return [by_pk[pk] for pk in section_order(infos, next_arrival(study.pk))]
+
+
+def _assignment_rows(participant: Participant, plan: list[tuple[Section, list[PlannedItem]]],
+                     order: list[Section]) -> list[Assignment]:
+    """Assignment rows of a plan in the participant's section order, seq 1..n over the study."""
+    by_section = {section.pk: items for section, items in plan}
+    rows, seq = [], 0
+    for section in order:
+        for position, it in enumerate(by_section[section.pk]):
+            seq += 1
+            rows.append(Assignment(participant=participant, section=section, position=position, clip=it.clip,
+                                   options=it.options, seq=seq, kind=it.kind, instructed=it.instructed))
+    return rows
 
 
 def start_participant(participant: Participant) -> bool:
@@ -171,22 +239,113 @@ def start_participant(participant: Participant) -> bool:
 
     Raises StudyUnavailable if the study closed or filled up before this participant started.
     """
-    with transaction.atomic():
-        study = Study.objects.select_for_update().get(pk=participant.study_id)
-        p = Participant.objects.select_for_update().get(pk=participant.pk)
-        if p.status != Participant.Status.CONSENTED:
+    started = _with_retries(lambda: _start(participant))
+    _with_retries(participant.refresh_from_db)
+    return started
+
+
+def _start(participant: Participant) -> bool:
+    """Plan without any lock (cached pools, counts read plainly), then the start's short transaction."""
+    p = Participant.objects.select_related("study").get(pk=participant.pk)
+    if p.status != Participant.Status.CONSENTED:
+        return False
+    study = p.study
+    check_open(study)
+    sections = list(study.sections.order_by("order", "id"))
+    pools = section_pools(study.pk, sections)
+    balanced = [s for s in sections if not s.reuse_section_id]
+    counts = read_counts(balanced)
+    _ensure_count_rows(balanced, pools, counts)
+    plan = plan_study(study, p.seed, sections=sections, pools=pools, counts=counts, extras=True)
+    order = participant_order(study, sections)
+
+    def fresh_plan():
+        """In the transaction: lock the counts; plan again only if they changed since planning."""
+        locked = read_counts(balanced, lock=True)
+        if _nonzero(locked) == _nonzero(counts):
+            return plan
+        return plan_study(study, p.seed, sections=sections, pools=pools, counts=locked, extras=True)
+
+    return _commit_start(p, study, fresh_plan, order)
+
+
+def _nonzero(counts: dict[int, dict[int, int]]) -> dict[int, dict[int, int]]:
+    return {pk: {c: n for c, n in row.items() if n} for pk, row in counts.items()}
+
+
+def _ensure_count_rows(sections: list[Section], pools: dict[int, SectionPool], counts) -> None:
+    """Create the missing zero counter rows of the sections' pool clips (once per clip; autocommit), so the
+    start's transaction can lock every count it reads."""
+    missing = [SectionClipCount(section_id=s.pk, clip_id=c.pk) for s in sections
+               for c in (pools.get(s.pk) or SectionPool()).clips if c.pk not in counts[s.pk]]
+    if missing:
+        SectionClipCount.objects.bulk_create(missing, ignore_conflicts=True, batch_size=500)
+
+
+SQLITE_RETRY_SECONDS = 30.0
+_SQLITE_WRITER = threading.Lock()
+
+
+def _one_writer():
+    """On SQLite, threads of this process queue for the start's write transaction (SQLite runs one writer at a
+    time anyway; queueing avoids transactions that fail and retry against each other). Elsewhere: nothing."""
+    return _SQLITE_WRITER if connection.vendor == "sqlite" else nullcontext()
+
+
+def _retryable(exc: Exception) -> bool:
+    """A lock conflict worth running the start again for: SQLite's "database/table is locked", PostgreSQL's
+    deadlock (40P01) or serialization failure (40001), e.g. two starts swapping counter rows in opposite order."""
+    if connection.vendor == "sqlite":
+        return "locked" in str(exc)
+    return getattr(exc.__cause__, "pgcode", None) in ("40P01", "40001") or "deadlock detected" in str(exc)
+
+
+def _with_retries(action, patience_s: float = SQLITE_RETRY_SECONDS):
+    """Run ``action``; retry it (jittered back-off, up to ``patience_s``) after a lock conflict (``_retryable``):
+    SQLite serialises writers and, in some cases (a read transaction upgrading to write, shared-cache test
+    databases), reports "locked" at once instead of waiting; PostgreSQL aborts one side of a deadlock."""
+    deadline = time.monotonic() + patience_s
+    attempt = 0
+    while True:
+        try:
+            return action()
+        except OperationalError as exc:
+            if not _retryable(exc) or time.monotonic() > deadline:
+                raise
+            attempt += 1
+            time.sleep(random.uniform(0.002, 0.002 * min(attempt, 25)))
+
+
+def _commit_start(p: Participant, study: Study, fresh_plan, order: list[Section]) -> bool:
+    """The start's transaction: claim the participant, lock and re-read the balancing counts (plan again only if
+    a concurrent start changed them), count this participant's clips, insert the assignments, check the limit.
+    Locks are taken in the same order by every start (participant row, count rows by (section, clip), counter
+    row), so starts queue on the count rows for this short tail but never deadlock."""
+    now = timezone.now()
+    with _one_writer(), transaction.atomic():
+        claimed = Participant.objects.filter(pk=p.pk, status=Participant.Status.CONSENTED).update(
+            status=Participant.Status.STARTED, started_at=now, last_active_at=now,
+            section_order=[s.pk for s in order])
+        if not claimed:
             return False
-        check_open(study)
-        rows = []
-        for section, items in plan_study(study, p.seed):
-            rows += [Assignment(participant=p, section=section, position=i, clip=it.clip, options=it.options)
-                     for i, it in enumerate(items)]
-        Assignment.objects.bulk_create(rows)
-        p.status = Participant.Status.STARTED
-        p.started_at = p.last_active_at = timezone.now()
-        p.save(update_fields=["status", "started_at", "last_active_at"])
-    participant.refresh_from_db()
+        plan = fresh_plan()
+        Participant.objects.filter(pk=p.pk).update(n_items=sum(len(items) for _, items in plan))
+        _count_trials(plan)
+        Assignment.objects.bulk_create(_assignment_rows(p, plan, order))
+        if study.max_participants:
+            _counter(study.pk).select_for_update(no_key=True).get()
+            if active_count(study) > study.max_participants:
+                raise StudyUnavailable(STUDY_FULL)
     return True
+
+
+def _count_trials(plan: list[tuple[Section, list[PlannedItem]]]) -> None:
+    """Add this participant's trial clips to the balancing counts: one F() UPDATE per balanced section
+    (practice items, attention checks and reusing sections are not counted)."""
+    for section, items in plan:
+        pks = [it.clip.pk for it in items if not it.kind]
+        if pks and not section.reuse_section_id:      # the rows exist: _ensure_count_rows made them
+            SectionClipCount.objects.filter(section_id=section.pk, clip_id__in=pks).update(n=F("n") + 1)
 
 
 @dataclass
@@ -194,23 +353,38 @@ class Step:
     """Where a participant is: kind in demographics | start | item | feedback | done."""
     kind: str
     assignment: Assignment | None = None
-    index: int = 0          # 1-based number of this clip among all of the participant's clips
+    index: int = 0          # 1-based number of this clip among all of the participant's clips (Assignment.seq)
     total: int = 0
+    next_assignment: Assignment | None = None     # the clip after this one (preloaded by the page), if asked for
 
 
-def current_step(participant: Participant) -> Step:
-    """The participant's next page, computed from the database only (so reloads and restarts resume)."""
+STEP_FIELDS = ("id", "participant_id", "section", "position", "clip", "options", "shown_at", "answered_at", "seq",
+               "kind", "instructed", *(f"clip__{f}" for f in ("id", "clip_id", "theme", "duration_s", "media_key",
+                                                              "video", "webm", "poster", "loop")))
+"""What a clip page reads of an assignment and its clip (its section is read whole: one small row)."""
+
+
+def open_items(participant: Participant, n: int = 1) -> list[Assignment]:
+    """The participant's first ``n`` unanswered assignments by seq: one indexed query (partial index on
+    (participant, seq) where answered_at is null), whatever the size of the study."""
+    qs = (Assignment.objects.filter(participant_id=participant.pk, answered_at__isnull=True)
+          .select_related("section", "clip").only(*STEP_FIELDS).order_by("seq"))
+    return list(qs[:n])
+
+
+def current_step(participant: Participant, lookahead: bool = False) -> Step:
+    """The participant's next page, computed from the database only (so reloads and restarts resume): at most one
+    query (the first unanswered assignment; with lookahead the one after it too). The total is the stored
+    Participant.n_items."""
     study = participant.study
     if study.ask_demographics and not participant.demographics_done:
         return Step("demographics")
     if participant.status == Participant.Status.CONSENTED:
         return Step("start")
-    assignments = list(participant.assignments.select_related("section", "clip").order_by("section__order",
-                                                                                           "section_id", "position"))
-    total = len(assignments)
-    for i, a in enumerate(assignments):
-        if a.answered_at is None:
-            return Step("item", a, i + 1, total)
+    total = participant.n_items
+    items = open_items(participant, 2 if lookahead else 1)
+    if items:
+        return Step("item", items[0], items[0].seq, total, items[1] if len(items) > 1 else None)
     if study.feedback_questions and not participant.feedback_done:
         return Step("feedback", None, total, total)
     return Step("done", None, total, total)

@@ -4,7 +4,8 @@
 DESIGN.md clips.csv fields plus `video` (MP4 path relative to MEDIA_ROOT), `webm` (or ""), `poster`, `plan`,
 `loop` (bool) and `metadata` (dict); optional `source_clip_id` (the clip_id of the source clip a generated clip was
 made from; also read from `pair` or metadata["source_clip_id"] / metadata["pair"]) and `sections` (the plan's
-section-type hints, a list or comma-separated; also read from metadata["sections"]).
+section-type hints, a list or comma-separated; also read from metadata["sections"]); optional `qa` (the quality
+record, a dict: generation.quality) and `qa_flag` (failed checks joined by ';', also read from qa["flag"]).
 """
 from __future__ import annotations
 
@@ -13,10 +14,10 @@ import math
 from django.db import transaction
 from django.db.models import QuerySet
 
-from study_protocol import CLIP_FLOAT_COLUMNS, CLIP_THEMES, GESTURE_EMOTIONS, MODALITIES, ORIGINS
+from study_protocol import CLIP_FLOAT_COLUMNS, CLIP_THEMES, GESTURE_EMOTIONS, MODALITIES, ORIGINS, QA_CHECKS
 
 from .models import Clip
-from .pools import PoolError, pool_lookups
+from .pools import INCLUDE_FLAGGED, PoolError, pool_lookups
 
 TEXT_FIELDS = ("emotion_label", "theme", "webm", "poster", "plan", "source_clip_id")
 
@@ -92,7 +93,25 @@ def clean_record(rec: dict, index: int = 0) -> dict:
     if isinstance(sections, str):
         sections = [s for s in sections.split(",")]
     out["sections"] = ",".join(str(s).strip() for s in sections if str(s).strip())
+    out["qa"], out["qa_flag"] = _qa(rec, where)
     return out
+
+
+def _qa(rec: dict, where: str) -> tuple[dict, str]:
+    """(quality record, flag) of a clip record: ``qa`` (a dict) and ``qa_flag`` (or qa["flag"]); failed checks
+    must be names of QA_CHECKS."""
+    qa = rec.get("qa") or {}
+    if not isinstance(qa, dict):
+        raise CatalogueError(f"{where}: field 'qa' must be a dict (the quality record), got {type(qa).__name__}")
+    flag = rec.get("qa_flag")
+    if _blank(flag):
+        flag = qa.get("flag", "")
+    flag = "" if _blank(flag) else str(flag).strip()
+    unknown = [f for f in flag.split(";") if f and f not in QA_CHECKS]
+    if unknown:
+        raise CatalogueError(f"{where}: field 'qa_flag': {unknown[0]!r} is not a quality check "
+                             f"({', '.join(QA_CHECKS)})")
+    return {k: v for k, v in qa.items() if k != "flag"}, flag
 
 
 def upsert_clips(records: list[dict]) -> int:
@@ -122,16 +141,23 @@ def retire_superseded(plan: str, current_clip_ids: set[str], entry_ids: set[str]
     return stale.update(retired=True)
 
 
-def pool_queryset(pool: dict | None) -> QuerySet:
+def pool_queryset(pool: dict | None, include_flagged: bool | None = None) -> QuerySet:
     """Clips (not retired) matching a section's pool filter (see studyapp.pools for the filter language).
 
-    Raises CatalogueError naming the filter when the pool is not valid; sub-pools are left to the assignment.
+    Clips that failed a quality check (``qa_flag`` not empty) are left out unless the pool says
+    ``"include_flagged": true`` or ``include_flagged`` is given (True for a sub-pool, which only narrows its
+    section's pool). Raises CatalogueError naming the filter when the pool is not valid; sub-pools are left to the
+    assignment.
     """
     try:
         calls = pool_lookups(pool)
     except PoolError as exc:
         raise CatalogueError(f"pool: {'; '.join(exc.errors['pool'])}") from exc
     qs = Clip.objects.filter(retired=False)
+    if include_flagged is None:
+        include_flagged = bool((pool or {}).get(INCLUDE_FLAGGED, False))
+    if not include_flagged:
+        qs = qs.filter(qa_flag="")
     for method, kwargs in calls:
         qs = getattr(qs, method)(**kwargs)
     return qs

@@ -9,6 +9,13 @@ Spreadsheet formula injection: participants type some of these cells (external_i
 that starts with =, +, -, @, a tab or a carriage return is written with a leading single quote (') so Excel,
 LibreOffice and Google Sheets show it as text instead of running it; plain numbers (e.g. an inversion rating of
 -7 or a response time) are written unchanged. docs/study.md tells researchers.
+
+Practice items and attention checks (studyapp.trial_extras): practice answers are never stored, and practice
+items are left out of assignments.csv. Attention checks are rows of responses.csv and assignments.csv with
+section_type ``attention_check`` (study_protocol.ATTENTION_CHECK) and question ``<key>=<instructed answer>``;
+participants.csv counts them per participant (``attention_passed``, ``attention_total``). Its ``section_order``
+column lists the ``order`` numbers (Section.order, as in assignments.csv's section_order) of the sections in the
+order the participant took them, joined by ';' (empty for a participant who has not started).
 """
 from __future__ import annotations
 
@@ -17,9 +24,16 @@ import re
 from collections.abc import Iterable, Iterator
 from pathlib import Path
 
-from django.db.models import Q
+from django.db.models import Case, F, Q, When
 
-from study_protocol import ASSIGNMENT_COLUMNS, CLIP_COLUMNS, PARTICIPANT_COLUMNS, RESPONSE_COLUMNS
+from study_protocol import (
+    ASSIGNMENT_COLUMNS,
+    ATTENTION_CHECK,
+    CLIP_COLUMNS,
+    PARTICIPANT_COLUMNS,
+    RESPONSE_COLUMNS,
+    attention_passed,
+)
 
 from .catalogue import pool_queryset
 from .models import Assignment, Clip, Response, Study
@@ -62,10 +76,16 @@ def _iso(dt) -> str:
     return dt.isoformat() if dt else ""
 
 
+def _exported_type():
+    """The section_type cell: the row's kind (attention check) when it has one, else its section's type."""
+    return Case(When(kind="", then=F("section__section_type")), default=F("kind"))
+
+
 def response_rows(study: Study) -> Iterator[list]:
     qs = (Response.objects.filter(section__study=study)
+          .annotate(exported_type=_exported_type())
           .order_by("participant_id", "section__order", "id")
-          .values_list("participant__public_id", "section__section_type", "clip__clip_id", "question", "answer",
+          .values_list("participant__public_id", "exported_type", "clip__clip_id", "question", "answer",
                        "response_ms"))
     for row in qs.iterator(chunk_size=CHUNK):
         yield list(row)
@@ -89,16 +109,33 @@ def feedback_keys(study: Study) -> list[str]:
     return [str(q["key"]) for q in study.feedback_questions or []]
 
 
+def attention_counts(study: Study) -> dict[int, tuple[int, int]]:
+    """Participant pk -> (attention checks passed, answered), from the study's attention-check responses."""
+    counts: dict[int, tuple[int, int]] = {}
+    rows = (Response.objects.filter(section__study=study, kind=ATTENTION_CHECK)
+            .values_list("participant_id", "question", "answer"))
+    for pk, question, answer in rows.iterator(chunk_size=CHUNK):
+        passed, total = counts.get(pk, (0, 0))
+        counts[pk] = (passed + attention_passed(question, answer), total + 1)
+    return counts
+
+
 def participant_rows(study: Study) -> Iterator[list]:
     keys = feedback_keys(study)
+    attention = attention_counts(study)
+    orders = dict(study.sections.values_list("pk", "order"))
     for p in study.participants.order_by("id").iterator(chunk_size=CHUNK):
+        passed, total = attention.get(p.pk, (0, 0))
+        order = ";".join(str(orders[pk]) for pk in p.section_order or [] if pk in orders)
         yield [p.public_id, p.gender, p.age_group, _iso(p.started_at), _iso(p.completed_at), p.status,
-               p.external_id] + [p.feedback.get(k, "") for k in keys]
+               p.external_id, passed, total, order] + [p.feedback.get(k, "") for k in keys]
 
 
 def assignment_rows(study: Study) -> Iterator[list]:
-    qs = (Assignment.objects.filter(section__study=study).order_by("participant_id", "section__order", "position")
-          .values_list("participant__public_id", "section__section_type", "section__order", "position",
+    qs = (Assignment.objects.filter(section__study=study).exclude(kind=Assignment.Kind.PRACTICE)
+          .annotate(exported_type=_exported_type())
+          .order_by("participant_id", "seq")
+          .values_list("participant__public_id", "exported_type", "section__order", "position",
                        "clip__clip_id", "options", "shown_at", "answered_at"))
     for pid, stype, order, pos, clip_id, options, shown, answered in qs.iterator(chunk_size=CHUNK):
         yield [pid, stype, order, pos, clip_id, ";".join(options or []), _iso(shown), _iso(answered)]
@@ -133,9 +170,12 @@ def write_study_csvs(study: Study, out_dir: str | Path) -> dict[str, Path]:
 
 
 def run_report(study: Study, out_dir: str | Path) -> dict:
-    """Export the CSVs and call the analysis library's report writer (analysis.report.write_report)."""
+    """Export the CSVs and call the analysis library's report writer (analysis.report.write_report) with the study's
+    exclusion rules (``Study.exclusion_rules``; empty = the analysis defaults), which the report states. Invalid rules
+    raise ValueError naming the key (the admin form checks them with analysis.exclusion.rule_errors)."""
     out = Path(out_dir)
     paths = write_study_csvs(study, out / "data")
     from analysis.report import write_report  # imported lazily: the analysis library is optional at runtime
 
-    return write_report(paths["responses"], paths["clips"], paths["participants"], out)
+    return write_report(paths["responses"], paths["clips"], paths["participants"], out,
+                        exclusion_rules=study.exclusion_rules or None)

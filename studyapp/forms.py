@@ -1,24 +1,31 @@
-"""Participant forms (consent, demographics, feedback), the researcher's create-from-preset form and the admin's
-section form (pool and options checked against the study protocol)."""
+"""Participant forms (consent, demographics, feedback), the researcher's create-from-preset form, the admin's study
+form (exclusion rules checked by the analysis library) and section form (the pool editor: pool and options as
+fields or raw JSON, checked against the study protocol) with the preview form of its live clip count."""
 from __future__ import annotations
 
 from django import forms
+from django.utils.translation import gettext
+from django.utils.translation import gettext_lazy as _
 
-from .models import Section, Study
-from .pools import validate_section
+from . import pool_editor
+from .i18n import display
+from .models import Clip, Section, Study
+from .pool_editor import PoolEditorFields
+from .pools import SUB_POOLS
 from .presets import preset_choices
+from .questions import section_type_choices
 
-GENDERS = [("female", "Female"), ("male", "Male"), ("non-binary", "Non-binary / another gender"),
-           ("undisclosed", "Prefer not to say")]
-AGE_GROUPS = [("18-24", "18-24"), ("25-34", "25-34"), ("35-44", "35-44"), ("45-54", "45-54"), ("55+", "55 or over"),
-              ("undisclosed", "Prefer not to say")]
+GENDERS = [("female", _("Female")), ("male", _("Male")), ("non-binary", _("Non-binary / another gender")),
+           ("undisclosed", _("Prefer not to say"))]
+AGE_GROUPS = [("18-24", "18-24"), ("25-34", "25-34"), ("35-44", "35-44"), ("45-54", "45-54"),
+              ("55+", _("55 or over")), ("undisclosed", _("Prefer not to say"))]
 
 
 PARAM_MAX_LENGTH = 100
-PARAM_TOO_LONG = ("The study link is not valid: its {name} is longer than 100 characters. Please open the study "
-                  "again from the recruitment site (Prolific); if this keeps happening, contact the researchers.")
-CHOICE_ERRORS = {"invalid_choice": "Please choose one of the answers shown.",   # never repeats the value sent
-                 "required": "Please answer this question."}
+PARAM_TOO_LONG = _("The study link is not valid: its {name} is longer than 100 characters. Please open the study "
+                    "again from the recruitment site (Prolific); if this keeps happening, contact the researchers.")
+CHOICE_ERRORS = {"invalid_choice": _("Please choose one of the answers shown."),   # never repeats the value sent
+                 "required": _("Please answer this question.")}
 
 
 def _link_param() -> forms.CharField:
@@ -29,8 +36,8 @@ class ConsentForm(forms.Form):
     """Consent plus the Prolific link parameters (hidden). A too-long parameter is an error the page shows (the
     message never repeats the value)."""
 
-    consent = forms.BooleanField(required=True, label="I have read the information above and agree to take part.",
-                                 error_messages={"required": "Please tick the box to agree before starting."})
+    consent = forms.BooleanField(required=True, label=_("I have read the information above and agree to take part."),
+                                 error_messages={"required": _("Please tick the box to agree before starting.")})
     PROLIFIC_PID = _link_param()
     STUDY_ID = _link_param()
     SESSION_ID = _link_param()
@@ -42,23 +49,26 @@ class ConsentForm(forms.Form):
 
 
 class DemographicsForm(forms.Form):
-    gender = forms.ChoiceField(choices=GENDERS, widget=forms.RadioSelect, label="Gender", error_messages=CHOICE_ERRORS)
-    age_group = forms.ChoiceField(choices=AGE_GROUPS, widget=forms.RadioSelect, label="Age group",
+    gender = forms.ChoiceField(choices=GENDERS, widget=forms.RadioSelect, label=_("Gender"),
+                               error_messages=CHOICE_ERRORS)
+    age_group = forms.ChoiceField(choices=AGE_GROUPS, widget=forms.RadioSelect, label=_("Age group"),
                                   error_messages=CHOICE_ERRORS)
 
 
 class FeedbackForm(forms.Form):
-    """Built from Study.feedback_questions: yes/no radios or an optional text box."""
+    """Built from Study.feedback_questions: yes/no radios or an optional text box. The question texts are the
+    researcher's; a preset's default question is shown in the active language (studyapp.i18n.display)."""
 
     def __init__(self, questions: list[dict], *args, **kwargs):
         super().__init__(*args, **kwargs)
         for q in questions:
             key = str(q["key"])
             if q.get("kind", "yesno") == "text":
-                self.fields[key] = forms.CharField(label=q["text"], required=False, max_length=2000,
+                self.fields[key] = forms.CharField(label=display(q["text"]), required=False, max_length=2000,
                                                    widget=forms.Textarea(attrs={"rows": 3}))
             else:
-                self.fields[key] = forms.ChoiceField(label=q["text"], choices=[("yes", "Yes"), ("no", "No")],
+                self.fields[key] = forms.ChoiceField(label=display(q["text"]),
+                                                     choices=[("yes", gettext("Yes")), ("no", gettext("No"))],
                                                      widget=forms.RadioSelect, error_messages=CHOICE_ERRORS)
 
 
@@ -74,24 +84,74 @@ class PresetStudyForm(forms.Form):
         return slug
 
 
-class SectionForm(forms.ModelForm):
-    """A section in the admin: every bad pool filter, option or count is an error on its field (studyapp.pools),
-    so a study can never reach a participant with a pool or options the assignment cannot use. (A field with an
-    error leaves cleaned_data, so Section.clean, which repeats the check, does not report it twice.)"""
+class SectionForm(forms.ModelForm, PoolEditorFields):
+    """A section in the admin: the pool and options as structured fields (studyapp.pool_editor) with the raw JSON
+    as an advanced field. The raw JSON wins only when none of its group's structured fields was edited (their
+    initial values are read from the saved JSON); otherwise the fields win and the raw JSON adds only the keys
+    they cannot show. Every bad pool filter, option or count is an error on the field it comes from
+    (studyapp.pools), so a study can never reach a participant with a pool or options the assignment cannot use.
+    (A field with an error leaves cleaned_data, so Section.clean, which repeats the check, does not report it
+    twice.)"""
 
     class Meta:
         model = Section
         fields = "__all__"
 
+    def __init__(self, *args, **kwargs):
+        super().__init__(*args, **kwargs)
+        for name, value in pool_editor.initial_values(self.instance.pool, self.instance.options).items():
+            self.initial.setdefault(name, value)
+        plans = catalogue_plans()
+        for name in ("pool_plan", *(f"pool_{sub}_plan" for sub in SUB_POOLS)):
+            if name in self.fields:
+                self.fields[name].widget.suggestions = plans
+
     def clean(self):
         data = super().clean()
-        if self.has_error("section_type"):
-            return data
-        section_type = data.get("section_type")
-        fields = {"pool": data.get("pool"), "options": data.get("options"),
-                  "clips_per_participant": data.get("clips_per_participant")}
-        for name, messages in validate_section(section_type, **fields).items():
-            if not self.has_error(name) and name in self.fields:
-                for message in messages:
-                    self.add_error(name, message)
+        pool_editor.resolve_section_json(self, data, pool_editor.touched_groups(self.changed_data))
         return data
+
+
+def catalogue_plans() -> list[str]:
+    """The plans of the clips in the catalogue (suggestions for the pool's plan boxes)."""
+    return sorted(p for p in Clip.objects.exclude(plan="").values_list("plan", flat=True).distinct())
+
+
+class SectionPreviewForm(PoolEditorFields):
+    """What the admin page sends while a section is edited (studyapp.views_pool): the section's type, count, raw
+    JSON and structured fields, and whether the structured fields of each group were edited on the page."""
+
+    section_type = forms.ChoiceField(choices=section_type_choices)
+    clips_per_participant = forms.IntegerField(required=False, min_value=0)
+    pool = forms.JSONField(required=False)
+    options = forms.JSONField(required=False)
+    touched_pool = forms.BooleanField(required=False)
+    touched_options = forms.BooleanField(required=False)
+
+    def clean(self):
+        data = super().clean()
+        touched = {"pool": bool(data.get("touched_pool")), "options": bool(data.get("touched_options"))}
+        pool_editor.resolve_section_json(self, data, touched)
+        return data
+
+
+class StudyAdminForm(forms.ModelForm):
+    """A study in the admin; the exclusion rules are checked by the analysis library (analysis.exclusion)."""
+
+    class Meta:
+        model = Study
+        fields = "__all__"
+
+    def clean_exclusion_rules(self):
+        rules = self.cleaned_data.get("exclusion_rules")
+        rules = {} if rules is None else rules
+        try:
+            from analysis.exclusion import rule_errors
+        except ImportError as exc:
+            raise forms.ValidationError(
+                "analysis library not installed: the exclusion rules cannot be checked (analysis.exclusion."
+                "rule_errors is missing)") from exc
+        errors = rule_errors(rules)
+        if errors:
+            raise forms.ValidationError(errors)
+        return rules

@@ -6,6 +6,11 @@ without them. `ranged_file_response` answers `Range: bytes=a-b` (single range; s
 streamed in 64 KiB blocks. Every answer carries an ETag (size and modification time) and Last-Modified: a
 revalidation with a matching If-None-Match (or, without one, an If-Modified-Since not older than the file) gets
 304 with no body, and an If-Range that no longer matches turns a range request into the whole file.
+
+Behind nginx (settings.MEDIA_ACCEL_REDIRECT, e.g. "/protected-media/"), `accel_redirect_response` answers instead
+with an empty 200 carrying `X-Accel-Redirect: /protected-media/<path below MEDIA_ROOT>`: nginx then serves the file
+from its `internal` location (Range, ETag/Last-Modified, 304 and sendfile by nginx), so no application thread is
+held while a slow player downloads. See deploy/nginx/study.conf and docs/deploy.md.
 """
 from __future__ import annotations
 
@@ -13,6 +18,7 @@ import mimetypes
 import os
 import re
 from pathlib import Path
+from urllib.parse import quote
 
 from django.conf import settings
 from django.http import Http404, HttpResponse, StreamingHttpResponse
@@ -23,9 +29,13 @@ RANGE_RE = re.compile(r"^bytes=(\d*)-(\d*)$")
 CONTENT_TYPES = {".mp4": "video/mp4", ".webm": "video/webm", ".png": "image/png", ".jpg": "image/jpeg"}
 
 
+def media_root() -> Path:
+    return Path(settings.MEDIA_ROOT).resolve()
+
+
 def media_path(relative: str) -> Path:
     """Absolute path of a catalogue media path, refusing anything outside MEDIA_ROOT."""
-    root = Path(settings.MEDIA_ROOT).resolve()
+    root = media_root()
     path = (root / relative).resolve()
     if root not in path.parents or not path.is_file():
         raise Http404("clip file not found")
@@ -122,3 +132,15 @@ def ranged_file_response(request, path: Path, content_type: str | None = None):
         response["Content-Range"] = f"bytes {start}-{end}/{size}"
     response["Accept-Ranges"] = "bytes"
     return _validators(response, etag, mtime)
+
+
+def accel_redirect_response(path: Path, prefix: str, content_type: str | None = None) -> HttpResponse:
+    """An empty response telling nginx to serve ``path`` (a file below MEDIA_ROOT, already checked by media_path)
+    from its internal location ``prefix`` (which nginx maps to MEDIA_ROOT). The path is percent-encoded; nginx
+    decodes it once. Content-Type is the app's choice (nginx would otherwise guess it from its mime.types)."""
+    relative = path.relative_to(media_root()).as_posix()
+    response = HttpResponse(content_type=content_type or CONTENT_TYPES.get(path.suffix.lower()) or (
+        mimetypes.guess_type(path.name)[0] or "application/octet-stream"))
+    response["X-Accel-Redirect"] = prefix + quote(relative, safe="/")
+    return response
+

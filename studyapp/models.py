@@ -12,7 +12,7 @@ from django.core.exceptions import ValidationError
 from django.db import models
 from django.utils import timezone
 
-from study_protocol import MODALITIES, ORIGINS
+from study_protocol import ATTENTION_CHECK, MODALITIES, ORIGINS
 
 from .pools import validate_section
 from .questions import section_type_choices
@@ -166,7 +166,12 @@ class Section(models.Model):
     options = models.JSONField(
         default=dict, blank=True,
         help_text='Type-specific options, e.g. naturalness {"anchors": {"1": "not natural at all", ...}, '
-                  '"n_generated": 3, "n_source": 3}; gesture_emotion {"n_options": 4}')
+                  '"n_generated": 3, "n_source": 3}; gesture_emotion {"n_options": 4}; any section '
+                  '{"attention_checks": {"count": 1, "answer": "sad", "positions": "random"}, "practice": true} '
+                  'or {"practice_clip": "<clip_id>"}')
+    counterbalance = models.BooleanField(
+        default=True, help_text="Rotates with the other rotating sections when the study counterbalances its "
+                                "section order; untick to pin this section to its place (e.g. a final section)")
 
     class Meta:
         ordering = ["study", "order", "id"]
@@ -186,6 +191,9 @@ class Section(models.Model):
                 errors["reuse_section"] = ["The reused section must belong to the same study."]
             elif (other.order, other.pk or 0) >= (self.order, self.pk or 10**12):
                 errors["reuse_section"] = ["The reused section must come before this one."]
+        practice_clip = (self.options or {}).get("practice_clip") if isinstance(self.options, dict) else None
+        if isinstance(practice_clip, str) and practice_clip and not Clip.objects.filter(clip_id=practice_clip).exists():
+            errors.setdefault("options", []).append(f"'practice_clip': no clip {practice_clip!r} in the catalogue")
         if errors:
             raise ValidationError(errors)
 
@@ -220,6 +228,8 @@ class Participant(models.Model):
     # SHA-256 of the one-time key the consent page gave this browser session: a second submit of the same
     # consent form (double click, two requests in flight) finds this participant instead of creating another.
     consent_key = models.CharField(max_length=64, blank=True, default="", editable=False)
+    # Number of clip pages (assignments) fixed at start: the "of N" of the progress, without counting rows.
+    n_items = models.PositiveIntegerField(default=0, editable=False)
 
     class Meta:
         constraints = [
@@ -234,7 +244,13 @@ class Participant(models.Model):
 
 
 class Assignment(models.Model):
-    """Clip `position` of `section` for one participant, fixed when the participant starts."""
+    """Clip `position` of `section` for one participant, fixed when the participant starts; `seq` numbers the
+    participant's clip pages 1..n over the whole study in the order they are shown (the URL's clip number)."""
+
+    class Kind(models.TextChoices):
+        TRIAL = "", "Trial"
+        PRACTICE = "practice", "Practice (never exported)"
+        ATTENTION = ATTENTION_CHECK, "Attention check"
 
     participant = models.ForeignKey(Participant, on_delete=models.CASCADE, related_name="assignments")
     section = models.ForeignKey(Section, on_delete=models.CASCADE, related_name="assignments")
@@ -243,12 +259,23 @@ class Assignment(models.Model):
     options = models.JSONField(default=list, blank=True, help_text="Answer options shown (gesture_emotion)")
     shown_at = models.DateTimeField(null=True, blank=True)
     answered_at = models.DateTimeField(null=True, blank=True)
+    seq = models.PositiveIntegerField(default=0)
+    kind = models.CharField(max_length=20, choices=Kind.choices, default=Kind.TRIAL, blank=True)
+    # Attention check: the answer the participant is told to give (Section.options["attention_checks"]["answer"]).
+    instructed = models.CharField(max_length=40, blank=True, default="")
 
     class Meta:
-        ordering = ["participant", "section__order", "position"]
+        ordering = ["participant", "seq"]
         constraints = [
             models.UniqueConstraint(fields=["participant", "section", "position"], name="unique_assignment_slot"),
-            models.UniqueConstraint(fields=["participant", "section", "clip"], name="unique_assignment_clip"),
+            models.UniqueConstraint(fields=["participant", "section", "clip"], condition=models.Q(kind=""),
+                                    name="unique_assignment_trial_clip"),
+            models.UniqueConstraint(fields=["participant", "seq"], name="unique_assignment_seq"),
+        ]
+        indexes = [
+            # The participant's current page: the first unanswered assignment by seq (one index probe).
+            models.Index(fields=["participant", "seq"], condition=models.Q(answered_at__isnull=True),
+                         name="assignment_unanswered"),
         ]
 
 
@@ -256,9 +283,12 @@ class Response(models.Model):
     participant = models.ForeignKey(Participant, on_delete=models.CASCADE, related_name="responses")
     section = models.ForeignKey(Section, on_delete=models.CASCADE, related_name="responses")
     clip = models.ForeignKey(Clip, on_delete=models.PROTECT, related_name="responses")
-    question = models.CharField(max_length=20)
+    question = models.CharField(max_length=60)
     answer = models.CharField(max_length=200)
     response_ms = models.PositiveIntegerField(null=True, blank=True)
+    # "" for an answer to the section's question, ATTENTION_CHECK for an attention check (exported as its
+    # section_type, with the instructed answer in `question`).
+    kind = models.CharField(max_length=20, blank=True, default="")
     created_at = models.DateTimeField(auto_now_add=True)
 
     class Meta:
@@ -267,3 +297,23 @@ class Response(models.Model):
             models.UniqueConstraint(fields=["participant", "section", "clip", "question"],
                                     name="unique_response"),
         ]
+
+
+class SectionClipCount(models.Model):
+    """How many participants were given `clip` in `section` (trials only): the balancing counts, read without a
+    lock when a participant's clips are planned and incremented with F() in the start's transaction."""
+
+    section = models.ForeignKey(Section, on_delete=models.CASCADE, related_name="clip_counts")
+    clip = models.ForeignKey(Clip, on_delete=models.CASCADE, related_name="section_counts")
+    n = models.PositiveIntegerField(default=0)
+
+    class Meta:
+        constraints = [models.UniqueConstraint(fields=["section", "clip"], name="unique_section_clip_count")]
+
+
+class StudyCounter(models.Model):
+    """Per-study counter row: `arrivals` numbers the participants who started (the Latin-square row of a
+    counterbalanced study); the row is also the short lock that keeps the participant limit exact."""
+
+    study = models.OneToOneField(Study, on_delete=models.CASCADE, primary_key=True, related_name="counter")
+    arrivals = models.PositiveIntegerField(default=0)

@@ -4,10 +4,13 @@ whether a pool or an option is well formed.
 
 A pool is a JSON object of catalogue filters: ``field`` or ``field__lookup`` -> value (a list without a lookup
 means ``in``), plus two boolean shorthands, ``transition`` (the clip has a final emotion) and ``rbf`` (the clip
-has a theme). A naturalness section may add ``generated`` and ``source`` sub-pools (filters of the same kind)
-for its two halves. Options are type-specific (``SECTION_OPTIONS``).
+has a theme), and the switch ``include_flagged`` (true: clips whose quality record failed a check, ``qa_flag``, are
+in the pool too; they are left out otherwise). A naturalness section may add ``generated`` and ``source``
+sub-pools (filters of the same kind) for its two halves. Options are type-specific (``SECTION_OPTIONS``).
 """
 from __future__ import annotations
+
+import math
 
 from study_protocol import (
     CLIP_THEMES,
@@ -18,6 +21,7 @@ from study_protocol import (
     NATURALNESS,
     ORIGINS,
     SECTION_MODALITY,
+    SECTION_QUESTIONS,
     SECTION_TYPES,
     VAD_DIMENSIONS,
     answer_values,
@@ -34,6 +38,8 @@ POOL_FIELDS = frozenset((*TEXT_FIELDS, *NUMBER_FIELDS, *INTEGER_FIELDS))
 TEXT_LOOKUPS = ("", "in", "startswith", "contains")
 NUMBER_LOOKUPS = ("", "in", "lt", "lte", "gt", "gte", "isnull")
 FLAGS = ("transition", "rbf")
+INCLUDE_FLAGGED = "include_flagged"
+"""Pool switch: also draw clips that failed a quality check (``Clip.qa_flag`` not empty)."""
 SUB_POOLS = ("generated", "source")
 """Sub-pools of a naturalness section: extra filters for its generated and its source clips."""
 
@@ -41,7 +47,11 @@ SECTION_OPTIONS: dict[str, tuple[str, ...]] = {
     "naturalness": ("anchors", "question", "n_generated", "n_source"),
     "gesture_emotion": ("n_options", "categories"),
 }
-"""section_type -> the option keys it understands; other section types take no options."""
+"""section_type -> the option keys it understands besides COMMON_OPTIONS."""
+
+COMMON_OPTIONS = ("attention_checks", "practice", "practice_clip")
+"""Options of every section type (studyapp.trial_extras): attention checks and a practice item."""
+ATTENTION_KEYS = ("count", "answer", "positions", "question")
 
 DEFAULT_GESTURE_OPTIONS = 4
 
@@ -76,8 +86,10 @@ def _value_error(key: str, name: str, lookup: str, value) -> str | None:
         bad = [p for p in parts if p not in vocabulary]
         return f"{key!r}: {bad[0]!r} is not one of {', '.join(vocabulary)}" if bad else None
     if name in INTEGER_FIELDS:
-        return None if _is_int(value) else f"{key!r} takes an integer, got {value!r}"
-    return None if _is_number(value) else f"{key!r} takes a number, got {value!r}"
+        ok = _is_int(value) and -2**63 <= value < 2**63          # the database's integer
+        return None if ok else f"{key!r} takes an integer (64-bit), got {value!r}"
+    ok = _is_number(value) and math.isfinite(value)               # JSON may carry NaN / Infinity
+    return None if ok else f"{key!r} takes a finite number, got {value!r}"
 
 
 def _filter_errors(key: str, value) -> list[str]:
@@ -108,7 +120,7 @@ def pool_errors(pool, section_type: str | None = None, sub_pools: bool = True) -
         return [f"the pool must be a JSON object of filters, got {type(pool).__name__}"]
     errors = []
     for key, value in pool.items():
-        if key in FLAGS:
+        if key in FLAGS or key == INCLUDE_FLAGGED:
             if not isinstance(value, bool):
                 errors.append(f"{key!r} takes true or false, got {value!r}")
         elif key in SUB_POOLS and sub_pools:
@@ -135,7 +147,7 @@ def pool_lookups(pool: dict | None) -> list[tuple[str, dict]]:
         raise PoolError({"pool": errors})
     calls = []
     for key, value in (pool or {}).items():
-        if key in SUB_POOLS:
+        if key in SUB_POOLS or key == INCLUDE_FLAGGED:
             continue
         if key == "transition":
             calls.append(("filter", {f"{FINAL_EMOTION_COLUMNS[0]}__isnull": not value}))
@@ -204,16 +216,65 @@ def _gesture_errors(options: dict) -> list[str]:
     return errors
 
 
+def _attention_errors(section_type: str, config, clips_per_participant: int | None, categories) -> list[str]:
+    """Problems of Section.options["attention_checks"], each naming 'attention_checks' and the bad field."""
+    name = "'attention_checks'"
+    if not isinstance(config, dict):
+        return [f"{name} must be an object like {{\"count\": 1, \"answer\": \"sad\", \"positions\": \"random\"}}, "
+                f"got {config!r}"]
+    errors = [f"{name}: unknown field {k!r} (fields: {', '.join(ATTENTION_KEYS)})" for k in config
+              if k not in ATTENTION_KEYS]
+    questions = SECTION_QUESTIONS.get(section_type, {})
+    key = config.get("question", next(iter(questions), ""))
+    if key not in questions:
+        return errors + [f"{name}: 'question' {key!r} is not a question of {section_type} sections "
+                         f"({', '.join(questions)})"]
+    allowed = list(categories) if section_type == "gesture_emotion" else list(answer_values(questions[key]))
+    answer = config.get("answer")
+    if not isinstance(answer, (str, int)) or isinstance(answer, bool) or str(answer) not in allowed:
+        errors.append(f"{name}: 'answer' must be one of the answers to {key!r} ({', '.join(allowed)}), "
+                      f"got {answer!r}")
+    count = config.get("count", 1)
+    if not _is_int(count) or count < 1:
+        errors.append(f"{name}: 'count' must be an integer 1 or more, got {count!r}")
+        count = 1
+    positions = config.get("positions", "random")
+    if positions != "random":
+        longest = clips_per_participant + count if clips_per_participant else None
+        if (not isinstance(positions, list) or len(positions) != count
+                or not all(_is_int(p) and p >= 1 and (longest is None or p <= longest) for p in positions)):
+            where = f" from 1 to {longest}" if longest else " of 1 or more"
+            errors.append(f"{name}: 'positions' must be \"random\" or a list of {count} integer place(s){where}, "
+                          f"got {positions!r}")
+    return errors
+
+
+def _extras_errors(section_type: str, options: dict, clips_per_participant: int | None) -> list[str]:
+    """Problems of the options every section type takes (COMMON_OPTIONS)."""
+    errors = []
+    if "attention_checks" in options:
+        categories = options.get("categories") if isinstance(options.get("categories"), list) else GESTURE_EMOTIONS
+        errors += _attention_errors(section_type, options["attention_checks"], clips_per_participant, categories)
+    if "practice" in options and not isinstance(options["practice"], bool):
+        errors.append(f"'practice' takes true or false, got {options['practice']!r}")
+    if "practice_clip" in options and not (isinstance(options["practice_clip"], str)
+                                           and options["practice_clip"].strip()):
+        errors.append(f"'practice_clip' must be the clip_id of a catalogue clip, got {options['practice_clip']!r}")
+    return errors
+
+
 def options_errors(section_type: str, options, clips_per_participant: int | None = None) -> list[str]:
     """Every problem of a section's type-specific options, each message naming its key."""
     if options is None or options == {}:
         return []
     if not isinstance(options, dict):
         return [f"the options must be a JSON object, got {type(options).__name__}"]
-    known = SECTION_OPTIONS.get(section_type, ())
-    errors = [f"unknown option {key!r} for {section_type} sections"
-              + (f" (options: {', '.join(known)})" if known else " (this section type takes no options)")
-              for key in options if key not in known]
+    own = SECTION_OPTIONS.get(section_type, ())
+    known = (*own, *COMMON_OPTIONS)
+    listed = (f"options: {', '.join(known)}" if own else
+              f"this section type takes no options of its own; every section takes {', '.join(COMMON_OPTIONS)}")
+    errors = [f"unknown option {key!r} for {section_type} sections ({listed})" for key in options if key not in known]
+    errors += _extras_errors(section_type, options, clips_per_participant)
     if section_type == "naturalness":
         errors += _naturalness_errors(options, clips_per_participant)
     elif section_type == "gesture_emotion":

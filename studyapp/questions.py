@@ -1,6 +1,8 @@
 """Questions of each section type: wording (REFERENCE.md section 4, verbatim where the papers give it), answer
-choices, and validation of posted answers. No Django import: views and tests share it. The question keys and
-answer values are study_protocol's (SECTION_QUESTIONS, answer_values); only the sentences shown live here.
+choices, and validation of posted answers. The question keys and answer values are study_protocol's
+(SECTION_QUESTIONS, answer_values); only the sentences shown live here. The sentences and labels are marked for
+translation (English msgids) and `questions_for` returns them in the active language (studyapp.i18n); the values
+posted and stored never change with the language.
 
 A question is asked once per (participant, section, clip); its answer is stored as text (DESIGN.md responses.csv):
 emotion labels joined by ";" for multi-select, an integer for scales, a label for forced choice.
@@ -8,6 +10,9 @@ emotion labels joined by ";" for multi-select, an integer for scales, a label fo
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+
+from django.utils.translation import gettext
+from django.utils.translation import gettext_noop as _
 
 from study_protocol import (
     GESTURE_EMOTIONS,
@@ -20,14 +25,16 @@ from study_protocol import (
     answer_values,
 )
 
+from .i18n import answer_label, display, theme_adjective
+
 # Seed 000 section 6.3.4 anchors and seed 003 Table 2 markers (1..5), verbatim.
-NATURALNESS_ANCHORS_GAIT = {"1": "not natural at all", "3": "satisfactory", "5": "very natural"}
+NATURALNESS_ANCHORS_GAIT = {"1": _("not natural at all"), "3": _("satisfactory"), "5": _("very natural")}
 NATURALNESS_ANCHORS_GESTURE = {
-    "1": "Very Unnatural (e.g. broken arms or legs, torso at an impossible angle)",
-    "2": "Not Realistic (e.g. limbs going inside the body or through the chair)",
-    "3": "Looks OK (no serious problems, but does not look very appealing)",
-    "4": "Looks good (no problems and the gestures look natural)",
-    "5": "Looks great! (the gestures look like they could be from a real person)",
+    "1": _("Very Unnatural (e.g. broken arms or legs, torso at an impossible angle)"),
+    "2": _("Not Realistic (e.g. limbs going inside the body or through the chair)"),
+    "3": _("Looks OK (no serious problems, but does not look very appealing)"),
+    "4": _("Looks good (no problems and the gestures look natural)"),
+    "5": _("Looks great! (the gestures look like they could be from a real person)"),
 }
 
 @dataclass(frozen=True)
@@ -41,24 +48,24 @@ class SectionWording:
 # naturalness may replace its text (Section.options["question"]).
 WORDING: dict[str, SectionWording] = {
     "emotion_choice": SectionWording("Perceived gait emotion (multi-select)", {
-        "perceived": ("Which emotion(s) do you perceive from this walk?",
-                      "Select every emotion you perceive; more than one is allowed.")}),
+        "perceived": (_("Which emotion(s) do you perceive from this walk?"),
+                      _("Select every emotion you perceive; more than one is allowed."))}),
     "emotion_transition": SectionWording("Gait emotion transition (initial and final)", {
-        "initial": ("Which emotion(s) do you perceive at the start of the clip?", "More than one is allowed."),
-        "final": ("Which emotion(s) do you perceive at the end of the clip?", "More than one is allowed.")}),
+        "initial": (_("Which emotion(s) do you perceive at the start of the clip?"), _("More than one is allowed.")),
+        "final": (_("Which emotion(s) do you perceive at the end of the clip?"), _("More than one is allowed."))}),
     "affect_likert": SectionWording("Pose affective features (5-point Likert)", {
         key: (label, "") for key, (label, _levels) in LIKERT_LEVELS.items()}),
     "naturalness": SectionWording("Naturalness (1..5)", {
-        "naturalness": ("How natural and smooth does this animation look?", "")}),
+        "naturalness": (_("How natural and smooth does this animation look?"), "")}),
     "gesture_emotion": SectionWording("Perceived gesture emotion (4 options)", {
-        "perceived": ("Which emotion do you perceive from the gestures?", "")}),
+        "perceived": (_("Which emotion do you perceive from the gestures?"), "")}),
     "neutral_validation": SectionWording("Neutral validation (7-way forced choice)", {
-        "perceived": ("Which of these best describes the walk?", "Choose one.")}),
+        "perceived": (_("Which of these best describes the walk?"), _("Choose one."))}),
     "theme_rating": SectionWording("Theme rating (1..7)", {
-        "rating": ("How {theme} does this walk look?", "Seven-point scale; choose one.")}),
+        "rating": (_("How {theme} does this walk look?"), _("Seven-point scale; choose one."))}),
     "theme_inversion": SectionWording("Theme inversion (-7..+7)", {
-        "rating": ("Does this walk look {opposite} or {theme}?",
-                   "From -7 (maximum opposite theme) through 0 (neutral) to +7 (maximum {theme}).")}),
+        "rating": (_("Does this walk look {opposite} or {theme}?"),
+                   _("From -7 (maximum opposite theme) through 0 (neutral) to +7 (maximum {theme})."))}),
 }
 
 
@@ -94,15 +101,16 @@ class Question:
         values = [v.strip() for v in raw if v is not None and v.strip() != ""]
         allowed = [c[0] for c in self.choices]
         if not values:
-            raise AnswerError(f"Please answer: {self.text}")
+            raise AnswerError(gettext("Please answer: {question}").format(question=self.text))
         for v in values:
             if v not in allowed:
-                raise AnswerError(f"'{short(v)}' is not an allowed answer to: {self.text}")
+                raise AnswerError(gettext("'{value}' is not an allowed answer to: {question}").format(
+                    value=short(v), question=self.text))
         if self.kind == "multi":
             chosen = set(values)
             return ";".join(v for v in allowed if v in chosen)   # canonical order, no duplicates
         if len(set(values)) != 1:
-            raise AnswerError(f"Choose exactly one answer to: {self.text}")
+            raise AnswerError(gettext("Choose exactly one answer to: {question}").format(question=self.text))
         return values[0]
 
 
@@ -113,15 +121,18 @@ def _widget(kind: str) -> str:
 
 
 def _value_labels(section_type: str, key: str, options: dict, theme: str, opposite: str) -> dict[str, str]:
-    """Labels of some answer values (a scale's anchors); values without one show no label, choices their name."""
+    """Labels of some answer values (a scale's anchors), in the active language; values without one show no
+    label, choices their name. theme/opposite: already translated adjectives."""
     if section_type == "affect_likert":
-        return {str(i): text for i, text in enumerate(LIKERT_LEVELS[key][1])}
+        return {str(i): gettext(text) for i, text in enumerate(LIKERT_LEVELS[key][1])}
     if section_type == "naturalness":
-        return {str(k): v for k, v in (options.get("anchors") or NATURALNESS_ANCHORS_GAIT).items()}
+        return {str(k): display(v) for k, v in (options.get("anchors") or NATURALNESS_ANCHORS_GAIT).items()}
     if section_type == "theme_rating":
-        return {"1": "not at all", "7": f"maximum {theme}"}
+        return {"1": gettext("not at all"), "7": gettext("maximum {theme}").format(theme=theme)}
     if section_type == "theme_inversion":
-        return {"-7": f"maximum {opposite} (opposite theme)", "0": "neutral", "7": f"maximum {theme} (original theme)"}
+        return {"-7": gettext("maximum {opposite} (opposite theme)").format(opposite=opposite),
+                "0": gettext("neutral"),
+                "7": gettext("maximum {theme} (original theme)").format(theme=theme)}
     return {}
 
 
@@ -147,8 +158,7 @@ def questions_for(section_type: str, options: dict | None = None, clip_theme: st
     if section_type not in SECTION_QUESTIONS:
         raise ValueError(f"unknown section_type {section_type!r}")
     options = options or {}
-    theme = clip_theme or ("original theme" if section_type == "theme_inversion" else "styled")
-    opposite = OPPOSITE_THEME.get(clip_theme, "opposite theme")
+    theme, opposite = _theme_words(section_type, clip_theme)
     questions = []
     for key, kind in SECTION_QUESTIONS[section_type].items():
         text, help_text = WORDING[section_type].questions[key]
@@ -156,11 +166,21 @@ def questions_for(section_type: str, options: dict | None = None, clip_theme: st
             text = options.get("question") or text
         labels = _value_labels(section_type, key, options, theme, opposite)
         widget = _widget(kind)
-        choices = [(v, labels.get(v, "") if widget == "scale" else labels.get(v, v.capitalize()))
+        choices = [(v, labels.get(v, "") if widget == "scale" else labels.get(v) or answer_label(kind, v))
                    for v in _values(section_type, kind, shown_options)]
-        questions.append(Question(key, text.format(theme=theme, opposite=opposite), widget, choices,
-                                  help_text.format(theme=theme, opposite=opposite), kind))
+        questions.append(Question(key, display(text).format(theme=theme, opposite=opposite), widget, choices,
+                                  display(help_text).format(theme=theme, opposite=opposite), kind))
     return questions
+
+
+def _theme_words(section_type: str, clip_theme: str) -> tuple[str, str]:
+    """(theme, opposite) as the adjectives shown in the active language; neutral words when the clip has none."""
+    if clip_theme:
+        theme = theme_adjective(clip_theme)
+    else:
+        theme = gettext("original theme") if section_type == "theme_inversion" else gettext("styled")
+    opposite = OPPOSITE_THEME.get(clip_theme)
+    return theme, theme_adjective(opposite) if opposite else gettext("opposite theme")
 
 
 def clean_answers(questions: list[Question], data) -> dict[str, str]:

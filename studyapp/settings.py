@@ -9,6 +9,10 @@ Variables (all optional for the demo):
     DATA_DIR          where the SQLite file, media and reports live (default: ./var)
     MEDIA_ROOT        where rendered clips live (default: DATA_DIR/media)
     PRODUCTION        "1" turns on HTTPS-only cookies, HSTS and the other deploy checks
+    MEDIA_ACCEL_REDIRECT  URL prefix of nginx's internal location for MEDIA_ROOT (e.g. /protected-media/): clip
+                      requests are then answered with X-Accel-Redirect and nginx sends the bytes (docs/deploy.md);
+                      empty (default): the app streams clips itself
+    REPORTS_DIR       where finished analysis-report zips are kept (default: DATA_DIR/reports)
 """
 import os
 from pathlib import Path
@@ -77,6 +81,13 @@ if not SECRET_KEY:
 
 MEDIA_ROOT = Path(os.environ.get("MEDIA_ROOT", DATA_DIR / "media"))
 MEDIA_URL = "/media/"
+# Behind nginx (deploy/nginx/study.conf): hand clip bytes to nginx after the app's checks. Must end with "/".
+MEDIA_ACCEL_REDIRECT = os.environ.get("MEDIA_ACCEL_REDIRECT", "").strip()
+if MEDIA_ACCEL_REDIRECT and not (MEDIA_ACCEL_REDIRECT.startswith("/") and MEDIA_ACCEL_REDIRECT.endswith("/")):
+    from django.core.exceptions import ImproperlyConfigured
+
+    raise ImproperlyConfigured(f"MEDIA_ACCEL_REDIRECT must start and end with '/', got {MEDIA_ACCEL_REDIRECT!r}")
+REPORTS_DIR = Path(os.environ.get("REPORTS_DIR", DATA_DIR / "reports"))
 STATIC_URL = "/static/"
 # collectstatic's target; outside production WhiteNoise serves from the app folders and needs none.
 STATIC_ROOT = Path(os.environ["STATIC_ROOT"]) if os.environ.get("STATIC_ROOT") else (
@@ -106,6 +117,8 @@ MIDDLEWARE = [
     "studyapp.security.ContentSecurityPolicyMiddleware",
     "whitenoise.middleware.WhiteNoiseMiddleware",
     "django.contrib.sessions.middleware.SessionMiddleware",
+    # each request starts in LANGUAGE_CODE; participant views activate their study's language (studyapp.i18n)
+    "studyapp.i18n.StudyLanguageMiddleware",
     "django.middleware.common.CommonMiddleware",
     "django.middleware.csrf.CsrfViewMiddleware",
     "django.contrib.auth.middleware.AuthenticationMiddleware",
@@ -158,7 +171,10 @@ AUTH_PASSWORD_VALIDATORS = [
     {"NAME": "django.contrib.auth.password_validation.CommonPasswordValidator"},
 ]
 
-LANGUAGE_CODE = "en-us"
+LANGUAGE_CODE = "en"
+# Languages a study may be shown in (Study.language); the catalogues are committed (locale/<code>/LC_MESSAGES).
+LANGUAGES = [("en", "English"), ("de", "Deutsch")]
+LOCALE_PATHS = [BASE_DIR / "locale"]
 TIME_ZONE = "UTC"
 USE_I18N = True
 USE_TZ = True

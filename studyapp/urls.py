@@ -1,8 +1,12 @@
-"""Root URL map: the Django admin under /admin/ and the study app (namespace "studyapp") at the root."""
+"""Root URL map: the Django admin under /admin/, the liveness probe /healthz and the study app (namespace
+"studyapp") at the root."""
 from django.contrib import admin
 from django.urls import include, path
 
+from studyapp import views_health
+
 urlpatterns = [
     path("admin/", admin.site.urls),
+    path("healthz", views_health.healthz, name="healthz"),
     path("", include("studyapp.urls_study")),
 ]

@@ -15,11 +15,16 @@ from django.shortcuts import get_object_or_404, redirect, render
 from django.urls import reverse
 from django.utils import timezone
 from django.utils.crypto import constant_time_compare
+from django.utils.translation import gettext
 from django.views.decorators.cache import never_cache
 from django.views.decorators.http import require_http_methods
 
+from study_protocol import ATTENTION_CHECK
+
 from .assignment import StudyUnavailable, check_open, current_step, start_participant
+from .duration import expected_minutes
 from .forms import PARAM_MAX_LENGTH, PARAM_TOO_LONG, ConsentForm, DemographicsForm, FeedbackForm
+from .i18n import activate_study_language
 from .media import media_path, ranged_file_response
 from .models import Assignment, Clip, Participant, Response, Study
 from .questions import AnswerError, clean_answers, questions_for
@@ -52,6 +57,7 @@ def _remember(request, participant: Participant) -> None:
 
 
 def _unavailable(request, study: Study, message: str, status: int = 200):
+    activate_study_language(study)
     return render(request, "studyapp/unavailable.html", {"study": study, "message": message}, status=status)
 
 
@@ -108,6 +114,7 @@ def study_entry(request, slug: str):
     remembers, or the one whose stored PROLIFIC_PID, STUDY_ID and SESSION_ID all equal the link's (a Prolific
     participant on another device). A PID alone never resumes anyone."""
     study = get_object_or_404(Study, slug=slug)
+    activate_study_language(study)
     params = _prolific_params(request)
     pid = params["PROLIFIC_PID"]
     remembered = request.session.get(SESSION_KEY, {}).get(study.slug)
@@ -163,6 +170,7 @@ def study_entry(request, slug: str):
         e for f in form.hidden_fields() for e in f.errors]
     link_params = {k: v for k, v in params.items() if len(v) <= PARAM_MAX_LENGTH}   # never echo an over-long one
     return render(request, "studyapp/consent.html", {"study": study, "form": form, "param_errors": errors,
+                                                     "expected_minutes": expected_minutes(study),
                                                      "link_params": link_params,
                                                      "consent_key": _issue_consent_key(request, study)})
 
@@ -179,7 +187,9 @@ def _store_missing_ids(participant: Participant, params: dict[str, str]) -> None
 
 
 def _participant(token: str) -> Participant:
-    return get_object_or_404(Participant.objects.select_related("study"), token=token)
+    participant = get_object_or_404(Participant.objects.select_related("study"), token=token)
+    activate_study_language(participant.study)
+    return participant
 
 
 @never_cache
@@ -199,9 +209,7 @@ def resume(request, token: str):
         return redirect("studyapp:item", token=token, n=step.index)
     if step.kind == "feedback":
         return redirect("studyapp:feedback", token=token)
-    if participant.status != Participant.Status.COMPLETED:
-        Participant.objects.filter(pk=participant.pk, completed_at__isnull=True).update(
-            status=Participant.Status.COMPLETED, completed_at=timezone.now())
+    mark_completed(participant)
     return redirect("studyapp:done", token=token)
 
 
@@ -231,14 +239,36 @@ def clip_sources(clip: Clip) -> dict:
 
 
 def item_context(section, clip, index: int, total: int, next_clip: Clip | None, options: list[str] | None,
-                 posted=None) -> dict:
-    """Template context of a clip page (participant and preview share it)."""
-    questions = questions_for(section.section_type, section.options, clip.theme, options)
+                 posted=None, kind: str = "", instructed: str = "") -> dict:
+    """Template context of a clip page (participant and preview share it). kind/instructed: the assignment's
+    (a practice item is marked "Practice"; an attention check asks one question with its instruction)."""
+    questions = item_questions(section, clip, options, kind, instructed)
     fields = [{"q": q, "selected": posted.getlist(q.key) if posted is not None else []} for q in questions]
     return {"section": section, "fields": fields, "sources": clip_sources(clip),
             "next_sources": clip_sources(next_clip) if next_clip else None,
             "loop": section.loop or clip.loop, "require_play": section.require_full_play,
-            "index": index, "total": total, "percent": int(round(100 * (index - 1) / max(total, 1)))}
+            "index": index, "total": total, "percent": int(round(100 * (index - 1) / max(total, 1))),
+            "practice": kind == Assignment.Kind.PRACTICE, **attention_context(questions, kind, instructed)}
+
+
+def item_questions(section, clip, options: list[str] | None, kind: str = "", instructed: str = "") -> list:
+    """The questions of one clip page: the section's, or for an attention check the one it instructs."""
+    questions = questions_for(section.section_type, section.options, clip.theme, options)
+    if kind == ATTENTION_CHECK:
+        key = instructed.partition("=")[0]
+        questions = [q for q in questions if q.key == key]
+    return questions
+
+
+def attention_context(questions: list, kind: str, instructed: str) -> dict:
+    """The instruction of an attention check: the label of the answer to give (its value for a scale), and
+    whether the question is multi-select (the page then says "only")."""
+    if kind != ATTENTION_CHECK or not questions:
+        return {"attention": ""}
+    value = instructed.partition("=")[2]
+    q = questions[0]
+    label = next((lbl for v, lbl in q.choices if v == value), value)
+    return {"attention": value if q.kind == "scale" or not label else label, "attention_multi": q.kind == "multi"}
 
 
 def client_ms(raw, server_ms: int) -> int | None:
@@ -254,19 +284,49 @@ def client_ms(raw, server_ms: int) -> int | None:
     return int(value)
 
 
+def step_url(token: str, step) -> str:
+    """The URL of a participant's step (the clip page, feedback or done), without going through /resume."""
+    if step.kind == "item":
+        return reverse("studyapp:item", kwargs={"token": token, "n": step.index})
+    if step.kind in ("feedback", "done"):
+        return reverse(f"studyapp:{step.kind}", kwargs={"token": token})
+    return reverse("studyapp:resume", kwargs={"token": token})
+
+
+def _after_answer_url(participant: Participant, n: int) -> str:
+    """Where the answer to clip n sends the participant: clip n + 1, or the feedback page, or the end (the
+    participant is then marked completed). No query unless the study ends here."""
+    token = participant.token
+    if n < participant.n_items:
+        return reverse("studyapp:item", kwargs={"token": token, "n": n + 1})
+    if participant.study.feedback_questions and not participant.feedback_done:
+        return reverse("studyapp:feedback", kwargs={"token": token})
+    mark_completed(participant)
+    return reverse("studyapp:done", kwargs={"token": token})
+
+
+def mark_completed(participant: Participant) -> None:
+    """Record the end of the study once (status completed, completed_at)."""
+    if participant.status != Participant.Status.COMPLETED:
+        Participant.objects.filter(pk=participant.pk, completed_at__isnull=True).update(
+            status=Participant.Status.COMPLETED, completed_at=timezone.now())
+
+
 @never_cache
 @require_http_methods(["GET", "POST"])
 def item(request, token: str, n: int):
-    """Clip number n (1-based over all of the participant's clips): show it, or save its answers."""
+    """Clip number n (1-based over all of the participant's clips): show it, or save its answers and redirect
+    straight to the next clip (or the feedback / end page). A constant number of indexed queries: the
+    participant, its first unanswered assignments, and on GET the one UPDATE of shown_at when first shown."""
     participant = _participant(token)
-    step = current_step(participant)
+    step = current_step(participant, lookahead=request.method == "GET")
     if step.kind != "item" or step.index != n:
         if request.method == "POST" and (step.kind != "item" or n < step.index):
             # An answer for a clip that is already answered: a double submit or a resubmitted old page.
-            return redirect("studyapp:resume", token=token)
+            return redirect(step_url(token, step))
         if request.method == "POST":
             return _render_item(request, participant, step, status=409,
-                                error="Please answer the clips in order: this is the clip you are on.")
+                                error=gettext("Please answer the clips in order: this is the clip you are on."))
         return redirect("studyapp:resume", token=token)
     assignment = step.assignment
     if request.method == "GET":
@@ -274,7 +334,7 @@ def item(request, token: str, n: int):
             Assignment.objects.filter(pk=assignment.pk, shown_at__isnull=True).update(shown_at=timezone.now())
         return _render_item(request, participant, step)
     section, clip = assignment.section, assignment.clip
-    questions = questions_for(section.section_type, section.options, clip.theme, assignment.options)
+    questions = item_questions(section, clip, assignment.options, assignment.kind, assignment.instructed)
     try:
         answers = clean_answers(questions, request.POST)
     except AnswerError as exc:
@@ -284,28 +344,33 @@ def item(request, token: str, n: int):
     if section.require_full_play and clip.duration_s and (now - shown).total_seconds() < MIN_PLAY_FRACTION * min(
             clip.duration_s, 120):
         return _render_item(request, participant, step, status=400,
-                            error="Please watch the whole clip before answering.")
+                            error=gettext("Please watch the whole clip before answering."))
     server_ms = min(max(int((now - shown).total_seconds() * 1000), 0), 2**31 - 1)
     response_ms = client_ms(request.POST.get("rt", ""), server_ms)
     if response_ms is None:
         response_ms = server_ms
     save_answers(assignment, answers, response_ms)
-    return redirect("studyapp:resume", token=token)
+    return redirect(_after_answer_url(participant, n))
 
 
 def save_answers(assignment: Assignment, answers: dict[str, str], response_ms: int) -> bool:
-    """Store the answers of one clip exactly once. Returns False if they were already stored."""
+    """Store the answers of one clip exactly once (one transaction: a conditional UPDATE claims the assignment,
+    one INSERT of its responses, one UPDATE of the participant's last activity). Returns False if they were
+    already stored. A practice item stores no responses; an attention check stores its one answer with kind
+    ATTENTION_CHECK and question ``<key>=<instructed answer>``."""
+    now = timezone.now()
     try:
         with transaction.atomic():
-            locked = Assignment.objects.select_for_update().get(pk=assignment.pk)
-            if locked.answered_at is not None:
+            if not Assignment.objects.filter(pk=assignment.pk, answered_at__isnull=True).update(answered_at=now):
                 return False
-            Response.objects.bulk_create([
-                Response(participant_id=locked.participant_id, section_id=locked.section_id, clip_id=locked.clip_id,
-                         question=key, answer=value, response_ms=response_ms) for key, value in answers.items()])
-            locked.answered_at = timezone.now()
-            locked.save(update_fields=["answered_at"])
-            Participant.objects.filter(pk=locked.participant_id).update(last_active_at=locked.answered_at)
+            if assignment.kind != Assignment.Kind.PRACTICE:
+                attention = assignment.kind == ATTENTION_CHECK
+                Response.objects.bulk_create([
+                    Response(participant_id=assignment.participant_id, section_id=assignment.section_id,
+                             clip_id=assignment.clip_id, question=assignment.instructed if attention else key,
+                             answer=value, response_ms=response_ms, kind=assignment.kind)
+                    for key, value in answers.items()])
+            Participant.objects.filter(pk=assignment.participant_id).update(last_active_at=now)
     except IntegrityError:      # unique_response caught a concurrent duplicate
         return False
     return True
@@ -313,11 +378,10 @@ def save_answers(assignment: Assignment, answers: dict[str, str], response_ms: i
 
 def _render_item(request, participant: Participant, step, status: int = 200, error: str = ""):
     assignment = step.assignment
-    nxt = (participant.assignments.filter(answered_at__isnull=True)
-           .exclude(pk=assignment.pk).select_related("clip", "section")
-           .order_by("section__order", "section_id", "position").first())
+    nxt = step.next_assignment
     ctx = item_context(assignment.section, assignment.clip, step.index, step.total, nxt.clip if nxt else None,
-                       assignment.options, request.POST if request.method == "POST" else None)
+                       assignment.options, request.POST if request.method == "POST" else None,
+                       assignment.kind, assignment.instructed)
     ctx.update({"participant": participant, "study": participant.study, "error": error,
                 "first_of_section": assignment.position == 0})
     return render(request, "studyapp/item.html", ctx, status=status)
@@ -334,7 +398,8 @@ def feedback(request, token: str):
     if request.method == "POST" and form.is_valid():
         Participant.objects.filter(pk=participant.pk, feedback_done=False).update(
             feedback=form.cleaned_data, feedback_done=True)
-        return redirect("studyapp:resume", token=token)
+        mark_completed(participant)
+        return redirect("studyapp:done", token=token)
     return render(request, "studyapp/feedback.html", {"participant": participant, "study": participant.study,
                                                       "form": form, "total": step.total})
 
@@ -344,15 +409,23 @@ def done(request, token: str):
     participant = _participant(token)
     if current_step(participant).kind != "done":
         return redirect("studyapp:resume", token=token)
+    mark_completed(participant)      # writes only for a participant who finished before this was recorded
     study = participant.study
     return render(request, "studyapp/done.html", {"participant": participant, "study": study,
                                                   "completion_url": study.completion_url()})
 
 
 def media(request, key: str, ext: str):
-    """A clip's MP4/WebM/poster by its opaque media key, with HTTP Range support."""
+    """A clip's MP4/WebM/poster by its opaque media key, with HTTP Range support; behind nginx
+    (settings.MEDIA_ACCEL_REDIRECT) the bytes are handed to nginx with X-Accel-Redirect after this lookup."""
+    from django.conf import settings
+
+    from .media import accel_redirect_response
+
     clip = get_object_or_404(Clip, media_key=key)
     relative = {"mp4": clip.video, "webm": clip.webm, "png": clip.poster}.get(ext, "")
     if not relative:
         return HttpResponse(status=404)
+    if settings.MEDIA_ACCEL_REDIRECT:
+        return accel_redirect_response(media_path(relative), settings.MEDIA_ACCEL_REDIRECT)
     return ranged_file_response(request, media_path(relative))

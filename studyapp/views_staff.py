@@ -2,7 +2,6 @@
 from __future__ import annotations
 
 import tempfile
-import zipfile
 from pathlib import Path
 
 from django.contrib import messages
@@ -19,6 +18,7 @@ from .forms import ConsentForm, PresetStudyForm
 from .models import Assignment, Participant, Response, Study
 from .presets import create_study_from_preset
 from .questions import AnswerError, clean_answers, questions_for
+from .reports import report_state, start_build
 from .views import item_context
 
 
@@ -91,6 +91,7 @@ def progress(request, study_id: int):
         sections.append({"section": section, "clips": list(per_clip),
                          "responses": Response.objects.filter(section=section).count()})
     ctx = {"study": study, "counts": counts, "sections": sections, "title": f"Progress: {study.title}",
+           "report": report_state(study),
            "started": counts.get(Participant.Status.STARTED, 0),
            "completed": counts.get(Participant.Status.COMPLETED, 0),
            "consented": counts.get(Participant.Status.CONSENTED, 0),
@@ -109,33 +110,33 @@ def export_csv(request, study_id: int, kind: str):
 
 
 @staff_member_required
+@require_http_methods(["GET", "POST"])
 def report_zip(request, study_id: int):
-    """Run the analysis report on the study's CSVs and send report.html, report.json, tables and figures as a zip."""
-    from .export import run_report
-
+    """The analysis report of the study's current data. POST starts a detached build (studyapp.reports) and
+    returns at once to the progress page, which shows the build's status; GET sends the finished zip of the
+    current data version, or goes back to the progress page when there is none yet."""
     study = get_object_or_404(Study, pk=study_id)
-    tmp = tempfile.TemporaryDirectory(prefix="study-report-")
+    if request.method == "POST":
+        try:
+            state = start_build(study)
+        except OSError as exc:              # REPORTS_DIR not writable, no disk space, no Python to start
+            messages.error(request, f"Could not start the report build: {exc}")
+            return redirect(reverse("studyapp:progress", args=[study.pk]) + "#report")
+        if state.status == "ready":
+            messages.info(request, "The report of the current data is ready.")
+        else:
+            messages.info(request, "Building the report in the background; this page shows when it is ready.")
+        return redirect(reverse("studyapp:progress", args=[study.pk]) + "#report")
+    state = report_state(study)
     try:
-        run_report(study, tmp.name)
-    except ImportError:
-        tmp.cleanup()
-        messages.error(request, "The analysis library (analysis.report) is not installed in this deployment.")
-        return redirect(reverse("studyapp:progress", args=[study.pk]))
-    except ValueError as exc:       # analysis.io.ValidationError: names file, line and column
-        tmp.cleanup()
-        messages.error(request, f"The study's exports did not validate: {exc}")
-        return redirect(reverse("studyapp:progress", args=[study.pk]))
-    spool = tempfile.SpooledTemporaryFile(max_size=16 * 1024 * 1024)
-    with zipfile.ZipFile(spool, "w", zipfile.ZIP_DEFLATED) as zf:
-        root = Path(tmp.name)
-        for path in sorted(root.rglob("*")):
-            if path.is_file():
-                zf.write(path, path.relative_to(root).as_posix())
-    tmp.cleanup()
-    spool.seek(0)
-    return FileResponse(spool, as_attachment=True, filename=f"{study.slug}-report.zip",
-                        content_type="application/zip")
-
+        fh = open(state.zip_path, "rb") if state.status == "ready" else None
+    except FileNotFoundError:        # pruned by a newer build a moment ago
+        fh = None
+    if fh is None:
+        messages.warning(request, "No report of the current data yet: build it first.")
+        return redirect(reverse("studyapp:progress", args=[study.pk]) + "#report")
+    return FileResponse(fh, as_attachment=True, content_type="application/zip",
+                        filename=f"{study.slug}-report-{state.version}.zip")
 
 
 def contact_sheet_response(request, clips):

@@ -93,12 +93,17 @@ FLAT_V1 = {"enc1_sizes": [16, 16, 8], "enc2_sizes": [16, 16, 8], "gru_hidden": 2
 
 def test_flat_configs_of_old_checkpoints_map_onto_the_sections():
     cfg = GaitNetConfig.from_dict(FLAT_V1)
-    assert cfg == GaitNetConfig()   # the shipped weights were trained with the CPU default
+    # The previous shipped weights were trained with the CPU default of before the style term and the free-running
+    # continuation: a stored config without those fields describes a run without them.
+    assert cfg == GaitNetConfig().with_overrides(lambda_style=0.0, extra_steps=0)
+    sectioned = GaitNetConfig().to_dict()
+    del sectioned["loss"]["style"], sectioned["train"]["extra_steps"]
+    assert GaitNetConfig.from_dict(sectioned) == cfg
     odd = GaitNetConfig.from_dict({**FLAT_V1, "gru_hidden": 64, "lambda_root": 0.0, "tf_decay": 0.5,
                                    "frame_step": 2, "pos_scale_m": 0.2, "notes": {"run": "x"}})
     assert odd.model == GaitModelConfig(gru_hidden=64)
-    assert odd.loss == GaitLossWeights(root=0.0, pos_scale_m=0.2)
-    assert odd.train == GaitTrainConfig(tf_decay=0.5) and odd.data == GaitDataConfig(frame_step=2)
+    assert odd.loss == GaitLossWeights(root=0.0, pos_scale_m=0.2, style=0.0)
+    assert odd.train == GaitTrainConfig(tf_decay=0.5, extra_steps=0) and odd.data == GaitDataConfig(frame_step=2)
     assert odd.notes == {"run": "x"}
     # The split form round-trips, tuples included.
     assert GaitNetConfig.from_dict(odd.to_dict()) == odd
@@ -349,7 +354,10 @@ def test_shipped_weights_load_and_generate():
         pytest.skip(f"shipped weights absent: {DEFAULT_WEIGHTS} (train with `python -m generation.gait.train`)")
     assert DEFAULT_WEIGHTS.stat().st_size < 10 * 2 ** 20
     net = load_default_model()
-    assert net.config == GaitNetConfig.from_dict(FLAT_V1) and net.fps == 7.5   # a gait_net/1 file
+    # Fine-tuned from the previous (gait_net/1) weights with the style term (docs/benchmarks/gait.md, issue 14).
+    assert net.config.model == GaitNetConfig().model and net.fps == 7.5
+    assert net.config.loss.style > 0 and net.config.train.extra_steps > 0
+    assert net.info["trained_on"] == "synthetic procedural corpus" and net.device.type == "cpu"
     seed = walk(WalkParams(), straight(10.0), 80, 30.0)
     (m,) = generate_gaits([seed], [curved(5.0, 1.0, 15.0)], np.array([[0.7, 0.1, 0.1, 0.1]]), steps=30, model=net)
     assert m.num_frames == 29 * 4 + 1
@@ -381,3 +389,48 @@ def test_command_line_options_build_the_config():
     assert paper.model == GaitModelConfig.paper() and paper.train.epochs == 5
     with pytest.raises(SystemExit):
         config_from_args(build_parser().parse_args(["--set", "no_such_field=1"]))
+
+
+def test_style_loss_is_phase_free_and_penalises_lost_amplitude():
+    from generation.gait.losses import style_loss, window_statistics
+    t = torch.linspace(0, 4 * math.pi, 40)
+    rng = torch.Generator().manual_seed(0)
+    base_pos = torch.randn(3, 1, 21, 3, generator=rng)
+    wave = torch.sin(t)[None, :, None, None] * torch.randn(3, 1, 21, 3, generator=rng) * 0.2
+    pos = base_pos + wave                                                    # (3, 40, 21, 3) a periodic motion
+    aff = torch.sin(t)[None, :, None] * torch.randn(3, 1, 18, generator=rng) + torch.randn(3, 1, 18, generator=rng)
+    assert window_statistics(aff, pos).shape == (3, 2 * 18 + 20)
+    assert style_loss([(aff, pos)], aff, pos).item() < 1e-6
+    half = len(t) // 2   # the same motion half a cycle later: same statistics
+    shifted = style_loss([(aff.roll(half, 1), pos.roll(half, 1))], aff, pos).item()
+    frozen = style_loss([(aff.mean(1, keepdim=True).expand_as(aff), pos.mean(1, keepdim=True).expand_as(pos))],
+                        aff, pos).item()
+    assert shifted < 1e-3 < 0.1 < frozen   # a frozen (mean) pose loses the amplitude and is penalised
+
+
+def test_rollout_continues_free_running_past_the_data(tiny_data):
+    cfg = GaitNetConfig.tiny(extra_steps=5)
+    net = GaitNet(cfg.model)
+    norm = fit_normalizer(tiny_data.subset("train"))
+    batch = tiny_data.batch([0, 1])
+    pred = rollout(net, norm, batch, 0.5, cfg.prefix_len, extra_steps=5)
+    assert pred["ext_aff"].shape == (2, 5, 18) and pred["ext_pos"].shape == (2, 5, 21, 3)
+    assert pred["q"].shape == batch["q"][:, 1:].shape
+    _, terms = total_loss(pred, ground_truth_targets(batch, norm), cfg.loss, style_from=cfg.prefix_len - 1)
+    assert terms["style"] > 0
+    _, none = total_loss(pred, ground_truth_targets(batch, norm), GaitLossWeights(style=0.0))
+    assert "style" not in none
+    assert GaitNetConfig.tiny(tf_start=0.3).train.tf_start == 0.3
+
+
+def test_fine_tuning_starts_from_a_weights_file(tiny_data, tmp_path):
+    cfg = GaitNetConfig.tiny(epochs=1, batch_size=2)
+    first = train(cfg, tiny_data, tmp_path / "a.pt", tmp_path / "a.ckpt", progress=False, log=lambda *_: None)
+    tuned = train(cfg.with_overrides(tf_start=0.2), tiny_data, tmp_path / "b.pt", tmp_path / "b.ckpt",
+                  progress=False, log=lambda *_: None, init=tmp_path / "a.pt")
+    assert tuned["history"][0]["tf"] == pytest.approx(0.2)
+    assert load_checkpoint(tmp_path / "b.pt")[2]["initialised_from"]["path"] == str(tmp_path / "a.pt")
+    assert not all(torch.equal(p, q) for p, q in zip(first["model"].parameters(), tuned["model"].parameters()))
+    with pytest.raises(ValueError, match="architecture"):
+        train(GaitNetConfig.tiny(epochs=1, gru_hidden=16), tiny_data, tmp_path / "c.pt", tmp_path / "c.ckpt",
+              progress=False, log=lambda *_: None, init=tmp_path / "a.pt")

@@ -214,9 +214,38 @@ def test_total_loss_ablation_weights():
     pred = qnormalize(target + 0.1)
     mask = torch.ones(B, T, dtype=torch.bool)
     _, parts = total_loss(pred, target, mask, _offsets(B), GESTURE_PARENTS, LossWeights(pose=0.0))
-    assert set(parts) == {"angle", "affective"}
+    assert set(parts) == {"angle", "affective", "velocity", "liveliness"}
+    _, parts = total_loss(pred, target, mask, _offsets(B), GESTURE_PARENTS, LossWeights(velocity=0.0, liveliness=0.0))
+    assert set(parts) == {"angle", "pose", "affective"}
     with pytest.raises(ValueError):
-        total_loss(pred, target, mask, _offsets(B), GESTURE_PARENTS, LossWeights(0.0, 0.0, 0.0))
+        total_loss(pred, target, mask, _offsets(B), GESTURE_PARENTS, LossWeights(0.0, 0.0, 0.0, 0.0, 0.0))
+
+
+def _wrist_positions(rotations: torch.Tensor) -> torch.Tensor:
+    from generation.gesture.losses import _positions
+
+    return _positions(rotations, _offsets(rotations.shape[0]), GESTURE_PARENTS)
+
+
+def test_liveliness_loss_punishes_a_still_answer_but_not_a_phase_shift():
+    """Issue 14: a motionless (mean) pose has a small pose error when the stroke phase is uncertain; the
+    liveliness term compares wrist-speed statistics, so it is large for the still answer and about zero for the
+    same motion shifted in time (whose pose error is large)."""
+    from generation.gesture.losses import liveliness_loss, velocity_loss
+    from generation.procedural.gesture import GestureParams, seated_gesture
+
+    m = seated_gesture(GestureParams(kind="beat", speed=1.5), 60, 10.0, seed=0)
+    seq = torch.as_tensor(m.rotations, dtype=torch.float32)
+    target, shifted = seq[None, 20:50], seq[None, 23:53]  # the beat, and the same beat 0.3 s later
+    still = target.mean(1, keepdim=True).expand_as(target)
+    still = still / still.norm(dim=-1, keepdim=True)
+    mask = torch.ones(1, 30, dtype=torch.bool)
+    p_t, p_shift, p_still = _wrist_positions(target), _wrist_positions(shifted), _wrist_positions(still)
+    live_shift, live_still = liveliness_loss(p_shift, p_t, mask, 10.0), liveliness_loss(p_still, p_t, mask, 10.0)
+    assert live_still > 0.05  # (m/s)^2: the still wrists miss the corpus speed
+    assert live_shift < 0.1 * live_still
+    assert pose_loss(shifted, target, mask, _offsets(1), GESTURE_PARENTS) > 0
+    assert velocity_loss(p_t, p_t, mask, 10.0) < 1e-10 < velocity_loss(p_still, p_t, mask, 10.0)
 
 
 def test_tiny_network_overfits_a_tiny_batch():

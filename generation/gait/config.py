@@ -8,7 +8,7 @@ As on the gesture side, the settings are split by what they configure:
 - :class:`GaitTrainConfig`: the optimiser, curriculum and augmentation of a training run;
 - :class:`GaitLossWeights`: the weights of the loss terms of eq. 13 and how the terms are measured.
 
-:class:`GaitNetConfig` holds one of each. The default is sized to train in about 20 minutes on one CPU thread;
+:class:`GaitNetConfig` holds one of each. The default is sized to train in about 10-20 minutes on one free CPU thread;
 ``GaitNetConfig.paper()`` (``GaitModelConfig.paper()`` for the network alone) has the paper's released sizes,
 so both are the same code path.
 
@@ -152,6 +152,12 @@ class GaitTrainConfig:
         dominant emotion (phase-aligned); the emotion input switches from that walk's label to the sequence's own
         label at the splice. Every corpus walk has one emotion throughout, so without this the motion history
         predicts the style and the network learns to ignore m (see train.splice_histories).
+    tf_start: the teacher-forcing ratio of the first epoch (ratio tf_start * tf_decay ** epoch); below 1 for
+        fine-tuning a trained network (``--init``), which starts where a full schedule would end.
+    extra_steps: after the last ground-truth step, the rollout keeps predicting this many steps free-running
+        (inputs from its own predictions, the path heading and emotion of the last step); they have no per-step
+        target and enter only the style term (``GaitLossWeights.style``), which asks them to keep the walk's style
+        statistics. This trains the long rollouts of generation (200+ steps) against drifting to an average gait.
     seed: seeds torch and numpy (runs are repeatable).
     """
 
@@ -162,6 +168,8 @@ class GaitTrainConfig:
     tf_decay: float = 0.91
     grad_clip: float = 1.0
     splice_frac: float = 0.3
+    extra_steps: int = 30
+    tf_start: float = 1.0
     seed: int = 0
 
     def to_dict(self) -> dict:
@@ -179,6 +187,9 @@ class GaitLossWeights:
     motion: L_motion (eq. 8, Euler-angle differences); versor: its unit-norm term.
     pose: L_pose (eq. 9); aff: L_aff (eq. 10; only with ``GaitModelConfig.use_affective``); root: L_root (eq. 11);
     fctc: L_fctc (eq. 12, foot contact); phase: the step-phase head (an addition of this implementation).
+    style: L_style (an addition): the time mean and spread of the affective features and the motion amplitude of
+        the predicted window and of the free-running continuation match the ground truth's
+        (``losses.style_loss``; 0 leaves it out, as in the paper and in checkpoints saved before the field).
     pos_scale_m: positions in the pose and foot losses are measured in units of this many metres.
     euler_order: axis order of the Euler angles compared by L_motion.
     """
@@ -190,6 +201,7 @@ class GaitLossWeights:
     root: float = 1.0
     fctc: float = 1.0
     phase: float = 1.0
+    style: float = 1.0
     pos_scale_m: float = 0.1
     euler_order: str = "zyx"
 
@@ -210,20 +222,27 @@ FLAT_NAMES: dict[str, tuple[str, str]] = {
                                           "num_joints", "num_emotions")},
     **{name: ("data", name) for name in ("seq_len", "frame_step", "prefix_frac")},
     **{name: ("train", name) for name in ("batch_size", "epochs", "lr", "lr_decay", "tf_decay", "grad_clip",
-                                          "splice_frac", "seed")},
-    **{f"lambda_{name}": ("loss", name) for name in ("motion", "versor", "pose", "aff", "root", "fctc", "phase")},
+                                          "splice_frac", "extra_steps", "tf_start", "seed")},
+    **{f"lambda_{name}": ("loss", name) for name in ("motion", "versor", "pose", "aff", "root", "fctc", "phase",
+                                                                  "style")},
     "pos_scale_m": ("loss", "pos_scale_m"),
     "euler_order": ("loss", "euler_order"),
 }
 """Field names of the single flat config used before the split (``gait_net/1`` checkpoints, ``--set``, the
 overrides of ``paper``/``tiny``) -> (section, field). ``notes`` kept its name."""
 
+BEFORE_FIELD: tuple[tuple[str, str, object], ...] = (("loss", "style", 0.0), ("train", "extra_steps", 0))
+"""(section, field, value) of fields added after checkpoints were written: a stored config without the field
+describes a run made without it (the paper's loss and rollout)."""
+
 
 @dataclass
 class GaitNetConfig:
     """Everything a gait network run is made of: architecture, data, training and loss weights (and free notes).
 
-    ``GaitNetConfig()`` is the CPU default that trained the shipped weights (GRU 2 x 256, 28 epochs).
+    ``GaitNetConfig()`` is the CPU default (GRU 2 x 256, 28 epochs, style term and a 30-step free-running
+    continuation). The shipped weights are the previous default run (without the style term) fine-tuned with it;
+    docs/benchmarks/gait.md has the commands.
     """
 
     model: GaitModelConfig = field(default_factory=GaitModelConfig)
@@ -239,14 +258,17 @@ class GaitNetConfig:
 
     @classmethod
     def paper(cls, **overrides) -> GaitNetConfig:
-        """The released model (:meth:`GaitModelConfig.paper`, about 9.9 M parameters) trained for 500 epochs.
+        """The released model (:meth:`GaitModelConfig.paper`, about 9.9 M parameters) trained for 500 epochs with
+        the paper's teacher-forcing decay 0.995 per epoch (the other settings are the default's).
         ``overrides`` use the flat names (:data:`FLAT_NAMES`), e.g. ``paper(epochs=10)``."""
-        return cls(model=GaitModelConfig.paper(), train=GaitTrainConfig(epochs=500)).with_overrides(**overrides)
+        return cls(model=GaitModelConfig.paper(), train=GaitTrainConfig(epochs=500, tf_decay=0.995)
+                   ).with_overrides(**overrides)
 
     @classmethod
     def tiny(cls, **overrides) -> GaitNetConfig:
-        """A very small network for tests (batches of 4, 2 epochs); flat-name ``overrides`` as in :meth:`paper`."""
-        return cls(model=GaitModelConfig.tiny(), train=GaitTrainConfig(batch_size=4, epochs=2)
+        """A very small network for tests (batches of 4, 2 epochs, 4 free-running extra steps); flat-name
+        ``overrides`` as in :meth:`paper`."""
+        return cls(model=GaitModelConfig.tiny(), train=GaitTrainConfig(batch_size=4, epochs=2, extra_steps=4)
                    ).with_overrides(**overrides)
 
     def with_overrides(self, **overrides) -> GaitNetConfig:
@@ -283,8 +305,16 @@ class GaitNetConfig:
             unknown = sorted(set(d) - set(SECTIONS) - {"notes"})
             if unknown:
                 raise ValueError(f"unknown GaitNetConfig fields {unknown}")
-            return cls(**{name: SECTIONS[name].from_dict(d.get(name, {})) for name in SECTIONS},
+            sections = {name: dict(d.get(name, {})) for name in SECTIONS}
+            for section, name, old in BEFORE_FIELD:   # files saved before these fields existed
+                if section in d:
+                    sections[section].setdefault(name, old)
+            return cls(**{name: SECTIONS[name].from_dict(sections[name]) for name in SECTIONS},
                        notes=dict(d.get("notes", {})))
         flat = dict(d)
         flat.setdefault("emotion_skip", False)  # checkpoints saved before the field existed
+        for section, name, old in BEFORE_FIELD:
+            names = {flat_name for flat_name, where in FLAT_NAMES.items() if where == (section, name)}
+            if not names & set(flat) and f"{section}.{name}" not in flat:
+                flat[f"{section}.{name}"] = old
         return cls().with_overrides(**flat)

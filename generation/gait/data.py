@@ -137,7 +137,13 @@ def step_phase(positions_30: np.ndarray, fps: float, skeleton) -> np.ndarray:
 # ---- normalisation -----------------------------------------------------------------------------
 @dataclass
 class Normalizer:
-    """Per-feature mean and std (training split) for affective, root and step features."""
+    """Per-feature mean and std (training split) for affective, root and step features.
+
+    ``aff_style_std`` (18,) is the spread across training walks of each walk's time-mean affective feature (the
+    scale on which an observer of whole walks compares them; some features, such as the shoulder / lower-back area
+    ratio, barely vary within or between walks, so their per-frame std is floored for the inputs and L_aff, but a
+    0.1 % offset of their mean is several walk-to-walk standard deviations). None in files saved before it existed.
+    """
 
     aff_mean: np.ndarray   # (18,)
     aff_std: np.ndarray
@@ -145,25 +151,35 @@ class Normalizer:
     root_std: np.ndarray
     step_mean: np.ndarray  # (3,) omega, s-bar, kappa
     step_std: np.ndarray
+    aff_style_std: np.ndarray | None = None
 
     CLIP = 6.0
     AFF_STD_FLOOR = 0.02  # radians / ratio units: nearly constant features must not dominate L_aff
 
     @classmethod
     def fit(cls, aff: np.ndarray, root: np.ndarray, step: np.ndarray) -> Normalizer:
+        """Statistics of (N, T, F) arrays (or (M, F) rows; then without ``aff_style_std``)."""
         def ms(x, floor=1e-6):
             x = x.reshape(-1, x.shape[-1])
             return x.mean(0), np.maximum(x.std(0), floor)
         (am, asd), (rm, rsd), (sm, ssd) = ms(aff, cls.AFF_STD_FLOOR), ms(root), ms(step)
-        return cls(am, asd, rm, rsd, sm, ssd)
+        style = np.maximum(aff.mean(-2).std(0), 1e-6) if aff.ndim == 3 else None
+        return cls(am, asd, rm, rsd, sm, ssd, style)
 
     def to_dict(self) -> dict:
-        return {k: np.asarray(getattr(self, k)).tolist() for k in
-                ("aff_mean", "aff_std", "root_mean", "root_std", "step_mean", "step_std")}
+        names = ("aff_mean", "aff_std", "root_mean", "root_std", "step_mean", "step_std", "aff_style_std")
+        return {k: np.asarray(getattr(self, k)).tolist() for k in names if getattr(self, k) is not None}
 
     @classmethod
     def from_dict(cls, d: dict) -> Normalizer:
         return cls(**{k: np.asarray(v, dtype=np.float64) for k, v in d.items()})
+
+    def style_scale(self, ref: torch.Tensor) -> torch.Tensor:
+        """(18,) factors turning standardised affective features (:meth:`aff`) into units of ``aff_style_std``
+        (ones when it is unknown)."""
+        if self.aff_style_std is None:
+            return torch.ones(len(self.aff_std), dtype=ref.dtype, device=ref.device)
+        return self._t("aff_std", ref) / self._t("aff_style_std", ref)
 
     def _t(self, name, ref: torch.Tensor) -> torch.Tensor:
         return torch.as_tensor(getattr(self, name), dtype=ref.dtype, device=ref.device)
@@ -251,9 +267,23 @@ class GaitSequences:
             kw[k] = v[it] if isinstance(v, torch.Tensor) else (v[idx] if isinstance(v, np.ndarray) else v)
         return GaitSequences(**kw)
 
+    def to(self, device: torch.device | str) -> GaitSequences:
+        """A copy with every tensor on ``device`` (training moves the whole, small, training set once, so that
+        batches are gathered on the device itself); the numpy fields stay on the host."""
+        kw = {k: (v.to(device) if isinstance(v, torch.Tensor) else v)
+              for k, v in ((k, getattr(self, k)) for k in self.__dataclass_fields__)}
+        out = GaitSequences(**kw)
+        if hasattr(self, "source"):
+            out.source = self.source
+        return out
+
+    @property
+    def device(self) -> torch.device:
+        return self.q.device
+
     def batch(self, idx) -> dict:
-        """Dict of tensors for sequences ``idx``."""
-        it = torch.as_tensor(np.asarray(idx), dtype=torch.long)
+        """Dict of tensors for sequences ``idx`` (on the device the sequences live on)."""
+        it = torch.as_tensor(np.asarray(idx), dtype=torch.long, device=self.q.device)
         return {k: getattr(self, k)[it] for k in ("q", "root", "theta", "omega", "sbar", "kappa", "ref", "aff",
                                                   "emotion", "offsets", "mean_height", "root_pos")}
 

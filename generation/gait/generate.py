@@ -21,6 +21,7 @@ from pathlib import Path
 import numpy as np
 import torch
 
+from generation.core.device import resolve_device
 from generation.core.foot_contact import plant_feet
 from generation.core.motion import Motion
 from generation.core.paths import GroundPath, straight
@@ -67,27 +68,46 @@ class LoadedGaitNet:
         """Network rate in steps per second (30 fps corpus / frame_step)."""
         return 30.0 / self.config.data.frame_step
 
+    @property
+    def device(self) -> torch.device:
+        """Where the model's weights are."""
+        return next(self.model.parameters()).device
+
+    def on(self, device: str | torch.device | None) -> LoadedGaitNet:
+        """This network on ``device`` (:func:`generation.core.device.resolve_device`): itself when it is there
+        already, otherwise a copy (cached per device), so that the shared default model is never moved."""
+        dev = resolve_device(device)
+        if dev == self.device:
+            return self
+        copies = self.__dict__.setdefault("_copies", {})
+        if str(dev) not in copies:
+            import copy
+            model = copy.deepcopy(self.model).to(dev).eval()
+            copies[str(dev)] = LoadedGaitNet(model, self.normalizer, self.path, dict(self.info), self.config)
+        return copies[str(dev)]
+
 
 _DEFAULT: LoadedGaitNet | None = None
 
 
-def load_model(path: str | Path) -> LoadedGaitNet:
-    """Load weights written by the training command."""
-    model, norm, payload = load_checkpoint(path)
-    info = {k: payload[k] for k in ("trained_on", "num_parameters", "corpus") if k in payload}
+def load_model(path: str | Path, device: str | torch.device | None = "cpu") -> LoadedGaitNet:
+    """Load weights written by the training command (on any device) onto ``device``."""
+    model, norm, payload = load_checkpoint(path, device)
+    info = {k: payload[k] for k in ("trained_on", "num_parameters", "corpus", "initialised_from") if k in payload}
     info["epochs"] = len(payload.get("history", []))
     return LoadedGaitNet(model, norm, str(path), info, GaitNetConfig.from_dict(payload["config"]))
 
 
-def load_default_model() -> LoadedGaitNet:
-    """The shipped weights ``generation/data/weights/gait_net_default.pt`` (cached after the first call)."""
+def load_default_model(device: str | torch.device | None = None) -> LoadedGaitNet:
+    """The shipped weights ``generation/data/weights/gait_net_default.pt`` (cached after the first call, on the
+    CPU; with ``device``, a copy on that device, also cached)."""
     global _DEFAULT
     if _DEFAULT is None:
         if not DEFAULT_WEIGHTS.exists():
             raise FileNotFoundError(
                 f"default gait weights missing: {DEFAULT_WEIGHTS}; train them with `python -m generation.gait.train`")
         _DEFAULT = load_model(DEFAULT_WEIGHTS)
-    return _DEFAULT
+    return _DEFAULT if device is None else _DEFAULT.on(device)
 
 
 # ---- emotions --------------------------------------------------------------------------------
@@ -260,24 +280,28 @@ def _advance_root(xz: np.ndarray, world: np.ndarray, s_step: torch.Tensor, delta
 
 
 def _predict_seed(net: LoadedGaitNet, seed: dict, emotions: np.ndarray) -> tuple[dict, torch.Tensor]:
-    """Run the network over the seed steps (the seed's emotion is the first step's): (prediction of the step after
-    the seed, GRU state)."""
-    norm = net.normalizer
+    """Run the network (on its device) over the seed steps (the seed's emotion is the first step's): (prediction
+    of the step after the seed, on the CPU; GRU state, on the network's device)."""
+    norm, dev = net.normalizer, net.device
     N, L = seed["q"].shape[:2]
     em_seed = torch.as_tensor(emotions[:, :1], dtype=torch.float32).expand(N, L, NUM_EMOTIONS)
-    out = net.model(seed["q"], norm.aff(seed["aff"]), norm.step(seed["theta"], seed["omega"], seed["sbar"],
-                                                                seed["kappa"]), norm.root(seed["root"]), em_seed)
-    return {k: v[:, -1] for k, v in out.items() if k != "hidden"}, out["hidden"]
+    inputs = (seed["q"], norm.aff(seed["aff"]), norm.step(seed["theta"], seed["omega"], seed["sbar"], seed["kappa"]),
+              norm.root(seed["root"]), em_seed)
+    out = net.model(*(x.to(dev) for x in inputs))
+    return {k: v[:, -1].cpu() for k, v in out.items() if k != "hidden"}, out["hidden"]
 
 
 def _predict_next(net: LoadedGaitNet, seed: dict, pred: dict, hidden: torch.Tensor, h: torch.Tensor,
                   step_in: torch.Tensor, emotion: torch.Tensor) -> tuple[dict, torch.Tensor]:
     """One network step fed with its previous prediction ``pred`` (root height deviation ``h``, step features
-    ``step_in``): (the next prediction, GRU state)."""
-    pos = heading_frame_positions(pred["q"], seed["mean_height"] + h.float(), seed["offsets"])
-    out = net.model.step(pred["q"], net.normalizer.aff(affective_features(pos)), step_in, pred["root"], emotion,
-                         hidden)
-    return {k: v for k, v in out.items() if k != "hidden"}, out["hidden"]
+    ``step_in``; CPU tensors): (the next prediction on the CPU, GRU state on the network's device). The forward
+    kinematics, affective features and network run on the network's device."""
+    dev = net.device
+    q = pred["q"].to(dev)
+    pos = heading_frame_positions(q, (seed["mean_height"] + h.float()).to(dev), seed["offsets"].to(dev))
+    out = net.model.step(q, net.normalizer.aff(affective_features(pos)), step_in.to(dev), pred["root"].to(dev),
+                         emotion.to(dev), hidden)
+    return {k: v.cpu() for k, v in out.items() if k != "hidden"}, out["hidden"]
 
 
 def _rollout(net: LoadedGaitNet, seed: dict, emotions: np.ndarray, trackers: list[_PathTracker],
@@ -346,7 +370,8 @@ def _metadata(net: LoadedGaitNet, emotions: np.ndarray, path: GroundPath, seed_m
 
 def generate_gaits(seeds, paths: list[GroundPath], emotions, steps: int = 200, fps_out: float = 30.0,
                    model: LoadedGaitNet | None = None, lookahead_m: float = 1.0, include_seed: bool = False,
-                   rng_seed: int = 0, foot_cleanup: bool = True) -> list[Motion]:
+                   rng_seed: int = 0, foot_cleanup: bool = True, device: str | torch.device | None = None
+                   ) -> list[Motion]:
     """Generate emotive gaits for N agents in one batch.
 
     Args:
@@ -367,6 +392,9 @@ def generate_gaits(seeds, paths: list[GroundPath], emotions, steps: int = 200, f
         foot_cleanup: plant the feet after generation (:func:`generation.core.foot_contact.plant_feet`: contacts
             detected in the output, the planted foot locked, legs solved with two-bone IK, no floor
             penetration); False returns the network's raw output (resampled).
+        device: where the network runs: None keeps the model where it is (the default model loads on the CPU),
+            or "auto" / "cpu" / "cuda" / "cuda:N" (:func:`generation.core.device.resolve_device`; the model is
+            copied there, the caller's is not moved). Path steering, resampling and foot planting stay on the CPU.
 
     Returns:
         N Motions on each seed's skeleton, metadata {"origin": "generated", "generator": "gait_net", "emotion",
@@ -374,6 +402,8 @@ def generate_gaits(seeds, paths: list[GroundPath], emotions, steps: int = 200, f
         "foot_cleanup" (when applied)}.
     """
     net = model if model is not None else load_default_model()
+    if device is not None:
+        net = net.on(device)
     seeds, emotions = _check_inputs(seeds, paths, emotions, steps)
     seed_motions, seed = _seed_batch(seeds, emotions, net.config.data, np.random.default_rng(rng_seed))
     placement = _Placement.onto_paths(paths, seed)

@@ -72,14 +72,48 @@ def phase_loss(omega_pred: torch.Tensor, omega_true: torch.Tensor) -> torch.Tens
     return (omega_pred - omega_true).abs().mean()
 
 
-def total_loss(pred: dict, true: dict, weights: GaitLossWeights, use_affective: bool = True
+def window_statistics(aff: torch.Tensor, pos: torch.Tensor, scale_m: float = 0.1,
+                      mean_scale: torch.Tensor | None = None) -> torch.Tensor:
+    """Phase-free style statistics of a window of steps: (N, 2 * 18 + J - 1).
+
+    The mean over time of the standardised affective features (N, L, 18), multiplied by ``mean_scale`` (18,)
+    (``Normalizer.style_scale``: walk-to-walk units), their standard deviation over time, and the standard
+    deviation over time of each root-relative joint position (N, L, J, 3; in units of ``scale_m``, summed over
+    x, y, z): the posture an observer of the whole walk sees and the motion amplitude that free-running
+    prediction tends to lose.
+    """
+    rel = (pos[..., 1:, :] - pos[..., :1, :]) / scale_m
+    amp = rel.var(dim=1, unbiased=False).sum(-1).clamp_min(1e-8).sqrt()
+    mean = aff.mean(1) if mean_scale is None else aff.mean(1) * mean_scale
+    return torch.cat((mean, aff.std(1, unbiased=False), amp), dim=-1)
+
+
+def style_loss(pred_windows: list[tuple[torch.Tensor, torch.Tensor]], aff_true: torch.Tensor, pos_true: torch.Tensor,
+               scale_m: float = 0.1, mean_scale: torch.Tensor | None = None) -> torch.Tensor:
+    """Sequence-level affect term (an addition of this implementation): squared difference of
+    :func:`window_statistics` of each predicted window (aff (N, L, 18), pos (N, L, J, 3)) from those of the
+    ground-truth window (``aff_true``, ``pos_true``), averaged over statistics and windows.
+
+    Every corpus walk keeps one style throughout, so a window predicted past the end of the ground truth (the
+    free-running continuation of :func:`generation.gait.train.rollout`) must keep the statistics of the true
+    window: this penalises the drift towards an average, smaller gait that the per-step losses leave free.
+    """
+    target = window_statistics(aff_true, pos_true, scale_m, mean_scale)
+    terms = [((window_statistics(a, p, scale_m, mean_scale) - target) ** 2).mean() for a, p in pred_windows]
+    return torch.stack(terms).mean()
+
+
+def total_loss(pred: dict, true: dict, weights: GaitLossWeights, use_affective: bool = True, style_from: int = 0
                ) -> tuple[torch.Tensor, dict]:
-    """Eq. 13 plus the phase term.
+    """Eq. 13 plus the phase term and the optional style term.
 
     ``pred`` and ``true`` hold ``q`` ((N, L, J, 4); ``pred["q_raw"]`` unnormalised), ``pos`` (N, L, J, 3) with
     root height, ``aff`` (N, L, 18), ``root`` (N, L, 3) and ``omega`` (N, L), all for the same target steps.
-    ``use_affective`` (``GaitModelConfig.use_affective``) adds L_aff. Terms with weight 0 are left out of the
-    total. Returns the weighted total and a dict of floats per term.
+    ``use_affective`` (``GaitModelConfig.use_affective``) adds L_aff. With ``weights.style`` > 0, L_style
+    (:func:`style_loss`) compares the windows ``[style_from:]`` of ``pred`` and ``true`` and, when ``pred`` has
+    ``ext_aff`` / ``ext_pos`` (steps predicted past the ground truth), that continuation too; ``true`` may carry
+    ``aff_style_scale`` (18,) for the feature means (:meth:`generation.gait.data.Normalizer.style_scale`).
+    Terms with weight 0 are left out of the total. Returns the weighted total and a dict of floats per term.
     """
     w = weights
     terms = {
@@ -91,5 +125,11 @@ def total_loss(pred: dict, true: dict, weights: GaitLossWeights, use_affective: 
     }
     if use_affective:
         terms["aff"] = affective_loss(pred["aff"], true["aff"])
+    if w.style != 0.0:
+        windows = [(pred["aff"][:, style_from:], pred["pos"][:, style_from:])]
+        if pred.get("ext_aff") is not None:
+            windows.append((pred["ext_aff"], pred["ext_pos"]))
+        terms["style"] = style_loss(windows, true["aff"][:, style_from:], true["pos"][:, style_from:],
+                                    w.pos_scale_m, true.get("aff_style_scale"))
     total = sum(getattr(w, k) * v for k, v in terms.items() if getattr(w, k) != 0.0)
     return total, {k: float(v.detach()) for k, v in terms.items()}

@@ -1,13 +1,18 @@
 """Training of the gait network (seed 000 section 5.3) with curriculum teacher forcing.
 
-Run ``python -m generation.gait.train --help`` (or ``python manage.py train_gait``). The default run
-reproduces ``generation/data/weights/gait_net_default.pt`` (see docs/benchmarks/gait.md for the command).
+Run ``python -m generation.gait.train --help`` (or ``python manage.py train_gait``); docs/benchmarks/gait.md has
+the commands that made ``generation/data/weights/gait_net_default.pt`` (a default run fine-tuned with ``--init``).
+``--device auto|cpu|cuda[:N]`` picks where it runs, ``--amp`` mixed precision on CUDA, ``--config paper`` the
+published size. Weights and checkpoints are written device-independent (tensors on the CPU).
 
 Each sequence has T = 60 steps. The first ``prefix_len`` (18) steps are always ground truth; at every
 later step each sequence's input is the ground truth with probability ``tf_decay ** epoch`` (the
 teacher-forcing ratio) and the network's own previous prediction otherwise (the curriculum of section 5.3,
 after Pavllo et al.). The network predicts step t + 1 from step t; the losses of eq. 8-13 are taken over
 all predicted steps.
+
+After the last ground-truth step the rollout continues ``extra_steps`` free-running steps whose window statistics
+enter the style term (:func:`generation.gait.losses.style_loss`), against drift in long generated walks.
 
 A fraction ``splice_frac`` of each batch gets the ground-truth prefix of a walk with another emotion and a label
 that switches to the sequence's own at the splice (:func:`splice_histories`), so that the emotion input, not the
@@ -24,6 +29,16 @@ from pathlib import Path
 
 import numpy as np
 import torch
+
+from generation.core.device import (
+    DEVICE_CHOICES,
+    autocast_context,
+    cpu_state_dict,
+    describe,
+    needs_grad_scaler,
+    resolve_device,
+    to_cpu,
+)
 
 from .config import GaitNetConfig
 from .data import (
@@ -46,8 +61,8 @@ CHECKPOINT_FORMAT = "gait_net/2"
 def fit_normalizer(data: GaitSequences) -> Normalizer:
     """Standardisation statistics from a (training) set of sequences."""
     step = torch.stack((data.omega, data.sbar, data.kappa), dim=-1)
-    return Normalizer.fit(data.aff.numpy().astype(np.float64), data.root.numpy().astype(np.float64),
-                          step.numpy().astype(np.float64))
+    as_np = lambda t: t.detach().cpu().numpy().astype(np.float64)  # noqa: E731
+    return Normalizer.fit(as_np(data.aff), as_np(data.root), as_np(step))
 
 
 def ground_truth_targets(batch: dict, norm: Normalizer) -> dict:
@@ -55,7 +70,8 @@ def ground_truth_targets(batch: dict, norm: Normalizer) -> dict:
     h = batch["root"][:, 1:, 0]
     pos = heading_frame_positions(batch["q"][:, 1:], batch["mean_height"][:, None] + h, batch["offsets"][:, None])
     return {"q": batch["q"][:, 1:], "pos": pos, "aff": norm.aff(batch["aff"][:, 1:]),
-            "root": norm.root(batch["root"][:, 1:]), "omega": norm.omega(batch["omega"][:, 1:])}
+            "root": norm.root(batch["root"][:, 1:]), "omega": norm.omega(batch["omega"][:, 1:]),
+            "aff_style_scale": norm.style_scale(batch["aff"])}
 
 
 def splice_histories(batch: dict, prefix: int, frac: float, rng: np.random.Generator) -> dict:
@@ -73,8 +89,8 @@ def splice_histories(batch: dict, prefix: int, frac: float, rng: np.random.Gener
     out = dict(batch, emotion=em)
     if frac <= 0.0 or B < 2:
         return out
-    dominant = batch["emotion"].argmax(-1).numpy()
-    theta = batch["theta"][:, prefix - 1].numpy()
+    dominant = batch["emotion"].argmax(-1).cpu().numpy()
+    theta = batch["theta"][:, prefix - 1].cpu().numpy()
     chosen = np.flatnonzero(rng.random(B) < frac)
     src = np.arange(B)
     for b in chosen:
@@ -82,10 +98,11 @@ def splice_histories(batch: dict, prefix: int, frac: float, rng: np.random.Gener
         if len(cand):
             dphase = np.abs(np.remainder(theta[cand] - theta[b] + math.pi, 2 * math.pi) - math.pi)
             src[b] = cand[np.argmin(dphase)]
-    swap = torch.as_tensor(src != np.arange(B))
+    device = batch["q"].device
+    swap = torch.as_tensor(src != np.arange(B), device=device)
     if not swap.any():
         return out
-    src_t = torch.as_tensor(src)
+    src_t = torch.as_tensor(src, device=device)
     for k in ("q", "root", "theta", "omega", "sbar", "kappa", "aff"):
         v = batch[k].clone()
         w = swap.view((B,) + (1,) * (v.dim() - 1))
@@ -95,30 +112,14 @@ def splice_histories(batch: dict, prefix: int, frac: float, rng: np.random.Gener
     return out
 
 
-def rollout(model: GaitNet, norm: Normalizer, batch: dict, tf_ratio: float, prefix: int,
-            generator: torch.Generator | None = None) -> dict:
-    """Run the network over a batch of sequences; returns predictions for steps 1..T-1.
+_PRED_KEYS = ("q_raw", "q", "pos", "root", "omega", "h", "aff")
 
-    Args:
-        batch: from :meth:`GaitSequences.batch` (B sequences of T steps); ``emotion`` is (B, C) or per step
-            (B, T, C).
-        tf_ratio: probability of feeding the ground truth (rather than the prediction) after the prefix.
-        prefix: number of leading steps always fed from the ground truth (>= 1).
 
-    Returns:
-        dict of (B, T-1, ...) tensors: q_raw, q, pos (heading frame, root at the predicted height), aff
-        (standardised, of the predicted pose), root (standardised), omega (standardised), and the raw
-        predicted root height ``h`` (B, T-1) in metres.
-    """
-    B, T = batch["q"].shape[:2]
-    # Full teacher forcing is the same as a ground-truth prefix covering the whole sequence (one GRU call).
-    prefix = T - 1 if tf_ratio >= 1.0 else max(1, min(prefix, T - 1))
-    em = batch["emotion"] if batch["emotion"].dim() == 3 else batch["emotion"][:, None].expand(B, T, -1)
-    aff_z = norm.aff(batch["aff"])
-    root_z = norm.root(batch["root"])
-    step_z = norm.step(batch["theta"], batch["omega"], batch["sbar"], batch["kappa"])
-    offsets = batch["offsets"]
-    mean_h = batch["mean_height"]
+def _decoder(norm: Normalizer, batch: dict):
+    """decode(out) -> (raw root features, root height deviation h in metres, heading-frame positions) of a network
+    output for ``batch`` (one step: (B, ...) or many: (B, L, ...))."""
+    offsets, mean_h = batch["offsets"], batch["mean_height"]
+    B = offsets.shape[0]
 
     def decode(out):
         root_raw = norm.root_inv(out["root"])
@@ -126,52 +127,125 @@ def rollout(model: GaitNet, norm: Normalizer, batch: dict, tf_ratio: float, pref
         pos = heading_frame_positions(out["q"], mean_h.view((B,) + (1,) * (h.dim() - 1)) + h,
                                       offsets if h.dim() == 1 else offsets[:, None])
         return root_raw, h, pos
+    return decode
 
-    out = model(batch["q"][:, :prefix], aff_z[:, :prefix], step_z[:, :prefix], root_z[:, :prefix], em[:, :prefix])
+
+def _runner(model: GaitNet, amp: bool):
+    """run(fn, *inputs): a forward call of ``model`` (``model`` or ``model.step``) inside the mixed-precision
+    region when ``amp``; outputs other than the GRU state come back as float32."""
+    device = next(model.parameters()).device
+
+    def run(fn, *inputs):
+        with autocast_context(device, amp):
+            out = fn(*inputs)
+        return {k: (v if k == "hidden" or not amp else v.float()) for k, v in out.items()}
+    return run
+
+
+def _decoded(out: dict, decode, norm: Normalizer) -> dict:
+    """One step's prediction with its decoded root, height, positions and standardised affective features."""
     root_raw, h, pos = decode(out)
-    preds = {"q_raw": [out["q_raw"]], "q": [out["q"]], "pos": [pos], "root": [out["root"]],
-             "omega": [out["omega"]], "h": [h], "aff": [norm.aff(affective_features(pos))]}
+    return {"q_raw": out["q_raw"], "q": out["q"], "pos": pos, "root": out["root"], "omega": out["omega"], "h": h,
+            "aff": norm.aff(affective_features(pos)), "root_raw": root_raw}
+
+
+def _predicted_step_inputs(norm: Normalizer, prev: dict, last: dict, ref: torch.Tensor, ref_prev: torch.Tensor):
+    """(theta, s-bar, standardised step features (B, 5)) of the next input step advanced from the previous
+    prediction ``prev`` and the previous input step's ``last`` theta and s-bar (as generation does)."""
+    omega_p = norm.omega_inv(prev["omega"]).clamp(0.0, math.pi)
+    theta_p = torch.remainder(last["theta"] + omega_p, 2 * math.pi)
+    sbar_p = (1 - SBAR_ALPHA) * last["sbar"] + SBAR_ALPHA * prev["root_raw"][:, 1]
+    kappa_p = kappa_torch(sbar_p, ref, last["sbar"], ref_prev)
+    return theta_p, sbar_p, norm.step(theta_p, omega_p, sbar_p, kappa_p)
+
+
+def _teacher_mask(B: int, tf_ratio: float, generator: torch.Generator | None, device: torch.device) -> torch.Tensor:
+    """(B,) True where a sequence's next input is the ground truth. The draw is made on the CPU generator, so that
+    runs on the CPU and on a GPU make the same choices."""
+    if tf_ratio >= 1.0:
+        use_gt = torch.ones(B, dtype=torch.bool)
+    elif tf_ratio <= 0.0:
+        use_gt = torch.zeros(B, dtype=torch.bool)
+    else:
+        use_gt = torch.rand(B, generator=generator) < tf_ratio
+    return use_gt.to(device)
+
+
+def _continue_free(run, model: GaitNet, norm: Normalizer, decode, prev: dict, last: dict, hidden, ref: torch.Tensor,
+                   emotion: torch.Tensor, steps: int) -> dict:
+    """``steps`` free-running predictions past the end of the ground truth (heading ``ref`` (B,) and ``emotion``
+    (B, C) of the last step): {"ext_aff": (B, steps, 18), "ext_pos": (B, steps, J, 3)}."""
+    aff, pos = [], []
+    for _ in range(steps):
+        theta_p, sbar_p, step_p = _predicted_step_inputs(norm, prev, last, ref, ref)
+        out = run(model.step, prev["q"], prev["aff"], step_p, prev["root"], emotion, hidden)
+        last, hidden, prev = {"theta": theta_p, "sbar": sbar_p}, out["hidden"], _decoded(out, decode, norm)
+        aff.append(prev["aff"][:, None])
+        pos.append(prev["pos"][:, None])
+    return {"ext_aff": torch.cat(aff, dim=1), "ext_pos": torch.cat(pos, dim=1)}
+
+
+def rollout(model: GaitNet, norm: Normalizer, batch: dict, tf_ratio: float, prefix: int,
+            generator: torch.Generator | None = None, extra_steps: int = 0, amp: bool = False) -> dict:
+    """Run the network over a batch of sequences; returns predictions for steps 1..T-1.
+
+    Args:
+        batch: from :meth:`GaitSequences.batch` (B sequences of T steps, on the model's device); ``emotion`` is
+            (B, C) or per step (B, T, C).
+        tf_ratio: probability of feeding the ground truth (rather than the prediction) after the prefix.
+        prefix: number of leading steps always fed from the ground truth (>= 1).
+        generator: CPU generator of the teacher-forcing draws.
+        extra_steps: free-running steps predicted after step T-1 (:func:`_continue_free`).
+        amp: forward passes under :func:`generation.core.device.autocast_context`.
+
+    Returns:
+        dict of (B, T-1, ...) tensors: q_raw, q, pos (heading frame, root at the predicted height), aff
+        (standardised, of the predicted pose), root (standardised), omega (standardised), and the raw
+        predicted root height ``h`` (B, T-1) in metres; with ``extra_steps``, ``ext_aff`` (B, E, 18) and
+        ``ext_pos`` (B, E, J, 3) of the continuation.
+    """
+    B, T = batch["q"].shape[:2]
+    device = batch["q"].device
+    # Full teacher forcing is the same as a ground-truth prefix covering the whole sequence (one GRU call).
+    prefix = T - 1 if tf_ratio >= 1.0 else max(1, min(prefix, T - 1))
+    em = batch["emotion"] if batch["emotion"].dim() == 3 else batch["emotion"][:, None].expand(B, T, -1)
+    aff_z, root_z = norm.aff(batch["aff"]), norm.root(batch["root"])
+    step_z = norm.step(batch["theta"], batch["omega"], batch["sbar"], batch["kappa"])
+    decode, run = _decoder(norm, batch), _runner(model, amp)
+    out = run(model, batch["q"][:, :prefix], aff_z[:, :prefix], step_z[:, :prefix], root_z[:, :prefix],
+              em[:, :prefix])
+    first = _decoded(out, decode, norm)
+    preds = {k: [first[k]] for k in _PRED_KEYS}
     hidden = out["hidden"]
     # Current inputs (step prefix - 1 was ground truth).
     last = {"theta": batch["theta"][:, prefix - 1], "sbar": batch["sbar"][:, prefix - 1]}
-    prev_pred = {k: preds[k][0][:, -1] for k in ("q", "pos", "root", "omega", "aff")}
-    prev_pred["root_raw"] = root_raw[:, -1]
+    prev = {k: v[:, -1] for k, v in first.items()}
     for t in range(prefix, T - 1):
-        # Inputs for step t from the previous prediction ...
-        omega_p = norm.omega_inv(prev_pred["omega"]).clamp(0.0, math.pi)
-        theta_p = torch.remainder(last["theta"] + omega_p, 2 * math.pi)
-        sbar_p = (1 - SBAR_ALPHA) * last["sbar"] + SBAR_ALPHA * prev_pred["root_raw"][:, 1]
-        kappa_p = kappa_torch(sbar_p, batch["ref"][:, t], last["sbar"], batch["ref"][:, t - 1])
-        step_p = norm.step(theta_p, omega_p, sbar_p, kappa_p)
-        # ... or from the ground truth, per sequence with probability tf_ratio.
-        if tf_ratio >= 1.0:
-            use_gt = torch.ones(B, dtype=torch.bool)
-        elif tf_ratio <= 0.0:
-            use_gt = torch.zeros(B, dtype=torch.bool)
-        else:
-            use_gt = torch.rand(B, generator=generator) < tf_ratio
-        g1, g2, g3 = use_gt[:, None], use_gt[:, None, None], use_gt
-        q_in = torch.where(g2, batch["q"][:, t], prev_pred["q"])
-        aff_in = torch.where(g1, aff_z[:, t], prev_pred["aff"])
-        root_in = torch.where(g1, root_z[:, t], prev_pred["root"])
+        # Inputs for step t from the previous prediction or, per sequence with probability tf_ratio, the truth.
+        theta_p, sbar_p, step_p = _predicted_step_inputs(norm, prev, last, batch["ref"][:, t], batch["ref"][:, t - 1])
+        g3 = _teacher_mask(B, tf_ratio, generator, device)
+        g1, g2 = g3[:, None], g3[:, None, None]
+        q_in = torch.where(g2, batch["q"][:, t], prev["q"])
+        aff_in = torch.where(g1, aff_z[:, t], prev["aff"])
+        root_in = torch.where(g1, root_z[:, t], prev["root"])
         step_in = torch.where(g1, step_z[:, t], step_p)
         last = {"theta": torch.where(g3, batch["theta"][:, t], theta_p),
                 "sbar": torch.where(g3, batch["sbar"][:, t], sbar_p)}
-        out = model.step(q_in, aff_in, step_in, root_in, em[:, t], hidden)
-        hidden = out["hidden"]
-        root_raw, h, pos = decode(out)
-        aff_p = norm.aff(affective_features(pos))
-        for k, v in (("q_raw", out["q_raw"]), ("q", out["q"]), ("pos", pos), ("root", out["root"]),
-                     ("omega", out["omega"]), ("h", h), ("aff", aff_p)):
-            preds[k].append(v[:, None])
-        prev_pred = {"q": out["q"], "pos": pos, "root": out["root"], "omega": out["omega"], "aff": aff_p,
-                     "root_raw": root_raw}
-    return {k: torch.cat(v, dim=1) for k, v in preds.items()}
+        out = run(model.step, q_in, aff_in, step_in, root_in, em[:, t], hidden)
+        hidden, prev = out["hidden"], _decoded(out, decode, norm)
+        for k in _PRED_KEYS:
+            preds[k].append(prev[k][:, None])
+    result = {k: torch.cat(v, dim=1) for k, v in preds.items()}
+    if extra_steps > 0:
+        result.update(_continue_free(run, model, norm, decode, prev, last, hidden, batch["ref"][:, -1], em[:, -1],
+                                     extra_steps))
+    return result
 
 
 def evaluate(model: GaitNet, norm: Normalizer, data: GaitSequences, config: GaitNetConfig,
-             batch_size: int = 64) -> dict:
-    """Free-running validation (teacher forcing 0 after the prefix): mean loss terms over ``data``."""
+             batch_size: int = 64, amp: bool = False) -> dict:
+    """Free-running validation (teacher forcing 0 after the prefix, plus ``train.extra_steps`` past the end): mean
+    loss terms over ``data`` (on the model's device)."""
     model.eval()
     sums: dict[str, float] = {}
     n = 0
@@ -179,8 +253,10 @@ def evaluate(model: GaitNet, norm: Normalizer, data: GaitSequences, config: Gait
         for start in range(0, len(data), batch_size):
             idx = np.arange(start, min(start + batch_size, len(data)))
             batch = data.batch(idx)
-            pred = rollout(model, norm, batch, 0.0, config.prefix_len)
-            loss, terms = total_loss(pred, ground_truth_targets(batch, norm), config.loss, config.model.use_affective)
+            pred = rollout(model, norm, batch, 0.0, config.prefix_len, extra_steps=config.train.extra_steps,
+                           amp=amp)
+            loss, terms = total_loss(pred, ground_truth_targets(batch, norm), config.loss, config.model.use_affective,
+                                     style_from=config.prefix_len - 1)
             terms["total"] = loss.item()
             for k, v in terms.items():
                 sums[k] = sums.get(k, 0.0) + v * len(idx)
@@ -190,7 +266,8 @@ def evaluate(model: GaitNet, norm: Normalizer, data: GaitSequences, config: Gait
 
 
 def save_checkpoint(path: Path, model: GaitNet, norm: Normalizer, config: GaitNetConfig, **extra) -> None:
-    """Write model weights, config and normaliser (plus any training state in ``extra``).
+    """Write model weights, config and normaliser (plus any training state in ``extra``), device-independent:
+    the weights and every tensor of ``extra`` (optimizer state) are copied to the CPU first.
 
     Format ``gait_net/2`` stores the config split by section (``GaitNetConfig.to_dict``); ``gait_net/1`` files
     (the flat config of before the split) are still read by :func:`load_checkpoint`.
@@ -198,15 +275,16 @@ def save_checkpoint(path: Path, model: GaitNet, norm: Normalizer, config: GaitNe
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     payload = {"format": CHECKPOINT_FORMAT, "config": config.to_dict(), "normalizer": norm.to_dict(),
-               "model": model.state_dict(), **extra}
+               "model": cpu_state_dict(model), **to_cpu(extra)}
     tmp = path.with_suffix(path.suffix + ".tmp")
     torch.save(payload, tmp)
     tmp.replace(path)
 
 
-def load_checkpoint(path: str | Path) -> tuple[GaitNet, Normalizer, dict]:
-    """Load a file written by :func:`save_checkpoint` (either format); returns (model in eval mode, normaliser,
-    payload). ``GaitNetConfig.from_dict(payload["config"])`` is the full config."""
+def load_checkpoint(path: str | Path, device: str | torch.device | None = "cpu") -> tuple[GaitNet, Normalizer, dict]:
+    """Load a file written by :func:`save_checkpoint` (either format; read onto the CPU whatever device wrote it);
+    returns (model in eval mode on ``device``, normaliser, payload). ``GaitNetConfig.from_dict(payload["config"])``
+    is the full config."""
     path = Path(path)
     if not path.exists():
         raise FileNotFoundError(f"gait network weights not found: {path}")
@@ -219,16 +297,52 @@ def load_checkpoint(path: str | Path) -> tuple[GaitNet, Normalizer, dict]:
             raise ValueError(f"{path}: checkpoint lacks field {key!r}")
     model = GaitNet(GaitNetConfig.from_dict(payload["config"]).model)
     model.load_state_dict(payload["model"])
+    model.to(resolve_device(device))
     model.eval()
     return model, Normalizer.from_dict(payload["normalizer"]), payload
 
 
-def _train_epoch(model: GaitNet, norm: Normalizer, opt, train_set: GaitSequences, config: GaitNetConfig, tf: float,
-                 rng: np.random.Generator, gen: torch.Generator, desc: str, progress: bool) -> dict[str, float]:
-    """One epoch over the training walks with teacher-forcing ratio ``tf``; returns the mean loss terms."""
+@dataclasses.dataclass
+class _Step:
+    """What one optimisation step needs besides the batch: model, normaliser, optimizer, config, the gradient
+    scaler of fp16 autocast (None otherwise) and the mixed-precision flag."""
+
+    model: GaitNet
+    norm: Normalizer
+    opt: torch.optim.Optimizer
+    config: GaitNetConfig
+    scaler: object | None = None
+    amp: bool = False
+
+    def __call__(self, batch: dict, tf: float, gen: torch.Generator) -> tuple[float, dict]:
+        cfg = self.config
+        pred = rollout(self.model, self.norm, batch, tf, cfg.prefix_len, gen, cfg.train.extra_steps, self.amp)
+        loss, terms = total_loss(pred, ground_truth_targets(batch, self.norm), cfg.loss, cfg.model.use_affective,
+                                 style_from=cfg.prefix_len - 1)
+        self.opt.zero_grad()
+        if self.scaler is not None:
+            self.scaler.scale(loss).backward()
+            self.scaler.unscale_(self.opt)
+        else:
+            loss.backward()
+        torch.nn.utils.clip_grad_norm_(self.model.parameters(), cfg.train.grad_clip)
+        if self.scaler is not None:
+            self.scaler.step(self.opt)
+            self.scaler.update()
+        else:
+            self.opt.step()
+        return loss.item(), terms
+
+
+def _train_epoch(step: _Step, train_set: GaitSequences, tf: float, rng: np.random.Generator, gen: torch.Generator,
+                 desc: str, progress: bool) -> dict[str, float]:
+    """One epoch over the training walks with teacher-forcing ratio ``tf``; returns the mean loss terms.
+
+    ``train_set`` already lives on the model's device (moved once before training: the corpus is small), so a
+    batch is an index into it and nothing is copied from the host per step."""
     from tqdm import tqdm
 
-    tc = config.train
+    tc = step.config.train
     # One row per corpus sequence per epoch, with a random subsampling offset when several exist.
     rows = rng.permutation(len(train_set))
     _, first = np.unique(train_set.base_index[rows], return_index=True)
@@ -237,81 +351,128 @@ def _train_epoch(model: GaitNet, norm: Normalizer, opt, train_set: GaitSequences
     sums: dict[str, float] = {}
     bar = tqdm(batches, desc=desc, disable=not progress, leave=False)
     for idx in bar:
-        batch = splice_histories(train_set.batch(idx), config.prefix_len, tc.splice_frac, rng)
-        pred = rollout(model, norm, batch, tf, config.prefix_len, gen)
-        loss, terms = total_loss(pred, ground_truth_targets(batch, norm), config.loss, config.model.use_affective)
-        opt.zero_grad()
-        loss.backward()
-        torch.nn.utils.clip_grad_norm_(model.parameters(), tc.grad_clip)
-        opt.step()
-        terms["total"] = loss.item()
+        batch = splice_histories(train_set.batch(idx), step.config.prefix_len, tc.splice_frac, rng)
+        total, terms = step(batch, tf, gen)
+        terms["total"] = total
         for k, v in terms.items():
             sums[k] = sums.get(k, 0.0) + v / len(batches)
-        bar.set_postfix(loss=f"{loss.item():.3f}")
+        bar.set_postfix(loss=f"{total:.3f}")
     return sums
 
 
+def _initialise_from(path: str | Path, step: _Step, log) -> dict:
+    """Copy the weights and normaliser of the weights file ``path`` into ``step`` (fine-tuning); returns
+    {"path", "sha256", "epochs"} for the new file's record. The architectures must match."""
+    from .data import file_sha256
+    model, norm, payload = load_checkpoint(path)
+    if model.config != step.model.config:
+        raise ValueError(f"--init {path}: its architecture {model.config} is not this run's {step.model.config}")
+    step.model.load_state_dict(model.state_dict())
+    if norm.aff_style_std is None:   # a file saved before the field: take it from this run's training walks
+        norm.aff_style_std = step.norm.aff_style_std
+    step.norm = norm
+    log(f"initialised from {path} ({len(payload.get('history', []))} epochs)")
+    return {"path": str(path), "sha256": file_sha256(path), "epochs": len(payload.get("history", []))}
+
+
+def _resume(path: Path, step: _Step, sched, rng, gen, log) -> tuple[list, int]:
+    """Restore the training state of ``path`` (read onto the CPU, moved onto the model's device by the
+    load_state_dict calls); returns (history, first epoch to run)."""
+    state = torch.load(path, map_location="cpu", weights_only=False)
+    step.model.load_state_dict(state["model"])
+    step.opt.load_state_dict(state["optimizer"])
+    sched.load_state_dict(state["scheduler"])
+    if step.scaler is not None and state.get("grad_scaler"):
+        step.scaler.load_state_dict(state["grad_scaler"])
+    step.norm = Normalizer.from_dict(state["normalizer"])
+    rng.bit_generator.state = state["numpy_rng"]
+    gen.set_state(state["torch_gen"])
+    torch.set_rng_state(state["torch_rng"])
+    log(f"resumed from {path} at epoch {state['epoch'] + 1}")
+    return state["history"], state["epoch"] + 1
+
+
 def train(config: GaitNetConfig, data: GaitSequences, out_path: str | Path, checkpoint_path: str | Path | None = None,
-          resume: bool = False, max_minutes: float | None = None, progress: bool = True, log=print) -> dict:
+          resume: bool = False, max_minutes: float | None = None, progress: bool = True, log=print,
+          device: str | torch.device | None = "auto", amp: bool = False, init: str | Path | None = None) -> dict:
     """Train on ``data`` (its "train" split; "val" for validation); returns the history.
 
     Writes ``checkpoint_path`` (full training state) after every epoch and the final small weights file
-    ``out_path`` (model, config, normaliser, history). ``resume`` continues from ``checkpoint_path``.
-    ``max_minutes`` stops after the epoch that crosses the budget (the history records it).
+    ``out_path`` (model, config, normaliser, history), both device-independent. ``resume`` continues from
+    ``checkpoint_path``. ``max_minutes`` stops after the epoch that crosses the budget (the history records it).
+    ``device``: "auto" (CUDA when available), "cpu", "cuda" or "cuda:N" (:func:`generation.core.device.resolve_device`);
+    the model is initialised on the CPU from the seed and then moved, and the teacher-forcing draws come from a CPU
+    generator, so a run of the same seed follows the same path on either device. ``amp``: mixed-precision forward
+    passes (bf16 autocast, fp16 with a gradient scaler on GPUs without bf16). ``init``: start from the weights
+    and normaliser of this weights file (same architecture; fine-tuning) instead of a random initialisation.
     """
     tc = config.train
+    dev = resolve_device(device)
     torch.manual_seed(tc.seed)
     rng = np.random.default_rng(tc.seed)
     gen = torch.Generator().manual_seed(tc.seed)
-    train_set = data.subset("train")
-    val_set = data.subset((data.split == "val") & (data.offset == 0))
+    train_set = data.subset("train").to(dev)
+    val_set = data.subset((data.split == "val") & (data.offset == 0)).to(dev)
     if len(train_set) == 0:
         raise ValueError("the corpus has no 'train' sequences")
-    norm = fit_normalizer(train_set)
-    model = GaitNet(config.model)
+    model = GaitNet(config.model).to(dev)
     opt = torch.optim.Adam(model.parameters(), lr=tc.lr)
     sched = torch.optim.lr_scheduler.ExponentialLR(opt, gamma=tc.lr_decay)
+    scaler = torch.amp.GradScaler("cuda") if needs_grad_scaler(dev, amp) else None
+    step = _Step(model, fit_normalizer(train_set), opt, config, scaler, amp)
+    init_info = _initialise_from(init, step, log) if init else None
     history: list[dict] = []
     start_epoch = 0
     # Training state lives under var/ (not next to the shipped weights) unless a path is given.
     checkpoint_path = Path(checkpoint_path) if checkpoint_path else CHECKPOINT_DIR / (Path(out_path).name + ".ckpt")
     if resume and checkpoint_path.exists():
-        state = torch.load(checkpoint_path, map_location="cpu", weights_only=False)
-        model.load_state_dict(state["model"])
-        opt.load_state_dict(state["optimizer"])
-        sched.load_state_dict(state["scheduler"])
-        norm = Normalizer.from_dict(state["normalizer"])
-        history = state["history"]
-        start_epoch = state["epoch"] + 1
-        rng.bit_generator.state = state["numpy_rng"]
-        gen.set_state(state["torch_gen"])
-        torch.set_rng_state(state["torch_rng"])
-        log(f"resumed from {checkpoint_path} at epoch {start_epoch}")
+        history, start_epoch = _resume(checkpoint_path, step, sched, rng, gen, log)
+    log(f"training on {describe(dev)}{', mixed precision' if amp else ''}")
     t0 = time.time()
     elapsed_before = history[-1]["elapsed_s"] if history else 0.0
     for epoch in range(start_epoch, tc.epochs):
-        tf = tc.tf_decay ** epoch
-        sums = _train_epoch(model, norm, opt, train_set, config, tf, rng, gen,
-                            desc=f"epoch {epoch + 1}/{tc.epochs} tf={tf:.2f}", progress=progress)
+        tf = tc.tf_start * tc.tf_decay ** epoch
+        sums = _train_epoch(step, train_set, tf, rng, gen, desc=f"epoch {epoch + 1}/{tc.epochs} tf={tf:.2f}",
+                            progress=progress)
         sched.step()
-        val = evaluate(model, norm, val_set, config) if len(val_set) else {}
+        val = evaluate(model, step.norm, val_set, config, amp=amp) if len(val_set) else {}
         elapsed = elapsed_before + time.time() - t0
-        record = {"epoch": epoch + 1, "tf": tf, "lr": opt.param_groups[0]["lr"], "train": sums, "val": val,
-                  "elapsed_s": elapsed}
-        history.append(record)
+        history.append({"epoch": epoch + 1, "tf": tf, "lr": opt.param_groups[0]["lr"], "train": sums, "val": val,
+                        "elapsed_s": elapsed, "device": str(dev), "amp": bool(amp)})
         log(f"epoch {epoch + 1}: train {sums['total']:.4f} val {val.get('total', float('nan')):.4f} "
             f"tf {tf:.3f} ({elapsed / 60:.1f} min)")
-        save_checkpoint(checkpoint_path, model, norm, config, optimizer=opt.state_dict(),
+        save_checkpoint(checkpoint_path, model, step.norm, config, optimizer=opt.state_dict(),
                         scheduler=sched.state_dict(), epoch=epoch, history=history,
                         numpy_rng=rng.bit_generator.state, torch_gen=gen.get_state(),
-                        torch_rng=torch.get_rng_state())
+                        torch_rng=torch.get_rng_state(), grad_scaler=scaler.state_dict() if scaler else None)
         if max_minutes is not None and elapsed > 60 * max_minutes:
             log(f"stopping after epoch {epoch + 1}: time budget of {max_minutes} min used")
             break
-    save_checkpoint(Path(out_path), model, norm, config, history=history,
+    save_checkpoint(Path(out_path), model, step.norm, config, history=history,
                     trained_on="synthetic procedural corpus", num_parameters=model.num_parameters(),
-                    corpus=getattr(data, "source", None))
-    return {"history": history, "model": model, "normalizer": norm}
+                    corpus=getattr(data, "source", None), initialised_from=init_info)
+    return {"history": history, "model": model, "normalizer": step.norm}
+
+
+CONFIG_NAMES = ("small", "paper")
+
+
+def named_config(name: str) -> GaitNetConfig:
+    """The configuration called ``name`` on the command line: "small" (``GaitNetConfig()``) or "paper"
+    (``GaitNetConfig.paper()``)."""
+    if name not in CONFIG_NAMES:
+        raise ValueError(f"unknown gait config {name!r}: use one of {', '.join(CONFIG_NAMES)}")
+    return GaitNetConfig.paper() if name == "paper" else GaitNetConfig()
+
+
+def amp_for(device: torch.device, amp: bool, log=print) -> bool:
+    """Whether mixed precision is used: ``amp`` on CUDA; on the CPU it is ignored with a message (bf16 autocast
+    measured slower than float32 on the CPU, see docs/benchmarks/device.md)."""
+    if amp and device.type != "cuda":
+        log("--amp ignored on the CPU: bf16 autocast was slower than float32 there "
+            "(benchmarks/bench_device.py); training in float32")
+        return False
+    return bool(amp)
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -323,11 +484,23 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--checkpoint", default=None,
                    help="training-state checkpoint for --resume (default var/gait_runs/<OUT name>.ckpt)")
     p.add_argument("--resume", action="store_true", help="continue from the checkpoint")
+    p.add_argument("--init", default=None, metavar="WEIGHTS.pt",
+                   help="fine-tune: start from this weights file's network and normaliser (same architecture); "
+                        "combine with --set tf_start=... for a lower starting teacher-forcing ratio")
     p.add_argument("--epochs", type=int, default=None)
     p.add_argument("--batch-size", type=int, default=None)
     p.add_argument("--seed", type=int, default=None)
     p.add_argument("--max-minutes", type=float, default=None, help="stop after the epoch that crosses this")
-    p.add_argument("--paper-size", action="store_true", help="the released model's sizes (about 9.9M parameters)")
+    p.add_argument("--config", choices=CONFIG_NAMES, default="small",
+                   help="small: the CPU default that trained the shipped weights (GRU 2 x 256, 28 epochs); paper: "
+                        "the published size end to end (GaitNetConfig.paper(): GRU 2 x 1024, 9.9 M parameters, "
+                        "500 epochs, teacher forcing 0.995^epoch)")
+    p.add_argument("--paper-size", action="store_true", help="same as --config paper")
+    p.add_argument("--device", default="auto", help=f"{DEVICE_CHOICES} (auto: CUDA when available, else the CPU)")
+    p.add_argument("--amp", action="store_true",
+                   help="mixed precision (autocast of the forward passes: bf16, or fp16 with a gradient scaler on "
+                        "GPUs without bf16); on the CPU it is ignored with a message (it measured slower there, "
+                        "docs/benchmarks/device.md)")
     p.add_argument("--no-affective", action="store_true", help="ablation: no affective inputs and no L_aff")
     p.add_argument("--no-root-loss", action="store_true", help="ablation: lambda_root = 0")
     p.add_argument("--set", action="append", default=[], metavar="FIELD=JSON",
@@ -342,7 +515,11 @@ def build_parser() -> argparse.ArgumentParser:
 
 def config_from_args(args) -> GaitNetConfig:
     """The GaitNetConfig of parsed options: default or ``--paper-size``, then ``--set``, then the named options."""
-    config = GaitNetConfig.paper() if args.paper_size else GaitNetConfig()
+    name = "paper" if getattr(args, "paper_size", False) else getattr(args, "config", "small")
+    try:
+        config = named_config(name)
+    except ValueError as exc:
+        raise SystemExit(f"--config: {exc}") from None
     overrides = {}
     for item in args.set:
         if "=" not in item:
@@ -366,6 +543,11 @@ def config_from_args(args) -> GaitNetConfig:
 def run(args, log=print) -> dict:
     """Train from parsed command-line options (shared by ``python -m`` and ``manage.py train_gait``)."""
     torch.set_num_threads(args.threads)
+    try:
+        device = resolve_device(getattr(args, "device", "auto"))
+    except ValueError as exc:
+        raise SystemExit(f"--device: {exc}") from None
+    amp = amp_for(device, getattr(args, "amp", False), log)
     config = config_from_args(args)
     data = load_corpus_sequences(args.corpus, num_sequences=args.num_sequences, seed=0,
                                  frame_step=config.data.frame_step, seq_len=config.data.seq_len,
@@ -373,7 +555,7 @@ def run(args, log=print) -> dict:
     counts = ", ".join(f"{s}: {int(((data.split == s) & (data.offset == 0)).sum())}" for s in ("train", "val", "test"))
     log(f"{len(data)} sequences ({counts}), network {GaitNet(config.model).num_parameters()} parameters")
     result = train(config, data, args.out, args.checkpoint, args.resume, args.max_minutes, progress=not args.quiet,
-                   log=log)
+                   log=log, device=device, amp=amp, init=getattr(args, "init", None))
     log(f"wrote {args.out}")
     return result
 

@@ -9,6 +9,9 @@ as the sentence takes to say (:func:`generation.gesture.config.gesture_seconds`)
 rest pose, is performed by a female or male body (``gesture_skeleton(build=gender)``) and leads with the dominant
 hand. Everything here is synthetic and labelled so in metadata; none of it is captured motion.
 
+Each sentence also gets a counterfactual variant, performed with another emotion than the one it was written for,
+so that the emotion attributes, not only the wording, decide the style (issue 14; :func:`build_dataset`).
+
 Splits are by sentence (80/10/10, stratified by emotion), so every variant of a sentence lands in one split.
 """
 from __future__ import annotations
@@ -157,7 +160,7 @@ def phrases(sentence: str) -> list[str]:
 
 
 def procedural_gesture(row: SentenceRow, gender: str, handedness: str, seed: int,
-                       fps: float = config.TRAIN_FPS) -> Motion:
+                       fps: float = config.TRAIN_FPS, emotion: str | None = None) -> Motion:
     """One SYNTHETIC training gesture for a sentence: procedural, seated, emotion-driven, at ``fps``.
 
     One gesture per phrase of the sentence (:func:`phrases`), its kind from the phrase's words
@@ -165,11 +168,13 @@ def procedural_gesture(row: SentenceRow, gender: str, handedness: str, seed: int
     variation from ``seed``) and the acting task (:func:`_task_style`); the length follows the word count.
     The procedural generator's own random details (beat phase, pointing aim) use one fixed seed: nothing in the
     text or the attributes could predict them, so a random draw per example would only add unlearnable noise.
+    ``emotion`` performs the sentence with another emotion than the one it was written for (default: its own).
     """
     from generation.procedural.emotion import gesture_params_for_vad
     from generation.procedural.gesture import seated_gesture
 
-    v, a, d = nrc_vad(row.emotion)
+    emotion = row.emotion if emotion is None else emotion
+    v, a, d = nrc_vad(emotion)
     rng = np.random.default_rng(seed)
     ending = row.sentence.rstrip()[-1:]
     params = [_task_style(gesture_params_for_vad(v, a, d, rng, kind=gesture_kind_for(p + ending, a),
@@ -178,7 +183,7 @@ def procedural_gesture(row: SentenceRow, gender: str, handedness: str, seed: int
     n_frames = config.gesture_frames(count_words(row.sentence), fps)
     motion = seated_gesture(params, n_frames, fps, gesture_skeleton(build=gender), seed=PROCEDURAL_DETAIL_SEED)
     motion.metadata.update({"synthetic": True, "origin": "procedural", "sentence_id": row.sentence_id,
-                            "task": row.task, "emotion_label": row.emotion, "kinds": [p.kind for p in params]})
+                            "task": row.task, "emotion_label": emotion, "kinds": [p.kind for p in params]})
     return motion
 
 
@@ -202,6 +207,8 @@ class GestureDataset:
         rest: (N, J, 4) float32 seated rest pose. root: (N, 3) float32 seated root position, metres.
         vad: (N, 3) float32. sentence_index: (N,) index into ``rows``. split: (N,) "train"/"val"/"test".
         gender, handedness: (N,) str. rows: the sentence rows. fps: frame rate.
+        emotion: (N,) str, the emotion each gesture performs (its sentence's own, or another one for the
+        counterfactual variants; None = the sentences' own).
     """
 
     tokens: np.ndarray
@@ -219,6 +226,11 @@ class GestureDataset:
     handedness: np.ndarray
     rows: list[SentenceRow]
     fps: float
+    emotion: np.ndarray | None = None
+
+    def __post_init__(self):
+        if self.emotion is None:
+            self.emotion = np.array([self.rows[int(i)].emotion for i in self.sentence_index])
 
     def __len__(self) -> int:
         return len(self.lengths)
@@ -232,34 +244,63 @@ class GestureDataset:
         return self.rows[int(self.sentence_index[i])]
 
     def batch(self, idx, noise: float = 0.0, generator: torch.Generator | None = None) -> dict[str, torch.Tensor]:
-        """Teacher-forcing batch for examples ``idx``, cropped to their longest sequence.
+        """Teacher-forcing batch for examples ``idx``, cropped to their longest sequence (CPU tensors).
 
         Returns tensors: tokens (B, S, 384), token_mask (B, S) bool, attributes (B, 9), inputs (B, T, J, 4) (the rest
         pose then frames 0..T-2, plus Gaussian ``noise`` before normalising), targets (B, T, J, 4), positions (B, T),
         progress (B, T, 2), mask (B, T) bool, offsets (B, J, 3), rest (B, J, 4).
         """
-        idx = np.asarray(idx)
-        T = int(self.lengths[idx].max())
-        S = int(self.token_lengths[idx].max())
-        targets = torch.from_numpy(self.rotations[idx, :T])
-        rest = torch.from_numpy(self.rest[idx])[:, None]
-        inputs = torch.cat((rest, targets[:, :-1]), dim=1)
+        return self.on_device(torch.device("cpu")).batch(idx, noise, generator)
+
+    def on_device(self, device: torch.device | str) -> DeviceCorpus:
+        """The arrays the training batches are cut from, as tensors placed once on ``device``."""
+        return DeviceCorpus(self, torch.device(device))
+
+
+class DeviceCorpus:
+    """A :class:`GestureDataset`'s training arrays as tensors on one device, so batches are cut there.
+
+    Moving the whole synthetic corpus (660 x 75 x 23 x 4 rotations, about 18 MB) to the GPU once keeps it busy:
+    a batch is a few index operations on the device, with no host-to-device copy. Random numbers (input noise) are
+    drawn from a CPU ``torch.Generator`` and then moved, so the same seed gives the same batches on every device.
+    """
+
+    def __init__(self, data: GestureDataset, device: torch.device):
+        self.device, self.fps = device, data.fps
+        self.lengths_np, self.token_lengths_np = data.lengths, data.token_lengths
+
+        def put(a):
+            return torch.from_numpy(np.ascontiguousarray(a)).to(device)
+
+        self.tokens, self.token_lengths = put(data.tokens), put(data.token_lengths)
+        self.rotations, self.lengths = put(data.rotations), put(data.lengths)
+        self.attributes, self.offsets, self.rest = put(data.attributes), put(data.offsets), put(data.rest)
+
+    def batch(self, idx, noise: float = 0.0, generator: torch.Generator | None = None) -> dict[str, torch.Tensor]:
+        """As :meth:`GestureDataset.batch`, with every tensor on :attr:`device`."""
+        idx_np = np.asarray(idx)
+        T = int(self.lengths_np[idx_np].max())
+        S = int(self.token_lengths_np[idx_np].max())
+        idx_t = torch.as_tensor(idx_np, dtype=torch.long).to(self.device)
+        targets = self.rotations[idx_t, :T]
+        rest = self.rest[idx_t]
+        inputs = torch.cat((rest[:, None], targets[:, :-1]), dim=1)
         if noise > 0:
-            inputs = inputs + noise * torch.randn(inputs.shape, generator=generator)
+            inputs = inputs + (noise * torch.randn(inputs.shape, generator=generator)).to(self.device)
             inputs = inputs / inputs.norm(dim=-1, keepdim=True)
-        lengths = torch.from_numpy(self.lengths[idx])
-        positions = torch.arange(T)[None].expand(len(idx), T)
+        lengths = self.lengths[idx_t]
+        positions = torch.arange(T, device=self.device)[None].expand(len(idx_np), T)
         return {
-            "tokens": torch.from_numpy(self.tokens[idx, :S]),
-            "token_mask": torch.arange(S)[None] < torch.from_numpy(self.token_lengths[idx])[:, None],
-            "attributes": torch.from_numpy(self.attributes[idx]),
+            "tokens": self.tokens[idx_t, :S],
+            "token_mask": torch.arange(S, device=self.device)[None] < self.token_lengths[idx_t][:, None],
+            "attributes": self.attributes[idx_t],
             "inputs": inputs,
             "targets": targets,
             "positions": positions,
             "progress": progress_features(positions, lengths, self.fps),
             "mask": positions < lengths[:, None],
-            "offsets": torch.from_numpy(self.offsets[idx]),
-            "rest": torch.from_numpy(self.rest[idx]),
+            "offsets": self.offsets[idx_t],
+            "rest": rest,
         }
 
 
@@ -274,74 +315,96 @@ def _generator_fingerprint() -> str:
     """Hash of the procedural generator's source, so cached pairs are rebuilt when it changes."""
     base = Path(__file__).resolve().parent.parent
     digest = hashlib.sha1()
-    for name in ("procedural_gesture.py", "emotion.py", "gesture/data.py", "gesture/config.py"):
+    for name in ("procedural/gesture.py", "procedural/emotion.py", "gesture/data.py", "gesture/config.py"):
         f = base / name
         if f.is_file():
             digest.update(f.read_bytes())
     return digest.hexdigest()
 
 
+def _make_pairs(rows: list[SentenceRow], variants: int, counterfactual: int, seed: int, fps: float) -> dict:
+    """The procedural gestures of every sentence: ``variants`` with the sentence's own emotion, then
+    ``counterfactual`` with another emotion drawn uniformly from the rest. Returns arrays sentence_index (N,),
+    emotion, gender, handedness (N,) str, lengths (N,) and rotations (N, T_max, 23, 4) float32 (padded with the
+    last frame)."""
+    rng = np.random.default_rng(seed)
+    motions, sentence_index, emotion, gender, hand = [], [], [], [], []
+    emotions = tuple(GESTURE_VAD)
+    for i, row in enumerate(rows):
+        others = [e for e in emotions if e != row.emotion]
+        for k in range(variants + counterfactual):
+            emo = row.emotion if k < variants else others[int(rng.integers(len(others)))]
+            g = config.GENDERS[int(rng.integers(2))]
+            h = config.HANDEDNESS[int(rng.integers(2))] if k % 2 == 0 else ("left" if hand[-1] == "right"
+                                                                             else "right")
+            m = procedural_gesture(row, g, h, seed=seed * 100_003 + i * (variants + counterfactual) + k, fps=fps,
+                                   emotion=emo)
+            motions.append(np_qfix(np_qnormalize(m.rotations)).astype(np.float32))
+            sentence_index.append(i)
+            emotion.append(emo)
+            gender.append(g)
+            hand.append(h)
+    lengths = np.array([len(m) for m in motions], dtype=np.int64)
+    rotations = np.zeros((len(motions), int(lengths.max()), 23, 4), dtype=np.float32)
+    for n, m in enumerate(motions):
+        rotations[n, : len(m)] = m
+        rotations[n, len(m):] = m[-1]
+    return {"sentence_index": np.array(sentence_index), "emotion": np.array(emotion), "gender": np.array(gender),
+            "handedness": np.array(hand), "lengths": lengths, "rotations": rotations}
+
+
 def build_dataset(variants: int = 2, seed: int = 0, fps: float = config.TRAIN_FPS,
                   sentences_csv: str | Path = config.SENTENCES_CSV, cache_dir: str | Path | None = None,
-                  rows: list[SentenceRow] | None = None) -> GestureDataset:
-    """Pair every sentence with ``variants`` procedural gestures (random gender and handedness per variant).
+                  rows: list[SentenceRow] | None = None, counterfactual: int = 1) -> GestureDataset:
+    """Pair every sentence with ``variants`` procedural gestures of its own emotion and ``counterfactual`` of
+    another emotion (random gender and handedness per gesture).
 
-    Token vectors are cached in ``cache_dir/sentence_tokens.npz``, the paired gestures in a second npz keyed by
-    the corpus content and the arguments, so a second call is fast.
+    The corpus sentences are written for one emotion each, so with own-emotion gestures only the wording and the
+    emotion attributes always agree and the network can read the style off the words; the counterfactual gestures
+    (the same sentence performed with another emotion) make the attributes carry it, which is what generation
+    with a chosen emotion needs (issue 14). Token vectors are cached in ``cache_dir/sentence_tokens.npz``, the
+    paired gestures in a second npz keyed by the corpus content and the arguments, so a second call is fast.
     """
     cache_dir = Path(cache_dir) if cache_dir is not None else config.VAR_DIR
     rows = rows if rows is not None else load_sentences(sentences_csv)
     split = split_sentences(rows, seed)
     encodings = cached_encodings([r.sentence for r in rows], cache_dir / "sentence_tokens.npz")
 
-    key_src = json.dumps([[r.sentence_id, r.emotion, r.task, r.sentence] for r in rows]) + f"|{variants}|{seed}|{fps}"
-    key_src += _generator_fingerprint()
+    key_src = json.dumps([[r.sentence_id, r.emotion, r.task, r.sentence] for r in rows])
+    key_src += f"|{variants}|{counterfactual}|{seed}|{fps}" + _generator_fingerprint()
     key = hashlib.sha1(key_src.encode()).hexdigest()[:12]
     motion_cache = cache_dir / f"gesture_pairs_{key}.npz"
-    rest_cache = {g: rest_rotations(g) for g in config.GENDERS}
     if motion_cache.is_file():
         with np.load(motion_cache, allow_pickle=False) as data:
-            sentence_index, gender, hand = data["sentence_index"], data["gender"], data["handedness"]
-            lengths = data["lengths"]
-            rotations = data["rotations"]
+            pairs = {k: data[k] for k in data.files}
     else:
-        rng = np.random.default_rng(seed)
-        motions, sentence_index, gender, hand = [], [], [], []
-        for i, row in enumerate(rows):
-            for k in range(variants):
-                g = config.GENDERS[int(rng.integers(2))]
-                h = config.HANDEDNESS[int(rng.integers(2))] if k % 2 == 0 else ("left" if hand[-1] == "right"
-                                                                                 else "right")
-                m = procedural_gesture(row, g, h, seed=seed * 100_003 + i * variants + k, fps=fps)
-                motions.append(np_qfix(np_qnormalize(m.rotations)).astype(np.float32))
-                sentence_index.append(i)
-                gender.append(g)
-                hand.append(h)
-        lengths = np.array([len(m) for m in motions], dtype=np.int64)
-        rotations = np.zeros((len(motions), int(lengths.max()), 23, 4), dtype=np.float32)
-        for n, m in enumerate(motions):
-            rotations[n, : len(m)] = m
-            rotations[n, len(m):] = m[-1]
-        sentence_index, gender, hand = np.array(sentence_index), np.array(gender), np.array(hand)
+        pairs = _make_pairs(rows, variants, counterfactual, seed, fps)
         motion_cache.parent.mkdir(parents=True, exist_ok=True)
-        np.savez_compressed(motion_cache, sentence_index=sentence_index, gender=gender, handedness=hand,
-                            lengths=lengths, rotations=rotations)
+        np.savez_compressed(motion_cache, **pairs)
+    return _assemble(pairs, rows, encodings, split, fps)
 
+
+def _assemble(pairs: dict, rows: list[SentenceRow], encodings: list[np.ndarray], split: dict[str, str],
+              fps: float) -> GestureDataset:
+    """A :class:`GestureDataset` from the arrays of :func:`_make_pairs` and the sentences' token vectors."""
+    from .text import pad_tokens
+
+    sentence_index, gender, hand = pairs["sentence_index"], pairs["gender"], pairs["handedness"]
     tokens_list = [encodings[i] for i in sentence_index]
     for e in tokens_list:
         assert e.shape[1] == EMBED_DIM
-    from .text import pad_tokens
-
     tokens, token_lengths = pad_tokens(tokens_list)
-    vad = np.array([nrc_vad(rows[i].emotion) for i in sentence_index], dtype=np.float32)
+    emotion = pairs["emotion"].astype(str)
+    vad = np.array([nrc_vad(e) for e in emotion], dtype=np.float32)
     attributes = np.stack([attribute_vector(rows[i].task, vad[n], gender[n], hand[n])
                            for n, i in enumerate(sentence_index)])
+    rest_cache = {g: rest_rotations(g) for g in config.GENDERS}
     offsets = np.stack([gesture_skeleton(build=str(g)).offsets for g in gender]).astype(np.float32)
     rest = np.stack([rest_cache[str(g)][0] for g in gender]).astype(np.float32)
     root = np.stack([rest_cache[str(g)][1] for g in gender]).astype(np.float32)
-    return GestureDataset(tokens=tokens, token_lengths=token_lengths, rotations=rotations, lengths=lengths,
-                          attributes=attributes, offsets=offsets, rest=rest, root=root, vad=vad,
-                          sentence_index=np.asarray(sentence_index), split=np.array([split[rows[i].sentence_id]
-                                                                                     for i in sentence_index]),
+    return GestureDataset(tokens=tokens, token_lengths=token_lengths, rotations=pairs["rotations"],
+                          lengths=pairs["lengths"], attributes=attributes, offsets=offsets, rest=rest, root=root,
+                          vad=vad, sentence_index=np.asarray(sentence_index),
+                          split=np.array([split[rows[i].sentence_id] for i in sentence_index]),
                           gender=np.asarray(gender).astype(str), handedness=np.asarray(hand).astype(str),
-                          rows=rows, fps=fps)
+                          rows=rows, fps=fps, emotion=emotion)

@@ -14,6 +14,7 @@ from pathlib import Path
 import numpy as np
 import torch
 
+from generation.core.device import resolve_device
 from generation.core.motion import Motion
 from generation.core.quaternion import qslerp
 from generation.core.skeleton import gesture_skeleton
@@ -31,8 +32,13 @@ class GestureModelUnavailable(RuntimeError):
     """The weights file is missing or not a gesture-network file."""
 
 
-def load_model(path: str | Path) -> GestureNet:
-    """A trained network in eval mode from a weights file written by :func:`generation.gesture.train.save_weights`."""
+def load_model(path: str | Path, device: torch.device | str | None = "cpu") -> GestureNet:
+    """A trained network in eval mode from a weights file written by :func:`generation.gesture.train.save_weights`.
+
+    The file holds CPU tensors and is read with ``map_location="cpu"`` (a GPU-trained file loads on any machine);
+    the network is then moved to ``device`` ("cpu", "cuda", "cuda:N" or "auto", see
+    :func:`generation.core.device.resolve_device`).
+    """
     path = Path(path)
     if not path.is_file():
         raise GestureModelUnavailable(f"{path}: gesture network weights not found; train them with "
@@ -45,7 +51,7 @@ def load_model(path: str | Path) -> GestureNet:
         raise GestureModelUnavailable(f"{path}: not a gesture network weights file ({exc})") from exc
     net.train_fps = float(blob.get("train_fps", config.TRAIN_FPS))
     net.eval()
-    return net
+    return net.to(resolve_device(device))
 
 
 _DEFAULT: GestureNet | None = None
@@ -69,10 +75,15 @@ def rollout(net: GestureNet, tokens: torch.Tensor, token_mask: torch.Tensor, att
         tokens (B, S, 384), token_mask (B, S) bool, attributes (B, 9), rest (B, J, 4) start-of-sequence pose,
         lengths (B,) frames to generate per sample, fps the network's frame rate, noise optional input jitter.
 
+    All tensors must be on the network's device; ``noise`` is drawn from the CPU ``generator`` and moved there,
+    so a seed gives the same jitter on every device.
+
     Returns:
-        (B, max(lengths), J, 4) unit quaternions; frames past a sample's length are meaningless.
+        (B, max(lengths), J, 4) unit quaternions on the network's device; frames past a sample's length are
+        meaningless.
     """
     net.eval()
+    device = tokens.device
     memory = net.encode(tokens, token_mask, attributes)
     B = tokens.shape[0]
     T = int(lengths.max())
@@ -86,14 +97,21 @@ def rollout(net: GestureNet, tokens: torch.Tensor, token_mask: torch.Tensor, att
         start = max(0, len(history) - W)
         window = torch.stack(history[start:], dim=1)
         if noise > 0:
-            window = window + noise * torch.randn(window.shape, generator=generator)
+            window = window + (noise * torch.randn(window.shape, generator=generator)).to(device)
             window = window / window.norm(dim=-1, keepdim=True)
-        positions = torch.arange(start, len(history))[None].expand(B, -1)
+        positions = torch.arange(start, len(history), device=device)[None].expand(B, -1)
         progress = progress_features(positions, lengths, fps)
         nxt = net.decode(memory, token_mask, attributes, window, positions, progress, rest)[:, -1]
         outputs.append(nxt)
         history.append(nxt)
     return torch.stack(outputs, dim=1)
+
+
+def _place(net: GestureNet, device: torch.device | str | None) -> torch.device:
+    """Move ``net`` to ``device`` (None: leave it) and return the device it is on."""
+    if device is not None:
+        net.to(resolve_device(device))
+    return next(net.parameters()).device
 
 
 def blend_rest_ends(rotations: np.ndarray, rest: np.ndarray, n_start: int, n_end: int) -> np.ndarray:
@@ -121,22 +139,28 @@ def blend_rest_ends(rotations: np.ndarray, rest: np.ndarray, n_start: int, n_end
     return out
 
 
-def decode_examples(net: GestureNet, data, idx, batch_size: int = 64) -> list[np.ndarray]:
+def decode_examples(net: GestureNet, data, idx, batch_size: int = 64,
+                    device: torch.device | str | None = None) -> list[np.ndarray]:
     """Generate the gesture of each dataset example ``idx`` from its text and attributes only.
 
+    ``device``: where to run (None = where the network is; otherwise the network is moved there).
     Returns a list of (L_i, J, 4) float64 arrays at the data's frame rate, L_i the example's length, with the same
     rest-pose blending as :func:`generate_gesture` (the ground truth is never fed to the decoder).
     """
+    dev = _place(net, device)
     idx = np.asarray(idx)
     out: list[np.ndarray] = []
     for start in range(0, len(idx), batch_size):
         chunk = idx[start:start + batch_size]
         S = int(data.token_lengths[chunk].max())
-        lengths = torch.from_numpy(data.lengths[chunk])
-        rot = rollout(net, torch.from_numpy(data.tokens[chunk, :S]),
-                      torch.arange(S)[None] < torch.from_numpy(data.token_lengths[chunk])[:, None],
-                      torch.from_numpy(data.attributes[chunk]), torch.from_numpy(data.rest[chunk]), lengths,
-                      data.fps).double().numpy()
+
+        def put(a):
+            return torch.from_numpy(np.ascontiguousarray(a)).to(dev)
+
+        rot = rollout(net, put(data.tokens[chunk, :S]),
+                      torch.arange(S, device=dev)[None] < put(data.token_lengths[chunk])[:, None],
+                      put(data.attributes[chunk]), put(data.rest[chunk]), put(data.lengths[chunk]),
+                      data.fps).double().cpu().numpy()
         for n, i in enumerate(chunk):
             L = int(data.lengths[i])
             out.append(blend_rest_ends(rot[n, :L], data.rest[i], int(round(START_BLEND_S * data.fps)),
@@ -146,7 +170,7 @@ def decode_examples(net: GestureNet, data, idx, batch_size: int = 64) -> list[np
 
 def generate_gesture(sentence: str, task: str = "narration", emotion: str = "joyous", gender: str = "female",
                      handedness: str = "right", fps: float = 30.0, model: GestureNet | None = None, seed: int = 0,
-                     noise: float = 0.0) -> Motion:
+                     noise: float = 0.0, device: torch.device | str | None = None) -> Motion:
     """A seated gesture Motion for ``sentence`` on the 23-joint skeleton of the gender's build.
 
     Args:
@@ -155,31 +179,48 @@ def generate_gesture(sentence: str, task: str = "narration", emotion: str = "joy
         gender: "female" or "male" (picks the body build). handedness: "left" or "right".
         fps: output frame rate. model: a network (default: the shipped one). seed, noise: the network is
         deterministic; with ``noise`` > 0 the decoder inputs are jittered (seeded) for variations.
+        device: where the network runs ("cpu", "cuda", "cuda:N", "auto"; None = where the model is). The model is
+        moved there; the result is the same Motion (numpy, CPU) whichever device computed it.
 
     Returns:
         Motion (T, 23, 4) at ``fps``, root fixed at the seated root position; metadata names the intent.
     """
+    return generate_gestures(sentence, [emotion], task, gender, handedness, fps, model, seed, noise, device)[0]
+
+
+def generate_gestures(sentence: str, emotions, task: str = "narration", gender: str = "female",
+                      handedness: str = "right", fps: float = 30.0, model: GestureNet | None = None, seed: int = 0,
+                      noise: float = 0.0, device: torch.device | str | None = None) -> list[Motion]:
+    """:func:`generate_gesture` for one sentence said with each of ``emotions``, decoded as one batch (the text is
+    encoded once): a list of Motions in the order of ``emotions``; the other arguments as there."""
     if task not in config.TASKS:
         raise ValueError(f"task must be one of {config.TASKS}, got {task!r}")
     if not fps > 0:
         raise ValueError(f"fps must be positive, got {fps}")
-    vad = nrc_vad(emotion)
-    attrs = attribute_vector(task, vad, gender, handedness)
+    emotions = list(emotions)
+    if not emotions:
+        raise ValueError("emotions is empty: give at least one emotion")
+    vads = [nrc_vad(e) for e in emotions]
+    attrs = np.stack([attribute_vector(task, vad, gender, handedness) for vad in vads])
     net = model if model is not None else load_default_model()
+    dev = _place(net, device)
     net_fps = float(getattr(net, "train_fps", config.TRAIN_FPS))
-    n_words = count_words(sentence)
-    n_frames = config.gesture_frames(n_words, net_fps)
-    tokens = torch.from_numpy(get_encoder().encode(sentence))[None]
+    n_frames = config.gesture_frames(count_words(sentence), net_fps)
+    B = len(emotions)
+    tokens = torch.from_numpy(get_encoder().encode(sentence))[None].expand(B, -1, -1)
     skeleton = gesture_skeleton(build=gender)
     rest_rot, root = rest_rotations(gender)
-    generator = torch.Generator().manual_seed(seed)
-    rot = rollout(net, tokens, torch.ones(tokens.shape[:2], dtype=torch.bool), torch.from_numpy(attrs)[None],
-                  torch.as_tensor(rest_rot, dtype=torch.float32)[None], torch.tensor([n_frames]), net_fps,
-                  noise=noise, generator=generator)[0].double().numpy()
-    rot = blend_rest_ends(rot, rest_rot, int(round(START_BLEND_S * net_fps)), int(round(END_BLEND_S * net_fps)))
-    motion = Motion(skeleton, rot, np.repeat(root[None], len(rot), axis=0), net_fps, {
-        "origin": "generated", "generator": "gesture_net", "sentence": sentence, "task": task,
-        "emotion_label": emotion, "valence": vad[0], "arousal": vad[1], "dominance": vad[2], "gender": gender,
-        "handedness": handedness, "trained_on": SYNTHETIC_LABEL, "network_fps": net_fps, "seed": seed,
-    })
-    return motion.resample(fps) if abs(fps - net_fps) > 1e-9 else motion
+    rest = torch.as_tensor(rest_rot, dtype=torch.float32)[None].expand(B, -1, -1)
+    rots = rollout(net, tokens.to(dev), torch.ones(tokens.shape[:2], dtype=torch.bool, device=dev),
+                   torch.from_numpy(attrs).to(dev), rest.to(dev), torch.full((B,), n_frames, device=dev), net_fps,
+                   noise=noise, generator=torch.Generator().manual_seed(seed)).double().cpu().numpy()
+    out = []
+    for emotion, vad, rot in zip(emotions, vads, rots):
+        rot = blend_rest_ends(rot, rest_rot, int(round(START_BLEND_S * net_fps)), int(round(END_BLEND_S * net_fps)))
+        motion = Motion(skeleton, rot, np.repeat(root[None], len(rot), axis=0), net_fps, {
+            "origin": "generated", "generator": "gesture_net", "sentence": sentence, "task": task,
+            "emotion_label": emotion, "valence": vad[0], "arousal": vad[1], "dominance": vad[2], "gender": gender,
+            "handedness": handedness, "trained_on": SYNTHETIC_LABEL, "network_fps": net_fps, "seed": seed,
+        })
+        out.append(motion.resample(fps) if abs(fps - net_fps) > 1e-9 else motion)
+    return out

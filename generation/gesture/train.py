@@ -4,12 +4,22 @@
 Seed 003 section 5.2: Adam, learning rate 1e-3 decayed by 0.999 every epoch, batches of 16 drawn without
 replacement, weight decay (the lambda ||W|| term of eq. 11), 80/10/10 split. Teacher forcing over whole sequences
 with the decoder's self-attention limited to the past ``window`` = 20 steps, which is exactly what autoregressive
-generation sees; small Gaussian noise on the teacher-forced input poses makes the network robust to its own
-errors at generation time, and so does parallel scheduled sampling (part of the inputs are the network's own
-predictions). Every 5 epochs the validation gestures are generated autoregressively from text and attributes and
-their pose error decides which weights are kept. A fixed seed makes runs repeatable; checkpoints (model,
-optimiser, epoch, history) are written every epoch and ``--resume`` continues from the last one. The best model
-is saved as plain weights (config + state dict, float32).
+generation sees; small Gaussian noise on the teacher-forced input poses and parallel scheduled sampling (a share of
+the inputs, up to all of them, are the network's own predictions, refined over a few no-grad passes) train it on
+inputs like the ones it feeds itself at generation time. Every 5 epochs the validation gestures are generated
+autoregressively from text and attributes; their pose error times (1 + their wrist-speed gap to the corpus)
+(:func:`generation.gesture.metrics.selection_score`) decides which weights are kept. A fixed seed makes runs
+repeatable; checkpoints (model, optimiser, epoch, history) are written every epoch and ``--resume`` continues from
+the last one. The best model is saved as plain weights (config + CPU state dict, float32).
+
+Devices (issue 19): ``--device auto|cpu|cuda[:N]`` (:func:`generation.core.device.resolve_device`); the corpus is
+moved to the device once (:class:`generation.gesture.data.DeviceCorpus`) and batches are cut there; every random
+draw (batch order, input noise, self-fed picks) comes from one CPU generator, so a seed gives the same run on any
+device up to float rounding. ``--amp`` runs the forward passes under CUDA autocast (ignored on the CPU).
+Files are device-independent: CPU tensors, read with ``map_location="cpu"``.
+
+Presets: ``--config small`` (the shipped weights: d_model 64, 269,772 parameters, a 20-minute CPU budget) and
+``--config paper`` (the published size, 26.2 M parameters, 600 epochs, no time budget; :func:`paper_config`).
 """
 from __future__ import annotations
 
@@ -23,14 +33,24 @@ from pathlib import Path
 import numpy as np
 import torch
 
+from generation.core.device import (
+    autocast_context,
+    cpu_state_dict,
+    describe,
+    needs_grad_scaler,
+    resolve_device,
+    to_cpu,
+)
 from generation.core.skeleton import GESTURE_PARENTS
 
 from . import config
-from .data import SYNTHETIC_LABEL, GestureDataset, build_dataset
+from .data import SYNTHETIC_LABEL, DeviceCorpus, GestureDataset, build_dataset
 from .generate import decode_examples
 from .losses import LossWeights, total_loss
-from .metrics import dataset_pose_error
-from .model import GestureNet, GestureNetConfig
+from .metrics import dataset_pose_error, selection_score
+from .model import MODEL_PRESETS, GestureNet, GestureNetConfig
+
+PRESETS = tuple(MODEL_PRESETS)
 
 
 @dataclass
@@ -44,12 +64,14 @@ class TrainConfig:
     weight_decay: float = 1e-5
     input_noise: float = 0.02
     # Parallel scheduled sampling (Duckworth et al. 2019): this share of the teacher-forced inputs is replaced
-    # by the network's own (no-grad) predictions, ramped up linearly over the first ``sampling_ramp`` epochs.
-    sampling: float = 0.5
+    # by the network's own (no-grad) predictions, ramped up linearly over the first ``sampling_ramp`` epochs;
+    # ``sampling_passes`` no-grad passes each feed the previous pass's predictions back in.
+    sampling: float = 1.0
     sampling_ramp: int = 15
-    sampling_passes: int = 1
+    sampling_passes: int = 3
     seed: int = 0
     variants: int = 2
+    counterfactual: int = 1  # extra gestures per sentence performed with another emotion (data.build_dataset)
     max_minutes: float | None = 20.0  # stop (and keep the best model) after this wall-clock time
     loss: LossWeights = field(default_factory=LossWeights)
     model: GestureNetConfig = field(default_factory=GestureNetConfig)
@@ -60,49 +82,70 @@ class TrainConfig:
     # Every this many epochs, generate the validation gestures autoregressively and measure their pose error;
     # the best model is chosen by it (0: choose by the teacher-forced validation loss instead).
     rollout_every: int = 5
+    init_from: str | None = None  # start from these weights (fine-tuning) instead of a random initialisation
+    device: str = "auto"
+    amp: bool = False
+    preset: str = "small"
 
 
-def _self_fed_inputs(net, b: dict, share: float, passes: int, generator: torch.Generator) -> torch.Tensor:
+def preset_config(name: str = "small", **overrides) -> TrainConfig:
+    """The :class:`TrainConfig` of a preset ("small": the shipped weights; "paper": the published size trained for
+    600 epochs without a time budget), with ``overrides`` applied."""
+    if name not in MODEL_PRESETS:
+        raise ValueError(f"unknown gesture config {name!r}; choose one of {', '.join(PRESETS)}")
+    base: dict = {"preset": name, "model": MODEL_PRESETS[name]()}
+    if name == "paper":
+        base.update(epochs=600, max_minutes=None)
+    base.update(overrides)
+    return TrainConfig(**base)
+
+
+def _forward(net, b: dict, inputs: torch.Tensor, amp: bool) -> torch.Tensor:
+    """The teacher-forced pass (under autocast when ``amp``), returned as float32 unit quaternions."""
+    with autocast_context(inputs.device, amp):
+        pred = net(b["tokens"], b["token_mask"], b["attributes"], inputs, b["positions"], b["progress"], b["rest"])
+    pred = pred.float()
+    return pred / pred.norm(dim=-1, keepdim=True).clamp_min(1e-8) if amp else pred
+
+
+def _self_fed_inputs(net, b: dict, share: float, passes: int, generator: torch.Generator,
+                     amp: bool = False) -> torch.Tensor:
     """Inputs where a random ``share`` of the frames are the network's own previous predictions (no grad)."""
     inputs = b["inputs"]
     with torch.no_grad():
         for _ in range(passes):
-            pred = net(b["tokens"], b["token_mask"], b["attributes"], inputs, b["positions"], b["progress"],
-                       b["rest"])
+            pred = _forward(net, b, inputs, amp)
             own = torch.cat((b["inputs"][:, :1], pred[:, :-1]), dim=1)
             pick = torch.rand(inputs.shape[:2], generator=generator) < share
             pick[:, 0] = False  # the start-of-sequence pose is always given
-            inputs = torch.where(pick[..., None, None], own, b["inputs"])
+            inputs = torch.where(pick.to(inputs.device)[..., None, None], own, b["inputs"])
     return inputs
 
 
-def _run_epoch(net, data: GestureDataset, idx: np.ndarray, cfg: TrainConfig, optimizer=None,
-               generator: torch.Generator | None = None, sampling: float = 0.0) -> dict[str, float]:
+def _run_epoch(net, corpus: DeviceCorpus, idx: np.ndarray, cfg: TrainConfig, optimizer=None,
+               generator: torch.Generator | None = None, sampling: float = 0.0, amp: bool = False,
+               scaler=None) -> dict[str, float]:
     """One pass over examples ``idx``; trains when an optimiser is given. Returns mean loss terms."""
     training = optimizer is not None
     net.train(training)
     if training:
-        perm = torch.randperm(len(idx), generator=generator).numpy()
-        idx = idx[perm]
+        idx = idx[torch.randperm(len(idx), generator=generator).numpy()]
     sums: dict[str, float] = {}
     count = 0
     for start in range(0, len(idx), cfg.batch_size):
-        b = data.batch(idx[start:start + cfg.batch_size], noise=cfg.input_noise if training else 0.0,
-                       generator=generator)
+        b = corpus.batch(idx[start:start + cfg.batch_size], noise=cfg.input_noise if training else 0.0,
+                         generator=generator)
         inputs = b["inputs"]
         if training and sampling > 0:
             net.eval()
-            inputs = _self_fed_inputs(net, b, sampling, cfg.sampling_passes, generator)
+            inputs = _self_fed_inputs(net, b, sampling, cfg.sampling_passes, generator, amp)
             net.train()
         with torch.set_grad_enabled(training):
-            pred = net(b["tokens"], b["token_mask"], b["attributes"], inputs, b["positions"], b["progress"],
-                       b["rest"])
-            loss, parts = total_loss(pred, b["targets"], b["mask"], b["offsets"], GESTURE_PARENTS, cfg.loss)
+            pred = _forward(net, b, inputs, amp)
+            loss, parts = total_loss(pred, b["targets"], b["mask"], b["offsets"], GESTURE_PARENTS, cfg.loss,
+                                     fps=corpus.fps)
         if training:
-            optimizer.zero_grad(set_to_none=True)
-            loss.backward()
-            torch.nn.utils.clip_grad_norm_(net.parameters(), 1.0)
-            optimizer.step()
+            _step(net, optimizer, loss, scaler)
         n = len(b["tokens"])
         count += n
         sums["total"] = sums.get("total", 0.0) + float(loss.detach()) * n
@@ -111,93 +154,153 @@ def _run_epoch(net, data: GestureDataset, idx: np.ndarray, cfg: TrainConfig, opt
     return {k: v / max(count, 1) for k, v in sums.items()}
 
 
+def _step(net, optimizer, loss: torch.Tensor, scaler) -> None:
+    """Backward pass, gradient clipping at norm 1 and an optimiser step (through the fp16 scaler when given)."""
+    optimizer.zero_grad(set_to_none=True)
+    if scaler is None:
+        loss.backward()
+        torch.nn.utils.clip_grad_norm_(net.parameters(), 1.0)
+        optimizer.step()
+        return
+    scaler.scale(loss).backward()
+    scaler.unscale_(optimizer)
+    torch.nn.utils.clip_grad_norm_(net.parameters(), 1.0)
+    scaler.step(optimizer)
+    scaler.update()
+
+
 def save_weights(net: GestureNet, path: str | Path, extra: dict) -> None:
-    """Write {config, state_dict (float32), train_fps, ...} to ``path``."""
+    """Write {config, state_dict (float32, CPU), train_fps, trained_on, ...} to ``path``."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    torch.save({"config": net.cfg.to_dict(), "state_dict": {k: v.detach().float().clone()
-                                                            for k, v in net.state_dict().items()},
+    state = {k: v.float().clone() for k, v in cpu_state_dict(net).items()}
+    torch.save({"config": net.cfg.to_dict(), "state_dict": state,
                 "train_fps": config.TRAIN_FPS, "trained_on": SYNTHETIC_LABEL, **extra}, path)
 
 
+@dataclass
+class _Run:
+    """The mutable state of one training run (what a checkpoint holds besides the network and optimiser)."""
+
+    history: list = field(default_factory=list)
+    best_val: float = float("inf")
+    best_state: dict | None = None
+    best_epoch: int = -1
+    start_epoch: int = 0
+    seconds_before: float = 0.0
+
+
+def _restore(path: Path, cfg: TrainConfig, net, optimizer, scheduler, generator, selected_by: str) -> _Run:
+    """Load a checkpoint (CPU tensors; the optimiser state follows the network onto its device)."""
+    ckpt = torch.load(path, map_location="cpu", weights_only=False)
+    if ckpt["model_config"] != cfg.model.to_dict():
+        raise ValueError(f"{path}: checkpoint model config {ckpt['model_config']} differs from the "
+                         f"requested {cfg.model.to_dict()}")
+    net.load_state_dict(ckpt["state_dict"])
+    optimizer.load_state_dict(ckpt["optimizer"])
+    scheduler.load_state_dict(ckpt["scheduler"])
+    generator.set_state(ckpt["generator"])
+    run = _Run(ckpt["history"], ckpt["best_val"], ckpt["best_state"], ckpt.get("best_epoch", -1),
+               ckpt["epoch"] + 1, float(ckpt.get("seconds", 0.0)))
+    if ckpt.get("selected_by") != selected_by:  # scores on another scale: start the selection afresh
+        run.best_val, run.best_state, run.best_epoch = float("inf"), None, -1
+    return run
+
+
+def _save_checkpoint(path: Path, epoch: int, net, optimizer, scheduler, generator, run: _Run, cfg: TrainConfig,
+                     selected_by: str, seconds: float) -> None:
+    path.parent.mkdir(parents=True, exist_ok=True)
+    torch.save({"epoch": epoch, "state_dict": cpu_state_dict(net), "optimizer": to_cpu(optimizer.state_dict()),
+                "scheduler": scheduler.state_dict(), "generator": generator.get_state(), "history": run.history,
+                "best_val": run.best_val, "best_state": run.best_state, "best_epoch": run.best_epoch,
+                "selected_by": selected_by, "seconds": seconds, "model_config": cfg.model.to_dict()}, path)
+
+
+def _build(cfg: TrainConfig, device: torch.device):
+    """Network (seeded initialisation on the CPU, or ``cfg.init_from``), optimiser, scheduler and generator."""
+    torch.manual_seed(cfg.seed)
+    np.random.seed(cfg.seed)
+    net = GestureNet(cfg.model)
+    if cfg.init_from:
+        blob = torch.load(cfg.init_from, map_location="cpu", weights_only=False)
+        if blob.get("config") != cfg.model.to_dict():
+            raise ValueError(f"{cfg.init_from}: its model config {blob.get('config')} differs from the requested "
+                             f"{cfg.model.to_dict()}")
+        net.load_state_dict(blob["state_dict"])
+    net.to(device)
+    optimizer = torch.optim.Adam(net.parameters(), lr=cfg.lr, weight_decay=cfg.weight_decay)
+    scheduler = torch.optim.lr_scheduler.ExponentialLR(optimizer, gamma=cfg.lr_decay)
+    return net, optimizer, scheduler, torch.Generator().manual_seed(cfg.seed)
+
+
 def train(cfg: TrainConfig, data: GestureDataset | None = None, progress: bool = True) -> dict:
-    """Train and save; returns {"history": [...], "best_val": float, "epochs_run": int, "seconds": float, "out"}."""
+    """Train and save; returns {"history": [...], "best_val", "epochs_run", "seconds", "device", "out"}."""
     from tqdm import tqdm
 
     torch.set_num_threads(cfg.threads)
-    torch.manual_seed(cfg.seed)
-    np.random.seed(cfg.seed)
-    data = data if data is not None else build_dataset(variants=cfg.variants, seed=cfg.seed)
+    device = resolve_device(cfg.device)
+    amp = bool(cfg.amp) and device.type == "cuda"  # CPU autocast does not speed this network up
+    scaler = torch.amp.GradScaler("cuda") if needs_grad_scaler(device, amp) else None
+    data = data if data is not None else build_dataset(variants=cfg.variants, seed=cfg.seed,
+                                                               counterfactual=cfg.counterfactual)
     train_idx, val_idx = data.indices("train"), data.indices("val")
     if len(train_idx) == 0:
         raise ValueError("the training split is empty")
-    net = GestureNet(cfg.model)
-    optimizer = torch.optim.Adam(net.parameters(), lr=cfg.lr, weight_decay=cfg.weight_decay)
-    scheduler = torch.optim.lr_scheduler.ExponentialLR(optimizer, gamma=cfg.lr_decay)
-    generator = torch.Generator().manual_seed(cfg.seed)
-    history: list[dict] = []
-    best_val, best_state, start_epoch, best_epoch = float("inf"), None, 0, -1
-    selected_by = "val_rollout_pose_error" if cfg.rollout_every > 0 else "val_loss"
-    seconds_before = 0.0  # wall-clock seconds of earlier (resumed) segments
+    corpus = data.on_device(device)
+    net, optimizer, scheduler, generator = _build(cfg, device)
+    selected_by = "val_rollout_pose_error_x_liveliness" if cfg.rollout_every > 0 else "val_loss"
     ckpt_path = Path(cfg.checkpoint)
-    if cfg.resume and ckpt_path.is_file():
-        ckpt = torch.load(ckpt_path, weights_only=False)
-        if ckpt["model_config"] != cfg.model.to_dict():
-            raise ValueError(f"{ckpt_path}: checkpoint model config {ckpt['model_config']} differs from the "
-                             f"requested {cfg.model.to_dict()}")
-        net.load_state_dict(ckpt["state_dict"])
-        optimizer.load_state_dict(ckpt["optimizer"])
-        scheduler.load_state_dict(ckpt["scheduler"])
-        generator.set_state(ckpt["generator"])
-        history, best_val, best_state = ckpt["history"], ckpt["best_val"], ckpt["best_state"]
-        best_epoch = ckpt.get("best_epoch", -1)
-        if ckpt.get("selected_by") != selected_by:  # scores on another scale: start the selection afresh
-            best_val, best_state, best_epoch = float("inf"), None, -1
-        start_epoch = ckpt["epoch"] + 1
-        seconds_before = float(ckpt.get("seconds", 0.0))
+    run = (_restore(ckpt_path, cfg, net, optimizer, scheduler, generator, selected_by)
+           if cfg.resume and ckpt_path.is_file() else _Run())
     t0 = time.time()
-    bar = tqdm(range(start_epoch, cfg.epochs), desc="gesture net", disable=not progress, unit="epoch")
-    epoch = start_epoch - 1
+    bar = tqdm(range(run.start_epoch, cfg.epochs), desc=f"gesture net on {describe(device)}", disable=not progress,
+               unit="epoch")
+    epoch = run.start_epoch - 1
     for epoch in bar:
+        t_epoch = time.time()
         share = cfg.sampling * min(1.0, epoch / max(cfg.sampling_ramp, 1))
-        tr = _run_epoch(net, data, train_idx, cfg, optimizer, generator, sampling=share)
+        tr = _run_epoch(net, corpus, train_idx, cfg, optimizer, generator, share, amp, scaler)
         scheduler.step()
         with torch.no_grad():
-            va = _run_epoch(net, data, val_idx, cfg) if len(val_idx) else tr
-        entry = {"epoch": epoch, "train": tr, "val": va, "lr": scheduler.get_last_lr()[0]}
+            va = _run_epoch(net, corpus, val_idx, cfg, amp=amp) if len(val_idx) else tr
+        entry = {"epoch": epoch, "train": tr, "val": va, "lr": scheduler.get_last_lr()[0],
+                 "epoch_seconds": time.time() - t_epoch}
         last_epoch = epoch == cfg.epochs - 1 or (cfg.max_minutes is not None
                                                  and (time.time() - t0) > 60 * cfg.max_minutes)
-        score = None
-        if cfg.rollout_every > 0 and len(val_idx) and ((epoch + 1) % cfg.rollout_every == 0 or last_epoch):
-            net.eval()
-            entry["val_rollout"] = dataset_pose_error(decode_examples(net, data, val_idx), data, val_idx)
-            score = entry["val_rollout"]["pose_error"]
-        elif cfg.rollout_every <= 0:
-            score = va["total"]
-        history.append(entry)
-        if score is not None and score < best_val:
-            best_val = score
-            best_state = {k: v.detach().clone() for k, v in net.state_dict().items()}
-            best_epoch = epoch
-        bar.set_postfix(train=f"{tr['total']:.4f}", val=f"{va['total']:.4f}", best=f"{best_val:.4f}")
-        ckpt_path.parent.mkdir(parents=True, exist_ok=True)
-        torch.save({"epoch": epoch, "state_dict": net.state_dict(), "optimizer": optimizer.state_dict(),
-                    "scheduler": scheduler.state_dict(), "generator": generator.get_state(), "history": history,
-                    "best_val": best_val, "best_state": best_state, "best_epoch": best_epoch,
-                    "selected_by": selected_by, "seconds": seconds_before + time.time() - t0,
-                    "model_config": cfg.model.to_dict()},
-                   ckpt_path)
+        score = _score(net, data, val_idx, cfg, epoch, last_epoch, va, entry)
+        run.history.append(entry)
+        if score is not None and score < run.best_val:
+            run.best_val, run.best_state, run.best_epoch = score, cpu_state_dict(net), epoch
+        bar.set_postfix(train=f"{tr['total']:.4f}", val=f"{va['total']:.4f}", best=f"{run.best_val:.4f}")
+        _save_checkpoint(ckpt_path, epoch, net, optimizer, scheduler, generator, run, cfg, selected_by,
+                         run.seconds_before + time.time() - t0)
         if last_epoch:
             break
-    seconds = seconds_before + time.time() - t0
-    if best_state is not None:
-        net.load_state_dict(best_state)
-    summary = {"epochs_run": epoch + 1, "best_val": best_val, "best_epoch": best_epoch,
-               "selected_by": selected_by,
-               "seconds": seconds, "out": cfg.out}
+    return _finish(net, cfg, run, epoch, selected_by, run.seconds_before + time.time() - t0, device)
+
+
+def _score(net, data, val_idx, cfg: TrainConfig, epoch: int, last_epoch: bool, va: dict, entry: dict):
+    """The model-selection score of this epoch (None when not measured this epoch); adds "val_rollout"."""
+    if cfg.rollout_every > 0 and len(val_idx) and ((epoch + 1) % cfg.rollout_every == 0 or last_epoch):
+        net.eval()
+        entry["val_rollout"] = dataset_pose_error(decode_examples(net, data, val_idx), data, val_idx)
+        return selection_score(entry["val_rollout"])
+    if cfg.rollout_every <= 0:
+        return va["total"]
+    return None
+
+
+def _finish(net, cfg: TrainConfig, run: _Run, epoch: int, selected_by: str, seconds: float,
+            device: torch.device) -> dict:
+    """Load the best state, save the weights file and return the run summary."""
+    if run.best_state is not None:
+        net.load_state_dict(run.best_state)
+    summary = {"epochs_run": epoch + 1, "best_val": run.best_val, "best_epoch": run.best_epoch,
+               "selected_by": selected_by, "seconds": seconds, "device": str(device), "preset": cfg.preset,
+               "out": cfg.out}
     save_weights(net, cfg.out, {"loss_weights": dataclasses.asdict(cfg.loss), "train_config": _jsonable(cfg),
-                                "history": history, **{k: v for k, v in summary.items() if k != "out"}})
-    summary["history"] = history
+                                "history": run.history, **{k: v for k, v in summary.items() if k != "out"}})
+    summary["history"] = run.history
     return summary
 
 
@@ -208,21 +311,32 @@ def _jsonable(cfg: TrainConfig) -> dict:
 def build_parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(description="Train the Text2Gestures network (seed 003) on the synthetic corpus.")
     d = TrainConfig()
-    p.add_argument("--epochs", type=int, default=d.epochs)
+    p.add_argument("--config", default="small", help=f"preset: {' or '.join(PRESETS)} (paper = the published "
+                   "26.3 M-parameter size, 600 epochs, no time budget)")
+    p.add_argument("--device", default=d.device, help="auto (CUDA when available), cpu, cuda or cuda:N")
+    p.add_argument("--amp", action="store_true", help="mixed-precision forward passes (CUDA autocast; ignored on "
+                   "the CPU)")
+    p.add_argument("--epochs", type=int, default=None, help="default: the preset's (400 small, 600 paper)")
     p.add_argument("--batch-size", type=int, default=d.batch_size)
     p.add_argument("--lr", type=float, default=d.lr)
     p.add_argument("--weight-decay", type=float, default=d.weight_decay)
     p.add_argument("--seed", type=int, default=d.seed)
     p.add_argument("--variants", type=int, default=d.variants, help="procedural gestures per sentence")
-    p.add_argument("--max-minutes", type=float, default=d.max_minutes,
-                   help="wall-clock budget in minutes (0 = none); keeps the best model")
+    p.add_argument("--counterfactual", type=int, default=d.counterfactual,
+                   help="extra procedural gestures per sentence performed with another emotion")
+    p.add_argument("--max-minutes", type=float, default=None,
+                   help="wall-clock budget in minutes (0 = none; default: 20 small, none paper); keeps the best model")
     p.add_argument("--sampling", type=float, default=d.sampling, help="share of self-fed decoder inputs")
+    p.add_argument("--sampling-ramp", type=int, default=d.sampling_ramp,
+                   help="epochs over which the self-fed share rises linearly to --sampling")
+    p.add_argument("--sampling-passes", type=int, default=d.sampling_passes,
+                   help="no-grad passes that build the self-fed inputs (more = closer to free-running generation)")
     p.add_argument("--input-noise", type=float, default=d.input_noise)
-    p.add_argument("--residual", choices=("previous", "rest", "none"), default=d.model.residual)
-    p.add_argument("--no-angle-loss", action="store_true")
-    p.add_argument("--no-pose-loss", action="store_true")
-    p.add_argument("--no-affective-loss", action="store_true")
-    p.add_argument("--d-model", type=int, default=d.model.d_model)
+    p.add_argument("--residual", choices=("previous", "rest", "none"), default=None)
+    for term in ("angle", "pose", "affective", "velocity", "liveliness"):
+        p.add_argument(f"--no-{term}-loss", action="store_true")
+    p.add_argument("--d-model", type=int, default=None, help="default: the preset's (64 small, 992 paper)")
+    p.add_argument("--init-from", default=None, help="start from these weights (fine-tuning; same model config)")
     p.add_argument("--out", default=d.out, help="where the best weights go")
     p.add_argument("--checkpoint", default=d.checkpoint)
     p.add_argument("--resume", action="store_true", help="continue from --checkpoint")
@@ -232,23 +346,34 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def config_from_args(args: argparse.Namespace) -> TrainConfig:
+    """A :class:`TrainConfig` from parsed options: the ``--config`` preset, then the options given explicitly."""
     base = LossWeights()
-    loss = LossWeights(angle=0.0 if args.no_angle_loss else base.angle, pose=0.0 if args.no_pose_loss else base.pose,
-                       affective=0.0 if args.no_affective_loss else base.affective)
-    return TrainConfig(epochs=args.epochs, batch_size=args.batch_size, lr=args.lr, weight_decay=args.weight_decay,
-                       seed=args.seed, variants=args.variants, max_minutes=args.max_minutes or None, loss=loss,
-                       sampling=args.sampling, input_noise=args.input_noise,
-                       model=GestureNetConfig(d_model=args.d_model, residual=args.residual), out=args.out,
-                       checkpoint=args.checkpoint,
-                       resume=args.resume, threads=args.threads)
+    loss = LossWeights(**{k: 0.0 if getattr(args, f"no_{k}_loss") else getattr(base, k)
+                          for k in ("angle", "pose", "affective", "velocity", "liveliness")})
+    cfg = preset_config(args.config or "small")
+    model = dataclasses.replace(cfg.model, **{k: v for k, v in (("d_model", args.d_model),
+                                                                 ("residual", args.residual)) if v is not None})
+    overrides = dict(batch_size=args.batch_size, lr=args.lr, weight_decay=args.weight_decay, seed=args.seed,
+                     variants=args.variants, counterfactual=args.counterfactual, loss=loss, sampling=args.sampling,
+                     sampling_ramp=args.sampling_ramp,
+                     sampling_passes=args.sampling_passes, input_noise=args.input_noise, model=model, out=args.out,
+                     checkpoint=args.checkpoint, resume=args.resume, threads=args.threads,
+                     init_from=args.init_from, device=args.device, amp=bool(args.amp))
+    if args.epochs is not None:
+        overrides["epochs"] = args.epochs
+    if args.max_minutes is not None:
+        overrides["max_minutes"] = args.max_minutes or None
+    resolve_device(args.device)  # an unknown or unavailable device fails here, before any data is built
+    return dataclasses.replace(cfg, **overrides)
 
 
 def main(argv: list[str] | None = None) -> dict:
     args = build_parser().parse_args(argv)
     summary = train(config_from_args(args), progress=not args.quiet)
     last = summary["history"][-1] if summary["history"] else {}
-    print(f"trained {summary['epochs_run']} epochs in {summary['seconds']:.0f} s; best val loss "
-          f"{summary['best_val']:.5f}; last {json.dumps(last.get('val', {}))}; weights -> {summary['out']}")
+    print(f"trained {summary['epochs_run']} epochs in {summary['seconds']:.0f} s on {summary['device']}; best "
+          f"selection score {summary['best_val']:.5f}; last {json.dumps(last.get('val', {}))}; "
+          f"weights -> {summary['out']}")
     return summary
 
 

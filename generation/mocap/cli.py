@@ -1,5 +1,6 @@
 """``python -m generation.mocap import PATH... --skeleton gait|gesture --out DIR``: files and folders -> Motions;
-``python -m generation.mocap corpus DIR... --out FILE.npz``: labelled gait Motions -> a corpus for train_gait.
+``python -m generation.mocap corpus DIR... --out FILE.npz``: labelled gait Motions -> a corpus for train_gait;
+with ``--skeleton gesture --sentences CSV``: gesture takes and their sentences -> a corpus for train_gesture.
 
 Writes ``DIR/<name>.npz`` per input (``Motion.save_npz``; a name used twice gets ``-2``, ``-3``...) and
 ``DIR/import_report.csv`` (:data:`~generation.mocap.importer.REPORT_COLUMNS`, one row per input, in input order).
@@ -64,12 +65,36 @@ def _parser() -> argparse.ArgumentParser:
     cor.add_argument("--stride", type=int, help="frames between window starts (default: --frames)")
     cor.add_argument("--fps", type=float, default=30.0, help="corpus frame rate (default 30)")
     cor.add_argument("--seed", type=int, default=0, help="seed of the train/val/test split by file")
+    cor.add_argument("--skeleton", choices=MODALITIES, default=MODALITIES[0],
+                     help="gait (default): windows for train_gait; gesture: one example per take for train_gesture")
+    cor.add_argument("--sentences", type=Path, help="gesture corpus: CSV source, sentence, task[, handedness]")
     return ap
+
+
+def run_gesture_corpus(args, motions, problems) -> int:
+    from .gesture_corpus import build_gesture_corpus, read_sentences, save_gesture_corpus
+
+    if args.sentences is None:
+        print("error: a gesture corpus needs --sentences CSV (source, sentence, task)", file=sys.stderr)
+        return 2
+    try:
+        arrays, skipped = build_gesture_corpus(motions, read_sentences(args.sentences))
+    except (LabelError, ValueError) as exc:
+        print("\n".join(f"error: {p}" for p in problems) + f"\nerror: {exc}", file=sys.stderr)
+        return 2
+    path = save_gesture_corpus(arrays, args.out)
+    print(f"wrote {path}: {len(arrays['lengths'])} gesture takes, {int(arrays['lengths'].sum())} frames at "
+          f"{float(arrays['fps']):g} fps", file=sys.stderr)
+    for p in problems + skipped:
+        print(f"  skipped: {p}", file=sys.stderr)
+    return 1 if problems or skipped else 0
 
 
 def run_corpus(args) -> int:
     from .corpus import build_captured_gait_corpus, load_motions
     motions, problems = load_motions(args.paths)
+    if args.skeleton == "gesture":
+        return run_gesture_corpus(args, motions, problems)
     try:
         corpus, skipped = build_captured_gait_corpus(motions, args.frames, args.fps, args.stride, args.seed)
     except ValueError as exc:

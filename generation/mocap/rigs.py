@@ -70,7 +70,7 @@ _LEGS = {
     "side_knee": ("side_leg", "side_lowerleg", "side_knee", "side_calf", "side_shin"),
     "side_ankle": ("side_ankle", "side_foot"),
     "side_toe": ("side_toebase", "side_toes", "side_toe", "side_toe0", "side_ball", "side_foot", "side_toebaseend",
-                 "side_toeend", "side_toesend", "side_toe0end", "side_footend", "side_ankleend"),
+                 "side_toeend", "side_toesend", "side_toe0end", "side_footend", "side_ankleend", "side_heelend"),
 }
 _ARMS = {
     "side_shoulder": ("side_arm", "side_upperarm", "side_shldr", "side_shoulder"),
@@ -84,8 +84,10 @@ _ARMS = {
 
 #: our gait joint -> candidate source keys (first present and unused wins)
 GAIT_CANDIDATES: dict[str, tuple[str, ...]] = _sided({
-    "root": _ROOT, "spine": _CHEST_TOP, "lower_back": _CHEST_LOW, "neck": _NECK, "head": _HEAD,
-    "side_hip": _LEGS["side_hip"], "side_knee": _LEGS["side_knee"], "side_heel": _LEGS["side_ankle"],
+    # our own names last (the BVH files the renderer keeps: motions/<clip_id>.bvh): "spine" is the chest only when
+    # the rig has no higher spine joint, "heel" is our ankle
+    "root": _ROOT, "spine": (*_CHEST_TOP, "spine"), "lower_back": _CHEST_LOW, "neck": _NECK, "head": _HEAD,
+    "side_hip": _LEGS["side_hip"], "side_knee": _LEGS["side_knee"], "side_heel": (*_LEGS["side_ankle"], "side_heel"),
     "side_toe": _LEGS["side_toe"],
     "side_shoulder": _ARMS["side_shoulder"], "side_elbow": _ARMS["side_elbow"], "side_hand": _ARMS["side_wrist"],
     "side_hand_index": _ARMS["side_index"],

@@ -32,7 +32,7 @@ SENTENCES = HERE.parent / "data" / "sentences_synthetic.csv"
 WEIGHTS = (0.4, 0.7, 1.0, 1.3)
 FEATURE_COUNTS = (1, 4, 7, 10)
 INVERSION_WEIGHT = -0.7
-RENDER = {"fps": 30, "duration_s": 10}  # the renderer's defaults: 1280x720 mannequin, camera auto, FXAA
+RENDER = {"fps": 25, "duration_s": 10}  # 25 fps (no paper states a video rate); 1280x720 mannequin, camera auto
 
 
 def _predominant(emotion: str, share: float = 0.8) -> list[float]:

@@ -1,6 +1,7 @@
 """The clip catalogue file ``clips.csv`` (DESIGN.md "Interchange formats"): write, read, check against files.
 
-One row per clip, columns exactly :data:`CLIP_COLUMNS`; blank cells are missing values. ``clip_id`` is the
+One row per clip, columns :data:`CLIP_COLUMNS` then the quality columns :data:`QA_COLUMNS` (issue 14; files
+without them still read, their rows get blank quality cells); blank cells are missing values. ``clip_id`` is the
 clip's content hash, which is also the stem of its files ``clips/<clip_id>.mp4|.webm|.png``.
 """
 from __future__ import annotations
@@ -11,7 +12,17 @@ import os
 from collections.abc import Iterable
 from pathlib import Path
 
-from study_protocol import CLIP_COLUMNS, CLIP_FLOAT_COLUMNS, CLIP_INT_COLUMNS, MODALITIES, ORIGINS
+from study_protocol import (
+    CLIP_COLUMNS,
+    CLIP_FLOAT_COLUMNS,
+    CLIP_INT_COLUMNS,
+    MODALITIES,
+    ORIGINS,
+    QA_COLUMNS,
+    QA_FLOAT_COLUMNS,
+)
+
+ALL_COLUMNS = (*CLIP_COLUMNS, *QA_COLUMNS)
 
 
 class CatalogueFormatError(ValueError):
@@ -41,9 +52,9 @@ def read_clips_csv(path: str | Path) -> list[dict]:
             raise CatalogueFormatError(f"{path}: line 1: missing column(s) {missing}")
         for line_no, raw in enumerate(reader, start=2):
             row: dict = {}
-            for col in CLIP_COLUMNS:
+            for col in ALL_COLUMNS:
                 text = (raw.get(col) or "").strip()
-                if col in CLIP_FLOAT_COLUMNS or col in CLIP_INT_COLUMNS:
+                if col in CLIP_FLOAT_COLUMNS or col in CLIP_INT_COLUMNS or col in QA_FLOAT_COLUMNS:
                     if not text:
                         row[col] = None
                         continue
@@ -68,6 +79,9 @@ def read_clips_csv(path: str | Path) -> list[dict]:
 def write_clips_csv(records: Iterable[dict], path: str | Path, merge: bool = True) -> list[dict]:
     """Write clip records (dicts with at least the CLIP_COLUMNS keys) to ``path`` atomically.
 
+    The quality columns come from a record's ``qa`` dict (:func:`generation.quality.qa_columns`) or, for rows
+    read back from the file, from their own qa_ keys.
+
     With ``merge``, rows already in the file whose clip_id is not among ``records`` are kept (the
     catalogue collects every plan rendered into this media folder); rows with the same clip_id are
     replaced. Rows are sorted by clip_id. Returns the rows written.
@@ -77,15 +91,18 @@ def write_clips_csv(records: Iterable[dict], path: str | Path, merge: bool = Tru
     if merge and path.exists():
         for row in read_clips_csv(path):
             rows[row["clip_id"]] = row
+    from generation.quality.checks import qa_columns
+
     for rec in records:
-        rows[str(rec["clip_id"])] = {c: rec.get(c) for c in CLIP_COLUMNS}
+        qa = qa_columns(rec["qa"]) if isinstance(rec.get("qa"), dict) else {c: rec.get(c) for c in QA_COLUMNS}
+        rows[str(rec["clip_id"])] = {**{c: rec.get(c) for c in CLIP_COLUMNS}, **qa}
     path.parent.mkdir(parents=True, exist_ok=True)
     tmp = path.with_name(f".{path.name}.tmp{os.getpid()}")
     with tmp.open("w", newline="", encoding="utf-8") as f:
         writer = csv.writer(f)
-        writer.writerow(CLIP_COLUMNS)
+        writer.writerow(ALL_COLUMNS)
         for clip_id in sorted(rows):
-            writer.writerow([_cell(rows[clip_id].get(c)) for c in CLIP_COLUMNS])
+            writer.writerow([_cell(rows[clip_id].get(c)) for c in ALL_COLUMNS])
     os.replace(tmp, path)
     return [rows[k] for k in sorted(rows)]
 

@@ -32,6 +32,7 @@ GENERATOR_VERSIONS = {
     "gait_net": "1",
     "procedural_walk": "1",
     "captured": "1",
+    "captured_file": "1",
     "neutral_walk": "1",
     "rbf": "1",
     "gesture_net": "1",
@@ -42,6 +43,7 @@ GENERATOR_MODULES = {
     "gait_net": ("generation.gait.generate", "generation.core.paths"),
     "procedural_walk": ("generation.procedural.walk", "generation.procedural.emotion", "generation.core.paths"),
     "captured": ("generation.formats.captured",),
+    "captured_file": ("generation.plans.captured_file", "generation.mocap.importer"),
     "neutral_walk": ("generation.rbf.neutral_base", "generation.rbf.stylise"),
     "rbf": ("generation.rbf.neutral_base", "generation.rbf.stylise"),
     "gesture_net": ("generation.gesture.generate",),
@@ -203,10 +205,22 @@ def make_path(trajectory: dict):
 
 
 # ---- generators --------------------------------------------------------------------------------
+DEVICE_ENV = "GENERATION_DEVICE"
+"""Environment variable naming the torch device of the network generators ("cpu" when unset; ``manage.py
+generate_clips --device`` sets it, so that the render worker processes it spawns inherit it)."""
+
+
+def generation_device(device: str | None = None) -> str:
+    """The device the network generators run on: ``device`` when given, else ``$GENERATION_DEVICE``, else "cpu"
+    (stimuli identical to those made on a machine without a GPU)."""
+    import os
+    return device or os.environ.get(DEVICE_ENV) or "cpu"
+
+
 def _gait_net(entry: ClipEntry, fps: float) -> Motion:
     from generation.gait.generate import emotion_transition, generate_gaits, load_default_model
 
-    net = load_default_model()
+    net = load_default_model(generation_device())
     inp = entry.inputs
     steps = int(math.ceil(inp["duration_s"] * net.fps)) + 1
     if "transition" in inp:
@@ -303,6 +317,16 @@ def transition_walk(a, b, path, n_frames: int, fps: float, seed: int | None = No
     return Motion(gait_skeleton(), np_qfix(rot), root, fps, meta)
 
 
+def _captured_file(entry: ClipEntry, fps: float) -> Motion:
+    """An imported motion file (generation/plans/captured_file.py); errors name the entry and the field."""
+    from .captured_file import CapturedFileError, captured_file_motion
+
+    try:
+        return captured_file_motion(entry.inputs, entry.modality, fps)
+    except CapturedFileError as exc:
+        raise ClipGenerationError(f"{entry.where}: {exc}") from None
+
+
 def _captured(entry: ClipEntry, fps: float) -> Motion:
     from generation.formats.captured import WALK_FILES, captured_walks, chain_clip_repeats
 
@@ -371,6 +395,7 @@ MAKERS = {
     "gait_net": _gait_net,
     "procedural_walk": _procedural_walk,
     "captured": _captured,
+    "captured_file": _captured_file,
     "neutral_walk": _neutral_walk,
     "rbf": _rbf,
     "gesture_net": _gesture_net,

@@ -5,6 +5,7 @@ A plan is a YAML (or JSON) file::
     name: demo
     description: ...
     render: {width: 640, height: 480, fps: 30, duration_s: 10}   # defaults for every clip
+    qa: {foot_skate_cm_s: 5, jerk: null}   # optional: quality thresholds (study_protocol.QA_THRESHOLDS; null = off)
     clips:
       - id: happy_straight          # unique within the plan; never shown to participants
         modality: gait              # gait | gesture
@@ -40,6 +41,7 @@ from study_protocol import (
     GESTURE_TASKS,
     GESTURE_VAD,
     HANDEDNESS,
+    MODALITIES,
     NEUTRAL_THEME,
     SECTION_TYPES,
     THEMES,
@@ -54,8 +56,9 @@ SENTENCE_SPLITS = ("train", "val", "test")
 CAPTURED_CLIPS = ("humanoid3d_walk.txt", "0walk_forward.txt", "turn_left0.txt", "turn_left1.txt",
                   "turn_right0.txt", "turn_right1.txt")
 
-#: generator -> (modality, allowed origins, the generators it may fall back to)
-GENERATORS: dict[str, tuple[str, tuple[str, ...], tuple[str, ...]]] = {
+#: generator -> (modality, allowed origins, the generators it may fall back to); modality None: the entry's
+#: ``modality`` (gait by default), for captured_file (an imported motion file, generation/plans/captured_file.py)
+GENERATORS: dict[str, tuple[str | None, tuple[str, ...], tuple[str, ...]]] = {
     "gait_net": ("gait", ("generated",), ("procedural_walk",)),
     "procedural_walk": ("gait", ("generated", "source"), ()),
     "captured": ("gait", ("source",), ()),
@@ -63,6 +66,7 @@ GENERATORS: dict[str, tuple[str, tuple[str, ...], tuple[str, ...]]] = {
     "rbf": ("gait", ("generated",), ()),
     "gesture_net": ("gesture", ("generated",), ("procedural_gesture",)),
     "procedural_gesture": ("gesture", ("source", "generated"), ()),
+    "captured_file": (None, ("source",), ()),
 }
 COMMON_FIELDS = {"id", "modality", "generator", "fallback", "origin", "seed", "sections", "render", "loop", "pair",
                  "note"}
@@ -74,6 +78,7 @@ GENERATOR_FIELDS: dict[str, set[str]] = {
     "rbf": {"theme", "weight", "n_features", "n_cycles", "speed"},
     "gesture_net": {"sentence", "task", "emotion_label", "gender", "handedness", "noise", "sentence_split"},
     "procedural_gesture": {"emotion_label", "vad", "kind", "gender", "handedness", "duration_s"},
+    "captured_file": {"file", "start_s", "emotion", "emotion_label", "vad"},
 }
 
 
@@ -130,6 +135,7 @@ class Plan:
     entries: tuple[ClipEntry, ...]
     source: str = ""
     meta: dict = field(default_factory=dict)
+    qa: dict = field(default_factory=dict)  # quality thresholds overriding study_protocol.QA_THRESHOLDS
 
     def entry(self, entry_id: str) -> ClipEntry:
         for e in self.entries:
@@ -241,6 +247,13 @@ def _generator_inputs(gen: str, raw: dict, duration_default: float) -> dict:
                                  "final": _emotion("transition.final", t["final"])}
         out["trajectory"] = _trajectory(raw.get("trajectory"))
         out["duration_s"] = _number("duration_s", raw.get("duration_s", duration_default), 1.0, 120.0)
+    elif gen == "captured_file":
+        from .captured_file import CapturedFileError, captured_file_inputs
+
+        try:
+            out.update(captured_file_inputs(raw))
+        except CapturedFileError as exc:
+            raise _FieldError(exc.field, exc.message) from None
     elif gen == "captured":
         out["clip"] = _choice("clip", raw.get("clip", "0walk_forward.txt"), CAPTURED_CLIPS)
         out["cycles"] = _integer("cycles", raw.get("cycles", 1), 1, 100)
@@ -297,8 +310,10 @@ def _validate_entry(i: int, raw, plan_render: RenderSettings) -> ClipEntry:
         entry_id = str(entry_id).strip()
         gen = _choice("generator", raw.get("generator"), GENERATORS)
         modality, origins, fallbacks = GENERATORS[gen]
-        given_modality = raw.get("modality", modality)
-        if given_modality != modality:
+        given_modality = raw.get("modality", modality or MODALITIES[0])
+        if modality is None:
+            modality = _choice("modality", given_modality, MODALITIES)
+        elif given_modality != modality:
             raise _FieldError("modality", f"generator {gen!r} makes {modality} clips, got {given_modality!r}")
         origin = _choice("origin", raw.get("origin", origins[0]), origins)
         unknown = set(raw) - COMMON_FIELDS - GENERATOR_FIELDS[gen]
@@ -344,7 +359,7 @@ def validate_plan(data, source: str = "<plan>") -> Plan:
     """A :class:`Plan` from parsed YAML/JSON, or PlanError naming the entry and field."""
     if not isinstance(data, dict):
         raise PlanError(f"{source}: a plan must be a mapping with 'name' and 'clips', got {type(data).__name__}")
-    unknown = set(data) - {"name", "description", "render", "clips", "meta"}
+    unknown = set(data) - {"name", "description", "render", "clips", "meta", "qa"}
     if unknown:
         raise PlanError(f"{source}: unknown top-level field(s) {sorted(unknown)}")
     name = data.get("name")
@@ -375,7 +390,15 @@ def validate_plan(data, source: str = "<plan>") -> Plan:
                             f"(id {keys[key].id!r}); change the seed to get a different clip")
         keys[key] = e
     description = data.get("description", "")
-    return Plan(name.strip(), str(description), render, tuple(entries), source, dict(data.get("meta") or {}))
+    from generation.quality.checks import QAThresholdError, resolve_thresholds
+
+    qa = data.get("qa") or {}
+    try:
+        resolve_thresholds(qa)
+    except QAThresholdError as exc:
+        raise PlanError(f"{source}: {exc}") from None
+    return Plan(name.strip(), str(description), render, tuple(entries), source, dict(data.get("meta") or {}),
+                dict(qa))
 
 
 def plan_path(name_or_path: str | Path) -> Path:

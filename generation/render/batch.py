@@ -26,7 +26,7 @@ from generation.plans.schema import ClipEntry, Plan, clip_hash, intent_fields
 
 from .clip import clip_files_complete, render_clip
 
-RECORD_VERSION = 1
+RECORD_VERSION = 2  # 2: records carry the quality record ``qa`` and ``qa_flag``
 
 
 @dataclass
@@ -38,6 +38,7 @@ class Job:
     clip_id: str
     generator_version: str
     fallback_reason: str | None = None
+    qa_thresholds: dict | None = None  # the plan's quality thresholds (resolved); None = study_protocol defaults
 
 
 @dataclass
@@ -52,7 +53,9 @@ class BatchResult:
 def plan_jobs(plan: Plan, limit: int | None = None) -> tuple[list[Job], list[tuple[str, str]]]:
     """Jobs for the plan's entries (first ``limit``), and (entry, message) for entries that cannot run."""
     from generation.plans.clipgen import ClipGenerationError, generator_version, resolve
+    from generation.quality.checks import resolve_thresholds
 
+    thresholds = resolve_thresholds(plan.qa)
     jobs, failures = [], []
     for entry in plan.entries[:limit] if limit else plan.entries:
         try:
@@ -61,7 +64,8 @@ def plan_jobs(plan: Plan, limit: int | None = None) -> tuple[list[Job], list[tup
             failures.append((entry.where, str(exc)))
             continue
         version = generator_version(run_entry.generator)
-        jobs.append(Job(entry, run_entry, clip_hash(run_entry, run_entry.generator, version), version, reason))
+        jobs.append(Job(entry, run_entry, clip_hash(run_entry, run_entry.generator, version), version, reason,
+                        thresholds))
     return jobs, failures
 
 
@@ -167,10 +171,36 @@ def render_job(job: Job, record: dict, clips_dir: str, records_dir: str) -> dict
     record["metadata"]["n_frames"] = result.n_frames
     record["metadata"]["fps"] = result.fps
     record["metadata"]["camera"] = _json_safe(result.camera)  # rule (fixed/follow), figure height fractions
-    record["metadata"]["timing_s"] = {"generate": round(t_gen, 3), "total": round(time.perf_counter() - t0, 3)}
+    t_qa = time.perf_counter()
+    _add_qa(record, job, motion, result.camera)
+    record["metadata"]["timing_s"] = {"generate": round(t_gen, 3), "qa": round(time.perf_counter() - t_qa, 3),
+                                      "total": round(time.perf_counter() - t0, 3)}
     record["record_version"] = RECORD_VERSION
     _write_json_atomic(record, Path(records_dir) / f"{job.clip_id}.json")
     return record
+
+
+def _add_qa(record: dict, job: Job, motion, camera: dict) -> None:
+    """Measure the clip's quality (:mod:`generation.quality`) into ``record["qa"]`` and ``record["qa_flag"]``."""
+    from generation.quality.observer import default_observer
+    from generation.quality.plan_qa import clip_qa, intended_emotion
+
+    observer = default_observer() if job.run_entry.modality == "gait" else None
+    result, _ = clip_qa(motion, job.run_entry.render, job.qa_thresholds, intended_emotion(job.run_entry.inputs),
+                        observer, camera_info=camera)
+    record["qa"] = _json_safe(result.as_dict())
+    record["qa_flag"] = result.flag
+
+
+def _recheck_qa(rec: dict, done: dict, job: Job) -> None:
+    """A stored record's quality values, re-checked against the plan's current thresholds."""
+    from generation.quality.checks import QAResult, failed_checks
+    from generation.quality.plan_qa import intended_emotion
+
+    stored = QAResult.from_dict(done.get("qa") or {})
+    flags = failed_checks(stored.values, job.qa_thresholds, intended_emotion(job.run_entry.inputs))
+    rec["qa"] = QAResult(stored.values, flags).as_dict()
+    rec["qa_flag"] = ";".join(flags)
 
 
 # ---- orchestration -----------------------------------------------------------------------------
@@ -218,6 +248,7 @@ def _select_todo(batch: _Batch, jobs: list[Job], plan: Plan, media_prefix: str, 
             for key in ("duration_s",):
                 rec[key] = done.get(key)
             rec["metadata"] = {**done.get("metadata", {}), **rec["metadata"]}
+            _recheck_qa(rec, done, job)
             batch.by_id[job.clip_id] = rec
             batch.result.skipped.append(job.clip_id)
             batch.emit("skip", {"clip_id": job.clip_id, "entry": job.entry.id})
@@ -275,9 +306,47 @@ def _render_pool(batch: _Batch, todo: list[Job], workers: int, threads_per_worke
         manager.shutdown()
 
 
+_WORKER_READY = False
+
+
+def render_job_on_worker(job: Job, record: dict, clips_dir: str, records_dir: str, threads: int = 1) -> dict:
+    """:func:`render_job` on a Dask worker: sets the worker process up once (threads, headless GL), no progress
+    queue (the scheduler reports clips as they finish)."""
+    global _WORKER_READY
+    if not _WORKER_READY:
+        _init_worker(None, threads)
+        _WORKER_READY = True
+    return render_job(job, record, clips_dir, records_dir)
+
+
+def _render_dask(batch: _Batch, todo: list[Job], scheduler, threads_per_worker: int) -> None:
+    """Render ``todo`` on a Dask distributed cluster: ``scheduler`` is its address (``tcp://host:port``) or a
+    ``distributed.Client``. Workers must see the same clips and records folders (a shared file system): they
+    write the files, this process collects the records."""
+    from distributed import Client, as_completed
+
+    client = scheduler if isinstance(scheduler, Client) else Client(scheduler, timeout=30)
+    try:
+        futures = {}
+        for job in todo:
+            fut = client.submit(render_job_on_worker, *batch.job_args(job), threads_per_worker, pure=False,
+                                key=f"render-{job.clip_id}-{os.getpid()}-{time.time_ns()}")
+            futures[fut] = job
+        for fut in as_completed(futures):
+            job = futures[fut]
+            try:
+                batch.finished(job, fut.result())
+            except Exception as exc:  # noqa: BLE001 - one bad clip must not stop the plan
+                batch.failed(job, exc)
+    finally:
+        if client is not scheduler:
+            client.close()
+
+
 def run_plan(plan: Plan, clips_dir: str | Path, records_dir: str | Path, media_prefix: str = "clips/",
              workers: int = 1, webm: bool = False, limit: int | None = None,
-             on_event: Callable[[str, dict], None] | None = None, threads_per_worker: int = 1) -> BatchResult:
+             on_event: Callable[[str, dict], None] | None = None, threads_per_worker: int = 1,
+             scheduler=None) -> BatchResult:
     """Render every entry of ``plan`` that is not already complete.
 
     Args:
@@ -290,6 +359,8 @@ def run_plan(plan: Plan, clips_dir: str | Path, records_dir: str | Path, media_p
         limit: only the first ``limit`` entries.
         on_event: progress callback ``on_event(kind, info)`` with kind in {"plan", "skip", "start", "frames",
             "done", "fail"} (the command draws tqdm bars from it).
+        scheduler: a Dask distributed scheduler address (``tcp://host:port``) or Client: render there instead of
+            in local processes (``workers`` is then ignored; the workers need the shared media folder).
     Returns a BatchResult with the records of every clip of the plan that exists now.
     """
     t0 = time.perf_counter()
@@ -304,7 +375,13 @@ def run_plan(plan: Plan, clips_dir: str | Path, records_dir: str | Path, media_p
     todo = _select_todo(batch, jobs, plan, media_prefix, webm)
     emit("plan", {"total": len(batch.by_id), "todo": len(todo), "skipped": len(batch.result.skipped)})
     _remove_stale(todo, clips_dir, records_dir)
-    if workers <= 1 or len(todo) <= 1:
+    if any(j.run_entry.modality == "gait" for j in todo) and (workers > 1 or scheduler is not None):
+        from generation.quality.observer import default_observer
+
+        default_observer()  # train/cache the quality observer once, not in every worker
+    if scheduler is not None:
+        _render_dask(batch, todo, scheduler, threads_per_worker)
+    elif workers <= 1 or len(todo) <= 1:
         _render_serial(batch, todo)
     else:
         _render_pool(batch, todo, workers, threads_per_worker)

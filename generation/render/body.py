@@ -83,19 +83,11 @@ def _trunk_profile(build: str, h: float, s: float) -> tuple[float, float]:
     return float(np.interp(h, t["h"], t["w"])) * s, float(np.interp(h, t["h"], t["d"]))
 
 
-def mannequin_parts(skeleton: Skeleton) -> list[Part]:
-    """The parts of a mannequin for ``skeleton`` (the 21-joint gait or 23-joint gesture skeleton, or any
-    skeleton with the same joint-name conventions: hips, knees, heels/ankles, toes, shoulders, elbows,
-    hands/wrists, neck, head)."""
-    s = skeleton.height / 1.75
-    build = skeleton.build if skeleton.build in _TRUNK else "male"
-    limb = {k: (v[0] * s, v[1] * s) for k, v in _LIMBS[build].items()}
-    lengths = skeleton.bone_lengths()
+def _trunk_parts(skeleton: Skeleton, build: str, s: float, neck: int | None) -> list[Part]:
+    """The trunk's elliptic capsules (see the comment inside) for a skeleton scaled by ``s`` = height / 1.75."""
     parents = skeleton.parents
     rest = skeleton.rest_positions()
     parts: list[Part] = []
-    neck = _first(skeleton, "neck")
-    head = _first(skeleton, "head")
     # Trunk: the chain from the root up to the neck in at most three elliptic capsules (pelvis/abdomen,
     # waist/chest, upper chest) between the chain joints nearest 0, 40 %, 75 % and 100 % of its height; a
     # part may span several spine bones (the gesture skeleton has five), which keeps the trunk from looking
@@ -124,6 +116,23 @@ def mannequin_parts(skeleton: Skeleton) -> list[Part]:
             length = float(np.linalg.norm(rest[jb] - rest[ja]))
             parts.append(Part(f"trunk_{k}", ja, jb, wa, wb, 0.0, length, sz=(da + db) / 2,
                               cap=0.65 if k == 0 else 0.25, side="hips" if frac[jb] < 0.5 else "shoulders"))
+    return parts
+
+
+def mannequin_parts(skeleton: Skeleton) -> list[Part]:
+    """The parts of a mannequin for ``skeleton`` (the 21-joint gait or 23-joint gesture skeleton, or any
+    skeleton with the same joint-name conventions: hips, knees, heels/ankles, toes, shoulders, elbows,
+    hands/wrists, neck, head)."""
+    s = skeleton.height / 1.75
+    build = skeleton.build if skeleton.build in _TRUNK else "male"
+    limb = {k: (v[0] * s, v[1] * s) for k, v in _LIMBS[build].items()}
+    lengths = skeleton.bone_lengths()
+    parents = skeleton.parents
+    rest = skeleton.rest_positions()
+    parts: list[Part] = []
+    neck = _first(skeleton, "neck")
+    head = _first(skeleton, "head")
+    parts += _trunk_parts(skeleton, build, s, neck)
     if neck is not None and head is not None:
         L = float(lengths[head])
         rx, ry, rz = (r * s for r in HEAD_RADII[build])

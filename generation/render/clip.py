@@ -18,10 +18,8 @@ from study_protocol import GENDERS
 from .body import head_top
 from .camera import body_outline, choose_cameras, facing_direction
 from .encode import VideoWriter, write_png_atomic
-from .scene import SCENES, chair_boxes
+from .scene import GROUND_MARGIN_M, SCENES, chair_boxes
 from .settings import RenderSettings
-
-GROUND_MARGIN_M = 25.0  # far enough that the floor edge stays out of view
 
 
 @dataclass(frozen=True)
@@ -77,9 +75,11 @@ def figure_outline(skel, positions: np.ndarray, body: str) -> np.ndarray:
     return body_outline(positions, head_top(skel, positions), 0.06 * s)
 
 
-def build_scene(motion: Motion, positions: np.ndarray, settings: RenderSettings, info: dict | None = None):
-    """The scene and per-frame camera poses for a prepared clip; ``info`` (when given) receives the camera
-    rule and the projected figure height fractions."""
+def plan_cameras(motion: Motion, positions: np.ndarray, settings: RenderSettings) -> tuple[list, dict, tuple]:
+    """Per-frame camera poses of a prepared clip without rendering: (poses, info, (skeleton, ground_y, chair)).
+
+    ``info`` holds the camera rule and the projected figure height fractions (``min_figure_fraction``...), the
+    body look and build, and ``seated``."""
     skel = body_skeleton(motion)
     s = skel.height / 1.75
     ground_y = float(positions[..., 1].min() - 0.03 * s)
@@ -98,12 +98,28 @@ def build_scene(motion: Motion, positions: np.ndarray, settings: RenderSettings,
     outline = figure_outline(skel, positions, settings.body)
     cams, cam_info = choose_cameras(positions, motion.rotations[0, 0], outline, settings.fps, settings.width,
                                     settings.height, settings.camera, seated, extra)
-    scene = SCENES[settings.body](skel, settings.width, settings.height, settings.anti_aliasing, extent, ground_y,
-                                  chair)
+    cam_info.update(body=settings.body, build=skel.build, seated=seated, extent=extent)
+    return cams, cam_info, (skel, ground_y, chair)
+
+
+def anti_aliasing_for(setting: str, cams: list) -> str:
+    """The anti-aliasing a clip gets: ``setting``, or for "auto" FXAA with a fixed camera (patch rendering keeps
+    it to the moving figure) and none with a moving one (FXAA over whole frames costs several frames' time)."""
+    if setting != "auto":
+        return setting
+    return "fxaa" if all(c is cams[0] for c in cams) else "none"
+
+
+def build_scene(motion: Motion, positions: np.ndarray, settings: RenderSettings, info: dict | None = None):
+    """The scene and per-frame camera poses for a prepared clip; ``info`` (when given) receives the camera
+    rule and the projected figure height fractions."""
+    cams, cam_info, (skel, ground_y, chair) = plan_cameras(motion, positions, settings)
+    extent = cam_info.pop("extent")
+    aa = anti_aliasing_for(settings.anti_aliasing, cams)
+    cam_info["anti_aliasing"] = aa
+    scene = SCENES[settings.body](skel, settings.width, settings.height, aa, extent, ground_y, chair)
     if info is not None:
         info.update(cam_info)
-        info["body"] = settings.body
-        info["build"] = skel.build
     return scene, cams
 
 

@@ -26,6 +26,10 @@ GROUND_COLOUR = (0.80, 0.80, 0.79)
 GRID_COLOUR = (0.58, 0.58, 0.58)
 SHADOW_COLOUR = (0.62, 0.62, 0.63)
 GROUND_TILE_M = 0.5
+GROUND_MARGIN_M = 25.0  # the floor reaches this far beyond the root's path: its edge stays out of view
+#: Grid lines reach this far beyond the root's path; the floor beyond is plain. Far grid lines are denser than the
+#: pixels and shimmer (moire) in a moving camera's frames, which also doubles the H.264 bitrate.
+GRID_MARGIN_M = 8.0
 
 
 def _side_colour(name: str) -> tuple[float, float, float]:
@@ -189,6 +193,11 @@ class StickFigureScene:
         plane = pv.Plane(center=((xmin + xmax) / 2, ground_y - 0.002, (zmin + zmax) / 2), direction=(0, 1, 0),
                          i_size=xmax - xmin, j_size=zmax - zmin, i_resolution=1, j_resolution=1)
         self.plotter.add_mesh(plane, color=GROUND_COLOUR, lighting=False)
+        shrink = max(0.0, GROUND_MARGIN_M - GRID_MARGIN_M)
+        xmin, xmax = (np.floor((xmin + shrink) / GROUND_TILE_M) * GROUND_TILE_M,
+                      np.ceil((xmax - shrink) / GROUND_TILE_M) * GROUND_TILE_M)
+        zmin, zmax = (np.floor((zmin + shrink) / GROUND_TILE_M) * GROUND_TILE_M,
+                      np.ceil((zmax - shrink) / GROUND_TILE_M) * GROUND_TILE_M)
         xs = np.arange(xmin, xmax + 1e-6, GROUND_TILE_M)
         zs = np.arange(zmin, zmax + 1e-6, GROUND_TILE_M)
         pts = np.concatenate([
@@ -373,38 +382,75 @@ class StickFigureScene:
         self.plotter.close()
 
 
+#: The mannequin's ground shadow: the floor colour darkened as a 28 % black overlay would, drawn opaque between the
+#: floor and the grid lines (a translucent disc costs a blending pass over the frame in software GL).
+SHADOW_OVERLAY = 0.28
+MANNEQUIN_SHADOW_COLOUR = tuple((1.0 - SHADOW_OVERLAY) * c for c in GROUND_COLOUR)
+
+
 class MannequinScene(StickFigureScene):
     """The default look: a low-poly humanoid mannequin (:mod:`generation.render.body`), matte clay colour,
-    a soft dark translucent ellipse as its ground shadow, on the same floor grid (and chair) as the sticks.
+    a soft dark ellipse as its ground shadow, on the same floor grid (and chair) as the sticks.
 
-    Meshes are built once from the skeleton's bone lengths; each frame sets one rigid transform per part.
+    The part meshes are built once from the skeleton's bone lengths and merged into one mesh (one actor, one
+    draw call); each frame computes one rigid transform per part and rewrites the merged mesh's points and
+    normals in place (no actors or buffers are rebuilt).
     """
 
     def _build_figure(self, pv, s: float) -> None:
         self.parts = mannequin_parts(self.skeleton)
         self.poser = PartPoser(self.skeleton, self.parts)
-        self.part_actors = []
-        for part in self.parts:
-            actor = self.plotter.add_mesh(part_mesh(part), color=MANNEQUIN_COLOUR, smooth_shading=True,
-                                          specular=0.0, diffuse=0.85, ambient=0.22)
-            self.part_actors.append(actor)
+        meshes = [part_mesh(part) for part in self.parts]
+        self._base_points = np.concatenate([np.asarray(m.points, dtype=float) for m in meshes])   # (N, 3)
+        self._base_normals = np.concatenate([np.asarray(m.point_data["Normals"], dtype=float) for m in meshes])
+        self._point_part = np.repeat(np.arange(len(meshes)), [m.n_points for m in meshes])          # (N,)
+        body = pv.merge(meshes, merge_points=False)
+        body.point_data["Normals"] = self._base_normals.copy()  # VTK would share (and we overwrite) the array
+        body.point_data.active_normals_name = "Normals"
+        actor = self.plotter.add_mesh(body, color=MANNEQUIN_COLOUR, smooth_shading=True, specular=0.0, diffuse=0.85,
+                                      ambient=0.22)
+        self.body_mesh = actor.mapper.dataset
+        self.part_actors = [actor]
         disc = pv.Disc(center=(0, 0, 0), inner=0.0, outer=1.0, normal=(0, 1, 0), c_res=32)
-        self.shadow = self.plotter.add_mesh(disc, color=(0.0, 0.0, 0.0), opacity=0.28, lighting=False)
+        self.shadow = self.plotter.add_mesh(disc, color=MANNEQUIN_SHADOW_COLOUR, lighting=False)
         self.shadow_radius = 0.32 * s
         j = self.skeleton.joints
         self._hips = (j.index("left_hip"), j.index("right_hip")) if "left_hip" in j else None
-        # Bounding radius around every joint for patch planning (trunk half-width, head above its joint, hands).
-        self.bone_radius = np.array([0.21 * s])
-        self.joint_radius = np.full(self.skeleton.num_joints, 0.21 * s)
+        # Bounding radius around every joint for patch planning: each mesh point counts for the nearer end of its
+        # part's bone, so the boxes of these spheres hold every part (hands beyond the wrist, the head's top).
+        self.joint_radius = self._joint_radii(meshes) + 0.02 * s
+        self.bone_radius = np.array([0.03 * s])
         self.head = self.neck = None
         self.bones, self.bone_actors, self.joint_actors = [], [], []
+
+    def _joint_radii(self, meshes) -> np.ndarray:
+        """(J,) metres: per joint, the farthest mesh point of the parts on its bones that is nearer to it than to the
+        bone's other end (part frames: joint ``a`` at the origin, ``b`` on +y at the rest distance)."""
+        rest = self.skeleton.rest_positions()
+        radius = np.zeros(self.skeleton.num_joints)
+        for part, mesh in zip(self.parts, meshes):
+            pts = np.asarray(mesh.points)
+            end = np.array([0.0, np.linalg.norm(rest[part.b] - rest[part.a]), 0.0])
+            da, db = np.linalg.norm(pts, axis=1), np.linalg.norm(pts - end, axis=1)
+            near_a = da <= db
+            radius[part.a] = max(radius[part.a], da[near_a].max(initial=0.0))
+            radius[part.b] = max(radius[part.b], db[~near_a].max(initial=0.0))
+        return radius
 
     def figure_actors(self) -> tuple:
         return (*self.part_actors, self.shadow)
 
     def set_pose(self, positions: np.ndarray) -> None:
-        for actor, m in zip(self.part_actors, self.poser.matrices(positions)):
-            actor.user_matrix = m
+        mats = self.poser.matrices(positions)[self._point_part]                     # (N, 4, 4)
+        rot = mats[:, :3, :3]
+        points = np.einsum("nij,nj->ni", rot, self._base_points) + mats[:, :3, 3]
+        normals = np.einsum("nij,nj->ni", rot, self._base_normals)
+        mesh = self.body_mesh
+        mesh.points[:] = points                     # in place: the mapper re-uploads the same buffers
+        mesh.point_data["Normals"][:] = normals
+        mesh.GetPoints().Modified()
+        mesh.GetPointData().GetNormals().Modified()
+        mesh.Modified()
         root = positions[0]
         side = positions[self._hips[0]] - positions[self._hips[1]] if self._hips else np.array([1.0, 0, 0])
         side = np.array([side[0], 0.0, side[2]])
@@ -413,7 +459,7 @@ class MannequinScene(StickFigureScene):
         rs = self.shadow_radius
         m = np.eye(4)
         m[:3, 0], m[:3, 2] = side * rs, fwd * rs * 0.72
-        m[:3, 3] = (root[0], self.ground_y + 0.002, root[2])
+        m[:3, 3] = (root[0], self.ground_y - 0.001, root[2])   # above the floor, under the grid lines
         self.shadow.user_matrix = m
 
 

@@ -1,9 +1,12 @@
 """Render a stimulus plan into clips, write <MEDIA_ROOT>/clips.csv and the Clip rows.
 
     python manage.py generate_clips --plan demo [--workers 2] [--webm] [--limit K] [--contact-sheet [PNG]]
+                                   [--scheduler tcp://HOST:PORT]
 
 Thin wrapper over :mod:`generation.render.batch`: the plan is validated before anything renders, clips whose
-files are complete are skipped (resumable), files are written under temporary names and renamed.
+files are complete are skipped (resumable), files are written under temporary names and renamed. Every clip gets
+a quality record (generation.quality); the command ends with a summary of clips per flag. With ``--scheduler``
+the clips render on a Dask distributed cluster whose workers share this media folder.
 """
 from __future__ import annotations
 
@@ -29,6 +32,12 @@ class Command(BaseCommand):
                             help="per-clip records (default <MEDIA_ROOT>/clip_records)")
         parser.add_argument("--no-db", action="store_true", help="do not write Clip rows (files and clips.csv only)")
         parser.add_argument("--no-progress", action="store_true", help="no progress bars")
+        parser.add_argument("--device", default="cpu",
+                            help="torch device of the network generators (gait_net, gesture_net): auto, cpu, cuda or "
+                                 "cuda:N (default cpu: the same stimuli as on a machine without a GPU)")
+        parser.add_argument("--scheduler", default=None, metavar="tcp://HOST:PORT",
+                            help="render on a Dask distributed cluster (its workers must share MEDIA_ROOT) instead "
+                                 "of local worker processes")
 
     def handle(self, *args, **opts):
         from generation.plans.catalogue import write_clips_csv
@@ -44,13 +53,23 @@ class Command(BaseCommand):
         except PlanError as exc:
             raise CommandError(str(exc)) from None
         os.environ.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow")
+        from generation.core.device import resolve_device
+        from generation.plans.clipgen import DEVICE_ENV
+
+        try:
+            os.environ[DEVICE_ENV] = str(resolve_device(opts["device"]))  # inherited by the render workers
+        except ValueError as exc:
+            raise CommandError(f"--device: {exc}") from None
         media_root = Path(settings.MEDIA_ROOT)
         clips_dir = media_root / "clips"
         records_dir = Path(opts["records_dir"]) if opts["records_dir"] else media_root / "clip_records"
         bars = _Bars(self.stdout, disabled=opts["no_progress"])
         try:
             result = run_plan(plan, clips_dir, records_dir, media_prefix="clips/", workers=opts["workers"],
-                              webm=opts["webm"], limit=opts["limit"], on_event=bars.event)
+                              webm=opts["webm"], limit=opts["limit"], on_event=bars.event,
+                              scheduler=opts["scheduler"])
+        except OSError as exc:  # e.g. no Dask scheduler at that address
+            raise CommandError(f"cannot render: {exc}") from None
         finally:
             bars.close()
         for _where, msg in result.failed:
@@ -74,6 +93,10 @@ class Command(BaseCommand):
                                   "answers, left out of new assignments)")
         self.stdout.write(f"plan {plan.name}: {len(result.rendered)} rendered, {len(result.skipped)} already done, "
                           f"{len(result.failed)} failed, {result.seconds:.1f} s; catalogue {csv_path}")
+        if records:
+            from generation.quality.plan_qa import summary_line
+
+            self.stdout.write(f"plan {plan.name}: " + summary_line(r.get("qa_flag", "") for r in records))
         if opts["contact_sheet"] is not None and records:
             from generation.render import contact_sheet
             from studyapp.catalogue import clip_label

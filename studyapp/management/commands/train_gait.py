@@ -1,7 +1,10 @@
-"""``manage.py train_gait``: train the seed 000 gait network (thin wrapper over generation.gait.train)."""
+"""``manage.py train_gait``: train the seed 000 gait network (thin wrapper over generation.gait.train).
+
+    python manage.py train_gait [--config small|paper] [--device auto|cpu|cuda[:N]] [--amp] [--resume] ...
+"""
 from __future__ import annotations
 
-from django.core.management.base import BaseCommand
+from django.core.management.base import BaseCommand, CommandError
 
 from generation.gait.train import build_parser, run
 from studyapp.management.cli import mirror_arguments, mirrored_namespace
@@ -9,7 +12,7 @@ from studyapp.management.cli import mirror_arguments, mirrored_namespace
 
 class Command(BaseCommand):
     help = ("Train the seed 000 emotive gait network on the synthetic gait corpus; the same options as "
-            "`python -m generation.gait.train`.")
+            "`python -m generation.gait.train` (--config small|paper, --device auto|cpu|cuda[:N], --amp).")
 
     def add_arguments(self, parser):
         mirror_arguments(parser, build_parser())
@@ -18,4 +21,7 @@ class Command(BaseCommand):
         ns = mirrored_namespace(build_parser(), options)
         if ns.set is None:
             ns.set = []
-        run(ns, log=lambda msg: self.stdout.write(msg))
+        try:
+            run(ns, log=lambda msg: self.stdout.write(msg))
+        except SystemExit as exc:   # the library reports bad options (--device, --config, --set) this way
+            raise CommandError(str(exc)) from None

@@ -1,7 +1,11 @@
-"""``manage.py train_gesture``: train the Text2Gestures network (thin wrapper over generation.gesture.train)."""
+"""``manage.py train_gesture``: train the Text2Gestures network (thin wrapper over generation.gesture.train).
+
+Same options as ``python -m generation.gesture.train``, including ``--config small|paper``,
+``--device auto|cpu|cuda[:N]`` and ``--amp``.
+"""
 from __future__ import annotations
 
-from django.core.management.base import BaseCommand
+from django.core.management.base import BaseCommand, CommandError
 
 from generation.gesture.train import build_parser, config_from_args, train
 from studyapp.management.cli import mirror_arguments, mirrored_namespace
@@ -9,13 +13,29 @@ from studyapp.management.cli import mirror_arguments, mirrored_namespace
 
 class Command(BaseCommand):
     help = ("Train the seed 003 gesture network on the synthetic sentence/procedural-gesture corpus; "
-            "the same options as `python -m generation.gesture.train`.")
+            "the same options as `python -m generation.gesture.train` (--config small|paper, "
+            "--device auto|cpu|cuda[:N], --amp).")
 
     def add_arguments(self, parser):
         mirror_arguments(parser, build_parser())
+        parser.add_argument("--corpus", help="train on an imported gesture corpus (python -m generation.mocap corpus "
+                                             "--skeleton gesture) instead of the synthetic one")
 
     def handle(self, *args, **options):
         ns = mirrored_namespace(build_parser(), options)
-        summary = train(config_from_args(ns), progress=not ns.quiet)
-        self.stdout.write(f"trained {summary['epochs_run']} epochs in {summary['seconds']:.0f} s; best val loss "
-                          f"{summary['best_val']:.5f}; weights -> {summary['out']}")
+        try:
+            cfg = config_from_args(ns)
+        except ValueError as exc:  # unknown preset, unavailable device
+            raise CommandError(str(exc)) from exc
+        data = None
+        if options.get("corpus"):
+            from generation.mocap.gesture_corpus import load_gesture_corpus
+
+            try:
+                data = load_gesture_corpus(options["corpus"], seed=cfg.seed)
+            except ValueError as exc:
+                raise CommandError(str(exc)) from exc
+        summary = train(cfg, data=data, progress=not ns.quiet)
+        self.stdout.write(f"trained {summary['epochs_run']} epochs in {summary['seconds']:.0f} s on "
+                          f"{summary['device']}; best selection score {summary['best_val']:.5f}; "
+                          f"weights -> {summary['out']}")

@@ -1,0 +1,196 @@
+"""Benchmark of the participant flow (issue 16): SQL statements per answered clip, and concurrent starts.
+
+    DATA_DIR=$(mktemp -d) .venv/bin/python benchmarks/flow_answer_and_start.py [--starts 200] [--threads 16]
+        [--out docs/benchmarks/flow.md]
+
+Runs on a fresh SQLite file database under DATA_DIR (WAL, the app's default), with the SYNTHETIC test catalogue
+(studyapp.testing.make_catalogue: placeholder clips, not rendered motion) and the "demo" preset study.
+1. Answer cost: SQL statements of one answered clip (GET the clip page + POST the answer, Django test client),
+   with 10 and with 2,000 participants in the study (the 2,000 bulk-inserted with full assignment sets), and
+   the number of HTTP round trips from one answer to the next clip page.
+2. Starts: ``--starts`` participants start from ``--threads`` threads at once (start_participant, the work of
+   the /resume page that starts them); wall time, per-start latency, and the per-clip spread of each section.
+Works on the code before issue 16 too (no Assignment.seq): run it from an older checkout for "before" figures.
+"""
+from __future__ import annotations
+
+import argparse
+import os
+import statistics
+import sys
+import tempfile
+import threading
+import time
+from collections import Counter
+from concurrent.futures import ThreadPoolExecutor
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def setup_django(data_dir: str) -> None:
+    os.environ["DATA_DIR"] = data_dir
+    os.environ.pop("DATABASE_URL", None)
+    os.environ.setdefault("DJANGO_SETTINGS_MODULE", "studyapp.settings")
+    sys.path.insert(0, os.getcwd())
+    import django
+    from django.core.management import call_command
+    from django.test.utils import setup_test_environment
+
+    django.setup()
+    setup_test_environment()
+    call_command("migrate", verbosity=0)
+
+
+def make_study():
+    from django.conf import settings
+
+    from studyapp.models import Study
+    from studyapp.presets import create_study_from_preset
+    from studyapp.testing import make_catalogue
+
+    make_catalogue(Path(settings.MEDIA_ROOT))
+    study = create_study_from_preset("demo", f"bench-{int(time.time() * 1000)}", plan="test",
+                                     status=Study.Status.OPEN)
+    study.sections.update(require_full_play=False)
+    return study
+
+
+def add_crowd(study, n: int) -> None:
+    """n - 1 started participants with the assignments of one real start, bulk-inserted."""
+    from studyapp.assignment import start_participant
+    from studyapp.models import Assignment, Participant
+
+    template = Participant.objects.create(study=study, demographics_done=True)
+    start_participant(template)
+    fields = [f for f in ("section_id", "position", "clip_id", "options", "seq", "kind", "instructed")
+              if hasattr(Assignment, f.removesuffix("_id")) or f.endswith("_id")]
+    rows = list(template.assignments.values(*fields))
+    offset = Participant.objects.count()
+    extra = {"n_items": len(rows)} if hasattr(Participant, "n_items") else {}
+    people = Participant.objects.bulk_create([
+        Participant(study=study, demographics_done=True, status=Participant.Status.STARTED, token=f"crowd-{i}",
+                    public_id=f"c{i}", **extra) for i in range(offset, offset + n - 1)], batch_size=500)
+    Assignment.objects.bulk_create([Assignment(participant=p, **r) for p in people for r in rows], batch_size=5000)
+
+
+def answer_cost(study, n_clips: int = 3) -> dict:
+    """Statements and round trips of answering n_clips clips of a fresh participant (mean per clip)."""
+    from django.db import connection
+    from django.test import Client
+    from django.test.utils import CaptureQueriesContext
+    from django.urls import reverse
+
+    from studyapp.assignment import current_step
+    from studyapp.models import Participant
+    from studyapp.questions import questions_for
+
+    client = Client()
+    r = client.post(reverse("studyapp:study_entry", args=[study.slug]), {"consent": "on"})
+    p = Participant.objects.get(token=r["Location"].rstrip("/").split("/")[-1])
+    client.post(reverse("studyapp:demographics", args=[p.token]), {"gender": "female", "age_group": "25-34"})
+    url = client.get(reverse("studyapp:resume", args=[p.token]))["Location"]
+    statements, commits, trips = [], [], []
+    for _ in range(n_clips):
+        step = current_step(Participant.objects.select_related("study").get(pk=p.pk))
+        a = step.assignment
+        data = {q.key: q.choices[0][0] for q in questions_for(a.section.section_type, a.section.options,
+                                                              a.clip.theme, a.options)}
+        with CaptureQueriesContext(connection) as q:
+            assert client.get(url).status_code == 200
+            r = client.post(url, data)
+            hops = 1
+            while "/clip/" not in r["Location"]:
+                r = client.get(r["Location"])
+                hops += 1
+            url = r["Location"]
+        sql = [x["sql"].upper() for x in q.captured_queries]
+        statements.append(len(sql))
+        commits.append(sum(s.startswith(("BEGIN", "SAVEPOINT")) for s in sql))
+        trips.append(1 + hops)
+    return {"statements": statistics.mean(statements), "transactions": statistics.mean(commits),
+            "requests": statistics.mean(trips)}
+
+
+def concurrent_starts(study, n: int, threads: int) -> dict:
+    from django.db import connection
+
+    from studyapp.assignment import start_participant
+    from studyapp.models import Assignment, Participant
+
+    people = [Participant.objects.create(study=study, demographics_done=True) for _ in range(n)]
+    gate = threading.Event()
+    latencies, failures = [], []
+
+    def one(p):
+        gate.wait()
+        t = time.perf_counter()
+        try:
+            start_participant(p)
+            latencies.append(time.perf_counter() - t)
+        except Exception as exc:  # noqa: BLE001 - counted and reported
+            failures.append(repr(exc))
+        finally:
+            connection.close()
+
+    with ThreadPoolExecutor(threads) as pool:
+        futures = [pool.submit(one, p) for p in people]
+        t0 = time.perf_counter()
+        gate.set()
+        for f in futures:
+            f.result()
+        wall = time.perf_counter() - t0
+    spreads = {}
+    for section in study.sections.filter(reuse_section__isnull=True).order_by("order"):
+        rows = Assignment.objects.filter(section=section, participant__in=people)
+        if hasattr(Assignment, "kind"):
+            rows = rows.filter(kind="")
+        worst = 0
+        for origin in set(rows.values_list("clip__origin", flat=True)):
+            c = Counter(rows.filter(clip__origin=origin).values_list("clip_id", flat=True))
+            worst = max(worst, max(c.values()) - min(c.values()))
+        spreads[f"{section.order} {section.section_type}"] = worst
+    lat = sorted(latencies)
+    return {"started": len(latencies), "failed": len(failures), "wall_s": wall,
+            "p50_ms": 1000 * lat[len(lat) // 2] if lat else float("nan"),
+            "p95_ms": 1000 * lat[int(len(lat) * 0.95) - 1] if lat else float("nan"), "spread": spreads,
+            "errors": Counter(failures).most_common(3)}
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--starts", type=int, default=200)
+    ap.add_argument("--threads", type=int, default=16)
+    ap.add_argument("--out", default="")
+    args = ap.parse_args(argv)
+    setup_django(os.environ.get("DATA_DIR") or tempfile.mkdtemp(prefix="flow-bench-"))
+    study = make_study()
+    add_crowd(study, 10)
+    small = answer_cost(study)
+    add_crowd(study, 2000)
+    large = answer_cost(study)
+    starts = concurrent_starts(make_study(), args.starts, args.threads)
+    lines = ["# Participant flow: answer cost and concurrent starts", "",
+             "Machine: 2-core CI VM, no GPU, shared with parallel jobs; date 2026-12-01. SQLite file database (WAL), "
+             "SYNTHETIC placeholder catalogue, demo preset. `benchmarks/flow_answer_and_start.py`.", "",
+             "| participants in study | SQL statements per answered clip (GET + POST) | transactions | "
+             "HTTP requests per answer |", "|---|---|---|---|",
+             f"| 10 | {small['statements']:.1f} | {small['transactions']:.1f} | {small['requests']:.0f} |",
+             f"| 2,000 | {large['statements']:.1f} | {large['transactions']:.1f} | {large['requests']:.0f} |", "",
+             f"Concurrent starts: {starts['started']} of {args.starts} started ({starts['failed']} failed) from "
+             f"{args.threads} threads in {starts['wall_s']:.2f} s; per start p50 {starts['p50_ms']:.0f} ms, "
+             f"p95 {starts['p95_ms']:.0f} ms.", "",
+             "Per-clip spread (most - least given clip; naturalness per origin half): "
+             + ", ".join(f"{k}: {v}" for k, v in starts["spread"].items()) + "."]
+    if starts["errors"]:
+        lines += ["", f"Errors: {starts['errors']}"]
+    text = "\n".join(lines) + "\n"
+    print(text)
+    if args.out:
+        Path(args.out).parent.mkdir(parents=True, exist_ok=True)
+        Path(args.out).write_text(text, encoding="utf-8")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

@@ -1,0 +1,137 @@
+"""Quality checks of one clip against thresholds: the record that goes into clips.csv (``qa_*`` columns), the
+Clip row (``qa``, ``qa_flag``) and the render record (``record["qa"]``).
+
+Checks (names in :data:`study_protocol.QA_CHECKS`), each against :data:`study_protocol.QA_THRESHOLDS` or a plan's
+``qa:`` overrides (a threshold set to null switches its check off):
+
+- ``foot_skate``: mean foot slide in contact > ``foot_skate_cm_s``;
+- ``penetration``: a foot joint deeper than ``penetration_cm`` below the floor;
+- ``jerk``: mean joint jerk > ``jerk`` m/s^3;
+- ``bone_error``: a bone length off by more than ``bone_error_mm``;
+- ``figure_height``: smallest projected figure height / frame height < ``figure_height_frac_walk`` (or
+  ``..._seated``), when the render's camera is known;
+- ``observer``: a gait with a dominant intended emotion (a share of at least 0.5) that the synthetic observer
+  reads as another emotion with probability >= ``observer_mismatch_p``.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from generation.core.motion import Motion
+from study_protocol import GAIT_EMOTIONS, QA_CHECKS, QA_COLUMNS, QA_THRESHOLDS
+
+from .metrics import motion_metrics
+
+GAIT_JOINTS = 21  # the observer reads the 21-joint gait skeleton's affective features
+DOMINANT_SHARE = 0.5
+
+
+class QAThresholdError(ValueError):
+    """A ``qa:`` block that cannot be used; the message names the key."""
+
+
+@dataclass
+class QAResult:
+    """The quality record of one clip: ``values`` (keys of the qa_ columns without the prefix; None = not
+    measured) and ``flags`` (failed checks, in QA_CHECKS order)."""
+
+    values: dict = field(default_factory=dict)
+    flags: list[str] = field(default_factory=list)
+
+    @property
+    def flag(self) -> str:
+        return ";".join(self.flags)
+
+    def as_dict(self) -> dict:
+        """JSON-safe record: the values plus ``flag``."""
+        return {**self.values, "flag": self.flag}
+
+    @classmethod
+    def from_dict(cls, qa: dict) -> QAResult:
+        values = {k: v for k, v in qa.items() if k != "flag"}
+        flag = qa.get("flag") or ""
+        return cls(values, [f for f in flag.split(";") if f])
+
+
+def resolve_thresholds(plan_qa: dict | None = None) -> dict:
+    """QA_THRESHOLDS overridden by a plan's ``qa:`` block; unknown keys and non-numbers raise QAThresholdError."""
+    out = dict(QA_THRESHOLDS)
+    if plan_qa is None:
+        return out
+    if not isinstance(plan_qa, dict):
+        raise QAThresholdError(f"field 'qa': expected a mapping of thresholds, got {plan_qa!r}")
+    for key, value in plan_qa.items():
+        if key not in QA_THRESHOLDS:
+            raise QAThresholdError(f"field 'qa.{key}': unknown threshold; expected one of {sorted(QA_THRESHOLDS)}")
+        if value is not None and (isinstance(value, bool) or not isinstance(value, (int, float))
+                                  or not math.isfinite(value) or value < 0):
+            raise QAThresholdError(f"field 'qa.{key}': expected a number >= 0 or null (check off), got {value!r}")
+        out[key] = None if value is None else float(value)
+    return out
+
+
+def _dominant(intended) -> str | None:
+    """The intended emotion with a share >= DOMINANT_SHARE of a gait emotion vector, or None."""
+    if intended is None:
+        return None
+    vec = np.asarray(intended, dtype=float)
+    if vec.shape != (len(GAIT_EMOTIONS),) or not np.isfinite(vec).all() or vec.sum() <= 0:
+        return None
+    vec = vec / vec.sum()
+    k = int(np.argmax(vec))
+    return GAIT_EMOTIONS[k] if vec[k] >= DOMINANT_SHARE else None
+
+
+def _over(value, limit) -> bool:
+    return limit is not None and value is not None and value > limit
+
+
+def evaluate(motion: Motion, thresholds: dict | None = None, figure_height_frac: float | None = None,
+             seated: bool = False, intended=None, observer=None) -> QAResult:
+    """Measure ``motion`` and check it.
+
+    Args:
+        motion: the clip's motion as rendered (after resampling and cutting), metres, floor at y = 0.
+        thresholds: from :func:`resolve_thresholds` (default: QA_THRESHOLDS).
+        figure_height_frac: smallest projected figure height / frame height over the frames (None: not checked).
+        seated: the clip shows a seated body (the seated figure-height threshold applies).
+        intended: the gait emotion vector (GAIT_EMOTIONS order) the clip should show, or None.
+        observer: a :class:`generation.quality.observer.GaitObserver` (None: no observer reading).
+    """
+    values = {k: round(v, 4) for k, v in motion_metrics(motion).items()}
+    values["figure_height_frac"] = None if figure_height_frac is None else round(float(figure_height_frac), 4)
+    values["observed"], values["observed_p"] = None, None
+    if observer is not None and motion.skeleton.num_joints == GAIT_JOINTS and motion.num_frames >= 2:
+        label, p = observer.observe(motion)
+        values["observed"], values["observed_p"] = label, round(p, 4)
+    values["seated"] = bool(seated)
+    return QAResult(values, failed_checks(values, thresholds, intended))
+
+
+def failed_checks(values: dict, thresholds: dict | None = None, intended=None) -> list[str]:
+    """The checks (QA_CHECKS order) that measured ``values`` (as in :attr:`QAResult.values`) fail; also used to
+    re-check a stored record against a plan's changed thresholds without measuring again."""
+    th = resolve_thresholds(None) if thresholds is None else thresholds
+    failed = {
+        "foot_skate": _over(values.get("foot_skate_cm_s"), th["foot_skate_cm_s"]),
+        "penetration": _over(values.get("penetration_cm"), th["penetration_cm"]),
+        "jerk": _over(values.get("jerk"), th["jerk"]),
+        "bone_error": _over(values.get("bone_error_mm"), th["bone_error_mm"]),
+    }
+    need = th["figure_height_frac_seated" if values.get("seated") else "figure_height_frac_walk"]
+    frac = values.get("figure_height_frac")
+    failed["figure_height"] = need is not None and frac is not None and frac < need
+    dominant = _dominant(intended)
+    observed, p = values.get("observed"), values.get("observed_p")
+    failed["observer"] = (th["observer_mismatch_p"] is not None and dominant is not None and observed is not None
+                          and p is not None and observed != dominant and p >= th["observer_mismatch_p"])
+    return [c for c in QA_CHECKS if failed[c]]
+
+
+def qa_columns(qa: dict | None) -> dict:
+    """The qa_ columns of clips.csv from a record's ``qa`` dict (as :meth:`QAResult.as_dict`); blanks when absent."""
+    qa = qa or {}
+    return {col: qa.get(col.removeprefix("qa_")) for col in QA_COLUMNS}

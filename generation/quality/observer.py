@@ -1,0 +1,114 @@
+"""A synthetic observer of gait emotion: logistic regression on the 18 gait affective features averaged over
+time, trained on the synthetic gait corpus's training split (moved here from benchmarks/bench_gait.py, which
+imports it). It stands in for a participant when checking clips; it is not a human judgement.
+
+``default_observer()`` trains it once per corpus version and keeps the fitted model in
+``var/quality/gait_observer_<corpus sha256[:12]>.pkl`` (and in memory per process).
+"""
+from __future__ import annotations
+
+import pickle
+from pathlib import Path
+
+import numpy as np
+
+from generation.core.features import np_gait_affective_features
+from generation.core.motion import Motion
+from study_protocol import GAIT_EMOTIONS
+
+REPO_ROOT = Path(__file__).resolve().parents[2]
+CACHE_DIR = REPO_ROOT / "var" / "quality"
+FEATURE_CLIP = 10.0
+_DEFAULT: dict[str, GaitObserver] = {}
+
+
+class GaitObserver:
+    """Logistic regression on the 18 affective features averaged over time (synthetic observer).
+
+    Args:
+        train: a :class:`generation.gait.data.GaitSequences` (``aff`` (N, T, 18) features, ``emotion`` (N, 4)).
+    Labels are GAIT_EMOTIONS indices (the argmax of each training sequence's emotion vector).
+    """
+
+    labels = GAIT_EMOTIONS
+
+    def __init__(self, train):
+        from sklearn.linear_model import LogisticRegression
+        from sklearn.pipeline import make_pipeline
+        from sklearn.preprocessing import StandardScaler
+        X = self.summarise_seq(train.aff.numpy())
+        y = train.emotion.numpy().argmax(1)
+        self.clf = make_pipeline(StandardScaler(), LogisticRegression(max_iter=2000, C=1.0)).fit(X, y)
+
+    @staticmethod
+    def summarise_seq(aff: np.ndarray) -> np.ndarray:
+        """(..., T, 18) features -> (..., 18) clipped time means."""
+        a = np.clip(aff, -FEATURE_CLIP, FEATURE_CLIP)
+        return a.mean(-2)
+
+    def features(self, motions: list[Motion], frames: slice = slice(None)) -> np.ndarray:
+        """(N, 18) time-mean affective features of 21-joint gait motions."""
+        return np.clip(np.stack([np_gait_affective_features(m.positions()[frames]).mean(0) for m in motions]),
+                       -FEATURE_CLIP, FEATURE_CLIP)
+
+    def predict_motions(self, motions: list[Motion], frames: slice = slice(None)) -> np.ndarray:
+        """(N,) GAIT_EMOTIONS indices."""
+        return self.clf.predict(self.features(motions, frames))
+
+    def proba_motions(self, motions: list[Motion], frames: slice = slice(None)) -> np.ndarray:
+        """(N, 4) probabilities in GAIT_EMOTIONS order."""
+        return self.clf.predict_proba(self.features(motions, frames))
+
+    def observe(self, motion: Motion) -> tuple[str, float]:
+        """(top label, its probability) for one gait motion."""
+        p = self.proba_motions([motion])[0]
+        k = int(np.argmax(p))
+        return self.labels[int(self.clf.classes_[k])], float(p[k])
+
+
+def _corpus_path(path: str | Path | None) -> Path:
+    from generation.gait.data import DEFAULT_CORPUS
+
+    p = Path(path) if path is not None else DEFAULT_CORPUS
+    return p if p.is_absolute() else REPO_ROOT / p
+
+
+def train_observer(corpus_path: str | Path | None = None) -> GaitObserver:
+    """A GaitObserver fitted on the training split (offset 0) of the gait corpus (built when missing)."""
+    from generation.gait.data import load_corpus_sequences
+
+    data = load_corpus_sequences(_corpus_path(corpus_path))
+    train = data.subset((data.split == "train") & (data.offset == 0))
+    obs = GaitObserver(train)
+    obs.corpus_sha256 = data.source["sha256"]
+    return obs
+
+
+def default_observer(corpus_path: str | Path | None = None) -> GaitObserver | None:
+    """The observer of the current corpus: from memory, from the cache file, or trained (and cached); None when
+    the gait corpus file does not exist (build it with the gait training; clips then get no observer reading)."""
+    from generation.gait.data import file_sha256
+
+    path = _corpus_path(corpus_path)
+    if not path.is_file():
+        return None
+    st = path.stat()
+    key = f"{path}:{st.st_mtime_ns}:{st.st_size}"   # hash the corpus once per process and version
+    if key in _DEFAULT:
+        return _DEFAULT[key]
+    sha = file_sha256(path)
+    cache = CACHE_DIR / f"gait_observer_{sha[:12]}.pkl"
+    obs = None
+    if cache.is_file():
+        try:
+            obs = pickle.loads(cache.read_bytes())
+        except Exception:  # noqa: BLE001 - a stale or foreign pickle: retrain
+            obs = None
+    if obs is None:
+        obs = train_observer(path)
+        CACHE_DIR.mkdir(parents=True, exist_ok=True)
+        tmp = cache.with_name(f".{cache.name}.tmp")
+        tmp.write_bytes(pickle.dumps(obs))
+        tmp.replace(cache)
+    _DEFAULT[key] = obs
+    return obs

@@ -1,0 +1,113 @@
+"""Quality records of a plan's clips without rendering video (the motion part, the projected figure height and the
+observer), and the per-flag summary that ``generate_clips`` prints.
+
+    python -m generation.quality.plan_qa --plan seed000 [--limit K] [--json out.json]
+
+The video render computes the same record for every clip it makes (:func:`generation.render.batch.render_job`).
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+import time
+from collections import Counter
+from collections.abc import Iterable
+
+from generation.core.motion import Motion
+from study_protocol import QA_CHECKS
+
+from .checks import QAResult, evaluate
+
+PASSED = "passed"
+
+
+def intended_emotion(inputs: dict):
+    """The gait emotion vector an entry asks for (None for transitions, themes, gestures and source walks)."""
+    return inputs.get("emotion")
+
+
+def clip_qa(motion: Motion, settings, thresholds: dict, intended=None, observer=None,
+            camera_info: dict | None = None) -> tuple[QAResult, dict]:
+    """The quality record of ``motion`` as the renderer shows it (resampled to ``settings.fps`` and cut to its
+    duration); the figure height comes from ``camera_info`` (a render's) or is projected here without rendering.
+    Returns (result, camera info)."""
+    from generation.render.clip import plan_cameras, prepare
+
+    clip, positions = prepare(motion, settings)
+    if camera_info is None:
+        _, camera_info, _ = plan_cameras(clip, positions, settings)
+        camera_info.pop("extent", None)
+    seated = bool(camera_info.get("seated", False))
+    result = evaluate(clip, thresholds, camera_info.get("min_figure_fraction"), seated, intended, observer)
+    return result, camera_info
+
+
+def needs_observer(entries: Iterable) -> bool:
+    return any(e.modality == "gait" for e in entries)
+
+
+def summary_counts(flags: Iterable[str]) -> Counter:
+    """Clips per flag: ``passed`` for an empty flag, else one count per failed check (a clip failing two checks
+    counts under both), plus ``flagged`` (clips with any flag)."""
+    counts: Counter = Counter()
+    for flag in flags:
+        if not flag:
+            counts[PASSED] += 1
+            continue
+        counts["flagged"] += 1
+        for check in flag.split(";"):
+            counts[check] += 1
+    return counts
+
+
+def summary_line(flags: Iterable[str]) -> str:
+    """'QA: 40 passed, 3 flagged (foot_skate 2, penetration 1)'."""
+    c = summary_counts(list(flags))
+    per = ", ".join(f"{k} {c[k]}" for k in QA_CHECKS if c[k])
+    return f"QA: {c[PASSED]} passed, {c['flagged']} flagged" + (f" ({per})" if per else "")
+
+
+def run(plan_name: str, limit: int | None = None, log=print) -> list[dict]:
+    """Make every entry's motion and compute its quality record (no video). Returns one row per entry."""
+    from generation.plans.clipgen import make_motion
+    from generation.plans.schema import load_plan
+    from generation.render.batch import plan_jobs
+
+    from .checks import resolve_thresholds
+    from .observer import default_observer
+
+    plan = load_plan(plan_name)
+    thresholds = resolve_thresholds(plan.qa)
+    jobs, failures = plan_jobs(plan, limit)
+    observer = default_observer() if needs_observer(j.run_entry for j in jobs) else None
+    rows = []
+    for job in jobs:
+        t0 = time.perf_counter()
+        motion = make_motion(job.run_entry, requested=job.entry.generator, fallback_reason=job.fallback_reason)
+        obs = observer if job.run_entry.modality == "gait" else None
+        result, cam = clip_qa(motion, job.run_entry.render, thresholds, intended_emotion(job.run_entry.inputs), obs)
+        rows.append({"entry": job.entry.id, "clip_id": job.clip_id, "generator": job.run_entry.generator,
+                     "camera": cam.get("rule"), **result.as_dict(), "seconds": round(time.perf_counter() - t0, 2)})
+        log(json.dumps(rows[-1]))
+    for where, msg in failures:
+        log(f"FAILED {where}: {msg}")
+    return rows
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--plan", required=True)
+    ap.add_argument("--limit", type=int, default=None)
+    ap.add_argument("--json", default=None)
+    args = ap.parse_args(argv)
+    rows = run(args.plan, args.limit)
+    print(f"plan {args.plan}: {len(rows)} clips; " + summary_line(r["flag"] for r in rows))
+    if args.json:
+        with open(args.json, "w", encoding="utf-8") as f:
+            json.dump(rows, f, indent=1)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,148 @@
+"""Study presets as plain data: one per paper's web study, and a demo with every section type. No Django.
+
+``studyapp.presets`` turns a preset into Study + Section rows (the researcher then edits them in the admin); the
+synthetic-study simulator (``analysis.design``) reads the same sections to simulate a study of that preset. Each
+section: ``section_type``, ``title``, ``instructions``, ``pool`` (catalogue filters, see ``studyapp.pools``),
+``clips_per_participant`` (0 = every clip of the pool), ``options`` (type-specific), or ``reuse`` (the index of an
+earlier section of the same preset whose clips it shows again).
+"""
+from __future__ import annotations
+
+from study_protocol import NEUTRAL_THEME
+
+# Seed 000 section 6.3.4 anchors and seed 003 Table 2 markers (1..5), verbatim. studyapp.questions marks the same
+# strings for translation (a test keeps the two equal); the study pages show them in the participant's language.
+NATURALNESS_ANCHORS_GAIT = {"1": "not natural at all", "3": "satisfactory", "5": "very natural"}
+NATURALNESS_ANCHORS_GESTURE = {
+    "1": "Very Unnatural (e.g. broken arms or legs, torso at an impossible angle)",
+    "2": "Not Realistic (e.g. limbs going inside the body or through the chair)",
+    "3": "Looks OK (no serious problems, but does not look very appealing)",
+    "4": "Looks good (no problems and the gestures look natural)",
+    "5": "Looks great! (the gestures look like they could be from a real person)",
+}
+
+CONSENT = (
+    "You are invited to take part in a research study on how people perceive the body motion of animated virtual "
+    "characters. You will watch short silent clips of a virtual character and answer a few questions about each. "
+    "Taking part is voluntary; you may stop at any time by closing the page. We record your answers, the time you "
+    "take to answer, your gender and age group; no name, e-mail or other identifying information is collected. "
+    "The anonymous answers will be analysed and may be published."
+)
+
+GAIT_GENERATED = {"modality": "gait", "origin": "generated", "transition": False, "rbf": False}
+GAIT_TRANSITION = {"modality": "gait", "origin": "generated", "transition": True}
+
+PRESETS: dict[str, dict] = {
+    "gait_ismar2020": {
+        "title": "Emotive gaits (ISMAR 2020 study)",
+        "introduction": "The study has three sections and takes about ten minutes. Each clip shows a virtual "
+                        "character walking.",
+        "feedback_questions": [
+            {"key": "distracted_camera", "text": "Were you distracted by the camera during the study?",
+             "kind": "yesno"},
+            {"key": "comments", "text": "Any other comments (optional)?", "kind": "text"},
+        ],
+        "sections": [
+            {"section_type": "emotion_choice", "title": "Section 1: perceived emotion",
+             "instructions": "Watch each walk and report the emotion(s) you perceive. You can choose more than one: "
+                             "for example, a walk that looks a little happy but mostly neutral can be marked both "
+                             "happy and neutral.",
+             "pool": GAIT_GENERATED, "clips_per_participant": 8},
+            {"section_type": "emotion_transition", "title": "Section 2: emotion transitions",
+             "instructions": "In these walks the emotion changes during the clip. Report the emotion(s) you perceive "
+                             "at the start and at the end.",
+             "pool": GAIT_TRANSITION, "clips_per_participant": 6},
+            {"section_type": "affect_likert", "title": "Section 3: posture and movement",
+             "instructions": "You will see the walks of section 1 again. Rate the torso, the arms, the pace and the "
+                             "flow of each walk.",
+             "reuse": 0},
+            {"section_type": "naturalness", "title": "Naturalness",
+             "instructions": "Rate how natural and smooth each animation looks, from 1 (not natural at all) through "
+                             "3 (satisfactory) to 5 (very natural).",
+             "pool": {"modality": "gait", "transition": False, "rbf": False}, "clips_per_participant": 4,
+             "options": {"anchors": NATURALNESS_ANCHORS_GAIT, "n_generated": 2, "n_source": 2}},
+        ],
+    },
+    "gestures_ieeevr2021": {
+        "title": "Emotive gestures (IEEE VR 2021 study)",
+        "introduction": "The study has two sections and takes about ten minutes. Each clip shows a virtual character "
+                        "sitting on a chair and gesturing.",
+        "feedback_questions": [
+            {"key": "distracted_no_face", "text": "Were you distracted by the lack of facial expressions?",
+             "kind": "yesno"},
+            {"key": "unable_gestures_only", "text": "Were you unable to determine the emotions from the gestures "
+                                                    "alone?", "kind": "yesno"},
+        ],
+        "sections": [
+            {"section_type": "gesture_emotion", "title": "Section 1: perceived emotion",
+             "instructions": "Watch each clip and choose the emotion you perceive from the gestures.",
+             "pool": {"modality": "gesture", "origin": "generated"}, "clips_per_participant": 6,
+             "options": {"n_options": 4}},
+            {"section_type": "naturalness", "title": "Section 2: quality of the gestures",
+             "instructions": "Rate the naturalness of the gestures in each clip.",
+             "pool": {"modality": "gesture"}, "clips_per_participant": 6,
+             "options": {"anchors": NATURALNESS_ANCHORS_GESTURE, "n_generated": 3, "n_source": 3,
+                         "question": "How natural do the gestures look?"}},
+        ],
+    },
+    "rbf_thms2016": {
+        "title": "Expert RBF style features (THMS 2016 study)",
+        "introduction": "Each clip shows a virtual character walking. You will rate the style of each walk.",
+        "feedback_questions": [],
+        "sections": [
+            {"section_type": "neutral_validation", "title": "The input walk",
+             "instructions": "Which of these best describes the walk?",
+             "pool": {"modality": "gait", "theme": NEUTRAL_THEME}, "clips_per_participant": 1},
+            {"section_type": "theme_rating", "title": "Theme ratings",
+             "instructions": "Rate the amount of the named style in each walk on a seven-point scale.",
+             "pool": {"rbf": True, "weight__gt": 0}, "clips_per_participant": 0, "loop": True},
+            {"section_type": "theme_inversion", "title": "Inversion",
+             "instructions": "Rate each walk from -7 (maximum opposite theme) through 0 (neutral) to +7 (maximum "
+                             "original theme).",
+             "pool": {"rbf": True, "weight__lt": 0}, "clips_per_participant": 0, "loop": True},
+        ],
+    },
+}
+
+# The demo: every section type with a few clips each (seed 000, 003 and 004 procedures, shortened).
+PRESETS["demo"] = {
+    "title": "Demo study: emotive motion of virtual characters",
+    "introduction": "A short demonstration with every kind of question. Each clip is a few seconds long.",
+    "feedback_questions": [
+        {"key": "distracted_camera", "text": "Were you distracted by the camera during the study?", "kind": "yesno"},
+        {"key": "distracted_no_face", "text": "Were you distracted by the lack of facial expressions?",
+         "kind": "yesno"},
+        {"key": "comments", "text": "Any other comments (optional)?", "kind": "text"},
+    ],
+    "sections": [
+        dict(PRESETS["gait_ismar2020"]["sections"][0], clips_per_participant=2),
+        dict(PRESETS["gait_ismar2020"]["sections"][1], clips_per_participant=1),
+        dict(PRESETS["gait_ismar2020"]["sections"][2],
+             instructions="You will see the walks of the first section again. Rate the torso, the arms, the pace "
+                          "and the flow of each walk."),
+        dict(PRESETS["gait_ismar2020"]["sections"][3], clips_per_participant=2,
+             options={"anchors": NATURALNESS_ANCHORS_GAIT, "n_generated": 1, "n_source": 1}),
+        # one gesture here leaves the demo plan's other generated gestures for the naturalness mix below
+        dict(PRESETS["gestures_ieeevr2021"]["sections"][0], clips_per_participant=1),
+        dict(PRESETS["gestures_ieeevr2021"]["sections"][1], clips_per_participant=2,
+             options=dict(PRESETS["gestures_ieeevr2021"]["sections"][1]["options"], n_generated=1, n_source=1)),
+        dict(PRESETS["rbf_thms2016"]["sections"][0]),
+        dict(PRESETS["rbf_thms2016"]["sections"][1], clips_per_participant=2),
+        dict(PRESETS["rbf_thms2016"]["sections"][2], clips_per_participant=1),
+    ],
+}
+
+
+for _sec in PRESETS["demo"]["sections"]:       # the demo mixes the papers' sections: drop their "Section N:" prefixes
+    _title = _sec["title"].split(": ", 1)[-1]
+    _sec["title"] = _title[:1].upper() + _title[1:]
+PRESETS["demo"]["sections"][0]["title"] = "Perceived emotion: walks"
+PRESETS["demo"]["sections"][4]["title"] = "Perceived emotion: gestures"
+
+
+#: The stimulus plan (generation/plans/<name>.yaml) whose clips each preset's sections draw:
+#: :func:`create_study_from_preset` adds a ``plan`` filter to every section pool, so clips of another plan in the
+#: same catalogue (the demo's, another paper's) never enter a study's pools. A researcher may change the filter in
+#: the admin.
+PRESET_PLANS = {"gait_ismar2020": "seed000", "gestures_ieeevr2021": "seed003", "rbf_thms2016": "seed004",
+                "demo": "demo"}

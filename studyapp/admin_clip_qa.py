@@ -1,0 +1,40 @@
+"""Admin list filter of clips by their quality record (issue 14): passed, flagged, or failed one given check."""
+from __future__ import annotations
+
+from django.contrib import admin
+from django.db.models import QuerySet
+
+from study_protocol import QA_CHECKS
+
+PASSED, FLAGGED = "passed", "flagged"
+
+
+class QualityFlagFilter(admin.SimpleListFilter):
+    """``?qa=passed`` (no failed check), ``?qa=flagged`` (any), ``?qa=<check>`` (that check failed)."""
+
+    title = "quality check"
+    parameter_name = "qa"
+
+    def lookups(self, request, model_admin):
+        return [(PASSED, "passed"), (FLAGGED, "flagged (any check)"),
+                *[(check, f"failed: {check.replace('_', ' ')}") for check in QA_CHECKS]]
+
+    def queryset(self, request, queryset: QuerySet) -> QuerySet:
+        value = self.value()
+        if value == PASSED:
+            return queryset.filter(qa_flag="")
+        if value == FLAGGED:
+            return queryset.exclude(qa_flag="")
+        if value in QA_CHECKS:
+            # qa_flag joins check names with ';' and no name is a prefix of another's ';'-bounded text.
+            return queryset.filter(qa_flag__regex=rf"(^|;){value}(;|$)")
+        return queryset
+
+
+def quality_flag(clip) -> str:
+    """The admin column: 'passed' or the failed checks."""
+    return clip.qa_flag.replace(";", ", ") if clip.qa_flag else PASSED
+
+
+quality_flag.short_description = "quality"
+quality_flag.admin_order_field = "qa_flag"

@@ -1,0 +1,85 @@
+"""The expected duration of a study for one participant, shown on the consent page (issue 18: an honest
+duration, computed from what the participant will get rather than typed in).
+
+    seconds = sum over sections of  items x (mean clip duration of the section's pool + PAGE_SECONDS
+                                              + questions x ANSWER_SECONDS_PER_QUESTION)
+              + practice items and attention checks (a check asks one question)
+              + DEMOGRAPHICS_SECONDS (when asked) + FEEDBACK_SECONDS_PER_QUESTION x feedback questions
+    minutes = ceil(seconds / 60)
+
+items: the section's clips per participant (all of its pool when 0; capped at the pool's size; a reusing
+section: as many as its source section). Clips without a duration count DEFAULT_CLIP_SECONDS.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+from study_protocol import SECTION_QUESTIONS
+
+from .models import Section, Study
+from .pool_cache import SectionPool, section_pools
+from .trial_extras import check_count
+
+ANSWER_SECONDS_PER_QUESTION = 5.0
+"""Time to read one question and choose an answer (s); a rough figure for short closed questions."""
+PAGE_SECONDS = 3.0
+"""Time per clip page besides watching and answering: loading, the button, the next page (s)."""
+DEFAULT_CLIP_SECONDS = 5.0
+"""Duration assumed for a clip whose duration is not in the catalogue (s)."""
+DEMOGRAPHICS_SECONDS = 30.0
+FEEDBACK_SECONDS_PER_QUESTION = 15.0
+
+
+@dataclass(frozen=True)
+class SectionTime:
+    """One section's share: clip pages (trials + checks + practice), mean clip length and questions per page."""
+    items: int
+    checks: int
+    practice: int
+    mean_clip_s: float
+    questions: int
+
+    @property
+    def seconds(self) -> float:
+        per_trial = self.mean_clip_s + PAGE_SECONDS + self.questions * ANSWER_SECONDS_PER_QUESTION
+        per_check = self.mean_clip_s + PAGE_SECONDS + ANSWER_SECONDS_PER_QUESTION
+        return (self.items + self.practice) * per_trial + self.checks * per_check
+
+
+def mean_duration(pool: SectionPool) -> float:
+    known = [c.duration_s for c in pool.clips if c.duration_s]
+    return sum(known) / len(known) if known else DEFAULT_CLIP_SECONDS
+
+
+def _trial_count(section: Section, pool: SectionPool) -> int:
+    k = section.clips_per_participant
+    return min(k, len(pool.clips)) if k else len(pool.clips)
+
+
+def section_times(sections: list[Section], pools: dict[int, SectionPool]) -> list[SectionTime]:
+    """The SectionTime of each section (study order), from the sections' pools."""
+    out: dict[int, SectionTime] = {}
+    for s in sections:
+        source = out.get(s.reuse_section_id) if s.reuse_section_id else None
+        pool = pools.get(s.reuse_section_id if source else s.pk) or SectionPool()
+        items = source.items if source else _trial_count(s, pool)
+        options = s.options if isinstance(s.options, dict) else {}
+        checks = check_count(options["attention_checks"]) if options.get("attention_checks") and items else 0
+        practice = 1 if options.get("practice") or options.get("practice_clip") else 0
+        out[s.pk] = SectionTime(items, checks, practice, source.mean_clip_s if source else mean_duration(pool),
+                                len(SECTION_QUESTIONS.get(s.section_type, {})))
+    return [out[s.pk] for s in sections]
+
+
+def expected_seconds(study: Study) -> float:
+    sections = list(study.sections.order_by("order", "id"))
+    total = sum(t.seconds for t in section_times(sections, section_pools(study.pk, sections)))
+    if study.ask_demographics:
+        total += DEMOGRAPHICS_SECONDS
+    return total + FEEDBACK_SECONDS_PER_QUESTION * len(study.feedback_questions or [])
+
+
+def expected_minutes(study: Study) -> int:
+    """The study's expected duration for one participant in whole minutes, rounded up (at least 1)."""
+    return max(1, math.ceil(expected_seconds(study) / 60))

@@ -1,0 +1,132 @@
+"""The pool editor's live count: how many catalogue clips a section's pool matches, for the admin page (a small
+fetch from static/studyapp/admin_pool.js while the researcher edits) and for the server-rendered page.
+
+``GET <admin>/studyapp/study/pool-count/?section_type=...&pool_modality=gait&pool=...&touched_pool=on`` takes
+the fields of one section form (names without the formset prefix) and answers JSON::
+
+    {"count": 12, "by_origin": {"generated": 8, "source": 4}, "summary": "12 clips match ...",
+     "warnings": [...], "errors": [{"field": "pool_weight_min", "label": "Weight from",
+     "messages": ["Enter a number."]}], "pool": {...}, "options": {...}, "used": {"pool": "fields", ...}}
+
+Staff only (403 JSON otherwise); bad input is an error in the answer (status 200), never a 500.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+from django.db import DatabaseError
+from django.http import JsonResponse
+from django.views.decorators.cache import never_cache
+
+from study_protocol import ORIGINS
+
+from .catalogue import CatalogueError, pool_queryset
+from .forms import SectionPreviewForm
+from .pool_editor import SUB_POOL_SECTION_TYPE
+from .pools import SUB_POOLS, pool_errors
+
+REUSED = "this section reuses the clips of an earlier section: its pool is not used"
+HALVES = tuple(name for name in SUB_POOLS if name in ORIGINS)
+"""The naturalness halves: each sub-pool is the clips of that origin (studyapp.assignment)."""
+
+
+@dataclass
+class PoolCount:
+    """Clips (not retired) a pool matches: ``total`` (None when the pool cannot be counted, ``errors`` say why)
+    and, for a naturalness section, ``by_origin``: its generated and source halves with their sub-pools."""
+
+    total: int | None
+    by_origin: dict[str, int] = field(default_factory=dict)
+    errors: list[str] = field(default_factory=list)
+
+    def summary(self) -> str:
+        if self.total is None:
+            return "the pool cannot be counted: " + "; ".join(self.errors)
+        one = self.total == 1
+        text = f"{self.total} clip{'' if one else 's'} in the catalogue match{'es' if one else ''}"
+        if self.by_origin:
+            text += " (" + ", ".join(f"{name} {n}" for name, n in self.by_origin.items()) + ")"
+        return text
+
+    def warnings(self, clips_per_participant: int | None, options: dict | None) -> list[str]:
+        """Where the pool is too small for what a participant is shown (earlier sections may use some clips)."""
+        if self.total is None:
+            return []
+        if self.total == 0:
+            return ["no clip matches: this section would show nothing"]
+        out = []
+        if clips_per_participant and self.total < clips_per_participant:
+            out.append(f"fewer than the {clips_per_participant} clips each participant sees")
+        for name in self.by_origin:
+            wanted = (options or {}).get(f"n_{name}")
+            if isinstance(wanted, int) and self.by_origin[name] < wanted:
+                out.append(f"fewer {name} clips ({self.by_origin[name]}) than the {wanted} each participant sees")
+        return out
+
+
+def count_pool(section_type: str | None, pool) -> PoolCount:
+    """Count the clips of a pool (studyapp.catalogue.pool_queryset); problems come back as errors, never raised."""
+    errors = pool_errors(pool, section_type)
+    if errors:
+        return PoolCount(None, errors=errors)
+    try:
+        base = pool_queryset(pool or {})
+        total = base.count()
+        by_origin = {}
+        if section_type == SUB_POOL_SECTION_TYPE:
+            for name in HALVES:
+                half = base.filter(origin=name)
+                if pool and pool.get(name):
+                    # a sub-pool only narrows its section's pool (flagged clips are the main pool's call)
+                    half = half.filter(pk__in=pool_queryset(pool[name], include_flagged=True).values("pk"))
+                by_origin[name] = half.count()
+    except (CatalogueError, DatabaseError, OverflowError, ValueError, TypeError) as exc:
+        return PoolCount(None, errors=[f"the catalogue cannot count this pool ({type(exc).__name__}: {exc})"])
+    return PoolCount(total, by_origin)
+
+
+def _field_errors(form) -> list[dict]:
+    out = []
+    for name, messages in form.errors.items():
+        label = str(form.fields[name].label or name.replace("_", " ")) if name in form.fields else name
+        out.append({"field": name, "label": label, "messages": [str(m) for m in messages]})
+    return out
+
+
+def preview(form: SectionPreviewForm, reuse_section: str = "") -> dict:
+    """The answer for one bound preview form: count, summary, warnings, errors, and the JSON a save would store."""
+    form.is_valid()
+    data = form.cleaned_data
+    answer = {"count": None, "by_origin": {}, "summary": "", "warnings": [], "errors": _field_errors(form),
+              "used": {group: "fields" if data.get(f"touched_{group}") else "raw" for group in ("pool", "options")}}
+    for group in ("pool", "options"):
+        if group in data:
+            answer[group] = data[group]
+    if "pool" not in data or "section_type" not in data:
+        answer["summary"] = "fix the errors to see how many clips match"
+        return answer
+    counted = count_pool(data["section_type"], data["pool"])
+    if counted.total is None:
+        answer["errors"].append({"field": "pool", "label": "pool", "messages": counted.errors})
+    answer.update(count=counted.total, by_origin=counted.by_origin, summary=counted.summary(),
+                  warnings=counted.warnings(data.get("clips_per_participant"), data.get("options")))
+    if reuse_section:
+        answer["warnings"].insert(0, REUSED)
+    return answer
+
+
+@never_cache
+def pool_count(request):
+    """GET only, staff only (403 JSON for anyone else, logged in or not)."""
+    user = request.user
+    if not (user.is_authenticated and user.is_active and user.is_staff):
+        return JsonResponse({"error": "staff only: log in to the admin first"}, status=403)
+    if request.method != "GET":
+        return JsonResponse({"error": "use GET"}, status=405)
+    answer = preview(SectionPreviewForm(request.GET), request.GET.get("reuse_section", ""))
+    try:
+        return JsonResponse(answer, json_dumps_params={"allow_nan": False})
+    except ValueError:                 # a NaN/Infinity in the echoed JSON: answer without the echo
+        answer.pop("pool", None)
+        answer.pop("options", None)
+        return JsonResponse(answer)
