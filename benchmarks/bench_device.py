@@ -79,6 +79,37 @@ def epoch_seconds(config: GaitNetConfig, data, device: torch.device, batches: in
             "parameters": model.num_parameters(), "batch_size": bs}
 
 
+def amp_ratio_interleaved(config: GaitNetConfig, data, device: torch.device, pairs: int = 3,
+                          batch_size: int = 16) -> dict:
+    """Time of a training batch with mixed precision over its float32 time, measured as alternating float32 / amp
+    batches (same model, same batches) so that a changing load from other jobs hits both alike; median ratio."""
+    config = config.with_overrides(batch_size=batch_size)
+    torch.manual_seed(0)
+    train_set = data.subset("train").to(device)
+    model = GaitNet(config.model).to(device)
+    norm = fit_normalizer(train_set)
+    opt = torch.optim.Adam(model.parameters(), lr=1e-3)
+    steps = {amp: _Step(model, norm, opt, config, amp=amp) for amp in (False, True)}
+    rng, gen = np.random.default_rng(0), torch.Generator().manual_seed(0)
+    ratios, t_amp, t_fp32 = [], [], []
+    for i in range(pairs + 1):
+        idx = rng.choice(len(train_set), batch_size, replace=False)
+        batch = splice_histories(train_set.batch(idx), config.prefix_len, config.train.splice_frac, rng)
+        times = {}
+        for amp in ((False, True) if i % 2 else (True, False)):
+            _sync(device)
+            t0 = time.perf_counter()
+            steps[amp](batch, 0.5, gen)
+            _sync(device)
+            times[amp] = time.perf_counter() - t0
+        if i:  # the first pair is a warm-up
+            ratios.append(times[True] / times[False])
+            t_amp.append(times[True])
+            t_fp32.append(times[False])
+    return {"ratio_median": float(np.median(ratios)), "ratios": ratios, "s_amp": t_amp, "s_fp32": t_fp32,
+            "batch_size": batch_size}
+
+
 def generation_speed(net: LoadedGaitNet, device: torch.device, steps: int = 100, repeats: int = 2) -> dict:
     """ms per agent per 30 fps frame of generate_gaits for 1 and 10 agents (best of ``repeats``)."""
     seed = None
@@ -125,6 +156,7 @@ def measure(batches: int) -> dict:
         r["paper"] = epoch_seconds(paper, data, dev, max(1, batches // 2), amp=False)
         if dev.type == "cuda" or _cpu_amp_check():
             r["small_amp"] = epoch_seconds(small, data, dev, batches, amp=True)
+            r["amp_interleaved"] = amp_ratio_interleaved(small, data, dev)
         r["generation_small"] = generation_speed(shipped, dev)
         r["generation_paper"] = generation_speed(paper_net, dev)
         res["devices"][dev.type] = r
@@ -167,10 +199,12 @@ def gait_markdown(res: dict) -> str:
                      _fmt_gen(cpu, "generation_paper", n), _fmt_gen(gpu, "generation_paper", n)))
     table = "\n".join(f"| {a} | {b} | {c} |" for a, b, c in rows)
     amp_note = ""
-    if "small_amp" in cpu:
-        ratio = cpu["small_amp"]["s_per_batch"] / cpu["small"]["s_per_batch"]
-        amp_note = (f"bf16 autocast on this CPU took {ratio:.2f}x the float32 time per batch, so `--amp` is "
-                    f"{'ignored on the CPU (with a message)' if ratio >= 1 else 'worth using on the CPU'}. ")
+    if "amp_interleaved" in cpu:
+        ratio = cpu["amp_interleaved"]["ratio_median"]
+        amp_note = (f"bf16 autocast on this CPU took {ratio:.2f}x the float32 time per training batch (median of "
+                    f"{len(cpu['amp_interleaved']['ratios'])} alternating float32 / bf16 batches of "
+                    f"{cpu['amp_interleaved']['batch_size']}, so that the other jobs' load hits both alike; the "
+                    f"separate rows above were timed minutes apart under a changing load). ")
     return f"""## Devices: training and generation speed
 
 Machine: 2-core CI VM, no GPU, shared with parallel jobs (load average {la0[0]:.1f} at the start, {la1[0]:.1f} at the
@@ -189,7 +223,7 @@ for its error message; `tests/test_device.py` compares a CPU and a CUDA run of o
 
 ### Gait network
 
-| measurement | CPU ({cpu['name']}) | GPU |
+| measurement | CPU, {m['torch_threads']} torch thread | GPU |
 |---|---|---|
 {table}
 | paper (two GTX 1080 Ti) | | {PAPER_MS_PER_AGENT_FRAME:.0f} ms per agent per frame |
@@ -223,9 +257,17 @@ def main(argv=None) -> int:
     ap.add_argument("--threads", type=int, default=1)
     ap.add_argument("--no-doc", action="store_true", help="do not rewrite docs/benchmarks/device.md")
     ap.add_argument("--out", default="var/benchmarks/bench_device.json")
+    ap.add_argument("--amp-only", action="store_true",
+                    help="only (re)measure the interleaved float32 / bf16 comparison into an existing --out JSON")
     args = ap.parse_args(argv)
     torch.set_num_threads(args.threads)
-    res = measure(args.batches)
+    if args.amp_only:
+        from generation.gait.data import load_corpus_sequences
+        res = json.loads(Path(args.out).read_text())
+        res["devices"]["cpu"]["amp_interleaved"] = amp_ratio_interleaved(GaitNetConfig(), load_corpus_sequences(),
+                                                                         torch.device("cpu"))
+    else:
+        res = measure(args.batches)
     Path(args.out).parent.mkdir(parents=True, exist_ok=True)
     Path(args.out).write_text(json.dumps(res, indent=1, default=float))
     print(gait_markdown(res))

@@ -191,6 +191,7 @@ STUDY_FULL = "This study is full: it has all the participants it needs. Thank yo
 
 
 def check_open(study: Study) -> None:
+    """Raise StudyUnavailable when the study is not open or has all the participants it needs."""
     if study.status != Study.Status.OPEN:
         raise StudyUnavailable(STUDY_CLOSED)
     if study.max_participants and active_count(study) >= study.max_participants:
@@ -198,6 +199,7 @@ def check_open(study: Study) -> None:
 
 
 def _counter(study_id: int):
+    """The study's StudyCounter row as a queryset (the row is created on first use)."""
     StudyCounter.objects.get_or_create(study_id=study_id)
     return StudyCounter.objects.filter(study_id=study_id)
 
@@ -270,6 +272,7 @@ def _start(participant: Participant) -> bool:
 
 
 def _nonzero(counts: dict[int, dict[int, int]]) -> dict[int, dict[int, int]]:
+    """The counts without zero rows (a missing row and a zero row mean the same)."""
     return {pk: {c: n for c, n in row.items() if n} for pk, row in counts.items()}
 
 
@@ -292,12 +295,21 @@ def _one_writer():
     return _SQLITE_WRITER if connection.vendor == "sqlite" else nullcontext()
 
 
-def _retryable(exc: Exception) -> bool:
+RETRY_SQLSTATES = ("40P01", "40001")
+"""PostgreSQL's deadlock_detected and serialization_failure."""
+
+
+def _retryable(exc: Exception, vendor: str | None = None) -> bool:
     """A lock conflict worth running the start again for: SQLite's "database/table is locked", PostgreSQL's
-    deadlock (40P01) or serialization failure (40001), e.g. two starts swapping counter rows in opposite order."""
-    if connection.vendor == "sqlite":
+    deadlock (40P01) or serialization failure (40001). Starts take their locks in one order (participant row,
+    count rows by (section, clip), counter row), so on PostgreSQL this is a safety net (e.g. for a future
+    REPEATABLE READ setting or a staff edit locking rows), not part of the normal path. The SQLSTATE is read
+    from the driver's exception: ``sqlstate`` (psycopg 3) or ``pgcode`` (psycopg2)."""
+    if (vendor or connection.vendor) == "sqlite":
         return "locked" in str(exc)
-    return getattr(exc.__cause__, "pgcode", None) in ("40P01", "40001") or "deadlock detected" in str(exc)
+    cause = exc.__cause__
+    code = getattr(cause, "sqlstate", None) or getattr(cause, "pgcode", None)
+    return code in RETRY_SQLSTATES or "deadlock detected" in str(exc)
 
 
 def _with_retries(action, patience_s: float = SQLITE_RETRY_SECONDS):

@@ -48,11 +48,13 @@ class SectionTime:
 
 
 def mean_duration(pool: SectionPool) -> float:
+    """Mean duration_s (s) of the pool's clips that have one; DEFAULT_CLIP_SECONDS when none has."""
     known = [c.duration_s for c in pool.clips if c.duration_s]
     return sum(known) / len(known) if known else DEFAULT_CLIP_SECONDS
 
 
 def _trial_count(section: Section, pool: SectionPool) -> int:
+    """Clips one participant rates in a section: clips_per_participant capped at the pool size (0 = all)."""
     k = section.clips_per_participant
     return min(k, len(pool.clips)) if k else len(pool.clips)
 
@@ -73,6 +75,7 @@ def section_times(sections: list[Section], pools: dict[int, SectionPool]) -> lis
 
 
 def expected_seconds(study: Study) -> float:
+    """The formula of the module docstring, in seconds."""
     sections = list(study.sections.order_by("order", "id"))
     total = sum(t.seconds for t in section_times(sections, section_pools(study.pk, sections)))
     if study.ask_demographics:

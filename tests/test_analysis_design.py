@@ -86,3 +86,14 @@ def test_no_django_imported():
     code = ("import sys, analysis.simulate, analysis.design, analysis.report; "
             "sys.exit(any(m.split('.')[0] == 'django' for m in sys.modules))")
     assert subprocess.run([sys.executable, "-c", code], capture_output=True).returncode == 0
+
+
+def test_preset_anchors_are_the_study_apps():
+    """study_presets keeps the naturalness anchors as plain text (no Django); studyapp.questions marks the same
+    strings for translation. They must not drift apart."""
+    import study_presets
+    from studyapp import questions
+
+    assert study_presets.NATURALNESS_ANCHORS_GAIT == {k: str(v) for k, v in questions.NATURALNESS_ANCHORS_GAIT.items()}
+    assert study_presets.NATURALNESS_ANCHORS_GESTURE == {k: str(v) for k, v in
+                                                         questions.NATURALNESS_ANCHORS_GESTURE.items()}

@@ -34,7 +34,8 @@ def test_valid_study_loads_from_file_objects(study):
     assert set(data.responses["section_type"].unique()) == set(SECTION_QUESTIONS)
     likert = data.responses[data.responses["section_type"] == "affect_likert"]
     assert likert["value"].between(0, 4).all()
-    assert data.clips.loc["sim-seed000-single_happy_neutral", ["happy", "neutral"]].tolist() == pytest.approx([0.6, 0.4])
+    mixed = data.clips.loc["sim-seed000-single_happy_neutral", ["happy", "neutral"]]   # seed000.yaml's (.6, .4)
+    assert mixed.tolist() == pytest.approx([0.6, 0.4])
 
 
 def test_valid_study_loads_from_paths(study, tmp_path):

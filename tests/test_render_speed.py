@@ -40,8 +40,9 @@ def test_merged_mannequin_poses_are_not_cumulative():
 def test_auto_anti_aliasing_follows_the_camera():
     a = CameraPose(np.zeros(3), np.ones(3))
     b = CameraPose(np.ones(3), np.zeros(3))
-    assert anti_aliasing_for("auto", [a, a, a]) == "fxaa"
-    assert anti_aliasing_for("auto", [a, b, a]) == "none"
+    assert anti_aliasing_for("auto", [a, a, a], seated=True) == "fxaa"
+    assert anti_aliasing_for("auto", [a, a, a], seated=False) == "none"      # walks: none, fixed camera or not
+    assert anti_aliasing_for("auto", [a, b, a], seated=True) == "none"
     assert anti_aliasing_for("msaa", [a, b]) == "msaa"
 
 
@@ -51,5 +52,5 @@ def test_render_records_the_anti_aliasing_used(tmp_path):
     res = render_clip(seated(T=6), tmp_path, "sit", RenderSettings(width=160, height=120, fps=10.0, duration_s=0.6))
     assert res.camera["rule"] == "fixed" and res.camera["anti_aliasing"] == "fxaa"
     res = render_clip(swinging_walk(T=6), tmp_path, "walk", RenderSettings(width=160, height=120, fps=10.0,
-                                                                         duration_s=0.6, camera="tracking"))
+                                                                         duration_s=0.6))
     assert res.camera["anti_aliasing"] == "none"

@@ -249,3 +249,28 @@ def test_question_list_of_attention_item_matches_questions_for(study):
     section = first_section(study)
     qs = questions_for(section.section_type, section.options)
     assert [q.key for q in qs] == list(SECTION_QUESTIONS[section.section_type])
+
+
+def test_checks_in_a_reusing_likert_section_and_gesture_practice(settings, tmp_path):
+    settings.MEDIA_ROOT = tmp_path / "media"
+    make_catalogue(settings.MEDIA_ROOT)
+    study = create_study_from_preset("demo", "d2", plan="test", status="open")
+    likert = study.sections.get(section_type="affect_likert")
+    assert likert.reuse_section_id
+    likert.options = {"attention_checks": {"answer": "2", "question": "pace", "positions": "random"}}
+    likert.full_clean()
+    likert.save()
+    gesture = study.sections.get(section_type="gesture_emotion")
+    gesture.options = {"practice": True}
+    gesture.save()
+    p = Participant.objects.create(study=study, demographics_done=True)
+    start_participant(p)
+    check = p.assignments.get(section=likert, kind=ATTENTION_CHECK)
+    source_clips = set(p.assignments.filter(section=likert.reuse_section, kind="").values_list("clip_id", flat=True))
+    assert check.clip_id in source_clips and check.instructed == "pace=2" and check.position > 0
+    assert [q.key for q in item_questions(likert, check.clip, check.options, check.kind, check.instructed)] == \
+        ["pace"]
+    practice = p.assignments.get(section=gesture, kind=Assignment.Kind.PRACTICE)
+    assert practice.position == 0 and practice.clip.modality == "gesture"
+    assert practice.clip_id not in set(pool_queryset(gesture.pool).values_list("pk", flat=True))
+    assert practice.clip.emotion_label in practice.options and len(practice.options) == 4

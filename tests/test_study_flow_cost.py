@@ -192,3 +192,17 @@ def test_participant_limit_exact_under_concurrent_starts(settings, tmp_path):
     assert Counter(results) == {"ok": 7, "full": 5}
     assert Participant.objects.filter(study=study, status="started").count() == 7
     assert Assignment.objects.filter(participant__status="consented").count() == 0
+
+
+def test_last_answer_without_feedback_goes_to_done_and_completes(study):
+    Study.objects.filter(pk=study.pk).update(feedback_questions=[])
+    study.refresh_from_db()
+    client, p = started_participant(study)
+    p.refresh_from_db()
+    while (step := current_step(p)).kind == "item":
+        r = client.post(reverse("studyapp:item", args=[p.token, step.index]), answer_for(step.assignment))
+        p.refresh_from_db()
+    assert r["Location"] == reverse("studyapp:done", args=[p.token])
+    assert p.status == "completed" and p.completed_at is not None
+    page = client.get(r["Location"])
+    assert page.status_code == 200 and study.completion_code.encode() in page.content

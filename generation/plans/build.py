@@ -85,7 +85,8 @@ def seed000() -> dict:
                       "clip": name, "cycles": 8, "sections": ["naturalness"],
                       "note": "captured walk (DeepMimic, CMU/SFU mocap), no emotion label"})
     return {"name": "seed000", "description": "Seed 000 (Bhattacharya et al., ISMAR 2020) web study stimuli: "
-            "single-emotion gaits, transition gaits, source motions; 10 s clips, fixed camera.",
+            "single-emotion gaits, transition gaits, source motions; 10 s clips at 25 fps (the paper gives no video "
+            "rate), camera auto (fitted, or following the walker on long paths).",
             "render": dict(RENDER), "clips": clips}
 
 
@@ -153,7 +154,7 @@ def seed003(narration: int = 3, conversation: int = 2, splits: tuple[str, ...] =
     return {"name": "seed003", "description": "Seed 003 (Bhattacharya et al., IEEE VR 2021) web study stimuli: "
             "generated gestures over the 11 MPI emotions for sentences held out from the network's training "
             "(test split), each paired with a source gesture (procedural, synthetic); seated agent on a chair, "
-            "fixed camera.",
+            "fixed camera; 25 fps video (the paper gives no video rate).",
             "render": dict(RENDER, duration_s=12), "clips": clips}
 
 
@@ -172,7 +173,8 @@ def seed004(n_cycles: int = 3) -> dict:
                       "sections": ["theme_inversion"], "loop": True})
     return {"name": "seed004", "description": "Seed 004 (Etemad & Arya, THMS 2016) perception study stimuli: "
             "neutral input walk, 6 themes x 4 weights x 4 feature counts, inversions at w = -0.7; short walk "
-            "cycles the player loops.", "render": dict(RENDER), "clips": clips}
+            "cycles the player loops; 25 fps video (the paper gives no video rate).", "render": dict(RENDER),
+            "clips": clips}
 
 
 def write_all(out_dir: Path = HERE) -> list[Path]:

@@ -35,11 +35,12 @@ class RenderSettings:
             recorded per clip (:attr:`generation.render.clip.RenderResult.camera_rule`).
         body: "mannequin" (default; a low-poly humanoid), "stick" (tubes and spheres, left blue, right
             orange) or "points" (a point-light display: white dots at the joints on black, no floor).
-        anti_aliasing: "auto" (default): "fxaa" with a fixed camera, where only the moving figure's patch is
-            re-rendered and anti-aliased each frame, "none" with a follow camera, where FXAA would run over every
-            whole 720p frame (about 5x the cost of the frame itself in software GL); "fxaa" (a screen-space
-            pass), "ssaa2" (render at 2x and average 2x2 blocks), "msaa" (VTK multisampling) or "none". The
-            choice made is recorded per clip (``RenderResult.camera["anti_aliasing"]``).
+        anti_aliasing: "auto" (default): "fxaa" for seated bodies with a fixed camera (a large, slow figure;
+            only the moving limbs' patch is re-rendered and anti-aliased each frame), "none" for walks (with a
+            follow camera FXAA would run over every whole 720p frame, about 5x the cost of the frame itself in
+            software GL; with a fixed one it still costs 75 % more per frame); "fxaa" (a screen-space pass),
+            "ssaa2" (render at 2x and average 2x2 blocks), "msaa" (VTK multisampling) or "none". The choice
+            made is recorded per clip (``RenderResult.camera["anti_aliasing"]``).
         crf: H.264 constant rate factor (lower is better quality; 23 is x264's default).
         preset: x264 preset.
         webm: also write a VP9 WebM.
