@@ -17,7 +17,7 @@ Perception models (:class:`PerceptionModel`) -- each answer is drawn independent
   probability multi_select_prob a second, different label from the same probabilities;
 - Likert: round(intended @ likert_means + participant bias N(0, 0.3) + N(0, likert_sd)), clipped to 0..4;
 - naturalness: categorical over 1..5 per (modality, origin);
-- gesture emotion: among the four offered choices, choice i with probability proportional to
+- gesture emotion: among the offered choices (the section's n_options), choice i with probability proportional to
   exp(-|VAD_i - VAD_intended| / gesture_temperature);
 - theme rating: round(theme_base + theme offset + weight_effect * (w - 0.4) / 0.9 + feature_effect *
   (1 - exp(-(n - 1) / 3)) / (1 - exp(-3)) + participant N(0, theme_subject_sd) + N(0, theme_noise_sd)), clipped

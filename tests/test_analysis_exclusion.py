@@ -145,3 +145,20 @@ def test_attention_check_answers_in_responses_are_counted():
     assert [(e["participant_id"], e["rule"]) for e in rep["exclusions"] if e["rule"] == "failed_attention"] == [
         (ids[1], "failed_attention")]
     assert rep["meta"]["n_responses"] == len(r)
+
+
+def test_cli_exclusion_rules(tmp_path):
+    from analysis.__main__ import main
+    from analysis.simulate import write_study
+
+    paths = write_study(str(tmp_path / "s"), 6, seed=3)
+    args = [paths["responses"], paths["clips"], paths["participants"], "--out", str(tmp_path / "r"), "--no-figures"]
+    assert main([*args, "--exclusion-rules", '{"max_straightline": 5}']) == 2
+    assert main([*args, "--exclusion-rules", "not json"]) == 2
+    rules = tmp_path / "rules.json"
+    rules.write_text('{"min_rt_fraction": 0.5, "min_straight": 4}', encoding="utf-8")
+    assert main([*args, "--exclusion-rules", str(rules)]) == 0
+    import json
+
+    meta = json.loads((tmp_path / "r" / "report.json").read_text())["meta"]["exclusion_rules"]
+    assert meta["min_rt_fraction"] == 0.5 and meta["min_straight"] == 4 and meta["source"] == "study settings"

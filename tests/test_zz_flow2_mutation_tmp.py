@@ -6,12 +6,6 @@ from tests.test_study_flow_concurrency import test_demo_starts_over_http_at_once
 
 @pytest.mark.django_db(transaction=True)
 def test_mut(settings, tmp_path, monkeypatch):
-    calls = []
-    real = assignment._retryable
-    def rec(exc, vendor=None):
-        v = real(exc, vendor)
-        calls.append(v)
-        return v
     def shuffled(sections, lock=False):
         out = {s.pk: {} for s in sections}
         rows = SectionClipCount.objects.filter(section__in=[s.pk for s in sections])
@@ -21,7 +15,6 @@ def test_mut(settings, tmp_path, monkeypatch):
             out[a][b] = n
         return out
     monkeypatch.setattr(assignment, "read_counts", shuffled)
-    monkeypatch.setattr(assignment, "_retryable", rec)
     monkeypatch.setattr(assignment._with_retries, "__defaults__", (300.0,))
     import django.test.client as dc
     orig = dc.Client.get
@@ -29,10 +22,7 @@ def test_mut(settings, tmp_path, monkeypatch):
         r = orig(self, *a, **k)
         if r.status_code == 500:
             import traceback
-            print("EXC", "".join(traceback.format_exception(*r.exc_info))[-1500:])
+            print("EXC", "".join(traceback.format_exception(*r.exc_info))[:3000])
         return r
     monkeypatch.setattr(dc.Client, "get", get)
-    try:
-        t(settings, tmp_path, monkeypatch)
-    finally:
-        print("CALLS", len(calls))
+    t(settings, tmp_path, monkeypatch)

@@ -18,6 +18,9 @@ A plan is a YAML (or JSON) file::
         sections: [emotion_choice]  # optional hint for the study set-up
         render: {camera: tracking}  # optional per-clip render overrides
 
+An imported motion-capture file is a source clip: ``generator: captured_file, file: path.npz|.bvh`` with optional
+labels (generation/plans/captured_file.py); a generated entry links to it with ``pair``.
+
 Entries are checked before anything is rendered; :class:`PlanError` names the entry (1-based), its id and
 the field: ``entry 3 (id 'x'): field 'weight': expected a number, got 'abc'``.
 
