@@ -440,6 +440,7 @@ def main(argv=None):
                      "n_train": int(len(data.indices("train"))), "n_val": int(len(data.indices("val"))),
                      "shipped": {"epochs": blob.get("epochs_run"), "seconds": blob.get("seconds"),
                                  "parameters": net.num_parameters(), "best_val": blob.get("best_val"),
+                                 "best_epoch": blob.get("best_epoch"),
                                  "train_config": blob.get("train_config", {})}}
     results["pose_error_table"] = _pose_table(net, data, test, blob, args)
     results["gt_acceleration"] = float(np.mean([
@@ -494,8 +495,9 @@ def _md_intro(r: dict) -> list[str]:
         "amplitude), with small per-example variation; the length is 0.5 s + 0.4 s per word + 1 s.",
         "",
         f"Shipped weights: {sh['parameters']:,} parameters, {sh['epochs']} epochs in {sh['seconds'] / 60:.1f} min on "
-        f"one thread (network at 10 fps).{init}, with the velocity and liveliness losses, all decoder inputs "
-        "self-fed (3 no-grad passes) and the weights chosen by validation pose error x (1 + wrist-speed gap).",
+        f"one thread (network at 10 fps; the weights after epoch {(sh.get('best_epoch') or 0) + 1} are kept)."
+        f"{init}, with the velocity and liveliness losses, all decoder inputs self-fed (3 no-grad passes) and the "
+        "weights chosen by validation pose error x (1 + wrist-speed gap).",
         "",
     ]
 

@@ -164,10 +164,13 @@ def pool_queryset(pool: dict | None, include_flagged: bool | None = None) -> Que
 
 
 def clip_label(record: dict) -> str:
-    """Caption of a clip on a contact sheet: plan entry id, origin and the generator actually used."""
+    """Caption of a clip on a contact sheet: plan entry id, origin, the generator actually used and the failed
+    quality checks, if any."""
     meta = record.get("metadata") or {}
     gen = meta.get("generator", "")
     if meta.get("fallback_for"):
         gen = f"{gen} (fallback for {meta['fallback_for']})"
-    parts = [str(meta.get("entry_id", record["clip_id"])), record["origin"], gen]
+    flag = record.get("qa_flag") or ""
+    parts = [str(meta.get("entry_id", record["clip_id"])), record["origin"], gen,
+             f"QA: {flag.replace(';', ', ')}" if flag else ""]
     return " | ".join(p for p in parts if p)

@@ -136,3 +136,13 @@ def test_run_plan_on_a_dask_cluster_then_resumes_locally(tmp_path):
     assert all("qa" in r and r["duration_s"] > 0 for r in result.records)
     again = run_plan(plan, tmp_path / "clips", tmp_path / "records")          # resumable across back-ends
     assert again.rendered == [] and len(again.skipped) == 2
+
+
+def test_contact_sheet_caption_names_failed_checks():
+    from studyapp.catalogue import clip_label
+
+    meta = {"entry_id": "walk_sunk", "generator": "procedural_walk"}
+    assert clip_label({"clip_id": "x", "origin": "generated", "metadata": meta, "qa_flag": "penetration;jerk"}) == \
+        "walk_sunk | generated | procedural_walk | QA: penetration, jerk"
+    assert clip_label({"clip_id": "x", "origin": "generated", "metadata": meta}) == \
+        "walk_sunk | generated | procedural_walk"

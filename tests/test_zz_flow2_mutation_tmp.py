@@ -6,6 +6,8 @@ from tests.test_study_flow_concurrency import test_demo_starts_over_http_at_once
 
 @pytest.mark.django_db(transaction=True)
 def test_mut(settings, tmp_path, monkeypatch):
+    calls = []
+    real = assignment._retryable
     def shuffled(sections, lock=False):
         out = {s.pk: {} for s in sections}
         rows = SectionClipCount.objects.filter(section__in=[s.pk for s in sections])
@@ -15,14 +17,22 @@ def test_mut(settings, tmp_path, monkeypatch):
             out[a][b] = n
         return out
     monkeypatch.setattr(assignment, "read_counts", shuffled)
-    monkeypatch.setattr(assignment._with_retries, "__defaults__", (300.0,))
-    import django.test.client as dc
-    orig = dc.Client.get
-    def get(self, *a, **k):
-        r = orig(self, *a, **k)
-        if r.status_code == 500:
-            import traceback
-            print("EXC", "".join(traceback.format_exception(*r.exc_info))[:3000])
-        return r
-    monkeypatch.setattr(dc.Client, "get", get)
-    t(settings, tmp_path, monkeypatch)
+    orig_wr = assignment._with_retries
+    def wr(action, patience_s=300):
+        import time
+        d = time.monotonic() + patience_s
+        while True:
+            try:
+                return action()
+            except Exception as exc:
+                v = real(exc) if isinstance(exc, assignment.OperationalError) else None
+                calls.append((type(exc).__module__, type(exc).__name__, type(exc.__cause__).__name__, v))
+                if not v:
+                    raise
+                time.sleep(0.01)
+    monkeypatch.setattr(assignment, "_with_retries", wr)
+    try:
+        t(settings, tmp_path, monkeypatch)
+    finally:
+        from collections import Counter
+        print("CALLS", Counter(calls))

@@ -155,6 +155,8 @@ class Normalizer:
 
     CLIP = 6.0
     AFF_STD_FLOOR = 0.02  # radians / ratio units: nearly constant features must not dominate L_aff
+    STYLE_STD_FLOOR = 1e-4   # floor of aff_style_std (the corpus's smallest is 3.3e-4, an area ratio)
+    MAX_STYLE_SCALE = 100.0  # cap of style_scale (the corpus's largest is 61): a few walks must not explode it
 
     @classmethod
     def fit(cls, aff: np.ndarray, root: np.ndarray, step: np.ndarray) -> Normalizer:
@@ -163,7 +165,7 @@ class Normalizer:
             x = x.reshape(-1, x.shape[-1])
             return x.mean(0), np.maximum(x.std(0), floor)
         (am, asd), (rm, rsd), (sm, ssd) = ms(aff, cls.AFF_STD_FLOOR), ms(root), ms(step)
-        style = np.maximum(aff.mean(-2).std(0), 1e-6) if aff.ndim == 3 else None
+        style = np.maximum(aff.mean(-2).std(0), cls.STYLE_STD_FLOOR) if aff.ndim == 3 else None
         return cls(am, asd, rm, rsd, sm, ssd, style)
 
     def to_dict(self) -> dict:
@@ -179,7 +181,7 @@ class Normalizer:
         (ones when it is unknown)."""
         if self.aff_style_std is None:
             return torch.ones(len(self.aff_std), dtype=ref.dtype, device=ref.device)
-        return self._t("aff_std", ref) / self._t("aff_style_std", ref)
+        return (self._t("aff_std", ref) / self._t("aff_style_std", ref)).clamp(max=self.MAX_STYLE_SCALE)
 
     def _t(self, name, ref: torch.Tensor) -> torch.Tensor:
         return torch.as_tensor(getattr(self, name), dtype=ref.dtype, device=ref.device)

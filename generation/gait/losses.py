@@ -18,6 +18,7 @@ from generation.core.quaternion import qeuler
 from .config import GaitLossWeights
 
 FOOT_JOINTS = (3, 4, 7, 8)  # left heel, left toe, right heel, right toe (gait skeleton)
+STD_EPS = 1e-4  # added to variances before the square root of the style statistics: finite gradients at rest
 
 
 def wrap_angle(a: torch.Tensor) -> torch.Tensor:
@@ -83,9 +84,9 @@ def window_statistics(aff: torch.Tensor, pos: torch.Tensor, scale_m: float = 0.1
     prediction tends to lose.
     """
     rel = (pos[..., 1:, :] - pos[..., :1, :]) / scale_m
-    amp = rel.var(dim=1, unbiased=False).sum(-1).clamp_min(1e-8).sqrt()
+    amp = (rel.var(dim=1, unbiased=False).sum(-1) + STD_EPS).sqrt()
     mean = aff.mean(1) if mean_scale is None else aff.mean(1) * mean_scale
-    return torch.cat((mean, aff.std(1, unbiased=False), amp), dim=-1)
+    return torch.cat((mean, (aff.var(1, unbiased=False) + STD_EPS).sqrt(), amp), dim=-1)
 
 
 def style_loss(pred_windows: list[tuple[torch.Tensor, torch.Tensor]], aff_true: torch.Tensor, pos_true: torch.Tensor,

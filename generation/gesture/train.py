@@ -27,6 +27,7 @@ import argparse
 import dataclasses
 import json
 import time
+import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -239,7 +240,9 @@ def train(cfg: TrainConfig, data: GestureDataset | None = None, progress: bool =
 
     torch.set_num_threads(cfg.threads)
     device = resolve_device(cfg.device)
-    amp = bool(cfg.amp) and device.type == "cuda"  # CPU autocast does not speed this network up
+    amp = bool(cfg.amp) and device.type == "cuda"
+    if cfg.amp and not amp:
+        warnings.warn(f"--amp is for CUDA autocast; ignored on {device} (training runs in float32)", stacklevel=2)
     scaler = torch.amp.GradScaler("cuda") if needs_grad_scaler(device, amp) else None
     data = data if data is not None else build_dataset(variants=cfg.variants, seed=cfg.seed,
                                                                counterfactual=cfg.counterfactual)
@@ -368,8 +371,13 @@ def config_from_args(args: argparse.Namespace) -> TrainConfig:
 
 
 def main(argv: list[str] | None = None) -> dict:
-    args = build_parser().parse_args(argv)
-    summary = train(config_from_args(args), progress=not args.quiet)
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    try:
+        cfg = config_from_args(args)
+    except ValueError as exc:  # unknown preset, unknown or unavailable device: a usage error, not a traceback
+        parser.error(str(exc))
+    summary = train(cfg, progress=not args.quiet)
     last = summary["history"][-1] if summary["history"] else {}
     print(f"trained {summary['epochs_run']} epochs in {summary['seconds']:.0f} s on {summary['device']}; best "
           f"selection score {summary['best_val']:.5f}; last {json.dumps(last.get('val', {}))}; "
