@@ -35,8 +35,7 @@ GAIT_TRANSITION = {"modality": "gait", "origin": "generated", "transition": True
 PRESETS: dict[str, dict] = {
     "gait_ismar2020": {
         "title": "Emotive gaits (ISMAR 2020 study)",
-        "introduction": "The study has three sections and takes about ten minutes. Each clip shows a virtual "
-                        "character walking.",
+        "introduction": "The study has three sections. Each clip shows a virtual character walking.",
         "feedback_questions": [
             {"key": "distracted_camera", "text": "Were you distracted by the camera during the study?",
              "kind": "yesno"},
@@ -65,8 +64,8 @@ PRESETS: dict[str, dict] = {
     },
     "gestures_ieeevr2021": {
         "title": "Emotive gestures (IEEE VR 2021 study)",
-        "introduction": "The study has two sections and takes about ten minutes. Each clip shows a virtual character "
-                        "sitting on a chair and gesturing.",
+        "introduction": "The study has two sections. Each clip shows a virtual character sitting on a chair and "
+                        "gesturing.",
         "feedback_questions": [
             {"key": "distracted_no_face", "text": "Were you distracted by the lack of facial expressions?",
              "kind": "yesno"},

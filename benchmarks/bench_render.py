@@ -1,6 +1,6 @@
 """Render + encode speed, and wall time of the built-in plans.
 
-    python benchmarks/bench_render.py speed [--frames 300] [--aa none fxaa msaa ssaa2] [--procs 1 2]
+    python benchmarks/bench_render.py speed [--frames 300] [--aa auto none fxaa msaa ssaa2] [--procs 1 2]
                                             [--motion walk gesture] [--patches 1 0]
                                             [--body mannequin stick points] [--width 1280 --height 720]
     python benchmarks/bench_render.py sheet [--out docs/img/render_contact_sheet.png]
@@ -247,7 +247,7 @@ def main() -> None:
     s.add_argument("--width", type=int, default=1280)
     s.add_argument("--height", type=int, default=720)
     s.add_argument("--body", nargs="+", default=["mannequin", "stick"], choices=["mannequin", "stick", "points"])
-    s.add_argument("--aa", nargs="+", default=["fxaa"])
+    s.add_argument("--aa", nargs="+", default=["auto"])
     s.add_argument("--procs", nargs="+", type=int, default=[1])
     s.add_argument("--motion", nargs="+", default=["walk", "gesture"], choices=["walk", "gesture"])
     s.add_argument("--patches", nargs="+", type=int, default=[1], help="1 = patch rendering, 0 = whole frames")
