@@ -198,8 +198,9 @@ class AssignmentInline(admin.TabularInline):
     model = Assignment
     extra = 0
     can_delete = False
-    fields = ["section", "position", "clip", "options", "shown_at", "answered_at"]
+    fields = ["seq", "section", "position", "kind", "clip", "options", "instructed", "shown_at", "answered_at"]
     readonly_fields = fields
+    ordering = ["seq"]      # the order the participant sees the pages (practice items and checks included)
 
 
 @admin.register(Participant)

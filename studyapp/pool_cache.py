@@ -58,7 +58,8 @@ def load_section_pool(section: Section) -> SectionPool:
     if section.reuse_section_id:
         return SectionPool()
     clips = list(light(pool_queryset(section.pool)).order_by("clip_id"))
-    subs = {key: set(pool_queryset(section.pool[key]).filter(pk__in=[c.pk for c in clips])
+    # a sub-pool only narrows the section's pool, which already decided about flagged clips
+    subs = {key: set(pool_queryset(section.pool[key], include_flagged=True).filter(pk__in=[c.pk for c in clips])
                      .values_list("pk", flat=True))
             for key in SUB_POOLS if isinstance((section.pool or {}).get(key), dict) and section.pool[key]}
     practice = []

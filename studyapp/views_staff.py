@@ -12,14 +12,16 @@ from django.shortcuts import get_object_or_404, redirect, render
 from django.urls import reverse
 from django.views.decorators.http import require_http_methods
 
+from study_protocol import ATTENTION_CHECK
+
 from .assignment import plan_study
 from .export import stream_csv
 from .forms import ConsentForm, PresetStudyForm
 from .models import Assignment, Participant, Response, Study
 from .presets import create_study_from_preset
-from .questions import AnswerError, clean_answers, questions_for
+from .questions import AnswerError, clean_answers
 from .reports import report_state, start_build
-from .views import item_context
+from .views import item_context, item_questions
 
 
 @staff_member_required
@@ -35,10 +37,22 @@ def create_from_preset(request):
 
 
 def _preview_plan(study: Study, seed: int):
+    """The preview participant's pages: (section, PlannedItem, position in section), practice items and attention
+    checks included, sections in the study's order (a counterbalanced study rotates them per participant)."""
     flat = []
-    for section, items in plan_study(study, seed, balanced=False):
+    for section, items in plan_study(study, seed, balanced=False, extras=True):
         flat += [(section, it, i) for i, it in enumerate(items)]
     return flat
+
+
+def _preview_label(it) -> str:
+    """The preview banner's clip label: the clip id, and for a practice item or an attention check its kind (and
+    the instructed answer), so the researcher sees what a participant would be scored on."""
+    if it.kind == ATTENTION_CHECK:
+        return f"{it.clip.clip_id} (attention check, instructed {it.instructed})"
+    if it.kind == Assignment.Kind.PRACTICE:
+        return f"{it.clip.clip_id} (practice, never stored)"
+    return it.clip.clip_id
 
 
 @staff_member_required
@@ -65,16 +79,15 @@ def preview_item(request, study_id: int, n: int):
     error = ""
     if request.method == "POST":
         try:
-            clean_answers(questions_for(section.section_type, section.options, it.clip.theme, it.options),
-                          request.POST)
+            clean_answers(item_questions(section, it.clip, it.options, it.kind, it.instructed), request.POST)
             return redirect(reverse("studyapp:preview_item", args=[study.pk, n + 1]) + f"?seed={seed}")
         except AnswerError as exc:
             error = str(exc)
     nxt = flat[n][1].clip if n < len(flat) else None
     ctx = item_context(section, it.clip, n, len(flat), nxt, it.options,
-                       request.POST if request.method == "POST" else None)
+                       request.POST if request.method == "POST" else None, kind=it.kind, instructed=it.instructed)
     ctx.update({"study": study, "preview": True, "seed": seed, "error": error, "first_of_section": position == 0,
-                "clip_label": it.clip.clip_id})
+                "clip_label": _preview_label(it)})
     return render(request, "studyapp/item.html", ctx, status=400 if error else 200)
 
 

@@ -274,3 +274,54 @@ def test_checks_in_a_reusing_likert_section_and_gesture_practice(settings, tmp_p
     assert practice.position == 0 and practice.clip.modality == "gesture"
     assert practice.clip_id not in set(pool_queryset(gesture.pool).values_list("pk", flat=True))
     assert practice.clip.emotion_label in practice.options and len(practice.options) == 4
+
+
+@pytest.fixture
+def staff_client(django_user_model):
+    user = django_user_model.objects.create_user("researcher", password="pw-researcher-1", is_staff=True,
+                                                 is_superuser=True)
+    c = Client()
+    c.force_login(user)
+    return c
+
+
+def test_preview_shows_practice_and_attention_check_and_records_nothing(study, staff_client):
+    section = first_section(study)
+    section.options = {"practice": True, "attention_checks": {"count": 1, "answer": "sad", "positions": [2]}}
+    section.save()
+    url = lambda n: reverse("studyapp:preview_item", args=[study.pk, n]) + "?seed=7"   # noqa: E731
+    first = staff_client.get(url(1)).content.decode()
+    assert "Practice" in first and "(practice, never stored)" in first
+    check = staff_client.get(url(3)).content.decode()
+    assert "Attention check" in check and "instructed perceived=sad" in check
+    assert "please select only" in check and "Sad" in check         # the participant's instruction, shown
+    assert staff_client.post(url(3), {}).status_code == 400           # validated like a participant's page
+    r = staff_client.post(url(3), {"perceived": "sad"})
+    assert r.status_code == 302 and r["Location"] == url(4)
+    n_trials = section.clips_per_participant + 2
+    assert staff_client.get(url(n_trials)).status_code == 200
+    assert not Participant.objects.filter(study=study).exists()
+    assert not Response.objects.exists() and not Assignment.objects.exists()
+
+
+def test_admin_participant_page_lists_seq_kind_and_instructed_answer(study, staff_client):
+    section = first_section(study)
+    section.options = {"attention_checks": {"count": 1, "answer": "sad", "positions": [2]}}
+    section.save()
+    _, p = started(study)
+    page = staff_client.get(reverse("admin:studyapp_participant_change", args=[p.pk])).content.decode()
+    assert "Seq" in page and "Attention check" in page and "perceived=sad" in page
+    assert 'name="assignments-0-seq"' not in page      # read-only
+
+
+def test_presets_do_not_hard_code_a_duration():
+    """The consent page computes the duration (studyapp.duration); preset texts must not state another."""
+    import re
+
+    from studyapp.presets import PRESETS
+
+    for key, preset in PRESETS.items():
+        texts = [preset.get("introduction", ""), preset.get("consent_text", "")]
+        texts += [s.get("instructions", "") for s in preset["sections"]]
+        for text in texts:
+            assert not re.search(r"\b(minutes?|hours?)\b", text, re.I), (key, text)

@@ -159,7 +159,7 @@ def test_neutral_base_rejects_other_skeletons():
 # ---- the paper's model: w, n, inversion ----------------------------------------------------------------
 def test_weight_zero_returns_the_neutral_walk(neutral):
     for theme in THEME_NAMES:
-        out = stylise(neutral, theme, 0.0, 10, n_cycles=1, fps=neutral.fps)
+        out = stylise(neutral, theme, 0.0, 10, n_cycles=1, fps=neutral.fps, plant=False)
         assert out.num_frames == neutral.num_frames
         np.testing.assert_allclose(out.positions(), neutral.positions(), atol=1e-5)  # 0.01 mm
 
@@ -274,7 +274,9 @@ def test_speed_warps_time_uniformly_and_walks_forward(neutral):
         assert np.all(np.diff(z) > 0)
         assert np.abs(clip.root_positions[:, 0]).max() < 0.1  # straight path
     # uniform time warp: speed 1.25 at 30 fps shows the same poses as speed 1 sampled at 30 / 1.25 = 24 fps
-    sparse = stylise(neutral, "tired", 0.7, 10, speed=1.0, n_cycles=4, fps=24.0)
+    # (before foot planting, which works in m/s and frames)
+    fast = stylise(neutral, "tired", 0.7, 10, speed=1.25, n_cycles=4, fps=30.0, plant=False)
+    sparse = stylise(neutral, "tired", 0.7, 10, speed=1.0, n_cycles=4, fps=24.0, plant=False)
     assert sparse.num_frames == fast.num_frames
     np.testing.assert_allclose(fast.positions(), sparse.positions(), atol=1e-9)
 

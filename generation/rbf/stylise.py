@@ -25,6 +25,7 @@ from __future__ import annotations
 import numpy as np
 import torch
 
+from generation.core.foot_contact import plant_feet
 from generation.core.kinematics import forward_kinematics, np_forward_kinematics
 from generation.core.motion import Motion
 from generation.core.quaternion import np_qbetween, np_qconj, np_qfix, np_qmul, np_qrot, np_qslerp
@@ -410,7 +411,7 @@ def keep_feet_above_ground(Y: np.ndarray, P: np.ndarray, skeleton: Skeleton) -> 
 
 
 def stylise(neutral_cycle: Motion, theme: str, weight: float, n_features: int, speed: float = 1.0,
-            n_cycles: int = 4, fps: float = 30.0, keep_ground: bool = True) -> Motion:
+            n_cycles: int = 4, fps: float = 30.0, keep_ground: bool = True, plant: bool = True) -> Motion:
     """Apply a seed 004 theme to a neutral walk cycle and walk it along a straight line.
 
     Args:
@@ -424,11 +425,14 @@ def stylise(neutral_cycle: Motion, theme: str, weight: float, n_features: int, s
         n_cycles: number of cycles in the result.
         fps: output frame rate.
         keep_ground: clamp edited foot joints to their neutral floor height (:func:`keep_feet_above_ground`).
+        plant: plant the feet of the walked result (:func:`plant_walk_feet`): the features move the feet (tired
+            shortens the ankle swing while the body keeps the neutral stride), so without it they slide.
 
     Returns:
         Motion on the neutral cycle's skeleton, round(n_cycles * cycle duration / speed * fps) frames, with
-        metadata origin, generator "rbf", theme, weight, n_features, speed, synthetic_base and the
-        bone-length errors before/after the fit (metres).
+        metadata origin, generator "rbf", theme, weight, n_features, speed, synthetic_base, the
+        bone-length errors before/after the fit (metres) and, when planted, ``foot_planting`` (True) and
+        ``foot_cleanup`` (see :func:`generation.core.foot_contact.plant_feet`).
     """
     if not speed > 0 or not np.isfinite(speed):
         raise ValueError(f"speed must be a positive number, got {speed!r}")
@@ -455,14 +459,30 @@ def stylise(neutral_cycle: Motion, theme: str, weight: float, n_features: int, s
         "fit_residual_max_m": result["residual"],
         "ground_lift_max_m": result["ground_lift"],
     }
-    return Motion(neutral_cycle.skeleton, rotations, root, fps, metadata)
+    motion = Motion(neutral_cycle.skeleton, rotations, root, fps, metadata)
+    return plant_walk_feet(motion) if plant else motion
 
 
-def neutral_walk(neutral_cycle: Motion, speed: float = 1.0, n_cycles: int = 4, fps: float = 30.0) -> Motion:
+def plant_walk_feet(motion: Motion) -> Motion:
+    """The walk with its feet planted and none below the floor (y = 0), metadata ``foot_planting: True``.
+
+    Contacts are detected on this motion (the styled one: the features change the legs), then
+    :func:`generation.core.foot_contact.plant_feet` locks each planted foot and re-solves hips, knees and
+    ankles with two-bone IK; the upper body, the root's path and the swing phase away from contacts are kept,
+    so the theme's features stay (measured in docs/benchmarks/motion_quality.md, "RBF foot planting").
+    """
+    planted = plant_feet(motion)
+    planted.metadata["foot_planting"] = True
+    return planted
+
+
+def neutral_walk(neutral_cycle: Motion, speed: float = 1.0, n_cycles: int = 4, fps: float = 30.0,
+                 plant: bool = True) -> Motion:
     """The neutral cycle itself walked like a stylised clip (for the neutral-validation section, Table I).
 
-    Same timing and path as :func:`stylise`; metadata origin "generated", generator "neutral_base", theme
-    "neutral", weight 0, n_features 0, speed, synthetic_base.
+    Same timing, path and foot planting (``plant``, :func:`plant_walk_feet`) as :func:`stylise`, so a styled
+    walk differs from the neutral one by its features only; metadata origin "generated", generator
+    "neutral_base", theme "neutral", weight 0, n_features 0, speed, synthetic_base (+ ``foot_planting``).
     """
     if not speed > 0 or not np.isfinite(speed):
         raise ValueError(f"speed must be a positive number, got {speed!r}")
@@ -476,8 +496,9 @@ def neutral_walk(neutral_cycle: Motion, speed: float = 1.0, n_cycles: int = 4, f
     metadata = {"origin": "generated", "generator": "neutral_base", "theme": "neutral", "weight": 0.0,
                 "n_features": 0, "speed": float(speed), "n_cycles": n_cycles,
                 "synthetic_base": bool(meta.get("synthetic", meta.get("synthetic_base", True)))}
-    return Motion(neutral_cycle.skeleton, rotations, root, fps, metadata)
+    motion = Motion(neutral_cycle.skeleton, rotations, root, fps, metadata)
+    return plant_walk_feet(motion) if plant else motion
 
 
-__all__ = ["neutral_walk", "stylise", "stylised_cycle", "theme_rbfs", "theme_displacement", "fit_to_skeleton",
-           "walker_frame_positions", "warp_and_repeat_cycle", "bone_length_error", "CYCLE_FRAMES"]
+__all__ = ["neutral_walk", "plant_walk_feet", "stylise", "stylised_cycle", "theme_rbfs", "theme_displacement",
+           "fit_to_skeleton", "walker_frame_positions", "warp_and_repeat_cycle", "bone_length_error", "CYCLE_FRAMES"]
