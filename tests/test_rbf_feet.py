@@ -95,3 +95,31 @@ def test_chained_captured_source_walk_is_planted_and_labelled():
     angles = np.degrees(np_gait_affective_features(motion.positions())[:, knees])
     assert (angles > 179.0).mean() < 0.02
     assert meta["foot_cleanup"]["pelvis_drop_max_m"] < 0.04
+
+
+@pytest.mark.django_db
+def test_sub_pools_keep_the_flagged_clips_their_section_pool_includes():
+    """A naturalness section whose pool includes flagged clips (e.g. a sliding source walk) keeps them in its
+    source/generated sub-pools: a sub-pool only narrows the section's pool (studyapp.pool_cache)."""
+    from studyapp.catalogue import upsert_clips
+    from studyapp.models import Section
+    from studyapp.pool_cache import load_section_pool
+    from studyapp.pool_editor import SUB_POOL_SECTION_TYPE
+    from studyapp.pools import INCLUDE_FLAGGED, SUB_POOLS
+
+    generated, source = SUB_POOLS
+
+    def rec(clip_id, origin, flag=""):
+        return {"clip_id": clip_id, "modality": "gait", "origin": origin, "happy": 0, "sad": 0, "angry": 0,
+                "neutral": 1.0, "duration_s": 2, "video": f"clips/{clip_id}.mp4", "poster": f"clips/{clip_id}.png",
+                "plan": "feet", "metadata": {}, "qa": {"foot_skate_cm_s": 11.0 if flag else 1.0, "flag": flag}}
+
+    upsert_clips([rec("gen", generated), rec("src_ok", source), rec("src_sliding", source, "foot_skate")])
+    pool = {"modality": "gait", INCLUDE_FLAGGED: True, source: {"modality": "gait"}, generated: {"modality": "gait"}}
+    loaded = load_section_pool(Section(section_type=SUB_POOL_SECTION_TYPE, pool=pool, options={}))
+    by_pk = {c.pk: c.clip_id for c in loaded.clips}
+    assert set(by_pk.values()) == {"gen", "src_ok", "src_sliding"}
+    assert {by_pk[pk] for pk in loaded.sub_pools[source]} == {"gen", "src_ok", "src_sliding"}  # modality filter
+    pool[INCLUDE_FLAGGED] = False
+    loaded = load_section_pool(Section(section_type=SUB_POOL_SECTION_TYPE, pool=pool, options={}))
+    assert {c.clip_id for c in loaded.clips} == {"gen", "src_ok"}

@@ -40,12 +40,12 @@ GENERATOR_VERSIONS = {
 }
 #: Modules each generator needs (checked before rendering starts).
 GENERATOR_MODULES = {
-    "gait_net": ("generation.gait.generate", "generation.core.paths"),
+    "gait_net": ("generation.gait.generate", "generation.core.paths", "generation.core.foot_contact"),
     "procedural_walk": ("generation.procedural.walk", "generation.procedural.emotion", "generation.core.paths"),
-    "captured": ("generation.formats.captured",),
+    "captured": ("generation.formats.captured", "generation.core.foot_contact"),
     "captured_file": ("generation.plans.captured_file", "generation.mocap.importer"),
-    "neutral_walk": ("generation.rbf.neutral_base", "generation.rbf.stylise"),
-    "rbf": ("generation.rbf.neutral_base", "generation.rbf.stylise"),
+    "neutral_walk": ("generation.rbf.neutral_base", "generation.rbf.stylise", "generation.core.foot_contact"),
+    "rbf": ("generation.rbf.neutral_base", "generation.rbf.stylise", "generation.core.foot_contact"),
     "gesture_net": ("generation.gesture.generate",),
     "procedural_gesture": ("generation.procedural.gesture", "generation.procedural.emotion"),
 }
