@@ -39,6 +39,9 @@ class Job:
     generator_version: str
     fallback_reason: str | None = None
     qa_thresholds: dict | None = None  # the plan's quality thresholds (resolved); None = study_protocol defaults
+    # torch device of the network generators, fixed where the jobs are planned so that Dask workers on other
+    # machines use it too (they do not inherit the submitting process's $GENERATION_DEVICE).
+    device: str | None = None
 
 
 @dataclass
@@ -52,7 +55,7 @@ class BatchResult:
 
 def plan_jobs(plan: Plan, limit: int | None = None) -> tuple[list[Job], list[tuple[str, str]]]:
     """Jobs for the plan's entries (first ``limit``), and (entry, message) for entries that cannot run."""
-    from generation.plans.clipgen import ClipGenerationError, generator_version, resolve
+    from generation.plans.clipgen import ClipGenerationError, generation_device, generator_version, resolve
     from generation.quality.checks import resolve_thresholds
 
     thresholds = resolve_thresholds(plan.qa)
@@ -65,7 +68,7 @@ def plan_jobs(plan: Plan, limit: int | None = None) -> tuple[list[Job], list[tup
             continue
         version = generator_version(run_entry.generator)
         jobs.append(Job(entry, run_entry, clip_hash(run_entry, run_entry.generator, version), version, reason,
-                        thresholds))
+                        thresholds, generation_device()))
     return jobs, failures
 
 
@@ -150,8 +153,10 @@ def _init_worker(progress_queue, threads: int, parent_pid: int | None = None) ->
 
 def render_job(job: Job, record: dict, clips_dir: str, records_dir: str) -> dict:
     """Make the motion, render its files, write the record last. Runs in a worker (or inline)."""
-    from generation.plans.clipgen import make_motion, write_motion_bvh
+    from generation.plans.clipgen import DEVICE_ENV, make_motion, write_motion_bvh
 
+    if job.device:
+        os.environ[DEVICE_ENV] = job.device
     t0 = time.perf_counter()
     motion = make_motion(job.run_entry, requested=job.entry.generator, fallback_reason=job.fallback_reason)
     write_motion_bvh(motion, Path(clips_dir).parent / "motions", job.clip_id)
