@@ -17,6 +17,7 @@ from study_protocol import ATTENTION_CHECK
 from .assignment import plan_study
 from .export import stream_csv
 from .forms import ConsentForm, PresetStudyForm
+from .i18n import activate_study_language
 from .models import Assignment, Participant, Response, Study
 from .presets import create_study_from_preset
 from .questions import AnswerError, clean_answers
@@ -55,10 +56,17 @@ def _preview_label(it) -> str:
     return it.clip.clip_id
 
 
+def _preview_seed(request) -> int:
+    """The preview participant's seed from ?seed= (12345 when absent or not a whole number)."""
+    raw = request.GET.get("seed", "")[:20]
+    return int(raw) if raw.lstrip("-").isdigit() else 12345
+
+
 @staff_member_required
 def preview_start(request, study_id: int):
     study = get_object_or_404(Study, pk=study_id)
-    seed = int(request.GET.get("seed", 12345))
+    activate_study_language(study)     # the preview shows the pages as participants see them
+    seed = _preview_seed(request)
     return render(request, "studyapp/consent.html", {"study": study, "form": ConsentForm(), "preview": True,
                                                      "seed": seed})
 
@@ -68,7 +76,8 @@ def preview_start(request, study_id: int):
 def preview_item(request, study_id: int, n: int):
     """Clip n of a preview participant with the given seed. Answers are validated, never stored."""
     study = get_object_or_404(Study, pk=study_id)
-    seed = int(request.GET.get("seed", 12345))
+    activate_study_language(study)     # the preview shows the pages as participants see them
+    seed = _preview_seed(request)
     flat = _preview_plan(study, seed)
     if not flat:
         messages.warning(request, "No section of this study has clips: the catalogue has none matching the pools.")
