@@ -278,7 +278,10 @@ def media_urls(n: int = 4) -> list[str]:
 def start_gunicorn(args, env: dict, log: Path) -> subprocess.Popen:
     """gunicorn on 127.0.0.1:--port; its stderr (warnings, Django's error tracebacks) goes to ``log``."""
     cmd = [sys.executable, "-m", "gunicorn", "studyapp.wsgi", "-w", str(args.workers), "-b",
-           f"127.0.0.1:{args.port}", "--log-level", "warning", "--timeout", "60", "--backlog", "2048"]
+           f"127.0.0.1:{args.port}", "--log-level", "warning", "--timeout", "60", "--backlog", "2048",
+           # Idle keep-alive connections stay open like behind nginx (keepalive_timeout 65s); gunicorn's default
+           # of 2 s closes them while a pausing participant's next POST is on its way ("connection closed").
+           "--keep-alive", "75"]
     if args.threads > 1:
         cmd += ["--worker-class", "gthread", "--threads", str(args.threads)]
     return subprocess.Popen(cmd, cwd=ROOT, env=env, stderr=open(log, "ab"))

@@ -9,16 +9,23 @@ from __future__ import annotations
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
-ORDER = ["core_features", "corpus", "rbf", "gait", "gesture", "render", "study", "analysis"]
+ORDER = ["core_features", "corpus", "rbf", "gait", "gesture", "device", "motion_quality", "render", "mocap",
+         "mocap_training", "study", "flow", "flow_postgres", "analysis"]
 TITLES = {
     "core_features": "Motion core: features, IK, BVH, captured walks (issue 3)",
     "corpus": "Procedural motion and the synthetic corpus (issue 3)",
     "rbf": "RBF style features (seed 004, issue 4)",
-    "gait": "Emotive gait network (seed 000, issue 5)",
-    "gesture": "Text2Gestures network (seed 003, issue 6)",
-    "render": "Rendering, plans and catalogue (issue 7)",
-    "study": "Study web app under load (issue 8)",
-    "analysis": "Analysis and reports (issue 9)",
+    "gait": "Emotive gait network (seed 000, issues 5 and 14)",
+    "gesture": "Text2Gestures network (seed 003, issues 6 and 14)",
+    "device": "Training and generation devices, paper-size configurations (issue 19)",
+    "motion_quality": "Motion quality: planted feet, quality gate (issue 14)",
+    "render": "Rendering, plans and catalogue (issues 7 and 13)",
+    "mocap": "Motion-capture import (issue 15)",
+    "mocap_training": "Training on imported capture (issue 15)",
+    "study": "Study web app under load (issues 8 and 16)",
+    "flow": "Participant flow: queries per answer, concurrent starts (issue 16)",
+    "flow_postgres": "Participant flow on PostgreSQL (issue 16)",
+    "analysis": "Analysis and reports (issues 9 and 17)",
 }
 
 

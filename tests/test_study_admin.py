@@ -195,13 +195,18 @@ def gait_study(study):
     return create_study_from_preset("gait_ismar2020", "gaits", plan="test", status="open")
 
 
-def test_analyze_command_and_report_zip(gait_study, staff, tmp_path):
+def test_analyze_command_and_report_zip(gait_study, staff, tmp_path, settings):
     for _ in range(3):
         finish(Participant.objects.create(study=gait_study))
     buf = io.StringIO()
     call_command("analyze", "gaits", "--out", str(tmp_path / "rep"), stdout=buf)
     assert (tmp_path / "rep" / "report.json").exists() and (tmp_path / "rep" / "report.html").exists()
     assert "gait_emotion_ad" in buf.getvalue()
+    settings.REPORTS_DIR = tmp_path / "reports"
+    # The zip is built outside the request (manage.py build_report); until then the download sends staff to the
+    # progress page.
+    assert staff.get(reverse("studyapp:report_zip", args=[gait_study.pk])).status_code == 302
+    call_command("build_report", str(gait_study.pk), stdout=io.StringIO())
     r = staff.get(reverse("studyapp:report_zip", args=[gait_study.pk]))
     assert r.status_code == 200 and r["Content-Type"] == "application/zip"
     import zipfile

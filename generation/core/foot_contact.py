@@ -187,6 +187,43 @@ def _ankle_targets(P: np.ndarray, leg: Leg, contact: np.ndarray, floor_y: float,
     return target
 
 
+def _pelvis_drop(P: np.ndarray, the_legs, targets, lengths: np.ndarray, fps: float) -> np.ndarray:
+    """(T,) metres to lower the root so that every ankle target is within its leg's reach, smoothed (a max filter
+    then a box filter of 0.15 s half-width: never below the needed drop, and the body does not bob)."""
+    drop = np.zeros(len(P))
+    for leg, target in zip(the_legs, targets):
+        reach = 0.998 * (lengths[leg.knee] + lengths[leg.ankle])
+        d = target - P[:, leg.hip]
+        horiz2 = d[:, 0] ** 2 + d[:, 2] ** 2
+        need_y = np.sqrt(np.maximum(reach ** 2 - horiz2, 0.0))   # the largest vertical hip-ankle distance
+        drop = np.maximum(drop, np.maximum(-d[:, 1] - need_y, 0.0))
+    if not drop.any():
+        return drop
+    k = max(1, int(round(0.15 * fps)))
+    kernel = np.ones(2 * k + 1) / (2 * k + 1)
+    drop = np.lib.stride_tricks.sliding_window_view(np.pad(drop, k, mode="edge"), 2 * k + 1).max(axis=1)
+    return np.convolve(np.pad(drop, k, mode="edge"), kernel, mode="valid")
+
+
+def _solve_leg(rot: np.ndarray, G: np.ndarray, P: np.ndarray, sk, leg, target: np.ndarray,
+               lengths: np.ndarray) -> None:
+    """Set the hip, knee and ankle local rotations of ``leg`` in ``rot`` (T, J, 4), in place, so the ankle reaches
+    ``target`` (T, 3) by two-bone IK; G: (T, J, 4) global rotations before the change; P: (T, J, 3) positions.
+    The foot keeps its world rotation."""
+    hip, knee = P[:, leg.hip], P[:, leg.knee]
+    l1, l2 = lengths[leg.knee], lengths[leg.ankle]
+    mid, _, _ = two_bone_ik(hip, target, l1, l2, knee - hip)
+    dist = np.linalg.norm(target - hip, axis=-1, keepdims=True)
+    end = hip + np.clip(dist, abs(l1 - l2) + 1e-6, (l1 + l2) * (1 - 1e-9)) * (target - hip) / np.maximum(dist, 1e-12)
+    g_hip_new = np_qmul(np_qbetween(knee - hip, mid - hip), G[:, leg.hip])
+    g_knee_tmp = np_qmul(g_hip_new, rot[:, leg.knee])
+    shin_now = np_qrot(g_knee_tmp, np.broadcast_to(sk.offsets[leg.ankle], mid.shape).copy())
+    g_knee_new = np_qmul(np_qbetween(shin_now, end - mid), g_knee_tmp)
+    rot[:, leg.hip] = np_qmul(np_qconj(G[:, sk.parents[leg.hip]]), g_hip_new)
+    rot[:, leg.knee] = np_qmul(np_qconj(g_hip_new), g_knee_new)
+    rot[:, leg.ankle] = np_qmul(np_qconj(g_knee_new), G[:, leg.ankle])
+
+
 def plant_feet(motion: Motion, contacts: np.ndarray | None = None, floor_y: float = 0.0,
                blend_frames: int | None = None, raise_pelvis: bool = True,
                lower_pelvis: bool = False) -> Motion:
@@ -231,41 +268,14 @@ def plant_feet(motion: Motion, contacts: np.ndarray | None = None, floor_y: floa
     raise_m = max(float(np.median(lift)), 0.0) if lift.size and raise_pelvis else 0.0
     root[:, 1] += raise_m
     P = P + np.array([0.0, raise_m, 0.0])
-    # lower the pelvis where a target is out of reach (smoothed so the body does not bob)
-    drop = np.zeros(len(P))
-    for leg, target in zip(the_legs, targets):
-        reach = 0.998 * (lengths[leg.knee] + lengths[leg.ankle])
-        d = target - P[:, leg.hip]
-        horiz2 = d[:, 0] ** 2 + d[:, 2] ** 2
-        need_y = np.sqrt(np.maximum(reach ** 2 - horiz2, 0.0))   # the largest vertical hip-ankle distance
-        drop = np.maximum(drop, np.maximum(-d[:, 1] - need_y, 0.0))
+    drop = _pelvis_drop(P, the_legs, targets, lengths, motion.fps)
     if drop.any() and lower_pelvis:
-        k = max(1, int(round(0.15 * motion.fps)))
-        kernel = np.ones(2 * k + 1) / (2 * k + 1)
-        padded = np.pad(drop, k, mode="edge")
-        # max filter then box filter: smooth and never below the needed drop
-        drop = np.lib.stride_tricks.sliding_window_view(padded, 2 * k + 1).max(axis=1)
-        drop = np.convolve(np.pad(drop, k, mode="edge"), kernel, mode="valid")
         root[:, 1] -= drop
         P = P - np.stack([np.zeros_like(drop), drop, np.zeros_like(drop)], -1)[:, None]
 
     G = global_rotations(rot, sk.parents)
     for leg, target in zip(the_legs, targets):
-        hip, knee = P[:, leg.hip], P[:, leg.knee]
-        l1, l2 = lengths[leg.knee], lengths[leg.ankle]
-        mid, _, _ = two_bone_ik(hip, target, l1, l2, knee - hip)
-        end = hip + np.clip(np.linalg.norm(target - hip, axis=-1, keepdims=True), abs(l1 - l2) + 1e-6,
-                            (l1 + l2) * (1 - 1e-9)) * (target - hip) / np.maximum(
-            np.linalg.norm(target - hip, axis=-1, keepdims=True), 1e-12)
-        g_hip_new = np_qmul(np_qbetween(knee - hip, mid - hip), G[:, leg.hip])
-        g_knee_old_local = rot[:, leg.knee]
-        g_knee_tmp = np_qmul(g_hip_new, g_knee_old_local)
-        shin_now = np_qrot(g_knee_tmp, np.broadcast_to(sk.offsets[leg.ankle], mid.shape).copy())
-        g_knee_new = np_qmul(np_qbetween(shin_now, end - mid), g_knee_tmp)
-        parent_hip = sk.parents[leg.hip]
-        rot[:, leg.hip] = np_qmul(np_qconj(G[:, parent_hip]), g_hip_new)
-        rot[:, leg.knee] = np_qmul(np_qconj(g_hip_new), g_knee_new)
-        rot[:, leg.ankle] = np_qmul(np_qconj(g_knee_new), G[:, leg.ankle])   # the foot keeps its world rotation
+        _solve_leg(rot, G, P, sk, leg, target, lengths)
     meta = dict(motion.metadata)
     meta["foot_cleanup"] = {"method": "contact lock + two-bone IK", "blend_frames": blend_frames,
                             "contact_share": round(float(contacts.mean()), 4),
