@@ -114,3 +114,21 @@ def admin_form_data(response) -> dict[str, str]:
         for form in formset.forms:
             data.update(fields(form))
     return data
+
+
+def wait_for(driver, condition, timeout: float = 20.0, what: str = "condition"):
+    """Poll ``condition(driver)`` (a selenium WebDriver) every 0.1 s until it returns something truthy, and return
+    that; AssertionError naming ``what`` and the page after ``timeout`` seconds. Exceptions while the page is
+    changing (element not there yet, stale element) count as "not yet"."""
+    import time
+
+    end = time.time() + timeout
+    while time.time() < end:
+        try:
+            value = condition(driver)
+            if value:
+                return value
+        except Exception:     # element not there yet / stale while navigating
+            pass
+        time.sleep(0.1)
+    raise AssertionError(f"timed out waiting for {what}; at {driver.current_url}")

@@ -29,7 +29,7 @@ from study_protocol import SECTION_QUESTIONS, SECTION_TYPES, answer_values
 from studyapp.export import stream_csv
 from studyapp.models import Assignment, Participant, Response, Study
 from studyapp.presets import create_study_from_preset
-from studyapp.testing import make_catalogue
+from studyapp.testing import make_catalogue, wait_for
 
 pytestmark = [pytest.mark.browser, pytest.mark.slow, pytest.mark.django_db(transaction=True)]
 
@@ -72,19 +72,6 @@ def wide_test_clip(path: Path, seconds: float = CLIP_SECONDS, fps: int = 10, siz
         writer.send(frame.tobytes())
     writer.close()
     return path
-
-
-def wait_for(driver, condition, timeout=20.0, what="condition"):
-    end = time.time() + timeout
-    while time.time() < end:
-        try:
-            value = condition(driver)
-            if value:
-                return value
-        except Exception:     # element not there yet / stale while navigating
-            pass
-        time.sleep(0.1)
-    raise AssertionError(f"timed out waiting for {what}; at {driver.current_url}")
 
 
 def press(driver, *keys):

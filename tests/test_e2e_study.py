@@ -22,22 +22,9 @@ from studyapp.export import stream_csv
 from studyapp.models import Participant, Response, Study
 from studyapp.presets import create_study_from_preset
 from studyapp.questions import questions_for
-from studyapp.testing import make_catalogue, tiny_mp4
+from studyapp.testing import make_catalogue, tiny_mp4, wait_for
 
 pytestmark = [pytest.mark.browser, pytest.mark.slow, pytest.mark.django_db(transaction=True)]
-
-
-def wait_for(driver, condition, timeout=20.0, what="condition"):
-    end = time.time() + timeout
-    while time.time() < end:
-        try:
-            value = condition(driver)
-            if value:
-                return value
-        except Exception:     # element not there yet / stale while navigating
-            pass
-        time.sleep(0.1)
-    raise AssertionError(f"timed out waiting for {what}; at {driver.current_url}")
 
 
 def path_of(driver) -> str:

@@ -377,7 +377,8 @@ def test_count_updates_as_a_field_changes_in_chromium(chromium, live_server, set
     import os
 
     from selenium.webdriver.common.by import By
-    from test_e2e_study import wait_for
+
+    from studyapp.testing import wait_for
 
     settings.MEDIA_ROOT = tmp_path / "media"
     make_catalogue(settings.MEDIA_ROOT)

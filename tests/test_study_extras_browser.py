@@ -15,22 +15,9 @@ from study_protocol import ATTENTION_CHECK
 from studyapp.duration import expected_minutes
 from studyapp.models import Assignment, Participant, Response, Study
 from studyapp.presets import create_study_from_preset
-from studyapp.testing import make_catalogue, tiny_mp4
+from studyapp.testing import make_catalogue, tiny_mp4, wait_for
 
 pytestmark = [pytest.mark.browser, pytest.mark.slow, pytest.mark.django_db(transaction=True)]
-
-
-def wait_for(driver, condition, timeout=20.0, what="condition"):
-    end = time.time() + timeout
-    while time.time() < end:
-        try:
-            value = condition(driver)
-            if value:
-                return value
-        except Exception:     # element not there yet / stale while navigating
-            pass
-        time.sleep(0.1)
-    raise AssertionError(f"timed out waiting for {what}; at {driver.current_url}")
 
 
 def shot(driver, folder: str | None, name: str) -> None:

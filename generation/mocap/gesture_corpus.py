@@ -19,7 +19,6 @@ float32 padded with the last frame, ``fps`` and ``metadata`` (JSON: origin captu
 """
 from __future__ import annotations
 
-import csv
 import json
 from pathlib import Path
 
@@ -27,21 +26,14 @@ import numpy as np
 
 from study_protocol import GESTURE_TASKS, GESTURE_VAD, HANDEDNESS
 
-from .labels import LabelError
+from .labels import LabelError, open_csv
 
 CSV_COLUMNS = ("source", "sentence", "task")
 
 
 def read_sentences(path: str | Path) -> dict[str, dict]:
     """{source: {"sentence", "task", "handedness"}} from a sentences CSV; LabelError names the file and line."""
-    path = Path(path)
-    try:
-        text = path.read_text(encoding="utf-8-sig")
-    except OSError as exc:
-        raise LabelError(f"{path}: cannot read ({exc.strerror or exc})") from None
-    reader = csv.DictReader(text.splitlines())
-    cols = [c.strip() for c in (reader.fieldnames or [])]
-    reader.fieldnames = cols
+    path, reader, cols = open_csv(path)
     if any(c not in cols for c in CSV_COLUMNS):
         raise LabelError(f"{path}: line 1: need the columns {', '.join(CSV_COLUMNS)} (and optionally handedness); "
                          f"found {', '.join(cols) or 'no header'}")

@@ -51,8 +51,9 @@ class Label:
         return out
 
 
-def read_labels(path: str | Path) -> dict[str, Label]:
-    """{source as written in the CSV: Label}; LabelError names the file and line of a bad row."""
+def open_csv(path: str | Path) -> tuple[Path, csv.DictReader, list[str]]:
+    """(path, a DictReader over its rows, the stripped header names) of a UTF-8 (BOM allowed) CSV file; LabelError
+    when it cannot be read. ``reader.line_num`` gives the line of the row just read, for error messages."""
     path = Path(path)
     try:
         text = path.read_text(encoding="utf-8-sig")
@@ -61,6 +62,12 @@ def read_labels(path: str | Path) -> dict[str, Label]:
     reader = csv.DictReader(text.splitlines())
     cols = [c.strip() for c in (reader.fieldnames or [])]
     reader.fieldnames = cols
+    return path, reader, cols
+
+
+def read_labels(path: str | Path) -> dict[str, Label]:
+    """{source as written in the CSV: Label}; LabelError names the file and line of a bad row."""
+    path, reader, cols = open_csv(path)
     has_vector = all(e in cols for e in GAIT_EMOTIONS)
     if "source" not in cols or not (has_vector or "emotion" in cols):
         raise LabelError(f"{path}: line 1: need a 'source' column and either 'emotion' or the columns "
