@@ -25,7 +25,7 @@ from pathlib import Path
 import pytest
 from django.urls import reverse
 
-from study_protocol import SECTION_QUESTIONS, SECTION_TYPES, answer_values
+from study_protocol import ATTENTION_CHECK, SECTION_QUESTIONS, SECTION_TYPES, answer_values
 from studyapp.export import stream_csv
 from studyapp.models import Assignment, Participant, Response, Study
 from studyapp.presets import create_study_from_preset
@@ -191,6 +191,13 @@ def german_study(settings, tmp_path):
         title, instructions = GERMAN_SECTIONS.get(section.section_type, ("", ""))
         section.title, section.instructions = title or section.title, instructions or section.instructions
         section.save(update_fields=["title", "instructions"])
+    # what a researcher sets up for Prolific: a practice item and an instructed-response attention check in the
+    # first section, and the sections' order counterbalanced across participants
+    walks = study.sections.get(section_type="emotion_choice")
+    walks.options = {**walks.options, "practice": True, "attention_checks": {"answer": "sad", "positions": [2]}}
+    walks.save(update_fields=["options"])
+    study.counterbalance_sections = True
+    study.save(update_fields=["counterbalance_sections"])
     return study
 
 
@@ -241,8 +248,20 @@ def focus_order_of_clip_page(driver, seen: list[str]) -> None:
     assert len(in_questions) >= n_questions, (seen, n_questions)
 
 
-def answer_clip_page(driver, n: int, section_type: str, seen: set[str], shots) -> None:
-    """Answer clip page n with number keys (the first unanswered question takes each key) and continue."""
+def press_instructed(driver, instructed: str) -> None:
+    """On an attention-check page (``instructed`` is "<question key>=<answer>"): the instruction is shown, and the
+    number key of the instructed answer chooses it."""
+    from selenium.webdriver.common.by import By
+
+    assert driver.find_element(By.CSS_SELECTOR, ".attention-instruction").is_displayed()
+    values = [e.get_attribute("value") for e in driver.find_elements(By.CSS_SELECTOR, "#answer-form input")
+              if e.get_attribute("type") in ("checkbox", "radio")]
+    press(driver, str(values.index(instructed.split("=", 1)[1]) + 1))
+
+
+def answer_clip_page(driver, n: int, section_type: str, seen: set[str], shots, instructed: str = "") -> None:
+    """Answer clip page n with number keys (the first unanswered question takes each key; on an attention check
+    the instructed answer's key) and continue."""
     from selenium.webdriver.common.keys import Keys
 
     wait_for(driver, lambda d: f"/clip/{n}/" in d.current_url, what=f"clip {n}")
@@ -273,6 +292,8 @@ def answer_clip_page(driver, n: int, section_type: str, seen: set[str], shots) -
         checked = [e.get_attribute("id") for e in driver.find_elements("css selector", "#answer-form input:checked")]
         assert checked == [f"q-{key}-1"] + ([f"q-{key}-3"] if multi else []), checked
         assert active_id(driver) in checked       # focus follows the key
+    elif instructed:
+        press_instructed(driver, instructed)
     else:
         for i, _ in enumerate(questions):
             press(driver, str(1 + (n + i) % 3))
@@ -314,11 +335,13 @@ def test_german_study_by_keyboard_only_is_accessible(chromium, live_server, germ
     keyboard_demographics(driver)
     wait_for(driver, lambda d: "/clip/1/" in d.current_url, what="first clip")
     participant = Participant.objects.get(external_id="kb-1")
-    in_order = ["seq"] if "seq" in {f.name for f in Assignment._meta.fields} else ["section__order", "position"]
-    order = [a.section.section_type for a in participant.assignments.select_related("section").order_by(*in_order)]
+    items = list(participant.assignments.select_related("section").order_by("seq"))
+    assert {a.kind for a in items} >= {Assignment.Kind.PRACTICE, Assignment.Kind.ATTENTION}
+    participant.refresh_from_db()
+    assert sorted(participant.section_order) == sorted(german_study.sections.values_list("pk", flat=True))
     seen: set[str] = set()
-    for n, section_type in enumerate(order, start=1):
-        answer_clip_page(driver, n, section_type, seen, shots)
+    for n, a in enumerate(items, start=1):
+        answer_clip_page(driver, n, a.section.section_type, seen, shots, instructed=a.instructed)
     assert seen >= set(SECTION_TYPES)
     keyboard_feedback(driver)
     wait_for(driver, lambda d: "/done/" in d.current_url, what="completion page")
@@ -343,3 +366,12 @@ def test_german_study_by_keyboard_only_is_accessible(chromium, live_server, germ
             assert set(row["answer"].split(";")) <= set(answer_values(kind)), row
     labels = {r["answer"] for r in rows if r["section_type"] == "emotion_choice"}
     assert labels and not any(a[:1].isupper() for a in labels), labels   # protocol labels, not "Glücklich"
+    # the attention check is exported as such with the instructed answer in the question; the practice item never
+    checks = [r for r in rows if r["section_type"] == ATTENTION_CHECK]
+    assert [(r["question"], r["answer"]) for r in checks] == [("perceived=sad", "sad")], checks
+    practice = participant.assignments.get(kind=Assignment.Kind.PRACTICE)
+    assert not Response.objects.filter(participant=participant, clip_id=practice.clip_id,
+                                       section_id=practice.section_id).exists()
+    people = list(csv.DictReader(io.StringIO("".join(stream_csv(german_study, "participants")))))
+    assert (people[0]["attention_passed"], people[0]["attention_total"]) == ("1", "1"), people
+    assert people[0]["section_order"], people   # the counterbalanced order, recorded per participant
