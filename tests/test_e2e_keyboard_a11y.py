@@ -295,8 +295,13 @@ def answer_clip_page(driver, n: int, section_type: str, seen: set[str], shots, i
     elif instructed:
         press_instructed(driver, instructed)
     else:
-        for i, _ in enumerate(questions):
-            press(driver, str(1 + (n + i) % 3))
+        numbered = section_type == "affect_likert"      # 0-4 scales: the key is the number shown, 0 included
+        digits = [str((n + i) % 3 + (0 if numbered else 1)) for i, _ in enumerate(questions)]
+        press(driver, *digits)
+        if numbered:
+            chosen = [driver.find_element("css selector", f"#answer-form input[name='{q.get_attribute('data-key')}']"
+                                          ":checked").get_attribute("value") for q in questions]
+            assert chosen == digits, (chosen, digits)
     checked = driver.find_elements("css selector", "#answer-form input:checked")
     assert {c.get_attribute("name") for c in checked} == {q.get_attribute("data-key") for q in questions}, \
         "a number key did not answer its question"

@@ -98,9 +98,19 @@
     return el.tagName === "INPUT" && !/^(radio|checkbox)$/.test(el.type);
   }
 
+  // Digit key -> option: on a numbered scale whose values are all single digits (0-4 Likert, 1-5 naturalness) the
+  // option showing that number; otherwise the n-th option (1 = first).
+  function optionForDigit(inputs, n) {
+    var numbered = Array.prototype.every.call(inputs, function (i) { return /^[0-9]$/.test(i.value); });
+    if (numbered) {
+      return Array.prototype.find.call(inputs, function (i) { return i.value === String(n); });
+    }
+    return n >= 1 ? inputs[n - 1] : undefined;
+  }
+
   function choose(fs, n, active) {
     var inputs = fs.querySelectorAll("input[type=radio], input[type=checkbox]");
-    var input = inputs[n - 1];
+    var input = optionForDigit(inputs, n);
     if (!input || input.disabled || fs.disabled) { return false; }
     input.checked = input.type === "checkbox" ? !input.checked : true;
     input.dispatchEvent(new Event("change", { bubbles: true }));
@@ -116,7 +126,7 @@
       if (e.altKey || e.ctrlKey || e.metaKey || e.defaultPrevented) { return; }
       var active = document.activeElement;
       if (isTyping(active)) { return; }
-      if (/^[1-9]$/.test(e.key)) {
+      if (/^[0-9]$/.test(e.key)) {
         var fs = targetQuestion(active);
         if (fs && choose(fs, Number(e.key), active)) { e.preventDefault(); }
         return;
