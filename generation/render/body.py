@@ -138,7 +138,10 @@ def mannequin_parts(skeleton: Skeleton) -> list[Part]:
         rx, ry, rz = (r * s for r in HEAD_RADII[build])
         # The head's top touches the body height in the rest pose.
         lift = skeleton.height - (rest[head, 1] + skeleton.root_height()) - ry
-        parts.append(Part("neck", neck, head, limb["neck"][0], limb["neck"][1], 0.0, 0.55 * L, side="shoulders"))
+        # The neck reaches into the head ellipsoid (its top 0.6 ry above the head's lowest point), so no gap opens
+        # between them on skeletons with a long neck->head bone or a lifted head.
+        neck_top = max(0.55 * L, L + lift - 0.4 * ry)
+        parts.append(Part("neck", neck, head, limb["neck"][0], limb["neck"][1], 0.0, neck_top, side="shoulders"))
         parts.append(Part("head", neck, head, 0.0, 0.0, 0.0, L + lift, side="shoulders", ellipsoid=(rx, ry, rz)))
     for side in ("left", "right"):
         def idx(*cands, side=side):

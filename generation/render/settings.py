@@ -9,7 +9,7 @@ from dataclasses import asdict, dataclass, fields
 
 #: Bump when the look of clips changes for the same settings (scene, camera placement): it is part of
 #: every clip's content hash, so changed clips get new files instead of stale ones being reused.
-RENDERER_VERSION = "3"  # 3: one merged mannequin mesh, opaque shadow, anti_aliasing "auto"
+RENDERER_VERSION = "4"  # 3: one merged mannequin mesh, opaque shadow, anti_aliasing "auto"; 4: neck reaches the head
 CAMERAS = ("auto", "fixed", "tracking")
 BODIES = ("mannequin", "stick", "points")
 ANTI_ALIASING = ("auto", "none", "fxaa", "ssaa2", "msaa")
