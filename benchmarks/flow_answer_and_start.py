@@ -122,6 +122,18 @@ def answer_cost(study, n_clips: int = 3) -> dict:
             "requests": statistics.mean(trips)}
 
 
+def release_together(work, items, threads: int, gate: threading.Event) -> float:
+    """Run ``work(item)`` for every item on ``threads`` threads; each call waits on ``gate``, which opens once all
+    are submitted, so they arrive together. Returns the wall seconds from opening the gate to the last finish."""
+    with ThreadPoolExecutor(threads) as pool:
+        futures = [pool.submit(work, item) for item in items]
+        t0 = time.perf_counter()
+        gate.set()
+        for f in futures:
+            f.result()
+        return time.perf_counter() - t0
+
+
 def concurrent_starts(study, n: int, threads: int) -> dict:
     from django.db import connection
 
@@ -143,13 +155,7 @@ def concurrent_starts(study, n: int, threads: int) -> dict:
         finally:
             connection.close()
 
-    with ThreadPoolExecutor(threads) as pool:
-        futures = [pool.submit(one, p) for p in people]
-        t0 = time.perf_counter()
-        gate.set()
-        for f in futures:
-            f.result()
-        wall = time.perf_counter() - t0
+    wall = release_together(one, people, threads, gate)
     lat = sorted(latencies)
     return {"started": len(latencies), "failed": len(failures), "wall_s": wall,
             "p50_ms": 1000 * lat[len(lat) // 2] if lat else float("nan"),
@@ -217,13 +223,7 @@ def http_starts(study, n: int, threads: int) -> dict:
         finally:
             connection.close()
 
-    with ThreadPoolExecutor(threads) as pool:
-        futures = [pool.submit(one, ct) for ct in ready]
-        t0 = time.perf_counter()
-        gate.set()
-        for f in futures:
-            f.result()
-        wall = time.perf_counter() - t0
+    wall = release_together(one, ready, threads, gate)
     people = list(Participant.objects.filter(token__in=[t for _, t in ready]))
     lat = sorted(latencies)
     return {"n": n, "wall_s": wall, "statuses": dict(sorted(statuses.items())),
