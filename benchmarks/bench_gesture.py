@@ -25,8 +25,6 @@ import numpy as np  # noqa: E402
 import torch  # noqa: E402
 from scipy import stats  # noqa: E402
 
-from generation.core.features import np_gesture_affective_features  # noqa: E402
-from generation.core.kinematics import np_forward_kinematics  # noqa: E402
 from generation.core.quaternion import np_qnormalize  # noqa: E402
 from generation.core.skeleton import gesture_skeleton  # noqa: E402
 from generation.gesture import config  # noqa: E402
@@ -41,6 +39,7 @@ from generation.gesture.metrics import (  # noqa: E402
 )
 from generation.gesture.model import GestureNetConfig  # noqa: E402
 from generation.gesture.train import TrainConfig, train  # noqa: E402
+from generation.quality.gesture_observer import corpus_descriptors, motion_descriptors, positions_of  # noqa: E402
 from study_protocol import GESTURE_EMOTIONS  # noqa: E402
 
 MACHINE = "2-core CI VM, no GPU, shared with parallel jobs"
@@ -54,12 +53,6 @@ ABLATIONS = {
 
 
 # ---- metrics ---------------------------------------------------------------------------------------
-def positions_of(rotations: np.ndarray, data: GestureDataset, i: int) -> np.ndarray:
-    """(T, J, 4) -> (T, J, 3) metres on example i's body, seated root."""
-    sk = gesture_skeleton(build=str(data.gender[i]))
-    return np_forward_kinematics(rotations, np.repeat(data.root[i][None].astype(np.float64), len(rotations), 0), sk)
-
-
 def pose_errors(pred: list[np.ndarray], data: GestureDataset, idx: np.ndarray) -> dict[str, float]:
     """Seed 003 Table 1 metric (:func:`generation.gesture.metrics.dataset_pose_error`)."""
     return dataset_pose_error(pred, data, idx)
@@ -96,30 +89,16 @@ def nearest_neighbour_baseline(data: GestureDataset, idx: np.ndarray) -> list[np
     return out
 
 
-def motion_descriptors(positions: np.ndarray, fps: float) -> dict[str, float]:
-    """Speed: 90th percentile over frames of the faster wrist's speed (m/s), i.e. the peak speed of the arm
-    swings; expansion: mean wrist spread d(10,14)/d(0,6) (feature D3/D6 of seed 003 Fig. 4); plus the mean and
-    std of the 15 affective features and both speed measures (the observer's inputs).
-
-    The speed measure (the "peak" of :func:`generation.gesture.metrics.wrist_speed_of_positions`) was chosen on the
-    procedural training gestures (Pearson r with arousal 0.47 there, against -0.20 for the clip-mean speed of both
-    wrists, which rest holds and two-handed gestures dilute)."""
-    ws = wrist_speed_of_positions(positions, fps)
-    feats = np_gesture_affective_features(positions)
-    return {"speed": ws["peak"], "expansion": float(feats[:, 11].mean()), "features": np.concatenate(
-        [feats.mean(0), feats.std(0), [ws["peak"], ws["mean"]]])}
-
-
 def fit_observers(data: GestureDataset) -> dict:
-    """Synthetic observers: logistic regressions on :func:`motion_descriptors` features of the procedural training
-    gestures, one for high vs low arousal and one for high vs low dominance (VAD value > 0.5)."""
+    """Synthetic observers: logistic regressions on :func:`generation.quality.gesture_observer.motion_descriptors`
+    features of the procedural training gestures, one for high vs low arousal and one for high vs low dominance
+    (VAD value > 0.5); the 11-way gesture observer of the quality gate uses the same features."""
     from sklearn.linear_model import LogisticRegression
     from sklearn.pipeline import make_pipeline
     from sklearn.preprocessing import StandardScaler
 
     tr = data.indices("train")
-    X_tr = np.stack([motion_descriptors(positions_of(data.rotations[i, : data.lengths[i]].astype(np.float64), data,
-                                                     i), data.fps)["features"] for i in tr])
+    X_tr = corpus_descriptors(data, tr)
     return {k: make_pipeline(StandardScaler(), LogisticRegression(max_iter=2000, C=1.0)).fit(X_tr,
                                                                                               data.vad[tr, dim] > 0.5)
             for k, dim in (("arousal", 1), ("dominance", 2))}

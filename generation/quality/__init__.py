@@ -6,6 +6,8 @@ Public interface:
     evaluate(motion, ...) -> QAResult       measures + failed checks against thresholds
     resolve_thresholds(plan_qa) -> dict     QA_THRESHOLDS (study_protocol) overridden by a plan's ``qa:`` block
     GaitObserver                            logistic regression on the 18 gait affective features (synthetic)
+    GestureObserver                         multinomial logistic regression over the 11 gesture emotions on gesture
+                                            motion descriptors (synthetic; gesture_observer.py)
 
 Pure numpy/scikit-learn; no Django, no VTK.
 """

@@ -10,8 +10,19 @@ Checks (names in :data:`study_protocol.QA_CHECKS`), each against :data:`study_pr
 - ``bone_error``: a bone length off by more than ``bone_error_mm``;
 - ``figure_height``: smallest projected figure height / frame height < ``figure_height_frac_walk`` (or
   ``..._seated``), when the render's camera is known;
-- ``observer``: a gait with a dominant intended emotion (a share of at least 0.5) that the synthetic observer
-  reads as another emotion with probability >= ``observer_mismatch_p``.
+- ``observer``: a gait with a dominant intended emotion (a share of at least 0.5) that the synthetic gait observer
+  reads as another emotion with probability >= ``observer_mismatch_p``; or a gesture whose synthetic gesture
+  observer (:mod:`generation.quality.gesture_observer`) reads an arousal at least ``gesture_arousal_gap`` away from
+  the intended ``emotion_label``'s (NRC-VAD arousal, 0..1; the observed arousal is the arousal of the 11 emotions
+  weighted by the observer's probabilities). The gesture rule reads arousal, not the top label: the 11 categories
+  overlap in VAD (afraid and disgusted differ by at most 0.04 in each dimension) and the observer confuses such
+  neighbours on generated gestures (69 % top-label accuracy, 97 % on the arousal half;
+  docs/benchmarks/motion_quality.md, "Gesture observer").
+
+Both observers are stand-ins for participants, trained on synthetic motion; a clip's record keeps the top label
+(``observed``), its probability (``observed_p``) and, for gestures, the observed arousal (``observed_arousal``; in
+the record and Clip.qa, not a clips.csv column). Gesture clips shorter than 2.5 s (the network's shortest gesture;
+the shortest training gesture is 2.7 s) get no reading: their descriptors are outside what it was fitted on.
 """
 from __future__ import annotations
 
@@ -21,8 +32,9 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from generation.core.motion import Motion
-from study_protocol import GAIT_EMOTIONS, QA_CHECKS, QA_COLUMNS, QA_THRESHOLDS
+from study_protocol import GAIT_EMOTIONS, GESTURE_VAD, QA_CHECKS, QA_COLUMNS, QA_THRESHOLDS
 
+from .gesture_observer import GestureObserver
 from .metrics import motion_metrics
 
 GAIT_JOINTS = 21  # the observer reads the 21-joint gait skeleton's affective features
@@ -98,13 +110,21 @@ def evaluate(motion: Motion, thresholds: dict | None = None, figure_height_frac:
         thresholds: from :func:`resolve_thresholds` (default: QA_THRESHOLDS).
         figure_height_frac: smallest projected figure height / frame height over the frames (None: not checked).
         seated: the clip shows a seated body (the seated figure-height threshold applies).
-        intended: the gait emotion vector (GAIT_EMOTIONS order) the clip should show, or None.
-        observer: a :class:`generation.quality.observer.GaitObserver` (None: no observer reading).
+        intended: the gait emotion vector (GAIT_EMOTIONS order) or the gesture emotion label (GESTURE_EMOTIONS)
+            the clip should show, or None.
+        observer: a :class:`generation.quality.observer.GaitObserver` for gait motions (21 joints) or a
+            :class:`generation.quality.gesture_observer.GestureObserver` for gesture motions (23 joints, at least
+            as long as its ``min_seconds``, 2.5 s); None or an observer of the other skeleton: no reading.
     """
     values = {k: round(v, 4) for k, v in motion_metrics(motion).items()}
     values["figure_height_frac"] = None if figure_height_frac is None else round(float(figure_height_frac), 4)
     values["observed"], values["observed_p"] = None, None
-    if observer is not None and motion.skeleton.num_joints == GAIT_JOINTS and motion.num_frames >= 2:
+    if isinstance(observer, GestureObserver):
+        if observer.reads(motion):
+            label, p, arousal = observer.reading(motion)
+            values["observed"], values["observed_p"] = label, round(p, 4)
+            values["observed_arousal"] = round(arousal, 4)
+    elif observer is not None and motion.skeleton.num_joints == GAIT_JOINTS and motion.num_frames >= 2:
         label, p = observer.observe(motion)
         values["observed"], values["observed_p"] = label, round(p, 4)
     values["seated"] = bool(seated)
@@ -124,11 +144,23 @@ def failed_checks(values: dict, thresholds: dict | None = None, intended=None) -
     need = th["figure_height_frac_seated" if values.get("seated") else "figure_height_frac_walk"]
     frac = values.get("figure_height_frac")
     failed["figure_height"] = need is not None and frac is not None and frac < need
-    dominant = _dominant(intended)
-    observed, p = values.get("observed"), values.get("observed_p")
-    failed["observer"] = (th["observer_mismatch_p"] is not None and dominant is not None and observed is not None
-                          and p is not None and observed != dominant and p >= th["observer_mismatch_p"])
+    if isinstance(intended, str):
+        failed["observer"] = _gesture_mismatch(values, intended, th["gesture_arousal_gap"])
+    else:
+        dominant = _dominant(intended)
+        observed, p = values.get("observed"), values.get("observed_p")
+        failed["observer"] = (th["observer_mismatch_p"] is not None and dominant is not None and observed is not None
+                              and p is not None and observed != dominant and p >= th["observer_mismatch_p"])
     return [c for c in QA_CHECKS if failed[c]]
+
+
+def _gesture_mismatch(values: dict, intended: str, gap) -> bool:
+    """Whether the gesture observer's arousal is at least ``gap`` away from the intended gesture emotion's NRC-VAD
+    arousal (False when the check is off, the label unknown or the clip was not observed)."""
+    observed = values.get("observed_arousal")
+    if gap is None or observed is None or intended not in GESTURE_VAD:
+        return False
+    return abs(observed - GESTURE_VAD[intended][1]) >= gap
 
 
 def qa_columns(qa: dict | None) -> dict:

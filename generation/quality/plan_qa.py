@@ -1,7 +1,9 @@
 """Quality records of a plan's clips without rendering video (the motion part, the projected figure height and the
-observer), and the per-flag summary that ``generate_clips`` prints.
+synthetic observer's reading: the gait observer for gait clips, the gesture observer for gesture clips), and the
+per-flag summary that ``generate_clips`` prints.
 
-    python -m generation.quality.plan_qa --plan seed000 [--limit K] [--json out.json]
+    python -m generation.quality.plan_qa --plan seed000 [--limit K] [--modality gesture] [--no-figure-height]
+        [--json out.json]
 
 The video render computes the same record for every clip it makes (:func:`generation.render.batch.render_job`).
 """
@@ -23,8 +25,11 @@ PASSED = "passed"
 
 
 def intended_emotion(inputs: dict):
-    """The gait emotion vector an entry asks for (None for transitions, themes, gestures and source walks)."""
-    return inputs.get("emotion")
+    """What the observer check compares with: the gait emotion vector an entry asks for, else its gesture emotion
+    label (``emotion_label``); None for transitions, themes, source walks and gestures given by VAD values."""
+    if inputs.get("emotion") is not None:
+        return inputs["emotion"]
+    return inputs.get("emotion_label")
 
 
 def clip_qa(motion: Motion, settings, thresholds: dict, intended=None, observer=None,
@@ -43,8 +48,16 @@ def clip_qa(motion: Motion, settings, thresholds: dict, intended=None, observer=
     return result, camera_info
 
 
-def needs_observer(entries: Iterable) -> bool:
-    return any(e.modality == "gait" for e in entries)
+def observer_for(modality: str):
+    """The synthetic observer that reads clips of ``modality`` ("gait": :func:`observer.default_observer`,
+    "gesture": :func:`gesture_observer.default_gesture_observer`); None for others or when it cannot be built."""
+    if modality == "gait":
+        from .observer import default_observer
+        return default_observer()
+    if modality == "gesture":
+        from .gesture_observer import default_gesture_observer
+        return default_gesture_observer()
+    return None
 
 
 def summary_counts(flags: Iterable[str]) -> Counter:
@@ -68,26 +81,34 @@ def summary_line(flags: Iterable[str]) -> str:
     return f"QA: {c[PASSED]} passed, {c['flagged']} flagged" + (f" ({per})" if per else "")
 
 
-def run(plan_name: str, limit: int | None = None, log=print) -> list[dict]:
-    """Make every entry's motion and compute its quality record (no video). Returns one row per entry."""
+def run(plan_name: str, limit: int | None = None, log=print, modality: str | None = None,
+        figure_height: bool = True) -> list[dict]:
+    """Make every entry's motion and compute its quality record (no video). Returns one row per entry.
+
+    ``modality``: only the entries of that modality ("gait" or "gesture"; None: all). ``figure_height=False``
+    skips the camera projection (no ``figure_height`` check, faster)."""
     from generation.plans.clipgen import make_motion
     from generation.plans.schema import load_plan
     from generation.render.batch import plan_jobs
 
     from .checks import resolve_thresholds
-    from .observer import default_observer
 
     plan = load_plan(plan_name)
     thresholds = resolve_thresholds(plan.qa)
     jobs, failures = plan_jobs(plan, limit)
-    observer = default_observer() if needs_observer(j.run_entry for j in jobs) else None
+    if modality is not None:
+        jobs = [j for j in jobs if j.run_entry.modality == modality]
+    observers = {m: observer_for(m) for m in sorted({j.run_entry.modality for j in jobs})}
     rows = []
     for job in jobs:
         t0 = time.perf_counter()
-        motion = make_motion(job.run_entry, requested=job.entry.generator, fallback_reason=job.fallback_reason)
-        obs = observer if job.run_entry.modality == "gait" else None
-        result, cam = clip_qa(motion, job.run_entry.render, thresholds, intended_emotion(job.run_entry.inputs), obs)
-        rows.append({"entry": job.entry.id, "clip_id": job.clip_id, "generator": job.run_entry.generator,
+        entry = job.run_entry
+        motion = make_motion(entry, requested=job.entry.generator, fallback_reason=job.fallback_reason)
+        intended = intended_emotion(entry.inputs)
+        camera = None if figure_height else {"rule": None, "seated": entry.modality == "gesture"}
+        result, cam = clip_qa(motion, entry.render, thresholds, intended, observers[entry.modality], camera)
+        rows.append({"entry": job.entry.id, "clip_id": job.clip_id, "modality": entry.modality,
+                     "generator": entry.generator, "intended": intended if isinstance(intended, str) else None,
                      "camera": cam.get("rule"), **result.as_dict(), "seconds": round(time.perf_counter() - t0, 2)})
         log(json.dumps(rows[-1]))
     for where, msg in failures:
@@ -99,9 +120,11 @@ def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--plan", required=True)
     ap.add_argument("--limit", type=int, default=None)
+    ap.add_argument("--modality", choices=("gait", "gesture"), default=None, help="only the entries of this modality")
+    ap.add_argument("--no-figure-height", action="store_true", help="skip the camera projection (figure_height)")
     ap.add_argument("--json", default=None)
     args = ap.parse_args(argv)
-    rows = run(args.plan, args.limit)
+    rows = run(args.plan, args.limit, modality=args.modality, figure_height=not args.no_figure_height)
     print(f"plan {args.plan}: {len(rows)} clips; " + summary_line(r["flag"] for r in rows))
     if args.json:
         with open(args.json, "w", encoding="utf-8") as f:

@@ -187,10 +187,9 @@ def render_job(job: Job, record: dict, clips_dir: str, records_dir: str) -> dict
 
 def _add_qa(record: dict, job: Job, motion, camera: dict) -> None:
     """Measure the clip's quality (:mod:`generation.quality`) into ``record["qa"]`` and ``record["qa_flag"]``."""
-    from generation.quality.observer import default_observer
-    from generation.quality.plan_qa import clip_qa, intended_emotion
+    from generation.quality.plan_qa import clip_qa, intended_emotion, observer_for
 
-    observer = default_observer() if job.run_entry.modality == "gait" else None
+    observer = observer_for(job.run_entry.modality)
     result, _ = clip_qa(motion, job.run_entry.render, job.qa_thresholds, intended_emotion(job.run_entry.inputs),
                         observer, camera_info=camera)
     record["qa"] = _json_safe(result.as_dict())
@@ -380,10 +379,11 @@ def run_plan(plan: Plan, clips_dir: str | Path, records_dir: str | Path, media_p
     todo = _select_todo(batch, jobs, plan, media_prefix, webm)
     emit("plan", {"total": len(batch.by_id), "todo": len(todo), "skipped": len(batch.result.skipped)})
     _remove_stale(todo, clips_dir, records_dir)
-    if any(j.run_entry.modality == "gait" for j in todo) and (workers > 1 or scheduler is not None):
-        from generation.quality.observer import default_observer
+    if workers > 1 or scheduler is not None:
+        from generation.quality.plan_qa import observer_for
 
-        default_observer()  # train/cache the quality observer once, not in every worker
+        for modality in sorted({j.run_entry.modality for j in todo}):
+            observer_for(modality)  # train/cache the quality observers once, not in every worker
     if scheduler is not None:
         _render_dask(batch, todo, scheduler, threads_per_worker)
     elif workers <= 1 or len(todo) <= 1:
