@@ -18,13 +18,22 @@ and starts gunicorn (gthread workers). Then:
 
 Pages are parsed generically (the post form with the most fields; radios/checkboxes take their first value, hidden
 fields are kept, redirects are followed whatever their target), so the driver does not depend on the exact page
-sequence. The locust driver (benchmarks/locustfile.py: gevent users, so the generator is not the bottleneck)
-is the default; --driver threads runs one Python thread per participant with `requests` (the issue-8 driver).
+sequence. An answer POST is acknowledged by a redirect or, as the clip page's form asks for it
+(studyapp.views.INLINE_NEXT_FIELD), by the next clip page itself, whose form action is then the page's URL (as the
+browser's study.js does). The locust driver (benchmarks/locustfile.py: gevent users, so the generator is not the
+bottleneck) is the default; --driver threads runs one Python thread per participant with `requests` (the issue-8
+driver).
 
 Reports answers per second (answer POSTs accepted / wall time, and answers stored / wall time), p50/p99 latency
-of answer POSTs and of clip pages (the GETs after an answer, redirects included), the healthz ceiling and the ratio
-of the study's requests/s to it, and lost / duplicated answers found in the database and in the streamed
-responses.csv (all must be 0).
+of answer POSTs and of clip pages (GETs of a clip page: reloads, and after a redirect), the healthz ceiling and the
+ratio of the study's requests/s to it, lost / duplicated answers found in the database and in the streamed
+responses.csv (all must be 0), and the CPU seconds of the study phase by gunicorn, PostgreSQL (the whole local
+server), the generator and the machine (Linux /proc), also per answered clip.
+
+    python benchmarks/bench_study_load.py --in-process-only --in-process 10 [--profile FILE]
+
+measures only the server time, CPU time and queries of each request kind in-process (Django test client, same
+scratch database set-up, no gunicorn or Locust), optionally with a cProfile of the measured participants.
 """
 from __future__ import annotations
 
@@ -189,9 +198,18 @@ def _answer_clip(http, page: Page, action: str, data: dict, n: int, rec: dict, a
     for _ in range(repeats):
         status, location, text, ms = http.request("POST", action, data, "answer POST")
         rec["answer_ms"].append(ms)
-        if not (300 <= status < 400 and location):
+        if not (300 <= status < 400 and location) and status != 200:
             rec["errors"].append(f"clip {n}: HTTP {status} {_snippet(text)}")
     rec["answer_posts"] += 1
+    if status == 200:
+        # The next clip page came as the answer (studyapp.views.INLINE_NEXT_FIELD); like the browser's script,
+        # take its form's action as the page's URL.
+        next_action, _data, _questions = fill_form(text, action)
+        if next_action is None or not CLIP_RE.search(next_action):
+            rec["errors"].append(f"clip {n}: HTTP 200 without a next clip page: {_snippet(text)}")
+            return Page(599, page.url, text, 0.0)
+        acknowledged.add(n)
+        return Page(200, next_action, text, 0.0)
     if not (300 <= status < 400 and location):
         return Page(status or 599, page.url, text, 0.0)
     acknowledged.add(n)
@@ -340,7 +358,7 @@ class DjangoClientHttp:
         from django.test import Client
 
         self.client = Client()
-        self.costs: dict[str, list[tuple[float, int]]] = {}
+        self.costs: dict[str, list[tuple[float, int, float]]] = {}     # name -> [(wall ms, queries, CPU ms)]
 
     def request(self, method: str, url: str, data: dict | None, name: str):
         from django.db import connection
@@ -349,21 +367,52 @@ class DjangoClientHttp:
         parts = urlsplit(url)
         path = parts.path + (f"?{parts.query}" if parts.query else "")
         with CaptureQueriesContext(connection) as queries:
-            t = time.perf_counter()
-            r = self.client.post(path, data) if method == "POST" else self.client.get(path)
-            ms = 1000 * (time.perf_counter() - t)
-        self.costs.setdefault(name, []).append((ms, len(queries)))
+            t, cpu = time.perf_counter(), time.thread_time()
+            r = (self.client.post(path, urlencode(data or {}), content_type="application/x-www-form-urlencoded")
+                 if method == "POST" else self.client.get(path))      # url-encoded like a browser's form
+            ms, cpu_ms = 1000 * (time.perf_counter() - t), 1000 * (time.thread_time() - cpu)
+        self.costs.setdefault(name, []).append((ms, len(queries), cpu_ms))
         return r.status_code, r.get("Location"), r.content.decode(), ms
 
 
-def in_process_costs(slug: str, n: int) -> dict[str, dict]:
-    """Per request kind: median server time (ms) and queries, from n participants taken in-process after the
-    load run (the machine's other load still applies)."""
+def in_process_costs(slug: str, n: int, profile: str = "") -> dict[str, dict]:
+    """Per request kind: median server time (wall ms; cpu_ms: this Python thread's CPU time, i.e. without
+    PostgreSQL's share and less sensitive to other load) and queries, from n participants taken in-process after the
+    load run (the machine's other load still applies). The first participant only warms up (imports, template
+    compilation, the pool cache) when n > 1. profile: also write cProfile stats of the measured participants to
+    this file (read with `python -m pstats FILE`)."""
+    import cProfile
+
+    if n > 1:
+        take_study(DjangoClientHttp(), "http://testserver", slug, 899_999, time.time() + 300)
     http = DjangoClientHttp()
+    profiler = cProfile.Profile() if profile else None
     for i in range(n):
+        if profiler:
+            profiler.enable()
         take_study(http, "http://testserver", slug, 900_000 + i, time.time() + 300)
-    return {name: {"n": len(v), "ms_p50": round(statistics.median(ms for ms, _ in v), 1),
-                   "queries_p50": statistics.median(q for _, q in v)} for name, v in sorted(http.costs.items())}
+        if profiler:
+            profiler.disable()
+    if profiler:
+        profiler.dump_stats(profile)
+    return {name: {"n": len(v), "ms_p50": round(statistics.median(c[0] for c in v), 2),
+                   "cpu_ms_p50": round(statistics.median(c[2] for c in v), 2),
+                   "queries_p50": statistics.median(c[1] for c in v)} for name, v in sorted(http.costs.items())}
+
+
+def in_process_only(args) -> dict:
+    """--in-process-only: the set-up of a load run (scratch PostgreSQL database, synthetic catalogue, demo study)
+    and the in-process costs, without gunicorn or Locust."""
+    db_url, name = scratch_db_url(args.db_url)
+    recreate_db(args.db_url, name)
+    out = Path(tempfile.mkdtemp(prefix="studybench-"))
+    try:
+        study = setup_django(db_url, out / "media")
+        return {"in_process": in_process_costs(study.slug, max(args.in_process, 1), args.profile),
+                "load_average_1m": round(os.getloadavg()[0], 1)}
+    finally:
+        if not args.keep_db:
+            drop_db(args.db_url, name)
 
 
 def run_threads(args, base: str, slug: str) -> list[dict]:
@@ -416,6 +465,90 @@ def locust_rows(csv_prefix: str) -> dict[str, dict]:
         return {f"{row['Type']} {row['Name']}".strip(): row for row in csv.DictReader(fh)}
 
 
+# ------------------------------------------------------------------------------------------ CPU accounting ---
+
+CLOCK_TICKS = os.sysconf("SC_CLK_TCK") if hasattr(os, "sysconf") else 100
+
+
+def _stat_fields(pid: int) -> list[str]:
+    """/proc/<pid>/stat from field 3 (state) on; [] when the process is gone."""
+    try:
+        return Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()
+    except OSError:
+        return []
+
+
+def tree_cpu_s(pid: int) -> float:
+    """CPU seconds of a process tree: every live process's own time and its reaped children's."""
+    total = 0.0
+    for p in process_tree(pid):
+        fields = _stat_fields(p)
+        total += sum(int(v) for v in fields[11:15]) / CLOCK_TICKS if fields else 0.0
+    return total
+
+
+def process_tree(pid: int) -> list[int]:
+    """pid and its descendants (Linux /proc/<pid>/task/*/children)."""
+    pids, todo = [], [pid]
+    while todo:
+        p = todo.pop()
+        pids.append(p)
+        for task in Path(f"/proc/{p}/task").glob("*"):      # nothing when p is gone
+            try:
+                todo += [int(c) for c in (task / "children").read_text().split()]
+            except OSError:
+                pass
+    return pids
+
+
+def postmaster_pid() -> int | None:
+    """The PostgreSQL server's main process (the parent of this process's backend), when it runs on this machine."""
+    from django.db import connection
+
+    with connection.cursor() as cursor:
+        cursor.execute("SELECT pg_backend_pid()")
+        backend = cursor.fetchone()[0]
+    fields = _stat_fields(backend)
+    return int(fields[1]) if fields else None
+
+
+def machine_busy_s() -> float:
+    """CPU seconds the whole machine has been busy (all cores; /proc/stat, idle and iowait excluded)."""
+    values = [int(v) for v in Path("/proc/stat").read_text().split("\n", 1)[0].split()[1:]]
+    return (sum(values[:8]) - values[3] - values[4]) / CLOCK_TICKS
+
+
+class CpuMeter:
+    """CPU seconds spent during the study phase by gunicorn (master and workers), PostgreSQL (the whole server:
+    backends, also those that exited, and its background processes), the load generator (children of this process
+    reaped meanwhile: locust) and the machine."""
+
+    def __init__(self, gunicorn_pid: int):
+        import resource
+
+        self._resource = resource
+        self.gunicorn_pid, self.postmaster = gunicorn_pid, postmaster_pid()
+        self.gunicorn0 = tree_cpu_s(gunicorn_pid)
+        self.postgres0 = tree_cpu_s(self.postmaster) if self.postmaster else 0.0
+        usage = resource.getrusage(resource.RUSAGE_CHILDREN)
+        self.children0 = usage.ru_utime + usage.ru_stime
+        self.machine0, self.t0 = machine_busy_s(), time.time()
+        self.result: dict = {}
+
+    def stop_servers(self) -> None:
+        """Read gunicorn's and PostgreSQL's share (call while gunicorn still runs)."""
+        gunicorn = tree_cpu_s(self.gunicorn_pid) - self.gunicorn0
+        postgres = tree_cpu_s(self.postmaster) - self.postgres0 if self.postmaster else float("nan")
+        self.result.update(cpu_s_gunicorn=round(gunicorn, 1), cpu_s_postgres=round(postgres, 1),
+                           cpu_s_machine=round(machine_busy_s() - self.machine0, 1),
+                           cpu_wall_s=round(time.time() - self.t0, 1))
+
+    def stop_generator(self) -> None:
+        """Read the generator's share (call once locust has been reaped)."""
+        usage = self._resource.getrusage(self._resource.RUSAGE_CHILDREN)
+        self.result["cpu_s_generator"] = round(usage.ru_utime + usage.ru_stime - self.children0, 1)
+
+
 def run_ceiling(args, base: str, env: dict, out: Path) -> dict:
     prefix = str(out / "ceiling")
     _locust(args, base, env, ["HealthUser"], args.ceiling_users, args.ceiling_users, args.ceiling_s, prefix)
@@ -425,7 +558,8 @@ def run_ceiling(args, base: str, env: dict, out: Path) -> dict:
             "healthz_failures": int(row.get("Failure Count", 0) or 0)}
 
 
-def run_locust_study(args, base: str, env: dict, out: Path, slug: str) -> tuple[list[dict], dict]:
+def run_locust_study(args, base: str, env: dict, out: Path, slug: str, meter: CpuMeter | None = None
+                     ) -> tuple[list[dict], dict]:
     results = out / "participants.jsonl"
     env = dict(env, STUDY_BENCH_SLUG=slug, STUDY_BENCH_RESULTS=str(results), STUDY_BENCH_VIEWERS=str(args.viewers),
                STUDY_BENCH_PARTICIPANTS=str(args.participants), STUDY_BENCH_TICKETS=str(out / "tickets"),
@@ -436,6 +570,8 @@ def run_locust_study(args, base: str, env: dict, out: Path, slug: str) -> tuple[
     n_users = args.participants + args.viewers
     _locust(args, base, env, users, n_users, n_users / args.arrival, args.arrival + args.time_limit + 30,
             str(out / "study"), results, args.participants)
+    if meter is not None:
+        meter.stop_generator()
     records = [json.loads(line) for line in results.open()] if results.exists() else []
     return records, locust_rows(str(out / "study"))
 
@@ -443,7 +579,8 @@ def run_locust_study(args, base: str, env: dict, out: Path, slug: str) -> tuple[
 # ------------------------------------------------------------------------------------------------ results ---
 
 def database_checks(study, records: list[dict]) -> dict:
-    """Lost = clips the server acknowledged (3xx after the answer POST) that are not answered in the database;
+    """Lost = clips the server acknowledged (a redirect or the next clip page after the answer POST) that are not
+    answered in the database;
     duplicated = (participant, section, clip, question) groups with more than one row, in the DB and the CSV."""
     import csv
     import io
@@ -513,6 +650,18 @@ def summarise(args, records: list[dict], checks: dict, ceiling: dict, stats: dic
     }
 
 
+def cpu_per_answered_clip(cpu: dict, result: dict) -> dict:
+    """CPU milliseconds per answered clip (acknowledged answer) of gunicorn, PostgreSQL and the generator, and
+    the share of the machine's busy time that none of them used (other jobs)."""
+    clips = result.get("acknowledged_clips") or 0
+    if not clips or "cpu_s_gunicorn" not in cpu:
+        return {}
+    ours = cpu["cpu_s_gunicorn"] + cpu["cpu_s_postgres"] + cpu.get("cpu_s_generator", 0.0)
+    return {f"cpu_ms_per_clip_{k}": round(1000 * cpu[f"cpu_s_{k}"] / clips, 2)
+            for k in ("gunicorn", "postgres", "generator") if f"cpu_s_{k}" in cpu} | {
+        "cpu_s_other_jobs": round(max(cpu["cpu_s_machine"] - ours, 0.0), 1)}
+
+
 def parse_args(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--participants", type=int, default=200)
@@ -535,6 +684,9 @@ def parse_args(argv=None):
     ap.add_argument("--keep-db", action="store_true", help="keep the scratch database")
     ap.add_argument("--in-process", type=int, default=2,
                     help="afterwards, participants taken in-process to measure each request's server time and queries")
+    ap.add_argument("--in-process-only", action="store_true",
+                    help="measure only the in-process costs (--in-process participants): no gunicorn, no Locust")
+    ap.add_argument("--profile", default="", help="with --in-process-only: write cProfile stats to this file")
     ap.add_argument("--json", default="", help="also write the figures to this JSON file")
     args = ap.parse_args(argv)
     if not 1 <= args.participants <= 400:
@@ -544,6 +696,12 @@ def parse_args(argv=None):
 
 def main(argv=None) -> dict:
     args = parse_args(argv)
+    if args.in_process_only:
+        result = in_process_only(args)
+        print(json.dumps(result, indent=1))
+        if args.json:
+            Path(args.json).write_text(json.dumps(result, indent=1))
+        return result
     db_url, name = scratch_db_url(args.db_url)
     recreate_db(args.db_url, name)
     out = Path(tempfile.mkdtemp(prefix="studybench-"))
@@ -558,10 +716,12 @@ def main(argv=None) -> dict:
         gunicorn = start_gunicorn(args, env, out / "gunicorn.log")
         try:
             wait_for_server(base)
-            ceiling, stats = {}, {}
+            ceiling, stats, meter = {}, {}, None
             if args.driver == "locust":
                 ceiling = run_ceiling(args, base, env, out)
-                records, stats = run_locust_study(args, base, env, out, study.slug)
+                meter = CpuMeter(gunicorn.pid)
+                records, stats = run_locust_study(args, base, env, out, study.slug, meter)
+                meter.stop_servers()
             else:
                 records = run_threads(args, base, study.slug)
         finally:
@@ -570,6 +730,8 @@ def main(argv=None) -> dict:
                     proc.send_signal(signal.SIGTERM)
                     proc.wait(30)
         result = summarise(args, records, database_checks(study, records), ceiling, stats)
+        if meter is not None:
+            result.update(meter.result, **cpu_per_answered_clip(meter.result, result))
         result["gunicorn_log"] = str(out / "gunicorn.log")
         if args.in_process:
             result["in_process"] = in_process_costs(study.slug, args.in_process)
@@ -590,6 +752,8 @@ def passed(result: dict) -> bool:
 
 if __name__ == "__main__":
     res = main()
+    if "lost" not in res:           # --in-process-only
+        sys.exit(0)
     if not passed(res):
         print("FAILED: lost, duplicated, incomplete or failed requests", file=sys.stderr)
     sys.exit(0 if passed(res) else 1)

@@ -1,7 +1,9 @@
 """Participant pages. All state lives in the database; the participant token travels in the URL (and the session
 remembers it per study), so a reload, the back button, a second tab or a server restart resumes exactly where the
-participant was. Every page is a server-rendered form with POST-redirect-GET; static/studyapp/study.js only
-enhances (plays, gates answers until the clip has played, measures response time, preloads the next clip).
+participant was. Every page is a server-rendered form with POST-redirect-GET, except that a clip page's own form
+is answered with the next clip page directly (one request per answered clip, INLINE_NEXT_FIELD; the browser's
+history entry then gets that page's URL); static/studyapp/study.js only enhances (plays, gates answers until the
+clip has played, measures response time, preloads the next clip, sets that URL).
 """
 from __future__ import annotations
 
@@ -10,7 +12,7 @@ import math
 import secrets
 
 from django.db import IntegrityError, transaction
-from django.http import HttpResponse
+from django.http import Http404, HttpResponse
 from django.shortcuts import get_object_or_404, redirect, render
 from django.urls import reverse
 from django.utils import timezone
@@ -25,8 +27,10 @@ from .assignment import StudyUnavailable, check_open, current_step, start_partic
 from .duration import expected_minutes
 from .forms import PARAM_MAX_LENGTH, PARAM_TOO_LONG, ConsentForm, DemographicsForm, FeedbackForm
 from .i18n import activate_study_language
+from .item_questions import questions_html
 from .media import media_path, ranged_file_response
 from .models import Assignment, Clip, Participant, Response, Study
+from .precompiled import PrecompiledSelect
 from .questions import AnswerError, clean_answers, questions_for
 
 SESSION_KEY = "study_tokens"
@@ -186,8 +190,17 @@ def _store_missing_ids(participant: Participant, params: dict[str, str]) -> None
         Participant.objects.filter(pk=participant.pk).update(**updates)
 
 
+# Every participant page's first read, compiled to SQL once per process (studyapp.precompiled).
+_PARTICIPANT_BY_TOKEN = PrecompiledSelect(
+    lambda token: Participant.objects.select_related("study").filter(token=token), "\0token-sentinel")
+
+
 def _participant(token: str) -> Participant:
-    participant = get_object_or_404(Participant.objects.select_related("study"), token=token)
+    """The participant of a URL token with its study (404 if none), the study's language activated."""
+    found = _PARTICIPANT_BY_TOKEN(token)
+    if not found:
+        raise Http404("No participant with this token")
+    participant = found[0]
     activate_study_language(participant.study)
     return participant
 
@@ -244,7 +257,8 @@ def item_context(section, clip, index: int, total: int, next_clip: Clip | None, 
     (a practice item is marked "Practice"; an attention check asks one question with its instruction)."""
     questions = item_questions(section, clip, options, kind, instructed)
     fields = [{"q": q, "selected": posted.getlist(q.key) if posted is not None else []} for q in questions]
-    return {"section": section, "fields": fields, "sources": clip_sources(clip),
+    return {"section": section, "fields": fields, "questions_html": questions_html(fields),
+            "sources": clip_sources(clip),
             "next_sources": clip_sources(next_clip) if next_clip else None,
             "loop": section.loop or clip.loop, "require_play": section.require_full_play,
             "index": index, "total": total, "percent": int(round(100 * (index - 1) / max(total, 1))),
@@ -312,12 +326,19 @@ def mark_completed(participant: Participant) -> None:
             status=Participant.Status.COMPLETED, completed_at=timezone.now())
 
 
+# The clip page's form carries this field: its answer POST is then answered with the next clip page itself
+# (static/studyapp/study.js puts that page's own URL into the address bar), one request per answered clip instead
+# of POST + redirect + GET. A POST without it (a script, a page from before) gets the redirect.
+INLINE_NEXT_FIELD = "inline_next"
+
+
 @never_cache
 @require_http_methods(["GET", "POST"])
 def item(request, token: str, n: int):
-    """Clip number n (1-based over all of the participant's clips): show it, or save its answers and redirect
-    straight to the next clip (or the feedback / end page). A constant number of indexed queries: the
-    participant, its first unanswered assignments, and on GET the one UPDATE of shown_at when first shown."""
+    """Clip number n (1-based over all of the participant's clips): show it, or save its answers and go straight
+    to the next clip (or the feedback / end page): the next clip page itself when the form asked for it
+    (INLINE_NEXT_FIELD), else a redirect. A constant number of indexed queries: the participant, its first
+    unanswered assignments, and on GET the one UPDATE of shown_at when first shown."""
     participant = _participant(token)
     step = current_step(participant, lookahead=request.method == "GET")
     if step.kind != "item" or step.index != n:
@@ -330,9 +351,7 @@ def item(request, token: str, n: int):
         return redirect("studyapp:resume", token=token)
     assignment = step.assignment
     if request.method == "GET":
-        if assignment.shown_at is None:
-            Assignment.objects.filter(pk=assignment.pk, shown_at__isnull=True).update(shown_at=timezone.now())
-        return _render_item(request, participant, step)
+        return _show_item(request, participant, step)
     section, clip = assignment.section, assignment.clip
     questions = item_questions(section, clip, assignment.options, assignment.kind, assignment.instructed)
     try:
@@ -350,7 +369,19 @@ def item(request, token: str, n: int):
     if response_ms is None:
         response_ms = server_ms
     save_answers(assignment, answers, response_ms)
+    if request.POST.get(INLINE_NEXT_FIELD) == "1" and n < participant.n_items:
+        nxt = current_step(participant, lookahead=True)
+        if nxt.kind == "item" and nxt.index == n + 1:
+            return _show_item(request, participant, nxt)
     return redirect(_after_answer_url(participant, n))
+
+
+def _show_item(request, participant: Participant, step):
+    """The clip page of `step` as first shown (no answer selected), recording shown_at the first time."""
+    assignment = step.assignment
+    if assignment.shown_at is None:
+        Assignment.objects.filter(pk=assignment.pk, shown_at__isnull=True).update(shown_at=timezone.now())
+    return _render_item(request, participant, step, posted=None)
 
 
 def save_answers(assignment: Assignment, answers: dict[str, str], response_ms: int) -> bool:
@@ -376,14 +407,21 @@ def save_answers(assignment: Assignment, answers: dict[str, str], response_ms: i
     return True
 
 
-def _render_item(request, participant: Participant, step, status: int = 200, error: str = ""):
+_POSTED = object()
+
+
+def _render_item(request, participant: Participant, step, status: int = 200, error: str = "", posted=_POSTED):
+    """The clip page of `step`; posted: the answers to show selected (default: this request's POST, if any)."""
     assignment = step.assignment
     nxt = step.next_assignment
+    if posted is _POSTED:
+        posted = request.POST if request.method == "POST" else None
     ctx = item_context(assignment.section, assignment.clip, step.index, step.total, nxt.clip if nxt else None,
-                       assignment.options, request.POST if request.method == "POST" else None,
-                       assignment.kind, assignment.instructed)
+                       assignment.options, posted, assignment.kind, assignment.instructed)
     ctx.update({"participant": participant, "study": participant.study, "error": error,
-                "first_of_section": assignment.position == 0})
+                "first_of_section": assignment.position == 0,
+                "form_action": reverse("studyapp:item", kwargs={"token": participant.token, "n": step.index}),
+                "inline_next_field": INLINE_NEXT_FIELD})
     return render(request, "studyapp/item.html", ctx, status=status)
 
 

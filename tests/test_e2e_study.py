@@ -12,6 +12,7 @@ import io
 import os
 import time
 import urllib.request
+from contextlib import contextmanager
 from pathlib import Path
 
 import pytest
@@ -61,6 +62,25 @@ def researcher_shots(driver, base: str, study: Study, folder: Path) -> None:
     full_shot(driver, folder / "study_admin_progress.png", width=1200)
     driver.get(base + reverse("admin:studyapp_study_change", args=[study.pk]))
     full_shot(driver, folder / "study_admin_study.png", width=1200)
+
+
+@contextmanager
+def requests_seen():
+    """The (method, path) of every request the live server starts meanwhile (static files and media excluded)."""
+    from django.core.signals import request_started
+
+    seen: list[tuple[str, str]] = []
+
+    def record(sender, environ=None, **kwargs):
+        path = (environ or {}).get("PATH_INFO", "")
+        if not path.startswith(("/static/", "/m/")):
+            seen.append(((environ or {}).get("REQUEST_METHOD", ""), path))
+
+    request_started.connect(record, weak=False)
+    try:
+        yield seen
+    finally:
+        request_started.disconnect(record)
 
 
 def pick_answers(driver, choice: int = 0):
@@ -130,9 +150,15 @@ def test_whole_demo_study_in_chromium(chromium, live_server, settings, tmp_path)
                     full_shot(driver, Path(shots) / "study_phone_affect_likert.png", width=390)
         pick_answers(driver, n % 3)
         if n == 2 and not reloaded:
-            # reload mid-section before answering: same clip again, nothing saved, nothing lost
+            # reload mid-section before answering: same clip again, nothing saved, nothing lost. Clip 2 came as the
+            # answer to clip 1's POST; study.js gave the page its own URL, so the reload is a plain GET of it.
             reloaded = True
-            driver.refresh()
+            with requests_seen() as seen:
+                driver.refresh()
+                wait_for(driver, lambda d: "/clip/2/" in d.current_url and d.find_element(By.ID, "answer-form"),
+                         what="reloaded clip 2")
+            assert seen and all(method == "GET" for method, _path in seen), seen
+            assert any(path.endswith("/clip/2/") for _method, path in seen), seen
             wait_for(driver, lambda d: d.find_element(By.ID, "next").is_enabled(), timeout=10 + 3 * seconds,
                      what="replayed")
             assert "/clip/2/" in driver.current_url

@@ -3,11 +3,14 @@
 - answering a clip (GET the clip page + POST the answer) takes the same number of SQL queries with 10 and with
   2,000 participants in the study, and goes straight to the next clip (no /resume hop);
 - a GET of a clip page writes nothing but the first shown_at;
+- the clip page's own form asks for the next clip page as the answer to its POST (one request per answered clip):
+  that page is the one a GET would show, a double submit still stores once, and its cost is constant too;
 - participants starting at once from threads all start, and every clip of a balanced section stays within 1 of
   the others.
 """
 from __future__ import annotations
 
+import re
 import threading
 import time
 from collections import Counter
@@ -19,10 +22,11 @@ from django.test.utils import CaptureQueriesContext
 from django.urls import reverse
 
 from studyapp.assignment import current_step, start_participant
-from studyapp.models import Assignment, Participant, SectionClipCount, Study
+from studyapp.models import Assignment, Participant, Response, SectionClipCount, Study
 from studyapp.presets import create_study_from_preset
 from studyapp.questions import questions_for
 from studyapp.testing import make_catalogue
+from studyapp.views import INLINE_NEXT_FIELD
 
 pytestmark = pytest.mark.django_db
 
@@ -206,3 +210,95 @@ def test_last_answer_without_feedback_goes_to_done_and_completes(study):
     assert p.status == "completed" and p.completed_at is not None
     page = client.get(r["Location"])
     assert page.status_code == 200 and study.completion_code.encode() in page.content
+
+
+# --- the clip page's own form: the answer POST is answered with the next clip page (one request per clip) ---
+
+def page_without_csrf(content: bytes) -> str:
+    """A page's HTML with the per-response CSRF token blanked (it is the only part that differs between two
+    renders of the same page)."""
+    return re.sub(r'name="csrfmiddlewaretoken" value="[^"]*"', 'name="csrfmiddlewaretoken" value=""',
+                  content.decode())
+
+
+def inline_answer(a: Assignment) -> dict:
+    return {**answer_for(a), INLINE_NEXT_FIELD: "1"}
+
+
+def test_clip_form_posts_to_its_own_url_and_asks_for_the_next_page(study):
+    client, p = started_participant(study)
+    url = reverse("studyapp:item", args=[p.token, 1])
+    html = client.get(url).content.decode()
+    form = re.search(r'<form method="post" id="answer-form"[^>]*>', html).group(0)
+    assert f'action="{url}"' in form
+    assert f'<input type="hidden" name="{INLINE_NEXT_FIELD}" value="1">' in html
+
+
+def test_inline_answer_returns_the_next_clip_page_as_a_get_would_show_it(study):
+    client, p = started_participant(study)
+    client.get(reverse("studyapp:item", args=[p.token, 1]))
+    first = current_step(Participant.objects.select_related("study").get(pk=p.pk)).assignment
+    r = client.post(reverse("studyapp:item", args=[p.token, 1]), inline_answer(first))
+    assert r.status_code == 200 and "Location" not in r
+    assert Response.objects.filter(participant=p, clip=first.clip).count() == len(answer_for(first))
+    second = Assignment.objects.get(participant=p, seq=2)
+    assert second.shown_at is not None                       # shown now, as by the GET it replaces
+    again = client.get(reverse("studyapp:item", args=[p.token, 2]))
+    assert again.status_code == 200
+    assert page_without_csrf(r.content) == page_without_csrf(again.content)
+    assert Assignment.objects.get(pk=second.pk).shown_at == second.shown_at     # the GET kept the first shown_at
+    assert b" checked" not in r.content                      # nothing of the previous answer is pre-selected
+
+
+def test_inline_double_submit_stores_once_and_redirects_to_the_current_clip(study):
+    client, p = started_participant(study)
+    url = reverse("studyapp:item", args=[p.token, 1])
+    client.get(url)
+    a = current_step(Participant.objects.select_related("study").get(pk=p.pk)).assignment
+    data = inline_answer(a)
+    assert client.post(url, data).status_code == 200
+    for _ in range(2):
+        r = client.post(url, data)
+        assert r.status_code == 302 and r["Location"] == reverse("studyapp:item", args=[p.token, 2])
+    assert Response.objects.filter(participant=p, clip=a.clip).count() == len(answer_for(a))
+
+
+def test_inline_refused_answer_shows_the_same_clip_with_the_selection(study):
+    client, p = started_participant(study)
+    url = reverse("studyapp:item", args=[p.token, 1])
+    client.get(url)
+    r = client.post(url, {"perceived": "joyful", INLINE_NEXT_FIELD: "1"})
+    assert r.status_code == 400 and f'action="{url}"'.encode() in r.content
+    assert not Response.objects.filter(participant=p).exists()
+
+
+def test_inline_answer_cost_does_not_grow_with_the_study(study):
+    """One inline answer (save clip n, show clip n + 1) costs the same queries with 10 and 2,000 participants, and
+    no more than the POST and the GET it replaces."""
+    add_crowd(study, 10)
+    client, p = started_participant(study)
+    client.get(reverse("studyapp:item", args=[p.token, 1]))
+
+    def one(n: int) -> int:
+        step = current_step(Participant.objects.select_related("study").get(pk=p.pk))
+        with CaptureQueriesContext(connection) as q:
+            r = client.post(reverse("studyapp:item", args=[p.token, n]), inline_answer(step.assignment))
+        assert r.status_code == 200
+        return len(q)
+
+    small = [one(n) for n in (1, 2, 3)]
+    add_crowd(study, 2000)
+    large = [one(n) for n in (4, 5, 6)]
+    assert small == large, (small, large)
+    assert large[0] <= 9, large
+
+
+def test_inline_last_answer_goes_to_feedback(study):
+    client, p = started_participant(study)
+    p.refresh_from_db()
+    while (step := current_step(p)).kind == "item":
+        r = client.post(reverse("studyapp:item", args=[p.token, step.index]), inline_answer(step.assignment))
+        p.refresh_from_db()
+        if step.index < p.n_items:
+            assert r.status_code == 200
+    assert r.status_code == 302 and r["Location"] == reverse("studyapp:feedback", args=[p.token])

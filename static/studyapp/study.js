@@ -1,5 +1,6 @@
 /* Progressive enhancement of the participant forms. Without JS every form still works (the server checks all).
    Clip page:
+   - the address bar shows the page's own URL, also when the page came as the answer to the previous clip's POST;
    - answers are enabled once the clip has played through (when the section requires it);
    - replay button; response time measured from page display to submit (hidden field "rt", ms);
    - the next clip is preloaded once this one can play; a double submit is blocked.
@@ -16,6 +17,12 @@
   var t0 = performance.now();
   var form = document.getElementById("answer-form");
   if (!form) { return; }
+  // A clip page that answers the previous clip's POST is shown under that POST's URL: give the history entry the
+  // page's own URL (the form's action), so a reload or a bookmark asks the server for this page with a GET instead
+  // of resending the previous answer (the server would ignore it, but the browser would ask first).
+  if (form.getAttribute("action") && window.history && window.history.replaceState) {
+    window.history.replaceState(window.history.state, "", form.getAttribute("action"));
+  }
   var submit = document.getElementById("next");
   var live = liveRegion();
   var video = document.getElementById("clip");
