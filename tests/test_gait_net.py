@@ -235,6 +235,20 @@ def test_splice_histories_switches_history_and_emotion(tiny_data):
     assert pred["q"].shape == batch["q"][:, 1:].shape
 
 
+def test_uniform_labels_replace_a_fraction_of_the_emotion_inputs(tiny_data):
+    from generation.gait.train import uniform_labels
+    batch = splice_histories(tiny_data.batch(np.arange(len(tiny_data))), 18, 0.0, np.random.default_rng(0))
+    none = uniform_labels(batch, 0.0, np.random.default_rng(0))
+    assert torch.equal(none["emotion"], batch["emotion"])
+    every = uniform_labels(batch, 1.0, np.random.default_rng(0))
+    assert torch.allclose(every["emotion"], torch.full_like(batch["emotion"], 0.25))
+    assert torch.equal(every["q"], batch["q"])   # only the emotion input changes
+    some = uniform_labels(batch, 0.5, np.random.default_rng(3))["emotion"]
+    dropped = (some == 0.25).all(-1).all(-1)
+    assert dropped.any() and not dropped.all()
+    assert torch.equal(some[~dropped], batch["emotion"][~dropped])
+
+
 def test_training_writes_checkpoint_and_resumes(tiny_data, tmp_path):
     cfg = GaitNetConfig.tiny(epochs=1, batch_size=2)
     out = tmp_path / "w.pt"
@@ -286,6 +300,53 @@ def test_generation_uses_the_emotion_input(tiny_net):
     a, b = generate_gaits([seed, seed], [straight(10.0)] * 2, np.array([[1, 0, 0, 0], [0, 1, 0, 0]]), steps=10,
                           model=tiny_net)
     assert not np.allclose(a.rotations, b.rotations)
+
+
+def test_emotion_guidance_extrapolates_from_the_uniform_emotion(tiny_net):
+    """Scale 0 is the plain network; a positive scale moves each step away from the uniform-emotion prediction
+    (for the uniform emotion itself it changes nothing); the scale stored with the weights is the default."""
+    from generation.gait.generate import _guided
+
+    seed = walk(WalkParams(), straight(10.0), 80, 30.0)
+    args = ([seed], [straight(10.0)], np.array([[0.7, 0.1, 0.1, 0.1]]))
+    (plain,) = generate_gaits(*args, steps=12, model=tiny_net, foot_cleanup=False)
+    (zero,) = generate_gaits(*args, steps=12, model=tiny_net, foot_cleanup=False, emotion_guidance=0.0)
+    (guided,) = generate_gaits(*args, steps=12, model=tiny_net, foot_cleanup=False, emotion_guidance=1.0)
+    np.testing.assert_array_equal(plain.rotations, zero.rotations)
+    assert not np.allclose(plain.rotations, guided.rotations)
+    assert np.allclose(np.linalg.norm(guided.rotations, axis=-1), 1.0, atol=1e-6)
+    uniform = ([seed], [straight(10.0)], np.full((1, 4), 0.25))
+    (u0,) = generate_gaits(*uniform, steps=12, model=tiny_net, foot_cleanup=False)
+    (u1,) = generate_gaits(*uniform, steps=12, model=tiny_net, foot_cleanup=False, emotion_guidance=2.0)
+    np.testing.assert_allclose(u0.rotations, u1.rotations, atol=1e-5)
+    # p + w (p - p0) on every output, rotations re-normalised.
+    cond = {"q_raw": torch.tensor([[[2.0, 0, 0, 0]]]), "root": torch.ones(1, 3), "omega": torch.ones(1)}
+    base = {"q_raw": torch.tensor([[[1.0, 1, 0, 0]]]), "root": torch.zeros(1, 3), "omega": torch.zeros(1)}
+    out = _guided(cond, base, 0.5)
+    assert torch.allclose(out["root"], torch.full((1, 3), 1.5)) and torch.allclose(out["omega"], torch.tensor([1.5]))
+    assert torch.allclose(out["q"], torch.tensor([[[2.5, -0.5, 0, 0]]]) / math.hypot(2.5, 0.5))
+    stored = LoadedGaitNet(tiny_net.model, tiny_net.normalizer, "g.pt", {"emotion_guidance": 1.0}, tiny_net.config)
+    (by_default,) = generate_gaits(*args, steps=12, model=stored, foot_cleanup=False)
+    np.testing.assert_array_equal(by_default.rotations, guided.rotations)
+    with pytest.raises(ValueError, match="emotion_guidance"):
+        generate_gaits(*args, steps=5, model=tiny_net, emotion_guidance=-1.0)
+
+
+def test_guidance_scale_choice_and_storage(tiny_net, tmp_path):
+    from generation.gait.guidance import choose_scale, lowest_class, write_guidance
+
+    def result(lo):
+        return {"val_walk_seeds": {"happy": 0.9, "sad": lo}, "unseen_mixtures": {"happy": 1.0, "sad": 0.95}}
+    results = {0.0: result(0.7), 1.0: result(0.85), 2.0: result(0.85), 3.0: result(0.6)}
+    assert lowest_class(results[1.0]) == 0.85
+    assert choose_scale(results) == 1.0   # the best lowest class; the smaller scale on a tie
+    path = tmp_path / "w.pt"
+    save_checkpoint(path, tiny_net.model, tiny_net.normalizer, tiny_net.config)
+    assert load_model(path).emotion_guidance == 0.0
+    write_guidance(path, 1.0, results, "abc")
+    loaded = load_model(path)
+    assert loaded.emotion_guidance == 1.0 and loaded.config == tiny_net.config
+    assert torch.load(path, weights_only=False)["emotion_guidance_selection"]["split"] == "val"
 
 
 def test_generation_plants_feet_by_default(tiny_net):

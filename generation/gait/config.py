@@ -158,6 +158,10 @@ class GaitTrainConfig:
         (inputs from its own predictions, the path heading and emotion of the last step); they have no per-step
         target and enter only the style term (``GaitLossWeights.style``), which asks them to keep the walk's style
         statistics. This trains the long rollouts of generation (200+ steps) against drifting to an average gait.
+    uniform_label_frac: fraction of training sequences whose emotion input is replaced by the uniform vector
+        (1/C each) at every step, as in classifier-free guidance training: the uniform vector then means "no
+        emotion asked, continue the history", the reference that emotion guidance at generation extrapolates from
+        (``generate_gaits(emotion_guidance=...)``). 0 (the default) leaves every label as it is.
     seed: seeds torch and numpy (runs are repeatable).
     """
 
@@ -170,6 +174,7 @@ class GaitTrainConfig:
     splice_frac: float = 0.3
     extra_steps: int = 30
     tf_start: float = 1.0
+    uniform_label_frac: float = 0.0
     seed: int = 0
 
     def to_dict(self) -> dict:
@@ -222,7 +227,8 @@ FLAT_NAMES: dict[str, tuple[str, str]] = {
                                           "num_joints", "num_emotions")},
     **{name: ("data", name) for name in ("seq_len", "frame_step", "prefix_frac")},
     **{name: ("train", name) for name in ("batch_size", "epochs", "lr", "lr_decay", "tf_decay", "grad_clip",
-                                          "splice_frac", "extra_steps", "tf_start", "seed")},
+                                          "splice_frac", "extra_steps", "tf_start", "uniform_label_frac",
+                                          "seed")},
     **{f"lambda_{name}": ("loss", name) for name in ("motion", "versor", "pose", "aff", "root", "fctc", "phase",
                                                                   "style")},
     "pos_scale_m": ("loss", "pos_scale_m"),

@@ -69,6 +69,12 @@ class LoadedGaitNet:
         return 30.0 / self.config.data.frame_step
 
     @property
+    def emotion_guidance(self) -> float:
+        """The emotion-guidance scale generation uses by default with these weights (``info["emotion_guidance"]``,
+        chosen on the validation walks and stored in the weights file; 0 when the file has none)."""
+        return float(self.info.get("emotion_guidance", 0.0))
+
+    @property
     def device(self) -> torch.device:
         """Where the model's weights are."""
         return next(self.model.parameters()).device
@@ -93,7 +99,8 @@ _DEFAULT: LoadedGaitNet | None = None
 def load_model(path: str | Path, device: str | torch.device | None = "cpu") -> LoadedGaitNet:
     """Load weights written by the training command (on any device) onto ``device``."""
     model, norm, payload = load_checkpoint(path, device)
-    info = {k: payload[k] for k in ("trained_on", "num_parameters", "corpus", "initialised_from") if k in payload}
+    info = {k: payload[k] for k in ("trained_on", "num_parameters", "corpus", "initialised_from", "emotion_guidance")
+            if k in payload}
     info["epochs"] = len(payload.get("history", []))
     return LoadedGaitNet(model, norm, str(path), info, GaitNetConfig.from_dict(payload["config"]))
 
@@ -304,13 +311,24 @@ def _predict_next(net: LoadedGaitNet, seed: dict, pred: dict, hidden: torch.Tens
     return {k: v.cpu() for k, v in out.items() if k != "hidden"}, out["hidden"]
 
 
+def _guided(cond: dict, plain: dict, scale: float) -> dict:
+    """Emotion guidance: the prediction conditioned on the requested emotion moved ``scale`` times further from
+    the prediction conditioned on the emotion-neutral (uniform) vector, in every output (unnormalised rotations,
+    then re-normalised; standardised root features and phase increment)."""
+    out = {k: v + scale * (v - plain[k]) for k, v in cond.items() if k in ("q_raw", "root", "omega")}
+    out["q"] = out["q_raw"] / out["q_raw"].norm(dim=-1, keepdim=True).clamp_min(1e-8)
+    return out
+
+
 def _rollout(net: LoadedGaitNet, seed: dict, emotions: np.ndarray, trackers: list[_PathTracker],
-             placement: _Placement, lookahead_m: float) -> tuple[np.ndarray, np.ndarray]:
+             placement: _Placement, lookahead_m: float, guidance: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
     """The autoregressive rollout (section 5.4.1) after the seed, one step per emotion row.
 
     Each step turns the prediction into world rotations in the heading frame of the pure-pursuit direction,
     moves the root by the predicted step (its height mean + h), then advances the phase, s-bar and kappa
     and feeds the prediction back. Returns world rotations (N, steps, J, 4) and root positions (N, steps, 3).
+    With ``guidance`` > 0 a second GRU state is run with the uniform emotion vector on the same (guided) inputs
+    and each step's prediction is :func:`_guided`.
     """
     norm, (N, steps) = net.normalizer, emotions.shape[:2]
     net.model.eval()
@@ -318,6 +336,11 @@ def _rollout(net: LoadedGaitNet, seed: dict, emotions: np.ndarray, trackers: lis
     out_root = np.zeros((N, steps, 3))
     with torch.no_grad():
         pred, hidden = _predict_seed(net, seed, emotions)
+        if guidance:
+            uniform = np.full_like(emotions, 1.0 / NUM_EMOTIONS)
+            em_plain = torch.as_tensor(uniform[:, 0], dtype=torch.float32)
+            plain, hidden_plain = _predict_seed(net, seed, uniform)
+            pred = _guided(pred, plain, guidance)
         theta, sbar = seed["theta"][:, -1].double(), seed["sbar"][:, -1].double()
         ref_prev = torch.as_tensor(placement.rot_yaw) + seed["ref"][:, -1].double()
         xz = placement.start.copy()
@@ -340,7 +363,11 @@ def _rollout(net: LoadedGaitNet, seed: dict, emotions: np.ndarray, trackers: lis
             kappa = kappa_torch(sbar_new, ref, sbar, ref_prev)
             sbar, ref_prev = sbar_new, ref
             step_in = norm.step(theta.float(), omega.float(), sbar.float(), kappa.float())
-            pred, hidden = _predict_next(net, seed, pred, hidden, h, step_in, em_all[:, k + 1])
+            cond, hidden = _predict_next(net, seed, pred, hidden, h, step_in, em_all[:, k + 1])
+            if guidance:
+                plain, hidden_plain = _predict_next(net, seed, pred, hidden_plain, h, step_in, em_plain)
+                cond = _guided(cond, plain, guidance)
+            pred = cond
     return out_rot, out_root
 
 
@@ -370,8 +397,8 @@ def _metadata(net: LoadedGaitNet, emotions: np.ndarray, path: GroundPath, seed_m
 
 def generate_gaits(seeds, paths: list[GroundPath], emotions, steps: int = 200, fps_out: float = 30.0,
                    model: LoadedGaitNet | None = None, lookahead_m: float = 1.0, include_seed: bool = False,
-                   rng_seed: int = 0, foot_cleanup: bool = True, device: str | torch.device | None = None
-                   ) -> list[Motion]:
+                   rng_seed: int = 0, foot_cleanup: bool = True, device: str | torch.device | None = None,
+                   emotion_guidance: float | None = None) -> list[Motion]:
     """Generate emotive gaits for N agents in one batch.
 
     Args:
@@ -395,6 +422,10 @@ def generate_gaits(seeds, paths: list[GroundPath], emotions, steps: int = 200, f
         device: where the network runs: None keeps the model where it is (the default model loads on the CPU),
             or "auto" / "cpu" / "cuda" / "cuda:N" (:func:`generation.core.device.resolve_device`; the model is
             copied there, the caller's is not moved). Path steering, resampling and foot planting stay on the CPU.
+        emotion_guidance: scale w of emotion guidance (:func:`_guided`): each step's prediction p(m) becomes
+            p(m) + w (p(m) - p(uniform)), so the requested emotion counts more against the seed's style; 0 is the
+            plain network, None the scale stored with the weights (:attr:`LoadedGaitNet.emotion_guidance`).
+            It doubles the network work per step.
 
     Returns:
         N Motions on each seed's skeleton, metadata {"origin": "generated", "generator": "gait_net", "emotion",
@@ -407,7 +438,11 @@ def generate_gaits(seeds, paths: list[GroundPath], emotions, steps: int = 200, f
     seeds, emotions = _check_inputs(seeds, paths, emotions, steps)
     seed_motions, seed = _seed_batch(seeds, emotions, net.config.data, np.random.default_rng(rng_seed))
     placement = _Placement.onto_paths(paths, seed)
-    rot, root = _rollout(net, seed, emotions, _path_trackers(paths, net.normalizer, steps), placement, lookahead_m)
+    guidance = net.emotion_guidance if emotion_guidance is None else float(emotion_guidance)
+    if guidance < 0 or not math.isfinite(guidance):
+        raise ValueError(f"emotion_guidance must be a finite number >= 0, got {guidance}")
+    rot, root = _rollout(net, seed, emotions, _path_trackers(paths, net.normalizer, steps), placement, lookahead_m,
+                         guidance)
     motions = []
     for i, path in enumerate(paths):
         r, rt = _with_seed(seed, placement, i, rot[i], root[i]) if include_seed else (rot[i], root[i])

@@ -16,7 +16,8 @@ enter the style term (:func:`generation.gait.losses.style_loss`), against drift 
 
 A fraction ``splice_frac`` of each batch gets the ground-truth prefix of a walk with another emotion and a label
 that switches to the sequence's own at the splice (:func:`splice_histories`), so that the emotion input, not the
-motion history, decides the style.
+motion history, decides the style. With ``uniform_label_frac`` > 0 a fraction of the sequences get the uniform
+emotion vector instead of their label (:func:`uniform_labels`; the reference of emotion guidance at generation).
 """
 from __future__ import annotations
 
@@ -110,6 +111,14 @@ def splice_histories(batch: dict, prefix: int, frac: float, rng: np.random.Gener
         out[k] = v
     em[:, :prefix - 1] = torch.where(swap[:, None, None], batch["emotion"][src_t, None], em[:, :prefix - 1])
     return out
+
+
+def uniform_labels(batch: dict, frac: float, rng: np.random.Generator) -> dict:
+    """Replace the per-step emotion input (B, T, C) of a fraction ``frac`` of the sequences by the uniform vector
+    (classifier-free guidance training; the targets stay the walk's own). Returns a new batch."""
+    em = batch["emotion"]
+    drop = torch.as_tensor(rng.random(em.shape[0]) < frac, device=em.device)
+    return dict(batch, emotion=torch.where(drop[:, None, None], torch.full_like(em, 1.0 / em.shape[-1]), em))
 
 
 _PRED_KEYS = ("q_raw", "q", "pos", "root", "omega", "h", "aff")
@@ -352,6 +361,8 @@ def _train_epoch(step: _Step, train_set: GaitSequences, tf: float, rng: np.rando
     bar = tqdm(batches, desc=desc, disable=not progress, leave=False)
     for idx in bar:
         batch = splice_histories(train_set.batch(idx), step.config.prefix_len, tc.splice_frac, rng)
+        if tc.uniform_label_frac > 0:
+            batch = uniform_labels(batch, tc.uniform_label_frac, rng)
         total, terms = step(batch, tf, gen)
         terms["total"] = total
         for k, v in terms.items():

@@ -1,0 +1,142 @@
+"""Choosing the emotion-guidance scale of a gait weights file on the VALIDATION walks (docs/benchmarks/gait.md,
+issue 14).
+
+Generation can extrapolate each step's prediction away from the one conditioned on the emotion-neutral (uniform)
+vector (``generate_gaits(emotion_guidance=w)``, :func:`generation.gait.generate._guided`). The scale is a property
+of the weights: it is chosen here, once, by the synthetic observer (:mod:`generation.quality.observer`) on the
+corpus's validation split (never the test split), and stored in the weights file as ``emotion_guidance``, which
+``generate_gaits`` uses by default. The observer is not used at generation time.
+
+Selection: for every candidate scale, 200-step gaits are generated from each validation walk's first 18 network
+steps with the walk's own (soft) label, and from procedural seeds of four unseen mixtures (dominant 0.55, others
+0.15; 10 per mixture; other seed walks than benchmarks/bench_gait.py's); the chosen scale has the highest lowest
+per-class accuracy over both, ties going to the smaller scale.
+
+Usage: ``python -m generation.gait.guidance --weights W.pt --scales 0,0.5,1,2 [--write]``.
+"""
+from __future__ import annotations
+
+import argparse
+import json
+from pathlib import Path
+
+import numpy as np
+import torch
+
+from study_protocol import GAIT_EMOTIONS
+
+from .data import DEFAULT_CORPUS, load_corpus_sequences
+
+SEED_STEPS = 18      # network steps of a seed walk (69 frames at 30 fps)
+STEPS = 200          # generated network steps per gait
+PER_MIXTURE = 10     # procedural seeds per unseen mixture
+PROCEDURAL_RNG_SEED = 101  # not the benchmark's (11): selection sees other procedural seed walks
+
+
+def unseen_mixtures() -> np.ndarray:
+    """(4, 4) emotion mixtures not in the corpus: dominant 0.55, the rest 0.15 each (row k dominated by
+    GAIT_EMOTIONS[k])."""
+    m = np.full((4, 4), 0.15)
+    np.fill_diagonal(m, 0.55)
+    return m
+
+
+def per_class_accuracy(pred: np.ndarray, intended: np.ndarray) -> dict[str, float]:
+    """{emotion: share of the gaits intended as it that the observer calls it} (NaN for an absent class)."""
+    return {e: float((pred[intended == k] == k).mean()) if (intended == k).any() else float("nan")
+            for k, e in enumerate(GAIT_EMOTIONS)}
+
+
+def evaluate_scale(net, scale: float, observer, corpus, val_rows: np.ndarray, val_emotion: np.ndarray) -> dict:
+    """Observer accuracy per class for one guidance scale: {"val_walk_seeds": {...}, "unseen_mixtures": {...}}.
+
+    val_rows: corpus indices of the validation walks; val_emotion: (N, 4) their soft labels."""
+    from generation.core.paths import straight
+
+    from .generate import generate_gaits
+
+    n_frames = 4 * SEED_STEPS - 3
+    seeds = [corpus.motion(int(i)).slice(0, n_frames) for i in val_rows]
+    own = generate_gaits(seeds, [straight(60.0)] * len(seeds), val_emotion, steps=STEPS, model=net,
+                         foot_cleanup=False, emotion_guidance=scale)
+    mix = np.repeat(unseen_mixtures(), PER_MIXTURE, axis=0)
+    proc = generate_gaits(None, [straight(60.0)] * len(mix), mix, steps=STEPS, model=net,
+                          rng_seed=PROCEDURAL_RNG_SEED, foot_cleanup=False, emotion_guidance=scale)
+    return {"val_walk_seeds": per_class_accuracy(observer.predict_motions(own), val_emotion.argmax(1)),
+            "unseen_mixtures": per_class_accuracy(observer.predict_motions(proc), mix.argmax(1))}
+
+
+def lowest_class(result: dict) -> float:
+    """The lowest per-class accuracy over both seed kinds of :func:`evaluate_scale`."""
+    return min(v for table in result.values() for v in table.values())
+
+
+def choose_scale(results: dict[float, dict]) -> float:
+    """The scale with the highest :func:`lowest_class`, the smaller scale on ties."""
+    return max(sorted(results), key=lambda s: (lowest_class(results[s]), -s))
+
+
+def select_guidance(weights: str | Path, scales: list[float], corpus_path: str | Path | None = None,
+                    log=print) -> tuple[float, dict[float, dict]]:
+    """Evaluate ``scales`` for ``weights`` on the validation walks; returns (chosen scale, results per scale)."""
+    from generation.procedural.corpus import GaitCorpus
+    from generation.quality.observer import GaitObserver
+
+    from .generate import load_model
+
+    if not scales or any(s < 0 for s in scales):
+        raise ValueError(f"give one or more guidance scales >= 0, got {scales}")
+    corpus_path = Path(corpus_path) if corpus_path else DEFAULT_CORPUS
+    data = load_corpus_sequences(corpus_path)
+    observer = GaitObserver(data.subset((data.split == "train") & (data.offset == 0)))
+    val = data.subset((data.split == "val") & (data.offset == 0))
+    corpus = GaitCorpus.load(corpus_path)
+    net = load_model(weights)
+    results = {}
+    for s in scales:
+        results[s] = evaluate_scale(net, s, observer, corpus, val.base_index, val.emotion.numpy().astype(np.float64))
+        log(f"guidance {s:g}: " + "; ".join(
+            f"{kind} " + " / ".join(f"{e} {v:.2f}" for e, v in table.items()) for kind, table in results[s].items())
+            + f"; lowest {lowest_class(results[s]):.2f}")
+    return choose_scale(results), results
+
+
+def write_guidance(weights: str | Path, scale: float, results: dict[float, dict], corpus_sha256: str) -> None:
+    """Store ``scale`` (and the validation table it was chosen from) in the weights file."""
+    path = Path(weights)
+    payload = torch.load(path, map_location="cpu", weights_only=False)
+    payload["emotion_guidance"] = float(scale)
+    payload["emotion_guidance_selection"] = {
+        "split": "val", "steps": STEPS, "corpus_sha256": corpus_sha256,
+        "results": {f"{s:g}": r for s, r in results.items()}}
+    tmp = path.with_suffix(path.suffix + ".tmp")
+    torch.save(payload, tmp)
+    tmp.replace(path)
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--weights", required=True, help="gait weights file")
+    ap.add_argument("--scales", default="0,0.5,1,2", help="comma-separated guidance scales to compare")
+    ap.add_argument("--corpus", default=None, help=f"corpus .npz (default {DEFAULT_CORPUS})")
+    ap.add_argument("--write", action="store_true", help="store the chosen scale in the weights file")
+    ap.add_argument("--threads", type=int, default=1)
+    args = ap.parse_args(argv)
+    torch.set_num_threads(args.threads)
+    try:
+        scales = [float(s) for s in args.scales.split(",")]
+    except ValueError:
+        raise SystemExit(f"--scales: expected comma-separated numbers, got {args.scales!r}") from None
+    chosen, results = select_guidance(args.weights, scales, args.corpus)
+    print(f"chosen guidance scale {chosen:g} (lowest class {lowest_class(results[chosen]):.2f})")
+    if args.write:
+        from .data import file_sha256
+        write_guidance(args.weights, chosen, results,
+                       file_sha256(Path(args.corpus) if args.corpus else DEFAULT_CORPUS))
+        print(f"wrote emotion_guidance={chosen:g} into {args.weights}")
+    print(json.dumps({f"{s:g}": r for s, r in results.items()}, indent=1))
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
