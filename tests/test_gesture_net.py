@@ -248,6 +248,44 @@ def test_liveliness_loss_punishes_a_still_answer_but_not_a_phase_shift():
     assert velocity_loss(p_t, p_t, mask, 10.0) < 1e-10 < velocity_loss(p_still, p_t, mask, 10.0)
 
 
+def test_peak_wrist_speed_is_the_benchmark_statistic():
+    """The loss's faster-wrist mean and 90th percentile equal the numpy metric the issue-14 table reports, padding
+    excluded, and the log-ratio liveliness loss charges a too-fast answer about as a too-slow one."""
+    from generation.gesture.losses import liveliness_loss, peak_wrist_speed
+    from generation.gesture.metrics import wrist_speed_of_positions
+    from generation.procedural.gesture import GestureParams, seated_gesture
+
+    seqs = [torch.as_tensor(seated_gesture(GestureParams(kind=k, speed=s), 40, 10.0, seed=0).rotations,
+                            dtype=torch.float32) for k, s in (("beat", 1.5), ("descriptive", 0.8))]
+    lengths = (40, 27)
+    batch = torch.stack(seqs)
+    mask = torch.arange(40)[None] < torch.tensor(lengths)[:, None]
+    positions = _wrist_positions(batch).double()
+    got = peak_wrist_speed(positions, mask, 10.0)
+    for b, L in enumerate(lengths):
+        want = wrist_speed_of_positions(positions[b, :L].numpy(), 10.0)
+        assert got[b, 0].item() == pytest.approx(want["mean"], rel=1e-3)  # 1e-8 m^2 inside the sqrt
+        assert got[b, 1].item() == pytest.approx(want["peak"], rel=1e-3)
+    # the same path scaled about the root: every wrist speed x1.5 or x1/1.5 costs about the same
+    t, m = positions[:1], mask[:1]
+    assert liveliness_loss(t, t, m, 10.0, "log_peak") < 1e-10
+    with pytest.raises(ValueError, match="liveliness form"):
+        liveliness_loss(t, t, m, 10.0, "rms")
+    too_fast, too_slow = (liveliness_loss(1.5 * t, t, m, 10.0, "log_peak"),
+                          liveliness_loss(t / 1.5, t, m, 10.0, "log_peak"))
+    assert too_fast.item() == pytest.approx(too_slow.item(), rel=0.3)  # log ratios: 1.5x costs about as 1/1.5x
+    assert too_fast > 0.05
+
+
+def test_emotion_speed_gap_is_the_worst_emotion_ratio():
+    from generation.gesture.metrics import emotion_speed_gap
+
+    speeds = np.array([[0.5, 1.0, 0.5, 1.0], [0.3, 0.6, 0.3, 0.6],   # joyous: generated = corpus
+                       [0.2, 0.5, 0.4, 0.5], [0.2, 0.5, 0.4, 0.5]])  # sad: mean at half the corpus'
+    assert emotion_speed_gap(speeds, ["joyous", "joyous", "sad", "sad"]) == pytest.approx(np.log(2))
+    assert emotion_speed_gap(speeds[:2], ["joyous", "joyous"]) == pytest.approx(0.0)
+
+
 def test_tiny_network_overfits_a_tiny_batch():
     torch.manual_seed(0)
     B, T = 2, 10
@@ -409,3 +447,22 @@ def test_shipped_network_expands_for_dominant_emotions(shipped):
                              model=shipped, fps=10.0)
         spread[emotion] = np_gesture_affective_features(m.positions())[:, 11].mean()  # wrist spread / torso
     assert spread["proud"] > spread["sad"] + 0.1
+
+
+def test_liveliness_options_are_opt_in():
+    """The default command trains the shipped recipe (mean/RMS liveliness in m/s, selection without the per-emotion
+    gap); --liveliness-form log_peak and --select-emotion-gap switch the issue-14 second-pass variants on."""
+    from generation.gesture.metrics import selection_score
+    from generation.gesture.train import build_parser, config_from_args
+
+    default = config_from_args(build_parser().parse_args(["--device", "cpu"]))
+    assert default.loss.liveliness_form == "speed" and not default.select_emotion_gap
+    assert default.loss.liveliness == LossWeights().liveliness
+    opted = config_from_args(build_parser().parse_args(["--device", "cpu", "--liveliness-form", "log_peak",
+                                                        "--liveliness-weight", "3", "--select-emotion-gap"]))
+    assert opted.loss.liveliness_form == "log_peak" and opted.loss.liveliness == 3.0 and opted.select_emotion_gap
+    with pytest.raises(ValueError, match="liveliness-weight"):
+        config_from_args(build_parser().parse_args(["--device", "cpu", "--liveliness-weight", "-1"]))
+    err = {"pose_error": 0.01, "speed_log_ratio": 0.2, "emotion_speed_gap": 0.4}
+    assert selection_score(err) == pytest.approx(0.012)
+    assert selection_score(err, emotion_gap=True) == pytest.approx(0.016)

@@ -38,7 +38,7 @@ def dataset_pose_error(pred: list[np.ndarray], data, idx) -> dict[str, float]:
     plus the mean :func:`upper_body_acceleration` of the predictions and their liveliness against the ground
     truth: ``speed_log_ratio`` = mean over sequences of |log(generated / true)| of the mean and of the peak wrist
     speed (:func:`wrist_speed`), averaged; 0 = as lively as the corpus, 0.69 = half or twice as fast."""
-    rows, accel, ratio = [], [], []
+    rows, accel, ratio, speeds = [], [], [], []
     for p, i in zip(pred, idx):
         L = int(data.lengths[i])
         rows.append(sequence_pose_error(p[:L], data.rotations[i, :L], str(data.gender[i]), data.root[i]))
@@ -46,19 +46,39 @@ def dataset_pose_error(pred: list[np.ndarray], data, idx) -> dict[str, float]:
         gen = wrist_speed(p[:L], str(data.gender[i]), data.root[i], data.fps)
         true = wrist_speed(data.rotations[i, :L], str(data.gender[i]), data.root[i], data.fps)
         ratio.append(np.mean([abs(np.log(max(gen[k], 1e-3) / max(true[k], 1e-3))) for k in ("mean", "peak")]))
+        speeds.append((gen["mean"], gen["peak"], true["mean"], true["peak"]))
     return {"pose_error": float(np.mean([r["all"] for r in rows])),
             "pose_error_upper": float(np.mean([r["upper"] for r in rows])),
             "rotation_error_deg": float(np.mean([r["rotation_deg"] for r in rows])),
-            "acceleration": float(np.mean(accel)), "speed_log_ratio": float(np.mean(ratio)), "n": len(rows)}
+            "acceleration": float(np.mean(accel)), "speed_log_ratio": float(np.mean(ratio)),
+            "emotion_speed_gap": emotion_speed_gap(np.array(speeds), [str(data.emotion[i]) for i in idx]),
+            "n": len(rows)}
 
 
-def selection_score(rollout_error: dict[str, float]) -> float:
-    """The number training minimises to choose the kept weights: pose error x (1 + speed_log_ratio).
+def emotion_speed_gap(speeds: np.ndarray, emotions: list[str]) -> float:
+    """Issue 14's criterion as one number: per emotion, the generated / corpus ratio of the mean over its examples
+    of the clip's mean and of its peak wrist speed; returns the largest |log ratio| (0.22 = 25% too slow or fast).
+
+    speeds (N, 4) = [generated mean, generated peak, corpus mean, corpus peak] m/s; emotions (N,) labels.
+    """
+    speeds = np.asarray(speeds, dtype=np.float64)
+    labels = np.asarray(emotions)
+    gaps = [abs(np.log(max(speeds[labels == e, k].mean(), 1e-3) / max(speeds[labels == e, k + 2].mean(), 1e-3)))
+            for e in np.unique(labels) for k in (0, 1)]
+    return float(max(gaps)) if gaps else 0.0
+
+
+def selection_score(rollout_error: dict[str, float], emotion_gap: bool = False) -> float:
+    """The number training minimises to choose the kept weights: pose error x (1 + speed_log_ratio), and with
+    ``emotion_gap`` pose error x (1 + speed_log_ratio + emotion_speed_gap).
 
     Pose error alone rewards regression to the mean pose (a damped gesture has a small average error when the
-    stroke phase is uncertain); the factor makes a gesture at half the corpus' wrist speed cost 1.7x as much.
+    stroke phase is uncertain); speed_log_ratio makes a gesture at half the corpus' wrist speed cost 1.7x as much;
+    emotion_speed_gap (:func:`emotion_speed_gap`) charges the worst emotion's speed ratio, which the per-sequence
+    average lets one emotion hide (issue 14: joyous at 0.67 with the average gap at 0.2).
     """
-    return float(rollout_error["pose_error"] * (1.0 + rollout_error.get("speed_log_ratio", 0.0)))
+    gap = rollout_error.get("emotion_speed_gap", 0.0) if emotion_gap else 0.0
+    return float(rollout_error["pose_error"] * (1.0 + rollout_error.get("speed_log_ratio", 0.0) + gap))
 
 
 def positions(rotations: np.ndarray, gender: str, root: np.ndarray) -> np.ndarray:

@@ -47,7 +47,7 @@ from generation.core.skeleton import GESTURE_PARENTS
 from . import config
 from .data import SYNTHETIC_LABEL, DeviceCorpus, GestureDataset, build_dataset
 from .generate import decode_examples
-from .losses import LossWeights, total_loss
+from .losses import LIVELINESS_FORMS, LossWeights, total_loss
 from .metrics import dataset_pose_error, selection_score
 from .model import MODEL_PRESETS, GestureNet, GestureNetConfig
 
@@ -83,6 +83,9 @@ class TrainConfig:
     # Every this many epochs, generate the validation gestures autoregressively and measure their pose error;
     # the best model is chosen by it (0: choose by the teacher-forced validation loss instead).
     rollout_every: int = 5
+    # add the worst per-emotion wrist-speed ratio on the validation split to the selection score
+    # (metrics.selection_score); off for the shipped weights
+    select_emotion_gap: bool = False
     init_from: str | None = None  # start from these weights (fine-tuning) instead of a random initialisation
     device: str = "auto"
     amp: bool = False
@@ -251,7 +254,8 @@ def train(cfg: TrainConfig, data: GestureDataset | None = None, progress: bool =
         raise ValueError("the training split is empty")
     corpus = data.on_device(device)
     net, optimizer, scheduler, generator = _build(cfg, device)
-    selected_by = "val_rollout_pose_error_x_liveliness" if cfg.rollout_every > 0 else "val_loss"
+    selected_by = ("val_loss" if cfg.rollout_every <= 0 else "val_rollout_pose_error_x_emotion_liveliness"
+                   if cfg.select_emotion_gap else "val_rollout_pose_error_x_liveliness")
     ckpt_path = Path(cfg.checkpoint)
     run = (_restore(ckpt_path, cfg, net, optimizer, scheduler, generator, selected_by)
            if cfg.resume and ckpt_path.is_file() else _Run())
@@ -287,7 +291,7 @@ def _score(net, data, val_idx, cfg: TrainConfig, epoch: int, last_epoch: bool, v
     if cfg.rollout_every > 0 and len(val_idx) and ((epoch + 1) % cfg.rollout_every == 0 or last_epoch):
         net.eval()
         entry["val_rollout"] = dataset_pose_error(decode_examples(net, data, val_idx), data, val_idx)
-        return selection_score(entry["val_rollout"])
+        return selection_score(entry["val_rollout"], emotion_gap=cfg.select_emotion_gap)
     if cfg.rollout_every <= 0:
         return va["total"]
     return None
@@ -338,6 +342,16 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--residual", choices=("previous", "rest", "none"), default=None)
     for term in ("angle", "pose", "affective", "velocity", "liveliness"):
         p.add_argument(f"--no-{term}-loss", action="store_true")
+    p.add_argument("--rollout-every", type=int, default=d.rollout_every,
+                   help="generate the validation gestures every this many epochs to choose the kept weights "
+                   "(0: choose by the teacher-forced validation loss)")
+    p.add_argument("--liveliness-weight", type=float, default=None,
+                   help=f"weight of the liveliness loss (default {LossWeights().liveliness})")
+    p.add_argument("--liveliness-form", choices=LIVELINESS_FORMS, default=LossWeights().liveliness_form,
+                   help="speed: each wrist's mean and RMS speed, squared m/s differences (the shipped weights); "
+                   "log_peak: also the faster wrist's mean and 90th percentile, squared log ratios")
+    p.add_argument("--select-emotion-gap", action="store_true",
+                   help="choose the kept weights by pose error x (1 + speed gap + worst per-emotion speed gap)")
     p.add_argument("--d-model", type=int, default=None, help="default: the preset's (64 small, 992 paper)")
     p.add_argument("--init-from", default=None, help="start from these weights (fine-tuning; same model config)")
     p.add_argument("--out", default=d.out, help="where the best weights go")
@@ -353,6 +367,11 @@ def config_from_args(args: argparse.Namespace) -> TrainConfig:
     base = LossWeights()
     loss = LossWeights(**{k: 0.0 if getattr(args, f"no_{k}_loss") else getattr(base, k)
                           for k in ("angle", "pose", "affective", "velocity", "liveliness")})
+    if args.liveliness_weight is not None and not args.no_liveliness_loss:
+        if args.liveliness_weight < 0:
+            raise ValueError(f"--liveliness-weight must be >= 0, got {args.liveliness_weight}")
+        loss = dataclasses.replace(loss, liveliness=args.liveliness_weight)
+    loss = dataclasses.replace(loss, liveliness_form=args.liveliness_form)
     cfg = preset_config(args.config or "small")
     model = dataclasses.replace(cfg.model, **{k: v for k, v in (("d_model", args.d_model),
                                                                  ("residual", args.residual)) if v is not None})
@@ -361,7 +380,8 @@ def config_from_args(args: argparse.Namespace) -> TrainConfig:
                      sampling_ramp=args.sampling_ramp,
                      sampling_passes=args.sampling_passes, input_noise=args.input_noise, model=model, out=args.out,
                      checkpoint=args.checkpoint, resume=args.resume, threads=args.threads,
-                     init_from=args.init_from, device=args.device, amp=bool(args.amp))
+                     init_from=args.init_from, device=args.device, amp=bool(args.amp),
+                     rollout_every=args.rollout_every, select_emotion_gap=bool(args.select_emotion_gap))
     if args.epochs is not None:
         overrides["epochs"] = args.epochs
     if args.max_minutes is not None:
