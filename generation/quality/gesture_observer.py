@@ -16,7 +16,6 @@ plus the peak and mean wrist speed, measured at the corpus frame rate (10 fps; c
 from __future__ import annotations
 
 import hashlib
-import pickle
 import warnings
 from pathlib import Path
 
@@ -28,6 +27,8 @@ from generation.core.motion import Motion
 from generation.core.skeleton import GESTURE_JOINTS, gesture_skeleton
 from generation.gesture.metrics import wrist_speed_of_positions
 from study_protocol import GESTURE_EMOTIONS, GESTURE_VAD
+
+from .pickle_cache import load_or_build
 
 REPO_ROOT = Path(__file__).resolve().parents[2]
 CACHE_DIR = REPO_ROOT / "var" / "quality"
@@ -210,22 +211,10 @@ def default_gesture_observer() -> GestureObserver | None:
         return None
     if key in _DEFAULT:
         return _DEFAULT[key]
-    cache = CACHE_DIR / f"gesture_observer_{key}.pkl"
-    obs = None
-    if cache.is_file():
-        try:
-            obs = pickle.loads(cache.read_bytes())
-        except Exception:  # noqa: BLE001 - a stale or foreign pickle: retrain
-            obs = None
-    if not isinstance(obs, GestureObserver):
-        try:
-            obs = train_gesture_observer()
-        except Exception as exc:  # noqa: BLE001 - any failure to build the corpus leaves clips without a reading
-            warnings.warn(f"gesture observer could not be trained ({type(exc).__name__}: {exc})", stacklevel=2)
-            return None
-        CACHE_DIR.mkdir(parents=True, exist_ok=True)
-        tmp = cache.with_name(f".{cache.name}.{id(obs)}.tmp")
-        tmp.write_bytes(pickle.dumps(obs))
-        tmp.replace(cache)
+    try:
+        obs = load_or_build(CACHE_DIR / f"gesture_observer_{key}.pkl", GestureObserver, train_gesture_observer)
+    except Exception as exc:  # noqa: BLE001 - any failure to build the corpus leaves clips without a reading
+        warnings.warn(f"gesture observer could not be trained ({type(exc).__name__}: {exc})", stacklevel=2)
+        return None
     _DEFAULT[key] = obs
     return obs

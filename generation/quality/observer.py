@@ -7,7 +7,6 @@ imports it). It stands in for a participant when checking clips; it is not a hum
 """
 from __future__ import annotations
 
-import pickle
 from pathlib import Path
 
 import numpy as np
@@ -15,6 +14,8 @@ import numpy as np
 from generation.core.features import np_gait_affective_features
 from generation.core.motion import Motion
 from study_protocol import GAIT_EMOTIONS
+
+from .pickle_cache import load_or_build
 
 REPO_ROOT = Path(__file__).resolve().parents[2]
 CACHE_DIR = REPO_ROOT / "var" / "quality"
@@ -97,18 +98,6 @@ def default_observer(corpus_path: str | Path | None = None) -> GaitObserver | No
     if key in _DEFAULT:
         return _DEFAULT[key]
     sha = file_sha256(path)
-    cache = CACHE_DIR / f"gait_observer_{sha[:12]}.pkl"
-    obs = None
-    if cache.is_file():
-        try:
-            obs = pickle.loads(cache.read_bytes())
-        except Exception:  # noqa: BLE001 - a stale or foreign pickle: retrain
-            obs = None
-    if obs is None:
-        obs = train_observer(path)
-        CACHE_DIR.mkdir(parents=True, exist_ok=True)
-        tmp = cache.with_name(f".{cache.name}.tmp")
-        tmp.write_bytes(pickle.dumps(obs))
-        tmp.replace(cache)
+    obs = load_or_build(CACHE_DIR / f"gait_observer_{sha[:12]}.pkl", GaitObserver, lambda: train_observer(path))
     _DEFAULT[key] = obs
     return obs
