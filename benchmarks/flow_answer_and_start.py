@@ -274,7 +274,7 @@ def _admin_connection(base_url: str):
 def report(args, engine: str, small: dict | None, large: dict | None, starts: dict, http: dict | None) -> str:
     """The Markdown page of the figures."""
     lines = ["# Participant flow: answer cost and concurrent starts", "",
-             "Machine: 2-core CI VM, no GPU, shared with parallel jobs; date 2026-12-01. "
+             f"Machine: 2-core CI VM, no GPU, shared with parallel jobs; date {time.strftime('%Y-%m-%d')}. "
              f"{engine}, SYNTHETIC placeholder catalogue, demo preset. `benchmarks/flow_answer_and_start.py`.", ""]
     if small and large:
         lines += ["| participants in study | SQL statements per answered clip (GET + POST) | transactions | "

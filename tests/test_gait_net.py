@@ -267,6 +267,17 @@ def test_training_writes_checkpoint_and_resumes(tiny_data, tmp_path):
         load_checkpoint(bad)
 
 
+def test_keep_epochs_writes_the_weights_of_every_epoch(tiny_data, tmp_path):
+    out = tmp_path / "run.pt"
+    train(GaitNetConfig.tiny(epochs=2, batch_size=2), tiny_data, out, tmp_path / "run.ckpt", progress=False,
+          log=lambda *_: None, keep_epochs=True)
+    assert sorted(p.name for p in tmp_path.glob("run_e*.pt")) == ["run_e01.pt", "run_e02.pt"]
+    _, _, first = load_checkpoint(tmp_path / "run_e01.pt")
+    _, _, last = load_checkpoint(tmp_path / "run_e02.pt")
+    assert [h["epoch"] for h in first["history"]] == [1] and [h["epoch"] for h in last["history"]] == [1, 2]
+    assert first["trained_on"] == "synthetic procedural corpus"
+
+
 def test_emotion_transition_interpolates_and_normalises():
     tr = emotion_transition([1, 0, 0, 0], [0, 2, 0, 0], 11)
     assert tr.shape == (11, 4)

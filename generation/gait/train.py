@@ -405,7 +405,8 @@ def _resume(path: Path, step: _Step, sched, rng, gen, log) -> tuple[list, int]:
 
 def train(config: GaitNetConfig, data: GaitSequences, out_path: str | Path, checkpoint_path: str | Path | None = None,
           resume: bool = False, max_minutes: float | None = None, progress: bool = True, log=print,
-          device: str | torch.device | None = "auto", amp: bool = False, init: str | Path | None = None) -> dict:
+          device: str | torch.device | None = "auto", amp: bool = False, init: str | Path | None = None,
+          keep_epochs: bool = False) -> dict:
     """Train on ``data`` (its "train" split; "val" for validation); returns the history.
 
     Writes ``checkpoint_path`` (full training state) after every epoch and the final small weights file
@@ -416,6 +417,8 @@ def train(config: GaitNetConfig, data: GaitSequences, out_path: str | Path, chec
     generator, so a run of the same seed follows the same path on either device. ``amp``: mixed-precision forward
     passes (bf16 autocast, fp16 with a gradient scaler on GPUs without bf16). ``init``: start from the weights
     and normaliser of this weights file (same architecture; fine-tuning) instead of a random initialisation.
+    ``keep_epochs``: also write the weights after every epoch to ``<out stem>_eNN.pt`` (for choosing an epoch on
+    the validation walks afterwards).
     """
     tc = config.train
     dev = resolve_device(device)
@@ -456,13 +459,23 @@ def train(config: GaitNetConfig, data: GaitSequences, out_path: str | Path, chec
                         scheduler=sched.state_dict(), epoch=epoch, history=history,
                         numpy_rng=rng.bit_generator.state, torch_gen=gen.get_state(),
                         torch_rng=torch.get_rng_state(), grad_scaler=scaler.state_dict() if scaler else None)
+        if keep_epochs:
+            out = Path(out_path)
+            _save_weights(out.with_name(f"{out.stem}_e{epoch + 1:02d}{out.suffix}"), model, step.norm, config,
+                          history, data, init_info)
         if max_minutes is not None and elapsed > 60 * max_minutes:
             log(f"stopping after epoch {epoch + 1}: time budget of {max_minutes} min used")
             break
-    save_checkpoint(Path(out_path), model, step.norm, config, history=history,
-                    trained_on="synthetic procedural corpus", num_parameters=model.num_parameters(),
-                    corpus=getattr(data, "source", None), initialised_from=init_info)
+    _save_weights(Path(out_path), model, step.norm, config, history, data, init_info)
     return {"history": history, "model": model, "normalizer": step.norm}
+
+
+def _save_weights(path: Path, model: GaitNet, norm: Normalizer, config: GaitNetConfig, history: list[dict],
+                  data: GaitSequences, init_info: dict | None) -> None:
+    """The small, device-independent weights file (model, config, normaliser, history, provenance)."""
+    save_checkpoint(path, model, norm, config, history=history, trained_on="synthetic procedural corpus",
+                    num_parameters=model.num_parameters(), corpus=getattr(data, "source", None),
+                    initialised_from=init_info)
 
 
 CONFIG_NAMES = ("small", "paper")
@@ -521,6 +534,8 @@ def build_parser() -> argparse.ArgumentParser:
                    help="subsampling offsets per sequence (augmentation; every 4th frame from frame 0..N-1)")
     p.add_argument("--threads", type=int, default=1)
     p.add_argument("--quiet", action="store_true", help="no progress bar")
+    p.add_argument("--keep-epochs", action="store_true",
+                   help="also write the weights after every epoch to <out stem>_eNN.pt")
     return p
 
 
@@ -566,7 +581,8 @@ def run(args, log=print) -> dict:
     counts = ", ".join(f"{s}: {int(((data.split == s) & (data.offset == 0)).sum())}" for s in ("train", "val", "test"))
     log(f"{len(data)} sequences ({counts}), network {GaitNet(config.model).num_parameters()} parameters")
     result = train(config, data, args.out, args.checkpoint, args.resume, args.max_minutes, progress=not args.quiet,
-                   log=log, device=device, amp=amp, init=getattr(args, "init", None))
+                   log=log, device=device, amp=amp, init=getattr(args, "init", None),
+                   keep_epochs=getattr(args, "keep_epochs", False))
     log(f"wrote {args.out}")
     return result
 

@@ -1,0 +1,79 @@
+"""Only the observer-recognition rows of benchmarks/bench_gait.py, for choosing among candidate weights quickly
+(about 30 s per split): each walk of a corpus split seeds a generated gait with its own emotion vector, and the
+synthetic observer (generation/quality/observer.py) reads it; optionally also procedural seeds of the unseen
+mixtures. Uses bench_gait's own functions, so the figures are the benchmark's.
+
+    python benchmarks/gait_observer_rows.py WEIGHTS.pt [WEIGHTS2.pt ...] [--split val|test|both]
+        [--guidance 0,1,2] [--no-procedural] [--steps 200]
+
+Choose on --split val; report test only for the chosen candidate.
+"""
+from __future__ import annotations
+
+import argparse
+import itertools
+import os
+import sys
+import time
+from pathlib import Path
+
+os.environ.setdefault("OMP_NUM_THREADS", "1")
+ROOT = Path(__file__).resolve().parents[1]
+sys.path[:0] = [str(ROOT), str(ROOT / "benchmarks")]
+
+import bench_gait as bench  # noqa: E402
+import numpy as np  # noqa: E402
+import torch  # noqa: E402
+
+from generation.core.paths import straight  # noqa: E402
+from generation.gait.data import DEFAULT_CORPUS, load_corpus_sequences  # noqa: E402
+from generation.gait.generate import load_model  # noqa: E402
+from generation.procedural.corpus import GaitCorpus  # noqa: E402
+from study_protocol import GAIT_EMOTIONS  # noqa: E402
+
+
+def row(table: dict) -> str:
+    """'overall (happy / sad / angry / neutral) lowest x'."""
+    per_class = " / ".join(f"{table[e]:.2f}" for e in GAIT_EMOTIONS)
+    return f"{table['overall']:.2f} ({per_class}) lowest {min(table[e] for e in GAIT_EMOTIONS):.2f}"
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("weights", nargs="+")
+    ap.add_argument("--split", choices=("val", "test", "both"), default="val")
+    ap.add_argument("--guidance", default="0", help="comma-separated emotion-guidance scales")
+    ap.add_argument("--no-procedural", action="store_true", help="skip the procedural seeds of unseen mixtures")
+    ap.add_argument("--steps", type=int, default=200)
+    ap.add_argument("--corpus", default=str(ROOT / DEFAULT_CORPUS))
+    args = ap.parse_args(argv)
+    try:
+        scales = [float(x) for x in args.guidance.split(",")]
+    except ValueError:
+        ap.error(f"--guidance: numbers separated by commas, got {args.guidance!r}")
+    torch.set_num_threads(1)
+    corpus, data = GaitCorpus.load(args.corpus), load_corpus_sequences(args.corpus)
+    observer = bench.Observer(data.subset((data.split == "train") & (data.offset == 0)))
+    splits = ["val", "test"] if args.split == "both" else [args.split]
+    for weights, scale in itertools.product(args.weights, scales):
+        net = load_model(weights)
+        net.info["emotion_guidance"] = scale
+        t0 = time.time()
+        for split in splits:
+            walks = data.subset((data.split == split) & (data.offset == 0))
+            emotions = walks.emotion.numpy().astype(np.float64)
+            seeds = bench.test_seeds(corpus, walks.base_index)
+            motions = bench.generate_gaits(seeds, [straight(60.0)] * len(seeds), emotions, steps=args.steps,
+                                           model=net)
+            table = bench.accuracy_table(observer.predict_motions(motions), emotions.argmax(1))
+            print(f"{Path(weights).name} w={scale:g} {split} walk seeds, own emotion: {row(table)}", flush=True)
+        if not args.no_procedural:
+            proc = bench.expressiveness_procedural_seeds(net, observer, args.steps, 10)
+            print(f"{Path(weights).name} w={scale:g} procedural seeds, unseen mixtures: "
+                  f"{row(proc['unseen_mixture'])}; pure: {row(proc['pure'])}", flush=True)
+        print(f"  ({time.time() - t0:.0f} s)", flush=True)
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
