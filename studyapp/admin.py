@@ -169,7 +169,7 @@ class StudyAdmin(admin.ModelAdmin):
 @admin.register(Clip)
 class ClipAdmin(admin.ModelAdmin):
     list_display = ["thumbnail", "clip_id", "modality", "origin", "emotion_label", "theme", "weight", "n_features",
-                    "duration_s", "plan", admin_clip_qa.quality_flag]
+                    "duration_s", "plan", admin_clip_qa.quality_flag, admin_clip_qa.observer_reading]
     list_filter = ["retired", admin_clip_qa.QualityFlagFilter, "modality", "origin", "plan", "theme", "emotion_label"]
     search_fields = ["clip_id", "plan"]
     readonly_fields = ["preview", "media_key", "created_at", "updated_at"]

@@ -1,4 +1,5 @@
-"""Admin list filter of clips by their quality record (issue 14): passed, flagged, or failed one given check."""
+"""Admin list filter and columns of clips by their quality record (issue 14): passed, flagged, or failed one given
+check; the synthetic observer's reading."""
 from __future__ import annotations
 
 from django.contrib import admin
@@ -38,3 +39,18 @@ def quality_flag(clip) -> str:
 
 quality_flag.short_description = "quality"
 quality_flag.admin_order_field = "qa_flag"
+
+
+def observer_reading(clip) -> str:
+    """The admin column: the synthetic observer's top label and probability ("sad 0.81"), for a gesture also the
+    observed arousal the gesture check compares ("afraid 0.55, arousal 0.71"); "" when the clip has no reading."""
+    qa = clip.qa or {}
+    label, p = qa.get("observed"), qa.get("observed_p")
+    if not label:
+        return ""
+    text = f"{label} {p:.2f}" if isinstance(p, (int, float)) else str(label)
+    arousal = qa.get("observed_arousal")
+    return f"{text}, arousal {arousal:.2f}" if isinstance(arousal, (int, float)) else text
+
+
+observer_reading.short_description = "observer (synthetic)"

@@ -70,6 +70,20 @@ def test_admin_filter_passed_flagged_and_per_check(rf):
     assert QualityFlagFilter in admin_obj.list_filter
 
 
+@pytest.mark.django_db
+def test_admin_observer_column_shows_label_probability_and_gesture_arousal():
+    from django.contrib.admin.sites import site
+
+    from studyapp.admin_clip_qa import observer_reading
+
+    gait, gesture, blank = Clip(qa={"observed": "sad", "observed_p": 0.8123}), Clip(
+        qa={"observed": "afraid", "observed_p": 0.55, "observed_arousal": 0.712}), Clip(qa={"observed": None})
+    assert observer_reading(gait) == "sad 0.81"
+    assert observer_reading(gesture) == "afraid 0.55, arousal 0.71"
+    assert observer_reading(blank) == "" and observer_reading(Clip()) == ""
+    assert observer_reading in site._registry[Clip].list_display
+
+
 TINY = {"width": 160, "height": 120, "fps": 10, "duration_s": 1.0}
 PLAN_CLIPS = [
     {"id": "walk_ok", "generator": "procedural_walk", "emotion": [0, 0, 0, 1],
