@@ -148,3 +148,15 @@ def test_old_clips_csv_without_qa_columns_still_reads(tmp_path):
 def test_summary_line_counts_clips_per_flag():
     line = summary_line(["", "", "penetration", "penetration;jerk"])
     assert line == "QA: 2 passed, 2 flagged (penetration 2, jerk 1)"
+
+
+def test_unread_line_says_which_clips_got_no_observer_reading():
+    from generation.quality.plan_qa import unread_line
+
+    read = [{"modality": "gait", "qa": {"observed": "sad"}}, {"modality": "gesture", "qa": {"observed": "proud"}},
+            {"modality": "rbf", "qa": {}}]
+    assert unread_line(read) == ""
+    line = unread_line(read + [{"modality": "gait", "qa": {"observed": None}}, {"modality": "gait"},
+                               {"modality": "gesture", "qa": {"observed": None}}])
+    assert line.startswith("QA: no observer reading")
+    assert "2 gait clip(s)" in line and "build_corpus" in line and "1 gesture clip(s)" in line

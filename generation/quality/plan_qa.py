@@ -81,6 +81,24 @@ def summary_line(flags: Iterable[str]) -> str:
     return f"QA: {c[PASSED]} passed, {c['flagged']} flagged" + (f" ({per})" if per else "")
 
 
+def unread_line(records: Iterable[dict]) -> str:
+    """'' when every gait and gesture clip got a synthetic observer's reading, else a line saying how many did not
+    and why that usually happens, so that a switched-off observer check is never silent. ``records``: render
+    records (``modality``, ``qa``)."""
+    missing = Counter(r.get("modality") for r in records
+                      if r.get("modality") in ("gait", "gesture") and not (r.get("qa") or {}).get("observed"))
+    if not missing:
+        return ""
+    parts = []
+    if missing["gait"]:
+        parts.append(f"{missing['gait']} gait clip(s) (no synthetic gait corpus at var/corpus/: "
+                     "`manage.py build_corpus` builds it in about a minute, then render again)")
+    if missing["gesture"]:
+        parts.append(f"{missing['gesture']} gesture clip(s) (shorter than 2.5 s, or the gesture corpus could not "
+                     "be built: see the warnings above)")
+    return "QA: no observer reading, so no observer check, for " + "; ".join(parts)
+
+
 def run(plan_name: str, limit: int | None = None, log=print, modality: str | None = None,
         figure_height: bool = True) -> list[dict]:
     """Make every entry's motion and compute its quality record (no video). Returns one row per entry.

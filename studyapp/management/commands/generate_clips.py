@@ -94,9 +94,11 @@ class Command(BaseCommand):
         self.stdout.write(f"plan {plan.name}: {len(result.rendered)} rendered, {len(result.skipped)} already done, "
                           f"{len(result.failed)} failed, {result.seconds:.1f} s; catalogue {csv_path}")
         if records:
-            from generation.quality.plan_qa import summary_line
+            from generation.quality.plan_qa import summary_line, unread_line
 
             self.stdout.write(f"plan {plan.name}: " + summary_line(r.get("qa_flag", "") for r in records))
+            if unread := unread_line(records):
+                self.stdout.write(f"plan {plan.name}: {unread}")
         if opts["contact_sheet"] is not None and records:
             from generation.render import contact_sheet
             from studyapp.catalogue import clip_label
