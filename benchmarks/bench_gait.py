@@ -38,6 +38,7 @@ from generation.core.skeleton import GAIT_PARENTS  # noqa: E402
 from generation.gait.data import load_corpus_sequences, world_rotations  # noqa: E402
 from generation.gait.generate import distance_to_path, emotion_transition, load_model  # noqa: E402
 from generation.gait.generate import generate_gaits as _generate_gaits  # noqa: E402
+from generation.gait.guidance import seed_walks, unseen_mixtures  # noqa: E402
 from generation.gait.train import DEFAULT_WEIGHTS, rollout  # noqa: E402
 from generation.quality.observer import GaitObserver  # noqa: E402
 from study_protocol import GAIT_EMOTIONS  # noqa: E402
@@ -117,16 +118,10 @@ def nearest_neighbour_errors(train, test, window: int = 6) -> dict:
 Observer = GaitObserver
 
 
-def test_seeds(corpus, test_rows, n_frames=PREFIX * 4 - 3):
-    """Seed Motions: the first 18 network steps (69 frames at 30 fps) of test sequences."""
-    return [corpus.motion(int(i)).slice(0, n_frames) for i in test_rows]
-
-
-def fixed_mixtures() -> np.ndarray:
-    """Four emotion mixtures not in the corpus (dominant 0.55, the rest 0.15 each)."""
-    m = np.full((4, 4), 0.15)
-    np.fill_diagonal(m, 0.55)
-    return m
+# Seed walks (the first 18 network steps of corpus walks) and the four unseen mixtures (dominant 0.55, the rest
+# 0.15 each) are the library's, so that the guidance selection and this benchmark use the same ones.
+test_seeds = seed_walks
+fixed_mixtures = unseen_mixtures
 
 
 def accuracy_table(pred: np.ndarray, intended: np.ndarray) -> dict:

@@ -11,6 +11,7 @@ from generation.plans.catalogue import read_clips_csv, write_clips_csv
 from generation.plans.schema import PlanError, validate_plan
 from generation.quality import QAThresholdError, evaluate, failed_checks, motion_metrics, resolve_thresholds
 from generation.quality.metrics import bone_error_mm, mean_jerk
+from generation.quality.observer import GaitObserver
 from generation.quality.plan_qa import summary_line
 from study_protocol import CLIP_COLUMNS, QA_COLUMNS, QA_THRESHOLDS
 from tests.test_render import seated, swinging_walk
@@ -56,7 +57,9 @@ def test_figure_height_threshold_depends_on_seated():
     assert "figure_height" not in evaluate(walk, figure_height_frac=None).flags   # not rendered: not checked
 
 
-class _FakeObserver:
+class _FakeObserver(GaitObserver):
+    """A gait observer with a fixed reading (the real one's reads/qa_values, no training)."""
+
     def __init__(self, label, p):
         self.label, self.p = label, p
 

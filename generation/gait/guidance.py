@@ -41,6 +41,11 @@ def unseen_mixtures() -> np.ndarray:
     return m
 
 
+def seed_walks(corpus, rows) -> list:
+    """Seed Motions: the first SEED_STEPS network steps (69 frames at 30 fps) of the corpus walks ``rows``."""
+    return [corpus.motion(int(i)).slice(0, 4 * SEED_STEPS - 3) for i in rows]
+
+
 def per_class_accuracy(pred: np.ndarray, intended: np.ndarray) -> dict[str, float]:
     """{emotion: share of the gaits intended as it that the observer calls it} (NaN for an absent class)."""
     return {e: float((pred[intended == k] == k).mean()) if (intended == k).any() else float("nan")
@@ -55,8 +60,7 @@ def evaluate_scale(net, scale: float, observer, corpus, val_rows: np.ndarray, va
 
     from .generate import generate_gaits
 
-    n_frames = 4 * SEED_STEPS - 3
-    seeds = [corpus.motion(int(i)).slice(0, n_frames) for i in val_rows]
+    seeds = seed_walks(corpus, val_rows)
     own = generate_gaits(seeds, [straight(60.0)] * len(seeds), val_emotion, steps=STEPS, model=net,
                          foot_cleanup=False, emotion_guidance=scale)
     mix = np.repeat(unseen_mixtures(), PER_MIXTURE, axis=0)

@@ -34,10 +34,8 @@ import numpy as np
 from generation.core.motion import Motion
 from study_protocol import GAIT_EMOTIONS, GESTURE_VAD, QA_CHECKS, QA_COLUMNS, QA_THRESHOLDS
 
-from .gesture_observer import GestureObserver
 from .metrics import motion_metrics
 
-GAIT_JOINTS = 21  # the observer reads the 21-joint gait skeleton's affective features
 DOMINANT_SHARE = 0.5
 
 
@@ -114,19 +112,14 @@ def evaluate(motion: Motion, thresholds: dict | None = None, figure_height_frac:
             the clip should show, or None.
         observer: a :class:`generation.quality.observer.GaitObserver` for gait motions (21 joints) or a
             :class:`generation.quality.gesture_observer.GestureObserver` for gesture motions (23 joints, at least
-            as long as its ``min_seconds``, 2.5 s); None or an observer of the other skeleton: no reading.
+            as long as its ``min_seconds``, 2.5 s); each says which motions it ``reads`` and gives their
+            ``qa_values``. None or an observer of the other skeleton: no reading.
     """
     values = {k: round(v, 4) for k, v in motion_metrics(motion).items()}
     values["figure_height_frac"] = None if figure_height_frac is None else round(float(figure_height_frac), 4)
     values["observed"], values["observed_p"] = None, None
-    if isinstance(observer, GestureObserver):
-        if observer.reads(motion):
-            label, p, arousal = observer.reading(motion)
-            values["observed"], values["observed_p"] = label, round(p, 4)
-            values["observed_arousal"] = round(arousal, 4)
-    elif observer is not None and motion.skeleton.num_joints == GAIT_JOINTS and motion.num_frames >= 2:
-        label, p = observer.observe(motion)
-        values["observed"], values["observed_p"] = label, round(p, 4)
+    if observer is not None and observer.reads(motion):
+        values.update(observer.qa_values(motion))
     values["seated"] = bool(seated)
     return QAResult(values, failed_checks(values, thresholds, intended))
 

@@ -159,6 +159,12 @@ class GestureObserver:
         """(N, 11) probabilities in GESTURE_EMOTIONS order."""
         return self.proba_features(self.features(motions))
 
+    def qa_values(self, motion: Motion) -> dict:
+        """The quality record's reading: ``observed`` (top label), ``observed_p`` (its probability) and
+        ``observed_arousal`` (what the gesture ``observer`` check compares)."""
+        label, p, arousal = self.reading(motion)
+        return {"observed": label, "observed_p": round(p, 4), "observed_arousal": round(arousal, 4)}
+
     def observe(self, motion: Motion) -> tuple[str, float]:
         """(top label, its probability) for one gesture motion."""
         label, p, _ = self.reading(motion)

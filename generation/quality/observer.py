@@ -13,6 +13,7 @@ import numpy as np
 
 from generation.core.features import np_gait_affective_features
 from generation.core.motion import Motion
+from generation.core.skeleton import GAIT_JOINTS
 from study_protocol import GAIT_EMOTIONS
 
 from .pickle_cache import load_or_build
@@ -59,6 +60,15 @@ class GaitObserver:
     def proba_motions(self, motions: list[Motion], frames: slice = slice(None)) -> np.ndarray:
         """(N, 4) probabilities in GAIT_EMOTIONS order."""
         return self.clf.predict_proba(self.features(motions, frames))
+
+    def reads(self, motion: Motion) -> bool:
+        """Whether the quality gate asks this observer about ``motion``: the 21-joint gait skeleton, >= 2 frames."""
+        return motion.skeleton.num_joints == len(GAIT_JOINTS) and motion.num_frames >= 2
+
+    def qa_values(self, motion: Motion) -> dict:
+        """The quality record's reading: ``observed`` (top label) and ``observed_p`` (its probability)."""
+        label, p = self.observe(motion)
+        return {"observed": label, "observed_p": round(p, 4)}
 
     def observe(self, motion: Motion) -> tuple[str, float]:
         """(top label, its probability) for one gait motion."""
