@@ -38,7 +38,13 @@ from generation.core.skeleton import GAIT_PARENTS  # noqa: E402
 from generation.gait.data import load_corpus_sequences, world_rotations  # noqa: E402
 from generation.gait.generate import distance_to_path, emotion_transition, load_model  # noqa: E402
 from generation.gait.generate import generate_gaits as _generate_gaits  # noqa: E402
-from generation.gait.guidance import seed_walks, unseen_mixtures  # noqa: E402
+from generation.gait.guidance import (  # noqa: E402
+    HELDOUT_SEED,
+    heldout_corpus,
+    seed_walks,
+    single_dominant,
+    unseen_mixtures,
+)
 from generation.gait.train import DEFAULT_WEIGHTS, rollout  # noqa: E402
 from generation.quality.observer import GaitObserver  # noqa: E402
 from study_protocol import GAIT_EMOTIONS  # noqa: E402
@@ -135,13 +141,36 @@ def accuracy_table(pred: np.ndarray, intended: np.ndarray) -> dict:
     return out
 
 
+def heldout_recognition(net, observer, corpus, walks, steps) -> dict:
+    """Own-emotion recognition with the walks of the second held-out corpus as seeds
+    (:func:`generation.gait.guidance.heldout_corpus`): every walk, the walks with one dominant label, and the
+    latter's even / odd halves (the halves used for choosing and for confirming candidates)."""
+    emotions = walks.emotion.numpy().astype(np.float64)
+    seeds = test_seeds(corpus, walks.base_index)
+    pred = observer.predict_motions(generate_gaits(seeds, [straight(60.0)] * len(seeds), emotions, steps=steps,
+                                                   model=net))
+    single = single_dominant(emotions)
+    even = walks.base_index % 2 == 0
+    out = {"all": accuracy_table(pred, emotions.argmax(1))}
+    for name, sel in (("untied", single), ("untied_even", single & even), ("untied_odd", single & ~even)):
+        out[name] = accuracy_table(pred[sel], emotions[sel].argmax(1))
+    out["left_out_tied"] = int((~single).sum())
+    itself = observer.clf.predict(observer.summarise_seq(walks.aff.numpy()))
+    out["walks_themselves_untied"] = accuracy_table(itself[single], emotions[single].argmax(1))
+    return out
+
+
 def expressiveness(net, observer, corpus, test_rows, test_emotion, steps, rng) -> dict:
     seeds = test_seeds(corpus, test_rows)
     N = len(seeds)
     paths = [straight(60.0) for _ in range(N)]
     res = {}
     own = generate_gaits(seeds, paths, test_emotion, steps=steps, model=net)
-    res["own_emotion"] = accuracy_table(observer.predict_motions(own), test_emotion.argmax(1))
+    own_pred = observer.predict_motions(own)
+    res["own_emotion"] = accuracy_table(own_pred, test_emotion.argmax(1))
+    single = single_dominant(test_emotion)
+    res["own_emotion_untied"] = accuracy_table(own_pred[single], test_emotion[single].argmax(1))
+    res["own_emotion_untied"]["left_out_tied"] = int((~single).sum())
     # Other emotions: each seed gets a fixed mixture whose dominant emotion differs from the seed's.
     mix = fixed_mixtures()
     target = np.array([(int(e.argmax()) + 1 + int(rng.integers(3))) % 4 for e in test_emotion])
@@ -406,8 +435,23 @@ def main(argv=None) -> int:
               f"{v['other_mixture_last_third']['overall']:.2f} | {v['transition_start']['overall']:.2f} / "
               f"{v['transition_end']['overall']:.2f} | {pt['first_50_steps']:.2f} / {pt['last_50_steps']:.2f} "
               f"({pt['constant_seed_emotion_last_50']:.2f}) |")
+        print("  own emotion per class, walks with one dominant label "
+              f"({v['own_emotion_untied']['left_out_tied']} tied left out):",
+              {e: round(v["own_emotion_untied"][e], 2) for e in GAIT_EMOTIONS})
         print("  own emotion per class:", {e: round(v["own_emotion"][e], 2) for e in GAIT_EMOTIONS},
               "confusion (rows intended h/s/a/n, cols observed):", v["own_emotion"]["confusion"])
+
+    held_path = heldout_corpus(Path(__file__).resolve().parents[1])
+    held_corpus, held = GaitCorpus.load(held_path), load_corpus_sequences(held_path)
+    held = held.subset(np.flatnonzero(held.offset == 0)[: 40 if args.quick else None])
+    results["own_emotion_heldout_corpus"] = {name: heldout_recognition(net, observer, held_corpus, held, args.steps)
+                                             for name, net in nets.items() if name != "no root loss"}
+    print(f"\nown emotion, seeds = the {len(held)} walks of the second held-out corpus (seed {HELDOUT_SEED}):")
+    for k, v in results["own_emotion_heldout_corpus"].items():
+        for part in ("all", "untied", "untied_even", "untied_odd", "walks_themselves_untied"):
+            t = v[part]
+            print(f"  {k} {part} (n {t['n']}): {t['overall']:.2f}", {e: round(t[e], 2) for e in GAIT_EMOTIONS},
+                  t["confusion"])
 
     print("\nseeds made from the intended emotion (seeds=None), observer accuracy:")
     for k, v in results["expressiveness_procedural_seeds"].items():

@@ -4,9 +4,11 @@ synthetic observer (generation/quality/observer.py) reads it; optionally also pr
 mixtures. Uses bench_gait's own functions, so the figures are the benchmark's.
 
     python benchmarks/gait_observer_rows.py WEIGHTS.pt [WEIGHTS2.pt ...] [--split val|test|both]
-        [--guidance 0,1,2] [--no-procedural] [--steps 200]
+        [--guidance 0,1,2] [--seed-frames 0,80,160] [--no-procedural] [--steps 200]
 
-Choose on --split val; report test only for the chosen candidate.
+Choose on --split val; report test only for the chosen candidate. With 19-29 walks per class one walk moves a
+class by 0.04, so for choosing, seed each walk at several frames (``--seed-frames``) and compare also the
+continuous score "p(own)": the observer's mean probability of the intended class, per class.
 """
 from __future__ import annotations
 
@@ -28,6 +30,7 @@ import torch  # noqa: E402
 from generation.core.paths import straight  # noqa: E402
 from generation.gait.data import DEFAULT_CORPUS, load_corpus_sequences  # noqa: E402
 from generation.gait.generate import load_model  # noqa: E402
+from generation.gait.guidance import heldout_corpus, seed_walks, single_dominant  # noqa: E402
 from generation.procedural.corpus import GaitCorpus  # noqa: E402
 from study_protocol import GAIT_EMOTIONS  # noqa: E402
 
@@ -38,35 +41,64 @@ def row(table: dict) -> str:
     return f"{table['overall']:.2f} ({per_class}) lowest {min(table[e] for e in GAIT_EMOTIONS):.2f}"
 
 
+def p_own_row(proba: np.ndarray, intended: np.ndarray) -> str:
+    """'p(own) happy / sad / angry / neutral (lowest x)': mean observer probability of the intended class."""
+    p = [float(proba[intended == k, k].mean()) for k in range(len(GAIT_EMOTIONS))]
+    return "p(own) " + " / ".join(f"{v:.3f}" for v in p) + f" (lowest {min(p):.3f})"
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("weights", nargs="+")
-    ap.add_argument("--split", choices=("val", "test", "both"), default="val")
+    ap.add_argument("--split", choices=("val", "test", "both", "extra-a", "extra-b"), default="val",
+                    help="extra-a / extra-b: the even / odd walks of --extra-corpus (every walk unseen in training)")
+    ap.add_argument("--extra-corpus", default=None,
+                    help="default: the held-out corpus of generation.gait.guidance.heldout_corpus (built with "
+                         "another seed when missing): more held-out walks, so that a class's figure rests on ~110 "
+                         "walks per half")
     ap.add_argument("--guidance", default="0", help="comma-separated emotion-guidance scales")
     ap.add_argument("--no-procedural", action="store_true", help="skip the procedural seeds of unseen mixtures")
     ap.add_argument("--steps", type=int, default=200)
+    ap.add_argument("--seed-frames", default="0", help="comma-separated first frames of the seed windows")
     ap.add_argument("--corpus", default=str(ROOT / DEFAULT_CORPUS))
     args = ap.parse_args(argv)
     try:
         scales = [float(x) for x in args.guidance.split(",")]
     except ValueError:
         ap.error(f"--guidance: numbers separated by commas, got {args.guidance!r}")
+    try:
+        starts = [int(x) for x in args.seed_frames.split(",")]
+    except ValueError:
+        ap.error(f"--seed-frames: whole numbers separated by commas, got {args.seed_frames!r}")
     torch.set_num_threads(1)
     corpus, data = GaitCorpus.load(args.corpus), load_corpus_sequences(args.corpus)
     observer = bench.Observer(data.subset((data.split == "train") & (data.offset == 0)))
     splits = ["val", "test"] if args.split == "both" else [args.split]
+    if args.split.startswith("extra"):
+        extra_path = args.extra_corpus or heldout_corpus(ROOT)
+        extra_corpus, extra = GaitCorpus.load(extra_path), load_corpus_sequences(extra_path)
+        parity = extra.base_index % 2 == (0 if args.split == "extra-a" else 1)
+        extra = extra.subset(np.asarray(parity & (extra.offset == 0)))
     for weights, scale in itertools.product(args.weights, scales):
         net = load_model(weights)
         net.info["emotion_guidance"] = scale
         t0 = time.time()
         for split in splits:
-            walks = data.subset((data.split == split) & (data.offset == 0))
-            emotions = walks.emotion.numpy().astype(np.float64)
-            seeds = bench.test_seeds(corpus, walks.base_index)
+            if split.startswith("extra"):
+                source, walks = extra_corpus, extra
+            else:
+                source, walks = corpus, data.subset((data.split == split) & (data.offset == 0))
+            emotions = np.tile(walks.emotion.numpy().astype(np.float64), (len(starts), 1))
+            seeds = [m for start in starts for m in seed_walks(source, walks.base_index, start)]
             motions = bench.generate_gaits(seeds, [straight(60.0)] * len(seeds), emotions, steps=args.steps,
                                            model=net)
-            table = bench.accuracy_table(observer.predict_motions(motions), emotions.argmax(1))
-            print(f"{Path(weights).name} w={scale:g} {split} walk seeds, own emotion: {row(table)}", flush=True)
+            proba = observer.proba_motions(motions)
+            table = bench.accuracy_table(proba.argmax(1), emotions.argmax(1))
+            single = single_dominant(emotions)
+            untied = bench.accuracy_table(proba[single].argmax(1), emotions[single].argmax(1))
+            print(f"{Path(weights).name} w={scale:g} {split} walk seeds (frames {args.seed_frames}), own emotion: "
+                  f"{row(table)}; {p_own_row(proba, emotions.argmax(1))}; without tied labels "
+                  f"({int((~single).sum())} left out): {row(untied)}", flush=True)
         if not args.no_procedural:
             proc = bench.expressiveness_procedural_seeds(net, observer, args.steps, 10)
             print(f"{Path(weights).name} w={scale:g} procedural seeds, unseen mixtures: "

@@ -481,6 +481,29 @@ def test_style_loss_is_phase_free_and_penalises_lost_amplitude():
     assert shifted < 1e-3 < 0.1 < frozen   # a frozen (mean) pose loses the amplitude and is penalised
 
 
+def test_class_style_loss_costs_a_shared_offset_not_walk_noise():
+    from generation.gait.losses import class_style_loss
+    rng = torch.Generator().manual_seed(1)
+    true = torch.randn(8, 20, 18, generator=rng)
+    emotion = torch.eye(4).repeat(2, 1)                  # walks 0-3 and 4-7: one of each class twice
+    noise = torch.randn(8, 1, 18, generator=rng)
+    noise[4:] = -noise[:4]                               # per-walk offsets that cancel within each class
+    assert class_style_loss([true + noise], true, emotion).item() < 1e-10
+    shared = torch.zeros(8, 1, 18)
+    shared[emotion[:, 2] == 1] = 0.5                     # every angry walk moved the same way
+    assert class_style_loss([true + shared], true, emotion).item() == pytest.approx(0.25 / 4)
+    scale = torch.full((18,), 2.0)
+    assert class_style_loss([true + shared], true, emotion, scale).item() == pytest.approx(1.0 / 4)
+    absent = torch.tensor([[1.0, 0, 0, 0]] * 8)          # classes absent from the batch add nothing
+    assert class_style_loss([true + 0.5], true, absent).item() == pytest.approx(0.25 / 4)
+
+
+def test_single_dominant_leaves_out_tied_labels():
+    from generation.gait.guidance import single_dominant
+    labels = np.array([[0.4, 0.0, 0.4, 0.2], [0.6, 0.0, 0.0, 0.4], [0.3, 0.3, 0.3, 0.1], [1.0, 0, 0, 0]])
+    assert single_dominant(labels).tolist() == [False, True, False, True]
+
+
 def test_rollout_continues_free_running_past_the_data(tiny_data):
     cfg = GaitNetConfig.tiny(extra_steps=5)
     net = GaitNet(cfg.model)
@@ -492,8 +515,13 @@ def test_rollout_continues_free_running_past_the_data(tiny_data):
     _, terms = total_loss(pred, ground_truth_targets(batch, norm), cfg.loss, style_from=cfg.prefix_len - 1)
     assert terms["style"] > 0
     _, none = total_loss(pred, ground_truth_targets(batch, norm), GaitLossWeights(style=0.0))
-    assert "style" not in none
+    assert "style" not in none and "class_style" not in terms
+    targets = ground_truth_targets(batch, norm)
+    assert targets["emotion"].shape == (2, batch["emotion"].shape[-1])
+    _, with_class = total_loss(pred, targets, GaitLossWeights(class_style=2.0), style_from=cfg.prefix_len - 1)
+    assert with_class["class_style"] >= 0
     assert GaitNetConfig.tiny(tf_start=0.3).train.tf_start == 0.3
+    assert GaitNetConfig.tiny(lambda_class_style=4).loss.class_style == 4
 
 
 def test_fine_tuning_starts_from_a_weights_file(tiny_data, tmp_path):

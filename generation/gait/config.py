@@ -195,6 +195,10 @@ class GaitLossWeights:
     style: L_style (an addition): the time mean and spread of the affective features and the motion amplitude of
         the predicted window and of the free-running continuation match the ground truth's
         (``losses.style_loss``; 0 leaves it out, as in the paper and in checkpoints saved before the field).
+    class_style: L_class (an addition, default off): the batch's per-emotion mean offset of the walks' time-mean
+        affective features from the ground truth's, in walk-to-walk units (``losses.class_style_loss``). The
+        per-walk style term weighs a shift shared by every walk of an emotion no more than walk-level noise,
+        yet such a shift is what moves a whole class across an observer's boundary.
     pos_scale_m: positions in the pose and foot losses are measured in units of this many metres.
     euler_order: axis order of the Euler angles compared by L_motion.
     """
@@ -207,6 +211,7 @@ class GaitLossWeights:
     fctc: float = 1.0
     phase: float = 1.0
     style: float = 1.0
+    class_style: float = 0.0
     pos_scale_m: float = 0.1
     euler_order: str = "zyx"
 
@@ -230,7 +235,7 @@ FLAT_NAMES: dict[str, tuple[str, str]] = {
                                           "splice_frac", "extra_steps", "tf_start", "uniform_label_frac",
                                           "seed")},
     **{f"lambda_{name}": ("loss", name) for name in ("motion", "versor", "pose", "aff", "root", "fctc", "phase",
-                                                                  "style")},
+                                                                  "style", "class_style")},
     "pos_scale_m": ("loss", "pos_scale_m"),
     "euler_order": ("loss", "euler_order"),
 }

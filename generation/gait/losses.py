@@ -104,6 +104,25 @@ def style_loss(pred_windows: list[tuple[torch.Tensor, torch.Tensor]], aff_true: 
     return torch.stack(terms).mean()
 
 
+def class_style_loss(pred_aff: list[torch.Tensor], aff_true: torch.Tensor, emotion: torch.Tensor,
+                     mean_scale: torch.Tensor | None = None) -> torch.Tensor:
+    """Per-emotion offset of the time-mean affective features (an addition of this implementation).
+
+    ``pred_aff``: predicted windows (N, L, 18) of standardised features; ``aff_true`` (N, L, 18) the ground
+    truth's; ``emotion`` (N, C) each walk's label vector, used as soft class membership; ``mean_scale`` (18,)
+    puts the means in walk-to-walk units. For each class c the membership-weighted mean over walks of
+    (predicted - true time mean) is a shared offset (C, 18); the loss is its mean square, averaged over windows.
+    Classes absent from the batch contribute 0.
+    """
+    target = aff_true.mean(1) if mean_scale is None else aff_true.mean(1) * mean_scale
+    share = emotion / emotion.sum(0, keepdim=True).clamp_min(1e-6)   # (N, C): each column sums to 1 (or 0)
+    terms = []
+    for a in pred_aff:
+        mean = a.mean(1) if mean_scale is None else a.mean(1) * mean_scale
+        terms.append(((share.T @ (mean - target)) ** 2).mean())
+    return torch.stack(terms).mean()
+
+
 def total_loss(pred: dict, true: dict, weights: GaitLossWeights, use_affective: bool = True, style_from: int = 0
                ) -> tuple[torch.Tensor, dict]:
     """Eq. 13 plus the phase term and the optional style term.
@@ -114,7 +133,9 @@ def total_loss(pred: dict, true: dict, weights: GaitLossWeights, use_affective: 
     (:func:`style_loss`) compares the windows ``[style_from:]`` of ``pred`` and ``true`` and, when ``pred`` has
     ``ext_aff`` / ``ext_pos`` (steps predicted past the ground truth), that continuation too; ``true`` may carry
     ``aff_style_scale`` (18,) for the feature means (:meth:`generation.gait.data.Normalizer.style_scale`).
-    Terms with weight 0 are left out of the total. Returns the weighted total and a dict of floats per term.
+    With ``weights.class_style`` > 0, ``true["emotion"]`` (N, C) gives the classes of :func:`class_style_loss`
+    over the same windows. Terms with weight 0 are left out of the total. Returns the weighted total and a dict
+    of floats per term.
     """
     w = weights
     terms = {
@@ -132,5 +153,11 @@ def total_loss(pred: dict, true: dict, weights: GaitLossWeights, use_affective: 
             windows.append((pred["ext_aff"], pred["ext_pos"]))
         terms["style"] = style_loss(windows, true["aff"][:, style_from:], true["pos"][:, style_from:],
                                     w.pos_scale_m, true.get("aff_style_scale"))
+    if w.class_style != 0.0:
+        windows = [pred["aff"][:, style_from:]]
+        if pred.get("ext_aff") is not None:
+            windows.append(pred["ext_aff"])
+        terms["class_style"] = class_style_loss(windows, true["aff"][:, style_from:], true["emotion"],
+                                                true.get("aff_style_scale"))
     total = sum(getattr(w, k) * v for k, v in terms.items() if getattr(w, k) != 0.0)
     return total, {k: float(v.detach()) for k, v in terms.items()}

@@ -67,12 +67,14 @@ def fit_normalizer(data: GaitSequences) -> Normalizer:
 
 
 def ground_truth_targets(batch: dict, norm: Normalizer) -> dict:
-    """Targets for predictions of steps 1..T-1 (shapes (B, T-1, ...))."""
+    """Targets for predictions of steps 1..T-1 (shapes (B, T-1, ...)), with ``emotion`` (B, C): each walk's own
+    label (the last step's input where the batch has per-step labels)."""
     h = batch["root"][:, 1:, 0]
     pos = heading_frame_positions(batch["q"][:, 1:], batch["mean_height"][:, None] + h, batch["offsets"][:, None])
     return {"q": batch["q"][:, 1:], "pos": pos, "aff": norm.aff(batch["aff"][:, 1:]),
             "root": norm.root(batch["root"][:, 1:]), "omega": norm.omega(batch["omega"][:, 1:]),
-            "aff_style_scale": norm.style_scale(batch["aff"])}
+            "aff_style_scale": norm.style_scale(batch["aff"]),
+            "emotion": batch["emotion"] if batch["emotion"].dim() == 2 else batch["emotion"][:, -1]}
 
 
 def splice_histories(batch: dict, prefix: int, frac: float, rng: np.random.Generator) -> dict:

@@ -13,6 +13,11 @@ Each sentence also gets a counterfactual variant, performed with another emotion
 so that the emotion attributes, not only the wording, decide the style (issue 14; :func:`build_dataset`).
 
 Splits are by sentence (80/10/10, stratified by emotion), so every variant of a sentence lands in one split.
+
+``build_dataset(augment=N)`` adds N more SYNTHETIC training sentences made by recombining the phrases of
+training-split sentences (:func:`augment_rows`; sentence ids ``aug00000``...), so that the network sees the same
+words in more contexts and learns each phrase's gesture kind from its words rather than memorising whole sentences.
+They are always in the training split; the split of the corpus sentences is computed before and does not change.
 """
 from __future__ import annotations
 
@@ -196,6 +201,99 @@ def _task_style(params, task: str):
                                head_motion=float(np.clip(params.head_motion * scale, 0.0, 0.4))).validate()
 
 
+AUGMENT_PREFIX = "aug"
+_JOINERS = (", ", ", ", "; ")
+
+
+def is_augmented(row: SentenceRow) -> bool:
+    """True for the phrase-recombination sentences of :func:`augment_rows` (never in the corpus CSV)."""
+    return row.sentence_id.startswith(AUGMENT_PREFIX)
+
+
+def _proper_words(rows: list[SentenceRow]) -> set[str]:
+    """Words written capitalised inside a sentence (not after . ? !) in ``rows``: names, days, "I", "I'm"...;
+    they keep their capital when a phrase that starts with them is moved inside a new sentence."""
+    out = {"I"}
+    for r in rows:
+        for m in re.finditer(r"[A-Za-z']+", r.sentence):
+            before = r.sentence[: m.start()].rstrip()
+            if before and before[-1] not in ".?!" and m.group()[0].isupper():
+                out.add(m.group())
+    return out
+
+
+def augment_rows(rows: list[SentenceRow], split: dict[str, str], n: int, seed: int = 0) -> list[SentenceRow]:
+    """``n`` SYNTHETIC training sentences made by recombining phrases of the training-split sentences of ``rows``.
+
+    Each new sentence joins a run of consecutive phrases (:func:`phrases`) of one training sentence with a run of
+    another's, at most :data:`MAX_PHRASES` phrases and no more words than the longest source sentence (nor fewer
+    than the shortest), e.g. "The report is on your desk, we actually did it!". Phrases are joined by ", " or "; ";
+    the first word is capitalised, later phrases lose their capital unless it starts a name or "I"; the sentence
+    ends with the last phrase's source's end mark, and a "?" or "!" that ended the first source stays after its
+    phrase (so end marks travel with their phrases). The task comes from
+    the first source; the emotion is drawn uniformly from the 11 emotions, balanced (each emotion n/11 times,
+    shuffled), so wording and emotion are decorrelated and each emotion gets each gesture kind: the kind then
+    follows the words (and arousal), which is what the network has to learn from them. Sentences that repeat a
+    corpus sentence (any split) or an earlier new one are redrawn. Ids are ``aug00000``, ``aug00001``, ...
+    Only sentences that ``split`` puts in "train" are sources; deterministic given ``rows``, ``split``, ``seed``.
+    """
+    if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or n < 0:
+        raise ValueError(f"augment must be a whole number >= 0 of extra training sentences, got {n!r}")
+    n = int(n)
+    if n == 0:
+        return []
+    sources = [r for r in rows if split.get(r.sentence_id) == "train" and not is_augmented(r)]
+    if len(sources) < 2:
+        raise ValueError(f"augment needs at least 2 training sentences to recombine, got {len(sources)}")
+    rng = np.random.default_rng(np.random.SeedSequence([int(seed), 0xA06]))
+    proper = _proper_words(sources)
+    parts = [phrases(r.sentence) for r in sources]
+    ends = [r.sentence.rstrip()[-1] if r.sentence.rstrip()[-1] in ".?!" else "." for r in sources]
+    n_words = [count_words(r.sentence) for r in sources]
+    lo, hi = min(n_words), max(n_words)
+    seen = {re.sub(r"\W+", " ", r.sentence).strip().lower() for r in rows}
+    emotions = tuple(GESTURE_VAD)
+    schedule: list[str] = []
+    out: list[SentenceRow] = []
+    attempts = 0
+    while len(out) < n:
+        attempts += 1
+        if attempts > 200 * n + 1000:
+            raise ValueError(f"could not make {n} distinct recombined sentences from {len(sources)} training "
+                             f"sentences (made {len(out)})")
+        a, b = (int(x) for x in rng.choice(len(sources), size=2, replace=False))
+        runs = []
+        for src in (a, b):
+            k = len(parts[src])
+            length = int(rng.integers(1, k + 1))
+            start = int(rng.integers(0, k - length + 1))
+            runs.append((parts[src][start:start + length], start + length == k))
+        chosen = runs[0][0] + runs[1][0]
+        words = sum(count_words(p) for p in chosen)
+        if len(chosen) > MAX_PHRASES or not lo <= words <= hi:
+            continue
+        # after each phrase: a joiner, or the first source's "?"/"!" when its run ends that sentence
+        marks = [_JOINERS[int(rng.integers(len(_JOINERS)))] for _ in chosen[:-1]]
+        if runs[0][1] and ends[a] in "?!":
+            marks[len(runs[0][0]) - 1] = ends[a] + " "
+        text = ""
+        for j, p in enumerate(chosen):
+            first, rest = (p.split(" ", 1) + [""])[:2]
+            if j == 0 or marks[j - 1].startswith(("?", "!")):
+                first = first[:1].upper() + first[1:]
+            elif first not in proper:
+                first = first[:1].lower() + first[1:]
+            text += (first + " " + rest).strip() + (marks[j] if j < len(marks) else ends[b])
+        norm = re.sub(r"\W+", " ", text).strip().lower()
+        if norm in seen:
+            continue
+        seen.add(norm)
+        if not schedule:
+            schedule = [emotions[int(i)] for i in rng.permutation(len(emotions))]
+        out.append(SentenceRow(f"{AUGMENT_PREFIX}{len(out):05d}", schedule.pop(), sources[a].task, text))
+    return out
+
+
 @dataclass
 class GestureDataset:
     """Padded arrays of paired examples (N examples, S tokens, T frames at ``fps``, J = 23 joints).
@@ -355,7 +453,7 @@ def _make_pairs(rows: list[SentenceRow], variants: int, counterfactual: int, see
 
 def build_dataset(variants: int = 2, seed: int = 0, fps: float = config.TRAIN_FPS,
                   sentences_csv: str | Path = config.SENTENCES_CSV, cache_dir: str | Path | None = None,
-                  rows: list[SentenceRow] | None = None, counterfactual: int = 1) -> GestureDataset:
+                  rows: list[SentenceRow] | None = None, counterfactual: int = 1, augment: int = 0) -> GestureDataset:
     """Pair every sentence with ``variants`` procedural gestures of its own emotion and ``counterfactual`` of
     another emotion (random gender and handedness per gesture).
 
@@ -364,7 +462,17 @@ def build_dataset(variants: int = 2, seed: int = 0, fps: float = config.TRAIN_FP
     (the same sentence performed with another emotion) make the attributes carry it, which is what generation
     with a chosen emotion needs (issue 14). Token vectors are cached in ``cache_dir/sentence_tokens.npz``, the
     paired gestures in a second npz keyed by the corpus content and the arguments, so a second call is fast.
+
+    ``augment`` = N > 0 adds N phrase-recombination sentences (:func:`augment_rows`, seeded by ``seed``) to the
+    training split, each paired with one procedural gesture of its drawn emotion (the emotions are already
+    spread over the 11, so no counterfactual is needed); the split of ``rows`` is computed first and is the same
+    as with ``augment=0``, so the validation and test examples do not change. Their token vectors and gestures
+    are cached in files of their own (``sentence_tokens_aug.npz``, ``gesture_pairs_aug_<key>.npz``, the key from
+    the new sentences, so from N, the seed and the corpus); ``augment=0`` reads and writes exactly the files it
+    did before.
     """
+    if isinstance(augment, bool) or not isinstance(augment, (int, np.integer)) or augment < 0:
+        raise ValueError(f"augment must be a whole number >= 0 of extra training sentences, got {augment!r}")
     cache_dir = Path(cache_dir) if cache_dir is not None else config.VAR_DIR
     rows = rows if rows is not None else load_sentences(sentences_csv)
     split = split_sentences(rows, seed)
@@ -381,7 +489,37 @@ def build_dataset(variants: int = 2, seed: int = 0, fps: float = config.TRAIN_FP
         pairs = _make_pairs(rows, variants, counterfactual, seed, fps)
         motion_cache.parent.mkdir(parents=True, exist_ok=True)
         np.savez_compressed(motion_cache, **pairs)
+    if augment:
+        extra = augment_rows(rows, split, int(augment), seed)
+        encodings = encodings + cached_encodings([r.sentence for r in extra], cache_dir / "sentence_tokens_aug.npz")
+        aug_src = json.dumps([[r.sentence_id, r.emotion, r.task, r.sentence] for r in extra])
+        aug_key = hashlib.sha1((aug_src + f"|{seed}|{fps}" + _generator_fingerprint()).encode()).hexdigest()[:12]
+        aug_cache = cache_dir / f"gesture_pairs_aug_{aug_key}.npz"
+        if aug_cache.is_file():
+            with np.load(aug_cache, allow_pickle=False) as data:
+                aug_pairs = {k: data[k] for k in data.files}
+        else:
+            aug_pairs = _make_pairs(extra, 1, 0, seed + 7919, fps)
+            aug_cache.parent.mkdir(parents=True, exist_ok=True)
+            np.savez_compressed(aug_cache, **aug_pairs)
+        pairs = _concat_pairs(pairs, aug_pairs, offset=len(rows))
+        split = {**split, **{r.sentence_id: "train" for r in extra}}
+        rows = list(rows) + extra
     return _assemble(pairs, rows, encodings, split, fps)
+
+
+def _concat_pairs(a: dict, b: dict, offset: int) -> dict:
+    """The arrays of two :func:`_make_pairs` results as one; ``b``'s sentence indices are shifted by ``offset``
+    and the shorter rotations are padded with their last frame, as :func:`_make_pairs` pads."""
+    T = max(a["rotations"].shape[1], b["rotations"].shape[1])
+
+    def pad(r):
+        return np.concatenate([r, np.repeat(r[:, -1:], T - r.shape[1], axis=1)], axis=1) if r.shape[1] < T else r
+
+    out = {k: np.concatenate([a[k], b[k]]) for k in ("emotion", "gender", "handedness", "lengths")}
+    out["sentence_index"] = np.concatenate([a["sentence_index"], b["sentence_index"] + offset])
+    out["rotations"] = np.concatenate([pad(a["rotations"]), pad(b["rotations"])])
+    return out
 
 
 def _assemble(pairs: dict, rows: list[SentenceRow], encodings: list[np.ndarray], split: dict[str, str],

@@ -73,6 +73,8 @@ class TrainConfig:
     seed: int = 0
     variants: int = 2
     counterfactual: int = 1  # extra gestures per sentence performed with another emotion (data.build_dataset)
+    # extra training sentences recombined from the training sentences' phrases (data.augment_rows); 0 = none
+    augment: int = 0
     max_minutes: float | None = 20.0  # stop (and keep the best model) after this wall-clock time
     loss: LossWeights = field(default_factory=LossWeights)
     model: GestureNetConfig = field(default_factory=GestureNetConfig)
@@ -200,6 +202,9 @@ def _restore(path: Path, cfg: TrainConfig, net, optimizer, scheduler, generator,
     if ckpt["model_config"] != cfg.model.to_dict():
         raise ValueError(f"{path}: checkpoint model config {ckpt['model_config']} differs from the "
                          f"requested {cfg.model.to_dict()}")
+    if ckpt.get("data", _data_options(cfg)) != _data_options(cfg):  # older checkpoints have no "data": not checked
+        raise ValueError(f"{path}: checkpoint was trained on data {ckpt['data']}, not the requested "
+                         f"{_data_options(cfg)}")
     net.load_state_dict(ckpt["state_dict"])
     optimizer.load_state_dict(ckpt["optimizer"])
     scheduler.load_state_dict(ckpt["scheduler"])
@@ -217,7 +222,14 @@ def _save_checkpoint(path: Path, epoch: int, net, optimizer, scheduler, generato
     torch.save({"epoch": epoch, "state_dict": cpu_state_dict(net), "optimizer": to_cpu(optimizer.state_dict()),
                 "scheduler": scheduler.state_dict(), "generator": generator.get_state(), "history": run.history,
                 "best_val": run.best_val, "best_state": run.best_state, "best_epoch": run.best_epoch,
-                "selected_by": selected_by, "seconds": seconds, "model_config": cfg.model.to_dict()}, path)
+                "selected_by": selected_by, "seconds": seconds, "model_config": cfg.model.to_dict(),
+                "data": _data_options(cfg)}, path)
+
+
+def _data_options(cfg: TrainConfig) -> dict:
+    """The options that decide the training corpus (build_dataset), so --resume refuses another corpus."""
+    return {"variants": cfg.variants, "counterfactual": cfg.counterfactual, "seed": cfg.seed,
+            "augment": cfg.augment}
 
 
 def _build(cfg: TrainConfig, device: torch.device):
@@ -247,8 +259,10 @@ def train(cfg: TrainConfig, data: GestureDataset | None = None, progress: bool =
     if cfg.amp and not amp:
         warnings.warn(f"--amp is for CUDA autocast; ignored on {device} (training runs in float32)", stacklevel=2)
     scaler = torch.amp.GradScaler("cuda") if needs_grad_scaler(device, amp) else None
+    if data is not None and cfg.augment:
+        warnings.warn(f"augment={cfg.augment} is ignored: training on the given dataset as it is", stacklevel=2)
     data = data if data is not None else build_dataset(variants=cfg.variants, seed=cfg.seed,
-                                                               counterfactual=cfg.counterfactual)
+                                                       counterfactual=cfg.counterfactual, augment=cfg.augment)
     train_idx, val_idx = data.indices("train"), data.indices("val")
     if len(train_idx) == 0:
         raise ValueError("the training split is empty")
@@ -277,13 +291,20 @@ def train(cfg: TrainConfig, data: GestureDataset | None = None, progress: bool =
         score = _score(net, data, val_idx, cfg, epoch, last_epoch, va, entry)
         run.history.append(entry)
         if score is not None and score < run.best_val:
-            run.best_val, run.best_state, run.best_epoch = score, cpu_state_dict(net), epoch
+            # a copy: on the CPU cpu_state_dict shares the parameters' storage, which the next steps overwrite
+            run.best_val, run.best_state, run.best_epoch = score, _snapshot(net), epoch
         bar.set_postfix(train=f"{tr['total']:.4f}", val=f"{va['total']:.4f}", best=f"{run.best_val:.4f}")
         _save_checkpoint(ckpt_path, epoch, net, optimizer, scheduler, generator, run, cfg, selected_by,
                          run.seconds_before + time.time() - t0)
         if last_epoch:
             break
     return _finish(net, cfg, run, epoch, selected_by, run.seconds_before + time.time() - t0, device)
+
+
+def _snapshot(net) -> dict:
+    """The network's weights now, as CPU tensors that later optimiser steps do not change (cpu_state_dict alone
+    returns the parameters' own storage when they are on the CPU)."""
+    return {k: v.clone() for k, v in cpu_state_dict(net).items()}
 
 
 def _score(net, data, val_idx, cfg: TrainConfig, epoch: int, last_epoch: bool, va: dict, entry: dict):
@@ -331,6 +352,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--variants", type=int, default=d.variants, help="procedural gestures per sentence")
     p.add_argument("--counterfactual", type=int, default=d.counterfactual,
                    help="extra procedural gestures per sentence performed with another emotion")
+    p.add_argument("--augment", type=int, default=d.augment,
+                   help="add this many synthetic training sentences recombined from the training sentences' phrases "
+                   "(one procedural gesture each, emotions spread evenly; validation and test unchanged; 0 = none)")
     p.add_argument("--max-minutes", type=float, default=None,
                    help="wall-clock budget in minutes (0 = none; default: 20 small, none paper); keeps the best model")
     p.add_argument("--sampling", type=float, default=d.sampling, help="share of self-fed decoder inputs")
@@ -364,6 +388,8 @@ def build_parser() -> argparse.ArgumentParser:
 
 def config_from_args(args: argparse.Namespace) -> TrainConfig:
     """A :class:`TrainConfig` from parsed options: the ``--config`` preset, then the options given explicitly."""
+    if args.augment < 0:
+        raise ValueError(f"--augment must be >= 0 (extra training sentences), got {args.augment}")
     base = LossWeights()
     loss = LossWeights(**{k: 0.0 if getattr(args, f"no_{k}_loss") else getattr(base, k)
                           for k in ("angle", "pose", "affective", "velocity", "liveliness")})
@@ -376,7 +402,8 @@ def config_from_args(args: argparse.Namespace) -> TrainConfig:
     model = dataclasses.replace(cfg.model, **{k: v for k, v in (("d_model", args.d_model),
                                                                  ("residual", args.residual)) if v is not None})
     overrides = dict(batch_size=args.batch_size, lr=args.lr, weight_decay=args.weight_decay, seed=args.seed,
-                     variants=args.variants, counterfactual=args.counterfactual, loss=loss, sampling=args.sampling,
+                     variants=args.variants, counterfactual=args.counterfactual, augment=args.augment, loss=loss,
+                     sampling=args.sampling,
                      sampling_ramp=args.sampling_ramp,
                      sampling_passes=args.sampling_passes, input_noise=args.input_noise, model=model, out=args.out,
                      checkpoint=args.checkpoint, resume=args.resume, threads=args.threads,
