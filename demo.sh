@@ -21,6 +21,9 @@ export DEBUG="${DEBUG:-0}"
 echo "==> database migrations"
 $PY manage.py migrate --noinput -v 0
 
+echo "==> synthetic gait corpus (built once, about 20 s; the gait clips' quality check reads them with an observer trained on it)"
+[ -f var/corpus/gait_corpus_synthetic.npz ] || $PY manage.py build_corpus -v 0 > /dev/null
+
 echo "==> demo clips (rendered once; unchanged clips are never rendered again)"
 $PY manage.py generate_clips --plan demo --workers "${DEMO_WORKERS:-2}"
 
