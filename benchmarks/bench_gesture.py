@@ -534,8 +534,8 @@ def _md_intro(r: dict) -> list[str]:
         f"{init}, with the velocity and liveliness losses, all decoder inputs self-fed (3 no-grad passes) and the "
         "weights chosen by validation pose error x (1 + wrist-speed gap). Until this version that choice did "
         "nothing on the CPU (the kept \"best\" state shared the parameters' storage, so every CPU run saved its last "
-        "epoch; fixed in `train._snapshot`): the previous shipped file holds its last epoch (31 of 31), not the "
-        "epoch 15 it named, and so do runs A-G of the second pass.",
+        "epoch; fixed in `generation.core.device.cpu_state_dict`, which now always copies): the previous shipped "
+        "file holds its last epoch (31 of 31), not the epoch 15 it named, and so do runs A-G of the second pass.",
         "",
     ]
 

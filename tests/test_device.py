@@ -63,6 +63,9 @@ def test_autocast_context_and_cpu_copies():
     net = torch.nn.Linear(3, 2)
     sd = cpu_state_dict(net)
     assert set(sd) == {"weight", "bias"} and all(v.device.type == "cpu" and not v.requires_grad for v in sd.values())
+    with torch.no_grad():
+        net.weight.add_(1.0)                  # a copy even on the CPU: later changes to the module do not reach it
+    assert not torch.equal(sd["weight"], net.weight)
     nested = to_cpu({"a": [torch.ones(2), (torch.zeros(1), 3)], "b": "x"})
     assert nested["b"] == "x" and nested["a"][1][1] == 3 and torch.equal(nested["a"][0], torch.ones(2))
 

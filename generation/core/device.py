@@ -73,8 +73,11 @@ def autocast_context(device: torch.device | str, enabled: bool):
 
 
 def cpu_state_dict(module: torch.nn.Module) -> dict:
-    """``module.state_dict()`` with every tensor detached and copied to the CPU (device-independent files)."""
-    return {k: v.detach().to("cpu") for k, v in module.state_dict().items()}
+    """``module.state_dict()`` with every tensor detached and copied to the CPU (device-independent files).
+
+    Always a copy, also when the module is on the CPU (where ``.to("cpu")`` would return the parameters' own
+    storage): a kept state then does not change with later optimiser steps."""
+    return {k: v.detach().to("cpu", copy=True) for k, v in module.state_dict().items()}
 
 
 def to_cpu(obj):

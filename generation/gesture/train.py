@@ -179,7 +179,7 @@ def save_weights(net: GestureNet, path: str | Path, extra: dict) -> None:
     """Write {config, state_dict (float32, CPU), train_fps, trained_on, ...} to ``path``."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    state = {k: v.float().clone() for k, v in cpu_state_dict(net).items()}
+    state = {k: v.float() for k, v in cpu_state_dict(net).items()}
     torch.save({"config": net.cfg.to_dict(), "state_dict": state,
                 "train_fps": config.TRAIN_FPS, "trained_on": SYNTHETIC_LABEL, **extra}, path)
 
@@ -291,20 +291,13 @@ def train(cfg: TrainConfig, data: GestureDataset | None = None, progress: bool =
         score = _score(net, data, val_idx, cfg, epoch, last_epoch, va, entry)
         run.history.append(entry)
         if score is not None and score < run.best_val:
-            # a copy: on the CPU cpu_state_dict shares the parameters' storage, which the next steps overwrite
-            run.best_val, run.best_state, run.best_epoch = score, _snapshot(net), epoch
+            run.best_val, run.best_state, run.best_epoch = score, cpu_state_dict(net), epoch
         bar.set_postfix(train=f"{tr['total']:.4f}", val=f"{va['total']:.4f}", best=f"{run.best_val:.4f}")
         _save_checkpoint(ckpt_path, epoch, net, optimizer, scheduler, generator, run, cfg, selected_by,
                          run.seconds_before + time.time() - t0)
         if last_epoch:
             break
     return _finish(net, cfg, run, epoch, selected_by, run.seconds_before + time.time() - t0, device)
-
-
-def _snapshot(net) -> dict:
-    """The network's weights now, as CPU tensors that later optimiser steps do not change (cpu_state_dict alone
-    returns the parameters' own storage when they are on the CPU)."""
-    return {k: v.clone() for k, v in cpu_state_dict(net).items()}
 
 
 def _score(net, data, val_idx, cfg: TrainConfig, epoch: int, last_epoch: bool, va: dict, entry: dict):
