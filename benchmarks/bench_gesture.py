@@ -136,31 +136,28 @@ def all_emotion_corpus_speeds(data: GestureDataset, rows: list) -> list[dict]:
     return out
 
 
-def liveliness_all_emotions(net, data: GestureDataset, idx: np.ndarray, corpus: list[dict]) -> dict:
-    """:func:`liveliness` over every held-out example x 11 emotions: per emotion len(idx) examples (99 on the test
-    split) instead of the 8-12 that carry each emotion in the split itself, against the procedural gestures of
-    :func:`all_emotion_corpus_speeds` (``corpus``)."""
-    rows, fake = all_emotion_examples(data, idx)
-    gen = decode_examples(net, fake, np.arange(len(rows)))
+def liveliness_all_emotions(examples: tuple[list, GestureDataset], gen: list[np.ndarray], corpus: list[dict]) -> dict:
+    """:func:`liveliness` over every held-out example x 11 emotions (``examples`` from :func:`all_emotion_examples`,
+    ``gen`` their decoded gestures): per emotion len(idx) examples (99 on the test split) instead of the 8-12 that
+    carry each emotion in the split itself, against the procedural gestures of :func:`all_emotion_corpus_speeds`
+    (``corpus``)."""
+    rows, fake = examples
     g = [wrist_speed(x, str(fake.gender[n]), fake.root[n], fake.fps) for n, x in enumerate(gen)]
-    per = {}
-    for emo in GESTURE_EMOTIONS:
-        sel = [n for n, (_, e, _) in enumerate(rows) if e == emo]
-        per[emo] = {"n": len(sel), **{f"{who}_{m}": float(np.mean([src[k][m] for k in sel]))
-                                      for who, src in (("gen", g), ("corpus", corpus)) for m in ("mean", "peak")}}
+    per, worst = speed_ratios([e for _, e, _ in rows], g, corpus)
     ratios = [v[f"gen_{m}"] / v[f"corpus_{m}"] for v in per.values() for m in ("mean", "peak")]
     return {"per_emotion": per, "n": len(rows), "cells_in_band": int(sum(0.75 <= x <= 1.25 for x in ratios)),
-            "worst_ratio_gap": float(max(abs(x - 1) for x in ratios))}
+            "worst_ratio_gap": worst}
 
 
-def expressiveness(net, data: GestureDataset, idx: np.ndarray, observers: dict) -> dict:
-    """Each held-out sentence said with each of the 11 emotions: Pearson r of speed with arousal and of
-    expansion with dominance; the synthetic observers (:func:`fit_observers`) classify high vs low arousal and
-    dominance (threshold 0.5) of the generated gestures (balanced accuracy)."""
+def expressiveness(examples: tuple[list, GestureDataset], gen: list[np.ndarray], data: GestureDataset,
+                   idx: np.ndarray, observers: dict) -> dict:
+    """Each held-out sentence said with each of the 11 emotions (``examples`` from :func:`all_emotion_examples`,
+    ``gen`` their decoded gestures): Pearson r of speed with arousal and of expansion with dominance; the
+    synthetic observers (:func:`fit_observers`) classify high vs low arousal and dominance (threshold 0.5) of the
+    generated gestures (balanced accuracy)."""
     from sklearn.metrics import balanced_accuracy_score
 
-    rows, fake = all_emotion_examples(data, idx)
-    gen = decode_examples(net, fake, np.arange(len(rows)))
+    rows, fake = examples
     desc = [motion_descriptors(positions_of(g, fake, n), data.fps) for n, g in enumerate(gen)]
     vad = fake.vad
     X = np.stack([d["features"] for d in desc])
@@ -234,6 +231,20 @@ def speed_benchmark(net, n_sentences: int = 20, repeats: int = 3) -> dict:
 
 
 # ---- liveliness (issue 14) ------------------------------------------------------------------------------
+def speed_ratios(emotions: list[str], gen: list[dict], corpus: list[dict]) -> tuple[dict, float]:
+    """Per emotion present in ``emotions`` (one label per example): n and the mean over its examples of the
+    generated and corpus clips' mean and peak wrist speed (``gen`` / ``corpus``: :func:`wrist_speed` dicts); and
+    the largest |generated / corpus - 1| over those cells."""
+    per = {}
+    for emo in GESTURE_EMOTIONS:
+        sel = [k for k, e in enumerate(emotions) if e == emo]
+        if sel:
+            per[emo] = {"n": len(sel), **{f"{who}_{m}": float(np.mean([src[k][m] for k in sel]))
+                                          for who, src in (("gen", gen), ("corpus", corpus)) for m in ("mean", "peak")}}
+    worst = max(abs(v[f"gen_{m}"] / v[f"corpus_{m}"] - 1) for v in per.values() for m in ("mean", "peak"))
+    return per, float(worst)
+
+
 def liveliness(net, data: GestureDataset, idx: np.ndarray) -> dict:
     """Wrist speed of generated vs corpus gestures for the same held-out sentences and attributes.
 
@@ -244,15 +255,9 @@ def liveliness(net, data: GestureDataset, idx: np.ndarray) -> dict:
     gen = decode_examples(net, data, idx)
     g = [wrist_speed(x, str(data.gender[i]), data.root[i], data.fps) for x, i in zip(gen, idx)]
     c = [wrist_speed(data.rotations[i, : data.lengths[i]], str(data.gender[i]), data.root[i], data.fps) for i in idx]
-    per = {}
-    for emo in GESTURE_EMOTIONS:
-        sel = [k for k, i in enumerate(idx) if data.emotion[i] == emo]
-        if sel:
-            per[emo] = {"n": len(sel), **{f"{who}_{m}": float(np.mean([src[k][m] for k in sel]))
-                                          for who, src in (("gen", g), ("corpus", c)) for m in ("mean", "peak")}}
+    per, worst = speed_ratios([str(data.emotion[i]) for i in idx], g, c)
     arousal = data.vad[idx, 1]
-    worst = max(abs(v[f"gen_{m}"] / v[f"corpus_{m}"] - 1) for v in per.values() for m in ("mean", "peak"))
-    return {"per_emotion": per, "n": int(len(idx)), "worst_ratio_gap": float(worst),
+    return {"per_emotion": per, "n": int(len(idx)), "worst_ratio_gap": worst,
             "r_gen": float(stats.pearsonr([x["peak"] for x in g], arousal)[0]),
             "r_corpus": float(stats.pearsonr([x["peak"] for x in c], arousal)[0])}
 
@@ -260,12 +265,14 @@ def liveliness(net, data: GestureDataset, idx: np.ndarray) -> dict:
 def liveliness_report(nets: dict, data: GestureDataset, idx: np.ndarray, observers: dict) -> dict:
     """:func:`liveliness` and the all-emotion r(peak speed, arousal) of :func:`expressiveness` per network."""
     out = {}
-    corpus = all_emotion_corpus_speeds(data, all_emotion_examples(data, idx)[0])
+    examples = all_emotion_examples(data, idx)
+    corpus = all_emotion_corpus_speeds(data, examples[0])
     for name, net in nets.items():
         live = liveliness(net, data, idx)
-        expr = expressiveness(net, data, idx, observers)
+        gen = decode_examples(net, examples[1], np.arange(len(examples[0])))
+        expr = expressiveness(examples, gen, data, idx, observers)
         out[name] = {**live, "r_all_emotions": expr["r_speed_arousal"], "n_all_emotions": expr["n_generated"],
-                     "all_emotions": liveliness_all_emotions(net, data, idx, corpus), "expressiveness": expr}
+                     "all_emotions": liveliness_all_emotions(examples, gen, corpus), "expressiveness": expr}
         print(name, json.dumps({k: v for k, v in out[name].items() if k != "expressiveness"}, default=float),
               flush=True)
     return out
