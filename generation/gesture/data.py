@@ -478,34 +478,32 @@ def build_dataset(variants: int = 2, seed: int = 0, fps: float = config.TRAIN_FP
     split = split_sentences(rows, seed)
     encodings = cached_encodings([r.sentence for r in rows], cache_dir / "sentence_tokens.npz")
 
-    key_src = json.dumps([[r.sentence_id, r.emotion, r.task, r.sentence] for r in rows])
-    key_src += f"|{variants}|{counterfactual}|{seed}|{fps}" + _generator_fingerprint()
-    key = hashlib.sha1(key_src.encode()).hexdigest()[:12]
-    motion_cache = cache_dir / f"gesture_pairs_{key}.npz"
-    if motion_cache.is_file():
-        with np.load(motion_cache, allow_pickle=False) as data:
-            pairs = {k: data[k] for k in data.files}
-    else:
-        pairs = _make_pairs(rows, variants, counterfactual, seed, fps)
-        motion_cache.parent.mkdir(parents=True, exist_ok=True)
-        np.savez_compressed(motion_cache, **pairs)
+    pairs = _cached_pairs(cache_dir, "gesture_pairs", rows, f"|{variants}|{counterfactual}|{seed}|{fps}",
+                          lambda: _make_pairs(rows, variants, counterfactual, seed, fps))
     if augment:
         extra = augment_rows(rows, split, int(augment), seed)
         encodings = encodings + cached_encodings([r.sentence for r in extra], cache_dir / "sentence_tokens_aug.npz")
-        aug_src = json.dumps([[r.sentence_id, r.emotion, r.task, r.sentence] for r in extra])
-        aug_key = hashlib.sha1((aug_src + f"|{seed}|{fps}" + _generator_fingerprint()).encode()).hexdigest()[:12]
-        aug_cache = cache_dir / f"gesture_pairs_aug_{aug_key}.npz"
-        if aug_cache.is_file():
-            with np.load(aug_cache, allow_pickle=False) as data:
-                aug_pairs = {k: data[k] for k in data.files}
-        else:
-            aug_pairs = _make_pairs(extra, 1, 0, seed + 7919, fps)
-            aug_cache.parent.mkdir(parents=True, exist_ok=True)
-            np.savez_compressed(aug_cache, **aug_pairs)
+        aug_pairs = _cached_pairs(cache_dir, "gesture_pairs_aug", extra, f"|{seed}|{fps}",
+                                  lambda: _make_pairs(extra, 1, 0, seed + 7919, fps))
         pairs = _concat_pairs(pairs, aug_pairs, offset=len(rows))
         split = {**split, **{r.sentence_id: "train" for r in extra}}
         rows = list(rows) + extra
     return _assemble(pairs, rows, encodings, split, fps)
+
+
+def _cached_pairs(cache_dir: Path, prefix: str, rows: list[SentenceRow], options: str, make) -> dict:
+    """The :func:`_make_pairs` arrays for ``rows``: read from ``cache_dir/<prefix>_<key>.npz`` (the key hashes the
+    rows, ``options`` and the generator's source) or made by ``make()`` and written there."""
+    src = json.dumps([[r.sentence_id, r.emotion, r.task, r.sentence] for r in rows]) + options
+    key = hashlib.sha1((src + _generator_fingerprint()).encode()).hexdigest()[:12]
+    path = cache_dir / f"{prefix}_{key}.npz"
+    if path.is_file():
+        with np.load(path, allow_pickle=False) as data:
+            return {k: data[k] for k in data.files}
+    pairs = make()
+    path.parent.mkdir(parents=True, exist_ok=True)
+    np.savez_compressed(path, **pairs)
+    return pairs
 
 
 def _concat_pairs(a: dict, b: dict, offset: int) -> dict:
