@@ -147,17 +147,14 @@ def total_loss(pred: dict, true: dict, weights: GaitLossWeights, use_affective: 
     }
     if use_affective:
         terms["aff"] = affective_loss(pred["aff"], true["aff"])
+    windows = [(pred["aff"][:, style_from:], pred["pos"][:, style_from:])]
+    if pred.get("ext_aff") is not None:
+        windows.append((pred["ext_aff"], pred["ext_pos"]))
     if w.style != 0.0:
-        windows = [(pred["aff"][:, style_from:], pred["pos"][:, style_from:])]
-        if pred.get("ext_aff") is not None:
-            windows.append((pred["ext_aff"], pred["ext_pos"]))
         terms["style"] = style_loss(windows, true["aff"][:, style_from:], true["pos"][:, style_from:],
                                     w.pos_scale_m, true.get("aff_style_scale"))
     if w.class_style != 0.0:
-        windows = [pred["aff"][:, style_from:]]
-        if pred.get("ext_aff") is not None:
-            windows.append(pred["ext_aff"])
-        terms["class_style"] = class_style_loss(windows, true["aff"][:, style_from:], true["emotion"],
-                                                true.get("aff_style_scale"))
+        terms["class_style"] = class_style_loss([aff for aff, _ in windows], true["aff"][:, style_from:],
+                                                true["emotion"], true.get("aff_style_scale"))
     total = sum(getattr(w, k) * v for k, v in terms.items() if getattr(w, k) != 0.0)
     return total, {k: float(v.detach()) for k, v in terms.items()}
