@@ -2,7 +2,7 @@
 
 ``studyapp.presets`` turns a preset into Study + Section rows (the researcher then edits them in the admin); the
 synthetic-study simulator (``analysis.design``) reads the same sections to simulate a study of that preset. Each
-section: ``section_type``, ``title``, ``instructions``, ``pool`` (catalogue filters, see ``studyapp.pools``),
+section: ``section_type``, ``title``, ``instructions``, ``pool`` (catalogue filters, see ``study_pools``),
 ``clips_per_participant`` (0 = every clip of the pool), ``options`` (type-specific), or ``reuse`` (the index of an
 earlier section of the same preset whose clips it shows again).
 """

@@ -11,7 +11,7 @@ Each plan entry becomes one SYNTHETIC clip row with id ``sim-<plan>-<entry id>``
 one: the entry's ``duration_s`` input, else its pair's (a generated gesture and its source), else the plan's render
 duration -- a rendered clip's real length may differ a little.
 
-Pools are matched as ``studyapp.pools`` defines them (field, ``field__lookup``, lists, the ``transition`` and ``rbf``
+Pools are matched as ``study_pools`` defines them (field, ``field__lookup``, lists, the ``transition`` and ``rbf``
 shorthands, naturalness sub-pools), on the clip rows plus their ``plan``.
 """
 from __future__ import annotations
@@ -21,9 +21,9 @@ from dataclasses import dataclass, field
 import numpy as np
 import pandas as pd
 
+from study_pools import DEFAULT_GESTURE_OPTIONS, FLAGS, INCLUDE_FLAGGED, SUB_POOLS, pool_errors
 from study_presets import PRESET_PLANS, PRESETS
 from study_protocol import CLIP_COLUMNS, FINAL_EMOTION_COLUMNS, GESTURE_EMOTIONS, SECTION_QUESTIONS
-from studyapp.pools import DEFAULT_GESTURE_OPTIONS, FLAGS, INCLUDE_FLAGGED, SUB_POOLS, pool_errors
 
 PAPER_PRESETS = ("gait_ismar2020", "gestures_ieeevr2021", "rbf_thms2016")
 """The three papers' studies; simulated one after the other as one SYNTHETIC study by default."""
@@ -127,7 +127,7 @@ def plan_clip_rows(plan) -> list[dict]:
     return rows
 
 
-# ---- pool filters (studyapp.pools semantics) -----------------------------------------------------------------------
+# ---- pool filters (study_pools semantics) -----------------------------------------------------------------------
 def _text(s: pd.Series) -> pd.Series:
     return s.fillna("").astype(str)
 

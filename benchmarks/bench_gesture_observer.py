@@ -8,7 +8,7 @@
 2. Generated gestures: one example of every test sentence said with each of the 11 emotions by the shipped gesture
    network (``decode_examples``, as in benchmarks/bench_gesture.py), read by the same observer.
 3. The seed003 plan's gesture entries: every motion made as ``generate_clips`` makes it (no video, no figure-height
-   projection) and checked by the quality gate (:func:`generation.quality.plan_qa.run`).
+   projection) and checked by the quality gate (:func:`generation.pipeline.plan_qa.run`).
 
 Everything here is synthetic: procedural gestures, a network trained on them, an observer trained on them.
 """
@@ -133,7 +133,7 @@ def generated_descriptors(data: GestureDataset, weights: Path) -> tuple[np.ndarr
 
 def plan_summary(plan: str, weights: Path) -> dict:
     """Quality gate over the plan's gesture entries without video or figure-height projection."""
-    from generation.quality.plan_qa import run, summary_line
+    from generation.pipeline.plan_qa import run, summary_line
 
     rows = run(plan, modality="gesture", figure_height=False, log=lambda s: None)
     out = {"rows": rows, "summary": summary_line(r["flag"] for r in rows)}

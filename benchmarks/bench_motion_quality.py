@@ -146,8 +146,8 @@ QA_MEASURES = ("foot_skate_cm_s", "penetration_cm", "jerk", "bone_error_mm", "fi
 
 def qa_table(plans: list[str]) -> tuple[str, dict]:
     """Per plan: clips, passed, flagged per check, and min / median / max of each measure."""
-    from generation.quality.plan_qa import run as run_qa
-    from generation.quality.plan_qa import summary_counts
+    from generation.pipeline.plan_qa import run as run_qa
+    from generation.pipeline.plan_qa import summary_counts
     from study_protocol import QA_CHECKS
 
     out, lines = {}, ["| plan | clips | passed | " + " | ".join(QA_CHECKS) + " |",

@@ -208,8 +208,8 @@ def sheet(args) -> list[dict]:
 def plans(args) -> list[dict]:
     from dataclasses import replace
 
+    from generation.pipeline.runner import run_plan
     from generation.plans.schema import load_plan
-    from generation.render.batch import run_plan
 
     rows = []
     samples = args.sample * len(args.plans) if len(args.sample) == 1 else args.sample

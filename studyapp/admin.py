@@ -12,10 +12,11 @@ from django.forms import Textarea
 from django.urls import path, reverse
 from django.utils.html import format_html, format_html_join
 
+from study_pools import SUB_POOLS
+
 from . import admin_clip_qa, pool_editor, views_pool, views_staff
 from .forms import SectionForm, StudyAdminForm
 from .models import Assignment, Clip, Participant, Response, Section, Study
-from .pools import SUB_POOLS
 from .questions import section_type_choices
 from .views_pool import count_pool
 
@@ -26,7 +27,7 @@ COMPACT = {models.JSONField: {"widget": Textarea(attrs={"rows": 2, "cols": 90})}
 SECTION_HAS_COUNTERBALANCE = "counterbalance" in {f.name for f in Section._meta.get_fields()}
 """Section.counterbalance (added by a later migration) is shown in the inline once the field exists."""
 
-RAW_JSON_HELP = ("The pool and options as JSON (studyapp.pools). The fields above win as soon as one of them is "
+RAW_JSON_HELP = ("The pool and options as JSON (study_pools). The fields above win as soon as one of them is "
                  "edited, and this JSON then only adds the keys they cannot show (e.g. <code>plan__startswith</code>, "
                  "<code>happy__gt</code>); it wins when the fields above are left as they were.")
 

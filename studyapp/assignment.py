@@ -35,10 +35,11 @@ from django.db import OperationalError, connection, transaction
 from django.db.models import F
 from django.utils import timezone
 
+from study_pools import SUB_POOLS
+
 from .counterbalance import SectionInfo, section_order
 from .models import Assignment, Clip, Participant, Section, SectionClipCount, Study, StudyCounter
 from .pool_cache import SectionPool, load_section_pool, section_pools
-from .pools import SUB_POOLS
 from .precompiled import PrecompiledSelect
 from .trial_extras import PlannedItem, gesture_options, with_extras
 

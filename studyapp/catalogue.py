@@ -14,10 +14,10 @@ import math
 from django.db import transaction
 from django.db.models import QuerySet
 
+from study_pools import INCLUDE_FLAGGED, PoolError, pool_lookups
 from study_protocol import CLIP_FLOAT_COLUMNS, CLIP_THEMES, GESTURE_EMOTIONS, MODALITIES, ORIGINS, QA_CHECKS
 
 from .models import Clip
-from .pools import INCLUDE_FLAGGED, PoolError, pool_lookups
 
 TEXT_FIELDS = ("emotion_label", "theme", "webm", "poster", "plan", "source_clip_id")
 
@@ -142,7 +142,7 @@ def retire_superseded(plan: str, current_clip_ids: set[str], entry_ids: set[str]
 
 
 def pool_queryset(pool: dict | None, include_flagged: bool | None = None) -> QuerySet:
-    """Clips (not retired) matching a section's pool filter (see studyapp.pools for the filter language).
+    """Clips (not retired) matching a section's pool filter (see study_pools for the filter language).
 
     Clips that failed a quality check (``qa_flag`` not empty) are left out unless the pool says
     ``"include_flagged": true`` or ``include_flagged`` is given (True for a sub-pool, which only narrows its

@@ -12,9 +12,9 @@ from django.core.exceptions import ValidationError
 from django.db import models
 from django.utils import timezone
 
+from study_pools import validate_section
 from study_protocol import ATTENTION_CHECK, MODALITIES, ORIGINS
 
-from .pools import validate_section
 from .questions import section_type_choices
 
 
@@ -180,7 +180,7 @@ class Section(models.Model):
         return f"{self.study.slug} #{self.order} {self.section_type}"
 
     def protocol_errors(self) -> dict[str, list[str]]:
-        """Field -> messages for a bad pool, options or count (studyapp.pools; no database query)."""
+        """Field -> messages for a bad pool, options or count (study_pools; no database query)."""
         return validate_section(self.section_type, self.pool, self.options, self.clips_per_participant)
 
     def clean(self):

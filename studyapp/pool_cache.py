@@ -16,11 +16,11 @@ from dataclasses import dataclass, field
 from django.core.cache import cache
 from django.db.models import Count, Max, Q
 
+from study_pools import SUB_POOLS
 from study_protocol import SECTION_MODALITY
 
 from .catalogue import pool_queryset
 from .models import Clip, Section
-from .pools import SUB_POOLS
 
 CLIP_FIELDS = ("id", "clip_id", "modality", "origin", "source_clip_id", "emotion_label", "theme", "duration_s",
                "media_key", "video", "webm", "poster", "loop")

@@ -1,11 +1,11 @@
 """The admin's pool editor: form fields <-> a section's ``pool`` and ``options`` JSON (the language of
-studyapp.pools), and the rule that decides which of the two a save uses.
+study_pools), and the rule that decides which of the two a save uses.
 
 Every *spec* below owns some keys of the JSON and one or more form fields:
 
 - ``read(json) -> (field values, the json without the keys it took)``
 - ``write(field values) -> the json fragment those values mean``
-- ``owner(message) -> the field a studyapp.pools message is about`` (messages name their key, e.g. ``'weight__gte'``)
+- ``owner(message) -> the field a study_pools message is about`` (messages name their key, e.g. ``'weight__gte'``)
 
 ``pool_to_fields`` / ``fields_to_pool`` (and ``options_to_fields`` / ``fields_to_options``) run every spec. Keys no
 spec can show (``plan__startswith``, ``happy__gt``, a key added to the pool language later) come back as the
@@ -24,9 +24,7 @@ from __future__ import annotations
 
 from django import forms
 
-from study_protocol import CLIP_THEMES, GESTURE_EMOTIONS, MODALITIES, NATURALNESS, ORIGINS, answer_values
-
-from .pools import (
+from study_pools import (
     COMMON_OPTIONS,
     DEFAULT_GESTURE_OPTIONS,
     INCLUDE_FLAGGED,
@@ -34,6 +32,7 @@ from .pools import (
     SUB_POOLS,
     validate_section,
 )
+from study_protocol import CLIP_THEMES, GESTURE_EMOTIONS, MODALITIES, NATURALNESS, ORIGINS, answer_values
 
 ANY = ""
 TRISTATE = [(ANY, "any"), ("yes", "yes"), ("no", "no")]
@@ -451,7 +450,7 @@ def write_specs(specs: list[ChoiceSpec], values: dict) -> dict:
 # ---- the editor's groups ------------------------------------------------------------------------------------------
 
 SUB_POOL_SECTION_TYPE = "naturalness"
-"""The section type whose pool may hold ``generated`` / ``source`` sub-pools (studyapp.pools)."""
+"""The section type whose pool may hold ``generated`` / ``source`` sub-pools (study_pools)."""
 
 
 def _main_pool_specs() -> list[ChoiceSpec]:
@@ -507,7 +506,7 @@ def _option_specs() -> dict[str, list[ChoiceSpec]]:
 
 
 def _common_option_specs() -> list[ChoiceSpec]:
-    """Options every section type takes (studyapp.pools.COMMON_OPTIONS)."""
+    """Options every section type takes (study_pools.COMMON_OPTIONS)."""
     o = OPTIONS_PREFIX
     specs = [FlagSpec(o + "practice", "practice", (), "Practice item first",
                       "one practice clip (not exported) from outside the pool, of the section's modality"),
@@ -599,7 +598,7 @@ def touched_groups(changed: list[str] | set[str]) -> dict[str, bool]:
 
 
 def _owner(specs: list[ChoiceSpec], message: str, values: dict) -> str | None:
-    """The structured field a studyapp.pools message is about: the spec that wrote the key the message names
+    """The structured field a study_pools message is about: the spec that wrote the key the message names
     (a key that came from the raw JSON's leftover is the raw field's)."""
     for spec in specs:
         if isinstance(spec, SubPoolSpec):

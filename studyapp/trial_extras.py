@@ -1,5 +1,5 @@
 """Practice trials and attention checks added to a section's planned clips (Section.options, checked by
-studyapp.pools.options_errors).
+study_pools.options_errors).
 
 - ``"practice": true`` or ``"practice_clip": "<clip_id>"``: one practice item first in the section, on a clip
   outside the section's pool (``practice``: a clip of the section's modality drawn with the participant's seed),
@@ -18,10 +18,10 @@ from __future__ import annotations
 import random
 from dataclasses import dataclass, field
 
+from study_pools import DEFAULT_GESTURE_OPTIONS
 from study_protocol import ATTENTION_CHECK, GESTURE_EMOTIONS, SECTION_QUESTIONS, attention_question
 
 from .models import Assignment, Clip, Section
-from .pools import DEFAULT_GESTURE_OPTIONS
 
 PRACTICE = Assignment.Kind.PRACTICE.value
 

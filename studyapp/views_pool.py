@@ -18,12 +18,12 @@ from django.db import DatabaseError
 from django.http import JsonResponse
 from django.views.decorators.cache import never_cache
 
+from study_pools import SUB_POOLS, pool_errors
 from study_protocol import ORIGINS
 
 from .catalogue import CatalogueError, pool_queryset
 from .forms import SectionPreviewForm
 from .pool_editor import SUB_POOL_SECTION_TYPE
-from .pools import SUB_POOLS, pool_errors
 
 REUSED = "this section reuses the clips of an earlier section: its pool is not used"
 HALVES = tuple(name for name in SUB_POOLS if name in ORIGINS)

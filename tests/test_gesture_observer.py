@@ -10,7 +10,8 @@ import yaml
 from generation.core.motion import Motion
 from generation.core.skeleton import gesture_skeleton
 from generation.gesture.data import build_dataset
-from generation.quality import checks, evaluate, failed_checks, plan_qa, qa_columns, resolve_thresholds
+from generation.pipeline import plan_qa
+from generation.quality import checks, evaluate, failed_checks, qa_columns, resolve_thresholds
 from generation.quality import gesture_observer as go
 from study_protocol import GESTURE_EMOTIONS, GESTURE_VAD, QA_THRESHOLDS
 from tests.test_render import seated, swinging_walk

@@ -75,7 +75,7 @@ def test_a_synthetic_file_is_not_called_captured(walk_files, tmp_path):
 def test_plan_build_writes_a_source_clip_record(walk_files, tmp_path):
     """The captured entry and a generated walk paired with it, rendered: the record of the captured clip says
     source, carries the label and the import, and the generated clip names it as its source."""
-    from generation.render.batch import run_plan
+    from generation.pipeline.runner import run_plan
 
     plan = validate_plan(_plan(
         _entry(walk_files / "walk.npz", sections=["naturalness"]),

@@ -7,12 +7,12 @@ import dataclasses
 import numpy as np
 import pytest
 
+from generation.pipeline.plan_qa import summary_line
 from generation.plans.catalogue import read_clips_csv, write_clips_csv
 from generation.plans.schema import PlanError, validate_plan
 from generation.quality import QAThresholdError, evaluate, failed_checks, motion_metrics, resolve_thresholds
 from generation.quality.metrics import bone_error_mm, mean_jerk
 from generation.quality.observer import GaitObserver
-from generation.quality.plan_qa import summary_line
 from study_protocol import CLIP_COLUMNS, QA_COLUMNS, QA_THRESHOLDS
 from tests.test_render import seated, swinging_walk
 
@@ -154,7 +154,7 @@ def test_summary_line_counts_clips_per_flag():
 
 
 def test_unread_line_says_which_clips_got_no_observer_reading():
-    from generation.quality.plan_qa import unread_line
+    from generation.pipeline.plan_qa import unread_line
 
     read = [{"modality": "gait", "qa": {"observed": "sad"}}, {"modality": "gesture", "qa": {"observed": "proud"}},
             {"modality": "rbf", "qa": {}}]

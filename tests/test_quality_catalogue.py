@@ -10,9 +10,9 @@ import yaml
 from django.core.management import call_command
 
 from generation.plans.catalogue import read_clips_csv
+from study_pools import pool_errors
 from studyapp.catalogue import CatalogueError, pool_queryset, upsert_clips
 from studyapp.models import Clip
-from studyapp.pools import pool_errors
 
 
 def rec(clip_id, flag="", **kw):
@@ -136,8 +136,8 @@ def test_generate_clips_flags_feet_through_the_floor_and_prints_a_summary(settin
 def test_run_plan_on_a_dask_cluster_then_resumes_locally(tmp_path):
     from distributed import Client, LocalCluster
 
+    from generation.pipeline.runner import run_plan
     from generation.plans.schema import validate_plan
-    from generation.render.batch import run_plan
 
     plan = validate_plan({"name": "dask", "render": TINY, "clips": [
         PLAN_CLIPS[0], {"id": "sit", "generator": "procedural_gesture", "origin": "source", "emotion_label": "sad",

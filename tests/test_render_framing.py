@@ -177,7 +177,7 @@ def test_build_from_metadata_changes_the_body():
 
 
 def test_plan_record_carries_the_camera_rule(tmp_path):
-    from generation.render.batch import run_plan
+    from generation.pipeline.runner import run_plan
 
     plan = validate_plan({"name": "t", "render": {"width": 128, "height": 72, "fps": 5, "duration_s": 1.0},
                           "clips": [{"id": "w", "generator": "procedural_walk", "emotion": [0, 0, 0, 1],

@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import pytest
 
+from generation.pipeline import runner as batch
 from generation.plans.schema import load_plan
-from generation.render import batch
 from studyapp.assignment import plan_study
 from studyapp.catalogue import upsert_clips
 from studyapp.presets import create_study_from_preset

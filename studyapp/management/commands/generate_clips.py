@@ -3,7 +3,7 @@
     python manage.py generate_clips --plan demo [--workers 2] [--webm] [--limit K] [--contact-sheet [PNG]]
                                    [--scheduler tcp://HOST:PORT]
 
-Thin wrapper over :mod:`generation.render.batch`: the plan is validated before anything renders, clips whose
+Thin wrapper over :mod:`generation.pipeline.runner`: the plan is validated before anything renders, clips whose
 files are complete are skipped (resumable), files are written under temporary names and renamed. Every clip gets
 a quality record (generation.quality); the command ends with a summary of clips per flag. With ``--scheduler``
 the clips render on a Dask distributed cluster whose workers share this media folder.
@@ -40,9 +40,9 @@ class Command(BaseCommand):
                                  "of local worker processes")
 
     def handle(self, *args, **opts):
+        from generation.pipeline.runner import run_plan
         from generation.plans.catalogue import write_clips_csv
         from generation.plans.schema import PlanError, load_plan
-        from generation.render.batch import run_plan
 
         if opts["workers"] < 1:
             raise CommandError(f"--workers must be at least 1, got {opts['workers']}")
@@ -94,7 +94,7 @@ class Command(BaseCommand):
         self.stdout.write(f"plan {plan.name}: {len(result.rendered)} rendered, {len(result.skipped)} already done, "
                           f"{len(result.failed)} failed, {result.seconds:.1f} s; catalogue {csv_path}")
         if records:
-            from generation.quality.plan_qa import summary_line, unread_line
+            from generation.pipeline.plan_qa import summary_line, unread_line
 
             self.stdout.write(f"plan {plan.name}: " + summary_line(r.get("qa_flag", "") for r in records))
             if unread := unread_line(records):

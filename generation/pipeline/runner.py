@@ -23,8 +23,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from generation.plans.schema import ClipEntry, Plan, clip_hash, intent_fields
-
-from .clip import clip_files_complete, render_clip
+from generation.render.clip import clip_files_complete, render_clip
 
 RECORD_VERSION = 2  # 2: records carry the quality record ``qa`` and ``qa_flag``
 
@@ -187,7 +186,7 @@ def render_job(job: Job, record: dict, clips_dir: str, records_dir: str) -> dict
 
 def _add_qa(record: dict, job: Job, motion, camera: dict) -> None:
     """Measure the clip's quality (:mod:`generation.quality`) into ``record["qa"]`` and ``record["qa_flag"]``."""
-    from generation.quality.plan_qa import clip_qa, intended_emotion, observer_for
+    from generation.pipeline.plan_qa import clip_qa, intended_emotion, observer_for
 
     observer = observer_for(job.run_entry.modality)
     result, _ = clip_qa(motion, job.run_entry.render, job.qa_thresholds, intended_emotion(job.run_entry.inputs),
@@ -198,8 +197,8 @@ def _add_qa(record: dict, job: Job, motion, camera: dict) -> None:
 
 def _recheck_qa(rec: dict, done: dict, job: Job) -> None:
     """A stored record's quality values, re-checked against the plan's current thresholds."""
+    from generation.pipeline.plan_qa import intended_emotion
     from generation.quality.checks import QAResult, failed_checks
-    from generation.quality.plan_qa import intended_emotion
 
     stored = QAResult.from_dict(done.get("qa") or {})
     flags = failed_checks(stored.values, job.qa_thresholds, intended_emotion(job.run_entry.inputs))
@@ -380,7 +379,7 @@ def run_plan(plan: Plan, clips_dir: str | Path, records_dir: str | Path, media_p
     emit("plan", {"total": len(batch.by_id), "todo": len(todo), "skipped": len(batch.result.skipped)})
     _remove_stale(todo, clips_dir, records_dir)
     if workers > 1 or scheduler is not None:
-        from generation.quality.plan_qa import observer_for
+        from generation.pipeline.plan_qa import observer_for
 
         for modality in sorted({j.run_entry.modality for j in todo}):
             observer_for(modality)  # train/cache the quality observers once, not in every worker

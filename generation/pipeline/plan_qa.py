@@ -2,10 +2,10 @@
 synthetic observer's reading: the gait observer for gait clips, the gesture observer for gesture clips), and the
 per-flag summary that ``generate_clips`` prints.
 
-    python -m generation.quality.plan_qa --plan seed000 [--limit K] [--modality gesture] [--no-figure-height]
+    python -m generation.pipeline.plan_qa --plan seed000 [--limit K] [--modality gesture] [--no-figure-height]
         [--json out.json]
 
-The video render computes the same record for every clip it makes (:func:`generation.render.batch.render_job`).
+The video render computes the same record for every clip it makes (:func:`generation.pipeline.runner.render_job`).
 """
 from __future__ import annotations
 
@@ -17,9 +17,8 @@ from collections import Counter
 from collections.abc import Iterable
 
 from generation.core.motion import Motion
+from generation.quality.checks import QAResult, evaluate
 from study_protocol import QA_CHECKS
-
-from .checks import QAResult, evaluate
 
 PASSED = "passed"
 
@@ -52,10 +51,10 @@ def observer_for(modality: str):
     """The synthetic observer that reads clips of ``modality`` ("gait": :func:`observer.default_observer`,
     "gesture": :func:`gesture_observer.default_gesture_observer`); None for others or when it cannot be built."""
     if modality == "gait":
-        from .observer import default_observer
+        from generation.quality.observer import default_observer
         return default_observer()
     if modality == "gesture":
-        from .gesture_observer import default_gesture_observer
+        from generation.quality.gesture_observer import default_gesture_observer
         return default_gesture_observer()
     return None
 
@@ -105,11 +104,10 @@ def run(plan_name: str, limit: int | None = None, log=print, modality: str | Non
 
     ``modality``: only the entries of that modality ("gait" or "gesture"; None: all). ``figure_height=False``
     skips the camera projection (no ``figure_height`` check, faster)."""
+    from generation.pipeline.runner import plan_jobs
     from generation.plans.clipgen import make_motion
     from generation.plans.schema import load_plan
-    from generation.render.batch import plan_jobs
-
-    from .checks import resolve_thresholds
+    from generation.quality.checks import resolve_thresholds
 
     plan = load_plan(plan_name)
     thresholds = resolve_thresholds(plan.qa)
