@@ -49,8 +49,17 @@ SECTION_OPTIONS: dict[str, tuple[str, ...]] = {
 }
 """section_type -> the option keys it understands besides COMMON_OPTIONS."""
 
-COMMON_OPTIONS = ("attention_checks", "practice", "practice_clip")
-"""Options of every section type (studyapp.trial_extras): attention checks and a practice item."""
+PLAYER_CONTROLS = ("replay-only", "full", "none")
+"""``controls`` option: play/pause and replay only (no seek bar, no speed menu; the default), the browser's full
+controls (seeking and speed allowed), or none (the clip plays by itself; seeking blocked)."""
+DEFAULT_PLAYER_CONTROLS = "replay-only"
+PLAYER_OPTIONS = ("controls", "max_replays")
+"""The clip player of every section type: its controls and how often a clip may be replayed (absent or null:
+unlimited; 0: played once)."""
+MAX_REPLAYS_LIMIT = 100
+
+COMMON_OPTIONS = ("attention_checks", "practice", "practice_clip", *PLAYER_OPTIONS)
+"""Options of every section type (studyapp.trial_extras): attention checks, a practice item, the clip player."""
 ATTENTION_KEYS = ("count", "answer", "positions", "question")
 
 DEFAULT_GESTURE_OPTIONS = 4
@@ -260,6 +269,17 @@ def _extras_errors(section_type: str, options: dict, clips_per_participant: int 
     if "practice_clip" in options and not (isinstance(options["practice_clip"], str)
                                            and options["practice_clip"].strip()):
         errors.append(f"'practice_clip' must be the clip_id of a catalogue clip, got {options['practice_clip']!r}")
+    return errors + player_errors(options)
+
+
+def player_errors(options: dict) -> list[str]:
+    """Problems of the clip player's options (PLAYER_OPTIONS), each message naming its key."""
+    errors = []
+    if "controls" in options and options["controls"] not in PLAYER_CONTROLS:
+        errors.append(f"'controls' must be one of {', '.join(PLAYER_CONTROLS)}, got {options['controls']!r}")
+    if options.get("max_replays") is not None:
+        msg = _count_error(options, "max_replays", 0, MAX_REPLAYS_LIMIT)
+        errors += [f"{msg} (blank or null: unlimited)"] if msg else []
     return errors
 
 
