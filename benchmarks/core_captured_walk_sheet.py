@@ -20,7 +20,7 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
 from generation.core.features import detect_foot_contacts  # noqa: E402
-from generation.formats.captured import captured_walks  # noqa: E402
+from generation.mocap.captured import captured_walks  # noqa: E402
 
 
 def main(out: Path) -> None:

@@ -31,7 +31,7 @@ from generation.core.motion import Motion  # noqa: E402
 from generation.core.quaternion import np_qfrom_axis_angle, np_qnormalize  # noqa: E402
 from generation.core.skeleton import gait_skeleton, gesture_skeleton  # noqa: E402
 from generation.formats.bvh import read_bvh, write_bvh  # noqa: E402
-from generation.formats.captured import captured_walks, chain_clip_repeats  # noqa: E402
+from generation.mocap.captured import captured_walks, chain_clip_repeats  # noqa: E402
 
 torch.set_num_threads(1)
 

@@ -117,7 +117,7 @@ def main(argv=None):
     out.append(f"| detected (`features.detect_foot_contacts`, lowest foot joint) | corpus, all kinds | {N} | "
                f"{np.mean(det_mean):.2f} | {np.max(det_max):.2f} |")
     try:
-        from generation.formats.captured import captured_walks
+        from generation.mocap.captured import captured_walks
         cap = []
         for m in captured_walks():
             fs = foot_skate(m.positions(), m.fps, m.skeleton)

@@ -26,8 +26,8 @@ sys.path.insert(0, str(ROOT))
 
 import numpy as np  # noqa: E402
 
-from generation.formats.captured import WALK_FILES, captured_walks, chain_clip_repeats  # noqa: E402
 from generation.mocap import ImportOptions, import_file  # noqa: E402
+from generation.mocap.captured import WALK_FILES, captured_walks, chain_clip_repeats  # noqa: E402
 from generation.mocap.conventions import export_as  # noqa: E402
 from generation.render.clip import render_frames  # noqa: E402
 from generation.render.contact_sheet import contact_sheet  # noqa: E402

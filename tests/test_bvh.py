@@ -8,7 +8,8 @@ import torch
 from generation.core.motion import Motion, MotionFormatError
 from generation.core.quaternion import np_qangle, np_qfrom_axis_angle, np_qnormalize
 from generation.core.skeleton import Skeleton, gait_skeleton, gesture_skeleton
-from generation.formats.bvh import default_joint_map, read_bvh, retarget, write_bvh
+from generation.formats.bvh import read_bvh, write_bvh
+from generation.mocap.retarget import default_joint_map, retarget
 
 torch.set_num_threads(1)
 

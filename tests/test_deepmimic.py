@@ -11,8 +11,8 @@ from scipy.spatial.transform import Rotation
 from generation.core.features import detect_foot_contacts, foot_skate, movement_features, np_gait_affective_features
 from generation.core.motion import MotionFormatError
 from generation.core.skeleton import GAIT_JOINTS
-from generation.formats.captured import WALK_FILES, captured_walks, chain_clip_repeats, load_captured_walk
 from generation.formats.deepmimic import DATA_DIR, deepmimic_skeleton, read_deepmimic
+from generation.mocap.captured import WALK_FILES, captured_walks, chain_clip_repeats, load_captured_walk
 
 torch.set_num_threads(1)
 

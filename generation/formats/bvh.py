@@ -1,36 +1,35 @@
-"""BVH motion files: reading any hierarchy, writing our skeletons, and retargeting by joint names.
+"""BVH motion files: reading any hierarchy and channel layout, and writing our skeletons.
 
-Reading (:func:`read_bvh`):
+Reading (:func:`parse_bvh`, :func:`read_bvh`):
 - any hierarchy and any per-joint channel order; rotations are intrinsic Euler angles in degrees applied in
   the listed order (``Zrotation Xrotation Yrotation`` means R = Rz Rx Ry acting on column vectors);
+- position channels on ANY joint are that joint's local translation in that frame (rigs such as the Bandai
+  Namco dataset's carry six channels on every joint and the root motion on ``Hips`` below a static
+  ``joint_Root``); :func:`parse_bvh` keeps them per frame and :meth:`BvhData.global_positions` is exact;
 - a joint name is the rest of its ``ROOT``/``JOINT`` line, so names with spaces (3ds Max Biped's
   ``Bip01 L Thigh``) are kept whole;
-- the root's position channels give its absolute position (as Blender reads them); position channels on other
-  joints are taken from the first frame as that joint's offset (their later changes are not representable on a
-  fixed skeleton and are recorded in ``metadata["ignored_channels"]``);
 - ``End Site`` blocks with a non-zero offset become leaf joints named ``<parent>_end`` with identity rotation;
   zero-offset end sites are dropped;
-- units: ``scale`` multiplies file units into metres. ``scale=None`` guesses from the rest-pose height (vertical
-  extent of the hierarchy): 0.5..3 -> metres (1), 50..300 -> centimetres (0.01), anything else is normalised to a
-  1.7 m body; the guess is recorded in ``metadata["bvh_scale"]`` and ``metadata["bvh_scale_guess"]``.
+- units: ``scale`` multiplies file units into metres. ``scale=None`` guesses from the posed body's extent
+  (median over frames; a rest pose with bones along local x says nothing about height): 0.5..3 -> metres (1),
+  50..300 -> centimetres (0.01), anything else is normalised to a 1.7 m body; the guess is recorded in
+  ``metadata["bvh_scale"]`` and ``metadata["bvh_scale_guess"]``.
 Malformed files raise :class:`~generation.core.motion.MotionFormatError` naming the file and line.
 
 Writing (:func:`write_bvh`): root with 3 position + 3 rotation channels, other joints 3 rotation channels,
 skeleton leaves written as ``End Site`` (BVH leaves carry no name or rotation, so leaf names come back as
 ``<parent>_end``; positions are kept exactly). Readable by Blender's and Unity's importers.
 
-Retargeting (:func:`retarget`): source FK positions, scaled by the ratio of hip heights, are mapped by joint name
-onto the target and solved with :func:`generation.core.ik.solve_rotations`.
+Retargeting onto our skeletons lives in :mod:`generation.mocap.retarget`.
 """
 from __future__ import annotations
 
 import re
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
-from generation.core.ik import bend_limb_to_target, ik_report, solve_rotations
-from generation.core.kinematics import np_forward_kinematics
 from generation.core.motion import Motion, MotionFormatError
 from generation.core.quaternion import np_qfix, qeuler, qfrom_euler
 from generation.core.skeleton import Skeleton
@@ -166,27 +165,87 @@ def _euler_channels_to_quat(values: np.ndarray, order: str) -> np.ndarray:
         return qfrom_euler(torch.as_tensor(np.radians(angles)), order).numpy()
 
 
-def _guess_scale(rest_height: float) -> tuple[float, str]:
-    if 0.5 <= rest_height <= 3.0:
+def _guess_scale(height: float) -> tuple[float, str]:
+    if 0.5 <= height <= 3.0:
         return 1.0, "metres"
-    if 50.0 <= rest_height <= 300.0:
+    if 50.0 <= height <= 300.0:
         return 0.01, "centimetres"
-    if rest_height <= 0:
+    if height <= 0:
         return 1.0, "flat hierarchy, kept as metres"
-    return 1.7 / rest_height, "unknown unit, normalised to a 1.7 m body"
+    return 1.7 / height, "unknown unit, normalised to a 1.7 m body"
 
 
-def read_bvh(path: str | Path, scale: float | None = None) -> Motion:
-    """Read a BVH file into a Motion on a skeleton named after the file (stem).
+@dataclass
+class BvhData:
+    """A BVH file as written: the hierarchy and, per frame, every joint's local rotation and translation.
+
+    Attributes:
+        path: the file.
+        names, parents: joints in file order (``<parent>_end`` leaves for non-zero End Sites), parent -1 = root.
+        offsets: (J, 3) OFFSET of each joint, file units.
+        channels: per joint the channel names in file order ([] for end sites).
+        end_site: per joint, whether it is an End Site leaf.
+        rotations: (T, J, 4) local rotations (w, x, y, z) from the rotation channels (identity where none).
+        translations: (T, J, 3) local translations, file units: the position channels where a joint has them
+            (missing axes from its OFFSET), else its OFFSET in every frame.
+        fps: 1 / Frame Time.
+    """
+
+    path: Path
+    names: tuple[str, ...]
+    parents: tuple[int, ...]
+    offsets: np.ndarray
+    channels: list[list[str]]
+    end_site: list[bool]
+    rotations: np.ndarray
+    translations: np.ndarray
+    fps: float
+
+    def global_positions(self, scale: float = 1.0) -> np.ndarray:
+        """(T, J, 3) world positions by forward kinematics with the per-frame translations, times ``scale``."""
+        return _fk_with_translations(self.rotations, self.translations, self.parents)[0] * scale
+
+    def height_extent(self) -> float:
+        """Median over frames of the posed body's largest axis extent, file units (the unit guess uses it: the
+        rest pose of some rigs lies along one axis and says nothing about the standing height)."""
+        P = self.global_positions()
+        return float(np.median((P.max(1) - P.min(1)).max(-1)))
+
+
+def _quat_to_matrix(q: np.ndarray) -> np.ndarray:
+    """(..., 4) unit quaternions (w, x, y, z) -> (..., 3, 3) rotation matrices."""
+    w, x, y, z = np.moveaxis(q, -1, 0)
+    return np.stack([
+        np.stack([1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)], -1),
+        np.stack([2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)], -1),
+        np.stack([2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)], -1),
+    ], -2)
+
+
+def _fk_with_translations(rotations: np.ndarray, translations: np.ndarray, parents) -> tuple[np.ndarray, np.ndarray]:
+    """Forward kinematics with a local translation per joint and frame.
 
     Args:
-        path: the .bvh file.
-        scale: metres per file unit; None guesses (see the module docstring).
-
+        rotations: (T, J, 4) local rotations; translations: (T, J, 3) local translations (the root's is its
+            world position); parents: parent index per joint, parents before children.
     Returns:
-        Motion with one joint per BVH joint (plus ``<parent>_end`` leaves for non-zero End Sites), rotations
-        (T, J, 4), root positions (T, 3) in metres, fps = 1 / Frame Time, metadata with ``source`` (file name),
-        ``bvh_scale``, ``bvh_scale_guess``, ``bvh_channels`` (per joint).
+        world positions (T, J, 3) and world rotation matrices (T, J, 3, 3).
+    """
+    local = _quat_to_matrix(rotations)
+    world_R = np.empty_like(local)
+    world_P = np.empty_like(translations)
+    for j, p in enumerate(parents):
+        if p < 0:
+            world_R[:, j] = local[:, j]
+            world_P[:, j] = translations[:, j]
+        else:
+            world_R[:, j] = world_R[:, p] @ local[:, j]
+            world_P[:, j] = world_P[:, p] + np.einsum("tab,tb->ta", world_R[:, p], translations[:, j])
+    return world_P, world_R
+
+
+def parse_bvh(path: str | Path) -> BvhData:
+    """Read a BVH file exactly as written (file units; see :class:`BvhData`).
 
     Raises:
         MotionFormatError: naming the file and the line of the first problem.
@@ -199,24 +258,88 @@ def read_bvh(path: str | Path, scale: float | None = None) -> Motion:
     tk = _Tokens(text, path)
     names, parents, offsets, channels, end_site = _parse_hierarchy(tk)
     values, frame_time = _read_frames(tk, sum(len(c) for c in channels))
+    rotations, translations = _apply_channels(values, offsets, channels)
+    return BvhData(path, tuple(names), tuple(parents), offsets, channels, end_site, np_qfix(rotations),
+                   translations, 1.0 / frame_time)
 
-    rest = Skeleton(path.stem, tuple(names), tuple(parents), offsets).rest_positions()
-    rest_height = float(rest[:, 1].max() - rest[:, 1].min())
+
+def _fold_static_root(rotations: np.ndarray, translations: np.ndarray, names: list[str], parents: list[int],
+                      tolerance: float):
+    """Drop a root that does not move and has one child (a placement joint such as ``joint_Root``): its constant
+    transform is folded into the child, which becomes the root and keeps its per-frame translation."""
+    children = [j for j, p in enumerate(parents) if p == 0]
+    static = (np.abs(translations[:, 0] - translations[0, 0]).max() <= tolerance
+              and np.abs(rotations[:, 0] - rotations[0, 0]).max() <= 1e-9)
+    if len(parents) < 3 or len(children) != 1 or not static:
+        return None
+    c = children[0]
+    R0 = _quat_to_matrix(rotations[0, 0])
+    translations = translations.copy()
+    rotations = rotations.copy()
+    translations[:, c] = translations[:, 0] + translations[:, c] @ R0.T
+    rotations[:, c] = qmul_np(rotations[:, 0], rotations[:, c])
+    keep = [j for j in range(len(names)) if j != 0]
+    new_index = {old: new for new, old in enumerate(keep)}
+    new_parents = [new_index.get(parents[j], -1) for j in keep]
+    return rotations[:, keep], translations[:, keep], [names[j] for j in keep], new_parents
+
+
+def qmul_np(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Hamilton product of (..., 4) quaternions (w, x, y, z), numpy."""
+    aw, ax, ay, az = np.moveaxis(a, -1, 0)
+    bw, bx, by, bz = np.moveaxis(b, -1, 0)
+    return np.stack([aw * bw - ax * bx - ay * by - az * bz, aw * bx + ax * bw + ay * bz - az * by,
+                     aw * by - ax * bz + ay * bw + az * bx, aw * bz + ax * by - ay * bx + az * bw], -1)
+
+
+def read_bvh(path: str | Path, scale: float | None = None) -> Motion:
+    """Read a BVH file into a Motion on a skeleton named after the file (stem).
+
+    Position channels on any joint are that joint's local translation. A Motion carries a translation only on
+    its root, so: a root that does not move and has one child (``joint_Root`` above ``Hips``) is folded into
+    that child; other joints whose translation varies keep their median translation as the bone offset, and the
+    largest resulting position error is recorded as ``metadata["translation_residual_m"]`` (read exact world
+    positions with :func:`parse_bvh` and :meth:`BvhData.global_positions`).
+
+    Args:
+        path: the .bvh file.
+        scale: metres per file unit; None guesses from the posed body's extent (see the module docstring).
+
+    Returns:
+        Motion (rotations (T, J, 4), root positions (T, 3) in metres, fps = 1 / Frame Time), metadata with
+        ``source`` (file name), ``bvh_scale``, ``bvh_scale_guess``, ``bvh_channels`` (per joint).
+
+    Raises:
+        MotionFormatError: naming the file and the line of the first problem.
+    """
+    data = parse_bvh(path)
+    path = data.path
     guess = "given"
     if scale is None:
-        scale, guess = _guess_scale(rest_height)
+        scale, guess = _guess_scale(data.height_extent())
     if not scale > 0:
         raise MotionFormatError(f"{path}: scale must be positive, got {scale}")
-
-    rotations, root_pos, offsets, ignored = _apply_channels(values, names, offsets, channels, rest_height)
+    names, parents = list(data.names), list(data.parents)
+    rotations, translations = data.rotations, data.translations
+    extent = max(data.height_extent(), 1e-9)
+    folded = _fold_static_root(rotations, translations, names, parents, 1e-6 * extent)
+    if folded is not None:
+        rotations, translations, names, parents = folded
+    offsets = np.median(translations, axis=0)
+    offsets[0] = 0.0
     skeleton = Skeleton(path.stem, tuple(names), tuple(parents), offsets * scale,
-                        height=rest_height * scale if rest_height > 0 else 1.0)
+                        height=extent * scale)
+    motion = Motion(skeleton, rotations, translations[:, 0] * scale, data.fps, {})
+    exact = _fk_with_translations(rotations, translations, parents)[0] * scale
+    residual = float(np.linalg.norm(motion.positions() - exact, axis=-1).max())
     metadata = {"source": path.name, "format": "bvh", "bvh_scale": scale, "bvh_scale_guess": guess,
-                "bvh_channels": {names[j]: chans for j, chans in enumerate(channels) if not end_site[j]}}
-    if ignored:
-        metadata["ignored_channels"] = [f"{n}: varying position channels (first frame used as offset)"
-                                        for n in ignored]
-    return Motion(skeleton, np_qfix(rotations), root_pos * scale, 1.0 / frame_time, metadata)
+                "bvh_channels": {data.names[j]: chans for j, chans in enumerate(data.channels)
+                                 if not data.end_site[j]}}
+    if folded is not None:
+        metadata["folded_root"] = data.names[0]
+    if residual > 1e-6:
+        metadata["translation_residual_m"] = residual
+    return Motion(skeleton, rotations, translations[:, 0] * scale, data.fps, metadata)
 
 
 def _read_frames(tk: _Tokens, n_ch: int) -> tuple[np.ndarray, float]:
@@ -252,33 +375,20 @@ def _read_frames(tk: _Tokens, n_ch: int) -> tuple[np.ndarray, float]:
     return np.array(rows, dtype=np.float64).reshape(n_frames, n_ch), frame_time
 
 
-def _apply_channels(values: np.ndarray, names: list[str], offsets: np.ndarray, channels: list[list[str]],
-                    rest_height: float):
-    """Per-joint channel blocks -> local rotations (T, J, 4), root positions (T, 3) and offsets (J, 3), in file
-    units, and the names of non-root joints whose position channels vary (only their first frame is kept)."""
-    n_frames, J = len(values), len(names)
+def _apply_channels(values: np.ndarray, offsets: np.ndarray, channels: list[list[str]]):
+    """Per-joint channel blocks -> local rotations (T, J, 4) and local translations (T, J, 3), file units."""
+    n_frames, J = len(values), len(channels)
     rotations = np.zeros((n_frames, J, 4))
     rotations[..., 0] = 1.0
-    root_pos = np.tile(offsets[0], (n_frames, 1))
-    ignored = []
+    translations = np.repeat(offsets[None].astype(np.float64), n_frames, axis=0)
     col = 0
-    offsets = offsets.copy()
     for j, chans in enumerate(channels):
         block = values[:, col:col + len(chans)]
         col += len(chans)
         pos_idx = [k for k, c in enumerate(chans) if c.endswith("position")]
         rot_idx = [k for k, c in enumerate(chans) if c.endswith("rotation")]
-        if pos_idx:
-            xyz = np.zeros((n_frames, 3))
-            xyz[:] = offsets[j] if j else 0.0
-            for k in pos_idx:
-                xyz[:, "XYZ".index(chans[k][0])] = block[:, k]
-            if j == 0:
-                root_pos = xyz
-            else:
-                offsets[j] = xyz[0]
-                if np.abs(xyz - xyz[0]).max() > 1e-6 * max(rest_height, 1e-9):
-                    ignored.append(names[j])
+        for k in pos_idx:
+            translations[:, j, "XYZ".index(chans[k][0])] = block[:, k]
         if rot_idx:
             order = "".join(chans[k][0].lower() for k in rot_idx)
             vals = block[:, rot_idx]
@@ -287,7 +397,7 @@ def _apply_channels(values: np.ndarray, names: list[str], offsets: np.ndarray, c
                 order += "".join(missing)
                 vals = np.concatenate([vals, np.zeros((n_frames, 3 - len(rot_idx)))], 1)
             rotations[:, j] = _euler_channels_to_quat(vals, order)
-    return rotations, root_pos, offsets, ignored
+    return rotations, translations
 
 
 def _is_float(v: str) -> bool:
@@ -355,191 +465,4 @@ def write_bvh(motion: Motion, path: str | Path, rotation_order: str = "ZXY", sca
     Path(path).write_text("\n".join(lines) + "\n", encoding="utf-8")
 
 
-# ---- retargeting -----------------------------------------------------------------------------------
-#: Candidate source names per gait-skeleton joint (first present wins): Mixamo/Unity-style, CMU-style
-#: (cgspeed conversion), our own skeletons and the DeepMimic humanoid.
-GAIT_NAME_CANDIDATES: dict[str, tuple[str, ...]] = {
-    "root": ("Hips", "hips", "Hip", "pelvis", "root"),
-    "left_hip": ("LeftUpLeg", "LeftHip", "LeftThigh", "LHip", "left_hip"),
-    "left_knee": ("LeftLeg", "LeftKnee", "LeftShin", "LKnee", "left_knee"),
-    "left_heel": ("LeftFoot", "LeftAnkle", "LAnkle", "left_heel", "left_ankle"),
-    "left_toe": ("LeftToeBase", "LeftToe", "LeftToe_End", "LeftFoot_end", "left_toe", "left_heel_end"),
-    "right_hip": ("RightUpLeg", "RightHip", "RightThigh", "RHip", "right_hip"),
-    "right_knee": ("RightLeg", "RightKnee", "RightShin", "RKnee", "right_knee"),
-    "right_heel": ("RightFoot", "RightAnkle", "RAnkle", "right_heel", "right_ankle"),
-    "right_toe": ("RightToeBase", "RightToe", "RightToe_End", "RightFoot_end", "right_toe", "right_heel_end"),
-    "lower_back": ("LowerBack", "Spine", "spine", "lower_back", "chest"),
-    "spine": ("Spine2", "Spine1", "Chest", "chest3", "chest4", "spine"),
-    "neck": ("Neck", "neck"),
-    "head": ("Head", "head", "Neck1", "Neck_end", "neck_end"),
-    "left_shoulder": ("LeftArm", "LeftShoulder", "LeftUpperArm", "left_shoulder"),
-    "left_elbow": ("LeftForeArm", "LeftElbow", "LeftLowerArm", "left_elbow"),
-    "left_hand": ("LeftHand", "LeftWrist", "left_hand", "left_wrist"),
-    "left_hand_index": ("LeftHandIndex1", "LeftHandMiddle1", "LeftFingerBase", "LeftHand_end", "left_hand_index",
-                        "left_wrist_end"),
-    "right_shoulder": ("RightArm", "RightShoulder", "RightUpperArm", "right_shoulder"),
-    "right_elbow": ("RightForeArm", "RightElbow", "RightLowerArm", "right_elbow"),
-    "right_hand": ("RightHand", "RightWrist", "right_hand", "right_wrist"),
-    "right_hand_index": ("RightHandIndex1", "RightHandMiddle1", "RightFingerBase", "RightHand_end",
-                         "right_hand_index", "right_wrist_end"),
-}
-#: Candidate source names per gesture-skeleton joint.
-GESTURE_NAME_CANDIDATES: dict[str, tuple[str, ...]] = {
-    "root": ("Hips", "hips", "Hip", "pelvis", "root"),
-    "chest": ("Spine", "LowerBack", "chest"),
-    "chest2": ("Spine1", "chest2"),
-    "chest3": ("Spine2", "Chest", "chest3"),
-    "chest4": ("Spine3", "UpperChest", "Chest2", "chest4"),
-    "neck": ("Neck", "neck"),
-    "head": ("Head", "head", "Neck1"),
-    "left_collar": ("LeftShoulder", "LeftCollar", "LeftClavicle", "left_collar"),
-    "left_shoulder": ("LeftArm", "LeftUpperArm", "left_shoulder"),
-    "left_elbow": ("LeftForeArm", "LeftElbow", "LeftLowerArm", "left_elbow"),
-    "left_wrist": ("LeftHand", "LeftWrist", "left_wrist", "left_hand"),
-    "right_collar": ("RightShoulder", "RightCollar", "RightClavicle", "right_collar"),
-    "right_shoulder": ("RightArm", "RightUpperArm", "right_shoulder"),
-    "right_elbow": ("RightForeArm", "RightElbow", "RightLowerArm", "right_elbow"),
-    "right_wrist": ("RightHand", "RightWrist", "right_wrist", "right_hand"),
-    "left_hip": ("LeftUpLeg", "LeftHip", "LeftThigh", "left_hip"),
-    "left_knee": ("LeftLeg", "LeftKnee", "LeftShin", "left_knee"),
-    "left_ankle": ("LeftFoot", "LeftAnkle", "left_ankle", "left_heel"),
-    "left_toe": ("LeftToeBase", "LeftToe", "LeftToe_End", "LeftFoot_end", "left_toe"),
-    "right_hip": ("RightUpLeg", "RightHip", "RightThigh", "right_hip"),
-    "right_knee": ("RightLeg", "RightKnee", "RightShin", "right_knee"),
-    "right_ankle": ("RightFoot", "RightAnkle", "right_ankle", "right_heel"),
-    "right_toe": ("RightToeBase", "RightToe", "RightToe_End", "RightFoot_end", "right_toe"),
-}
-
-
-def default_joint_map(source: Skeleton, target: Skeleton) -> dict[str, str]:
-    """Map target joint names to source joint names from the candidate tables (first present name wins).
-
-    The target must be the gait or gesture skeleton (by joint names); joints with no candidate present are left
-    out (retarget interpolates or keeps them straight).
-    """
-    table = GAIT_NAME_CANDIDATES if "left_hand_index" in target.joints else GESTURE_NAME_CANDIDATES
-    present = set(source.joints)
-    out = {}
-    for name in target.joints:
-        for cand in table.get(name, ()):
-            if cand in present:
-                out[name] = cand
-                break
-    return out
-
-
-def _leg_height(skeleton: Skeleton) -> float:
-    """Root height above the lowest rest joint, or the rest vertical extent when the root is at the bottom."""
-    rest = skeleton.rest_positions()
-    extent = float(rest[:, 1].max() - rest[:, 1].min())
-    h = skeleton.root_height()
-    return h if h > 0.2 * extent else extent
-
-
-def retarget(motion: Motion, target_skeleton: Skeleton, joint_map: dict[str, str] | None = None,
-             metadata: dict | None = None, foot_ik: bool = True) -> Motion:
-    """Move a motion onto another skeleton by matching joints by name.
-
-    The source's FK positions are scaled by target hip height / source hip height (so strides and root heights
-    fit the target's legs), mapped target joint <- source joint, and solved with IK on the target (bone lengths
-    of the target are kept; directions come from the source). Target joints without a mapping are placed on the
-    line between their nearest mapped ancestor and descendant in proportion to rest bone lengths, or, for
-    leaves, keep the identity local rotation.
-
-    With ``foot_ik`` (default) each mapped leg chain (``<side>_hip`` - ``<side>_knee`` - ``<side>_heel`` or
-    ``_ankle``) is then bent with two-bone IK so the heel/ankle lands exactly on the scaled source position, and
-    the foot's children point where the source's do. Matching directions alone would move the feet with every
-    difference in leg proportions and make planted feet slide; this keeps the source's foot contacts.
-
-    Args:
-        motion: source Motion.
-        target_skeleton: e.g. ``gait_skeleton()``.
-        joint_map: {target joint name: source joint name}; default :func:`default_joint_map`. The root must be
-            mapped.
-        metadata: merged over a copy of the source metadata.
-
-    Returns:
-        Motion on ``target_skeleton`` at the source fps; metadata gains ``retarget`` (scale, map, IK error of the
-        mapped joints in metres).
-    """
-    src = motion.skeleton
-    tgt = target_skeleton
-    joint_map = dict(default_joint_map(src, tgt) if joint_map is None else joint_map)
-    for t_name, s_name in joint_map.items():
-        tgt.index(t_name)
-        src.index(s_name)
-    root_name = tgt.joints[0]
-    if root_name not in joint_map:
-        raise ValueError(f"retarget: the target root {root_name!r} must be mapped (joint_map has {sorted(joint_map)})")
-    scale = _leg_height(tgt) / _leg_height(src)
-    src_pos = motion.positions() * scale
-    T, J = motion.num_frames, tgt.num_joints
-    P = np.zeros((T, J, 3))
-    known = np.zeros(J, bool)
-    for t_name, s_name in joint_map.items():
-        P[:, tgt.index(t_name)] = src_pos[:, src.index(s_name)]
-        known[tgt.index(t_name)] = True
-    fill_unmapped_joints(P, known, tgt)
-    rotations = solve_rotations(P, tgt, known)
-    if foot_ik:
-        rotations = place_feet_on_source(rotations, P, known, tgt, joint_map)
-    meta = dict(motion.metadata)
-    meta.update(metadata or {})
-    out = Motion(tgt, rotations, P[:, 0].copy(), motion.fps, meta)
-    mapped = [tgt.index(n) for n in joint_map]
-    err = np.linalg.norm(out.positions()[:, mapped] - P[:, mapped], axis=-1)
-    meta["retarget"] = {"source_skeleton": src.name, "scale": scale, "joint_map": joint_map,
-                        "max_error_m": float(err.max()), "mean_error_m": float(err.mean())}
-    return out
-
-
-def place_feet_on_source(rotations: np.ndarray, P: np.ndarray, known: np.ndarray, tgt: Skeleton,
-                joint_map: dict[str, str]) -> np.ndarray:
-    """Two-bone IK of each mapped leg onto the desired heel/ankle positions; returns new rotations."""
-    Q = np_forward_kinematics(rotations, P[:, 0], tgt)
-    lengths = tgt.bone_lengths()
-    children = tgt.children()
-    changed = False
-    for side in ("left", "right"):
-        for end in (f"{side}_heel", f"{side}_ankle"):
-            chain = (f"{side}_hip", f"{side}_knee", end)
-            if not all(n in tgt.joints and n in joint_map for n in chain):
-                continue
-            e = tgt.index(end)
-            if tgt.parents[e] != tgt.index(chain[1]) or tgt.parents[tgt.index(chain[1])] != tgt.index(chain[0]):
-                continue
-            Q = bend_limb_to_target(Q, tgt, end, P[:, e])
-            for c in children[e]:
-                if known[c] and lengths[c] > 1e-9:
-                    d = P[:, c] - P[:, e]
-                    Q[:, c] = Q[:, e] + lengths[c] * d / np.maximum(np.linalg.norm(d, axis=-1, keepdims=True), 1e-12)
-            changed = True
-    return solve_rotations(Q, tgt) if changed else rotations
-
-
-def fill_unmapped_joints(P: np.ndarray, known: np.ndarray, sk: Skeleton) -> None:
-    """Place unmapped interior joints between mapped ancestor and descendant (in place; marks them known)."""
-    children = sk.children()
-    lengths = sk.bone_lengths()
-    for j in range(sk.num_joints):
-        if known[j]:
-            continue
-        # nearest mapped ancestor
-        a, dist_a = sk.parents[j], lengths[j]
-        while a >= 0 and not known[a]:
-            dist_a += lengths[a]
-            a = sk.parents[a]
-        # nearest mapped descendant along first children
-        d, dist_d = j, 0.0
-        while not known[d] and children[d]:
-            d = children[d][0]
-            dist_d += lengths[d]
-        if a < 0 or not known[d] or d == j:
-            continue
-        frac = dist_a / max(dist_a + dist_d, 1e-12)
-        P[:, j] = P[:, a] + frac * (P[:, d] - P[:, a])
-        known[j] = True
-
-
-__all__ = ["read_bvh", "write_bvh", "retarget", "default_joint_map", "GAIT_NAME_CANDIDATES",
-           "GESTURE_NAME_CANDIDATES", "ik_report"]
+__all__ = ["read_bvh", "parse_bvh", "BvhData", "write_bvh"]

@@ -20,9 +20,9 @@ import numpy as np
 from generation.core.motion import Motion
 from generation.core.quaternion import np_qfrom_axis_angle, np_qmul, np_qrot
 from generation.core.skeleton import REFERENCE_HEIGHT_M, Skeleton, gait_skeleton
+from generation.formats.deepmimic import DATA_DIR, read_deepmimic
 
-from .bvh import retarget
-from .deepmimic import DATA_DIR, read_deepmimic
+from .retarget import retarget
 
 #: (file, description). All are walks; the turn clips walk along a curve.
 WALK_FILES = (

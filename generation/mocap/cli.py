@@ -54,6 +54,10 @@ def _parser() -> argparse.ArgumentParser:
     imp.add_argument("--up", default="auto", choices=("auto", "+y", "-y", "+z", "-z", "+x", "-x"))
     imp.add_argument("--height", type=float, default=1.75, help="our skeleton's height in metres (default 1.75)")
     imp.add_argument("--build", choices=GENDERS, default="male")
+    imp.add_argument("--proportions", choices=("ours", "source"), default="ours",
+                     help="ours: our skeleton of --height/--build (default); source: the actor's bone lengths")
+    imp.add_argument("--max-import-error-cm", type=float, default=3.0,
+                     help="a file whose solve misses a source joint by more is an error (default 3)")
     imp.add_argument("--quiet", action="store_true", help="no progress bar or summary")
     cor = sub.add_parser("corpus", help="labelled imported gait Motions -> a gait corpus .npz for train_gait",
                          description="Cut imported, labelled gait Motions (.npz, folders searched recursively) "
@@ -121,7 +125,7 @@ def run_import(args) -> int:
         return 2
     options = ImportOptions(skeleton=args.skeleton, height=args.height, build=args.build, scale=args.scale,
                             fps=args.fps, input_fps=args.input_fps, layout=args.layout, joint_map=joint_map,
-                            up=args.up)
+                            up=args.up, proportions=args.proportions, max_import_error_m=args.max_import_error_cm / 100)
     inputs = collect_inputs(args.paths)
     args.out.mkdir(parents=True, exist_ok=True)
     rows, used = [], set()

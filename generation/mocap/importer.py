@@ -26,10 +26,11 @@ import numpy as np
 from generation.core.ik import solve_rotations
 from generation.core.motion import Motion, MotionFormatError
 from generation.core.skeleton import REFERENCE_HEIGHT_M, Skeleton, gait_skeleton, gesture_skeleton
-from generation.formats.bvh import fill_unmapped_joints, place_feet_on_source, read_bvh
+from generation.formats.bvh import parse_bvh
 
 from .labels import Label
 from .positions import LAYOUT_MAPS, read_positions
+from .retarget import fill_unmapped_joints, fit_proportions, place_feet_on_source
 from .rigs import auto_joint_map, check_joint_map
 
 BVH_SUFFIXES = (".bvh",)
@@ -37,7 +38,41 @@ POSITION_SUFFIXES = (".csv", ".npy")
 SUFFIXES = BVH_SUFFIXES + POSITION_SUFFIXES
 
 REPORT_COLUMNS = ("source", "status", "message", "frames", "fps", "duration_s", "mapped_joints", "unmapped_joints",
-                  "retarget_max_error_m", "height_m")
+                  "retarget_max_error_m", "height_m", "import_error_cm")
+
+#: Hip-joint height / standing height (greater trochanter level, Drillis & Contini 1966 segment proportions).
+HIP_HEIGHT_FRACTION = 0.530
+
+
+class ImportCheckError(ValueError):
+    """A file that was read but failed the import checks; ``values`` are the report cells measured."""
+
+    def __init__(self, message: str, values: dict):
+        super().__init__(message)
+        self.values = values
+
+
+def standing_height_m(P: np.ndarray, names, joint_map: dict[str, str]) -> float:
+    """Estimated standing height (head top to sole), metres, of a body given as (T, K, 3) positions, y-up.
+
+    Rigs place their head joint anywhere from the neck to mid-head and few mark the head top, but hip joint
+    centres are anatomical: the standing hip height is thigh + shin (median bone lengths over the frames) + the
+    ankle's lowest height above the floor (the lowest foot point of the clip), divided by
+    :data:`HIP_HEIGHT_FRACTION`. 0 when the legs are not mapped.
+    """
+    idx = {n: k for k, n in enumerate(names)}
+    legs = []
+    floor = float(P[..., 1].min())
+    for side in ("left", "right"):
+        chain = [joint_map.get(f"{side}_{j}") for j in ("hip", "knee")]
+        ankle = joint_map.get(f"{side}_heel") or joint_map.get(f"{side}_ankle")
+        if None in chain or ankle is None:
+            continue
+        hip, knee, foot = idx[chain[0]], idx[chain[1]], idx[ankle]
+        thigh = np.median(np.linalg.norm(P[:, hip] - P[:, knee], axis=-1))
+        shin = np.median(np.linalg.norm(P[:, knee] - P[:, foot], axis=-1))
+        legs.append(thigh + shin + float(np.percentile(P[:, foot, 1], 5)) - floor)
+    return float(np.mean(legs)) / HIP_HEIGHT_FRACTION if legs else 0.0
 
 # proper rotations taking each world axis (with sign) onto +y
 _UP_TO_Y = {
@@ -57,6 +92,10 @@ class ImportOptions:
     Attributes:
         skeleton: "gait" (21 joints) or "gesture" (23 joints).
         height: our skeleton's height, metres; build: "male" or "female".
+        proportions: "source" keeps the actor's bone lengths on our joints (the import check's solve);
+            "ours" moves the motion onto our skeleton of ``height`` and ``build``.
+        max_import_error_m: a file whose source-proportioned solve misses a mapped joint by more is an error.
+        height_range_m: a file whose estimated standing height lies outside is an error.
         scale: metres per file unit; None guesses from the body height.
         fps: resample the result to this frame rate; None keeps the source's.
         input_fps: frame rate of position files (they store none).
@@ -74,6 +113,9 @@ class ImportOptions:
     layout: str | None = None
     joint_map: dict[str, str] = field(default_factory=dict)
     up: str = "auto"
+    proportions: str = "ours"
+    max_import_error_m: float = 0.03
+    height_range_m: tuple[float, float] = (1.2, 2.3)
 
     def target(self) -> Skeleton:
         if self.skeleton == "gait":
@@ -108,11 +150,8 @@ def load_source(path: Path, options: ImportOptions) -> tuple[np.ndarray, tuple[s
     """Global positions (T, K, 3) in file units (up axis not yet corrected), joint names, fps, info (format; for
     BVH the rest-pose positions (K, 3), whose height along the up axis gives the units)."""
     if path.suffix.lower() in BVH_SUFFIXES:
-        m = read_bvh(path, scale=1.0)
-        info = {"format": "bvh", "rest": m.skeleton.rest_positions()}
-        if "ignored_channels" in m.metadata:
-            info["ignored_channels"] = m.metadata["ignored_channels"]
-        return m.positions(), m.skeleton.joints, m.fps, info
+        data = parse_bvh(path)
+        return data.global_positions(), data.names, data.fps, {"format": "bvh"}
     P, names = read_positions(path, options.layout)
     return P, names, options.input_fps, {"format": path.suffix.lower().lstrip(".")}
 
@@ -141,25 +180,62 @@ def _leg_length(P: np.ndarray, index: dict[str, int], end: str) -> float:
     return float(np.mean(sides)) if sides else 0.0
 
 
-def solve_onto(P_src: np.ndarray, names, target: Skeleton, joint_map: dict[str, str]) -> tuple[Motion, float, float]:
-    """Mapped source positions (T, K, 3), metres, y-up -> (Motion at fps 1, scale applied, max error m)."""
+def _place_source(P_src: np.ndarray, names, target: Skeleton, joint_map: dict[str, str], scale: float):
+    """Source positions (T, K, 3) times ``scale`` on the target's joints: (T, J, 3), known (J,), mapped indices."""
     idx = {n: k for k, n in enumerate(names)}
-    end = "heel" if "left_heel" in target.joints else "ankle"
-    src_leg = _leg_length(P_src, {ours: idx[theirs] for ours, theirs in joint_map.items()}, end)
-    tgt_leg = _leg_length(target.rest_positions(), {n: j for j, n in enumerate(target.joints)}, end)
-    scale = tgt_leg / src_leg if src_leg > 1e-6 else 1.0
     T, J = len(P_src), target.num_joints
     P = np.zeros((T, J, 3))
     known = np.zeros(J, bool)
     for ours, theirs in joint_map.items():
         P[:, target.index(ours)] = P_src[:, idx[theirs]] * scale
         known[target.index(ours)] = True
-    mapped = np.flatnonzero(known)
+    return P, known, np.flatnonzero(known)
+
+
+def _solve(P: np.ndarray, known: np.ndarray, mapped: np.ndarray, target: Skeleton, joint_map: dict[str, str],
+           fit: bool = False) -> tuple[Motion, float]:
+    """IK of placed positions onto ``target`` (feet put on the source's): (Motion at fps 1, max mapped error m).
+    With ``fit`` the target first takes the source's rest geometry (:func:`fit_proportions`)."""
+    P = P.copy()
+    known = known.copy()
     fill_unmapped_joints(P, known, target)
+    if fit:
+        target = fit_proportions(P, known, target)
     rotations = place_feet_on_source(solve_rotations(P, target, known), P, known, target, joint_map)
     motion = Motion(target, rotations, P[:, 0].copy(), 1.0, {})
     err = np.linalg.norm(motion.positions()[:, mapped] - P[:, mapped], axis=-1)
-    return motion, scale, float(err.max())
+    return motion, float(err.max())
+
+
+def solve_onto(P_src: np.ndarray, names, target: Skeleton, joint_map: dict[str, str],
+               proportions: str = "ours") -> tuple[Motion, float, float, float]:
+    """Mapped source positions (T, K, 3), metres, y-up -> a Motion on our joints.
+
+    The import check always solves onto our joints with the source's bone lengths
+    (:func:`~generation.mocap.retarget.fit_proportions`): its largest error over mapped joints says whether the
+    file was read and solved right (millimetres for a right reading; bone-length changes within a take and rest
+    directions that differ from ours add a few). ``proportions="source"`` returns that motion (the actor's body);
+    ``"ours"`` moves it onto ``target``'s own lengths: positions scaled by our leg length / the source's, feet put
+    where the scaled source's are.
+
+    Returns:
+        (Motion at fps 1, scale applied to the source positions, import error m, retarget error m): the import
+        error of the source-proportioned solve, and the largest mapped-joint distance of the returned motion.
+    """
+    idx = {n: k for k, n in enumerate(names)}
+    P, known, mapped = _place_source(P_src, names, target, joint_map, 1.0)
+    motion, import_err = _solve(P, known, mapped, target, joint_map, fit=True)
+    if proportions == "source":
+        return motion, 1.0, import_err, import_err
+    if proportions != "ours":
+        raise ValueError(f"proportions must be 'source' or 'ours', got {proportions!r}")
+    end = "heel" if "left_heel" in target.joints else "ankle"
+    src_leg = _leg_length(P_src, {ours: idx[theirs] for ours, theirs in joint_map.items()}, end)
+    tgt_leg = _leg_length(target.rest_positions(), {n: j for j, n in enumerate(target.joints)}, end)
+    scale = tgt_leg / src_leg if src_leg > 1e-6 else 1.0
+    P, known, mapped = _place_source(P_src, names, target, joint_map, scale)
+    motion, err = _solve(P, known, mapped, target, joint_map)
+    return motion, scale, import_err, err
 
 
 def import_file(path: str | Path, options: ImportOptions, label: Label | None = None,
@@ -172,8 +248,10 @@ def import_file(path: str | Path, options: ImportOptions, label: Label | None = 
     t0 = time.perf_counter()
     try:
         motion, row_extra = _import(path, options, label)
-    except (MotionFormatError, ValueError) as exc:  # RigMapError, LabelError are ValueErrors
+    except (MotionFormatError, ValueError) as exc:  # RigMapError, LabelError, ImportCheckError are ValueErrors
         msg = str(exc)
+        if isinstance(exc, ImportCheckError):
+            row.update(exc.values)
         row["message"] = msg if str(path) in msg else f"{path}: {msg}"
         return ImportResult(None, row, time.perf_counter() - t0)
     row.update(row_extra, status="ok")
@@ -191,21 +269,31 @@ def _import(path: Path, options: ImportOptions, label: Label | None) -> tuple[Mo
     if up not in _UP_TO_Y:
         raise ValueError(f"up must be 'auto' or one of {', '.join(_UP_TO_Y)}, got {up!r}")
     P = P @ _UP_TO_Y[up].T
-    if "rest" in info:    # BVH: the rest pose's height along the up axis (as read_bvh guesses, axis-aware)
-        rest_y = info.pop("rest") @ _UP_TO_Y[up][1]
-        extent = float(rest_y.max() - rest_y.min())
-    else:                 # positions: the median height over the frames
-        extent = float(np.median(P[..., 1].max(1) - P[..., 1].min(1)))
+    extent = float(np.median(P[..., 1].max(1) - P[..., 1].min(1)))   # the posed body's height over the frames
     unit, guess = (options.scale, "given") if options.scale is not None else _guess_unit(extent)
     if not unit > 0:
         raise ValueError(f"--scale must be positive, got {unit}")
     P = P * unit
-    info.update(unit_scale=unit, unit_guess=guess, height_m=extent * unit)
-    solved, scale, err = solve_onto(P, names, target, joint_map)
+    height = standing_height_m(P, names, joint_map)
+    info.update(unit_scale=unit, unit_guess=guess, height_m=height)
+    solved, scale, import_err, err = solve_onto(P, names, target, joint_map, options.proportions)
+    problems = []
+    if import_err > options.max_import_error_m:
+        problems.append(f"import error {100 * import_err:.1f} cm exceeds {100 * options.max_import_error_m:.1f} cm "
+                        "(the solved body does not reproduce the file's joint positions: wrong channels, units or "
+                        "joint map?)")
+    low, high = options.height_range_m
+    if not low <= height <= high:
+        problems.append(f"standing height {height:.2f} m is outside {low}-{high} m (wrong units? give --scale)")
+    if problems:
+        raise ImportCheckError("; ".join(problems), {"retarget_max_error_m": f"{err:.6f}",
+                                                     "import_error_cm": f"{100 * import_err:.2f}",
+                                                     "height_m": f"{height:.4f}"})
     meta = {"origin": "captured", "synthetic": False, "source": path.name, "source_path": str(path),
             "format": info["format"], "unit_scale": info["unit_scale"], "unit_guess": info["unit_guess"],
             "up_axis": up, "source_height_m": info["height_m"],
-            "retarget": {"scale": scale, "joint_map": joint_map, "max_error_m": err}}
+            "proportions": options.proportions,
+            "retarget": {"scale": scale, "joint_map": joint_map, "max_error_m": err, "import_error_m": import_err}}
     if "ignored_channels" in info:
         meta["ignored_channels"] = info["ignored_channels"]
     if label is not None:
@@ -221,4 +309,5 @@ def _import(path: Path, options: ImportOptions, label: Label | None) -> tuple[Mo
     return motion, {"frames": motion.num_frames, "fps": f"{motion.fps:.6g}", "duration_s": f"{motion.duration:.4f}",
                     "mapped_joints": len(joint_map), "unmapped_joints": ";".join(unmapped),
                     "retarget_max_error_m": f"{err:.6f}", "height_m": f"{info['height_m']:.4f}",
+                    "import_error_cm": f"{100 * import_err:.2f}",
                     "message": ""}

@@ -42,7 +42,7 @@ GENERATOR_VERSIONS = {
 GENERATOR_MODULES = {
     "gait_net": ("generation.gait.generate", "generation.core.paths", "generation.core.foot_contact"),
     "procedural_walk": ("generation.procedural.walk", "generation.procedural.emotion", "generation.core.paths"),
-    "captured": ("generation.formats.captured", "generation.core.foot_contact"),
+    "captured": ("generation.mocap.captured", "generation.core.foot_contact"),
     "captured_file": ("generation.plans.captured_file", "generation.mocap.importer"),
     "neutral_walk": ("generation.rbf.neutral_base", "generation.rbf.stylise", "generation.core.foot_contact"),
     "rbf": ("generation.rbf.neutral_base", "generation.rbf.stylise", "generation.core.foot_contact"),
@@ -328,7 +328,7 @@ def _captured_file(entry: ClipEntry, fps: float) -> Motion:
 
 
 def _captured(entry: ClipEntry, fps: float) -> Motion:
-    from generation.formats.captured import WALK_FILES, captured_walks, chain_clip_repeats
+    from generation.mocap.captured import WALK_FILES, captured_walks, chain_clip_repeats
 
     names = [name for name, _ in WALK_FILES]
     clip = entry.inputs["clip"]

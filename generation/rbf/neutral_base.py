@@ -5,7 +5,7 @@ warping into 100 frames and averaged them, so that no single actor's style survi
 result was perceived as neutral by 75 % of viewers (Table I). We do the same with what we have:
 
 1. Sources: procedural neutral walks (:func:`generation.procedural.walk.walk`, marked synthetic) of
-   several body sizes and builds, plus the real captured walks of :func:`generation.formats.captured.captured_walks`
+   several body sizes and builds, plus the real captured walks of :func:`generation.mocap.captured.captured_walks`
    when that module is available and they use the gait skeleton.
 2. Cutting: a cycle runs from a left heel strike to the next one, with one right heel strike between
    (strikes are the onsets of :func:`generation.core.features.detect_foot_contacts`). Cycles in which a joint
@@ -220,7 +220,7 @@ def default_sources(n_frames_s: float = 3.3, fps: float = 100.0, include_capture
     """Neutral walks to average: procedural walks of :data:`DEFAULT_BODIES` and the captured walks if any.
 
     Each procedural walk is ``n_frames_s`` seconds long (about two full cycles at the neutral cadence) with
-    a different footprint-jitter seed. Captured walks are included only when ``generation.formats.captured`` exists and
+    a different footprint-jitter seed. Captured walks are included only when ``generation.mocap.captured`` exists and
     yields gait-skeleton motions.
     """
     from generation.procedural.walk import WalkParams, walk
@@ -248,7 +248,7 @@ def _is_straight(motion: Motion, max_turn_deg: float = 20.0) -> bool:
 
 
 def captured_sources() -> list[Motion]:
-    """Real captured straight walks on the gait skeleton from :mod:`generation.formats.captured`, or [] if unavailable.
+    """Real captured straight walks on the gait skeleton from :mod:`generation.mocap.captured`, or [] if unavailable.
 
     Turning clips (described as turning, or turning by more than 20 degrees) are left out: the paper averaged
     straight walks. A loopable clip (``loop == "wrap"``) is
@@ -256,7 +256,7 @@ def captured_sources() -> list[Motion]:
     tells :func:`neutral_cycle_from_motions` to keep only its first cycle, so the repeat does not count twice.
     """
     try:
-        from generation.formats.captured import captured_walks, chain_clip_repeats
+        from generation.mocap.captured import captured_walks, chain_clip_repeats
     except ImportError:
         return []
     out = []
