@@ -199,3 +199,16 @@ in the order this participant took them, joined by ';' (counterbalanced studies 
 ASSIGNMENT_COLUMNS = ("participant_id", "section_type", "section_order", "position", "clip_id", "options",
                       "shown_at", "answered_at")
 """assignments.csv (an extra export): which clips each participant was given, in order."""
+
+VIEWING_TIME_FIELDS = ("first_play_ms", "ended_ms", "stall_ms")
+"""Viewing-record times in milliseconds: from the clip page's display to the clip's first playing frame and to its
+first end (blank: never played / never reached its end), and the total time playback waited for data."""
+VIEWING_COUNT_FIELDS = ("plays", "pauses", "seeks", "stalls", "hidden")
+"""Viewing-record counts: plays from the start (the first play and every replay), pauses by the participant, seek
+attempts (blocked or not), stalls (playback waiting for data) and times the page was hidden (another tab, a
+minimised window) while the clip was playing."""
+VIEWING_FIELDS = ("first_play_ms", "ended_ms", "plays", "pauses", "seeks", "stalls", "stall_ms", "hidden")
+"""The fields of a viewing record, in viewing.csv's order."""
+VIEWING_COLUMNS = ("participant_id", "clip_id", "section_type", *VIEWING_FIELDS)
+"""viewing.csv, in order: one row per answered clip page (practice items left out). All fields blank: the browser
+sent no record (no JavaScript, an older page)."""

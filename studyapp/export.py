@@ -3,7 +3,9 @@ study_protocol), plus assignments.csv (what each participant was shown, for audi
 
 Rows are produced by generators over `.iterator()` queries, so a large study streams in constant memory (an
 HTTP StreamingHttpResponse or a file on disk); no export builds the whole file as one string.
-Preview runs record nothing, so every participant row is a real participant.
+Preview runs record nothing, so every participant row is a real participant. viewing.csv (VIEWING_COLUMNS) has
+one row per answered clip page: how the clip was watched (studyapp.viewing), blank fields where the browser sent
+no record.
 
 Spreadsheet formula injection: participants type some of these cells (external_id, feedback). Every text cell
 that starts with =, +, -, @, a tab or a carriage return is written with a leading single quote (') so Excel,
@@ -32,14 +34,19 @@ from study_protocol import (
     CLIP_COLUMNS,
     PARTICIPANT_COLUMNS,
     RESPONSE_COLUMNS,
+    VIEWING_COLUMNS,
+    VIEWING_FIELDS,
     attention_passed,
 )
 
 from .catalogue import pool_queryset
 from .models import Assignment, Clip, Response, Study
 
-__all__ = ["ASSIGNMENT_COLUMNS", "CLIP_COLUMNS", "PARTICIPANT_COLUMNS", "RESPONSE_COLUMNS", "run_report",
-           "stream_csv", "write_study_csvs"]
+__all__ = ["ASSIGNMENT_COLUMNS", "CLIP_COLUMNS", "EXPORT_KINDS", "PARTICIPANT_COLUMNS", "RESPONSE_COLUMNS",
+           "VIEWING_COLUMNS", "run_report", "stream_csv", "write_study_csvs"]
+
+EXPORT_KINDS = ("responses", "clips", "participants", "assignments", "viewing")
+"""The CSV exports, each written as ``<kind>.csv``."""
 
 CHUNK = 2000
 
@@ -141,8 +148,21 @@ def assignment_rows(study: Study) -> Iterator[list]:
         yield [pid, stype, order, pos, clip_id, ";".join(options or []), _iso(shown), _iso(answered)]
 
 
+def viewing_rows(study: Study) -> Iterator[list]:
+    """One row per answered clip page (practice items left out): participant, clip, section type, then
+    VIEWING_FIELDS (blank where unknown or when the browser sent no record)."""
+    qs = (Assignment.objects.filter(section__study=study, answered_at__isnull=False)
+          .exclude(kind=Assignment.Kind.PRACTICE)
+          .annotate(exported_type=_exported_type())
+          .order_by("participant_id", "seq")
+          .values_list("participant__public_id", "clip__clip_id", "exported_type", "viewing"))
+    for pid, clip_id, stype, viewing in qs.iterator(chunk_size=CHUNK):
+        record = viewing if isinstance(viewing, dict) else {}
+        yield [pid, clip_id, stype, *(record.get(f) for f in VIEWING_FIELDS)]
+
+
 def stream_csv(study: Study, kind: str) -> Iterator[str]:
-    """Lines of `kind` in responses | clips | participants | assignments."""
+    """Lines of `kind` in EXPORT_KINDS."""
     if kind == "responses":
         return _csv_lines(RESPONSE_COLUMNS, response_rows(study))
     if kind == "clips":
@@ -151,16 +171,18 @@ def stream_csv(study: Study, kind: str) -> Iterator[str]:
         return _csv_lines([*PARTICIPANT_COLUMNS, *feedback_keys(study)], participant_rows(study))
     if kind == "assignments":
         return _csv_lines(ASSIGNMENT_COLUMNS, assignment_rows(study))
-    raise ValueError(f"unknown export {kind!r}; choose responses, clips, participants or assignments")
+    if kind == "viewing":
+        return _csv_lines(VIEWING_COLUMNS, viewing_rows(study))
+    raise ValueError(f"unknown export {kind!r}; choose {', '.join(EXPORT_KINDS)}")
 
 
 def write_study_csvs(study: Study, out_dir: str | Path) -> dict[str, Path]:
-    """Write responses.csv, clips.csv, participants.csv (DESIGN.md) and assignments.csv into out_dir; returns their
-    paths by kind."""
+    """Write responses.csv, clips.csv, participants.csv (DESIGN.md), assignments.csv and viewing.csv into out_dir;
+    returns their paths by kind."""
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     paths = {}
-    for kind in ("responses", "clips", "participants", "assignments"):
+    for kind in EXPORT_KINDS:
         path = out / f"{kind}.csv"
         with open(path, "w", newline="", encoding="utf-8") as fh:
             for line in stream_csv(study, kind):

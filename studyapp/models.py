@@ -263,6 +263,9 @@ class Assignment(models.Model):
     kind = models.CharField(max_length=20, choices=Kind.choices, default=Kind.TRIAL, blank=True)
     # Attention check: the answer the participant is told to give (Section.options["attention_checks"]["answer"]).
     instructed = models.CharField(max_length=40, blank=True, default="")
+    # How the clip was watched before the answer (studyapp.viewing): study_protocol.VIEWING_FIELDS -> int or null;
+    # null when the browser sent no record. Exported as viewing.csv.
+    viewing = models.JSONField(null=True, blank=True, editable=False)
 
     class Meta:
         ordering = ["participant", "seq"]

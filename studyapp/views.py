@@ -32,6 +32,7 @@ from .media import media_path, ranged_file_response
 from .models import Assignment, Clip, Participant, Response, Study
 from .precompiled import PrecompiledSelect
 from .questions import AnswerError, clean_answers, questions_for
+from .viewing import VIEWING_FORM_FIELDS, parse_viewing, player_options
 
 SESSION_KEY = "study_tokens"
 CONSENT_KEYS = "consent_keys"
@@ -261,6 +262,7 @@ def item_context(section, clip, index: int, total: int, next_clip: Clip | None, 
             "sources": clip_sources(clip),
             "next_sources": clip_sources(next_clip) if next_clip else None,
             "loop": section.loop or clip.loop, "require_play": section.require_full_play,
+            "player": player_options(section.options), "viewing_fields": VIEWING_FORM_FIELDS,
             "index": index, "total": total, "percent": int(round(100 * (index - 1) / max(total, 1))),
             "practice": kind == Assignment.Kind.PRACTICE, **attention_context(questions, kind, instructed)}
 
@@ -368,7 +370,8 @@ def item(request, token: str, n: int):
     response_ms = client_ms(request.POST.get("rt", ""), server_ms)
     if response_ms is None:
         response_ms = server_ms
-    save_answers(assignment, answers, response_ms)
+    viewing = parse_viewing(request.POST, min(MAX_RESPONSE_MS, server_ms + RT_SLACK_MS))
+    save_answers(assignment, answers, response_ms, viewing)
     if request.POST.get(INLINE_NEXT_FIELD) == "1" and n < participant.n_items:
         nxt = current_step(participant, lookahead=True)
         if nxt.kind == "item" and nxt.index == n + 1:
@@ -384,15 +387,18 @@ def _show_item(request, participant: Participant, step):
     return _render_item(request, participant, step, posted=None)
 
 
-def save_answers(assignment: Assignment, answers: dict[str, str], response_ms: int) -> bool:
-    """Store the answers of one clip exactly once (one transaction: a conditional UPDATE claims the assignment,
-    one INSERT of its responses, one UPDATE of the participant's last activity). Returns False if they were
-    already stored. A practice item stores no responses; an attention check stores its one answer with kind
-    ATTENTION_CHECK and question ``<key>=<instructed answer>``."""
+def save_answers(assignment: Assignment, answers: dict[str, str], response_ms: int,
+                 viewing: dict | None = None) -> bool:
+    """Store the answers of one clip exactly once (one transaction: a conditional UPDATE claims the assignment
+    and stores its viewing record, one INSERT of its responses, one UPDATE of the participant's last activity).
+    Returns False if they were already stored. A practice item stores no responses; an attention check stores its
+    one answer with kind ATTENTION_CHECK and question ``<key>=<instructed answer>``."""
     now = timezone.now()
     try:
         with transaction.atomic():
-            if not Assignment.objects.filter(pk=assignment.pk, answered_at__isnull=True).update(answered_at=now):
+            claimed = Assignment.objects.filter(pk=assignment.pk, answered_at__isnull=True).update(
+                answered_at=now, viewing=viewing)
+            if not claimed:
                 return False
             if assignment.kind != Assignment.Kind.PRACTICE:
                 attention = assignment.kind == ATTENTION_CHECK

@@ -15,7 +15,7 @@ from django.views.decorators.http import require_http_methods
 from study_protocol import ATTENTION_CHECK
 
 from .assignment import plan_study
-from .export import stream_csv
+from .export import EXPORT_KINDS, stream_csv
 from .forms import ConsentForm, PresetStudyForm
 from .i18n import activate_study_language
 from .models import Assignment, Participant, Response, Study
@@ -124,7 +124,7 @@ def progress(request, study_id: int):
 @staff_member_required
 def export_csv(request, study_id: int, kind: str):
     study = get_object_or_404(Study, pk=study_id)
-    if kind not in ("responses", "clips", "participants", "assignments"):
+    if kind not in EXPORT_KINDS:
         raise Http404("unknown export")
     response = StreamingHttpResponse(stream_csv(study, kind), content_type="text/csv; charset=utf-8")
     response["Content-Disposition"] = f'attachment; filename="{study.slug}-{kind}.csv"'

@@ -2,7 +2,8 @@
    Clip page:
    - the address bar shows the page's own URL, also when the page came as the answer to the previous clip's POST;
    - answers are enabled once the clip has played through (when the section requires it);
-   - replay button; response time measured from page display to submit (hidden field "rt", ms);
+   - the player's controls, replay limit and seek blocking, and the viewing record sent with the answer
+     (setUpPlayer); response time measured from page display to submit (hidden field "rt", ms);
    - the next clip is preloaded once this one can play; a double submit is blocked.
    Every form with data-keys (clip, demographics, feedback pages): keyboard answering
    - number keys 1-9 choose option 1-9 of the question that has focus, or else of the first unanswered question
@@ -26,7 +27,7 @@
   var submit = document.getElementById("next");
   var live = liveRegion();
   var video = document.getElementById("clip");
-  if (video) { setUpPlayer(video); }
+  var fillViewing = video ? setUpPlayer(video) : null;
   if (form.dataset.keys) { setUpKeys(); }
   setUpSubmit();
 
@@ -38,41 +39,167 @@
     return el;
   }
 
+  // The clip player (the section's options, data-controls / data-max-replays on the video):
+  // - "replay-only": a play/pause and a Replay button, no seek bar, no speed menu; "none": only Replay, once the clip
+  //   ended; "full": the browser's own controls. Outside "full" every seek is undone (the seek bar of picture-in-
+  //   picture, the keyboard, media keys, a script) and the speed is kept at 1.
+  // - data-max-replays (blank: unlimited) limits the plays after the first.
+  // - the viewing record goes with the answer as hidden fields view_<field> (study_protocol.VIEWING_FIELDS; times
+  //   in ms from the page's display): first playing frame, first end, plays, pauses, seek attempts, stalls (playback
+  //   waiting for data) and their total time, and how often the page was hidden while the clip played.
   function setUpPlayer(video) {
     var fieldsets = form.querySelectorAll("fieldset");
     var note = document.getElementById("play-note");
     var replay = document.getElementById("replay");
+    var playPause = document.getElementById("play-pause");
     var requirePlay = video.dataset.requirePlay === "1";
-    var played = false;
+    var controls = video.dataset.controls || "full";
+    var canSeek = controls === "full";
+    var maxReplays = video.dataset.maxReplays ? Number(video.dataset.maxReplays) : Infinity;
+    var rec = { first_play_ms: null, ended_ms: null, plays: 0, pauses: 0, seeks: 0, stalls: 0, stall_ms: 0,
+                hidden: 0 };
+    var played = false;        // reached its end once: answers enabled
+    var atEnd = false;         // ended and not started again yet
+    var ownSeeks = 0;          // seeks this script makes (replay, undoing a blocked seek), not counted as attempts
+    var ownPause = false;      // a pause this script makes (replays used up), not counted as the participant's
+    var safeTime = 0;          // how far the clip got by playing: where a blocked seek returns to
+    var stallStart = null;
+    var blocked = false;       // the browser did not let the clip start by itself
+    function now() { return Math.round(performance.now() - t0); }
+    function replaysLeft() { return rec.plays === 0 ? Infinity : maxReplays - (rec.plays - 1); }
     function setEnabled(on) {
       fieldsets.forEach(function (fs) { fs.disabled = !on; });
       submit.disabled = !on;
     }
+    function say(text) { if (text) { note.textContent = text; } }
     function markPlayed() {
+      if (rec.ended_ms === null) { rec.ended_ms = now(); }
       if (played) { return; }
       played = true;
       setEnabled(true);
-      note.textContent = note.dataset.ready;
+      say(note.dataset.ready + (note.dataset.replaysLeft ? " " + note.dataset.replaysLeft : ""));
     }
+    function updateButtons() {
+      var left = replaysLeft();
+      replay.hidden = controls === "none" ? !((atEnd && left > 0) || (rec.plays === 0 && blocked)) : maxReplays === 0;
+      replay.disabled = left <= 0;
+      if (played && left <= 0 && maxReplays > 0) { say(note.dataset.noReplays); }
+      if (playPause) {
+        playPause.hidden = false;
+        playPause.textContent = video.paused || video.ended ? playPause.dataset.play : playPause.dataset.pause;
+      }
+    }
+    function seekTo(t) { ownSeeks += 1; video.currentTime = t; }
+    function startOver() {          // a replay: one more play from the start, if any is left
+      if (replaysLeft() <= 0) { return false; }
+      rec.plays += 1;
+      atEnd = false;
+      safeTime = 0;
+      seekTo(0);
+      return true;
+    }
+    function stopHere() { ownPause = true; video.pause(); }
     if (requirePlay && !form.querySelector(".error")) {
       setEnabled(false);
-      note.textContent = note.dataset.wait;
+      say(note.dataset.wait);
     }
-    replay.hidden = false;
-    replay.addEventListener("click", function () { video.currentTime = 0; video.play(); });
-    video.addEventListener("ended", markPlayed);
+    replay.addEventListener("click", function () {
+      if (rec.plays === 0) { video.play(); return; }      // autoplay was blocked: this is the first play
+      if (startOver()) { video.play(); }
+      updateButtons();
+    });
+    if (playPause) {
+      playPause.addEventListener("click", function () {
+        if (atEnd) { if (startOver()) { video.play(); } } else if (video.paused) { video.play(); } else { video.pause(); }
+        updateButtons();
+      });
+    }
+    video.addEventListener("playing", function () {
+      if (rec.first_play_ms === null) { rec.first_play_ms = now(); rec.plays = 1; }
+      if (stallStart !== null) { rec.stall_ms += now() - stallStart; stallStart = null; }
+      updateButtons();
+    });
+    video.addEventListener("play", function () {
+      // The browser's own play button on an ended clip (full controls) starts it over: a replay.
+      if (atEnd) {
+        if (!startOver()) { stopHere(); }
+      }
+      updateButtons();
+    });
+    video.addEventListener("pause", function () {
+      if (!ownPause && !video.ended && !atEnd) { rec.pauses += 1; }
+      ownPause = false;
+      updateButtons();
+    });
+    video.addEventListener("ended", function () { atEnd = true; markPlayed(); updateButtons(); });
+    video.addEventListener("waiting", function () {
+      if (!video.seeking && !video.paused && stallStart === null) { rec.stalls += 1; stallStart = now(); }
+    });
+    video.addEventListener("seeking", function () {
+      if (ownSeeks > 0) { ownSeeks -= 1; return; }
+      var t = video.currentTime;
+      if (video.loop && t < 0.5 && safeTime > (video.duration || 0) - 0.75) { return; }   // a loop starting over
+      if (atEnd && t < 0.1) { return; }            // the browser restarts an ended clip on play
+      rec.seeks += 1;
+      if (!canSeek && Math.abs(t - safeTime) > 0.05) {
+        seekTo(safeTime);
+        say(note.dataset.noSeek);
+      }
+    });
     var last = 0;
     video.addEventListener("timeupdate", function () {
-      // A looping clip never fires "ended": count a wrap-around (time jumping back) as one full play.
-      if (video.loop && video.currentTime + 0.25 < last && last > 0.5 * (video.duration || 0)) { markPlayed(); }
-      last = video.currentTime;
+      var t = video.currentTime;
+      // A looping clip never fires "ended": count a wrap-around (time jumping back) as one full play, and as a
+      // replay once it has played through.
+      if (video.loop && t + 0.25 < last && last > 0.5 * (video.duration || 0)) {
+        markPlayed();
+        rec.plays += 1;
+        safeTime = 0;
+        if (rec.plays - 1 > maxReplays) { rec.plays -= 1; stopHere(); atEnd = true; }
+        updateButtons();
+      }
+      if (!video.seeking && t >= safeTime && t - safeTime < 1.5) { safeTime = t; }
+      last = t;
     });
-    video.addEventListener("error", function () { setEnabled(true); note.textContent = note.dataset.failed; },
-                           true);
+    video.addEventListener("ratechange", function () {
+      if (!canSeek && video.playbackRate !== 1) { video.playbackRate = 1; }
+    });
+    if (!canSeek) {
+      // Arrow keys, Home/End, j/l and the like seek a focused video in some browsers.
+      video.addEventListener("keydown", function (e) {
+        if (/^(Arrow(Left|Right|Up|Down)|Home|End|PageUp|PageDown|j|l|,|\.)$/.test(e.key)) {
+          e.preventDefault();
+          e.stopPropagation();
+          rec.seeks += 1;
+          say(note.dataset.noSeek);
+        }
+      });
+      if (navigator.mediaSession && navigator.mediaSession.setActionHandler) {
+        ["seekto", "seekbackward", "seekforward", "previoustrack", "nexttrack"].forEach(function (action) {
+          try {
+            navigator.mediaSession.setActionHandler(action, function () { rec.seeks += 1; say(note.dataset.noSeek); });
+          } catch (err) { /* an action this browser does not know */ }
+        });
+      }
+    }
+    document.addEventListener("visibilitychange", function () {
+      if (document.hidden && !video.paused && !video.ended) { rec.hidden += 1; }
+    });
+    video.addEventListener("error", function () { setEnabled(true); say(note.dataset.failed); }, true);
+    updateButtons();
     var p = video.play();
-    if (p && p.catch) { p.catch(function () { note.textContent = note.dataset.pressPlay; }); }
+    if (p && p.catch) {
+      p.catch(function () { blocked = true; say(note.dataset.pressPlay); updateButtons(); });
+    }
     video.addEventListener("canplaythrough", preloadNext);
     setTimeout(preloadNext, 4000);
+    return function fillViewing() {
+      if (stallStart !== null) { rec.stall_ms += now() - stallStart; stallStart = null; }
+      Object.keys(rec).forEach(function (key) {
+        var input = form.querySelector("input[data-viewing][name='view_" + key + "']");
+        if (input) { input.value = rec[key] === null ? "" : String(rec[key]); }
+      });
+    };
   }
 
   function preloadNext() {
@@ -153,6 +280,7 @@
       sent = true;
       var rt = document.getElementById("rt");
       if (rt) { rt.value = String(Math.round(performance.now() - t0)); }
+      if (fillViewing) { fillViewing(); }
       submit.disabled = false;
       setTimeout(function () { submit.disabled = true; }, 0);
     });
