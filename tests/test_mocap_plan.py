@@ -137,3 +137,32 @@ def test_our_own_bvh_files_import_back(walk_files, tmp_path):
     assert result.motion is not None, result.row
     assert result.row["unmapped_joints"] == "" and float(result.row["retarget_max_error_m"]) < 1e-3
     np.testing.assert_allclose(result.motion.positions(), walk.positions(), atol=2e-3)
+
+
+def test_source_json_beside_the_file_gives_licence_citation_and_take(walk_files, tmp_path):
+    folder = tmp_path / "takes"
+    folder.mkdir()
+    (folder / "dataset-1_walk_sad_002.npz").write_bytes((walk_files / "walk.npz").read_bytes())
+    (folder / "SOURCE.json").write_text(json.dumps({
+        "dataset": "Example dataset", "licence": "CC BY-NC 4.0", "citation": "A. Author. Title. 2023.",
+        "name_pattern": r"dataset-(?P<dataset_part>\d)_(?P<content>[a-z-]+)_(?P<style>[a-z-]+)_(?P<take>\d{3})"}))
+    plan = validate_plan(_plan(_entry(folder / "dataset-1_walk_sad_002.npz")))
+    m = clipgen.make_motion(plan.entries[0]).metadata
+    assert (m["licence"], m["citation"], m["dataset"]) == ("CC BY-NC 4.0", "A. Author. Title. 2023.",
+                                                           "Example dataset")
+    assert (m["content"], m["style"], m["take"]) == ("walk", "sad", "002") and m["captured"] is True
+    (folder / "SOURCE.json").write_text("[1, 2]")
+    with pytest.raises(PlanError, match="SOURCE.json"):
+        validate_plan(_plan(_entry(folder / "dataset-1_walk_sad_002.npz")))
+
+
+def test_relative_file_falls_back_to_the_repository_root(walk_files, monkeypatch, tmp_path):
+    from generation.plans import captured_file
+
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.setattr(captured_file, "REPO_ROOT", walk_files)
+    plan = validate_plan(_plan(_entry("walk.npz")))
+    assert plan.entries[0].inputs["file"] == "walk.npz"
+    assert clipgen.make_motion(plan.entries[0]).num_frames > 0
+    with pytest.raises(PlanError, match="no such file"):
+        validate_plan(_plan(_entry("missing.npz")))

@@ -12,7 +12,13 @@ The clip's ``origin`` is always ``source``: it is the captured motion a study co
 participant is never shown both. Labels default to those the importer stored in the file (``--labels`` /
 ``--label-pattern``); the entry's own labels win. A ``.bvh`` is imported on the fly with the importer's defaults
 (:func:`generation.mocap.import_file`: rig auto-mapping, units and up axis guessed). Relative paths are relative
-to the working directory of the command that reads the plan.
+to the working directory of the command that reads the plan, else to the repository root (so the built-in plans
+can name the shipped real takes in ``generation/data/mocap/``).
+
+Provenance: a ``SOURCE.json`` beside the file (``{"dataset": ..., "licence": ..., "citation": ..., "url": ...,
+"name_pattern": regex with named groups such as content, style, take}``) is copied into the clip's metadata as
+``dataset``, ``licence``, ``citation``, ``url`` and the groups the file name matches (``take``...): real data keeps
+its licence and citation in everything derived from it.
 
 The file's SHA-256 goes into the entry's inputs, so the clip hash changes (and the clip is rendered anew) when the
 file does. Metadata of the motion: ``captured`` (True unless the file says it is synthetic), ``imported_file``,
@@ -23,12 +29,16 @@ from __future__ import annotations
 
 import functools
 import hashlib
+import json
 import math
+import re
 from pathlib import Path
 
 from study_protocol import GAIT_EMOTIONS, GESTURE_VAD, MODALITIES
 
 SUFFIXES = (".npz", ".bvh")
+REPO_ROOT = Path(__file__).resolve().parents[2]
+PROVENANCE_FILE = "SOURCE.json"
 
 
 class CapturedFileError(ValueError):
@@ -72,6 +82,35 @@ def _load(path: str, digest: str, modality: str, fps: float | None):
     if result.motion is None:
         raise CapturedFileError("file", result.row["message"])
     return result.motion
+
+
+def resolve_file(given: str) -> Path:
+    """The file a plan names: as given (relative to the working directory), else relative to the repository root."""
+    path = Path(given)
+    if path.is_file() or path.is_absolute():
+        return path
+    in_repo = REPO_ROOT / path
+    return in_repo if in_repo.is_file() else path
+
+
+def provenance(path: Path) -> dict:
+    """Dataset, licence, citation and name fields of a captured file from the ``SOURCE.json`` beside it ({} when
+    there is none). A SOURCE.json that is not a JSON object of strings raises CapturedFileError."""
+    sidecar = path.parent / PROVENANCE_FILE
+    if not sidecar.is_file():
+        return {}
+    try:
+        info = json.loads(sidecar.read_text(encoding="utf-8"))
+        if not isinstance(info, dict) or not all(isinstance(v, str) for v in info.values()):
+            raise ValueError("expected a JSON object of strings")
+        pattern = re.compile(info.get("name_pattern", "(?!)"))
+    except (ValueError, re.error) as exc:
+        raise CapturedFileError("file", f"{sidecar}: {exc}") from None
+    out = {k: info[k] for k in ("dataset", "licence", "citation", "url") if k in info}
+    match = pattern.fullmatch(path.stem)
+    if match:
+        out.update({k: v for k, v in match.groupdict().items() if v is not None})
+    return out
 
 
 def _number(field: str, value, lo: float, hi: float) -> float:
@@ -134,11 +173,13 @@ def captured_file_inputs(raw: dict) -> dict:
     if not isinstance(given, str) or not given.strip():
         raise CapturedFileError("file", f"required: the path of a Motion .npz (python -m generation.mocap import) "
                                         f"or a .bvh, got {given!r}")
-    path = Path(given.strip())
+    path = resolve_file(given.strip())
     if path.suffix.lower() not in SUFFIXES:
         raise CapturedFileError("file", f"{given!r}: expected a {' or '.join(SUFFIXES)} file")
     if not path.is_file():
-        raise CapturedFileError("file", f"no such file {given!r} (relative paths are relative to {Path.cwd()})")
+        raise CapturedFileError("file", f"no such file {given!r} (relative paths are relative to {Path.cwd()} "
+                                        f"or to {REPO_ROOT})")
+    provenance(path)                        # a bad SOURCE.json fails here, before anything renders
     out = {"file": given.strip(), "sha256": file_digest(path), "format": path.suffix.lower().lstrip("."),
            "start_s": _number("start_s", raw.get("start_s", 0.0), 0.0, 86400.0)}
     labels, source = _entry_labels(raw, modality), "entry"
@@ -159,7 +200,7 @@ def captured_file_inputs(raw: dict) -> dict:
 
 def captured_file_motion(inputs: dict, modality: str, fps: float):
     """The Motion of a validated ``captured_file`` entry at ``fps``, from ``start_s`` on, with honest metadata."""
-    path = Path(inputs["file"])
+    path = resolve_file(inputs["file"])
     if not path.is_file() or file_digest(path) != inputs["sha256"]:
         raise CapturedFileError("file", f"{inputs['file']!r} is missing or changed since the plan was read")
     motion = _load(str(path.resolve()), inputs["sha256"], modality, None)
@@ -182,6 +223,7 @@ def captured_file_motion(inputs: dict, modality: str, fps: float):
                 "retarget_max_error_m": retarget.get("max_error_m"), "unit_scale": meta.get("unit_scale"),
                 "up_axis": meta.get("up_axis")},
         "labels_from": inputs.get("labels_from")})
+    meta.update(provenance(path))
     for key in ("emotion", "emotion_label", "vad"):
         if key in inputs:
             meta[key] = dict(zip(GAIT_EMOTIONS, inputs[key])) if key == "emotion" else inputs[key]
