@@ -24,6 +24,7 @@ from django.views.decorators.http import require_http_methods
 from study_protocol import ATTENTION_CHECK
 
 from .assignment import StudyUnavailable, check_open, current_step, start_participant
+from .device_check import device_context
 from .duration import expected_minutes
 from .forms import PARAM_MAX_LENGTH, PARAM_TOO_LONG, ConsentForm, DemographicsForm, FeedbackForm
 from .i18n import activate_study_language
@@ -177,7 +178,8 @@ def study_entry(request, slug: str):
     return render(request, "studyapp/consent.html", {"study": study, "form": form, "param_errors": errors,
                                                      "expected_minutes": expected_minutes(study),
                                                      "link_params": link_params,
-                                                     "consent_key": _issue_consent_key(request, study)})
+                                                     "consent_key": _issue_consent_key(request, study),
+                                                     **device_context()})
 
 
 def _store_missing_ids(participant: Participant, params: dict[str, str]) -> None:

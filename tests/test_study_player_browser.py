@@ -1,0 +1,182 @@
+"""In headless Chromium: the replay-only player undoes a seek (script and keyboard), counts a pause, a hidden tab
+and a replay, stops replays at max_replays, and viewing.csv records exactly that; the consent page's device check
+stops a too-small window and a browser that cannot play the clips before the study starts.
+STUDY_SCREENSHOTS=<folder> saves docs/img/study_player_replay_only.png (desktop) and
+study_player_replay_only_360.png (360 px wide) there."""
+from __future__ import annotations
+
+import csv
+import io
+import os
+import time
+from pathlib import Path
+
+import pytest
+from django.urls import reverse
+
+from study_protocol import VIEWING_COLUMNS
+from studyapp.export import stream_csv
+from studyapp.models import Participant, Study
+from studyapp.presets import create_study_from_preset
+from studyapp.testing import make_catalogue, tiny_mp4, wait_for
+
+pytestmark = [pytest.mark.browser, pytest.mark.slow, pytest.mark.django_db(transaction=True)]
+
+CLIP_S = 3.0
+
+
+@pytest.fixture
+def study(settings, tmp_path):
+    settings.MEDIA_ROOT = tmp_path / "media"
+    video = tiny_mp4(tmp_path / "clip.mp4", seconds=CLIP_S, size=160)
+    make_catalogue(settings.MEDIA_ROOT, video_bytes=video.read_bytes(), duration_s=CLIP_S)
+    s = create_study_from_preset("gait_ismar2020", "player", plan="test", status=Study.Status.OPEN)
+    section = s.sections.get(order=1)
+    section.options = {"controls": "replay-only", "max_replays": 1}
+    section.save()
+    return s
+
+
+def js(driver, script: str, *args):
+    return driver.execute_script(script, *args)
+
+
+def player_state(driver) -> dict:
+    return js(driver, "var v = document.getElementById('clip'); return {t: v.currentTime, paused: v.paused, "
+                      "ended: v.ended, rate: v.playbackRate};")
+
+
+def viewport(driver, width: int, height: int) -> None:
+    driver.execute_cdp_cmd("Emulation.setDeviceMetricsOverride",
+                           {"width": width, "height": height, "deviceScaleFactor": 1, "mobile": width < 500})
+
+
+def shot(driver, folder: str | None, name: str, width: int) -> None:
+    """A full-page screenshot at ``width`` CSS pixels (the page's own height), then the desktop viewport again."""
+    if not folder:
+        return
+    viewport(driver, width, 800)
+    height = int(js(driver, "return document.documentElement.scrollHeight"))
+    viewport(driver, width, min(height, 2400))
+    time.sleep(0.4)
+    driver.save_screenshot(str(Path(folder) / name))
+    driver.execute_cdp_cmd("Emulation.clearDeviceMetricsOverride", {})
+
+
+def set_hidden(driver, hidden: bool) -> None:
+    """The page as another tab would make it: document.hidden / visibilityState, then a visibilitychange event."""
+    js(driver, "var h = arguments[0];"
+               "Object.defineProperty(document, 'hidden', {configurable: true, get: function () { return h; }});"
+               "Object.defineProperty(document, 'visibilityState', {configurable: true,"
+               " get: function () { return h ? 'hidden' : 'visible'; }});"
+               "document.dispatchEvent(new Event('visibilitychange'));", hidden)
+
+
+def start(driver, url: str) -> None:
+    from selenium.webdriver.common.by import By
+
+    driver.get(url)
+    driver.find_element(By.CSS_SELECTOR, "label.check").click()
+    driver.find_element(By.ID, "start-study").click()
+    wait_for(driver, lambda d: "/about-you/" in d.current_url, what="demographics page")
+    for name in ("gender", "age_group"):
+        driver.find_element(By.CSS_SELECTOR, f"input[name={name}]").find_element(By.XPATH, "..").click()
+    driver.find_element(By.CSS_SELECTOR, "button[type=submit]").click()
+    wait_for(driver, lambda d: "/clip/1/" in d.current_url, what="first clip")
+
+
+def test_replay_only_player_and_viewing_csv(chromium, live_server, study):
+    from selenium.webdriver.common.by import By
+
+    driver = chromium
+    shots = os.environ.get("STUDY_SCREENSHOTS")
+    start(driver, live_server.url + reverse("studyapp:study_entry", args=[study.slug]) + "?PROLIFIC_PID=v-1")
+    video = driver.find_element(By.ID, "clip")
+    assert video.get_attribute("controls") is None                      # no seek bar, no speed menu
+    play_pause, replay = driver.find_element(By.ID, "play-pause"), driver.find_element(By.ID, "replay")
+    assert play_pause.is_displayed() and replay.is_displayed()
+    assert not driver.find_element(By.ID, "next").is_enabled()
+    wait_for(driver, lambda d: player_state(d)["t"] > 0.3, what="clip playing")
+
+    # A seek (the seek bar of picture-in-picture or a script would do this) is undone; so is a speed change.
+    before = player_state(driver)["t"]
+    js(driver, "document.getElementById('clip').currentTime = arguments[0];", CLIP_S - 0.2)
+    wait_for(driver, lambda d: not js(d, "return document.getElementById('clip').seeking;"), what="seek undone")
+    assert player_state(driver)["t"] < before + 1.0
+    assert "not possible" in driver.find_element(By.ID, "play-note").text
+    js(driver, "var v = document.getElementById('clip'); v.focus();"
+               "v.dispatchEvent(new KeyboardEvent('keydown', {key: 'ArrowRight', bubbles: true, cancelable: true}));")
+    js(driver, "document.getElementById('clip').playbackRate = 4;")
+    assert player_state(driver)["rate"] == 1
+
+    # The tab is hidden while the clip plays, then shown again.
+    assert not player_state(driver)["paused"]
+    set_hidden(driver, True)
+    set_hidden(driver, False)
+
+    # A pause with the player's button, then play on.
+    play_pause.click()
+    wait_for(driver, lambda d: player_state(d)["paused"], what="paused")
+    assert play_pause.text == "Play"
+    play_pause.click()
+    wait_for(driver, lambda d: not player_state(d)["paused"], what="playing again")
+
+    wait_for(driver, lambda d: d.find_element(By.ID, "next").is_enabled(), timeout=20, what="clip ended")
+    assert player_state(driver)["ended"]
+    shot(driver, shots, "study_player_replay_only.png", 1000)
+    shot(driver, shots, "study_player_replay_only_360.png", 360)
+
+    # One replay is allowed (max_replays 1), then the button is disabled.
+    replay.click()
+    wait_for(driver, lambda d: not player_state(d)["ended"] and player_state(d)["t"] > 0.2, what="replaying")
+    assert not replay.is_enabled()
+    wait_for(driver, lambda d: player_state(d)["ended"], timeout=20, what="replay ended")
+    assert "used all replays" in driver.find_element(By.ID, "play-note").text
+    play_pause.click()                                                   # a replay by the play button: refused
+    time.sleep(0.5)
+    assert player_state(driver)["ended"] or player_state(driver)["paused"]
+
+    driver.find_element(By.CSS_SELECTOR, "#answer-form input[value='sad']").find_element(By.XPATH, "..").click()
+    driver.find_element(By.ID, "next").click()
+    wait_for(driver, lambda d: "/clip/2/" in d.current_url, what="clip 2")
+
+    p = Participant.objects.get(external_id="v-1")
+    rows = list(csv.DictReader(io.StringIO("".join(stream_csv(study, "viewing")))))
+    assert tuple(rows[0]) == VIEWING_COLUMNS
+    assert len(rows) == 1
+    row = rows[0]
+    assert row["participant_id"] == p.public_id and row["section_type"] == "emotion_choice"
+    assert row["clip_id"] == p.assignments.get(seq=1).clip.clip_id
+    assert (row["plays"], row["pauses"], row["hidden"]) == ("2", "1", "1"), row
+    assert int(row["seeks"]) == 2, row                                   # the script seek and the arrow key
+    first, ended = int(row["first_play_ms"]), int(row["ended_ms"])
+    assert 0 <= first < ended, row
+    assert ended >= CLIP_S * 1000 * 0.9, row                            # the pause made it longer, never shorter
+    assert row["stalls"] != "" and row["stall_ms"] != ""
+
+
+def test_device_check_stops_small_windows_and_unplayable_browsers(chromium, live_server, study):
+    from selenium.webdriver.common.by import By
+
+    driver = chromium
+    url = live_server.url + reverse("studyapp:study_entry", args=[study.slug])
+    driver.get(url)
+    box = driver.find_element(By.ID, "device-check")
+    assert not box.is_displayed() and driver.find_element(By.ID, "start-study").is_enabled()
+
+    viewport(driver, 280, 500)
+    wait_for(driver, lambda d: d.find_element(By.ID, "device-check").is_displayed(), what="too-small message")
+    assert "too small" in box.text and "320 × 300" in box.text and "280 × 500" in box.text
+    assert not driver.find_element(By.ID, "start-study").is_enabled()
+    viewport(driver, 360, 640)                                           # a phone: fine
+    wait_for(driver, lambda d: not d.find_element(By.ID, "device-check").is_displayed(), what="message gone")
+    assert driver.find_element(By.ID, "start-study").is_enabled()
+    driver.execute_cdp_cmd("Emulation.clearDeviceMetricsOverride", {})
+
+    # A browser without the clips' codecs.
+    driver.execute_cdp_cmd("Page.addScriptToEvaluateOnNewDocument",
+                           {"source": "HTMLMediaElement.prototype.canPlayType = function () { return ''; };"})
+    driver.get(url)
+    box = driver.find_element(By.ID, "device-check")
+    assert box.is_displayed() and "cannot play" in box.text
+    assert not driver.find_element(By.ID, "start-study").is_enabled()
