@@ -34,6 +34,21 @@ CLIP_THEMES = (*THEMES, NEUTRAL_THEME)
 NEUTRAL_CHOICES = (NEUTRAL_THEME, *THEMES)
 """The 7-way forced choice of seed 004's neutral validation (Table I)."""
 
+CAPTURE_GAIT_EMOTIONS = {"happy": "happy", "sad": "sad", "angry": "angry", "normal": "neutral"}
+"""Style names of captured motion (the Bandai Namco Research Motion Dataset, Kobayashi et al. 2023,
+arXiv:2306.08861) -> seed 000's gait emotions: dataset 1's happy, sad, angry and normal (= neutral)."""
+
+CAPTURE_THEMES = {"happy": "happy", "sad": "sad", "active": "energetic", "tired": "tired", "exhausted": "tired",
+                  "feminine": "feminine", "masculinity": "masculine", "masculine": "masculine"}
+"""Style names of captured motion -> seed 004's themes: active is energetic, tired (dataset 1) and exhausted
+(dataset 2) are tired, masculinity (dataset 1) and masculine (dataset 2) are masculine."""
+
+
+def capture_label(style: str) -> str:
+    """A captured style's label in the study vocabulary: its gait emotion (normal -> neutral), else its theme
+    (active -> energetic, exhausted -> tired, masculinity -> masculine), else the style's own name."""
+    return CAPTURE_GAIT_EMOTIONS.get(style) or CAPTURE_THEMES.get(style) or style
+
 GESTURE_VAD: dict[str, tuple[float, float, float]] = {
     "afraid": (0.010, 0.775, 0.245),
     "amused": (0.942, 0.847, 0.596),
