@@ -1,5 +1,5 @@
 """CLI: ``python -m analysis RESPONSES CLIPS PARTICIPANTS --out DIR [--alpha A] [--permutations N] [--no-figures]
-[--no-exclusions]``.
+[--no-exclusions] [--exclusion-rules JSON] [--viewing VIEWING]``.
 
 Exit status 0 on success, 2 with a message naming file, line and column on invalid input.
 """
@@ -31,8 +31,11 @@ def main(argv=None) -> int:
                     help="the study's exclusion thresholds: a JSON object or a .json file, e.g. "
                          "'{\"min_rt_fraction\": 0.25, \"max_straightline\": 0.9, \"min_attention_pass\": 1.0}' "
                          "(keys: see analysis.exclusion.RULES)")
+    ap.add_argument("--viewing", metavar="VIEWING_CSV",
+                    help="viewing.csv (optional): list answers given without a full view of the clip and enable the "
+                         "viewing exclusion rules (max_unended_share, max_hidden_share)")
     a = ap.parse_args(argv)
-    for path in (a.responses, a.clips, a.participants):
+    for path in (a.responses, a.clips, a.participants, *([a.viewing] if a.viewing else [])):
         if not os.path.isfile(path):
             print(f"error: no such file: {path}", file=sys.stderr)
             return 2
@@ -58,7 +61,7 @@ def main(argv=None) -> int:
     try:
         report = write_report(a.responses, a.clips, a.participants, a.out, a.alpha, a.permutations,
                               figures=not a.no_figures, exclude=not a.no_exclusions,
-                              exclusion_rules=rules)
+                              exclusion_rules=rules, viewing_csv=a.viewing)
     except ValidationError as exc:
         print(f"error: invalid input\n{exc}", file=sys.stderr)
         return 2

@@ -22,7 +22,9 @@ such an object (the Study admin form calls it) and :func:`exclusions` applies it
 when at least this share of their answers in a rating-scale section have one value; 1.0 = all of them),
 ``min_straight`` (answers a section needs before straight-lining is judged) and ``min_attention_pass``
 (**Failed attention checks**: excluded when ``attention_passed / attention_total`` of participants.csv is below it;
-when the export has no such columns, or a participant met no check, the rule does not apply and the report says so).
+when the export has no such columns, or a participant met no check, the rule does not apply and the report says so),
+and the two rules on how the clips were watched (viewing.csv, :mod:`analysis.viewing`; off unless set below 1):
+``max_unended_share`` (answered before the clip ended) and ``max_hidden_share`` (tab hidden during playback).
 """
 
 from __future__ import annotations
@@ -31,6 +33,8 @@ import numpy as np
 import pandas as pd
 
 from study_protocol import ATTENTION_COLUMNS, INTEGER_RANGES, SECTION_QUESTIONS, attention_passed
+
+from .viewing import viewing_exclusions
 
 SCALE_SECTIONS = tuple(s for s, qs in SECTION_QUESTIONS.items() if all(k in INTEGER_RANGES for k in qs.values()))
 """Sections whose answers are points of a rating scale (study_protocol: every question of an integer kind)."""
@@ -48,6 +52,10 @@ RULES: dict[str, tuple[type, float, float, float, str]] = {
     "min_straight": (int, 2, 10_000, MIN_STRAIGHT, "answers a section needs before straight-lining is judged"),
     "min_attention_pass": (float, 0.0, 1.0, MIN_ATTENTION_PASS, "excluded when the share of attention checks "
                                                                 "passed is below this"),
+    "max_unended_share": (float, 0.0, 1.0, 1.0, "excluded when more than this share of answers with a viewing record "
+                                                "came before the clip ended (1 = off)"),
+    "max_hidden_share": (float, 0.0, 1.0, 1.0, "excluded when more than this share of answers with a viewing record "
+                                               "had the page hidden while the clip played (1 = off)"),
 }
 """Exclusion rule key -> (type, lowest, highest, default, meaning). ``Study.exclusion_rules`` uses these keys."""
 
@@ -169,29 +177,45 @@ def attention_failures(participants: pd.DataFrame | None, min_attention_pass: fl
 
 def exclusions(responses: pd.DataFrame, clips: pd.DataFrame, fast_fraction: float = FAST_FRACTION,
                max_fast_share: float = MAX_FAST_SHARE, min_straight: int = MIN_STRAIGHT, *,
-               participants: pd.DataFrame | None = None, rules: dict | None = None) -> pd.DataFrame:
+               participants: pd.DataFrame | None = None, rules: dict | None = None,
+               viewing: pd.DataFrame | None = None) -> pd.DataFrame:
     """Who is excluded and why: one row per participant and rule that applies (a participant may have several).
-    Columns participant_id, rule (too_fast | straight_lining | failed_attention), detail, n_answers.
+    Columns participant_id, rule (too_fast | straight_lining | failed_attention | answered_before_end |
+    tab_hidden), detail, n_answers.
 
     ``rules`` (a ``Study.exclusion_rules`` object, checked by :func:`rule_errors`; ValueError when invalid) replaces
-    the keyword thresholds; ``participants`` (participants.csv) enables the attention-check rule. The sentence on
-    that rule's applicability is in ``table.attrs["attention"]``."""
+    the keyword thresholds; ``participants`` (participants.csv) enables the attention-check rule and ``viewing``
+    (viewing.csv) the viewing rules. The sentences on their applicability are in ``table.attrs["attention"]`` and
+    ``table.attrs["viewing"]``."""
+    r = resolve_rules(rules)
     if rules is not None:
-        r = resolve_rules(rules)
         fast_fraction, max_fast_share, min_straight = r["min_rt_fraction"], r["max_fast_share"], r["min_straight"]
-        max_straightline, min_attention = r["max_straightline"], r["min_attention_pass"]
-    else:
-        max_straightline, min_attention = MAX_STRAIGHTLINE, MIN_ATTENTION_PASS
+    max_straightline, min_attention = r["max_straightline"], r["min_attention_pass"]
     attention, attention_note = attention_failures(participants, min_attention, responses.attrs.get("attention_checks"))
+    watched, viewing_note = viewing_exclusions(viewing, r["max_unended_share"], r["max_hidden_share"])
     parts = [t for t in (fast_answers(responses, clips, fast_fraction, max_fast_share),
-                         straight_lining(responses, min_straight, max_straightline), attention) if len(t)]
+                         straight_lining(responses, min_straight, max_straightline), attention, watched) if len(t)]
     if not parts:
         out = pd.DataFrame(columns=COLUMNS)
     else:
         out = pd.concat(parts, ignore_index=True).sort_values(["participant_id", "rule"], kind="stable").reset_index(
             drop=True)
     out.attrs["attention"] = attention_note
+    out.attrs["viewing"] = viewing_note
     return out
+
+
+def removed_counts(responses: pd.DataFrame, table: pd.DataFrame) -> pd.DataFrame:
+    """What each exclusion rule removed: rows rule, participants (excluded by this rule), answers (their rows of
+    responses.csv), and a last row ``any rule`` for the union (a participant hit by two rules counts once there)."""
+    pid = responses["participant_id"].astype(str)
+    per_participant = pid.value_counts()
+    rows = []
+    groups = [(rule, set(g["participant_id"].astype(str))) for rule, g in table.groupby("rule", sort=True)]
+    for rule, people in [*groups, ("any rule", set(table["participant_id"].astype(str)))]:
+        rows.append({"rule": rule, "participants": len(people),
+                     "answers": int(per_participant.reindex(sorted(people)).fillna(0).sum())})
+    return pd.DataFrame(rows, columns=["rule", "participants", "answers"])
 
 
 def apply_exclusions(responses: pd.DataFrame, table: pd.DataFrame) -> pd.DataFrame:

@@ -37,6 +37,8 @@ from study_protocol import (
     RESPONSE_COLUMNS,
     SECTION_QUESTIONS,
     VAD_DIMENSIONS,
+    VIEWING_COLUMNS,
+    VIEWING_FIELDS,
 )
 
 ANSWER_KINDS = tuple(dict.fromkeys(kind for questions in SECTION_QUESTIONS.values() for kind in questions.values()))
@@ -258,6 +260,34 @@ def read_participants(src) -> pd.DataFrame:
     df["duration_s"] = dur
     df["completed"] = df["completed_at"].notna() | (df["status"] == "completed")
     return df.set_index("participant_id", drop=False)
+
+
+def read_viewing(src, participants: pd.DataFrame | None = None) -> pd.DataFrame:
+    """Read and validate viewing.csv (:data:`study_protocol.VIEWING_COLUMNS`, one row per answered clip page).
+
+    ``participant_id`` and ``clip_id`` must be set; every field of :data:`study_protocol.VIEWING_FIELDS` is blank
+    (unknown, or no record) or a non-negative integer (times in ms, counts). With ``participants`` (as from
+    :func:`read_participants`) every participant_id must be one of them. Returns the rows with the fields as floats
+    (NaN where blank); extra columns are kept."""
+    df, name = _read_raw(src, "viewing.csv")
+    col = _Collector(name)
+    _check_columns(df, VIEWING_COLUMNS, col)
+    for c in ("participant_id", "clip_id", "section_type"):
+        df[c] = df[c].str.strip()
+    for c in ("participant_id", "clip_id"):
+        col.add_mask(df, _blank(df[c]), c, f"{c} is empty")
+    if participants is not None:
+        known = set(participants["participant_id"].astype(str))
+        col.add_mask(df, ~df["participant_id"].isin(known).to_numpy() & ~_blank(df["participant_id"]),
+                     "participant_id", lambda v: f"unknown participant {v!r} (not in participants.csv)")
+    for c in VIEWING_FIELDS:
+        value = _numeric(df[c])
+        bad = ~_blank(df[c]) & ~(value.notna() & (value >= 0) & (value == value.round())).to_numpy()
+        col.add_mask(df, bad, c, lambda v: f"{v!r} is not blank or a non-negative integer")
+        df[c] = value.astype(float)
+    if col.total:
+        raise ValidationError(col.problems, col.total)
+    return df.drop(columns="_line").reset_index(drop=True)
 
 
 class _CodedColumn:
@@ -510,16 +540,19 @@ def _recode(labels: np.ndarray, inv: np.ndarray) -> tuple[np.ndarray, np.ndarray
 
 @dataclass
 class StudyData:
-    """The three validated exports. ``ignored_columns`` names unknown columns that were not used."""
+    """The three validated exports, and viewing.csv when given (else None). ``ignored_columns`` names unknown
+    columns that were not used."""
 
     responses: pd.DataFrame
     clips: pd.DataFrame
     participants: pd.DataFrame
     ignored_columns: dict[str, list[str]] = field(default_factory=dict)
+    viewing: pd.DataFrame | None = None
 
 
-def load_study(responses_src, clips_src, participants_src) -> StudyData:
-    """Read and cross-validate all three exports. Problems of every file are gathered into one ValidationError."""
+def load_study(responses_src, clips_src, participants_src, viewing_src=None) -> StudyData:
+    """Read and cross-validate all three exports, and viewing.csv when ``viewing_src`` is given (it is optional:
+    older exports lack it). Problems of every file are gathered into one ValidationError."""
     problems: list[Problem] = []
     total = 0
     clips = participants = None
@@ -540,8 +573,15 @@ def load_study(responses_src, clips_src, participants_src) -> StudyData:
     except ValidationError as exc:
         problems += exc.problems
         total += exc.total
+    viewing = None
+    if viewing_src is not None:
+        try:
+            viewing = read_viewing(viewing_src, participants)
+        except ValidationError as exc:
+            problems += exc.problems
+            total += exc.total
     if total:
         raise ValidationError(problems[:MAX_LISTED], total)
     ignored = {name: df.attrs.get("ignored_columns", []) for name, df in (("clips.csv", clips),
                                                                        ("responses.csv", responses))}
-    return StudyData(responses, clips, participants, {k: v for k, v in ignored.items() if v})
+    return StudyData(responses, clips, participants, {k: v for k, v in ignored.items() if v}, viewing)

@@ -26,13 +26,18 @@ import pandas as pd
 
 from . import agreement, emotion, exclusion, likert, mixed, naturalness, participants, recognition, themes, vad
 from . import figures as figure_mod
+from . import viewing as viewing_mod
 from .io import StudyData, load_study
 
-TABLE_KEYS = ("exclusions", "gait_emotion_ad", "transition_ad", "likert_consistency_ad", "likert_distribution",
+TABLE_KEYS = ("exclusions", "exclusion_counts", "viewing_incomplete", "gait_emotion_ad", "transition_ad",
+              "likert_consistency_ad", "likert_distribution",
               "naturalness", "naturalness_test", "vad_pearson", "theme_anova", "theme_descriptives", "theme_inversion",
               "neutral_validation", "demographic_differences", "agreement",
               "mixed_models")
-"""Keys of report.json holding a list of records (one CSV each). ``participants`` and ``meta`` are objects."""
+"""Keys of report.json holding a list of records (one CSV each). ``participants``, ``viewing`` and ``meta`` are
+objects."""
+SCREENING_KEYS = ("exclusions", "exclusion_counts", "viewing_incomplete")
+"""Tables about the data rather than findings: an empty one is not "no data for this analysis"."""
 
 AD_LABEL_BLIND = ("It is label-blind: it compares two sets of four numbers without which emotion each number "
                   "belongs to, so intended happy (1,0,0,0) against perceived pure neutral (0,0,0,1) is not rejected; "
@@ -52,6 +57,12 @@ RECOGNITION_METHOD = ("Confusion matrix, rows intended, columns perceived; an an
 
 METHODS = {
     "exclusions": "",  # depends on the rules in force: exclusion_method()
+    "exclusion_counts": "Per rule: participants it excludes and their answers (rows of responses.csv) removed; "
+                        "'any rule' counts each excluded participant once.",
+    "viewing_incomplete": "Answers with a viewing record (viewing.csv) given before the clip had played to its end "
+                          "(ended_ms blank): first_play_ms blank = never played; seeks = seek attempts; hidden = "
+                          "times the page was hidden while the clip played. Answers without a record are not "
+                          "listed.",
     "gait_emotion_ad": "Seed 000's test, kept for fidelity. Each answer -> indicator vector / number of labels; "
                        "mean over answers, l1-normalised; scipy.stats.anderson_ksamp (midrank) on the 4 intended vs "
                        "the 4 perceived components; p interpolated and capped to [0.001, 0.25]. " + AD_LABEL_BLIND,
@@ -88,13 +99,25 @@ def exclusion_method(rules: dict) -> str:
             f"answers faster than {rules['min_rt_fraction']:g} x the clip duration (too_fast); with {straight} of at "
             f"least {rules['min_straight']} answers of a rating-scale section equal (straight_lining); who passed "
             f"less than {rules['min_attention_pass']:.0%} of their attention checks (failed_attention, when "
-            "participants.csv has attention columns). The participants summary describes everyone.")
+            "participants.csv has attention columns)" + _viewing_method(rules)
+            + ". The participants summary describes everyone.")
+
+
+def _viewing_method(rules: dict) -> str:
+    """The viewing rules in force as the end of exclusion_method's sentence ('' when both are off)."""
+    bits = [f"; with more than {rules[key]:.0%} of their recorded answers {what} ({rule}, from viewing.csv)"
+            for key, rule, what in (("max_unended_share", "answered_before_end", "given before the clip ended"),
+                                    ("max_hidden_share", "tab_hidden", "with the page hidden during playback"))
+            if rules[key] < 1]
+    return "".join(bits)
 
 
 METHODS["exclusions"] = exclusion_method(exclusion.resolve_rules())
 
 TITLES = {
     "exclusions": "Excluded participants and why",
+    "exclusion_counts": "What each exclusion rule removed",
+    "viewing_incomplete": "Answers given without a full view of the clip",
     "gait_emotion_ad": "Single gait emotions: seed 000's test, 2-sample Anderson-Darling of the 4 intended vs the 4 "
                        "perceived values (seed 000 6.3.1)",
     "transition_ad": "Emotion transitions: seed 000's test, initial and final, 2-sample Anderson-Darling (seed 000 "
@@ -184,7 +207,21 @@ def _recognition_summary(name: str, res: dict, alpha: float) -> str | None:
             f"{int(tests['p_value'].notna().sum())} emotions; Cohen's kappa = {res['kappa']:.2f}.")
 
 
-def _summary(tables: dict, parts: dict, alpha: float, recog: dict | None = None, exclude: bool = True) -> list[str]:
+def _viewing_sentence(summary: dict) -> str:
+    """One summary line on how the clips were watched (analysis.viewing.viewing_summary)."""
+    if not summary:
+        return "Viewing: no viewing.csv given; answers were not screened on how the clips were watched."
+    if not summary["n_recorded"]:
+        return f"Viewing: none of the {summary['n_answers']} answers in viewing.csv has a viewing record."
+    return (f"Viewing: {summary['n_without_full_view']} of {summary['n_recorded']} answers with a viewing record "
+            f"were given without a full view of the clip; {summary['n_hidden']} had the page hidden during playback, "
+            f"{summary['n_seek_attempts']} a seek attempt, {summary['n_stalled']} a stall"
+            + (f" ({summary['n_answers'] - summary['n_recorded']} answers without a record)"
+               if summary["n_answers"] > summary["n_recorded"] else "") + ".")
+
+
+def _summary(tables: dict, parts: dict, alpha: float, recog: dict | None = None, exclude: bool = True,
+             viewing: dict | None = None) -> list[str]:
     """Plain-language headline findings: recognition first, then the papers' tests."""
     out = []
     for key, res in (recog or {}).items():
@@ -246,8 +283,13 @@ def _summary(tables: dict, parts: dict, alpha: float, recog: dict | None = None,
                                                       if by_rule else "") + ".")
         if ex.attrs.get("attention", "").startswith("failed_attention: not applicable"):
             out.append("Attention checks: " + ex.attrs["attention"].split(": ", 1)[1] + ".")
+        counts = tables.get("exclusion_counts", pd.DataFrame())
+        if len(counts) > 1:
+            out.append("Removed per rule: " + "; ".join(f"{r['rule']}: {r['participants']} participant(s), "
+                                                        f"{r['answers']} answers" for _, r in counts.iterrows()) + ".")
     else:
         out.append("Exclusions: not applied (--no-exclusions).")
+    out.append(_viewing_sentence(viewing or {}))
     if parts.get("synthetic"):
         out.insert(0, "SYNTHETIC DATA: every participant is simulated (ids 'sim-'); these are not findings.")
     return out
@@ -260,6 +302,7 @@ def _exclusion_meta(exclude: bool, given: dict | None, rules: dict, excl: pd.Dat
            "given": dict(given or {}), "method": exclusion_method(rules)}
     if exclude:
         out["attention"] = excl.attrs.get("attention", "")
+        out["viewing"] = excl.attrs.get("viewing", "")
     return out
 
 
@@ -276,17 +319,24 @@ def build_report(data: StudyData, alpha: float = 0.05, permutations: int = 0,
     if permutations < 0:
         raise ValueError(f"permutations must be >= 0, not {permutations}")
     rules = exclusion.resolve_rules(exclusion_rules)
-    excl = (exclusion.exclusions(data.responses, data.clips, participants=data.participants, rules=rules)
+    excl = (exclusion.exclusions(data.responses, data.clips, participants=data.participants, rules=rules,
+                                 viewing=data.viewing)
             if exclude else pd.DataFrame(columns=exclusion.COLUMNS))
     kept = StudyData(exclusion.apply_exclusions(data.responses, excl), data.clips, data.participants,
-                     data.ignored_columns)
+                     data.ignored_columns, data.viewing)
     tables, extras = analyse(kept, alpha, permutations)
     tables["exclusions"] = excl
+    tables["exclusion_counts"] = (exclusion.removed_counts(data.responses, excl) if exclude
+                                  else pd.DataFrame(columns=["rule", "participants", "answers"]))
+    tables["viewing_incomplete"] = (viewing_mod.incomplete_views(data.viewing) if data.viewing is not None
+                                    else pd.DataFrame(columns=viewing_mod.INCOMPLETE_COLUMNS))
+    viewing_summary = viewing_mod.viewing_summary(data.viewing)
     if len(excl):
         extras["participants"] = participants.participant_summary(data.participants, data.responses)
     extras["participants"]["n_excluded"] = int(excl["participant_id"].nunique())
     report = {k: _records(tables[k], k) for k in TABLE_KEYS}
     report["participants"] = _clean(extras["participants"])
+    report["viewing"] = _clean(viewing_summary)
     report["recognition"] = {k: _clean(recognition.recognition_json(v)) for k, v in extras["recognition"].items()}
     notes = []
     a = tables["theme_anova"]
@@ -294,7 +344,7 @@ def build_report(data: StudyData, alpha: float = 0.05, permutations: int = 0,
         notes.append(f"Theme RM-ANOVA: participants with missing cells were dropped per theme "
                      f"(up to {int(a['n_dropped'].max())} per theme).")
     for k in TABLE_KEYS:
-        if tables[k].empty and k != "exclusions":
+        if tables[k].empty and k not in SCREENING_KEYS:
             notes.append(f"{k}: no data for this analysis in responses.csv.")
     for key in ("gait_emotion_ad", "transition_ad"):
         t = tables[key]
@@ -317,7 +367,8 @@ def build_report(data: StudyData, alpha: float = 0.05, permutations: int = 0,
         "alpha": alpha, "permutations": permutations, "synthetic": synthetic,
         "exclusion_rules": _exclusion_meta(exclude, exclusion_rules, rules, excl),
         "n_responses": len(data.responses), "n_clips": len(data.clips), "n_participants": len(data.participants),
-        "summary": _summary(tables, extras["participants"], alpha, extras["recognition"], exclude), "notes": notes,
+        "summary": _summary(tables, extras["participants"], alpha, extras["recognition"], exclude, viewing_summary),
+        "notes": notes,
         "methods": "docs/analysis.md",
     })
     return report, tables, extras
@@ -339,16 +390,18 @@ def _make_figures(tables: dict, extras: dict) -> dict:
 
 def write_report(responses_csv, clips_csv, participants_csv, out_dir, alpha: float = 0.05,
                  permutations: int = 0, *, figures: bool = True, exclude: bool = True,
-                 exclusion_rules: dict | None = None) -> dict:
+                 exclusion_rules: dict | None = None, viewing_csv=None) -> dict:
     """Validate the three exports (paths or text file objects), analyse, and write the report folder.
 
     ``figures=False`` skips the PNG/SVG figures (the HTML then has tables only); the analyses are the same.
     ``exclude=False`` analyses every participant (no exclusion rules, :mod:`analysis.exclusion`);
     ``exclusion_rules`` are a study's thresholds (``Study.exclusion_rules``), stated in the report.
+    ``viewing_csv`` (optional) is viewing.csv: the report then lists the answers given without a full view and the
+    viewing exclusion rules can apply.
     Raises :class:`analysis.io.ValidationError` (listing file, line and column of each problem) on invalid input.
     Returns the report dict (also written as ``out_dir/report.json``).
     """
-    data = load_study(responses_csv, clips_csv, participants_csv)
+    data = load_study(responses_csv, clips_csv, participants_csv, viewing_csv)
     report, tables, extras = build_report(data, alpha, permutations, exclude, exclusion_rules)
     os.makedirs(out_dir, exist_ok=True)
     for k in TABLE_KEYS:
@@ -373,12 +426,12 @@ def write_report(responses_csv, clips_csv, participants_csv, out_dir, alpha: flo
 
 def report_zip_bytes(responses_csv, clips_csv, participants_csv, alpha: float = 0.05, permutations: int = 0,
                      *, figures: bool = True, exclude: bool = True,
-                     exclusion_rules: dict | None = None) -> tuple[dict, bytes]:
+                     exclusion_rules: dict | None = None, viewing_csv=None) -> tuple[dict, bytes]:
     """Run :func:`write_report` into a temporary folder and return (report dict, the folder as a zip archive's
     bytes) -- for a download view. Raises ValidationError like write_report."""
     with tempfile.TemporaryDirectory() as tmp:
         report = write_report(responses_csv, clips_csv, participants_csv, tmp, alpha, permutations, figures=figures,
-                              exclude=exclude, exclusion_rules=exclusion_rules)
+                              exclude=exclude, exclusion_rules=exclusion_rules, viewing_csv=viewing_csv)
         buf = io.BytesIO()
         with zipfile.ZipFile(buf, "w", zipfile.ZIP_DEFLATED) as zf:
             for name in sorted(os.listdir(tmp)):
@@ -397,6 +450,8 @@ FIG_FOR_TABLE = {"gait_emotion_ad": "fig_emotion_vectors", "transition_ad": "fig
                  "likert_distribution": "fig_likert", "vad_pearson": "fig_vad", "naturalness": "fig_naturalness",
                  "theme_descriptives": "fig_theme_ratings", "theme_inversion": "fig_inversion"}
 MAX_HTML_ROWS = 60
+EMPTY_TABLE_HTML = {"exclusions": "<p>No participant excluded.</p>", "exclusion_counts": "<p>Nothing removed.</p>",
+                    "viewing_incomplete": "<p>None (or no viewing.csv).</p>"}
 
 
 def _inline_svg(path: str) -> str:
@@ -486,10 +541,10 @@ def render_html(report: dict, tables: dict, figs: dict, extras: dict | None = No
         if k == "exclusions" and meta.get("exclusion_rules", {}).get("applied"):
             ex_meta = meta["exclusion_rules"]
             parts.append(f"<p class='method'>Thresholds from the {h(ex_meta['source'])}. "
-                         f"{h(ex_meta.get('attention', ''))}.</p>")
+                         f"{h(ex_meta.get('attention', ''))}. {h(ex_meta.get('viewing', ''))}.</p>")
         df = tables[k]
         if df.empty:
-            parts.append("<p>No participant excluded.</p>" if k == "exclusions" else "<p>No data.</p>")
+            parts.append(EMPTY_TABLE_HTML.get(k, "<p>No data.</p>"))
             continue
         fig = FIG_FOR_TABLE.get(k)
         if fig in figs:

@@ -192,7 +192,8 @@ def write_study_csvs(study: Study, out_dir: str | Path) -> dict[str, Path]:
 
 
 def run_report(study: Study, out_dir: str | Path) -> dict:
-    """Export the CSVs and call the analysis library's report writer (analysis.report.write_report) with the study's
+    """Export the CSVs and call the analysis library's report writer (analysis.report.write_report, viewing.csv
+    included) with the study's
     exclusion rules (``Study.exclusion_rules``; empty = the analysis defaults), which the report states. Invalid rules
     raise ValueError naming the key (the admin form checks them with analysis.exclusion.rule_errors)."""
     out = Path(out_dir)
@@ -200,4 +201,4 @@ def run_report(study: Study, out_dir: str | Path) -> dict:
     from analysis.report import write_report  # imported lazily: the analysis library is optional at runtime
 
     return write_report(paths["responses"], paths["clips"], paths["participants"], out,
-                        exclusion_rules=study.exclusion_rules or None)
+                        exclusion_rules=study.exclusion_rules or None, viewing_csv=paths["viewing"])
