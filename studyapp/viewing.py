@@ -3,8 +3,9 @@
 static/studyapp/study.js measures how the clip was watched and posts each field of
 ``study_protocol.VIEWING_FIELDS`` as a hidden input named ``view_<field>`` (times in ms from the page's display,
 counts as integers). Nothing here rejects an answer: a field that is missing, not an integer, negative, beyond
-its bound or inconsistent is stored as None (unknown), and a post with no field at all (no JavaScript, a page
-from before) stores no record. Stored on ``Assignment.viewing`` in the same UPDATE that marks the clip answered.
+its bound or inconsistent is stored as None (unknown), and a post without any usable field (no JavaScript: the
+fields stay blank; a page from before: no fields) stores no record. Stored on ``Assignment.viewing`` in the same
+UPDATE that marks the clip answered.
 """
 from __future__ import annotations
 
@@ -47,13 +48,12 @@ def _integer(raw, high: int) -> int | None:
 
 
 def parse_viewing(post, page_ms: int) -> dict | None:
-    """The viewing record of an answer POST: field -> int or None; None when the post carries no field.
+    """The viewing record of an answer POST: field -> int or None; None when no field has a usable value (the
+    fields missing, or left blank because the page ran without JavaScript).
 
     page_ms: the longest a time may be (the time since the page was shown as the server measured it, plus slack):
     a time beyond it is not a measurement. ``ended_ms`` before ``first_play_ms`` is dropped (a clip ends after
     it starts), and so is a record claiming an end without any play."""
-    if not any(field_name(f) in post for f in VIEWING_FIELDS):
-        return None
     record = {}
     for name in VIEWING_FIELDS:
         raw = post.get(field_name(name), "")
@@ -62,4 +62,4 @@ def parse_viewing(post, page_ms: int) -> dict | None:
     first, ended = record["first_play_ms"], record["ended_ms"]
     if ended is not None and (first is None or ended < first or record["plays"] == 0):
         record["ended_ms"] = None
-    return record
+    return record if any(v is not None for v in record.values()) else None

@@ -64,6 +64,9 @@ def test_parse_keeps_a_plausible_record():
 
 def test_a_post_without_record_stores_none():
     assert parse_viewing({"perceived": "sad", "rt": "900"}, page_ms=10_000) is None
+    blank_form = {field_name(f): "" for f in VIEWING_FIELDS}               # the page without JavaScript
+    assert parse_viewing(blank_form, page_ms=10_000) is None
+    assert parse_viewing({**blank_form, field_name("plays"): "-4"}, page_ms=10_000) is None
 
 
 @pytest.mark.parametrize("name,raw", [
