@@ -27,7 +27,10 @@ from django import forms
 from study_pools import (
     COMMON_OPTIONS,
     DEFAULT_GESTURE_OPTIONS,
+    DEFAULT_PLAYER_CONTROLS,
     INCLUDE_FLAGGED,
+    MAX_REPLAYS_LIMIT,
+    PLAYER_CONTROLS,
     SECTION_OPTIONS,
     SUB_POOLS,
     validate_section,
@@ -282,6 +285,29 @@ class FlagSpec(ChoiceSpec):
         return {self.key: True} if values.get(self.field) else {}
 
 
+class SelectSpec(ChoiceSpec):
+    """One value of a vocabulary (the player's ``controls``): a drop-down whose blank choice leaves the key out
+    (the section then gets ``default``)."""
+
+    def __init__(self, field: str, key: str, vocabulary, label: str, help_text: str, default: str):
+        super().__init__(field, key, vocabulary, label, help_text)
+        self.default = default
+
+    def form_fields(self) -> dict[str, forms.Field]:
+        choices = [("", f"default ({self.default})"), *((v, v) for v in self.vocabulary)]
+        return {self.field: forms.ChoiceField(choices=choices, required=False, label=self.label,
+                                              help_text=self.help)}
+
+    def read(self, data: dict) -> tuple[dict, dict]:
+        if isinstance(data.get(self.key), str) and data[self.key] in self.vocabulary:
+            return {self.field: data[self.key]}, {k: v for k, v in data.items() if k != self.key}
+        return {}, data
+
+    def write(self, values: dict) -> dict:
+        value = values.get(self.field)
+        return {self.key: value} if value else {}
+
+
 class SubPoolSpec(ChoiceSpec):
     """A naturalness sub-pool (``generated`` / ``source``): the inner specs applied to ``pool[name]``."""
 
@@ -512,7 +538,13 @@ def _common_option_specs() -> list[ChoiceSpec]:
                       "one practice clip (not exported) from outside the pool, of the section's modality"),
              ValueSpec(o + "practice_clip", "practice_clip", "Practice clip", "a clip_id of the catalogue; blank: "
                        "drawn at random when the box above is ticked", forms.CharField, max_length=200),
-             AttentionSpec(o + "attention")]
+             AttentionSpec(o + "attention"),
+             SelectSpec(o + "controls", "controls", PLAYER_CONTROLS, "Player controls",
+                        "replay-only: play/pause and replay, no seek bar or speed; full: the browser's controls "
+                        "(seeking allowed); none: the clip plays by itself, replay once it ended",
+                        DEFAULT_PLAYER_CONTROLS),
+             ValueSpec(o + "max_replays", "max_replays", "Replays allowed", "plays after the first; blank: unlimited, "
+                       "0: the clip plays once", forms.IntegerField, min_value=0, max_value=MAX_REPLAYS_LIMIT)]
     return [spec for spec in specs if spec.key in COMMON_OPTIONS]
 
 

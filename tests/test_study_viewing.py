@@ -55,6 +55,22 @@ def test_bad_player_options_name_the_key(options, words):
     assert options_errors("gesture_emotion", {**options, "categories": ["proud", "sad", "afraid", "happy"]})
 
 
+@pytest.mark.parametrize("stype,options", [("emotion_choice", {"controls": "full", "max_replays": 2}),
+                                           ("naturalness", {"controls": "none", "max_replays": 0}),
+                                           ("gesture_emotion", {"controls": "replay-only"})])
+def test_pool_editor_shows_and_writes_the_player_options(stype, options):
+    from studyapp import pool_editor as pe
+
+    values, leftover = pe.options_to_fields(options)
+    assert leftover == {} and values[pe.OPTIONS_PREFIX + "controls"] == options["controls"]
+    assert pe.fields_to_options(values, leftover, stype) == options
+    blank = pe.fields_to_options({pe.OPTIONS_PREFIX + "controls": "", pe.OPTIONS_PREFIX + "max_replays": None}, {},
+                                 stype)
+    assert "controls" not in blank and "max_replays" not in blank      # blank: the default player, unlimited
+    fields = pe.form_fields()
+    assert not fields[pe.OPTIONS_PREFIX + "max_replays"].clean(None) and fields[pe.OPTIONS_PREFIX + "controls"]
+
+
 # ---- parsing ---------------------------------------------------------------------------------------------------
 
 def test_parse_keeps_a_plausible_record():
