@@ -1,12 +1,16 @@
 """``python -m generation.mocap import PATH... --skeleton gait|gesture --out DIR``: files and folders -> Motions;
 ``python -m generation.mocap corpus DIR... --out FILE.npz``: labelled gait Motions -> a corpus for train_gait;
-with ``--skeleton gesture --sentences CSV``: gesture takes and their sentences -> a corpus for train_gesture.
+with ``--skeleton gesture --sentences CSV``: gesture takes and their sentences -> a corpus for train_gesture;
+``python -m generation.mocap dataset bandai-namco DIR --out CORPUS.npz``: a labelled capture dataset -> the
+real-capture corpus (:mod:`generation.mocap.real_corpus`) and ``import_report.csv`` beside it.
 
 Writes ``DIR/<name>.npz`` per input (``Motion.save_npz``; a name used twice gets ``-2``, ``-3``...) and
 ``DIR/import_report.csv`` (:data:`~generation.mocap.importer.REPORT_COLUMNS`, one row per input, in input order).
 Exit status 0 when every input imported, 1 when any failed (the others are still written), 2 for bad arguments
 (argparse) or an unreadable labels file / joint map / pattern. ``corpus``: 0 when every Motion was used, 1 when
-some were skipped (listed; the corpus is still written), 2 when none gave a window.
+some were skipped (listed; the corpus is still written), 2 when none gave a window. ``dataset``: 0 when every
+selected take imported, 1 when any file failed or none was found (the others are still saved), 2 for bad
+arguments.
 """
 from __future__ import annotations
 
@@ -72,7 +76,49 @@ def _parser() -> argparse.ArgumentParser:
     cor.add_argument("--skeleton", choices=MODALITIES, default=MODALITIES[0],
                      help="gait (default): windows for train_gait; gesture: one example per take for train_gesture")
     cor.add_argument("--sentences", type=Path, help="gesture corpus: CSV source, sentence, task[, handedness]")
+    _add_dataset_parser(sub)
     return ap
+
+
+def _add_dataset_parser(sub) -> None:
+    from .bandai_namco import FAST_CONTENTS, GESTURE_CONTENTS, LOCOMOTION_CONTENTS, SPLIT_RULE, importable_contents
+    from .real_corpus import real_corpus_path
+
+    def names(table):
+        return ", ".join(f"dataset {k}: {' '.join(v)}" for k, v in table.items())
+
+    ds = sub.add_parser("dataset", help="a labelled capture dataset -> the real-capture corpus .npz",
+                        description="Import every locomotion take onto the gait skeleton and every gesture take "
+                                    "onto the gesture skeleton, keeping dataset, content, style, label, take and "
+                                    "the held-out split; write the corpus and import_report.csv beside it. "
+                                    f"Split: {SPLIT_RULE}")
+    ds.add_argument("source", choices=("bandai-namco",), help="the dataset's layout")
+    ds.add_argument("root", type=Path, metavar="DIR", help="folder holding the dataset (searched recursively)")
+    ds.add_argument("--out", type=Path, default=real_corpus_path(),
+                    help=f"corpus .npz to write (default {real_corpus_path()}, or $REAL_CORPUS)")
+    ds.add_argument("--contents", nargs="+", choices=sorted(importable_contents()), metavar="CONTENT",
+                    help=f"import only these contents (default: locomotion {names(LOCOMOTION_CONTENTS)}; "
+                         f"gestures {names(GESTURE_CONTENTS)}; {names(FAST_CONTENTS)} only when named)")
+    ds.add_argument("--limit", type=int, help="import at most N of the selected takes (in path order)")
+    ds.add_argument("--workers", type=int, default=1, help="import processes (default 1)")
+    ds.add_argument("--height", type=float, default=1.75, help="our skeletons' height in metres (default 1.75)")
+    ds.add_argument("--build", choices=GENDERS, default="male")
+    ds.add_argument("--quiet", action="store_true", help="no progress bar or summary")
+
+
+def run_dataset(args) -> int:
+    from .bandai_namco import LayoutError
+    from .dataset_import import build_bandai_namco
+
+    if args.limit is not None and args.limit < 1 or args.workers < 1:
+        print("error: --limit and --workers must be at least 1", file=sys.stderr)
+        return 2
+    try:
+        return build_bandai_namco(args.root, args.out, args.contents, args.limit, args.workers, args.height,
+                                  args.build, args.quiet)
+    except LayoutError as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return 2
 
 
 def run_gesture_corpus(args, motions, problems) -> int:
@@ -171,4 +217,6 @@ def main(argv=None) -> int:
         return run_import(args)
     if args.command == "corpus":
         return run_corpus(args)
+    if args.command == "dataset":
+        return run_dataset(args)
     return 2  # pragma: no cover - argparse requires a command
