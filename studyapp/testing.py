@@ -132,3 +132,17 @@ def wait_for(driver, condition, timeout: float = 20.0, what: str = "condition"):
             pass
         time.sleep(0.1)
     raise AssertionError(f"timed out waiting for {what}; at {driver.current_url}")
+
+
+def consent_and_demographics(driver) -> None:
+    """In a browser (selenium WebDriver) on a study's consent page: consent, start, answer the demographics page
+    with its first choices, and wait for the first clip page."""
+    from selenium.webdriver.common.by import By
+
+    driver.find_element(By.CSS_SELECTOR, "label.check").click()
+    driver.find_element(By.CSS_SELECTOR, "button[type=submit]").click()
+    wait_for(driver, lambda d: "/about-you/" in d.current_url, what="demographics page")
+    for name in ("gender", "age_group"):
+        driver.find_element(By.CSS_SELECTOR, f"input[name={name}]").find_element(By.XPATH, "..").click()
+    driver.find_element(By.CSS_SELECTOR, "button[type=submit]").click()
+    wait_for(driver, lambda d: "/clip/1/" in d.current_url, what="first clip")

@@ -23,7 +23,7 @@ from studyapp.export import stream_csv
 from studyapp.models import Participant, Response, Study
 from studyapp.presets import create_study_from_preset
 from studyapp.questions import questions_for
-from studyapp.testing import make_catalogue, tiny_mp4, wait_for
+from studyapp.testing import consent_and_demographics, make_catalogue, tiny_mp4, wait_for
 
 pytestmark = [pytest.mark.browser, pytest.mark.slow, pytest.mark.django_db(transaction=True)]
 
@@ -118,13 +118,7 @@ def test_whole_demo_study_in_chromium(chromium, live_server, settings, tmp_path)
     driver.get(entry_url)
     if shots:
         full_shot(driver, Path(shots) / "study_consent.png")
-    driver.find_element(By.CSS_SELECTOR, "label.check").click()
-    driver.find_element(By.CSS_SELECTOR, "button[type=submit]").click()
-    wait_for(driver, lambda d: "/about-you/" in d.current_url, what="demographics page")
-    for name in ("gender", "age_group"):
-        driver.find_element(By.CSS_SELECTOR, f"input[name={name}]").find_element(By.XPATH, "..").click()
-    driver.find_element(By.CSS_SELECTOR, "button[type=submit]").click()
-    wait_for(driver, lambda d: "/clip/1/" in d.current_url, what="first clip")
+    consent_and_demographics(driver)
     participant = Participant.objects.get(external_id="e2e-1")
     total = participant.assignments.count()
     seen_types, reloaded, went_back = set(), False, False

@@ -15,7 +15,7 @@ from study_protocol import ATTENTION_CHECK
 from studyapp.duration import expected_minutes
 from studyapp.models import Assignment, Participant, Response, Study
 from studyapp.presets import create_study_from_preset
-from studyapp.testing import make_catalogue, tiny_mp4, wait_for
+from studyapp.testing import consent_and_demographics, make_catalogue, tiny_mp4, wait_for
 
 pytestmark = [pytest.mark.browser, pytest.mark.slow, pytest.mark.django_db(transaction=True)]
 
@@ -66,13 +66,7 @@ def test_practice_and_attention_check_in_chromium(chromium, live_server, setting
     duration = driver.find_element(By.CSS_SELECTOR, "p.duration").text
     assert f"about {expected_minutes(study)} minute" in duration
     shot(driver, shots, "study_consent_duration.png")
-    driver.find_element(By.CSS_SELECTOR, "label.check").click()
-    driver.find_element(By.CSS_SELECTOR, "button[type=submit]").click()
-    wait_for(driver, lambda d: "/about-you/" in d.current_url, what="demographics page")
-    for name in ("gender", "age_group"):
-        driver.find_element(By.CSS_SELECTOR, f"input[name={name}]").find_element(By.XPATH, "..").click()
-    driver.find_element(By.CSS_SELECTOR, "button[type=submit]").click()
-    wait_for(driver, lambda d: "/clip/1/" in d.current_url, what="first clip")
+    consent_and_demographics(driver)
     # 1: the practice item, marked as such
     badge = driver.find_element(By.CSS_SELECTOR, ".practice-badge")
     assert badge.is_displayed() and "Practice" in badge.text

@@ -18,7 +18,7 @@ from study_protocol import VIEWING_COLUMNS
 from studyapp.export import stream_csv
 from studyapp.models import Participant, Study
 from studyapp.presets import create_study_from_preset
-from studyapp.testing import make_catalogue, tiny_mp4, wait_for
+from studyapp.testing import consent_and_demographics, make_catalogue, tiny_mp4, wait_for
 
 pytestmark = [pytest.mark.browser, pytest.mark.slow, pytest.mark.django_db(transaction=True)]
 
@@ -72,25 +72,13 @@ def set_hidden(driver, hidden: bool) -> None:
                "document.dispatchEvent(new Event('visibilitychange'));", hidden)
 
 
-def start(driver, url: str) -> None:
-    from selenium.webdriver.common.by import By
-
-    driver.get(url)
-    driver.find_element(By.CSS_SELECTOR, "label.check").click()
-    driver.find_element(By.ID, "start-study").click()
-    wait_for(driver, lambda d: "/about-you/" in d.current_url, what="demographics page")
-    for name in ("gender", "age_group"):
-        driver.find_element(By.CSS_SELECTOR, f"input[name={name}]").find_element(By.XPATH, "..").click()
-    driver.find_element(By.CSS_SELECTOR, "button[type=submit]").click()
-    wait_for(driver, lambda d: "/clip/1/" in d.current_url, what="first clip")
-
-
 def test_replay_only_player_and_viewing_csv(chromium, live_server, study):
     from selenium.webdriver.common.by import By
 
     driver = chromium
     shots = os.environ.get("STUDY_SCREENSHOTS")
-    start(driver, live_server.url + reverse("studyapp:study_entry", args=[study.slug]) + "?PROLIFIC_PID=v-1")
+    driver.get(live_server.url + reverse("studyapp:study_entry", args=[study.slug]) + "?PROLIFIC_PID=v-1")
+    consent_and_demographics(driver)
     video = driver.find_element(By.ID, "clip")
     assert video.get_attribute("controls") is None                      # no seek bar, no speed menu
     play_pause, replay = driver.find_element(By.ID, "play-pause"), driver.find_element(By.ID, "replay")

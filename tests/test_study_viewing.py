@@ -15,9 +15,8 @@ from study_pools import options_errors, player_errors
 from study_protocol import VIEWING_COLUMNS, VIEWING_FIELDS
 from studyapp.export import stream_csv
 from studyapp.models import Assignment, Participant, Study
-from studyapp.presets import create_study_from_preset
-from studyapp.testing import make_catalogue
 from studyapp.viewing import MAX_COUNT, field_name, parse_viewing
+from tests import test_study_flow as flow
 from tests.test_study_flow import answer_for, consent, cur, demographics
 
 GOOD_RECORD = {"first_play_ms": 120, "ended_ms": 2400, "plays": 2, "pauses": 1, "seeks": 3, "stalls": 1,
@@ -109,14 +108,7 @@ def test_missing_fields_are_unknown():
 
 # ---- the answer path -------------------------------------------------------------------------------------------
 
-@pytest.fixture
-def study(settings, tmp_path):
-    settings.MEDIA_ROOT = tmp_path / "media"
-    make_catalogue(settings.MEDIA_ROOT)
-    s = create_study_from_preset("demo", "demo", plan="test", status=Study.Status.OPEN)
-    s.sections.update(require_full_play=False)
-    return s
-
+study = flow.study          # the open demo study of the participant-flow tests (a fixture)
 
 def started(client: Client, study: Study) -> Participant:
     p = consent(client, study)
