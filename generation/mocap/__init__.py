@@ -9,7 +9,10 @@ unmapped_joints, retarget_max_error_m, height_m``). Modules:
 - :mod:`.positions`: CSV/NPY joint positions and named layouts (Emotion-Gait 16 joints, Kinect v2);
 - :mod:`.labels`: emotion labels from a CSV or a file-name pattern, in the study vocabulary;
 - :mod:`.importer`: one file -> Motion + report row (units, up axis, scaling, IK);
-- :mod:`.cli`: the command.
+- :mod:`.bandai_namco`: the Bandai Namco Research Motion Dataset's layout, labels and held-out split by take;
+- :mod:`.dataset_import`: a labelled dataset -> the real-capture corpus (process pool, report per file);
+- :mod:`.real_corpus`: the real-capture corpus file (:class:`~.real_corpus.CorpusClip`, save/load, filters);
+- :mod:`.cli`: the command (``import``, ``corpus``, ``dataset bandai-namco DIR --out CORPUS``).
 See docs/mocap.md.
 """
 from .importer import REPORT_COLUMNS, ImportOptions, ImportResult, import_file
