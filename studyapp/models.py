@@ -15,6 +15,7 @@ from django.utils import timezone
 from study_pools import validate_section
 from study_protocol import ATTENTION_CHECK, MODALITIES, ORIGINS
 
+from .permissions import STUDY_PERMISSIONS
 from .questions import section_type_choices
 
 
@@ -136,6 +137,7 @@ class Study(models.Model):
     class Meta:
         verbose_name_plural = "studies"
         ordering = ["-created_at"]
+        permissions = STUDY_PERMISSIONS
 
     def __str__(self) -> str:
         return self.title

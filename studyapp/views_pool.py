@@ -8,7 +8,8 @@ the fields of one section form (names without the formset prefix) and answers JS
      "warnings": [...], "errors": [{"field": "pool_weight_min", "label": "Weight from",
      "messages": ["Enter a number."]}], "pool": {...}, "options": {...}, "used": {"pool": "fields", ...}}
 
-Staff only (403 JSON otherwise); bad input is an error in the answer (status 200), never a 500.
+Staff with the permission studyapp.view_clip only (403 JSON otherwise); bad input is an error in the answer
+(status 200), never a 500.
 """
 from __future__ import annotations
 
@@ -23,6 +24,7 @@ from study_protocol import ORIGINS
 
 from .catalogue import CatalogueError, pool_queryset
 from .forms import SectionPreviewForm
+from .permissions import has_staff_permission
 from .pool_editor import SUB_POOL_SECTION_TYPE
 
 REUSED = "this section reuses the clips of an earlier section: its pool is not used"
@@ -117,10 +119,12 @@ def preview(form: SectionPreviewForm, reuse_section: str = "") -> dict:
 
 @never_cache
 def pool_count(request):
-    """GET only, staff only (403 JSON for anyone else, logged in or not)."""
+    """GET only; staff with studyapp.view_clip only (403 JSON for anyone else, logged in or not)."""
     user = request.user
     if not (user.is_authenticated and user.is_active and user.is_staff):
         return JsonResponse({"error": "staff only: log in to the admin first"}, status=403)
+    if not has_staff_permission(user, "studyapp.view_clip"):
+        return JsonResponse({"error": "this count needs the permission studyapp.view_clip"}, status=403)
     if request.method != "GET":
         return JsonResponse({"error": "use GET"}, status=405)
     answer = preview(SectionPreviewForm(request.GET), request.GET.get("reuse_section", ""))

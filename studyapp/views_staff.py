@@ -1,11 +1,15 @@
-"""Researcher pages (staff only): create from preset, preview without recording, progress, exports, report."""
+"""Researcher pages (staff only): create from preset, preview without recording, progress, exports, report.
+
+Each page needs a staff account (else the admin login) and one Django permission (else 403): creating a study
+studyapp.add_study, preview and progress studyapp.view_study, CSV exports and the analysis report (participant
+data, Prolific IDs included) studyapp.export_participant_data.
+"""
 from __future__ import annotations
 
 import tempfile
 from pathlib import Path
 
 from django.contrib import messages
-from django.contrib.admin.views.decorators import staff_member_required
 from django.db.models import Count, Q
 from django.http import FileResponse, Http404, StreamingHttpResponse
 from django.shortcuts import get_object_or_404, redirect, render
@@ -19,13 +23,14 @@ from .export import EXPORT_KINDS, stream_csv
 from .forms import ConsentForm, PresetStudyForm
 from .i18n import activate_study_language
 from .models import Assignment, Participant, Response, Study
+from .permissions import EXPORT_PERMISSION, staff_permission_required
 from .presets import create_study_from_preset
 from .questions import AnswerError, clean_answers
 from .reports import report_state, start_build
 from .views import item_context, item_questions
 
 
-@staff_member_required
+@staff_permission_required("studyapp.add_study")
 @require_http_methods(["GET", "POST"])
 def create_from_preset(request):
     form = PresetStudyForm(request.POST or None)
@@ -62,7 +67,7 @@ def _preview_seed(request) -> int:
     return int(raw) if raw.lstrip("-").isdigit() else 12345
 
 
-@staff_member_required
+@staff_permission_required("studyapp.view_study")
 def preview_start(request, study_id: int):
     study = get_object_or_404(Study, pk=study_id)
     activate_study_language(study)     # the preview shows the pages as participants see them
@@ -71,7 +76,7 @@ def preview_start(request, study_id: int):
                                                      "seed": seed})
 
 
-@staff_member_required
+@staff_permission_required("studyapp.view_study")
 @require_http_methods(["GET", "POST"])
 def preview_item(request, study_id: int, n: int):
     """Clip n of a preview participant with the given seed. Answers are validated, never stored."""
@@ -100,7 +105,7 @@ def preview_item(request, study_id: int, n: int):
     return render(request, "studyapp/item.html", ctx, status=400 if error else 200)
 
 
-@staff_member_required
+@staff_permission_required("studyapp.view_study")
 def progress(request, study_id: int):
     study = get_object_or_404(Study, pk=study_id)
     counts = {row["status"]: row["n"] for row in study.participants.values("status").annotate(n=Count("id"))}
@@ -121,7 +126,7 @@ def progress(request, study_id: int):
     return render(request, "studyapp/staff/progress.html", ctx)
 
 
-@staff_member_required
+@staff_permission_required(EXPORT_PERMISSION)
 def export_csv(request, study_id: int, kind: str):
     study = get_object_or_404(Study, pk=study_id)
     if kind not in EXPORT_KINDS:
@@ -131,7 +136,7 @@ def export_csv(request, study_id: int, kind: str):
     return response
 
 
-@staff_member_required
+@staff_permission_required(EXPORT_PERMISSION)
 @require_http_methods(["GET", "POST"])
 def report_zip(request, study_id: int):
     """The analysis report of the study's current data. POST starts a detached build (studyapp.reports) and

@@ -9,7 +9,7 @@ import sys
 import types
 
 import pytest
-from django.contrib.auth.models import User
+from django.contrib.auth.models import Permission, User
 from django.test import Client
 from django.urls import reverse
 
@@ -136,6 +136,7 @@ def catalogue(db, settings, tmp_path):
 @pytest.fixture
 def staff(db):
     user = User.objects.create_user("researcher", password="pw-researcher-1", is_staff=True)
+    user.user_permissions.add(Permission.objects.get(codename="view_clip"))     # the count needs it
     c = Client()
     c.force_login(user)
     return c
@@ -155,7 +156,11 @@ def test_count_endpoint_is_staff_only(catalogue):
     r = plain.get(url, {"section_type": "theme_rating"})
     assert r.status_code == 403 and "staff" in r.json()["error"]
     staff = Client()
-    staff.force_login(User.objects.create_user("r", password="pw-r-1", is_staff=True))
+    user = User.objects.create_user("r", password="pw-r-1", is_staff=True)
+    staff.force_login(user)
+    r = staff.get(url, {"section_type": "theme_rating"})
+    assert r.status_code == 403 and "studyapp.view_clip" in r.json()["error"]
+    user.user_permissions.add(Permission.objects.get(codename="view_clip"))
     assert staff.post(url, {"section_type": "theme_rating"}).status_code == 405
 
 

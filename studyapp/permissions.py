@@ -1,0 +1,49 @@
+"""Who may open the researcher pages: the staff-plus-permission decorator, the custom permissions of the study
+models and the permission set of the shipped "researcher" group (created by a data migration)."""
+from __future__ import annotations
+
+from functools import wraps
+
+from django.contrib.admin.views.decorators import staff_member_required
+from django.core.exceptions import PermissionDenied
+
+EXPORT_PERMISSION = "studyapp.export_participant_data"
+"""Download a study's CSV exports and analysis report (participant data, Prolific IDs included)."""
+
+STUDY_PERMISSIONS = [
+    ("export_participant_data", "Can download participant data (CSV exports and analysis reports)"),
+]
+"""Custom permissions declared in Study.Meta: what no add/change/delete/view model permission covers."""
+
+RESEARCHER_GROUP = "researcher"
+RESEARCHER_PERMISSIONS = [
+    # studies and their sections: create (also from a preset), edit, open/close, preview, progress
+    "add_study", "change_study", "view_study",
+    "add_section", "change_section", "delete_section", "view_section",
+    # the clip catalogue (pool editor's live count, contact sheets) and collected data, read only
+    "view_clip", "view_participant", "view_response",
+    "export_participant_data",
+]
+"""Codenames (app studyapp) the "researcher" group holds: run studies and read their data; no deleting
+studies, participants or answers and no editing of the catalogue or of collected data."""
+
+
+def has_staff_permission(user, perm: str) -> bool:
+    """An active staff account holding ``perm`` ("app_label.codename"); superusers hold every permission."""
+    return bool(user.is_authenticated and user.is_active and user.is_staff and user.has_perm(perm))
+
+
+def staff_permission_required(perm: str):
+    """View decorator: anonymous and non-staff users go to the admin login (like staff_member_required); a staff
+    member without ``perm`` gets 403 (PermissionDenied)."""
+
+    def decorator(view):
+        @wraps(view)
+        def checked(request, *args, **kwargs):
+            if not request.user.has_perm(perm):
+                raise PermissionDenied(f"this page needs the permission {perm}")
+            return view(request, *args, **kwargs)
+
+        return staff_member_required(checked)
+
+    return decorator
