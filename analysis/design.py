@@ -1,15 +1,15 @@
-"""The design of a simulated study, read from study presets and the stimulus plans they draw on. No Django.
+"""The design of a simulated study, read from study presets and the planned clips of their plans. No Django.
 
 A real study is a preset (``study_presets.PRESETS``: its sections, clips per participant, options, pools) filled
-with the clips of a plan (``generation/plans/<name>.yaml``, ``study_presets.PRESET_PLANS``). The simulator
-(:mod:`analysis.simulate`) takes the same two inputs, so a simulated study has the structure of a real export of that
-preset: the same sections in the same order, the same number of clips per participant, the same questions and answer
-options, and a clips.csv whose rows are the plan's entries (intended emotions, themes, weights as the renderer
-records them; see :func:`generation.plans.schema.intent_fields`).
+with the clips of a plan (``study_presets.PRESET_PLANS``). The simulator (:mod:`analysis.simulate`) takes the same
+two inputs, so a simulated study has the structure of a real export of that preset: the same sections in the same
+order, the same number of clips per participant, the same questions and answer options, and a clips.csv whose rows
+are the plan's entries.
 
-Each plan entry becomes one SYNTHETIC clip row with id ``sim-<plan>-<entry id>``. Its ``duration_s`` is the planned
-one: the entry's ``duration_s`` input, else its pair's (a generated gesture and its source), else the plan's render
-duration -- a rendered clip's real length may differ a little.
+The plans' clips come as a planned clips table: clips.csv rows (the public columns, ``study_protocol.CLIP_COLUMNS``)
+plus :data:`EXTRA_COLUMNS`, one SYNTHETIC row ``sim-<plan>-<entry id>`` per plan entry. The table of the preset
+plans ships as :data:`PLANNED_CLIPS`; ``python -m generation.plans.planned PLAN --out FILE`` writes one for any plan
+(the analysis reads the file and never imports the generation library).
 
 Pools are matched as ``study_pools`` defines them (field, ``field__lookup``, lists, the ``transition`` and ``rbf``
 shorthands, naturalness sub-pools), on the clip rows plus their ``plan``.
@@ -17,6 +17,7 @@ shorthands, naturalness sub-pools), on the clip rows plus their ``plan``.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from pathlib import Path
 
 import numpy as np
 import pandas as pd
@@ -28,7 +29,10 @@ from study_protocol import CLIP_COLUMNS, FINAL_EMOTION_COLUMNS, GESTURE_EMOTIONS
 PAPER_PRESETS = ("gait_ismar2020", "gestures_ieeevr2021", "rbf_thms2016")
 """The three papers' studies; simulated one after the other as one SYNTHETIC study by default."""
 EXTRA_COLUMNS = ("plan", "entry_id", "source_clip_id")
-"""Columns of :attr:`StudyDesign.clips` after CLIP_COLUMNS (the design's, not clips.csv's)."""
+"""Columns of a planned clips table and of :attr:`StudyDesign.clips` after CLIP_COLUMNS (not clips.csv's)."""
+PLANNED_CLIPS = Path(__file__).resolve().parent / "data" / "planned_clips.csv"
+"""The planned clips of every preset's plan (written by ``python -m generation.plans.planned``)."""
+TEXT_COLUMNS = ("clip_id", "modality", "origin", "emotion_label", "theme", *EXTRA_COLUMNS)
 
 
 class DesignError(ValueError):
@@ -100,31 +104,31 @@ class StudyDesign:
         return np.array([pos.get(s, -1) for s in self.clips["source_clip_id"]], dtype=int)
 
 
-# ---- clips from a plan ---------------------------------------------------------------------------------------------
-def _duration(entry, by_id: dict) -> float:
-    if "duration_s" in entry.inputs:
-        return float(entry.inputs["duration_s"])
-    pair = by_id.get(entry.pair)
-    if pair is not None and "duration_s" in pair.inputs:
-        return float(pair.inputs["duration_s"])
-    return float(entry.render.duration_s)
+# ---- planned clips ------------------------------------------------------------------------------------------------
+def read_planned_clips(path: str | Path = PLANNED_CLIPS) -> pd.DataFrame:
+    """A planned clips table (CSV): CLIP_COLUMNS + :data:`EXTRA_COLUMNS`, numbers as floats (blank NaN), blank
+    ``emotion_label``/``theme`` None, blank ``source_clip_id`` "". Raises DesignError naming missing columns."""
+    try:
+        raw = pd.read_csv(path, dtype=str, keep_default_na=False)
+    except (OSError, pd.errors.ParserError, pd.errors.EmptyDataError) as exc:
+        raise DesignError(f"planned clips {path}: cannot read ({exc})") from None
+    missing = [c for c in (*CLIP_COLUMNS, *EXTRA_COLUMNS) if c not in raw.columns]
+    if missing:
+        raise DesignError(f"planned clips {path}: missing columns {missing} "
+                          "(write the table with python -m generation.plans.planned)")
+    return clip_table(raw[[*CLIP_COLUMNS, *EXTRA_COLUMNS]])
 
 
-def plan_clip_rows(plan) -> list[dict]:
-    """One SYNTHETIC clip row per entry of a validated plan (generation.plans.schema.Plan): CLIP_COLUMNS +
-    :data:`EXTRA_COLUMNS`, intent columns from the entry (blanks ``None``)."""
-    from generation.plans.schema import intent_fields
-
-    by_id = {e.id: e for e in plan.entries}
-    rows = []
-    for e in plan.entries:
-        row = {c: None for c in CLIP_COLUMNS}
-        row.update(intent_fields(e))
-        row.update(clip_id=f"sim-{plan.name}-{e.id}", modality=e.modality, origin=e.origin,
-                   duration_s=round(_duration(e, by_id), 3), plan=plan.name, entry_id=e.id,
-                   source_clip_id=f"sim-{plan.name}-{e.pair}" if e.pair else "")
-        rows.append(row)
-    return rows
+def clip_table(clips: pd.DataFrame) -> pd.DataFrame:
+    """The design's clip table from planned clip rows: numeric columns as floats (blank NaN), text columns as
+    strings with blanks missing (``source_clip_id`` keeps "" for none), rows renumbered from 0."""
+    out = {}
+    for c in clips.columns:
+        if c not in TEXT_COLUMNS:
+            out[c] = pd.to_numeric(clips[c], errors="coerce").to_numpy(float)
+        else:
+            out[c] = [v if isinstance(v, str) and (v or c == "source_clip_id") else None for v in clips[c]]
+    return pd.DataFrame(out, columns=list(clips.columns))
 
 
 # ---- pool filters (study_pools semantics) -----------------------------------------------------------------------
@@ -194,35 +198,38 @@ def _section(spec: dict, order: int, preset: str, plan: str, clips: pd.DataFrame
 
 
 def design_from_presets(presets: tuple[str, ...] | list[str] = PAPER_PRESETS, plans: dict | None = None,
-                        name: str | None = None) -> StudyDesign:
+                        name: str | None = None, clips: pd.DataFrame | str | Path | None = None) -> StudyDesign:
     """The design of a study made of ``presets`` (one after the other), each drawing the clips of its plan.
 
     Args:
         presets: keys of study_presets.PRESETS, e.g. ("demo",) or the default :data:`PAPER_PRESETS`.
-        plans: preset -> plan name or path (default study_presets.PRESET_PLANS); the plan is loaded and validated
-            with generation.plans.schema.load_plan.
-    Raises DesignError naming the preset or section when a preset is unknown or a pool selects no clip of the plan.
+        plans: preset -> plan name (default study_presets.PRESET_PLANS).
+        clips: the planned clips table (a DataFrame of CLIP_COLUMNS + :data:`EXTRA_COLUMNS` or a CSV path; default
+            :data:`PLANNED_CLIPS`) holding the rows of every chosen plan.
+    Raises DesignError naming the preset, plan or section when a preset is unknown, a plan has no rows in the
+    table or a pool selects no clip of the plan.
     """
-    from generation.plans.schema import load_plan
-
     presets = tuple(presets)
     unknown = [p for p in presets if p not in PRESETS]
     if unknown or not presets:
         raise DesignError(f"unknown preset(s) {unknown}; choose among {sorted(PRESETS)}")
-    chosen = {p: (plans or {}).get(p, PRESET_PLANS[p]) for p in presets}
-    rows, loaded = [], {}
-    for plan_ref in dict.fromkeys(chosen.values()):
-        plan = load_plan(plan_ref)
-        loaded[plan_ref] = plan.name
-        rows += plan_clip_rows(plan)
-    clips = pd.DataFrame(rows, columns=[*CLIP_COLUMNS, *EXTRA_COLUMNS])
-    for c in clips.columns:
-        if c not in ("clip_id", "modality", "origin", "emotion_label", "theme", *EXTRA_COLUMNS):
-            clips[c] = pd.to_numeric(clips[c], errors="coerce")
+    if isinstance(clips, pd.DataFrame):
+        table = clip_table(clips)
+    else:
+        table = read_planned_clips(PLANNED_CLIPS if clips is None else clips)
+    chosen = {p: str((plans or {}).get(p, PRESET_PLANS[p])) for p in presets}
+    parts = []
+    for plan in dict.fromkeys(chosen.values()):
+        rows = table[table["plan"] == plan]
+        if rows.empty:
+            raise DesignError(f"plan {plan!r} has no rows in the planned clips table (known: "
+                              f"{sorted(set(table['plan']))}); write them with "
+                              f"python -m generation.plans.planned {plan} --out FILE and pass that file")
+        parts.append(rows)
+    table = clip_table(pd.concat(parts))
     sections: list[SectionDesign] = []
     for preset in presets:
         offset = len(sections)
         for spec in PRESETS[preset]["sections"]:
-            sections.append(_section(spec, len(sections) + 1, preset, loaded[chosen[preset]], clips, offset))
-    return StudyDesign(name or "+".join(presets), presets, {p: loaded[chosen[p]] for p in presets}, tuple(sections),
-                       clips)
+            sections.append(_section(spec, len(sections) + 1, preset, chosen[preset], table, offset))
+    return StudyDesign(name or "+".join(presets), presets, dict(chosen), tuple(sections), table)

@@ -35,7 +35,6 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 import pandas as pd
 
-from generation.plans.schema import PlanError
 from study_presets import PRESETS
 from study_protocol import (
     ASSIGNMENT_COLUMNS,
@@ -368,11 +367,13 @@ def simulate_design(n_participants: int, design: StudyDesign, seed: int = 0, mod
 
 
 def simulate_study(n_participants: int, seed: int = 0, model: PerceptionModel | None = None,
-                   completion_rate: float = 0.95, presets=PAPER_PRESETS, plans: dict | None = None, **overrides):
+                   completion_rate: float = 0.95, presets=PAPER_PRESETS, plans: dict | None = None, clips=None,
+                   **overrides):
     """Draw a SYNTHETIC study of ``n_participants`` observers.
 
-    ``presets`` (default the three papers' studies, one after the other) and ``plans`` (preset -> plan name or file;
-    default each preset's own plan) give the design (:mod:`analysis.design`). ``model`` (default
+    ``presets`` (default the three papers' studies, one after the other), ``plans`` (preset -> plan name; default
+    each preset's own plan) and ``clips`` (the planned clips table, DataFrame or CSV path; default the shipped
+    :data:`analysis.design.PLANNED_CLIPS`) give the design (:mod:`analysis.design`). ``model`` (default
     :class:`PerceptionModel`) with keyword ``overrides`` of its fields (e.g. ``weight_effect=0, feature_effect=0`` for
     no theme effect). A share ``1 - completion_rate`` of participants stop part-way (status "abandoned", no
     completed_at, their answers up to that point kept).
@@ -381,17 +382,17 @@ def simulate_study(n_participants: int, seed: int = 0, model: PerceptionModel | 
     participants.csv (DESIGN.md); :func:`simulate_design` also returns the assignments. Vectorised: 10,000
     participants of the paper studies (about 1.7 million answers) take a few seconds.
     """
-    sim = simulate_design(n_participants, design_from_presets(presets, plans), seed, model, completion_rate,
-                          **overrides)
+    design = design_from_presets(presets, plans, clips=clips)
+    sim = simulate_design(n_participants, design, seed, model, completion_rate, **overrides)
     return sim.responses, sim.clips, sim.participants
 
 
 def write_study(out_dir: str, n_participants: int, seed: int = 0, presets=PAPER_PRESETS, plans: dict | None = None,
-                **overrides) -> dict[str, str]:
+                clips=None, **overrides) -> dict[str, str]:
     """Simulate and write responses.csv, clips.csv, participants.csv and assignments.csv into ``out_dir``; returns
     their paths by kind."""
     os.makedirs(out_dir, exist_ok=True)
-    sim = simulate_design(n_participants, design_from_presets(presets, plans), seed, **overrides)
+    sim = simulate_design(n_participants, design_from_presets(presets, plans, clips=clips), seed, **overrides)
     paths = {}
     for name in ("responses", "clips", "participants", "assignments"):
         paths[name] = os.path.join(out_dir, f"{name}.csv")
@@ -410,13 +411,17 @@ def main(argv=None) -> int:
     ap.add_argument("--preset", action="append", choices=sorted(PRESETS), metavar="PRESET",
                     help=f"study preset to simulate (repeat for several, in order; default: {' '.join(PAPER_PRESETS)})")
     ap.add_argument("--plan", action="append", default=[], metavar="PRESET=PLAN",
-                    help="the plan (built-in name or file) a preset's clips come from (default: the preset's own)")
+                    help="the plan a preset's clips come from (default: the preset's own)")
+    ap.add_argument("--clips", default=None, metavar="CSV",
+                    help="planned clips table holding the plans' rows (default: the preset plans' shipped table; "
+                         "python -m generation.plans.planned PLAN --out CSV writes one for any plan)")
     a = ap.parse_args(argv)
     plans = dict(x.split("=", 1) for x in a.plan if "=" in x)
     if len(plans) != len(a.plan):
         print("error: --plan takes PRESET=PLAN", file=sys.stderr)
         return 2
-    kw = {"completion_rate": a.completion_rate, "presets": tuple(a.preset or PAPER_PRESETS), "plans": plans}
+    kw = {"completion_rate": a.completion_rate, "presets": tuple(a.preset or PAPER_PRESETS), "plans": plans,
+          "clips": a.clips}
     if a.no_theme_effect:
         kw.update(weight_effect=0.0, feature_effect=0.0)
     if a.participants < 1:
@@ -424,7 +429,7 @@ def main(argv=None) -> int:
         return 2
     try:
         paths = write_study(a.out, a.participants, a.seed, **kw)
-    except (DesignError, PlanError) as exc:
+    except DesignError as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 2
     print("SYNTHETIC study written:", ", ".join(paths.values()))

@@ -38,14 +38,14 @@ from generation.core.skeleton import GAIT_PARENTS  # noqa: E402
 from generation.gait.data import load_corpus_sequences, world_rotations  # noqa: E402
 from generation.gait.generate import distance_to_path, emotion_transition, load_model  # noqa: E402
 from generation.gait.generate import generate_gaits as _generate_gaits  # noqa: E402
-from generation.gait.guidance import (  # noqa: E402
+from generation.gait.train import DEFAULT_WEIGHTS, rollout  # noqa: E402
+from generation.quality.gait_guidance import (  # noqa: E402
     HELDOUT_SEED,
     heldout_corpus,
     seed_walks,
     single_dominant,
     unseen_mixtures,
 )
-from generation.gait.train import DEFAULT_WEIGHTS, rollout  # noqa: E402
 from generation.quality.observer import GaitObserver  # noqa: E402
 from study_protocol import GAIT_EMOTIONS  # noqa: E402
 
@@ -143,7 +143,7 @@ def accuracy_table(pred: np.ndarray, intended: np.ndarray) -> dict:
 
 def heldout_recognition(net, observer, corpus, walks, steps) -> dict:
     """Own-emotion recognition with the walks of the second held-out corpus as seeds
-    (:func:`generation.gait.guidance.heldout_corpus`): every walk, the walks with one dominant label, and the
+    (:func:`generation.quality.gait_guidance.heldout_corpus`): every walk, the walks with one dominant label, and the
     latter's even / odd halves (the halves used for choosing and for confirming candidates)."""
     emotions = walks.emotion.numpy().astype(np.float64)
     seeds = test_seeds(corpus, walks.base_index)

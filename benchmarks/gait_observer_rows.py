@@ -30,8 +30,8 @@ import torch  # noqa: E402
 from generation.core.paths import straight  # noqa: E402
 from generation.gait.data import DEFAULT_CORPUS, load_corpus_sequences  # noqa: E402
 from generation.gait.generate import load_model  # noqa: E402
-from generation.gait.guidance import heldout_corpus, seed_walks, single_dominant  # noqa: E402
 from generation.procedural.corpus import GaitCorpus  # noqa: E402
+from generation.quality.gait_guidance import heldout_corpus, seed_walks, single_dominant  # noqa: E402
 from study_protocol import GAIT_EMOTIONS  # noqa: E402
 
 
@@ -53,7 +53,7 @@ def main(argv=None) -> int:
     ap.add_argument("--split", choices=("val", "test", "both", "extra-a", "extra-b"), default="val",
                     help="extra-a / extra-b: the even / odd walks of --extra-corpus (every walk unseen in training)")
     ap.add_argument("--extra-corpus", default=None,
-                    help="default: the held-out corpus of generation.gait.guidance.heldout_corpus (built with "
+                    help="default: the held-out corpus of generation.quality.gait_guidance.heldout_corpus (built with "
                          "another seed when missing): more held-out walks, so that a class's figure rests on ~110 "
                          "walks per half")
     ap.add_argument("--guidance", default="0", help="comma-separated emotion-guidance scales")

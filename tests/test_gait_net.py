@@ -344,7 +344,7 @@ def test_emotion_guidance_extrapolates_from_the_uniform_emotion(tiny_net):
 
 
 def test_guidance_scale_choice_and_storage(tiny_net, tmp_path):
-    from generation.gait.guidance import choose_scale, lowest_class, write_guidance
+    from generation.quality.gait_guidance import choose_scale, lowest_class, write_guidance
 
     def result(lo):
         return {"val_walk_seeds": {"happy": 0.9, "sad": lo}, "unseen_mixtures": {"happy": 1.0, "sad": 0.95}}
@@ -499,7 +499,7 @@ def test_class_style_loss_costs_a_shared_offset_not_walk_noise():
 
 
 def test_single_dominant_leaves_out_tied_labels():
-    from generation.gait.guidance import single_dominant
+    from generation.quality.gait_guidance import single_dominant
     labels = np.array([[0.4, 0.0, 0.4, 0.2], [0.6, 0.0, 0.0, 0.4], [0.3, 0.3, 0.3, 0.1], [1.0, 0, 0, 0]])
     assert single_dominant(labels).tolist() == [False, True, False, True]
 

@@ -1,19 +1,19 @@
-"""Choosing the emotion-guidance scale of a gait weights file on the VALIDATION walks (docs/benchmarks/gait.md,
-issue 14).
+"""Choosing the emotion-guidance scale of a gait weights file on the VALIDATION walks (docs/benchmarks/gait.md).
 
 Generation can extrapolate each step's prediction away from the one conditioned on the emotion-neutral (uniform)
 vector (``generate_gaits(emotion_guidance=w)``, :func:`generation.gait.generate._guided`). The scale is a property
-of the weights: it is chosen here, once, by the synthetic observer (:mod:`generation.quality.observer`) on the
-corpus's validation split (never the test split), and stored in the weights file as ``emotion_guidance``, which
-``generate_gaits`` uses by default. The observer is not used at generation time.
+of the weights: it is chosen here, once, by the synthetic observer (:mod:`generation.quality.observer`; hence this
+module lives in the quality layer, above the gait network it tunes) on the corpus's validation split (never the
+test split), and stored in the weights file as ``emotion_guidance``, which ``generate_gaits`` uses by default. The
+observer is not used at generation time.
 
 Selection: for every candidate scale, 200-step gaits are generated from each validation walk's first 18 network
 steps with the walk's own (soft) label (walks whose label ties for the largest are left out: no single intended
-emotion), and from procedural seeds of four unseen mixtures (dominant 0.55, others
-0.15; 10 per mixture; other seed walks than benchmarks/bench_gait.py's); the chosen scale has the highest lowest
-per-class accuracy over both, ties going to the smaller scale.
+emotion), and from procedural seeds of four unseen mixtures (dominant 0.55, others 0.15; 10 per mixture; other
+seed walks than benchmarks/bench_gait.py's); the chosen scale has the highest lowest per-class accuracy over both,
+ties going to the smaller scale.
 
-Usage: ``python -m generation.gait.guidance --weights W.pt --scales 0,0.5,1,2 [--write]``.
+Usage: ``python -m generation.quality.gait_guidance --weights W.pt --scales 0,0.5,1,2 [--write]``.
 """
 from __future__ import annotations
 
@@ -24,9 +24,13 @@ from pathlib import Path
 import numpy as np
 import torch
 
+from generation.core.paths import straight
+from generation.gait.data import DEFAULT_CORPUS, file_sha256, load_corpus_sequences
+from generation.gait.generate import generate_gaits, load_model
+from generation.procedural.corpus import GaitCorpus, build_and_save
 from study_protocol import GAIT_EMOTIONS
 
-from .data import DEFAULT_CORPUS, load_corpus_sequences
+from .observer import GaitObserver
 
 SEED_STEPS = 18      # network steps of a seed walk (69 frames at 30 fps)
 STEPS = 200          # generated network steps per gait
@@ -66,8 +70,6 @@ def heldout_corpus(root: Path, log=print) -> Path:
     procedural generator with another seed (:data:`HELDOUT_SEED`): 1000 walks, none trained on (its own split
     column is ignored), about 225 per dominant class.
     """
-    from generation.procedural.corpus import build_and_save
-
     path = root / HELDOUT_CORPUS
     if not path.is_file():
         log(f"building the held-out gait corpus (seed {HELDOUT_SEED}) -> {path}")
@@ -86,10 +88,6 @@ def evaluate_scale(net, scale: float, observer, corpus, val_rows: np.ndarray, va
 
     val_rows: corpus indices of the validation walks; val_emotion: (N, 4) their soft labels (walks whose labels
     tie for the largest are left out: :func:`single_dominant`)."""
-    from generation.core.paths import straight
-
-    from .generate import generate_gaits
-
     single = single_dominant(val_emotion)
     val_rows, val_emotion = val_rows[single], val_emotion[single]
     seeds = seed_walks(corpus, val_rows)
@@ -115,11 +113,6 @@ def choose_scale(results: dict[float, dict]) -> float:
 def select_guidance(weights: str | Path, scales: list[float], corpus_path: str | Path | None = None,
                     log=print) -> tuple[float, dict[float, dict]]:
     """Evaluate ``scales`` for ``weights`` on the validation walks; returns (chosen scale, results per scale)."""
-    from generation.procedural.corpus import GaitCorpus
-    from generation.quality.observer import GaitObserver
-
-    from .generate import load_model
-
     if not scales or any(s < 0 for s in scales):
         raise ValueError(f"give one or more guidance scales >= 0, got {scales}")
     corpus_path = Path(corpus_path) if corpus_path else DEFAULT_CORPUS
@@ -166,7 +159,6 @@ def main(argv=None) -> int:
     chosen, results = select_guidance(args.weights, scales, args.corpus)
     print(f"chosen guidance scale {chosen:g} (lowest class {lowest_class(results[chosen]):.2f})")
     if args.write:
-        from .data import file_sha256
         write_guidance(args.weights, chosen, results,
                        file_sha256(Path(args.corpus) if args.corpus else DEFAULT_CORPUS))
         print(f"wrote emotion_guidance={chosen:g} into {args.weights}")
