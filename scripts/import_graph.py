@@ -6,6 +6,9 @@ they hide cycles as well as top-level ones do. Exits 1 when the package graph ha
 
     python scripts/import_graph.py            # edges, then cycles if any
     python scripts/import_graph.py --local    # also list each function-local import with its file and line
+
+Importable (``from scripts.import_graph import package_edges, find_cycles``): tests/test_layers.py checks the layer
+rules on the same edges.
 """
 from __future__ import annotations
 
@@ -32,18 +35,19 @@ def package_of(module: str) -> str | None:
     return None
 
 
-def module_name(path: Path) -> str:
-    rel = path.relative_to(ROOT).with_suffix("")
+def module_name(path: Path, root: Path = ROOT) -> str:
+    """Dotted module name of a file under ``root`` (a package's ``__init__.py`` is the package)."""
+    rel = path.relative_to(root).with_suffix("")
     parts = list(rel.parts)
     if parts[-1] == "__init__":
         parts = parts[:-1]
     return ".".join(parts)
 
 
-def imports_of(path: Path) -> list[tuple[str, int, bool]]:
+def imports_of(path: Path, root: Path = ROOT) -> list[tuple[str, int, bool]]:
     """(imported module, line, inside a function) for every import statement of a file."""
     tree = ast.parse(path.read_text(), filename=str(path))
-    this = module_name(path)
+    this = module_name(path, root)
     is_package = path.name == "__init__.py"
     found: list[tuple[str, int, bool]] = []
 
@@ -67,26 +71,28 @@ def imports_of(path: Path) -> list[tuple[str, int, bool]]:
     return found
 
 
-def project_files() -> list[Path]:
-    files = [ROOT / f"{name}.py" for name in TOP_MODULES if (ROOT / f"{name}.py").exists()]
+def project_files(root: Path = ROOT) -> list[Path]:
+    """The top-level protocol modules and every module of the three libraries (migrations left out)."""
+    files = [root / f"{name}.py" for name in TOP_MODULES if (root / f"{name}.py").exists()]
     for library in LIBRARIES:
-        files += sorted(p for p in (ROOT / library).rglob("*.py") if "migrations" not in p.parts)
+        files += sorted(p for p in (root / library).rglob("*.py") if "migrations" not in p.parts)
     return files
 
 
-def package_edges() -> tuple[dict[tuple[str, str], list[tuple[str, int, bool]]], list[tuple[Path, int, str]]]:
+def package_edges(root: Path = ROOT) -> tuple[dict[tuple[str, str], list[tuple[str, int, bool]]],
+                                              list[tuple[Path, int, str]]]:
     """Edges between distinct packages, each with its (file, line, local) occurrences; and all local imports."""
     edges: dict[tuple[str, str], list] = defaultdict(list)
     local_imports: list[tuple[Path, int, str]] = []
-    for path in project_files():
-        source = package_of(module_name(path))
-        for target, line, local in imports_of(path):
+    for path in project_files(root):
+        source = package_of(module_name(path, root))
+        for target, line, local in imports_of(path, root):
             if local:
                 local_imports.append((path, line, target))
             dest = package_of(target)
             if dest is None or dest == source:
                 continue
-            edges[(source, dest)].append((str(path.relative_to(ROOT)), line, local))
+            edges[(source, dest)].append((str(path.relative_to(root)), line, local))
     return edges, local_imports
 
 
