@@ -13,8 +13,13 @@ Variables (all optional for the demo):
                       requests are then answered with X-Accel-Redirect and nginx sends the bytes (docs/deploy.md);
                       empty (default): the app streams clips itself
     REPORTS_DIR       where finished analysis-report zips are kept (default: DATA_DIR/reports)
+    LOGIN_FAILURE_LIMIT   failed logins after which an account, or an address, is locked out (default 5)
+    LOGIN_LOCKOUT_MINUTES how long such a lockout lasts (default 15)
+    TRUSTED_PROXY_COUNT   reverse proxies in front of the app whose X-Forwarded-For is trusted for the client
+                      address of the login throttle (default: 1 with PRODUCTION=1, the nginx recipe; else 0)
 """
 import os
+from datetime import timedelta
 from pathlib import Path
 
 import dj_database_url
@@ -27,6 +32,21 @@ def env_bool(name: str, default: bool = False) -> bool:
     if value is None or value == "":
         return default
     return value.strip().lower() in {"1", "true", "yes", "on"}
+
+
+def env_int(name: str, default: int, minimum: int = 0) -> int:
+    raw = os.environ.get(name, "").strip()
+    if not raw:
+        return default
+    try:
+        value = int(raw)
+    except ValueError:
+        value = minimum - 1
+    if value < minimum:
+        from django.core.exceptions import ImproperlyConfigured
+
+        raise ImproperlyConfigured(f"{name} must be a whole number >= {minimum}, got {raw!r}")
+    return value
 
 
 def env_list(name: str, default: str) -> list[str]:
@@ -109,6 +129,7 @@ INSTALLED_APPS = [
     "django.contrib.sessions",
     "django.contrib.messages",
     "django.contrib.staticfiles",
+    "axes",
     "studyapp",
 ]
 
@@ -124,6 +145,8 @@ MIDDLEWARE = [
     "django.contrib.auth.middleware.AuthenticationMiddleware",
     "django.contrib.messages.middleware.MessageMiddleware",
     "django.middleware.clickjacking.XFrameOptionsMiddleware",
+    # turns a locked-out login (studyapp.login_throttle) into its 429 page; other requests pass untouched
+    "axes.middleware.AxesMiddleware",
 ]
 
 ROOT_URLCONF = "studyapp.urls"
@@ -180,6 +203,21 @@ USE_I18N = True
 USE_TZ = True
 
 LOGIN_URL = "/admin/login/"
+
+# Login throttling (django-axes, studyapp.login_throttle): failed logins count per account and per address; at
+# the limit that account or address is locked out for the cool-off time, without checking the password.
+AUTHENTICATION_BACKENDS = [
+    "studyapp.login_throttle.ThrottledLoginBackend",
+    "django.contrib.auth.backends.ModelBackend",
+]
+AXES_FAILURE_LIMIT = env_int("LOGIN_FAILURE_LIMIT", 5, minimum=1)
+AXES_COOLOFF_TIME = timedelta(minutes=env_int("LOGIN_LOCKOUT_MINUTES", 15, minimum=1))
+AXES_LOCKOUT_PARAMETERS = ["username", "ip_address"]
+AXES_RESET_ON_SUCCESS = True
+AXES_LOCKOUT_CALLABLE = "studyapp.login_throttle.lockout_response"
+AXES_CLIENT_IP_CALLABLE = "studyapp.login_throttle.client_ip"
+AXES_HTTP_RESPONSE_CODE = 429
+TRUSTED_PROXY_COUNT = env_int("TRUSTED_PROXY_COUNT", 1 if PRODUCTION else 0)
 
 if PRODUCTION:
     SECURE_SSL_REDIRECT = env_bool("SECURE_SSL_REDIRECT", True)

@@ -151,6 +151,15 @@ def test_body_size_limit(stack):
     assert r.status_code == 413
 
 
+def test_login_requests_are_rate_limited(stack):
+    """The admin login allows a burst of 5 beyond the 10/minute rate per address; nginx answers 429 after that,
+    while the participant pages stay open."""
+    codes = [get(f"{stack['https']}/admin/login/").status_code for _ in range(12)]
+    # the app's own answer (this stack has no collected admin static files) for 1 + burst, nginx's 429 after
+    assert 429 not in codes[:6] and set(codes[6:]) == {429}, codes
+    assert get(f"{stack['https']}/healthz").status_code == 200
+
+
 def test_tokens_stay_out_of_the_access_log(stack):
     get(f"{stack['https']}/p/SECRETTOKEN123/clip/1/?PROLIFIC_PID=SECRETPID")
     log = stack["tmp"] / "log" / "study.access.log"
