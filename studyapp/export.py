@@ -23,6 +23,7 @@ from __future__ import annotations
 
 import csv
 import re
+import unicodedata
 from collections.abc import Iterable, Iterator
 from pathlib import Path
 
@@ -59,15 +60,17 @@ class _Echo:
 
 
 FORMULA_STARTS = ("=", "+", "-", "@", "\t", "\r")
-PLAIN_NUMBER = re.compile(r"[+-]?(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?")
+PLAIN_NUMBER = re.compile(r"[+-]?(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?", re.ASCII)
 
 
 def safe_cell(value):
-    """A CSV cell a spreadsheet will not run as a formula: text starting with one of FORMULA_STARTS gets a
-    leading single quote; numbers and text that is a plain number ("-7", "-0.25") are left as they are."""
+    """A CSV cell a spreadsheet will not run as a formula: text whose NFKC form starts with one of FORMULA_STARTS
+    (so also the full-width ＝ ＋ － ＠, which spreadsheets read as = + - @) gets a leading single quote; numbers
+    and text that is a plain ASCII number ("-7", "-0.25") are left as they are."""
     if value is None:
         return ""
-    if isinstance(value, str) and value.startswith(FORMULA_STARTS) and not PLAIN_NUMBER.fullmatch(value):
+    if (isinstance(value, str) and unicodedata.normalize("NFKC", value).startswith(FORMULA_STARTS)
+            and not PLAIN_NUMBER.fullmatch(value)):
         return "'" + value
     return value
 

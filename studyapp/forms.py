@@ -15,6 +15,7 @@ from .models import Clip, Section, Study
 from .pool_editor import PoolEditorFields
 from .presets import preset_choices
 from .questions import section_type_choices
+from .redirects import check_completion_url
 
 GENDERS = [("female", _("Female")), ("male", _("Male")), ("non-binary", _("Non-binary / another gender")),
            ("undisclosed", _("Prefer not to say"))]
@@ -137,11 +138,17 @@ class SectionPreviewForm(PoolEditorFields):
 
 
 class StudyAdminForm(forms.ModelForm):
-    """A study in the admin; the exclusion rules are checked by the analysis library (analysis.exclusion)."""
+    """A study in the admin; the exclusion rules are checked by the analysis library (analysis.exclusion), the
+    completion URL must be http(s) (studyapp.redirects)."""
 
     class Meta:
         model = Study
         fields = "__all__"
+
+    def clean_completion_redirect(self):
+        value = (self.cleaned_data.get("completion_redirect") or "").strip()
+        check_completion_url(value)
+        return value
 
     def clean_exclusion_rules(self):
         rules = self.cleaned_data.get("exclusion_rules")

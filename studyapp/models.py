@@ -17,6 +17,7 @@ from study_protocol import ATTENTION_CHECK, MODALITIES, ORIGINS
 
 from .permissions import STUDY_PERMISSIONS
 from .questions import section_type_choices
+from .redirects import check_completion_url, safe_completion_url
 
 
 def new_token() -> str:
@@ -142,8 +143,16 @@ class Study(models.Model):
     def __str__(self) -> str:
         return self.title
 
+    def clean(self):
+        try:
+            check_completion_url(self.completion_redirect)
+        except ValidationError as exc:
+            raise ValidationError({"completion_redirect": exc.messages}) from None
+
     def completion_url(self) -> str:
-        return self.completion_redirect.replace("{code}", self.completion_code) if self.completion_redirect else ""
+        """The completion URL with the code filled in; "" when there is none or it is not http(s)."""
+        url = self.completion_redirect.replace("{code}", self.completion_code) if self.completion_redirect else ""
+        return safe_completion_url(url)
 
 
 class Section(models.Model):

@@ -1,7 +1,8 @@
 """Small security pieces that need no extra package:
 
 - `ContentSecurityPolicyMiddleware`: a Content-Security-Policy on every response (no inline script or style: every
-  script and style sheet is a file under static/).
+  script and style sheet is a file under static/), and a Permissions-Policy that turns off the browser features
+  the site never uses (camera, microphone, location, sensors, payment, USB, ...).
 - `RedactTokensFilter`: a logging filter that blanks participant credentials (the /p/<token>/ path segment and the
   PROLIFIC_PID / STUDY_ID / SESSION_ID query values) in any log line, e.g. Django's "Not Found: /p/<token>/...".
 - `redact()`: the same rewriting for one string (the gunicorn access logger of studyapp.gunicorn_logging uses it).
@@ -25,6 +26,14 @@ CONTENT_SECURITY_POLICY = "; ".join([
     "base-uri 'none'",
     "frame-ancestors 'none'",
     "form-action 'self'",
+])
+
+PERMISSIONS_POLICY = ", ".join([
+    *(f"{feature}=()" for feature in ("accelerometer", "ambient-light-sensor", "bluetooth", "camera",
+                                      "display-capture", "geolocation", "gyroscope", "hid", "magnetometer",
+                                      "microphone", "midi", "payment", "serial", "usb", "xr-spatial-tracking")),
+    # the clip player may go full screen and play on its own page
+    "autoplay=(self)", "fullscreen=(self)", "picture-in-picture=(self)",
 ])
 
 SECRET_PARAMS = ("PROLIFIC_PID", "STUDY_ID", "SESSION_ID", "token")
@@ -53,14 +62,18 @@ class RedactTokensFilter(logging.Filter):
 
 
 class ContentSecurityPolicyMiddleware:
-    """Adds settings.CONTENT_SECURITY_POLICY (default above) unless the view already set one."""
+    """Adds settings.CONTENT_SECURITY_POLICY and settings.PERMISSIONS_POLICY (defaults above) unless the view
+    already set that header; an empty setting leaves its header out."""
 
     def __init__(self, get_response):
         self.get_response = get_response
-        self.policy = getattr(settings, "CONTENT_SECURITY_POLICY", CONTENT_SECURITY_POLICY)
+        self.headers = {"Content-Security-Policy": getattr(settings, "CONTENT_SECURITY_POLICY",
+                                                           CONTENT_SECURITY_POLICY),
+                        "Permissions-Policy": getattr(settings, "PERMISSIONS_POLICY", PERMISSIONS_POLICY)}
 
     def __call__(self, request):
         response = self.get_response(request)
-        if self.policy and "Content-Security-Policy" not in response:
-            response["Content-Security-Policy"] = self.policy
+        for header, policy in self.headers.items():
+            if policy and header not in response:
+                response[header] = policy
         return response

@@ -114,7 +114,7 @@ def _prolific_conflict(request, study: Study):
 
 
 @never_cache
-@require_http_methods(["GET", "POST"])
+@require_http_methods(["GET", "HEAD", "POST"])
 def study_entry(request, slug: str):
     """Welcome + consent. Resumes a known participant instead of restarting: the one this browser session
     remembers, or the one whose stored PROLIFIC_PID, STUDY_ID and SESSION_ID all equal the link's (a Prolific
@@ -172,7 +172,7 @@ def study_entry(request, slug: str):
             return redirect("studyapp:resume", token=participant.token)
     else:
         form = ConsentForm(initial={k: v for k, v in params.items() if len(v) <= PARAM_MAX_LENGTH})
-    errors = _param_errors(params) if request.method == "GET" else [
+    errors = _param_errors(params) if request.method != "POST" else [
         e for f in form.hidden_fields() for e in f.errors]
     link_params = {k: v for k, v in params.items() if len(v) <= PARAM_MAX_LENGTH}   # never echo an over-long one
     return render(request, "studyapp/consent.html", {"study": study, "form": form, "param_errors": errors,
@@ -230,7 +230,7 @@ def resume(request, token: str):
 
 
 @never_cache
-@require_http_methods(["GET", "POST"])
+@require_http_methods(["GET", "HEAD", "POST"])
 def demographics(request, token: str):
     participant = _participant(token)
     if participant.demographics_done:
@@ -337,14 +337,14 @@ INLINE_NEXT_FIELD = "inline_next"
 
 
 @never_cache
-@require_http_methods(["GET", "POST"])
+@require_http_methods(["GET", "HEAD", "POST"])
 def item(request, token: str, n: int):
     """Clip number n (1-based over all of the participant's clips): show it, or save its answers and go straight
     to the next clip (or the feedback / end page): the next clip page itself when the form asked for it
     (INLINE_NEXT_FIELD), else a redirect. A constant number of indexed queries: the participant, its first
     unanswered assignments, and on GET the one UPDATE of shown_at when first shown."""
     participant = _participant(token)
-    step = current_step(participant, lookahead=request.method == "GET")
+    step = current_step(participant, lookahead=request.method != "POST")
     if step.kind != "item" or step.index != n:
         if request.method == "POST" and (step.kind != "item" or n < step.index):
             # An answer for a clip that is already answered: a double submit or a resubmitted old page.
@@ -354,7 +354,7 @@ def item(request, token: str, n: int):
                                 error=gettext("Please answer the clips in order: this is the clip you are on."))
         return redirect("studyapp:resume", token=token)
     assignment = step.assignment
-    if request.method == "GET":
+    if request.method != "POST":
         return _show_item(request, participant, step)
     section, clip = assignment.section, assignment.clip
     questions = item_questions(section, clip, assignment.options, assignment.kind, assignment.instructed)
@@ -382,9 +382,10 @@ def item(request, token: str, n: int):
 
 
 def _show_item(request, participant: Participant, step):
-    """The clip page of `step` as first shown (no answer selected), recording shown_at the first time."""
+    """The clip page of `step` as first shown (no answer selected), recording shown_at the first time it is
+    shown (a GET; a HEAD, e.g. an uptime monitor's, shows nothing and records nothing)."""
     assignment = step.assignment
-    if assignment.shown_at is None:
+    if assignment.shown_at is None and request.method == "GET":
         Assignment.objects.filter(pk=assignment.pk, shown_at__isnull=True).update(shown_at=timezone.now())
     return _render_item(request, participant, step, posted=None)
 
@@ -434,7 +435,7 @@ def _render_item(request, participant: Participant, step, status: int = 200, err
 
 
 @never_cache
-@require_http_methods(["GET", "POST"])
+@require_http_methods(["GET", "HEAD", "POST"])
 def feedback(request, token: str):
     participant = _participant(token)
     step = current_step(participant)
