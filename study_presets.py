@@ -121,8 +121,11 @@ PRESETS["demo"] = {
                           "and the flow of each walk."),
         dict(PRESETS["gait_ismar2020"]["sections"][3], clips_per_participant=2,
              options={"anchors": NATURALNESS_ANCHORS_GAIT, "n_generated": 1, "n_source": 1}),
-        # one gesture here leaves the demo plan's other generated gestures for the naturalness mix below
-        dict(PRESETS["gestures_ieeevr2021"]["sections"][0], clips_per_participant=1),
+        # one gesture here leaves the demo plan's other generated gestures for the naturalness mix below; the pool
+        # takes every gesture meant for this section, the real captured ones included (seed 003 showed generated
+        # gestures only; the demo shows that real ones can be asked about too)
+        dict(PRESETS["gestures_ieeevr2021"]["sections"][0], clips_per_participant=1,
+             pool={"modality": "gesture", "sections__contains": "gesture_emotion"}),
         dict(PRESETS["gestures_ieeevr2021"]["sections"][1], clips_per_participant=2,
              options=dict(PRESETS["gestures_ieeevr2021"]["sections"][1]["options"], n_generated=1, n_source=1)),
         dict(PRESETS["rbf_thms2016"]["sections"][0]),

@@ -49,6 +49,21 @@ def capture_label(style: str) -> str:
     (active -> energetic, exhausted -> tired, masculinity -> masculine), else the style's own name."""
     return CAPTURE_GAIT_EMOTIONS.get(style) or CAPTURE_THEMES.get(style) or style
 
+
+CAPTURE_GESTURE_EMOTIONS = {"happy": "joyous", "sad": "sad", "angry": "angry", "proud": "proud", "normal": "neutral"}
+"""Style names of captured gestures (Bandai Namco dataset 1's bow, bye, byebye, guide, respond) -> seed 003's gesture
+emotions (GESTURE_EMOTIONS), where the style names the same emotion: happy is joyous (the MPI category of happiness),
+sad, angry and proud are themselves, normal (the actor's plain performance) is neutral. ``not-confident`` is not
+mapped to ashamed: it names a lack of self-assurance (hesitant, withdrawn movement), not shame, the self-conscious
+emotion about a wrong done, and the dataset's labels describe a performance style, not a felt emotion; it keeps its
+own name. The other styles (tired, active, feminine, childish, ...) are not emotions of GESTURE_EMOTIONS."""
+
+
+def capture_gesture_emotion(style: str) -> str | None:
+    """The gesture emotion a captured style shows (CAPTURE_GESTURE_EMOTIONS), or None where none is honest."""
+    return CAPTURE_GESTURE_EMOTIONS.get(style)
+
+
 GESTURE_VAD: dict[str, tuple[float, float, float]] = {
     "afraid": (0.010, 0.775, 0.245),
     "amused": (0.942, 0.847, 0.596),

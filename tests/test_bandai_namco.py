@@ -75,7 +75,8 @@ def test_shipped_takes_follow_the_layout_and_carry_the_licence():
                                                 "feminine", "masculine"}
     assert all(t.skeleton == "gait" and t.dataset == "bandai-namco-1" for t in walks.values())
     gestures = sorted((t.content, t.style, t.skeleton) for t in takes if t.content != "walk")
-    assert gestures == [("bow", "sad", "gesture"), ("bye", "happy", "gesture")]
+    assert gestures == [("bow", "sad", "gesture"), ("bye", "angry", "gesture"), ("bye", "happy", "gesture"),
+                        ("bye", "normal", "gesture"), ("bye", "proud", "gesture"), ("bye", "sad", "gesture")]
     assert all(t.split == bn.split_for(t.name) for t in takes)
     assert "Attribution-NonCommercial 4.0" in (bn.SHIPPED_DIR / "LICENSE").read_text(encoding="utf-8")
     notice = (bn.SHIPPED_DIR / "NOTICE.md").read_text(encoding="utf-8")
