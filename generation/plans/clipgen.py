@@ -44,8 +44,10 @@ GENERATOR_MODULES = {
     "procedural_walk": ("generation.procedural.walk", "generation.procedural.emotion", "generation.core.paths"),
     "captured": ("generation.mocap.captured", "generation.core.foot_contact"),
     "captured_file": ("generation.plans.captured_file", "generation.mocap.importer"),
-    "neutral_walk": ("generation.rbf.neutral_base", "generation.rbf.stylise", "generation.core.foot_contact"),
-    "rbf": ("generation.rbf.neutral_base", "generation.rbf.stylise", "generation.core.foot_contact"),
+    "neutral_walk": ("generation.rbf.neutral_base", "generation.rbf.real_neutral", "generation.rbf.stylise",
+                     "generation.core.foot_contact"),
+    "rbf": ("generation.rbf.neutral_base", "generation.rbf.real_neutral", "generation.rbf.data_features",
+            "generation.rbf.stylise", "generation.core.foot_contact"),
     "gesture_net": ("generation.gesture.generate",),
     "procedural_gesture": ("generation.procedural.gesture", "generation.procedural.emotion"),
 }
@@ -349,8 +351,13 @@ def _captured(entry: ClipEntry, fps: float) -> Motion:
     return motion
 
 
-@functools.lru_cache(maxsize=1)
-def _neutral_cycle() -> Motion:
+@functools.lru_cache(maxsize=2)
+def _neutral_cycle(base: str = "real") -> Motion:
+    """The RBF styliser's neutral base: averaged real normal walks (shipped file) or averaged procedural walks."""
+    if base == "real":
+        from generation.rbf.real_neutral import load_cycle
+
+        return load_cycle()
     from generation.rbf.neutral_base import neutral_cycle
 
     return neutral_cycle()
@@ -359,12 +366,13 @@ def _neutral_cycle() -> Motion:
 def _neutral_walk(entry: ClipEntry, fps: float) -> Motion:
     from generation.rbf.stylise import cycle_stride, plant_walk_feet, warp_and_repeat_cycle
 
-    base = _neutral_cycle()
     inp = entry.inputs
+    base = _neutral_cycle(inp.get("base", "real"))
     rot, root = warp_and_repeat_cycle(base.rotations, base.root_positions, cycle_stride(base), base.duration,
                                       inp["speed"], inp["n_cycles"], fps)
     meta = dict(base.metadata)
-    meta.update({"generator": "neutral_walk", "n_cycles": inp["n_cycles"], "speed": inp["speed"]})
+    meta.update({"generator": "neutral_walk", "n_cycles": inp["n_cycles"], "speed": inp["speed"],
+                 "base": inp.get("base", "real")})
     # planted like the RBF-styled walks it is compared with (_rbf), so they differ by the features only
     return plant_walk_feet(Motion(base.skeleton, rot, root, fps, meta))
 
@@ -373,8 +381,10 @@ def _rbf(entry: ClipEntry, fps: float) -> Motion:
     from generation.rbf.stylise import stylise
 
     inp = entry.inputs
-    return stylise(_neutral_cycle(), inp["theme"], inp["weight"], inp["n_features"], speed=inp["speed"],
-                   n_cycles=inp["n_cycles"], fps=fps)
+    motion = stylise(_neutral_cycle(inp.get("base", "real")), inp["theme"], inp["weight"], inp["n_features"],
+                     speed=inp["speed"], n_cycles=inp["n_cycles"], fps=fps, features=inp.get("features", "expert"))
+    motion.metadata["base"] = inp.get("base", "real")
+    return motion
 
 
 def _gesture_net(entry: ClipEntry, fps: float) -> Motion:

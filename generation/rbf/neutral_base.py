@@ -170,8 +170,6 @@ def neutral_cycle_from_motions(motions: list[Motion], skeleton: Skeleton | None 
         along +z. metadata: origin "generated", generator "neutral_base", synthetic (True if any source is),
         sources, n_cycles, time_warping, ik_error_max_m.
     """
-    from generation.core.ik import inverse_kinematics
-
     if m < 20:
         raise ValueError(f"m must be at least 20 frames, got {m}")
     skeleton = skeleton or gait_skeleton()
@@ -192,6 +190,32 @@ def neutral_cycle_from_motions(motions: list[Motion], skeleton: Skeleton | None 
                          + (f"; cycles rejected as glitches (a joint faster than {MAX_JOINT_SPEED_M_S} m/s): "
                             f"{rejected}" if rejected else ""))
     mean, stride, duration = average_cycles(cycles)
+    metadata = {
+        "origin": "generated",
+        "generator": "neutral_base",
+        "synthetic": any(u["synthetic"] for u in used if u["cycles"]),
+        "sources": used,
+        "n_cycles": len(cycles),
+        "time_warping": TIME_WARPING,
+    }
+    return cycle_motion(mean, stride, duration, skeleton, metadata)
+
+
+def cycle_motion(mean: np.ndarray, stride: float, duration: float, skeleton: Skeleton, metadata: dict) -> Motion:
+    """Put an averaged cycle onto a skeleton: scale, add the progression, inverse kinematics, ground the feet.
+
+    Args:
+        mean: (m, J, 3) periodic positions in heights in the walker's frame (:func:`average_cycles`).
+        stride: stride / height; duration: cycle seconds.
+        skeleton: target skeleton; metadata: what to record (``cycle_frames``, ``stride_m``,
+            ``cycle_duration_s`` and ``ik_error_max_m`` are added).
+
+    Returns:
+        Motion of m frames at fps = m / duration whose root advances ``metadata["stride_m"]`` per cycle along +z.
+    """
+    from generation.core.ik import inverse_kinematics
+
+    m = mean.shape[0]
     H = skeleton.height
     positions = mean * H
     stride_m = stride * H
@@ -201,18 +225,8 @@ def neutral_cycle_from_motions(motions: list[Motion], skeleton: Skeleton | None 
     left, right = foot_joints(skeleton)
     floor = fitted[:, left + right, 1].min()
     root = motion.root_positions - np.array([0.0, floor, 0.0])
-    metadata = {
-        "origin": "generated",
-        "generator": "neutral_base",
-        "synthetic": any(u["synthetic"] for u in used if u["cycles"]),
-        "sources": used,
-        "n_cycles": len(cycles),
-        "cycle_frames": m,
-        "time_warping": TIME_WARPING,
-        "stride_m": [0.0, 0.0, stride_m],
-        "cycle_duration_s": duration,
-        "ik_error_max_m": report.max_error_m,
-    }
+    metadata = {**metadata, "cycle_frames": m, "stride_m": [0.0, 0.0, stride_m], "cycle_duration_s": duration,
+                "ik_error_max_m": report.max_error_m}
     return Motion(skeleton, motion.rotations, root, m / duration, metadata)
 
 

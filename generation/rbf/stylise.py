@@ -38,6 +38,7 @@ _MODELLED = frozenset(name for joints in BODY_PARTS.values() for name in joints)
 PAPER_WEIGHTS = (0.4, 0.7, 1.0, 1.3)  # Fig. 7
 PAPER_FEATURE_COUNTS = (1, 4, 7, 10)  # Fig. 7
 INVERSION_WEIGHT = -0.7  # Fig. 8
+FEATURE_SOURCES = ("expert", "data")  # Table III's expert features, or RBFs fitted to real themed walks
 
 # Two-bone chains (root, middle, end) of the 21-joint gait skeleton solved analytically.
 GAIT_LIMB_CHAINS = (
@@ -140,11 +141,21 @@ def theme_displacement(P: np.ndarray, skeleton: Skeleton, theme: str, n_features
     per-marker displacement. The root's (pelvis) edits are not passed on, as that would only translate the
     body. Without ``propagate`` only joints outside the paper's model (toes, hand tips) follow their parent.
     """
+    return rbf_displacement(P, skeleton, theme_rbfs(P, skeleton, theme, n_features, height), propagate)
+
+
+def rbf_displacement(P: np.ndarray, skeleton: Skeleton, dofs: dict[tuple[str, str], np.ndarray],
+                     propagate: bool = True) -> np.ndarray:
+    """Displacement (m, J, 3) metres of per-DOF RBFs {(joint, axis): (M, 3)} on a cycle shaped like P (m, J, 3).
+
+    Propagation as in :func:`theme_displacement`; with ``propagate`` False only joints outside the paper's
+    model (toes, hand tips) follow their parent (right for features fitted to every DOF of real data).
+    """
     m, J = P.shape[:2]
     S = np.zeros((m, J, 3))
     edited = np.zeros((J, 3), dtype=bool)
     t = np.arange(m, dtype=np.float64)
-    for (joint, axis), params in theme_rbfs(P, skeleton, theme, n_features, height).items():
+    for (joint, axis), params in dofs.items():
         j, a = skeleton.index(joint), AXES[axis]
         S[:, j, a] += rbf_sum(t, params, period=m)
         edited[j, a] = True
@@ -362,7 +373,7 @@ def warp_and_repeat_cycle(rotations: np.ndarray, root: np.ndarray, stride: np.nd
 # Public entry point
 # --------------------------------------------------------------------------------------------------
 def stylised_cycle(neutral_cycle: Motion, theme: str, weight: float, n_features: int,
-                   keep_ground: bool = True) -> dict:
+                   keep_ground: bool = True, features: str = "expert") -> dict:
     """One stylised cycle on the skeleton, with the intermediate arrays.
 
     Returns a dict with ``P`` (m, J, 3) neutral walker-frame positions, ``S`` (m, J, 3) secondary
@@ -371,14 +382,24 @@ def stylised_cycle(neutral_cycle: Motion, theme: str, weight: float, n_features:
     frame, and the bone-length errors ``before`` (of Y) and ``after`` (of the fit), the largest
     distance ``residual`` between fitted and edited positions and the largest ``ground_lift`` applied by
     :func:`keep_feet_above_ground` (when ``keep_ground``), all metres.
+
+    ``features``: "expert" (Table III, :func:`theme_displacement`) or "data" (RBFs fitted to real themed walks,
+    :func:`generation.rbf.data_features.data_rbfs`, applied to their own DOFs without propagation).
     """
+    if features not in FEATURE_SOURCES:
+        raise ValueError(f"features must be one of {list(FEATURE_SOURCES)}, got {features!r}")
     if not np.isfinite(weight):
         raise ValueError(f"weight must be a finite number, got {weight!r}")
     if theme not in THEME_NAMES:
         raise ValueError(f"unknown theme {theme!r}; expected one of {list(THEME_NAMES)}")
     skel = neutral_cycle.skeleton
     P, progression = walker_frame_positions(neutral_cycle)
-    S = theme_displacement(P, skel, theme, n_features)
+    if features == "expert":
+        S = theme_displacement(P, skel, theme, n_features)
+    else:
+        from .data_features import data_rbfs
+
+        S = rbf_displacement(P, skel, data_rbfs(theme, n_features, skel.height, P.shape[0]), propagate=False)
     Y = P + float(weight) * S
     target, lifted = keep_feet_above_ground(Y, P, skel) if keep_ground else (Y, 0.0)
     rotations, root = fit_to_skeleton(target, skel, neutral_cycle.rotations)
@@ -411,7 +432,8 @@ def keep_feet_above_ground(Y: np.ndarray, P: np.ndarray, skeleton: Skeleton) -> 
 
 
 def stylise(neutral_cycle: Motion, theme: str, weight: float, n_features: int, speed: float = 1.0,
-            n_cycles: int = 4, fps: float = 30.0, keep_ground: bool = True, plant: bool = True) -> Motion:
+            n_cycles: int = 4, fps: float = 30.0, keep_ground: bool = True, plant: bool = True,
+            features: str = "expert") -> Motion:
     """Apply a seed 004 theme to a neutral walk cycle and walk it along a straight line.
 
     Args:
@@ -427,6 +449,7 @@ def stylise(neutral_cycle: Motion, theme: str, weight: float, n_features: int, s
         keep_ground: clamp edited foot joints to their neutral floor height (:func:`keep_feet_above_ground`).
         plant: plant the feet of the walked result (:func:`plant_walk_feet`): the features move the feet (tired
             shortens the ankle swing while the body keeps the neutral stride), so without it they slide.
+        features: "expert" (Table III) or "data" (fitted to real themed walks; see :func:`stylised_cycle`).
 
     Returns:
         Motion on the neutral cycle's skeleton, round(n_cycles * cycle duration / speed * fps) frames, with
@@ -440,7 +463,7 @@ def stylise(neutral_cycle: Motion, theme: str, weight: float, n_features: int, s
         raise ValueError(f"fps must be positive, got {fps!r}")
     if isinstance(n_cycles, bool) or not isinstance(n_cycles, int) or n_cycles < 1:
         raise ValueError(f"n_cycles must be a positive integer, got {n_cycles!r}")
-    result = stylised_cycle(neutral_cycle, theme, weight, n_features, keep_ground)
+    result = stylised_cycle(neutral_cycle, theme, weight, n_features, keep_ground, features)
     stride = cycle_stride(neutral_cycle)
     rotations, root = warp_and_repeat_cycle(result["rotations"], result["root"], stride, neutral_cycle.duration,
                                             speed, n_cycles, fps)
@@ -451,6 +474,7 @@ def stylise(neutral_cycle: Motion, theme: str, weight: float, n_features: int, s
         "theme": theme,
         "weight": float(weight),
         "n_features": int(n_features),
+        "features": features,
         "speed": float(speed),
         "synthetic_base": bool(base_meta.get("synthetic", base_meta.get("synthetic_base", True))),
         "n_cycles": n_cycles,
@@ -459,8 +483,19 @@ def stylise(neutral_cycle: Motion, theme: str, weight: float, n_features: int, s
         "fit_residual_max_m": result["residual"],
         "ground_lift_max_m": result["ground_lift"],
     }
+    metadata.update(base_provenance(base_meta))
+    if features == "data" and "licence" not in metadata:
+        from .data_features import load_data_features
+
+        data = load_data_features()
+        metadata.update({"licence": data["licence"], "citation": data["citation"]})
     motion = Motion(neutral_cycle.skeleton, rotations, root, fps, metadata)
     return plant_walk_feet(motion) if plant else motion
+
+
+def base_provenance(base_meta: dict) -> dict:
+    """What a clip keeps of its base cycle's provenance: captured_base, licence, citation, dataset_url."""
+    return {k: base_meta[k] for k in ("captured_base", "licence", "citation", "dataset_url") if k in base_meta}
 
 
 def plant_walk_feet(motion: Motion) -> Motion:
@@ -495,10 +530,12 @@ def neutral_walk(neutral_cycle: Motion, speed: float = 1.0, n_cycles: int = 4, f
     meta = neutral_cycle.metadata
     metadata = {"origin": "generated", "generator": "neutral_base", "theme": "neutral", "weight": 0.0,
                 "n_features": 0, "speed": float(speed), "n_cycles": n_cycles,
-                "synthetic_base": bool(meta.get("synthetic", meta.get("synthetic_base", True)))}
+                "synthetic_base": bool(meta.get("synthetic", meta.get("synthetic_base", True))),
+                **base_provenance(meta)}
     motion = Motion(neutral_cycle.skeleton, rotations, root, fps, metadata)
     return plant_walk_feet(motion) if plant else motion
 
 
 __all__ = ["neutral_walk", "plant_walk_feet", "stylise", "stylised_cycle", "theme_rbfs", "theme_displacement",
+           "rbf_displacement", "FEATURE_SOURCES",
            "fit_to_skeleton", "walker_frame_positions", "warp_and_repeat_cycle", "bone_length_error", "CYCLE_FRAMES"]

@@ -1,0 +1,48 @@
+"""Command line of the RBF styliser's real-capture data: build the averaged neutral walk and the data features.
+
+    python -m generation.rbf neutral  [--corpus CORPUS] [--out generation/data/rbf/neutral_real.npz]
+    python -m generation.rbf features [--corpus CORPUS] [--out generation/data/rbf/data_features.json]
+
+CORPUS is the real-capture corpus (``python -m generation.mocap dataset bandai-namco DIR --out CORPUS``; default
+``var/mocap/bandai-namco.npz`` or $REAL_CORPUS). Both read the train split only.
+"""
+from __future__ import annotations
+
+import argparse
+import sys
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(prog="python -m generation.rbf", description=__doc__.splitlines()[0])
+    sub = parser.add_subparsers(dest="command", required=True)
+    for name, help_ in (("neutral", "average real normal-walk cycles into the neutral base cycle"),
+                        ("features", "fit data-driven RBF features per theme to real themed walks")):
+        p = sub.add_parser(name, help=help_)
+        p.add_argument("--corpus", default=None, help="real-capture corpus .npz (default: REAL_CORPUS or var/mocap)")
+        p.add_argument("--out", default=None, help="output file (default: the shipped file in generation/data/rbf)")
+    args = parser.parse_args(argv)
+    if args.command == "neutral":
+        from .real_neutral import SHIPPED_PATH, build_real_neutral
+
+        cycle = build_real_neutral(args.corpus, args.out or SHIPPED_PATH)
+        md = cycle.metadata
+        print(f"neutral cycle: {md['n_cycles']} cycles from {md['n_takes']} takes, {cycle.duration:.3f} s, "
+              f"stride {md['stride_m'][2]:.3f} m, DTW spread {md['dtw_spread']['before']:.5f} -> "
+              f"{md['dtw_spread']['after']:.5f} heights -> {args.out or SHIPPED_PATH}")
+        return 0
+    from generation.core.skeleton import GAIT_JOINTS
+    from generation.mocap.real_corpus import load_real_corpus, real_corpus_path
+
+    from .data_features import SHIPPED_PATH as FEATURES_PATH
+    from .data_features import fit_data_features, save_data_features
+
+    clips = load_real_corpus(args.corpus or real_corpus_path(), skeleton="gait", split="train", contents=["walk"])
+    features = fit_data_features(clips, GAIT_JOINTS)
+    save_data_features(features, args.out or FEATURES_PATH)
+    for theme, entry in features["themes"].items():
+        print(f"{theme}: {len(entry['dofs'])} DOFs, top {entry['features'][:3]}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
