@@ -171,15 +171,27 @@ CLIP_FLOAT_COLUMNS = (*GAIT_EMOTIONS, *FINAL_EMOTION_COLUMNS, *VAD_DIMENSIONS, "
 CLIP_INT_COLUMNS = ("n_features",)
 
 # ---- per-clip quality record (issue 14): optional extra columns of clips.csv after CLIP_COLUMNS ----------------
-QA_CHECKS = ("foot_skate", "penetration", "jerk", "bone_error", "figure_height", "observer")
+QA_CHECKS = ("foot_skate", "penetration", "jerk", "bone_error", "figure_height", "observer", "realism")
 """Quality checks; a clip's ``qa_flag`` joins the names of those it failed with ';' (empty = passed)."""
 
+QA_REALISM_COLUMNS = ("qa_skate_cm_s", "qa_skate_ratio", "qa_toe_skim", "qa_stance_knee_deg", "qa_pelvis_bounce_cm",
+                      "qa_speed_cv")
+"""Realism measures of gait clips (generation/quality/realism.py): foot speed near the floor (cm/s), GMD's
+foot-skating ratio, toe-skim share, stance knee flexion (degrees), pelvis bounce (cm), walking-speed variability."""
+
 QA_COLUMNS = ("qa_foot_skate_cm_s", "qa_penetration_cm", "qa_jerk", "qa_bone_error_mm", "qa_figure_height_frac",
-              "qa_observed", "qa_observed_p", "qa_flag")
-"""The quality columns of clips.csv, in order, after CLIP_COLUMNS (old files without them still read)."""
+              "qa_observed", "qa_observed_p", "qa_flag", *QA_REALISM_COLUMNS, "qa_observer")
+"""The quality columns of clips.csv, in order, after CLIP_COLUMNS (old files without them, or without the realism
+columns and ``qa_observer`` that follow ``qa_flag``, still read: missing cells are blank). ``qa_observer`` names the
+observer behind ``qa_observed``: ``real`` (trained on real capture), ``synthetic`` or ``synthetic-gesture``."""
 
 QA_FLOAT_COLUMNS = ("qa_foot_skate_cm_s", "qa_penetration_cm", "qa_jerk", "qa_bone_error_mm", "qa_figure_height_frac",
-                    "qa_observed_p")
+                    "qa_observed_p", *QA_REALISM_COLUMNS)
+
+QA_OBSERVERS = ("real", "synthetic")
+"""Which gait observer fills ``qa_observed`` (plan ``qa: {observer: ...}``, env ``QA_GAIT_OBSERVER``): ``real``, a
+classifier trained on real captured walks (generation/quality/real_observer.py, the default), or ``synthetic``,
+trained on the procedural corpus (generation/quality/observer.py)."""
 
 QA_THRESHOLDS = {
     "foot_skate_cm_s": 10.0,         # max mean foot slide in contact (corpus walks 2.2-2.6, raw network 15-30)
@@ -197,7 +209,11 @@ QA_THRESHOLDS = {
 observer reads (generation/quality/gesture_observer.py: the NRC-VAD arousal of the 11 emotions weighted by its
 probabilities) is at least this far from the NRC-VAD arousal (0..1) of the clip's intended ``emotion_label``. On
 held-out generated gestures 0.30 flagged none of 363 honest clips and 93 % of clips labelled with an emotion whose
-arousal differs by 0.3 or more (docs/benchmarks/motion_quality.md, "Gesture observer")."""
+arousal differs by 0.3 or more (docs/benchmarks/motion_quality.md, "Gesture observer").
+
+The ``realism`` check's bounds (``<measure>_min`` / ``<measure>_max``, e.g. ``stance_knee_deg_max``) are the real
+corpus's own ranges, kept in generation/quality/realism_ranges.json; generation.quality.checks.resolve_thresholds
+adds them to these, and a plan's ``qa:`` block overrides them the same way."""
 
 RESPONSE_COLUMNS = ("participant_id", "section_type", "clip_id", "question", "answer", "response_ms")
 """responses.csv, in order: one row per answer."""

@@ -159,7 +159,10 @@ def test_unread_line_says_which_clips_got_no_observer_reading():
     read = [{"modality": "gait", "qa": {"observed": "sad"}}, {"modality": "gesture", "qa": {"observed": "proud"}},
             {"modality": "rbf", "qa": {}}]
     assert unread_line(read) == ""
-    line = unread_line(read + [{"modality": "gait", "qa": {"observed": None}}, {"modality": "gait"},
-                               {"modality": "gesture", "qa": {"observed": None}}])
+    unread = read + [{"modality": "gait", "qa": {"observed": None}}, {"modality": "gait"},
+                     {"modality": "gesture", "qa": {"observed": None}}]
+    line = unread_line(unread, "synthetic")
     assert line.startswith("QA: no observer reading")
     assert "2 gait clip(s)" in line and "build_corpus" in line and "1 gesture clip(s)" in line
+    real = unread_line(unread)                       # the real-capture observer is the default
+    assert "2 gait clip(s) (no real-capture observer" in real and "generation/data/mocap/bandai-namco" in real

@@ -188,7 +188,7 @@ def _add_qa(record: dict, job: Job, motion, camera: dict) -> None:
     """Measure the clip's quality (:mod:`generation.quality`) into ``record["qa"]`` and ``record["qa_flag"]``."""
     from generation.pipeline.plan_qa import clip_qa, intended_emotion, observer_for
 
-    observer = observer_for(job.run_entry.modality)
+    observer = observer_for(job.run_entry.modality, (job.qa_thresholds or {}).get("observer"))
     result, _ = clip_qa(motion, job.run_entry.render, job.qa_thresholds, intended_emotion(job.run_entry.inputs),
                         observer, camera_info=camera)
     record["qa"] = _json_safe(result.as_dict())
@@ -382,7 +382,8 @@ def run_plan(plan: Plan, clips_dir: str | Path, records_dir: str | Path, media_p
         from generation.pipeline.plan_qa import observer_for
 
         for modality in sorted({j.run_entry.modality for j in todo}):
-            observer_for(modality)  # train/cache the quality observers once, not in every worker
+            # train/cache the quality observers once, not in every worker
+            observer_for(modality, (todo[0].qa_thresholds or {}).get("observer"))
     if scheduler is not None:
         _render_dask(batch, todo, scheduler, threads_per_worker)
     elif workers <= 1 or len(todo) <= 1:

@@ -19,24 +19,38 @@ Checks (names in :data:`study_protocol.QA_CHECKS`), each against :data:`study_pr
   neighbours on generated gestures (69 % top-label accuracy, 97 % on the arousal half;
   docs/benchmarks/motion_quality.md, "Gesture observer").
 
-Both observers are stand-ins for participants, trained on synthetic motion; a clip's record keeps the top label
-(``observed``), its probability (``observed_p``) and, for gestures, the observed arousal (``observed_arousal``; in
-the record and Clip.qa, not a clips.csv column). Gesture clips shorter than 2.5 s (the network's shortest gesture;
-the shortest training gesture is 2.7 s) get no reading: their descriptors are outside what it was fitted on.
+- ``realism``: a gait clip whose realism measures (:mod:`generation.quality.realism`: foot speed near the floor,
+  foot-skating ratio, toe skim, stance knee flexion, pelvis bounce, walking-speed variability) leave the real
+  corpus's own ranges (:mod:`generation.quality.realism_ranges`; bounds ``<measure>_min``/``<measure>_max``).
+
+The gait observer is by default the real-capture observer (:mod:`generation.quality.real_observer`, trained on
+real captured walks); the synthetic one (trained on the procedural corpus) is chosen with the plan's
+``qa: {observer: synthetic}`` or the env var ``QA_GAIT_OBSERVER=synthetic``. The gesture observer is synthetic.
+Observers are stand-ins for participants; a clip's record keeps the top label (``observed``), its probability
+(``observed_p``), which observer read it (``observer``: real, synthetic or synthetic-gesture) and, for gestures,
+the observed arousal (``observed_arousal``; in the record and Clip.qa, not a clips.csv column). Gesture clips
+shorter than 2.5 s (the network's shortest gesture; the shortest training gesture is 2.7 s) get no reading: their
+descriptors are outside what it was fitted on.
 """
 from __future__ import annotations
 
 import math
+import os
 from dataclasses import dataclass, field
 
 import numpy as np
 
 from generation.core.motion import Motion
-from study_protocol import GAIT_EMOTIONS, GESTURE_VAD, QA_CHECKS, QA_COLUMNS, QA_THRESHOLDS
+from generation.core.skeleton import GAIT_JOINTS
+from study_protocol import GAIT_EMOTIONS, GESTURE_VAD, QA_CHECKS, QA_COLUMNS, QA_OBSERVERS, QA_THRESHOLDS
 
 from .metrics import motion_metrics
+from .realism import MEASURES, realism_measures
+from .realism_ranges import out_of_range, realism_thresholds
 
 DOMINANT_SHARE = 0.5
+OBSERVER_KEY = "observer"
+OBSERVER_ENV = "QA_GAIT_OBSERVER"
 
 
 class QAThresholdError(ValueError):
@@ -66,16 +80,31 @@ class QAResult:
         return cls(values, [f for f in flag.split(";") if f])
 
 
+def default_observer_kind() -> str:
+    """The gait observer when a plan names none: ``$QA_GAIT_OBSERVER`` (real or synthetic), else ``real``."""
+    kind = os.environ.get(OBSERVER_ENV, "").strip() or "real"
+    if kind not in QA_OBSERVERS:
+        raise QAThresholdError(f"{OBSERVER_ENV}={kind!r}: expected one of {', '.join(QA_OBSERVERS)}")
+    return kind
+
+
 def resolve_thresholds(plan_qa: dict | None = None) -> dict:
-    """QA_THRESHOLDS overridden by a plan's ``qa:`` block; unknown keys and non-numbers raise QAThresholdError."""
-    out = dict(QA_THRESHOLDS)
+    """QA_THRESHOLDS plus the realism bounds (realism_ranges.json) and the gait observer kind (``observer``:
+    real or synthetic), overridden by a plan's ``qa:`` block; unknown keys and bad values raise
+    QAThresholdError."""
+    out = {**QA_THRESHOLDS, **realism_thresholds(), OBSERVER_KEY: default_observer_kind()}
     if plan_qa is None:
         return out
     if not isinstance(plan_qa, dict):
         raise QAThresholdError(f"field 'qa': expected a mapping of thresholds, got {plan_qa!r}")
     for key, value in plan_qa.items():
-        if key not in QA_THRESHOLDS:
-            raise QAThresholdError(f"field 'qa.{key}': unknown threshold; expected one of {sorted(QA_THRESHOLDS)}")
+        if key == OBSERVER_KEY:
+            if value not in QA_OBSERVERS:
+                raise QAThresholdError(f"field 'qa.{key}': expected one of {', '.join(QA_OBSERVERS)}, got {value!r}")
+            out[key] = value
+            continue
+        if key not in out:
+            raise QAThresholdError(f"field 'qa.{key}': unknown threshold; expected one of {sorted(out)}")
         if value is not None and (isinstance(value, bool) or not isinstance(value, (int, float))
                                   or not math.isfinite(value) or value < 0):
             raise QAThresholdError(f"field 'qa.{key}': expected a number >= 0 or null (check off), got {value!r}")
@@ -110,16 +139,24 @@ def evaluate(motion: Motion, thresholds: dict | None = None, figure_height_frac:
         seated: the clip shows a seated body (the seated figure-height threshold applies).
         intended: the gait emotion vector (GAIT_EMOTIONS order) or the gesture emotion label (GESTURE_EMOTIONS)
             the clip should show, or None.
-        observer: a :class:`generation.quality.observer.GaitObserver` for gait motions (21 joints) or a
+        observer: a gait observer for gait motions (21 joints: the real-capture
+            :class:`generation.quality.real_observer.RealGaitObserver` or the synthetic
+            :class:`generation.quality.observer.GaitObserver`) or a
             :class:`generation.quality.gesture_observer.GestureObserver` for gesture motions (23 joints, at least
             as long as its ``min_seconds``, 2.5 s); each says which motions it ``reads`` and gives their
             ``qa_values``. None or an observer of the other skeleton: no reading.
+
+    Gait-skeleton motions also get the realism measures (:data:`generation.quality.realism.MEASURES`; None for
+    other skeletons).
     """
     values = {k: round(v, 4) for k, v in motion_metrics(motion).items()}
     values["figure_height_frac"] = None if figure_height_frac is None else round(float(figure_height_frac), 4)
-    values["observed"], values["observed_p"] = None, None
+    values["observed"], values["observed_p"], values["observer"] = None, None, None
     if observer is not None and observer.reads(motion):
         values.update(observer.qa_values(motion))
+    gait = motion.skeleton.joints == GAIT_JOINTS and motion.num_frames >= 2
+    realism = realism_measures(motion) if gait else dict.fromkeys(MEASURES)
+    values.update({k: None if v is None else round(v, 4) for k, v in realism.items()})
     values["seated"] = bool(seated)
     return QAResult(values, failed_checks(values, thresholds, intended))
 
@@ -144,6 +181,7 @@ def failed_checks(values: dict, thresholds: dict | None = None, intended=None) -
         observed, p = values.get("observed"), values.get("observed_p")
         failed["observer"] = (th["observer_mismatch_p"] is not None and dominant is not None and observed is not None
                               and p is not None and observed != dominant and p >= th["observer_mismatch_p"])
+    failed["realism"] = bool(out_of_range(values, th))
     return [c for c in QA_CHECKS if failed[c]]
 
 

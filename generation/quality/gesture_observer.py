@@ -161,9 +161,10 @@ class GestureObserver:
 
     def qa_values(self, motion: Motion) -> dict:
         """The quality record's reading: ``observed`` (top label), ``observed_p`` (its probability) and
-        ``observed_arousal`` (what the gesture ``observer`` check compares)."""
+        ``observed_arousal`` (what the gesture ``observer`` check compares), and ``observer``: synthetic-gesture."""
         label, p, arousal = self.reading(motion)
-        return {"observed": label, "observed_p": round(p, 4), "observed_arousal": round(arousal, 4)}
+        return {"observed": label, "observed_p": round(p, 4), "observed_arousal": round(arousal, 4),
+                "observer": "synthetic-gesture"}
 
     def observe(self, motion: Motion) -> tuple[str, float]:
         """(top label, its probability) for one gesture motion."""

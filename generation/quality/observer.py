@@ -66,9 +66,10 @@ class GaitObserver:
         return motion.skeleton.num_joints == len(GAIT_JOINTS) and motion.num_frames >= 2
 
     def qa_values(self, motion: Motion) -> dict:
-        """The quality record's reading: ``observed`` (top label) and ``observed_p`` (its probability)."""
+        """The quality record's reading: ``observed`` (top label), ``observed_p`` (its probability) and
+        ``observer``: synthetic."""
         label, p = self.observe(motion)
-        return {"observed": label, "observed_p": round(p, 4)}
+        return {"observed": label, "observed_p": round(p, 4), "observer": "synthetic"}
 
     def observe(self, motion: Motion) -> tuple[str, float]:
         """(top label, its probability) for one gait motion."""

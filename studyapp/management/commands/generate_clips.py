@@ -95,9 +95,10 @@ class Command(BaseCommand):
                           f"{len(result.failed)} failed, {result.seconds:.1f} s; catalogue {csv_path}")
         if records:
             from generation.pipeline.plan_qa import summary_line, unread_line
+            from generation.quality.checks import resolve_thresholds
 
             self.stdout.write(f"plan {plan.name}: " + summary_line(r.get("qa_flag", "") for r in records))
-            if unread := unread_line(records):
+            if unread := unread_line(records, resolve_thresholds(plan.qa)["observer"]):
                 self.stdout.write(f"plan {plan.name}: {unread}")
         if opts["contact_sheet"] is not None and records:
             from generation.render import contact_sheet

@@ -1,0 +1,76 @@
+"""The real-capture gait observer: trained on a tiny corpus of the shipped real walks, cached, its fallbacks, and
+its reading in the quality gate."""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from generation.mocap.real_corpus import save_real_corpus
+from generation.pipeline.plan_qa import observer_for, unread_line
+from generation.quality import evaluate, resolve_thresholds
+from generation.quality import real_observer as ro
+from study_protocol import CAPTURE_GAIT_EMOTIONS
+
+
+@pytest.fixture(scope="module")
+def shipped():
+    """The shipped real walks (8 takes, one per style) on the gait skeleton."""
+    return ro.shipped_clips()
+
+
+@pytest.fixture()
+def fresh(monkeypatch, tmp_path):
+    """An empty in-memory observer cache and a temporary pickle folder."""
+    monkeypatch.setattr(ro, "_DEFAULT", {})
+    monkeypatch.setattr(ro, "CACHE_DIR", tmp_path / "cache")
+    return tmp_path
+
+
+def test_observer_trained_on_a_tiny_corpus_reads_its_takes_and_is_cached(shipped, fresh, monkeypatch):
+    corpus = save_real_corpus(fresh / "tiny.npz", shipped, {"split_rule": "test corpus"})
+    obs = ro.default_real_observer(corpus)
+    assert "tiny.npz" in obs.source and sum(obs.train_takes.values()) == 4
+    for clip in shipped:
+        if clip.style in CAPTURE_GAIT_EMOTIONS:
+            label, p = obs.observe(clip.motion)
+            assert label == CAPTURE_GAIT_EMOTIONS[clip.style] and 0.25 < p <= 1.0
+            assert obs.proba(clip.motion).sum() == pytest.approx(1.0)
+    by_style = {c.style: c for c in shipped}
+    assert obs.theme_proba(by_style["masculinity"].motion, "feminine_vs_masculine") > 0.5
+    assert obs.theme_proba(by_style["feminine"].motion, "feminine_vs_masculine") < 0.5
+    assert obs.theme_proba(by_style["tired"].motion, "energetic_vs_tired") > 0.5
+    pickles = list((fresh / "cache").glob("real_gait_observer_v*_*.pkl"))
+    assert len(pickles) == 1 and ro.corpus_digest(corpus)[:12] in pickles[0].name
+    # a new process (empty memory) loads the pickle instead of training again
+    monkeypatch.setattr(ro, "_DEFAULT", {})
+    monkeypatch.setattr(ro, "train_real_observer", lambda path: pytest.fail("trained again"))
+    again = ro.default_real_observer(corpus)
+    np.testing.assert_allclose(again.proba(shipped[0].motion), obs.proba(shipped[0].motion))
+
+
+def test_the_gate_flags_a_real_walk_read_as_another_emotion(shipped, fresh):
+    obs = ro.RealGaitObserver(shipped, source="shipped test")
+    sad = next(c for c in shipped if c.style == "sad")
+    _, p = obs.observe(sad.motion)
+    th = resolve_thresholds({"observer_mismatch_p": p - 1e-6})
+    res = evaluate(sad.motion, th, intended=[1.0, 0.0, 0.0, 0.0], observer=obs)      # meant happy, reads sad
+    assert res.values["observed"] == "sad" and res.values["observer"] == "real" and "observer" in res.flags
+    assert "observer" not in evaluate(sad.motion, th, intended=[0.0, 1.0, 0.0, 0.0], observer=obs).flags
+
+
+def test_without_a_corpus_it_falls_back_to_the_shipped_takes_or_says_there_is_none(shipped, fresh, monkeypatch):
+    missing = fresh / "absent.npz"
+    monkeypatch.setattr(ro, "shipped_clips", lambda: shipped)
+    obs = ro.default_real_observer(missing)
+    assert "shipped real takes only" in obs.source and str(missing) in obs.source
+    assert obs.observe(next(c for c in shipped if c.style == "angry").motion)[0] == "angry"
+
+    def no_files():
+        raise FileNotFoundError("generation/data/mocap/bandai-namco: gone")
+
+    monkeypatch.setattr(ro, "_DEFAULT", {})
+    monkeypatch.setattr(ro, "shipped_clips", no_files)
+    monkeypatch.setenv("REAL_CORPUS", str(missing))
+    assert ro.default_real_observer() is None and observer_for("gait", "real") is None
+    line = unread_line([{"modality": "gait", "qa": {"observed": None}}], "real")
+    assert "no real-capture observer" in line
