@@ -4,8 +4,10 @@
 # Environment: DEMO_ADMIN_USER / DEMO_ADMIN_PASSWORD (default admin / a generated password kept in var/),
 #              HOST (127.0.0.1), PORT (8000), DEMO_WORKERS (2),
 #              DEBUG (off; DEBUG=1 bash demo.sh shows Django's debug pages: never on a reachable host).
-# The server's access log leaves out participant tokens and Prolific IDs (studyapp/gunicorn_logging.py); gthread
-# workers let a slow video download never block an answer.
+# The server's access log leaves out participant tokens and Prolific IDs (studyapp/gunicorn_logging.py). gunicorn
+# faces the network directly here, so it runs asyncio (ASGI) workers: a client sending its request a byte at a
+# time, or downloading a video slowly, holds a connection, never a thread (docs/security.md "Slow clients"). For a
+# public study put nginx in front (docs/deploy.md).
 set -euo pipefail
 cd "$(dirname "$0")"
 bash scripts/bootstrap.sh
@@ -59,5 +61,5 @@ cat <<MSG
   Stop the server with Ctrl-C; run 'bash demo.sh' again to restart (nothing is redone).
 
 MSG
-exec .venv/bin/gunicorn studyapp.wsgi -b "$HOST:$PORT" -w 2 --worker-class gthread --threads 4 \
+exec .venv/bin/gunicorn studyapp.asgi:application -b "$HOST:$PORT" -w 2 --worker-class asgi \
     --access-logfile - --logger-class studyapp.gunicorn_logging.RedactingLogger

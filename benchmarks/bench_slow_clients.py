@@ -186,11 +186,16 @@ def main(argv=None) -> None:
         for name in args.server or sorted(SERVERS):
             rows += run(name, args, env, Path(tmp))
             print(rows[-2], rows[-1], flush=True)
-    print("\n| server | phase | probes | p50 ms | p99 ms | max ms | failed/timed out |")
-    print("|---|---|---|---|---|---|---|")
-    for r in rows:
-        print(f"| {r['server']} | {r['phase']} | {r['probes']} | {r['p50_ms']} | {r['p99_ms']} | {r['max_ms']} | "
-              f"{r['failed']} |")
+    print_table(["server", "phase", "probes", "p50 ms", "p99 ms", "max ms", "failed/timed out"],
+                [[r[k] for k in ("server", "phase", "probes", "p50_ms", "p99_ms", "max_ms", "failed")] for r in rows])
+
+
+def print_table(header: list[str], rows: list[list]) -> None:
+    """A Markdown table of ``rows`` under ``header`` on stdout."""
+    print("\n| " + " | ".join(header) + " |")
+    print("|" + "---|" * len(header))
+    for row in rows:
+        print("| " + " | ".join(str(v) for v in row) + " |")
 
 
 if __name__ == "__main__":
