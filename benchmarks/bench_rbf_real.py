@@ -1,0 +1,304 @@
+"""Seed 004 on real capture: the averaged neutral walk checked against real normal walks, expert vs data-driven
+RBF features per theme, what the real-capture observers read, and a contact sheet per theme.
+
+Run:  OMP_NUM_THREADS=1 python benchmarks/bench_rbf_real.py [--corpus var/mocap/bandai-namco.npz]
+          [--out docs/benchmarks/rbf_real.json] [--doc docs/benchmarks/rbf.md] [--sheets docs/img]
+
+Needs the real-capture corpus (``python -m generation.mocap dataset bandai-namco DIR --out CORPUS``). Real data:
+Bandai Namco Research Motion Dataset 1 and 2 (Kobayashi et al. 2023, arXiv:2306.08861; CC BY-NC 4.0).
+
+- Neutral: the shipped averaged cycle (``generation.rbf.real_neutral.load_cycle``) walked for 4 cycles at 30 fps
+  (``neutral_walk``), beside the procedural base; measures: walking speed (median over 1 s windows of the root's
+  ground-plane speed), cadence (steps/min, from the median interval between heel strikes), stance knee flexion and
+  pelvis bounce (``generation.quality.realism``), compared with every real normal walk (both datasets, all splits).
+- Expert vs data (``generation.rbf.compare.compare_theme``): per theme the top DOFs by amplitude.
+- Observers (``generation.quality.real_observer``): the four-emotion classifier and the theme-pair classifiers,
+  their held-out accuracy on the test split's takes (take level: mean window probability > 0.5), and their reading
+  of the neutral walk, of each theme styled with expert and with data features (w = 0.7 and 1.0, all ten
+  features) and of the real themed test takes.
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+import tempfile
+import warnings
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))
+
+from generation.mocap.real_corpus import load_real_corpus, real_corpus_path  # noqa: E402
+from generation.quality.real_observer import THEME_PAIRS, default_real_observer  # noqa: E402
+from generation.quality.realism import realism_measures  # noqa: E402
+from generation.rbf.compare import compare_theme  # noqa: E402
+from generation.rbf.neutral_base import heel_strikes, neutral_cycle  # noqa: E402
+from generation.rbf.real_neutral import load_cycle  # noqa: E402
+from generation.rbf.stylise import neutral_walk, stylise  # noqa: E402
+from generation.rbf.themes import THEME_NAMES  # noqa: E402
+from study_protocol import CAPTURE_THEMES, GAIT_EMOTIONS  # noqa: E402
+
+MARK_START, MARK_END = "<!-- rbf-real:start -->", "<!-- rbf-real:end -->"
+CHECKED = ("speed_m_s", "cadence_steps_min", "stance_knee_deg", "pelvis_bounce_cm")
+WEIGHTS = (0.7, 1.0)
+PAIR_OF = {theme: (pair, side) for pair, sides in THEME_PAIRS.items()
+           for side, styles in enumerate(sides) for theme in {CAPTURE_THEMES[s] for s in styles}}
+
+
+def walk_measures(motion) -> dict:
+    """Speed (m/s), cadence (steps/min), stance knee flexion (deg) and pelvis bounce (cm) of a walk."""
+    P = motion.positions()
+    fps = motion.fps
+    w = max(1, int(round(fps)))
+    root = P[:, 0, [0, 2]]
+    speeds = np.linalg.norm(root[w:] - root[:-w], axis=-1) * fps / w
+    left, right = heel_strikes(P, fps, motion.skeleton)
+    strikes = np.sort(np.concatenate([left, right]))
+    cadence = 60.0 * fps / float(np.median(np.diff(strikes))) if len(strikes) > 2 else float("nan")
+    r = realism_measures(motion)
+    return {"speed_m_s": float(np.median(speeds)), "cadence_steps_min": cadence,
+            "stance_knee_deg": r["stance_knee_deg"], "pelvis_bounce_cm": r["pelvis_bounce_cm"]}
+
+
+def neutral_section(corpus: Path, observer) -> dict:
+    real = load_real_corpus(corpus, skeleton="gait", contents=["walk"], styles=["normal"])
+    real_rows = [dict(walk_measures(c.motion), name=c.name, split=c.split) for c in real]
+    base = load_cycle()
+    bases = {"real (averaged)": base, "procedural (averaged, synthetic)": neutral_cycle()}
+    rows = {}
+    for name, cyc in bases.items():
+        walk = neutral_walk(cyc, n_cycles=4, fps=30.0)
+        row = walk_measures(walk)
+        row["observer"] = dict(zip(GAIT_EMOTIONS, observer.proba(walk).round(3).tolist()))
+        rows[name] = row
+    ranges = {k: (float(np.nanmin([r[k] for r in real_rows])), float(np.nanmax([r[k] for r in real_rows])))
+              for k in CHECKED}
+    for row in rows.values():
+        row["inside"] = {k: bool(ranges[k][0] <= row[k] <= ranges[k][1]) for k in CHECKED}
+    test = [c for c in real if c.split == "test"]
+    real_read = np.mean([observer.proba(c.motion) for c in test], axis=0)
+    md = base.metadata
+    return {"metadata": {k: md[k] for k in ("n_cycles", "n_takes", "time_warping", "dtw_spread", "stride_m",
+                                            "cycle_duration_s", "ik_error_max_m", "captured_sources")},
+            "bases": rows, "real_ranges": ranges, "real_takes": len(real_rows),
+            "real_test_normal_read": dict(zip(GAIT_EMOTIONS, real_read.round(3).tolist()))}
+
+
+def pair_accuracy(observer, corpus: Path) -> dict:
+    """Held-out (test split) take-level accuracy of each theme-pair classifier and of the emotion classifier."""
+    out = {}
+    test = load_real_corpus(corpus, skeleton="gait", split="test", contents=["walk"])
+    for pair, (first, second) in THEME_PAIRS.items():
+        takes = [c for c in test if c.style in first + second]
+        hits = [(observer.theme_proba(c.motion, pair) > 0.5) == (c.style in second) for c in takes]
+        out[pair] = {"takes": len(takes), "accuracy": float(np.mean(hits)) if hits else None}
+    style_to_emotion = {"happy": "happy", "sad": "sad", "angry": "angry", "normal": "neutral"}
+    emo = [c for c in test if c.dataset == "bandai-namco-1" and c.style in style_to_emotion]
+    hits = [observer.observe(c.motion)[0] == style_to_emotion[c.style] for c in emo]
+    out["emotions (dataset 1)"] = {"takes": len(emo), "accuracy": float(np.mean(hits)) if hits else None}
+    return out
+
+
+def intended_p(observer, motion, theme: str) -> float:
+    """The theme-pair classifier's probability of ``theme`` for a motion."""
+    pair, side = PAIR_OF[theme]
+    p = observer.theme_proba(motion, pair)
+    return p if side == 1 else 1.0 - p
+
+
+def observer_section(observer, corpus: Path, base) -> dict:
+    test = load_real_corpus(corpus, skeleton="gait", split="test", contents=["walk"])
+    neutral = neutral_walk(base, n_cycles=4, fps=30.0)
+    out = {}
+    for theme in THEME_NAMES:
+        styles = [s for s, t in CAPTURE_THEMES.items() if t == theme]
+        real = [c for c in test if c.style in styles]
+        row = {"pair": PAIR_OF[theme][0], "neutral": intended_p(observer, neutral, theme),
+               "real_test": float(np.mean([intended_p(observer, c.motion, theme) for c in real])),
+               "real_test_takes": len(real)}
+        for w in WEIGHTS:
+            for features in ("expert", "data"):
+                clip = stylise(base, theme, w, 10, n_cycles=4, fps=30.0, features=features)
+                row[f"{features}_{w}"] = intended_p(observer, clip, theme)
+                if theme in ("happy", "sad"):
+                    row[f"{features}_{w}_emotion_p"] = float(observer.proba(clip)[GAIT_EMOTIONS.index(theme)])
+        if theme in ("happy", "sad"):
+            row["real_test_emotion_p"] = float(np.mean([observer.proba(c.motion)[GAIT_EMOTIONS.index(theme)]
+                                                        for c in real if c.dataset == "bandai-namco-1"]))
+        out[theme] = row
+    return out
+
+
+def contact_sheets(base, corpus: Path, out_dir: Path, weight: float = 1.0) -> list[Path]:
+    """docs/img/rbf_real_<theme>.png: neutral, expert-styled, data-styled, a real themed test take; 5 frames each."""
+    from PIL import Image
+
+    from generation.render.clip import render_frames
+    from generation.render.contact_sheet import contact_sheet
+    from generation.render.settings import RenderSettings
+
+    times = [0.5 + 0.25 * k for k in range(5)]
+    settings = RenderSettings(width=320, height=400, fps=30, duration_s=times[-1] + 0.2, camera="tracking")
+    test = load_real_corpus(corpus, skeleton="gait", split="test", contents=["walk"])
+    neutral = neutral_walk(base, n_cycles=3, fps=30.0)
+    written = []
+    for theme in THEME_NAMES:
+        styles = [s for s, t in CAPTURE_THEMES.items() if t == theme]
+        real = next(c for c in sorted(test, key=lambda c: (c.dataset, c.take)) if c.style in styles)
+        rows = [("neutral (real avg)", neutral),
+                (f"{theme} expert w{weight}", stylise(base, theme, weight, 10, n_cycles=3, fps=30.0)),
+                (f"{theme} data w{weight}", stylise(base, theme, weight, 10, n_cycles=3, fps=30.0, features="data")),
+                (f"REAL {real.style} {real.dataset[-1]}/{real.take}", real.motion)]
+        posters, labels = [], []
+        with tempfile.TemporaryDirectory() as tmp:
+            for label, motion in rows:
+                wanted = [int(round(t * settings.fps)) for t in times]
+                for k, img in enumerate(render_frames(motion, settings, patches=False)):
+                    if k in wanted:
+                        p = Path(tmp) / f"{len(posters):03d}.png"
+                        Image.fromarray(img).save(p)
+                        posters.append(p)
+                        labels.append(f"{label}, {k / settings.fps:.2f} s")
+                    if k >= wanted[-1]:
+                        break
+            path = out_dir / f"rbf_real_{theme}.png"
+            contact_sheet(posters, labels, path, columns=len(times), thumb_width=170)
+        Image.open(path).quantize(96).save(path, optimize=True)  # a 96-colour palette: a third of the bytes
+        written.append(path)
+    return written
+
+
+def _f(v, fmt="{:.2f}"):
+    return "-" if v is None else fmt.format(v)
+
+
+def markdown(result: dict) -> str:
+    n = result["neutral"]
+    md = n["metadata"]
+    takes = [s for s in md["captured_sources"] if s["cycles"]]
+    per_ds = {}
+    for s in takes:
+        d = per_ds.setdefault(s["dataset"], [0, 0])
+        d[0] += 1
+        d[1] += s["cycles"]
+    lines = [MARK_START, "## Seed 004 on real capture (`benchmarks/bench_rbf_real.py`)", "",
+             f"Machine: {result['machine']}. Date: {result['date']}. Command: "
+             "`OMP_NUM_THREADS=1 python benchmarks/bench_rbf_real.py --doc docs/benchmarks/rbf.md --sheets docs/img`. "
+             "Real data: Bandai Namco Research Motion Dataset 1 and 2 (Kobayashi et al. 2023, arXiv:2306.08861; "
+             "CC BY-NC 4.0).", "",
+             "### The averaged neutral walk", "",
+             f"{md['n_cycles']} steady two-step cycles from {md['n_takes']} train-split normal walks ("
+             + ", ".join(f"{ds}: {v[1]} cycles from {v[0]} takes" for ds, v in sorted(per_ds.items()))
+             + f"), at most 4 per take; time warping: {md['time_warping']}. Cycle spread across the cycles "
+             f"(mean per-frame standard deviation, walker heights): {md['dtw_spread']['before']:.4f} after contact "
+             f"warping, {md['dtw_spread']['after']:.4f} after DTW. Cycle {md['cycle_duration_s']:.3f} s, stride "
+             f"{md['stride_m'][2]:.3f} m, IK re-fit error {md['ik_error_max_m'] * 1000:.1f} mm.", "",
+             f"Walked for 4 cycles at 30 fps (feet planted), against the range (min-max) of all {n['real_takes']} "
+             "real normal walks (both datasets, all splits):", "",
+             "| base | speed (m/s) | cadence (steps/min) | stance knee (deg) | pelvis bounce (cm) | real observer "
+             "(happy/sad/angry/neutral) |", "|---|---|---|---|---|---|"]
+    for name, row in n["bases"].items():
+        cells = [f"{row[k]:.2f}{'' if row['inside'][k] else ' **(outside)**'}" for k in CHECKED]
+        obs = "/".join(f"{row['observer'][e]:.2f}" for e in GAIT_EMOTIONS)
+        lines.append(f"| {name} | " + " | ".join(cells) + f" | {obs} |")
+    rr = n["real_ranges"]
+    lines.append("| real normal walks (range) | " + " | ".join(f"{rr[k][0]:.2f}-{rr[k][1]:.2f}" for k in CHECKED)
+                 + " | test takes: " + "/".join(f"{n['real_test_normal_read'][e]:.2f}" for e in GAIT_EMOTIONS)
+                 + " |")
+    acc = result["accuracy"]
+    lines += ["", "### Real-capture observers: held-out accuracy (test-split takes)", "",
+              "| classifier | test takes | accuracy |", "|---|---|---|"]
+    lines += [f"| {k} | {v['takes']} | {_f(v['accuracy'])} |" for k, v in acc.items()]
+    lines += ["", "### Expert vs data-driven features per theme", "",
+              "w = 1, displacement / walker height over one cycle. `shared`: DOFs both edit; `sign`: share of "
+              "shared DOFs where the data move the expert's way at the expert's peak; `ratio`: median data/expert "
+              "amplitude; `rows in common`: of the experts' Table III rows (body part x axis), how many are among "
+              "the data's first ten.", "",
+              "| theme | rows in common | shared DOFs | sign agree | median ratio | data's first five rows |",
+              "|---|---|---|---|---|---|"]
+    for theme, c in result["compare"].items():
+        lines.append(f"| {theme} | {c['used_overlap']} of {len(c['expert_features'])} | {c['shared_dofs']} | "
+                     f"{_f(c['sign_agreement'])} | {_f(c['median_ratio'])} | "
+                     + ", ".join(f"{p} {a}" for p, a in c["data_features"][:5]) + " |")
+    lines += ["", "Top DOFs per theme (largest amplitude of either set; peaks in walker heights, signed):", "",
+              "| theme | DOF | expert peak | data peak | sign agree | peak shift (cycle) | ratio | corr |",
+              "|---|---|---|---|---|---|---|---|"]
+    for theme, c in result["compare"].items():
+        for r in c["rows"][:6]:
+            sa = "-" if r["sign_agree"] is None else ("yes" if r["sign_agree"] else "**no**")
+            lines.append(f"| {theme} | {r['joint']} {r['axis']} | {_f(r['expert_peak'], '{:+.3f}')} | "
+                         f"{_f(r['data_peak'], '{:+.3f}')} | {sa} | {_f(r['peak_shift'])} | {_f(r['ratio'])} | "
+                         f"{_f(r['corr'])} |")
+    lines += ["", "### Which features the real-capture theme observers agree with", "",
+              "Probability of the intended theme from the theme-pair classifier (its pair in brackets; held-out "
+              "accuracy above), all ten features; real = mean over the real themed test takes:", "",
+              "| theme (pair) | neutral | expert 0.7 | data 0.7 | expert 1.0 | data 1.0 | real test takes | "
+              "observer prefers |", "|---|---|---|---|---|---|---|---|"]
+    for theme, row in result["observers"].items():
+        data_wins = [row[f"data_{w}"] > row[f"expert_{w}"] for w in WEIGHTS]
+        better = "data" if all(data_wins) else "expert" if not any(data_wins) else "mixed"
+        lines.append(f"| {theme} ({row['pair']}) | {row['neutral']:.2f} | {row['expert_0.7']:.2f} | "
+                     f"{row['data_0.7']:.2f} | {row['expert_1.0']:.2f} | {row['data_1.0']:.2f} | "
+                     f"{row['real_test']:.2f} ({row['real_test_takes']}) | {better} |")
+    lines += ["", "Four-emotion observer (trained on dataset 1 only), probability of the theme's emotion:", "",
+              "| theme | expert 0.7 | data 0.7 | expert 1.0 | data 1.0 | real dataset-1 test take |",
+              "|---|---|---|---|---|---|"]
+    for theme in ("happy", "sad"):
+        row = result["observers"][theme]
+        lines.append(f"| {theme} | " + " | ".join(f"{row[f'{f}_{w}_emotion_p']:.2f}" for w in WEIGHTS
+                                                  for f in ("expert", "data"))
+                     + f" | {row['real_test_emotion_p']:.2f} |")
+    lines += ["", MARK_END]
+    return "\n".join(lines) + "\n"
+
+
+def write_block(doc: Path, block: str) -> None:
+    """Replace the marked block in ``doc`` (or append it)."""
+    text = doc.read_text(encoding="utf-8") if doc.is_file() else ""
+    if MARK_START in text and MARK_END in text:
+        head, rest = text.split(MARK_START, 1)
+        tail = rest.split(MARK_END, 1)[1].lstrip("\n")
+        text = head + block + tail
+    else:
+        text = text.rstrip("\n") + "\n\n" + block
+    doc.write_text(text, encoding="utf-8")
+
+
+def main(argv=None) -> int:
+    import datetime
+    import platform
+
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--corpus", type=Path, default=None)
+    ap.add_argument("--out", type=Path, default=ROOT / "docs" / "benchmarks" / "rbf_real.json")
+    ap.add_argument("--doc", type=Path, default=None, help="write the marked section into this page")
+    ap.add_argument("--sheets", type=Path, default=None, help="write rbf_real_<theme>.png into this folder")
+    a = ap.parse_args(argv)
+    warnings.filterwarnings("ignore", message="The given NumPy array is not writable")
+    corpus = a.corpus or real_corpus_path()
+    if not Path(corpus).is_file():
+        raise SystemExit(f"no real-capture corpus at {corpus}; build it with python -m generation.mocap dataset ...")
+    observer = default_real_observer(corpus)
+    base = load_cycle()
+    result = {"machine": f"{platform.machine()} {platform.system()}, 2 shared cores, no GPU",
+              "date": datetime.date.today().isoformat(),
+              "neutral": neutral_section(corpus, observer), "accuracy": pair_accuracy(observer, corpus),
+              "compare": {t: compare_theme(base, t) for t in THEME_NAMES},
+              "observers": observer_section(observer, corpus, base)}
+    a.out.parent.mkdir(parents=True, exist_ok=True)
+    a.out.write_text(json.dumps(result, indent=1, default=float) + "\n", encoding="utf-8")
+    block = markdown(result)
+    print(block)
+    if a.doc:
+        write_block(a.doc, block)
+    if a.sheets:
+        for p in contact_sheets(base, corpus, a.sheets):
+            print(f"wrote {p}")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
