@@ -320,13 +320,14 @@ def _free_port() -> int:
 def test_shipped_gunicorn_command_keeps_tokens_out_of_the_logs_and_debug_off(tmp_path):
     """The attack: request URLs with a participant token and Prolific IDs, then read the server's output."""
     demo = (ROOT / "demo.sh").read_text()
-    flags = ["--worker-class", "gthread", "--threads", "4", "--access-logfile", "-",
+    flags = ["--worker-class", "asgi", "--access-logfile", "-",
              "--logger-class", "studyapp.gunicorn_logging.RedactingLogger"]
-    assert " ".join(flags[:4]) in demo and "--logger-class studyapp.gunicorn_logging.RedactingLogger" in demo
+    assert "studyapp.asgi:application" in demo and " ".join(flags[:2]) in demo
+    assert "--logger-class studyapp.gunicorn_logging.RedactingLogger" in demo
     env = {k: v for k, v in os.environ.items() if k not in {"DATABASE_URL", "PRODUCTION", "DEBUG", "SECRET_KEY"}}
     env.update(DATA_DIR=str(tmp_path), DJANGO_SETTINGS_MODULE="studyapp.settings")
     port = _free_port()
-    server = subprocess.Popen([sys.executable, "-m", "gunicorn", "studyapp.wsgi", "-b", f"127.0.0.1:{port}",
+    server = subprocess.Popen([sys.executable, "-m", "gunicorn", "studyapp.asgi:application", "-b", f"127.0.0.1:{port}",
                                "-w", "1", *flags], cwd=ROOT, env=env, stdout=subprocess.PIPE,
                               stderr=subprocess.STDOUT, text=True)
     base = f"http://127.0.0.1:{port}"
