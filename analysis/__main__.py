@@ -11,6 +11,7 @@ import json
 import os
 import sys
 
+from .exclusion import rule_errors
 from .io import ValidationError
 
 
@@ -44,8 +45,6 @@ def main(argv=None) -> int:
         return 2
     rules = None
     if a.exclusion_rules:
-        from .exclusion import rule_errors
-
         text = a.exclusion_rules
         try:
             rules = json.loads(open(text, encoding="utf-8").read() if os.path.isfile(text) else text)

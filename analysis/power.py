@@ -160,7 +160,7 @@ def power_table(preset: str, participants, effects: dict | None = None, sims: in
 
 def fig_power(table: pd.DataFrame, alpha: float = 0.05):
     """Power against participants, one line per test, the conventional 0.8 dashed."""
-    from .figures import plt
+    from .figures import plt  # heavy: matplotlib, only when a figure is drawn
 
     fig, ax = plt.subplots(figsize=(5.5, 3.4))
     for test, g in table.groupby("test", sort=False):
@@ -211,7 +211,7 @@ def main(argv=None) -> int:
         print(f"| {r['test']} | {r['effects']} | {r['participants']} | {r['power']:.3f} | {r['mc_se']:.3f} |")
     os.makedirs(a.out, exist_ok=True)
     table.to_csv(os.path.join(a.out, "power.csv"), index=False)
-    from .figures import save_figure
+    from .figures import save_figure  # heavy: matplotlib, only when a figure is drawn
 
     paths = save_figure(fig_power(table, a.alpha), a.out, "power")
     print(f"wrote {os.path.join(a.out, 'power.csv')}, {paths['png']}, {paths['svg']}")

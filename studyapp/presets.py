@@ -12,6 +12,8 @@ from django.db import transaction
 
 from study_presets import CONSENT, PRESET_PLANS, PRESETS
 
+from .models import Section, Study
+
 __all__ = ["CONSENT", "PRESETS", "PRESET_PLANS", "create_study_from_preset", "preset_choices", "preset_sections"]
 
 _OWN_PLAN = object()
@@ -41,7 +43,6 @@ def create_study_from_preset(preset: str, slug: str, title: str | None = None, s
     Every section pool draws only clips of ``plan``: by default the preset's own plan (:data:`PRESET_PLANS`), so a
     paper's study never shows demo clips; another plan name for a copy of a paper plan; None for no plan filter.
     """
-    from .models import Section, Study
 
     if preset not in PRESETS:
         raise KeyError(f"unknown preset {preset!r}; choose one of {sorted(PRESETS)}")

@@ -39,6 +39,7 @@ from pathlib import Path
 from django.conf import settings
 from django.db.models import Count, Max, Q
 
+from .export import run_report
 from .models import Clip, Participant, Response, Study
 
 REPORT_NAME = "report.zip"
@@ -211,7 +212,6 @@ def prune_old_versions(study_id: int, keep: str) -> list[Path]:
 def build_report(study: Study, version: str, lock_fd: int) -> Path:
     """Write version's report.zip (the caller holds the lock through lock_fd). On failure error.txt says why and
     the exception propagates."""
-    from .export import run_report
 
     folder = version_dir(study.pk, version)
     _record_start(lock_fd, os.getpid())

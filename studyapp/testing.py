@@ -7,7 +7,12 @@ from __future__ import annotations
 
 import hashlib
 import itertools
+import time
 from pathlib import Path
+
+import imageio_ffmpeg
+import numpy as np
+from django import forms
 
 from study_protocol import GAIT_EMOTIONS, GESTURE_EMOTIONS, NEUTRAL_THEME, THEMES
 
@@ -31,8 +36,6 @@ def write_media(media_root: Path, payload: bytes, suffix: str = ".mp4") -> str:
 
 def tiny_mp4(path: Path, seconds: float = 1.0, fps: int = 10, size: int = 64, shade: int = 0) -> Path:
     """A real H.264 MP4 (yuv420p, faststart) of a moving grey square, via imageio-ffmpeg."""
-    import imageio_ffmpeg
-    import numpy as np
 
     path.parent.mkdir(parents=True, exist_ok=True)
     writer = imageio_ffmpeg.write_frames(str(path), (size, size), fps=fps, codec="libx264", pix_fmt_out="yuv420p",
@@ -94,7 +97,6 @@ def make_catalogue(media_root: Path, video_bytes: bytes | None = None, duration_
 def admin_form_data(response) -> dict[str, str]:
     """The POST data an admin change (or add) page would submit unchanged: its main form and every inline
     formset with its management form, from the page's template context (Django test client response)."""
-    from django import forms
 
     def fields(form) -> dict[str, str]:
         data = {}
@@ -120,7 +122,6 @@ def wait_for(driver, condition, timeout: float = 20.0, what: str = "condition"):
     """Poll ``condition(driver)`` (a selenium WebDriver) every 0.1 s until it returns something truthy, and return
     that; AssertionError naming ``what`` and the page after ``timeout`` seconds. Exceptions while the page is
     changing (element not there yet, stale element) count as "not yet"."""
-    import time
 
     end = time.time() + timeout
     while time.time() < end:
@@ -137,7 +138,7 @@ def wait_for(driver, condition, timeout: float = 20.0, what: str = "condition"):
 def consent_and_demographics(driver) -> None:
     """In a browser (selenium WebDriver) on a study's consent page: consent, start, answer the demographics page
     with its first choices, and wait for the first clip page."""
-    from selenium.webdriver.common.by import By
+    from selenium.webdriver.common.by import By  # optional: selenium is installed for the browser tests only
 
     driver.find_element(By.CSS_SELECTOR, "label.check").click()
     driver.find_element(By.CSS_SELECTOR, "button[type=submit]").click()

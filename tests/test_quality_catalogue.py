@@ -94,10 +94,11 @@ PLAN_CLIPS = [
 
 
 def _sink_entry(monkeypatch, entry_id: str, depth_m: float = 0.05):
-    """Make ``entry_id``'s motion go ``depth_m`` through the floor (the generator's output, lowered)."""
-    from generation.plans import clipgen
+    """Make ``entry_id``'s motion go ``depth_m`` through the floor (the generator's output, lowered), where the
+    plan runner calls it."""
+    from generation.pipeline import runner
 
-    original = clipgen.make_motion
+    original = runner.make_motion
 
     def make_motion(entry, *args, **kwargs):
         motion = original(entry, *args, **kwargs)
@@ -105,7 +106,7 @@ def _sink_entry(monkeypatch, entry_id: str, depth_m: float = 0.05):
             motion = dataclasses.replace(motion, root_positions=motion.root_positions - [0.0, depth_m, 0.0])
         return motion
 
-    monkeypatch.setattr(clipgen, "make_motion", make_motion)
+    monkeypatch.setattr(runner, "make_motion", make_motion)
 
 
 @pytest.mark.django_db

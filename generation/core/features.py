@@ -24,6 +24,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 from scipy.ndimage import gaussian_filter1d
 
+from .quaternion import np_qrot
 from .skeleton import GAIT_JOINTS, GESTURE_JOINTS, Skeleton
 
 if TYPE_CHECKING:
@@ -61,7 +62,7 @@ _EPS2 = 1e-12  # m^2, keeps sqrt differentiable at zero distance
 
 
 def _check(positions: torch.Tensor, num_joints: int, what: str) -> torch.Tensor:
-    import torch
+    import torch  # heavy: only the torch variants load torch
     if not isinstance(positions, torch.Tensor):
         raise TypeError(f"{what}: expected a torch.Tensor, got {type(positions).__name__}; use the np_ function")
     if positions.dim() < 2 or tuple(positions.shape[-2:]) != (num_joints, 3):
@@ -70,7 +71,7 @@ def _check(positions: torch.Tensor, num_joints: int, what: str) -> torch.Tensor:
 
 
 def _angle(P: torch.Tensor, p: int, q: int, r: int) -> torch.Tensor:
-    import torch
+    import torch  # heavy: only the torch variants load torch
     u = P[..., p, :] - P[..., q, :]
     v = P[..., r, :] - P[..., q, :]
     cross = torch.linalg.cross(u, v)
@@ -78,19 +79,19 @@ def _angle(P: torch.Tensor, p: int, q: int, r: int) -> torch.Tensor:
 
 
 def _dist(P: torch.Tensor, a: int, b: int) -> torch.Tensor:
-    import torch
+    import torch  # heavy: only the torch variants load torch
     diff = P[..., a, :] - P[..., b, :]
     return torch.sqrt((diff * diff).sum(-1) + _EPS2)
 
 
 def _area(P: torch.Tensor, p: int, q: int, r: int) -> torch.Tensor:
-    import torch
+    import torch  # heavy: only the torch variants load torch
     cross = torch.linalg.cross(P[..., p, :] - P[..., q, :], P[..., r, :] - P[..., q, :])
     return 0.5 * torch.sqrt((cross * cross).sum(-1) + _EPS2 * _EPS2)
 
 
 def _features(P, angles, dists, areas, angle_scale: float) -> torch.Tensor:
-    import torch
+    import torch  # heavy: only the torch variants load torch
     cols = [_angle(P, *a) * angle_scale for a in angles]
     cols += [_dist(P, *a) / _dist(P, *b) for a, b in dists]
     cols += [_area(P, *a) / _area(P, *b) for a, b in areas]
@@ -127,14 +128,14 @@ def gesture_affective_features(positions: torch.Tensor) -> torch.Tensor:
 
 def np_gait_affective_features(positions: np.ndarray) -> np.ndarray:
     """numpy twin of :func:`gait_affective_features`: (..., 21, 3) -> (..., 18) float64."""
-    import torch
+    import torch  # heavy: only the torch variants load torch
     with torch.no_grad():
         return gait_affective_features(torch.as_tensor(np.asarray(positions, dtype=np.float64))).numpy()
 
 
 def np_gesture_affective_features(positions: np.ndarray) -> np.ndarray:
     """numpy twin of :func:`gesture_affective_features`: (..., 23, 3) -> (..., 15) float64."""
-    import torch
+    import torch  # heavy: only the torch variants load torch
     with torch.no_grad():
         return gesture_affective_features(torch.as_tensor(np.asarray(positions, dtype=np.float64))).numpy()
 
@@ -246,7 +247,6 @@ def facing_directions(positions: np.ndarray, skeleton: Skeleton, root_rotations:
     Returns (..., T).
     """
     if root_rotations is not None:
-        from .quaternion import np_qrot
         fwd = np_qrot(root_rotations, np.broadcast_to([0.0, 0.0, 1.0], np.shape(root_rotations)[:-1] + (3,)).copy())
     else:
         left = positions[..., skeleton.index("left_hip"), :] - positions[..., skeleton.index("right_hip"), :]

@@ -38,7 +38,7 @@ def forward_kinematics(
     Returns:
         (..., J, 3) positions in metres (and global rotations when asked).
     """
-    import torch
+    import torch  # heavy: only the torch variants load torch
     positions: list[torch.Tensor] = []
     global_rot: list[torch.Tensor] = []
     offsets = offsets.to(rotations.dtype)
@@ -57,14 +57,14 @@ def forward_kinematics(
 
 def fk_skeleton(rotations: torch.Tensor, root_positions: torch.Tensor, skeleton: Skeleton) -> torch.Tensor:
     """Torch forward kinematics on a :class:`Skeleton`; shapes as in :func:`forward_kinematics`."""
-    import torch
+    import torch  # heavy: only the torch variants load torch
     offsets = torch.tensor(skeleton.offsets, dtype=rotations.dtype, device=rotations.device)
     return forward_kinematics(rotations, root_positions, offsets, skeleton.parents)
 
 
 def np_forward_kinematics(rotations: np.ndarray, root_positions: np.ndarray, skeleton: Skeleton) -> np.ndarray:
     """numpy forward kinematics: (..., J, 4), (..., 3) -> (..., J, 3) metres, float64."""
-    import torch
+    import torch  # heavy: only the torch variants load torch
     with torch.no_grad():
         pos = fk_skeleton(torch.as_tensor(np.asarray(rotations, dtype=np.float64)),
                           torch.as_tensor(np.asarray(root_positions, dtype=np.float64)), skeleton)

@@ -19,16 +19,19 @@ section 5.1). Per step we compute, on the ground plane (x, z; y-up):
 """
 from __future__ import annotations
 
+import hashlib
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 import torch
 
+from generation.core.features import gait_affective_features, movement_features
 from generation.core.kinematics import forward_kinematics, np_forward_kinematics
 from generation.core.quaternion import np_qfix, np_qmul, np_qrot, qmul
 from generation.core.rigging import yaw_quat
 from generation.core.skeleton import GAIT_PARENTS, gait_skeleton
+from generation.procedural.corpus import GaitCorpus, build_gait_corpus
 
 DEFAULT_CORPUS = Path("var/corpus/gait_corpus_synthetic.npz")
 SBAR_ALPHA = 0.3      # low-pass coefficient of s-bar per network step
@@ -124,13 +127,11 @@ def heading_frame_positions(q: torch.Tensor, root_y: torch.Tensor, offsets: torc
 
 def affective_features(positions: torch.Tensor) -> torch.Tensor:
     """The 18 pose affective features (..., 18) of positions (..., 21, 3) (``generation.core.features``)."""
-    from generation.core.features import gait_affective_features  # another helper's module; imported when used
     return gait_affective_features(positions)
 
 
 def step_phase(positions_30: np.ndarray, fps: float, skeleton) -> np.ndarray:
     """Stepping phase theta (..., T) in [0, 2 pi) of (..., T, J, 3) positions (``generation.core.features``)."""
-    from generation.core.features import movement_features
     return np.remainder(np.asarray(movement_features(positions_30, fps, skeleton)["step_phase"]), 2 * np.pi)
 
 
@@ -366,7 +367,6 @@ def load_corpus_sequences(path: str | Path | None = None, num_sequences: int = 1
                           frame_step: int = 4, seq_len: int = 60, offsets: tuple[int, ...] = (0,)) -> GaitSequences:
     """Load (or build and save, when missing) the synthetic gait corpus and prepare network sequences
     (one row per corpus sequence and subsampling offset)."""
-    from generation.procedural.corpus import GaitCorpus, build_gait_corpus  # another helper's module
     path = Path(path) if path is not None else DEFAULT_CORPUS
     if path.exists():
         corpus = GaitCorpus.load(path)
@@ -384,7 +384,6 @@ def load_corpus_sequences(path: str | Path | None = None, num_sequences: int = 1
 
 def file_sha256(path: str | Path) -> str:
     """Hex SHA-256 of a file (identifies the corpus version a model was trained on)."""
-    import hashlib
     h = hashlib.sha256()
     with open(path, "rb") as f:
         for chunk in iter(lambda: f.read(1 << 20), b""):

@@ -14,6 +14,7 @@ Output frames are interpolated from the network rate to ``fps_out`` (Motion.resa
 """
 from __future__ import annotations
 
+import copy
 import math
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -25,6 +26,9 @@ from generation.core.device import resolve_device
 from generation.core.foot_contact import plant_feet
 from generation.core.motion import Motion
 from generation.core.paths import GroundPath, straight
+from generation.core.quaternion import np_qfix, np_qnormalize
+from generation.procedural.emotion import gait_params_for_emotion
+from generation.procedural.walk import WalkParams, walk
 from study_protocol import GAIT_EMOTIONS
 
 from .config import NUM_EMOTIONS, NUM_JOINTS, GaitDataConfig, GaitNetConfig
@@ -87,7 +91,6 @@ class LoadedGaitNet:
             return self
         copies = self.__dict__.setdefault("_copies", {})
         if str(dev) not in copies:
-            import copy
             model = copy.deepcopy(self.model).to(dev).eval()
             copies[str(dev)] = LoadedGaitNet(model, self.normalizer, self.path, dict(self.info), self.config)
         return copies[str(dev)]
@@ -145,9 +148,7 @@ def _seed_motion(seed, emotion0: np.ndarray, n_frames: int, rng: np.random.Gener
     """A Motion from a seed given as Motion, WalkParams, a params dict, or None (procedural seed)."""
     if isinstance(seed, Motion):
         return seed
-    from generation.procedural.walk import WalkParams, walk
     if seed is None:
-        from generation.procedural.emotion import gait_params_for_emotion  # another helper's module
         params = gait_params_for_emotion(emotion0, rng)
     elif isinstance(seed, WalkParams):
         params = seed
@@ -455,7 +456,6 @@ def generate_gaits(seeds, paths: list[GroundPath], emotions, steps: int = 200, f
 
 def wrap_quaternions(q: np.ndarray) -> np.ndarray:
     """Unit-normalise and make sign-continuous along time (T, J, 4)."""
-    from generation.core.quaternion import np_qfix, np_qnormalize
     return np_qfix(np_qnormalize(q))
 
 

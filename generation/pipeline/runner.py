@@ -11,10 +11,12 @@ opaque keys).
 """
 from __future__ import annotations
 
+import dataclasses
 import json
 import multiprocessing as mp
 import os
 import queue as queue_mod
+import threading
 import time
 import traceback
 from collections.abc import Callable
@@ -22,25 +24,17 @@ from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from generation.plans.schema import ClipEntry, Plan, clip_hash, intent_fields
+from generation.plans.clipgen import DEVICE_ENV, make_motion, write_motion_bvh
+from generation.plans.schema import ClipEntry, Plan, intent_fields
+from generation.quality.checks import QAResult, failed_checks
 from generation.render.clip import clip_files_complete, render_clip
 
+from .jobs import Job, plan_jobs
+from .plan_qa import clip_qa, intended_emotion, observer_for
+
+__all__ = ["BatchResult", "Job", "base_record", "plan_jobs", "render_job", "render_job_on_worker", "run_plan"]
+
 RECORD_VERSION = 2  # 2: records carry the quality record ``qa`` and ``qa_flag``
-
-
-@dataclass
-class Job:
-    """One clip to make: the plan entry, the entry that will run (maybe a fallback) and the clip id."""
-
-    entry: ClipEntry
-    run_entry: ClipEntry
-    clip_id: str
-    generator_version: str
-    fallback_reason: str | None = None
-    qa_thresholds: dict | None = None  # the plan's quality thresholds (resolved); None = study_protocol defaults
-    # torch device of the network generators, fixed where the jobs are planned so that Dask workers on other
-    # machines use it too (they do not inherit the submitting process's $GENERATION_DEVICE).
-    device: str | None = None
 
 
 @dataclass
@@ -50,25 +44,6 @@ class BatchResult:
     skipped: list[str] = field(default_factory=list)
     failed: list[tuple[str, str]] = field(default_factory=list)   # (entry label, message)
     seconds: float = 0.0
-
-
-def plan_jobs(plan: Plan, limit: int | None = None) -> tuple[list[Job], list[tuple[str, str]]]:
-    """Jobs for the plan's entries (first ``limit``), and (entry, message) for entries that cannot run."""
-    from generation.plans.clipgen import ClipGenerationError, generation_device, generator_version, resolve
-    from generation.quality.checks import resolve_thresholds
-
-    thresholds = resolve_thresholds(plan.qa)
-    jobs, failures = [], []
-    for entry in plan.entries[:limit] if limit else plan.entries:
-        try:
-            run_entry, reason = resolve(entry)
-        except ClipGenerationError as exc:
-            failures.append((entry.where, str(exc)))
-            continue
-        version = generator_version(run_entry.generator)
-        jobs.append(Job(entry, run_entry, clip_hash(run_entry, run_entry.generator, version), version, reason,
-                        thresholds, generation_device()))
-    return jobs, failures
 
 
 def _json_safe(obj):
@@ -133,8 +108,6 @@ def _init_worker(progress_queue, threads: int, parent_pid: int | None = None) ->
     global _PROGRESS_QUEUE
     _PROGRESS_QUEUE = progress_queue
     if parent_pid is not None:
-        import threading
-
         threading.Thread(target=_exit_with_parent, args=(parent_pid,), daemon=True).start()
     os.environ.setdefault("OMP_NUM_THREADS", str(threads))
     os.environ.setdefault("MKL_NUM_THREADS", str(threads))
@@ -143,7 +116,7 @@ def _init_worker(progress_queue, threads: int, parent_pid: int | None = None) ->
     os.environ.setdefault("LP_NUM_THREADS", str(threads))
     os.environ.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow")
     try:
-        import torch
+        import torch  # heavy: loaded in render workers only, to cap their threads
 
         torch.set_num_threads(threads)
     except ImportError:  # pragma: no cover - torch is a project dependency
@@ -152,8 +125,6 @@ def _init_worker(progress_queue, threads: int, parent_pid: int | None = None) ->
 
 def render_job(job: Job, record: dict, clips_dir: str, records_dir: str) -> dict:
     """Make the motion, render its files, write the record last. Runs in a worker (or inline)."""
-    from generation.plans.clipgen import DEVICE_ENV, make_motion, write_motion_bvh
-
     if job.device:
         os.environ[DEVICE_ENV] = job.device
     t0 = time.perf_counter()
@@ -186,9 +157,7 @@ def render_job(job: Job, record: dict, clips_dir: str, records_dir: str) -> dict
 
 def _add_qa(record: dict, job: Job, motion, camera: dict) -> None:
     """Measure the clip's quality (:mod:`generation.quality`) into ``record["qa"]`` and ``record["qa_flag"]``."""
-    from generation.pipeline.plan_qa import clip_qa, intended_emotion, observer_for
-
-    observer = observer_for(job.run_entry.modality, (job.qa_thresholds or {}).get("observer"))
+    observer = observer_for(job.run_entry.modality)
     result, _ = clip_qa(motion, job.run_entry.render, job.qa_thresholds, intended_emotion(job.run_entry.inputs),
                         observer, camera_info=camera)
     record["qa"] = _json_safe(result.as_dict())
@@ -197,9 +166,6 @@ def _add_qa(record: dict, job: Job, motion, camera: dict) -> None:
 
 def _recheck_qa(rec: dict, done: dict, job: Job) -> None:
     """A stored record's quality values, re-checked against the plan's current thresholds."""
-    from generation.pipeline.plan_qa import intended_emotion
-    from generation.quality.checks import QAResult, failed_checks
-
     stored = QAResult.from_dict(done.get("qa") or {})
     flags = failed_checks(stored.values, job.qa_thresholds, intended_emotion(job.run_entry.inputs))
     rec["qa"] = QAResult(stored.values, flags).as_dict()
@@ -326,7 +292,7 @@ def _render_dask(batch: _Batch, todo: list[Job], scheduler, threads_per_worker: 
     """Render ``todo`` on a Dask distributed cluster: ``scheduler`` is its address (``tcp://host:port``) or a
     ``distributed.Client``. Workers must see the same clips and records folders (a shared file system): they
     write the files, this process collects the records."""
-    from distributed import Client, as_completed
+    from distributed import Client, as_completed  # optional ([cluster] extra): only Dask rendering needs it
 
     client = scheduler if isinstance(scheduler, Client) else Client(scheduler, timeout=30)
     try:
@@ -379,11 +345,8 @@ def run_plan(plan: Plan, clips_dir: str | Path, records_dir: str | Path, media_p
     emit("plan", {"total": len(batch.by_id), "todo": len(todo), "skipped": len(batch.result.skipped)})
     _remove_stale(todo, clips_dir, records_dir)
     if workers > 1 or scheduler is not None:
-        from generation.pipeline.plan_qa import observer_for
-
         for modality in sorted({j.run_entry.modality for j in todo}):
-            # train/cache the quality observers once, not in every worker
-            observer_for(modality, (todo[0].qa_thresholds or {}).get("observer"))
+            observer_for(modality)  # train/cache the quality observers once, not in every worker
     if scheduler is not None:
         _render_dask(batch, todo, scheduler, threads_per_worker)
     elif workers <= 1 or len(todo) <= 1:
@@ -419,6 +382,4 @@ def _drain(q, emit, started: set | None = None) -> None:
 
 
 def _with_webm(entry: ClipEntry) -> ClipEntry:
-    import dataclasses
-
     return dataclasses.replace(entry, render=dataclasses.replace(entry.render, webm=True))

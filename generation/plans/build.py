@@ -12,15 +12,9 @@ The plans are plain YAML afterwards; researchers copy and edit them. What each r
   conversation sentences, and one "source" gesture per generated one (seed 003's were motion-captured; ours
   are procedural, marked synthetic) paired through ``pair`` so the study never shows both to one person.
   The generated gestures' sentences come from the gesture network's held-out test split (each entry says
-  ``sentence_split: test``), so the study shows the network on inputs it was not trained on. Beside them, REAL
-  source gestures: the shipped Bandai Namco ``bye`` takes in the five styles that name a gesture emotion
-  (``study_protocol.CAPTURE_GESTURE_EMOTIONS``), seated on the chair (``seated: true``), for the naturalness and
-  gesture-emotion sections.
+  ``sentence_split: test``), so the study shows the network on inputs it was not trained on.
 - seed004 (THMS 2016, section V): the neutral input walk, 6 themes x weights (0.4, 0.7, 1.0, 1.3) x feature
-  counts (1, 4, 7, 10), and the inversions at w = -0.7 with all ten features; short looping clips. The neutral base
-  is averaged from real normal walks (``base: real``, the default).
-- seed004_data: each theme at w = 0.7 with the experts' features and with data-driven features (``features:
-  data``, fitted to real themed walks) side by side, on the same real neutral base.
+  counts (1, 4, 7, 10), and the inversions at w = -0.7 with all ten features; short looping clips.
 """
 from __future__ import annotations
 
@@ -29,6 +23,8 @@ from pathlib import Path
 
 import yaml
 
+from generation.gesture.config import gesture_seconds
+from generation.gesture.text import count_words
 from study_protocol import GAIT_EMOTIONS, GESTURE_EMOTIONS, GESTURE_TASKS, THEMES
 
 from .schema import CAPTURED_CLIPS
@@ -99,8 +95,8 @@ def seed000() -> dict:
 def _sentence_splits() -> dict[str, str]:
     """sentence_id -> "train" | "val" | "test" as the gesture network's training split them
     (``generation.gesture.data.split_sentences`` with the training seed)."""
-    from generation.gesture.data import load_sentences, split_sentences
-    from generation.gesture.train import TrainConfig
+    from generation.gesture.data import load_sentences, split_sentences  # heavy: torch
+    from generation.gesture.train import TrainConfig  # heavy: torch
 
     return split_sentences(load_sentences(SENTENCES), TrainConfig().seed)
 
@@ -131,31 +127,7 @@ def _sentences(per_emotion_narration: int, per_emotion_conversation: int,
 
 
 def _gesture_seconds(sentence: str) -> float:
-    try:
-        from generation.gesture.config import gesture_seconds
-        from generation.gesture.text import count_words
-
-        return round(float(gesture_seconds(count_words(sentence))), 2)
-    except ImportError:
-        return round(min(12.0, max(2.5, 1.5 + 0.4 * len(sentence.split()))), 2)
-
-
-SHIPPED_GESTURES = "generation/data/mocap/bandai-namco/Bandai-Namco-Research-Motiondataset-1/data"
-REAL_SOURCE_CONTENT = "bye"
-
-
-def real_source_gestures(content: str = REAL_SOURCE_CONTENT, styles=None) -> list[dict]:
-    """``captured_file`` entries of the shipped real ``content`` takes (take 001) in each captured style that names a
-    gesture emotion (``study_protocol.CAPTURE_GESTURE_EMOTIONS``; default all five), seated on the chair, labelled
-    with that emotion, for the naturalness and gesture-emotion sections."""
-    from study_protocol import CAPTURE_GESTURE_EMOTIONS
-
-    styles = tuple(CAPTURE_GESTURE_EMOTIONS) if styles is None else tuple(styles)
-    return [{"id": f"real_{content}_{style}", "generator": "captured_file", "modality": "gesture", "origin": "source",
-             "file": f"{SHIPPED_GESTURES}/dataset-1_{content}_{style}_001.bvh", "seated": True,
-             "emotion_label": CAPTURE_GESTURE_EMOTIONS[style], "sections": ["naturalness", "gesture_emotion"],
-             "note": f"REAL captured gesture (Bandai Namco Research Motion Dataset 1, {content} {style}, take 1; "
-                     f"CC BY-NC 4.0), seated"} for style in styles]
+    return round(float(gesture_seconds(count_words(sentence))), 2)
 
 
 def seed003(narration: int = 3, conversation: int = 2, splits: tuple[str, ...] = ("test",)) -> dict:
@@ -175,13 +147,10 @@ def seed003(narration: int = 3, conversation: int = 2, splits: tuple[str, ...] =
                       "task": row["task"],
                       "emotion_label": row["emotion"], "gender": gender, "handedness": handedness, "seed": k + 1,
                       "pair": f"source_{sid}", "sections": ["gesture_emotion", "naturalness"]})
-    clips.extend(real_source_gestures())
     return {"name": "seed003", "description": "Seed 003 (Bhattacharya et al., IEEE VR 2021) web study stimuli: "
             "generated gestures over the 11 MPI emotions for sentences held out from the network's training "
-            "(test split), each paired with a source gesture (procedural, synthetic), and real captured source "
-            "gestures (Bandai Namco 'bye' in the styles happy, sad, angry, proud, normal = joyous, sad, angry, proud, "
-            "neutral; CC BY-NC 4.0, Kobayashi et al. 2023, arXiv:2306.08861) seated on the chair; seated agent on a "
-            "chair, fixed camera; 25 fps video (the paper gives no video rate).",
+            "(test split), each paired with a source gesture (procedural, synthetic); seated agent on a chair, "
+            "fixed camera; 25 fps video (the paper gives no video rate).",
             "render": dict(RENDER, duration_s=12), "clips": clips}
 
 
@@ -199,30 +168,14 @@ def seed004(n_cycles: int = 3) -> dict:
                       "weight": INVERSION_WEIGHT, "n_features": 10, "n_cycles": n_cycles,
                       "sections": ["theme_inversion"], "loop": True})
     return {"name": "seed004", "description": "Seed 004 (Etemad & Arya, THMS 2016) perception study stimuli: "
-            "neutral input walk averaged from real normal walks (Bandai Namco, CC BY-NC 4.0, Kobayashi et al. 2023), "
-            "6 themes x 4 weights x 4 feature counts, inversions at w = -0.7; short walk cycles the player loops; "
-            "25 fps video (the paper gives no video rate).", "render": dict(RENDER), "clips": clips}
-
-
-def seed004_data(n_cycles: int = 3, weight: float = 0.7) -> dict:
-    """Expert-styled and data-styled walks of each theme side by side, on the real neutral base."""
-    clips = [{"id": "neutral_walk", "generator": "neutral_walk", "origin": "source", "n_cycles": n_cycles,
-              "sections": ["neutral_validation"], "loop": True}]
-    for theme in THEMES:
-        for features in ("expert", "data"):
-            clips.append({"id": f"{theme}_{features}_w{weight}", "generator": "rbf", "origin": "generated",
-                          "theme": theme, "weight": weight, "n_features": 10, "features": features,
-                          "n_cycles": n_cycles, "sections": ["theme_rating"], "loop": True})
-    return {"name": "seed004_data", "description": "Seed 004's themes with the experts' features (Table III) beside "
-            "data-driven features fitted to real themed walks (Bandai Namco, CC BY-NC 4.0, Kobayashi et al. 2023), "
-            f"all ten features at w = {weight}, on the neutral walk averaged from real normal walks; 25 fps video.",
-            "render": dict(RENDER), "clips": clips}
+            "neutral input walk, 6 themes x 4 weights x 4 feature counts, inversions at w = -0.7; short walk "
+            "cycles the player loops; 25 fps video (the paper gives no video rate).", "render": dict(RENDER),
+            "clips": clips}
 
 
 def write_all(out_dir: Path = HERE) -> list[Path]:
     written = []
-    for name, data in (("seed000", seed000()), ("seed003", seed003()), ("seed004", seed004()),
-                       ("seed004_data", seed004_data())):
+    for name, data in (("seed000", seed000()), ("seed003", seed003()), ("seed004", seed004())):
         path = out_dir / f"{name}.yaml"
         header = (f"# Built-in plan {name}; written by `python -m generation.plans.build` (edit a copy, or change\n"
                   f"# build.py and rerun). {len(data['clips'])} clips.\n")

@@ -12,6 +12,7 @@ import os
 from collections.abc import Iterable
 from pathlib import Path
 
+from generation.quality.checks import qa_columns
 from study_protocol import (
     CLIP_COLUMNS,
     CLIP_FLOAT_COLUMNS,
@@ -91,8 +92,6 @@ def write_clips_csv(records: Iterable[dict], path: str | Path, merge: bool = Tru
     if merge and path.exists():
         for row in read_clips_csv(path):
             rows[row["clip_id"]] = row
-    from generation.quality.checks import qa_columns
-
     for rec in records:
         qa = qa_columns(rec["qa"]) if isinstance(rec.get("qa"), dict) else {c: rec.get(c) for c in QA_COLUMNS}
         rows[str(rec["clip_id"])] = {**{c: rec.get(c) for c in CLIP_COLUMNS}, **qa}

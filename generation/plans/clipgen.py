@@ -1,7 +1,8 @@
 """Turn a validated plan entry into a Motion by calling the right generator.
 
-Generators are imported lazily, inside the function that needs them, so a missing or broken generator
-fails only the entries that use it, with a message naming the entry (:class:`ClipGenerationError`).
+The network generators (gait_net, gesture_net, rbf: they load torch) are imported inside the function that
+needs them, so planning, hashing and procedural clips never load torch, and a missing or broken network fails only
+the entries that use it, with a message naming the entry (:class:`ClipGenerationError`).
 
 A network generator whose weights are not there yet may be replaced by the entry's ``fallback``
 (procedural_walk for gait_net, procedural_gesture for gesture_net). The clip is then recorded with the
@@ -16,13 +17,27 @@ import functools
 import hashlib
 import importlib
 import math
+import os
 from pathlib import Path
 
 import numpy as np
 
+from generation.core import paths
+from generation.core.foot_contact import plant_feet
 from generation.core.motion import Motion
+from generation.core.paths import GroundPath
+from generation.core.quaternion import np_qfix, np_qslerp
+from generation.core.skeleton import gait_skeleton, gesture_skeleton
+from generation.formats.bvh import write_bvh
+from generation.gesture.config import gesture_seconds
+from generation.mocap.captured import WALK_FILES, captured_walks, chain_clip_repeats
+from generation.procedural.emotion import gait_params_for_emotion, gesture_params_for_vad
+from generation.procedural.gesture import seated_gesture
+from generation.procedural.walk import walk
+from generation.rbf.neutral_base import neutral_cycle
 from study_protocol import GESTURE_VAD
 
+from .captured_file import CapturedFileError, captured_file_motion
 from .schema import ClipEntry
 
 #: Declared generator versions. Clip hashes also carry a digest of each generator's source code and data
@@ -44,10 +59,8 @@ GENERATOR_MODULES = {
     "procedural_walk": ("generation.procedural.walk", "generation.procedural.emotion", "generation.core.paths"),
     "captured": ("generation.mocap.captured", "generation.core.foot_contact"),
     "captured_file": ("generation.plans.captured_file", "generation.mocap.importer"),
-    "neutral_walk": ("generation.rbf.neutral_base", "generation.rbf.real_neutral", "generation.rbf.stylise",
-                     "generation.core.foot_contact"),
-    "rbf": ("generation.rbf.neutral_base", "generation.rbf.real_neutral", "generation.rbf.data_features",
-            "generation.rbf.stylise", "generation.core.foot_contact"),
+    "neutral_walk": ("generation.rbf.neutral_base", "generation.rbf.stylise", "generation.core.foot_contact"),
+    "rbf": ("generation.rbf.neutral_base", "generation.rbf.stylise", "generation.core.foot_contact"),
     "gesture_net": ("generation.gesture.generate",),
     "procedural_gesture": ("generation.procedural.gesture", "generation.procedural.emotion"),
 }
@@ -181,12 +194,7 @@ def fallback_entry(entry: ClipEntry) -> ClipEntry:
     if entry.generator == "gesture_net":
         inp = entry.inputs
         n_words = len(inp["sentence"].split())
-        try:
-            from generation.gesture.config import gesture_seconds
-
-            seconds = float(gesture_seconds(n_words))
-        except Exception:  # noqa: BLE001 - the network's package may be the thing that is missing
-            seconds = 2.0 + 0.4 * n_words
+        seconds = float(gesture_seconds(n_words))
         inputs = {"emotion_label": inp["emotion_label"], "kind": None, "gender": inp["gender"],
                   "handedness": inp["handedness"], "duration_s": round(min(max(seconds, 2.0), 60.0), 3)}
         fb = dataclasses.replace(fb, inputs=inputs)
@@ -196,8 +204,6 @@ def fallback_entry(entry: ClipEntry) -> ClipEntry:
 # ---- paths -------------------------------------------------------------------------------------
 def make_path(trajectory: dict):
     """A GroundPath from a normalised plan trajectory (metres; angles in degrees in the plan)."""
-    from generation.core import paths
-
     kind, length = trajectory["kind"], trajectory["length_m"]
     if kind == "straight":
         return paths.straight(length)
@@ -215,12 +221,11 @@ generate_clips --device`` sets it, so that the render worker processes it spawns
 def generation_device(device: str | None = None) -> str:
     """The device the network generators run on: ``device`` when given, else ``$GENERATION_DEVICE``, else "cpu"
     (stimuli identical to those made on a machine without a GPU)."""
-    import os
     return device or os.environ.get(DEVICE_ENV) or "cpu"
 
 
 def _gait_net(entry: ClipEntry, fps: float) -> Motion:
-    from generation.gait.generate import emotion_transition, generate_gaits, load_default_model
+    from generation.gait.generate import emotion_transition, generate_gaits, load_default_model  # heavy: torch
 
     net = load_default_model(generation_device())
     inp = entry.inputs
@@ -234,9 +239,6 @@ def _gait_net(entry: ClipEntry, fps: float) -> Motion:
 
 
 def _procedural_walk(entry: ClipEntry, fps: float) -> Motion:
-    from generation.procedural.emotion import gait_params_for_emotion
-    from generation.procedural.walk import walk
-
     inp = entry.inputs
     rng = np.random.default_rng(entry.seed)
     n_frames = int(round(inp["duration_s"] * fps)) + 1
@@ -268,10 +270,6 @@ def transition_walk(a, b, path, n_frames: int, fps: float, seed: int | None = No
 
     Returns a Motion of ``n_frames`` frames at ``fps`` on the gait skeleton.
     """
-    from generation.core.paths import GroundPath
-    from generation.core.quaternion import np_qfix, np_qslerp
-    from generation.procedural.walk import walk
-
     T = int(n_frames)
     weights = [0.0] + [(k + 1) / (n_blend + 1) for k in range(n_blend)] + [1.0]
     mid = (1.0 - 2 * hold) / n_blend
@@ -314,15 +312,11 @@ def transition_walk(a, b, path, n_frames: int, fps: float, seed: int | None = No
         segments_meta.append({"blend": round(w, 4), "start_frame": start, "params": params.to_dict()})
     meta = {"origin": "procedural", "synthetic": True, "path_kind": path.kind, "transition_segments": segments_meta,
             "transition_method": "segmented procedural walk with cross-fades (clipgen.transition_walk)"}
-    from generation.core.skeleton import gait_skeleton
-
     return Motion(gait_skeleton(), np_qfix(rot), root, fps, meta)
 
 
 def _captured_file(entry: ClipEntry, fps: float) -> Motion:
     """An imported motion file (generation/plans/captured_file.py); errors name the entry and the field."""
-    from .captured_file import CapturedFileError, captured_file_motion
-
     try:
         return captured_file_motion(entry.inputs, entry.modality, fps)
     except CapturedFileError as exc:
@@ -330,8 +324,6 @@ def _captured_file(entry: ClipEntry, fps: float) -> Motion:
 
 
 def _captured(entry: ClipEntry, fps: float) -> Motion:
-    from generation.mocap.captured import WALK_FILES, captured_walks, chain_clip_repeats
-
     names = [name for name, _ in WALK_FILES]
     clip = entry.inputs["clip"]
     if clip not in names:
@@ -343,52 +335,40 @@ def _captured(entry: ClipEntry, fps: float) -> Motion:
         # foot jumped 6-9 cm (skate 9-11 cm/s over 8 repeats vs 3-8 for one clip). Plant the feet, and say so.
         # lower_pelvis: locking the sliding source feet put the stance knee fully straight in 17-27 % of the
         # frames; lowering the pelvis where out of reach (<= 2.5 cm, smoothed) avoids that.
-        from generation.core.foot_contact import plant_feet
-
         motion = plant_feet(motion, lower_pelvis=True)
         motion.metadata.update({"foot_planting": True,
                                 "foot_planting_reason": "seams of the chained repeats (chain_clip_repeats)"})
     return motion
 
 
-@functools.lru_cache(maxsize=2)
-def _neutral_cycle(base: str = "real") -> Motion:
-    """The RBF styliser's neutral base: averaged real normal walks (shipped file) or averaged procedural walks."""
-    if base == "real":
-        from generation.rbf.real_neutral import load_cycle
-
-        return load_cycle()
-    from generation.rbf.neutral_base import neutral_cycle
-
+@functools.lru_cache(maxsize=1)
+def _neutral_cycle() -> Motion:
     return neutral_cycle()
 
 
 def _neutral_walk(entry: ClipEntry, fps: float) -> Motion:
-    from generation.rbf.stylise import cycle_stride, plant_walk_feet, warp_and_repeat_cycle
+    from generation.rbf.stylise import cycle_stride, plant_walk_feet, warp_and_repeat_cycle  # heavy: torch
 
+    base = _neutral_cycle()
     inp = entry.inputs
-    base = _neutral_cycle(inp.get("base", "real"))
     rot, root = warp_and_repeat_cycle(base.rotations, base.root_positions, cycle_stride(base), base.duration,
                                       inp["speed"], inp["n_cycles"], fps)
     meta = dict(base.metadata)
-    meta.update({"generator": "neutral_walk", "n_cycles": inp["n_cycles"], "speed": inp["speed"],
-                 "base": inp.get("base", "real")})
+    meta.update({"generator": "neutral_walk", "n_cycles": inp["n_cycles"], "speed": inp["speed"]})
     # planted like the RBF-styled walks it is compared with (_rbf), so they differ by the features only
     return plant_walk_feet(Motion(base.skeleton, rot, root, fps, meta))
 
 
 def _rbf(entry: ClipEntry, fps: float) -> Motion:
-    from generation.rbf.stylise import stylise
+    from generation.rbf.stylise import stylise  # heavy: torch
 
     inp = entry.inputs
-    motion = stylise(_neutral_cycle(inp.get("base", "real")), inp["theme"], inp["weight"], inp["n_features"],
-                     speed=inp["speed"], n_cycles=inp["n_cycles"], fps=fps, features=inp.get("features", "expert"))
-    motion.metadata["base"] = inp.get("base", "real")
-    return motion
+    return stylise(_neutral_cycle(), inp["theme"], inp["weight"], inp["n_features"], speed=inp["speed"],
+                   n_cycles=inp["n_cycles"], fps=fps)
 
 
 def _gesture_net(entry: ClipEntry, fps: float) -> Motion:
-    from generation.gesture.generate import generate_gesture
+    from generation.gesture.generate import generate_gesture  # heavy: torch
 
     inp = entry.inputs
     return generate_gesture(inp["sentence"], inp["task"], inp["emotion_label"], inp["gender"], inp["handedness"],
@@ -396,10 +376,6 @@ def _gesture_net(entry: ClipEntry, fps: float) -> Motion:
 
 
 def _procedural_gesture(entry: ClipEntry, fps: float) -> Motion:
-    from generation.core.skeleton import gesture_skeleton
-    from generation.procedural.emotion import gesture_params_for_vad
-    from generation.procedural.gesture import seated_gesture
-
     inp = entry.inputs
     v, a, d = GESTURE_VAD[inp["emotion_label"]] if "emotion_label" in inp else inp["vad"]
     rng = np.random.default_rng(entry.seed)
@@ -463,8 +439,6 @@ def write_motion_bvh(motion: Motion, motions_dir: str | Path, clip_id: str) -> P
     ``motions_dir`` is never served: a motion file names no condition, but its id is the clip's.
     Returns the path written.
     """
-    from generation.formats.bvh import write_bvh
-
     if not clip_id or any(c in clip_id for c in "/\\.") or clip_id.strip() != clip_id:
         raise ValueError(f"clip id {clip_id!r} cannot name a file")
     motions_dir = Path(motions_dir)

@@ -36,6 +36,9 @@ import math
 from dataclasses import dataclass, field
 from pathlib import Path
 
+import yaml
+
+from generation.quality.checks import QAThresholdError, resolve_thresholds
 from generation.render.settings import RENDERER_VERSION, RenderSettings, RenderSettingsError
 from study_protocol import (
     FINAL_EMOTION_COLUMNS,
@@ -51,16 +54,13 @@ from study_protocol import (
     VAD_DIMENSIONS,
 )
 
+from .captured_file import CapturedFileError, captured_file_inputs
+
 PLANS_DIR = Path(__file__).resolve().parent
 TRAJECTORY_KINDS = ("straight", "curved", "sharp_turn")
 #: Splits of the gesture network's sentence corpus (generation.gesture.data.split_sentences); a gesture_net
 #: entry may say which one its sentence comes from (a record for the study: held-out inputs are "test").
 SENTENCE_SPLITS = ("train", "val", "test")
-#: Neutral base cycle of the RBF styliser: "real" (averaged real normal walks, generation/data/rbf/neutral_real.npz)
-#: or "procedural" (averaged synthetic walks, generation.rbf.neutral_base.neutral_cycle).
-RBF_BASES = ("real", "procedural")
-#: Style features of an rbf entry: "expert" (Table III of seed 004) or "data" (fitted to real themed walks).
-RBF_FEATURES = ("expert", "data")
 CAPTURED_CLIPS = ("humanoid3d_walk.txt", "0walk_forward.txt", "turn_left0.txt", "turn_left1.txt",
                   "turn_right0.txt", "turn_right1.txt")
 
@@ -82,11 +82,11 @@ GENERATOR_FIELDS: dict[str, set[str]] = {
     "gait_net": {"emotion", "transition", "trajectory", "duration_s"},
     "procedural_walk": {"emotion", "transition", "trajectory", "duration_s"},
     "captured": {"clip", "cycles"},
-    "neutral_walk": {"n_cycles", "speed", "base"},
-    "rbf": {"theme", "weight", "n_features", "n_cycles", "speed", "base", "features"},
+    "neutral_walk": {"n_cycles", "speed"},
+    "rbf": {"theme", "weight", "n_features", "n_cycles", "speed"},
     "gesture_net": {"sentence", "task", "emotion_label", "gender", "handedness", "noise", "sentence_split"},
     "procedural_gesture": {"emotion_label", "vad", "kind", "gender", "handedness", "duration_s"},
-    "captured_file": {"file", "start_s", "emotion", "emotion_label", "vad", "seated"},
+    "captured_file": {"file", "start_s", "emotion", "emotion_label", "vad"},
 }
 
 
@@ -256,8 +256,6 @@ def _generator_inputs(gen: str, raw: dict, duration_default: float) -> dict:
         out["trajectory"] = _trajectory(raw.get("trajectory"))
         out["duration_s"] = _number("duration_s", raw.get("duration_s", duration_default), 1.0, 120.0)
     elif gen == "captured_file":
-        from .captured_file import CapturedFileError, captured_file_inputs
-
         try:
             out.update(captured_file_inputs(raw))
         except CapturedFileError as exc:
@@ -268,7 +266,6 @@ def _generator_inputs(gen: str, raw: dict, duration_default: float) -> dict:
     elif gen == "neutral_walk":
         out["n_cycles"] = _integer("n_cycles", raw.get("n_cycles", 3), 1, 50)
         out["speed"] = _number("speed", raw.get("speed", 1.0), 0.2, 3.0)
-        out["base"] = _choice("base", raw.get("base", RBF_BASES[0]), RBF_BASES)
     elif gen == "rbf":
         if "theme" not in raw:
             raise _FieldError("theme", f"required; one of {list(THEMES)}")
@@ -279,8 +276,6 @@ def _generator_inputs(gen: str, raw: dict, duration_default: float) -> dict:
         out["n_features"] = _integer("n_features", raw.get("n_features", 10), 1, 10)
         out["n_cycles"] = _integer("n_cycles", raw.get("n_cycles", 3), 1, 50)
         out["speed"] = _number("speed", raw.get("speed", 1.0), 0.2, 3.0)
-        out["base"] = _choice("base", raw.get("base", RBF_BASES[0]), RBF_BASES)
-        out["features"] = _choice("features", raw.get("features", RBF_FEATURES[0]), RBF_FEATURES)
     elif gen == "gesture_net":
         out["sentence"] = _text("sentence", raw.get("sentence"))
         out["task"] = _choice("task", raw.get("task", GESTURE_TASKS[0]), GESTURE_TASKS)
@@ -401,8 +396,6 @@ def validate_plan(data, source: str = "<plan>") -> Plan:
                             f"(id {keys[key].id!r}); change the seed to get a different clip")
         keys[key] = e
     description = data.get("description", "")
-    from generation.quality.checks import QAThresholdError, resolve_thresholds
-
     qa = data.get("qa") or {}
     try:
         resolve_thresholds(qa)
@@ -435,8 +428,6 @@ def load_plan(name_or_path: str | Path) -> Plan:
         if path.suffix.lower() == ".json":
             data = json.loads(text)
         else:
-            import yaml
-
             data = yaml.safe_load(text)
     except Exception as exc:  # noqa: BLE001 - json.JSONDecodeError / yaml.YAMLError carry the line and column
         raise PlanError(f"{path}: cannot parse ({exc})") from None

@@ -194,7 +194,7 @@ def _ring_profile(r0: float, r1: float, y0: float, y1: float, cap: float, n_cap:
 
 def part_mesh(part: Part, n_around: int = 12):
     """The PyVista mesh of a part in its own frame (metres), with point normals for smooth shading."""
-    import pyvista as pv
+    import pyvista as pv  # heavy: VTK, loaded only when a frame is drawn
 
     if part.ellipsoid is not None:
         rx, ry, rz = part.ellipsoid

@@ -6,6 +6,8 @@ import textwrap
 from collections.abc import Sequence
 from pathlib import Path
 
+from PIL import Image, ImageDraw, ImageFont
+
 
 def contact_sheet(poster_paths: Sequence[str | Path], labels: Sequence[str], out_png: str | Path,
                   columns: int | None = None, thumb_width: int = 320) -> Path:
@@ -18,7 +20,6 @@ def contact_sheet(poster_paths: Sequence[str | Path], labels: Sequence[str], out
         columns: grid width; default about sqrt(n) * 1.3.
     Returns the output path.
     """
-    from PIL import Image, ImageDraw, ImageFont
 
     if len(poster_paths) != len(labels):
         raise ValueError(f"{len(poster_paths)} posters but {len(labels)} labels")

@@ -9,7 +9,9 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
+import imageio_ffmpeg
 import numpy as np
+from PIL import Image
 
 
 def temp_path(final: Path) -> Path:
@@ -39,8 +41,6 @@ class VideoWriter:
 
     def __init__(self, path: str | Path, width: int, height: int, fps: float, crf: int = 23,
                  preset: str = "veryfast", threads: int = 0):
-        import imageio_ffmpeg
-
         self.path = Path(path)
         self.kind = self.path.suffix.lstrip(".").lower()
         self.tmp = temp_path(self.path)
@@ -77,7 +77,6 @@ class VideoWriter:
 
 def write_png_atomic(image: np.ndarray, path: str | Path) -> Path:
     """Write an RGB image (H, W, 3) uint8 to ``path`` through a temporary name."""
-    from PIL import Image
 
     path = Path(path)
     tmp = temp_path(path)
@@ -88,6 +87,5 @@ def write_png_atomic(image: np.ndarray, path: str | Path) -> Path:
 
 def probe_video(path: str | Path) -> tuple[int, float]:
     """(frame count, seconds) of a video file by decoding it with the bundled ffmpeg."""
-    import imageio_ffmpeg
 
     return imageio_ffmpeg.count_frames_and_secs(str(path))

@@ -118,7 +118,7 @@ class StickFigureScene:
     def __init__(self, skeleton: Skeleton, width: int, height: int, anti_aliasing: str,
                  ground_extent: tuple[float, float, float, float], ground_y: float = 0.0,
                  chair: list[tuple] | None = None):
-        import pyvista as pv
+        import pyvista as pv  # heavy: VTK, loaded only when a scene is built
 
         self.skeleton = skeleton
         self.width, self.height = width, height

@@ -5,6 +5,8 @@ import argparse
 
 from django.core.management.base import CommandError
 
+from studyapp.models import Study
+
 
 def mirror_arguments(parser: argparse.ArgumentParser, source: argparse.ArgumentParser) -> None:
     """Add every option of a library's parser (e.g. ``generation.gait.train.build_parser()``) to ``parser``."""
@@ -29,7 +31,6 @@ def mirrored_namespace(source: argparse.ArgumentParser, options: dict) -> argpar
 
 def study_by_slug(slug: str):
     """The Study with ``slug``, or a CommandError listing the known slugs."""
-    from studyapp.models import Study
 
     study = Study.objects.filter(slug=slug).first()
     if study is None:

@@ -29,7 +29,7 @@ class Command(BaseCommand):
             raise CommandError(str(exc)) from exc
         data = None
         if options.get("corpus"):
-            from generation.mocap.gesture_corpus import load_gesture_corpus
+            from generation.mocap.gesture_corpus import load_gesture_corpus  # heavy: torch, only with --corpus
 
             try:
                 data = load_gesture_corpus(options["corpus"], seed=cfg.seed)

@@ -1,0 +1,40 @@
+"""Jobs of a plan: each entry resolved to the generator that will run (or its fallback), hashed to its clip id,
+with the plan's quality thresholds and the torch device of the network generators."""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from generation.plans.clipgen import ClipGenerationError, generation_device, generator_version, resolve
+from generation.plans.schema import ClipEntry, Plan, clip_hash
+from generation.quality.checks import resolve_thresholds
+
+
+@dataclass
+class Job:
+    """One clip to make: the plan entry, the entry that will run (maybe a fallback) and the clip id."""
+
+    entry: ClipEntry
+    run_entry: ClipEntry
+    clip_id: str
+    generator_version: str
+    fallback_reason: str | None = None
+    qa_thresholds: dict | None = None  # the plan's quality thresholds (resolved); None = study_protocol defaults
+    # torch device of the network generators, fixed where the jobs are planned so that Dask workers on other
+    # machines use it too (they do not inherit the submitting process's $GENERATION_DEVICE).
+    device: str | None = None
+
+
+def plan_jobs(plan: Plan, limit: int | None = None) -> tuple[list[Job], list[tuple[str, str]]]:
+    """Jobs for the plan's entries (first ``limit``), and (entry, message) for entries that cannot run."""
+    thresholds = resolve_thresholds(plan.qa)
+    jobs, failures = [], []
+    for entry in plan.entries[:limit] if limit else plan.entries:
+        try:
+            run_entry, reason = resolve(entry)
+        except ClipGenerationError as exc:
+            failures.append((entry.where, str(exc)))
+            continue
+        version = generator_version(run_entry.generator)
+        jobs.append(Job(entry, run_entry, clip_hash(run_entry, run_entry.generator, version), version, reason,
+                        thresholds, generation_device()))
+    return jobs, failures
