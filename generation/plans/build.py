@@ -14,7 +14,10 @@ The plans are plain YAML afterwards; researchers copy and edit them. What each r
   The generated gestures' sentences come from the gesture network's held-out test split (each entry says
   ``sentence_split: test``), so the study shows the network on inputs it was not trained on.
 - seed004 (THMS 2016, section V): the neutral input walk, 6 themes x weights (0.4, 0.7, 1.0, 1.3) x feature
-  counts (1, 4, 7, 10), and the inversions at w = -0.7 with all ten features; short looping clips.
+  counts (1, 4, 7, 10), and the inversions at w = -0.7 with all ten features; short looping clips. The neutral base
+  is averaged from real normal walks (``base: real``, the default).
+- seed004_data: each theme at w = 0.7 with the experts' features and with data-driven features (``features:
+  data``, fitted to real themed walks) side by side, on the same real neutral base.
 """
 from __future__ import annotations
 
@@ -168,14 +171,36 @@ def seed004(n_cycles: int = 3) -> dict:
                       "weight": INVERSION_WEIGHT, "n_features": 10, "n_cycles": n_cycles,
                       "sections": ["theme_inversion"], "loop": True})
     return {"name": "seed004", "description": "Seed 004 (Etemad & Arya, THMS 2016) perception study stimuli: "
-            "neutral input walk, 6 themes x 4 weights x 4 feature counts, inversions at w = -0.7; short walk "
-            "cycles the player loops; 25 fps video (the paper gives no video rate).", "render": dict(RENDER),
+            "neutral input walk averaged from real normal walks (Bandai Namco, CC BY-NC 4.0, Kobayashi et al. 2023), "
+            "6 themes x 4 weights x 4 feature counts, inversions at w = -0.7; short walk cycles the player loops; "
+            "25 fps video (the paper gives no video rate).", "render": dict(RENDER), "qa": dict(LOOPED_CYCLE_QA),
             "clips": clips}
+
+
+#: One averaged cycle looped (the paper's stimulus) has no cycle-to-cycle change of walking speed, so the real
+#: corpus's lower bound on speed variability (generation/quality/realism_ranges.json) does not apply to it.
+LOOPED_CYCLE_QA = {"speed_cv_min": None}
+
+
+def seed004_data(n_cycles: int = 3, weight: float = 0.7) -> dict:
+    """Expert-styled and data-styled walks of each theme side by side, on the real neutral base."""
+    clips = [{"id": "neutral_walk", "generator": "neutral_walk", "origin": "source", "n_cycles": n_cycles,
+              "sections": ["neutral_validation"], "loop": True}]
+    for theme in THEMES:
+        for features in ("expert", "data"):
+            clips.append({"id": f"{theme}_{features}_w{weight}", "generator": "rbf", "origin": "generated",
+                          "theme": theme, "weight": weight, "n_features": 10, "features": features,
+                          "n_cycles": n_cycles, "sections": ["theme_rating"], "loop": True})
+    return {"name": "seed004_data", "description": "Seed 004's themes with the experts' features (Table III) beside "
+            "data-driven features fitted to real themed walks (Bandai Namco, CC BY-NC 4.0, Kobayashi et al. 2023), "
+            f"all ten features at w = {weight}, on the neutral walk averaged from real normal walks; 25 fps video.",
+            "render": dict(RENDER), "qa": dict(LOOPED_CYCLE_QA), "clips": clips}
 
 
 def write_all(out_dir: Path = HERE) -> list[Path]:
     written = []
-    for name, data in (("seed000", seed000()), ("seed003", seed003()), ("seed004", seed004())):
+    for name, data in (("seed000", seed000()), ("seed003", seed003()), ("seed004", seed004()),
+                       ("seed004_data", seed004_data())):
         path = out_dir / f"{name}.yaml"
         header = (f"# Built-in plan {name}; written by `python -m generation.plans.build` (edit a copy, or change\n"
                   f"# build.py and rerun). {len(data['clips'])} clips.\n")

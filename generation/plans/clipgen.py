@@ -35,6 +35,7 @@ from generation.procedural.emotion import gait_params_for_emotion, gesture_param
 from generation.procedural.gesture import seated_gesture
 from generation.procedural.walk import walk
 from generation.rbf.neutral_base import neutral_cycle
+from generation.rbf.real_neutral import load_cycle
 from study_protocol import GESTURE_VAD
 
 from .captured_file import CapturedFileError, captured_file_motion
@@ -59,8 +60,10 @@ GENERATOR_MODULES = {
     "procedural_walk": ("generation.procedural.walk", "generation.procedural.emotion", "generation.core.paths"),
     "captured": ("generation.mocap.captured", "generation.core.foot_contact"),
     "captured_file": ("generation.plans.captured_file", "generation.mocap.importer"),
-    "neutral_walk": ("generation.rbf.neutral_base", "generation.rbf.stylise", "generation.core.foot_contact"),
-    "rbf": ("generation.rbf.neutral_base", "generation.rbf.stylise", "generation.core.foot_contact"),
+    "neutral_walk": ("generation.rbf.neutral_base", "generation.rbf.real_neutral", "generation.rbf.stylise",
+                     "generation.core.foot_contact"),
+    "rbf": ("generation.rbf.neutral_base", "generation.rbf.real_neutral", "generation.rbf.data_features",
+            "generation.rbf.stylise", "generation.core.foot_contact"),
     "gesture_net": ("generation.gesture.generate",),
     "procedural_gesture": ("generation.procedural.gesture", "generation.procedural.emotion"),
 }
@@ -341,20 +344,22 @@ def _captured(entry: ClipEntry, fps: float) -> Motion:
     return motion
 
 
-@functools.lru_cache(maxsize=1)
-def _neutral_cycle() -> Motion:
-    return neutral_cycle()
+@functools.lru_cache(maxsize=2)
+def _neutral_cycle(base: str = "real") -> Motion:
+    """The RBF styliser's neutral base: averaged real normal walks (shipped file) or averaged procedural walks."""
+    return load_cycle() if base == "real" else neutral_cycle()
 
 
 def _neutral_walk(entry: ClipEntry, fps: float) -> Motion:
     from generation.rbf.stylise import cycle_stride, plant_walk_feet, warp_and_repeat_cycle  # heavy: torch
 
-    base = _neutral_cycle()
     inp = entry.inputs
+    base = _neutral_cycle(inp.get("base", "real"))
     rot, root = warp_and_repeat_cycle(base.rotations, base.root_positions, cycle_stride(base), base.duration,
                                       inp["speed"], inp["n_cycles"], fps)
     meta = dict(base.metadata)
-    meta.update({"generator": "neutral_walk", "n_cycles": inp["n_cycles"], "speed": inp["speed"]})
+    meta.update({"generator": "neutral_walk", "n_cycles": inp["n_cycles"], "speed": inp["speed"],
+                 "base": inp.get("base", "real")})
     # planted like the RBF-styled walks it is compared with (_rbf), so they differ by the features only
     return plant_walk_feet(Motion(base.skeleton, rot, root, fps, meta))
 
@@ -363,8 +368,10 @@ def _rbf(entry: ClipEntry, fps: float) -> Motion:
     from generation.rbf.stylise import stylise  # heavy: torch
 
     inp = entry.inputs
-    return stylise(_neutral_cycle(), inp["theme"], inp["weight"], inp["n_features"], speed=inp["speed"],
-                   n_cycles=inp["n_cycles"], fps=fps)
+    motion = stylise(_neutral_cycle(inp.get("base", "real")), inp["theme"], inp["weight"], inp["n_features"],
+                     speed=inp["speed"], n_cycles=inp["n_cycles"], fps=fps, features=inp.get("features", "expert"))
+    motion.metadata["base"] = inp.get("base", "real")
+    return motion
 
 
 def _gesture_net(entry: ClipEntry, fps: float) -> Motion:

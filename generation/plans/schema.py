@@ -61,6 +61,11 @@ TRAJECTORY_KINDS = ("straight", "curved", "sharp_turn")
 #: Splits of the gesture network's sentence corpus (generation.gesture.data.split_sentences); a gesture_net
 #: entry may say which one its sentence comes from (a record for the study: held-out inputs are "test").
 SENTENCE_SPLITS = ("train", "val", "test")
+#: Neutral base cycle of the RBF styliser: "real" (averaged real normal walks, generation/data/rbf/neutral_real.npz)
+#: or "procedural" (averaged synthetic walks, generation.rbf.neutral_base.neutral_cycle).
+RBF_BASES = ("real", "procedural")
+#: Style features of an rbf entry: "expert" (Table III of seed 004) or "data" (fitted to real themed walks).
+RBF_FEATURES = ("expert", "data")
 CAPTURED_CLIPS = ("humanoid3d_walk.txt", "0walk_forward.txt", "turn_left0.txt", "turn_left1.txt",
                   "turn_right0.txt", "turn_right1.txt")
 
@@ -82,8 +87,8 @@ GENERATOR_FIELDS: dict[str, set[str]] = {
     "gait_net": {"emotion", "transition", "trajectory", "duration_s"},
     "procedural_walk": {"emotion", "transition", "trajectory", "duration_s"},
     "captured": {"clip", "cycles"},
-    "neutral_walk": {"n_cycles", "speed"},
-    "rbf": {"theme", "weight", "n_features", "n_cycles", "speed"},
+    "neutral_walk": {"n_cycles", "speed", "base"},
+    "rbf": {"theme", "weight", "n_features", "n_cycles", "speed", "base", "features"},
     "gesture_net": {"sentence", "task", "emotion_label", "gender", "handedness", "noise", "sentence_split"},
     "procedural_gesture": {"emotion_label", "vad", "kind", "gender", "handedness", "duration_s"},
     "captured_file": {"file", "start_s", "emotion", "emotion_label", "vad"},
@@ -266,6 +271,7 @@ def _generator_inputs(gen: str, raw: dict, duration_default: float) -> dict:
     elif gen == "neutral_walk":
         out["n_cycles"] = _integer("n_cycles", raw.get("n_cycles", 3), 1, 50)
         out["speed"] = _number("speed", raw.get("speed", 1.0), 0.2, 3.0)
+        out["base"] = _choice("base", raw.get("base", RBF_BASES[0]), RBF_BASES)
     elif gen == "rbf":
         if "theme" not in raw:
             raise _FieldError("theme", f"required; one of {list(THEMES)}")
@@ -276,6 +282,8 @@ def _generator_inputs(gen: str, raw: dict, duration_default: float) -> dict:
         out["n_features"] = _integer("n_features", raw.get("n_features", 10), 1, 10)
         out["n_cycles"] = _integer("n_cycles", raw.get("n_cycles", 3), 1, 50)
         out["speed"] = _number("speed", raw.get("speed", 1.0), 0.2, 3.0)
+        out["base"] = _choice("base", raw.get("base", RBF_BASES[0]), RBF_BASES)
+        out["features"] = _choice("features", raw.get("features", RBF_FEATURES[0]), RBF_FEATURES)
     elif gen == "gesture_net":
         out["sentence"] = _text("sentence", raw.get("sentence"))
         out["task"] = _choice("task", raw.get("task", GESTURE_TASKS[0]), GESTURE_TASKS)
