@@ -170,7 +170,7 @@ CLIP_COLUMNS = ("clip_id", "modality", "origin", *GAIT_EMOTIONS, *FINAL_EMOTION_
 CLIP_FLOAT_COLUMNS = (*GAIT_EMOTIONS, *FINAL_EMOTION_COLUMNS, *VAD_DIMENSIONS, "weight", "duration_s")
 CLIP_INT_COLUMNS = ("n_features",)
 
-# ---- per-clip quality record (issue 14): optional extra columns of clips.csv after CLIP_COLUMNS ----------------
+# ---- per-clip quality record: optional extra columns of clips.csv after CLIP_COLUMNS -------------------------
 QA_CHECKS = ("foot_skate", "penetration", "jerk", "bone_error", "figure_height", "observer", "realism")
 """Quality checks; a clip's ``qa_flag`` joins the names of those it failed with ';' (empty = passed)."""
 
@@ -200,7 +200,8 @@ QA_THRESHOLDS = {
     "bone_error_mm": 1.0,            # max bone length deviation
     "figure_height_frac_walk": 0.50,    # min figure height / frame height in every frame (walks)
     "figure_height_frac_seated": 0.60,  # the same for seated gestures
-    "observer_mismatch_p": 0.90,     # flag a gait whose observer names another emotion with at least this p
+    "observer_mismatch_p": 0.90,     # flag a gait whose synthetic observer names another emotion with this p
+    "observer_mismatch_p_real": 0.40,  # the same for the real-capture observer (its right reads: p 0.44-0.80)
     "gesture_arousal_gap": 0.30,     # flag a gesture whose observer's arousal is this far from the intended one's
 }
 """Default thresholds of the quality checks; a plan's ``qa:`` block overrides them by key (null disables one).
@@ -210,6 +211,11 @@ observer reads (generation/quality/gesture_observer.py: the NRC-VAD arousal of t
 probabilities) is at least this far from the NRC-VAD arousal (0..1) of the clip's intended ``emotion_label``. On
 held-out generated gestures 0.30 flagged none of 363 honest clips and 93 % of clips labelled with an emotion whose
 arousal differs by 0.3 or more (docs/benchmarks/motion_quality.md, "Gesture observer").
+
+``observer_mismatch_p_real``: the real-capture gait observer (generation/quality/real_observer.py) is less sure of
+itself than the synthetic one: on held-out real takes its top probability was 0.44-0.80 when right and 0.52 when
+wrong (4 classes, chance 0.25), so a gait it reads as another emotion with p >= 0.40 is flagged
+(docs/benchmarks/mocap.md, "Real-capture gait observer").
 
 The ``realism`` check's bounds (``<measure>_min`` / ``<measure>_max``, e.g. ``stance_knee_deg_max``) are the real
 corpus's own ranges, kept in generation/quality/realism_ranges.json; generation.quality.checks.resolve_thresholds

@@ -10,8 +10,9 @@ Checks (names in :data:`study_protocol.QA_CHECKS`), each against :data:`study_pr
 - ``bone_error``: a bone length off by more than ``bone_error_mm``;
 - ``figure_height``: smallest projected figure height / frame height < ``figure_height_frac_walk`` (or
   ``..._seated``), when the render's camera is known;
-- ``observer``: a gait with a dominant intended emotion (a share of at least 0.5) that the synthetic gait observer
-  reads as another emotion with probability >= ``observer_mismatch_p``; or a gesture whose synthetic gesture
+- ``observer``: a gait with a dominant intended emotion (a share of at least 0.5) that the gait observer reads as
+  another emotion with probability >= ``observer_mismatch_p_real`` (the real-capture observer) or
+  ``observer_mismatch_p`` (the synthetic one); or a gesture whose synthetic gesture
   observer (:mod:`generation.quality.gesture_observer`) reads an arousal at least ``gesture_arousal_gap`` away from
   the intended ``emotion_label``'s (NRC-VAD arousal, 0..1; the observed arousal is the arousal of the 11 emotions
   weighted by the observer's probabilities). The gesture rule reads arousal, not the top label: the 11 categories
@@ -46,7 +47,6 @@ from study_protocol import GAIT_EMOTIONS, GESTURE_VAD, QA_CHECKS, QA_COLUMNS, QA
 
 from .metrics import motion_metrics
 from .realism import MEASURES, realism_measures
-from .realism_ranges import out_of_range, realism_thresholds
 
 DOMINANT_SHARE = 0.5
 OBSERVER_KEY = "observer"
@@ -92,6 +92,8 @@ def resolve_thresholds(plan_qa: dict | None = None) -> dict:
     """QA_THRESHOLDS plus the realism bounds (realism_ranges.json) and the gait observer kind (``observer``:
     real or synthetic), overridden by a plan's ``qa:`` block; unknown keys and bad values raise
     QAThresholdError."""
+    from .realism_ranges import realism_thresholds  # here, so that `python -m ...realism_ranges` runs cleanly
+
     out = {**QA_THRESHOLDS, **realism_thresholds(), OBSERVER_KEY: default_observer_kind()}
     if plan_qa is None:
         return out
@@ -179,8 +181,11 @@ def failed_checks(values: dict, thresholds: dict | None = None, intended=None) -
     else:
         dominant = _dominant(intended)
         observed, p = values.get("observed"), values.get("observed_p")
-        failed["observer"] = (th["observer_mismatch_p"] is not None and dominant is not None and observed is not None
-                              and p is not None and observed != dominant and p >= th["observer_mismatch_p"])
+        limit = th.get("observer_mismatch_p_real") if values.get("observer") == "real" else th["observer_mismatch_p"]
+        failed["observer"] = (limit is not None and dominant is not None and observed is not None
+                              and p is not None and observed != dominant and p >= limit)
+    from .realism_ranges import out_of_range
+
     failed["realism"] = bool(out_of_range(values, th))
     return [c for c in QA_CHECKS if failed[c]]
 

@@ -13,6 +13,12 @@ have both.
 Threshold keys (the plan's ``qa:`` block overrides them; null switches a bound off): ``<measure>_max`` for every
 measure and ``<measure>_min`` for the two-sided ones, e.g. ``stance_knee_deg_max``.
 
+Bounds listed in :data:`NOT_APPLIED` are computed and recorded but not applied (None) until their reason is gone; a
+plan may still set them. The stance-knee bounds are there: the retargeted real walks never straighten the knee
+(smallest knee flexion 25-29 degrees in each of the 8 shipped walks, where the source BVH of the same takes reaches
+0-5 degrees; median +9 to +12 degrees), so the corpus's knee range says more about the retargeting than about the
+actors.
+
     python -m generation.quality.realism_ranges [--corpus PATH] [--out JSON]   # recompute from the corpus
 """
 from __future__ import annotations
@@ -33,6 +39,10 @@ TWO_SIDED = ("stance_knee_deg", "pelvis_bounce_cm", "speed_cv")
 LOW_PCT, HIGH_PCT = 1.0, 99.0
 REPORT_PCTS = (1, 5, 50, 95, 99)
 _CACHE: dict[str, dict] = {}
+_KNEE_REASON = ("retargeted real walks never straighten the knee (min flexion 25-29 deg vs 0-5 deg in the source "
+                "BVH of the same takes); the corpus's knee range reflects the retargeting")
+#: Bounds recorded but not applied, with the reason (kept in the ranges file's ``not_applied``).
+NOT_APPLIED = {"stance_knee_deg_min": _KNEE_REASON, "stance_knee_deg_max": _KNEE_REASON}
 
 
 def threshold_keys() -> tuple[str, ...]:
@@ -58,9 +68,11 @@ def load_ranges(path: str | Path | None = None) -> dict:
 
 
 def realism_thresholds(path: str | Path | None = None) -> dict:
-    """{threshold key: float} from the ranges file (every key of :func:`threshold_keys`)."""
+    """{threshold key: float, or None for a bound in the file's ``not_applied``} from the ranges file (every key
+    of :func:`threshold_keys`)."""
     data = load_ranges(path)
-    out = {k: float(v) for k, v in data["thresholds"].items()}
+    off = data.get("not_applied", {})
+    out = {k: None if k in off else float(v) for k, v in data["thresholds"].items()}
     missing = set(threshold_keys()) - set(out)
     if missing:
         raise ValueError(f"{path or RANGES_PATH}: thresholds lack {sorted(missing)}; recompute the file")
@@ -97,7 +109,8 @@ def compute_ranges(rows: list[dict]) -> dict:
         rows: one dict per real take: ``style``, ``split`` and the :data:`MEASURES` values (None where undefined).
     Returns:
         {"rule", "units", "thresholds", "pooled": {measure: percentiles}, "per_style": {style: {measure: ...}},
-        "n_train", "test_flagged_share"} with percentiles over the training split.
+        "n_train", "test_flagged_share" (held-out takes outside the applied bounds), "not_applied"} with
+        percentiles over the training split.
     """
     train = [r for r in rows if r["split"] == "train"]
     if not train:
@@ -113,10 +126,11 @@ def compute_ranges(rows: list[dict]) -> dict:
     for r in train:
         by_style[r["style"]].append(r)
     test = [r for r in rows if r["split"] == "test"]
-    flagged = [bool(out_of_range(r, thresholds)) for r in test]
+    applied = {k: None if k in NOT_APPLIED else v for k, v in thresholds.items()}
+    flagged = [bool(out_of_range(r, applied)) for r in test]
     return {"rule": f"pooled {LOW_PCT:g}th-{HIGH_PCT:g}th percentiles over the real training takes (one value per "
                     f"take); upper bound only for {', '.join(m for m in MEASURES if m not in TWO_SIDED)}",
-            "units": UNITS, "thresholds": thresholds, "pooled": pooled,
+            "units": UNITS, "thresholds": thresholds, "not_applied": NOT_APPLIED, "pooled": pooled,
             "per_style": {s: {m: _percentiles([r[m] for r in rs]) for m in MEASURES}
                           for s, rs in sorted(by_style.items())},
             "n_train": len(train), "n_test": len(test),
