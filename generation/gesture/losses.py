@@ -28,6 +28,8 @@ from generation.core.features import gesture_affective_features
 from generation.core.kinematics import forward_kinematics
 from generation.core.quaternion import qeuler
 
+from .real_range import real_range_loss
+
 EULER_ORDER = "zyx"
 WRISTS = (10, 14)  # left_wrist, right_wrist on the 23-joint gesture skeleton
 
@@ -178,20 +180,30 @@ class LossWeights:
     velocity: float = 1.0
     liveliness: float = 2.0
     liveliness_form: str = "speed"  # or "log_peak" (:func:`liveliness_loss`)
+    # keep each sequence's speed, reach, holds and head motion within the real captured range of its emotion
+    # (generation.gesture.real_range; off for the weights before it)
+    real_range: float = 0.0
 
 
 def total_loss(pred, target, mask, offsets, parents, weights: LossWeights,
-               fps: float = 10.0) -> tuple[torch.Tensor, dict]:
-    """Weighted sum of the terms -> (scalar, {"angle", "pose", "affective", "velocity", "liveliness": float}).
+               fps: float = 10.0, real_bounds: tuple | None = None) -> tuple[torch.Tensor, dict]:
+    """Weighted sum of the terms -> (scalar, {"angle", "pose", "affective", "velocity", "liveliness",
+    "real_range": float}).
 
     Terms with weight 0 are skipped; forward kinematics runs once for all position-based terms. ``fps`` is the
-    frame rate of the sequences (for the velocities).
+    frame rate of the sequences (for the velocities). ``real_bounds`` = (lo, hi), each (B, 6), the real captured
+    range of each sequence's emotion (:func:`generation.gesture.real_range.range_arrays`), needed when
+    ``weights.real_range`` > 0.
     """
     parts: dict[str, torch.Tensor] = {}
     if weights.angle:
         parts["angle"] = angle_loss(pred, target, mask)
-    if weights.pose or weights.affective or weights.velocity or weights.liveliness:
+    if weights.pose or weights.affective or weights.velocity or weights.liveliness or weights.real_range:
         p_pred, p_true = _positions(pred, offsets, parents), _positions(target, offsets, parents)
+        if weights.real_range:
+            if real_bounds is None:
+                raise ValueError("the real_range loss needs real_bounds (lo, hi) per sequence")
+            parts["real_range"] = real_range_loss(p_pred, mask, fps, *real_bounds)
         if weights.pose:
             parts["pose"] = _position_loss(p_pred, p_true, mask)
         if weights.affective:

@@ -51,6 +51,7 @@ from .generate import decode_examples
 from .losses import LIVELINESS_FORMS, LossWeights, total_loss
 from .metrics import dataset_pose_error, selection_score
 from .model import MODEL_PRESETS, GestureNet, GestureNetConfig
+from .real_range import range_arrays
 
 PRESETS = tuple(MODEL_PRESETS)
 
@@ -142,6 +143,10 @@ def _run_epoch(net, corpus: DeviceCorpus, idx: np.ndarray, cfg: TrainConfig, opt
     for start in range(0, len(idx), cfg.batch_size):
         b = corpus.batch(idx[start:start + cfg.batch_size], noise=cfg.input_noise if training else 0.0,
                          generator=generator)
+        bounds = getattr(corpus, "real_bounds", None)
+        if bounds is not None:
+            pick = torch.as_tensor(np.asarray(idx[start:start + cfg.batch_size])).to(corpus.device)
+            bounds = (bounds[0][pick], bounds[1][pick])
         inputs = b["inputs"]
         if training and sampling > 0:
             net.eval()
@@ -150,7 +155,7 @@ def _run_epoch(net, corpus: DeviceCorpus, idx: np.ndarray, cfg: TrainConfig, opt
         with torch.set_grad_enabled(training):
             pred = _forward(net, b, inputs, amp)
             loss, parts = total_loss(pred, b["targets"], b["mask"], b["offsets"], GESTURE_PARENTS, cfg.loss,
-                                     fps=corpus.fps)
+                                     fps=corpus.fps, real_bounds=bounds)
         if training:
             _step(net, optimizer, loss, scaler)
         n = len(b["tokens"])
@@ -267,6 +272,8 @@ def train(cfg: TrainConfig, data: GestureDataset | None = None, progress: bool =
     if len(train_idx) == 0:
         raise ValueError("the training split is empty")
     corpus = data.on_device(device)
+    if cfg.loss.real_range:
+        corpus.real_bounds = tuple(torch.from_numpy(a).to(device) for a in range_arrays(data.emotion))
     net, optimizer, scheduler, generator = _build(cfg, device)
     selected_by = ("val_loss" if cfg.rollout_every <= 0 else "val_rollout_pose_error_x_emotion_liveliness"
                    if cfg.select_emotion_gap else "val_rollout_pose_error_x_liveliness")
@@ -367,6 +374,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--liveliness-form", choices=LIVELINESS_FORMS, default=LossWeights().liveliness_form,
                    help="speed: each wrist's mean and RMS speed, squared m/s differences (the shipped weights); "
                    "log_peak: also the faster wrist's mean and 90th percentile, squared log ratios")
+    p.add_argument("--real-range-weight", type=float, default=0.0,
+                   help="weight of the loss that keeps each gesture's wrist and elbow speed, reach, holds and head "
+                   "motion within the real captured range of its emotion (generation.gesture.real_range; 0 = off)")
     p.add_argument("--select-emotion-gap", action="store_true",
                    help="choose the kept weights by pose error x (1 + speed gap + worst per-emotion speed gap)")
     p.add_argument("--d-model", type=int, default=None, help="default: the preset's (64 small, 992 paper)")
@@ -391,6 +401,9 @@ def config_from_args(args: argparse.Namespace) -> TrainConfig:
             raise ValueError(f"--liveliness-weight must be >= 0, got {args.liveliness_weight}")
         loss = dataclasses.replace(loss, liveliness=args.liveliness_weight)
     loss = dataclasses.replace(loss, liveliness_form=args.liveliness_form)
+    if args.real_range_weight < 0:
+        raise ValueError(f"--real-range-weight must be >= 0, got {args.real_range_weight}")
+    loss = dataclasses.replace(loss, real_range=args.real_range_weight)
     cfg = preset_config(args.config or "small")
     model = dataclasses.replace(cfg.model, **{k: v for k, v in (("d_model", args.d_model),
                                                                  ("residual", args.residual)) if v is not None})

@@ -12,7 +12,10 @@ The plans are plain YAML afterwards; researchers copy and edit them. What each r
   conversation sentences, and one "source" gesture per generated one (seed 003's were motion-captured; ours
   are procedural, marked synthetic) paired through ``pair`` so the study never shows both to one person.
   The generated gestures' sentences come from the gesture network's held-out test split (each entry says
-  ``sentence_split: test``), so the study shows the network on inputs it was not trained on.
+  ``sentence_split: test``), so the study shows the network on inputs it was not trained on. Beside them, REAL
+  source gestures: the shipped Bandai Namco ``bye`` takes in the five styles that name a gesture emotion
+  (``study_protocol.CAPTURE_GESTURE_EMOTIONS``), seated on the chair (``seated: true``), for the naturalness and
+  gesture-emotion sections.
 - seed004 (THMS 2016, section V): the neutral input walk, 6 themes x weights (0.4, 0.7, 1.0, 1.3) x feature
   counts (1, 4, 7, 10), and the inversions at w = -0.7 with all ten features; short looping clips. The neutral base
   is averaged from real normal walks (``base: real``, the default).
@@ -133,6 +136,24 @@ def _gesture_seconds(sentence: str) -> float:
     return round(float(gesture_seconds(count_words(sentence))), 2)
 
 
+SHIPPED_GESTURES = "generation/data/mocap/bandai-namco/Bandai-Namco-Research-Motiondataset-1/data"
+REAL_SOURCE_CONTENT = "bye"
+
+
+def real_source_gestures(content: str = REAL_SOURCE_CONTENT, styles=None) -> list[dict]:
+    """``captured_file`` entries of the shipped real ``content`` takes (take 001) in each captured style that names a
+    gesture emotion (``study_protocol.CAPTURE_GESTURE_EMOTIONS``; default all five), seated on the chair, labelled
+    with that emotion, for the naturalness and gesture-emotion sections."""
+    from study_protocol import CAPTURE_GESTURE_EMOTIONS
+
+    styles = tuple(CAPTURE_GESTURE_EMOTIONS) if styles is None else tuple(styles)
+    return [{"id": f"real_{content}_{style}", "generator": "captured_file", "modality": "gesture", "origin": "source",
+             "file": f"{SHIPPED_GESTURES}/dataset-1_{content}_{style}_001.bvh", "seated": True,
+             "emotion_label": CAPTURE_GESTURE_EMOTIONS[style], "sections": ["naturalness", "gesture_emotion"],
+             "note": f"REAL captured gesture (Bandai Namco Research Motion Dataset 1, {content} {style}, take 1; "
+                     f"CC BY-NC 4.0), seated"} for style in styles]
+
+
 def seed003(narration: int = 3, conversation: int = 2, splits: tuple[str, ...] = ("test",)) -> dict:
     """Generated gestures for sentences of the network's held-out test split (``splits``), each entry recording
     its ``sentence_split``, and one paired source gesture each."""
@@ -150,10 +171,13 @@ def seed003(narration: int = 3, conversation: int = 2, splits: tuple[str, ...] =
                       "task": row["task"],
                       "emotion_label": row["emotion"], "gender": gender, "handedness": handedness, "seed": k + 1,
                       "pair": f"source_{sid}", "sections": ["gesture_emotion", "naturalness"]})
+    clips.extend(real_source_gestures())
     return {"name": "seed003", "description": "Seed 003 (Bhattacharya et al., IEEE VR 2021) web study stimuli: "
             "generated gestures over the 11 MPI emotions for sentences held out from the network's training "
-            "(test split), each paired with a source gesture (procedural, synthetic); seated agent on a chair, "
-            "fixed camera; 25 fps video (the paper gives no video rate).",
+            "(test split), each paired with a source gesture (procedural, synthetic), and real captured source "
+            "gestures (Bandai Namco 'bye' in the styles happy, sad, angry, proud, normal = joyous, sad, angry, proud, "
+            "neutral; CC BY-NC 4.0, Kobayashi et al. 2023, arXiv:2306.08861) seated on the chair; seated agent on a "
+            "chair, fixed camera; 25 fps video (the paper gives no video rate).",
             "render": dict(RENDER, duration_s=12), "clips": clips}
 
 

@@ -6,6 +6,7 @@
       modality: gait                     # gait (default) | gesture; an .npz must be on that skeleton
       emotion: happy                     # optional label: gait emotion vector / name; gesture emotion_label or vad
       start_s: 2.0                       # optional: skip the first seconds (the clip lasts the render duration)
+      seated: true                       # gesture only: seat a standing capture as the seated agents sit
 
 The clip's ``origin`` is always ``source``: it is the captured motion a study compares generated clips with
 (naturalness sections). A generated entry names it in ``pair`` (its ``source_clip_id`` in the catalogue), so a
@@ -19,6 +20,10 @@ Provenance: a ``SOURCE.json`` beside the file (``{"dataset": ..., "licence": ...
 "name_pattern": regex with named groups such as content, style, take}``) is copied into the clip's metadata as
 ``dataset``, ``licence``, ``citation``, ``url`` and the groups the file name matches (``take``...): real data keeps
 its licence and citation in everything derived from it.
+
+``seated: true`` (gesture modality only) seats a standing captured gesture on the chair as the seed 003 agents sit:
+legs and pelvis in the seated rest pose, trunk, head and arms from the capture, hands kept clear of the body and
+the chair (:func:`generation.mocap.seated_gesture.seat_gesture`; its report is in the ``seating`` metadata).
 
 The file's SHA-256 goes into the entry's inputs, so the clip hash changes (and the clip is rendered anew) when the
 file does. Metadata of the motion: ``captured`` (True unless the file says it is synthetic), ``imported_file``,
@@ -36,6 +41,7 @@ from pathlib import Path
 
 from generation.core.motion import Motion, MotionFormatError
 from generation.mocap import ImportOptions, import_file
+from generation.mocap.seated_gesture import seat_gesture
 from study_protocol import GAIT_EMOTIONS, GESTURE_VAD, MODALITIES
 
 SUFFIXES = (".npz", ".bvh")
@@ -180,6 +186,12 @@ def captured_file_inputs(raw: dict) -> dict:
     provenance(path)                        # a bad SOURCE.json fails here, before anything renders
     out = {"file": given.strip(), "sha256": file_digest(path), "format": path.suffix.lower().lstrip("."),
            "start_s": _number("start_s", raw.get("start_s", 0.0), 0.0, 86400.0)}
+    seated = raw.get("seated", False)
+    if not isinstance(seated, bool) or (seated and modality != "gesture"):
+        raise CapturedFileError("seated", f"expected true or false, and true only with modality gesture (got "
+                                          f"{seated!r} with modality {modality!r})")
+    if seated:
+        out["seated"] = True
     labels, source = _entry_labels(raw, modality), "entry"
     if out["format"] == "npz":
         motion = _load(str(path.resolve()), out["sha256"], modality, None)
@@ -209,6 +221,8 @@ def captured_file_motion(inputs: dict, modality: str, fps: float):
     if start >= motion.num_frames - 1:
         raise CapturedFileError("start_s", f"{inputs['start_s']:g} s is past the end of {inputs['file']!r}")
     motion = motion.slice(start)            # a copy: the loaded Motion is cached and shared
+    if inputs.get("seated"):
+        motion = seat_gesture(motion)
     motion = motion.resample(fps) if abs(motion.fps - fps) > 1e-9 else motion
     meta = dict(motion.metadata)
     synthetic = bool(meta.get("synthetic", False))

@@ -91,7 +91,7 @@ GENERATOR_FIELDS: dict[str, set[str]] = {
     "rbf": {"theme", "weight", "n_features", "n_cycles", "speed", "base", "features"},
     "gesture_net": {"sentence", "task", "emotion_label", "gender", "handedness", "noise", "sentence_split"},
     "procedural_gesture": {"emotion_label", "vad", "kind", "gender", "handedness", "duration_s"},
-    "captured_file": {"file", "start_s", "emotion", "emotion_label", "vad"},
+    "captured_file": {"file", "start_s", "emotion", "emotion_label", "vad", "seated"},
 }
 
 
