@@ -1,6 +1,7 @@
-"""Quality records of a plan's clips without rendering video (the motion part, the projected figure height and the
-synthetic observer's reading: the gait observer for gait clips, the gesture observer for gesture clips), and the
-per-flag summary that ``generate_clips`` prints.
+"""Quality records of a plan's clips without rendering video (the motion part, the realism measures of gait clips,
+the projected figure height and an observer's reading: for gait clips the real-capture observer, or the synthetic
+one when the plan's ``qa: {observer: synthetic}`` or ``QA_GAIT_OBSERVER=synthetic`` asks; for gesture clips the
+synthetic gesture observer), and the per-flag summary that ``generate_clips`` prints.
 
     python -m generation.pipeline.plan_qa --plan seed000 [--limit K] [--modality gesture] [--no-figure-height]
         [--json out.json]
@@ -19,9 +20,11 @@ from collections.abc import Iterable
 from generation.core.motion import Motion
 from generation.plans.clipgen import make_motion
 from generation.plans.schema import load_plan
-from generation.quality.checks import QAResult, evaluate, resolve_thresholds
+from generation.quality.checks import QAResult, default_observer_kind, evaluate, resolve_thresholds
 from generation.quality.gesture_observer import default_gesture_observer
 from generation.quality.observer import default_observer
+from generation.quality.real_observer import default_real_observer
+from generation.quality.realism_ranges import out_of_range
 from generation.render.clip import plan_cameras, prepare
 from study_protocol import QA_CHECKS
 
@@ -52,10 +55,14 @@ def clip_qa(motion: Motion, settings, thresholds: dict, intended=None, observer=
     return result, camera_info
 
 
-def observer_for(modality: str):
-    """The synthetic observer that reads clips of ``modality`` ("gait": :func:`observer.default_observer`,
-    "gesture": :func:`gesture_observer.default_gesture_observer`); None for others or when it cannot be built."""
+def observer_for(modality: str, kind: str | None = None):
+    """The observer that reads clips of ``modality``: "gait" with ``kind`` "real" (the default, see
+    :func:`generation.quality.checks.default_observer_kind`; :func:`real_observer.default_real_observer`) or
+    "synthetic" (:func:`observer.default_observer`); "gesture": :func:`gesture_observer.default_gesture_observer`.
+    None for other modalities or when it cannot be built (:func:`unread_line` then says why)."""
     if modality == "gait":
+        if (kind or default_observer_kind()) == "real":
+            return default_real_observer()
         return default_observer()
     if modality == "gesture":
         return default_gesture_observer()
@@ -83,16 +90,29 @@ def summary_line(flags: Iterable[str]) -> str:
     return f"QA: {c[PASSED]} passed, {c['flagged']} flagged" + (f" ({per})" if per else "")
 
 
-def unread_line(records: Iterable[dict]) -> str:
-    """'' when every gait and gesture clip got a synthetic observer's reading, else a line saying how many did not
-    and why that usually happens, so that a switched-off observer check is never silent. ``records``: render
-    records (``modality``, ``qa``)."""
+def observer_line(kind: str, observer) -> str:
+    """Which gait observer reads the clips and from what data (the real one names its corpus, or says that it fell
+    back to the shipped takes), or that none is available."""
+    if observer is None:
+        return f"QA: gait observer {kind}: not available"
+    source = getattr(observer, "source", "")
+    return f"QA: gait observer {kind}" + (f" ({source})" if source else "")
+
+
+def unread_line(records: Iterable[dict], gait_kind: str = "real") -> str:
+    """'' when every gait and gesture clip got an observer's reading, else a line saying how many did not and why
+    that usually happens, so that a switched-off observer check is never silent. ``records``: render records
+    (``modality``, ``qa``); ``gait_kind``: the gait observer asked (real or synthetic)."""
     missing = Counter(r.get("modality") for r in records
                       if r.get("modality") in ("gait", "gesture") and not (r.get("qa") or {}).get("observed"))
     if not missing:
         return ""
     parts = []
-    if missing["gait"]:
+    if missing["gait"] and gait_kind == "real":
+        parts.append(f"{missing['gait']} gait clip(s) (no real-capture observer: no corpus at var/mocap/ "
+                     "(`python -m generation.mocap dataset bandai-namco DIR`), and the shipped real takes in "
+                     "generation/data/mocap/bandai-namco/ are missing or do not import)")
+    elif missing["gait"]:
         parts.append(f"{missing['gait']} gait clip(s) (no synthetic gait corpus at var/corpus/: "
                      "`manage.py build_corpus` builds it in about a minute, then render again)")
     if missing["gesture"]:
@@ -112,7 +132,9 @@ def run(plan_name: str, limit: int | None = None, log=print, modality: str | Non
     jobs, failures = plan_jobs(plan, limit)
     if modality is not None:
         jobs = [j for j in jobs if j.run_entry.modality == modality]
-    observers = {m: observer_for(m) for m in sorted({j.run_entry.modality for j in jobs})}
+    observers = {m: observer_for(m, thresholds["observer"]) for m in sorted({j.run_entry.modality for j in jobs})}
+    if "gait" in observers:
+        log(observer_line(thresholds["observer"], observers["gait"]))
     rows = []
     for job in jobs:
         t0 = time.perf_counter()
@@ -123,7 +145,9 @@ def run(plan_name: str, limit: int | None = None, log=print, modality: str | Non
         result, cam = clip_qa(motion, entry.render, thresholds, intended, observers[entry.modality], camera)
         rows.append({"entry": job.entry.id, "clip_id": job.clip_id, "modality": entry.modality,
                      "generator": entry.generator, "intended": intended if isinstance(intended, str) else None,
-                     "camera": cam.get("rule"), **result.as_dict(), "seconds": round(time.perf_counter() - t0, 2)})
+                     "camera": cam.get("rule"), **result.as_dict(),
+                     "realism_out": ";".join(out_of_range(result.values, thresholds)),
+                     "seconds": round(time.perf_counter() - t0, 2)})
         log(json.dumps(rows[-1]))
     for where, msg in failures:
         log(f"FAILED {where}: {msg}")

@@ -157,7 +157,7 @@ def render_job(job: Job, record: dict, clips_dir: str, records_dir: str) -> dict
 
 def _add_qa(record: dict, job: Job, motion, camera: dict) -> None:
     """Measure the clip's quality (:mod:`generation.quality`) into ``record["qa"]`` and ``record["qa_flag"]``."""
-    observer = observer_for(job.run_entry.modality)
+    observer = observer_for(job.run_entry.modality, (job.qa_thresholds or {}).get("observer"))
     result, _ = clip_qa(motion, job.run_entry.render, job.qa_thresholds, intended_emotion(job.run_entry.inputs),
                         observer, camera_info=camera)
     record["qa"] = _json_safe(result.as_dict())
@@ -346,7 +346,8 @@ def run_plan(plan: Plan, clips_dir: str | Path, records_dir: str | Path, media_p
     _remove_stale(todo, clips_dir, records_dir)
     if workers > 1 or scheduler is not None:
         for modality in sorted({j.run_entry.modality for j in todo}):
-            observer_for(modality)  # train/cache the quality observers once, not in every worker
+            # train/cache the quality observers once, not in every worker
+            observer_for(modality, (todo[0].qa_thresholds or {}).get("observer"))
     if scheduler is not None:
         _render_dask(batch, todo, scheduler, threads_per_worker)
     elif workers <= 1 or len(todo) <= 1:
