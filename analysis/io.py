@@ -207,8 +207,8 @@ def read_clips(src) -> pd.DataFrame:
 
 
 def _read_qa_columns(df: pd.DataFrame, out: pd.DataFrame, col: _Collector) -> None:
-    """The optional quality columns (QA_COLUMNS, issue 14) into ``out``: numbers as float (NaN where blank), text
-    stripped; a file without them (an older clips.csv) simply has none."""
+    """The optional quality columns (QA_COLUMNS) into ``out``: numbers as float (NaN where blank), text
+    stripped; a clips.csv without them simply has none."""
     for c in QA_COLUMNS:
         if c not in df.columns:
             continue

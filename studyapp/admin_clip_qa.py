@@ -1,4 +1,4 @@
-"""Admin list filter and columns of clips by their quality record (issue 14): passed, flagged, or failed one given
+"""Admin list filter and columns of clips by their quality record: passed, flagged, or failed one given
 check; the synthetic observer's reading."""
 from __future__ import annotations
 

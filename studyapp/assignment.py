@@ -10,7 +10,7 @@ Rules (seed 000 section 6.1, seed 003 section 6.1, seed 004 section V):
 - practice items and attention checks (studyapp.trial_extras) and the counterbalanced section order
   (studyapp.counterbalance) are fixed at the start too.
 
-Concurrency (issue 16): a start plans without any lock: pools from a per-study cache (studyapp.pool_cache), the
+Concurrency: a start plans without any lock: pools from a per-study cache (studyapp.pool_cache), the
 balancing counts from SectionClipCount (one row per section and pool clip) read plainly. Its transaction then
 claims the participant, locks the count rows of its sections (FOR NO KEY UPDATE on PostgreSQL, in (section, clip)
 order; SQLite runs one writer at a time anyway), plans again only if another start changed the counts meanwhile

@@ -1,5 +1,5 @@
-"""The expected duration of a study for one participant, shown on the consent page (issue 18: an honest
-duration, computed from what the participant will get rather than typed in).
+"""The expected duration of a study for one participant, shown on the consent page: an honest
+duration, computed from what the participant will get rather than typed in.
 
     seconds = sum over sections of  items x (mean clip duration of the section's pool + PAGE_SECONDS
                                               + questions x ANSWER_SECONDS_PER_QUESTION)

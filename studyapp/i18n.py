@@ -1,4 +1,4 @@
-"""Languages of the participant pages (issue 18).
+"""Languages of the participant pages.
 
 A study is shown in one language, chosen per study in the admin (Study.language, one of settings.LANGUAGES).
 The views call `activate_study_language(study)` as soon as they know the study; `StudyLanguageMiddleware` starts

@@ -1,5 +1,5 @@
 """The question fieldsets of a clip page (templates/studyapp/item_questions.html), rendered once per distinct
-content and kept in a bounded per-process cache (issue 16).
+content and kept in a bounded per-process cache.
 
 Rendering the radio/checkbox loops was most of a clip page's template time, yet a page's questions depend only on
 their wording, choices and kinds in the active language: thousands of participants see the same few dozen

@@ -74,7 +74,7 @@ class Clip(models.Model):
     sections = models.CharField(max_length=300, blank=True)
     loop = models.BooleanField(default=False)
     metadata = models.JSONField(default=dict, blank=True)
-    # Per-clip quality record (issue 14): the qa_* values of clips.csv without the prefix, e.g.
+    # Per-clip quality record: the qa_* values of clips.csv without the prefix, e.g.
     # {"foot_skate_cm_s": 0.4, "figure_height_frac": 0.62, "observed": "sad", "observed_p": 0.91}.
     qa = models.JSONField(default=dict, blank=True)
     qa_flag = models.CharField(max_length=300, blank=True, db_index=True,

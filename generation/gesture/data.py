@@ -10,7 +10,7 @@ rest pose, is performed by a female or male body (``gesture_skeleton(build=gende
 hand. Everything here is synthetic and labelled so in metadata; none of it is captured motion.
 
 Each sentence also gets a counterfactual variant, performed with another emotion than the one it was written for,
-so that the emotion attributes, not only the wording, decide the style (issue 14; :func:`build_dataset`).
+so that the emotion attributes, not only the wording, decide the style (:func:`build_dataset`).
 
 Splits are by sentence (80/10/10, stratified by emotion), so every variant of a sentence lands in one split.
 
@@ -459,7 +459,7 @@ def build_dataset(variants: int = 2, seed: int = 0, fps: float = config.TRAIN_FP
     The corpus sentences are written for one emotion each, so with own-emotion gestures only the wording and the
     emotion attributes always agree and the network can read the style off the words; the counterfactual gestures
     (the same sentence performed with another emotion) make the attributes carry it, which is what generation
-    with a chosen emotion needs (issue 14). Token vectors are cached in ``cache_dir/sentence_tokens.npz``, the
+    with a chosen emotion needs. Token vectors are cached in ``cache_dir/sentence_tokens.npz``, the
     paired gestures in a second npz keyed by the corpus content and the arguments, so a second call is fast.
 
     ``augment`` = N > 0 adds N phrase-recombination sentences (:func:`augment_rows`, seeded by ``seed``) to the

@@ -4,7 +4,7 @@ All take predicted and ground-truth local rotations (B, T, J, 4) unit quaternion
 (True = a real frame, False = padding), and return a scalar: the paper's sums, divided by the number of valid
 frames (and joints) so the value does not grow with batch or sequence length.
 
-Why the two extra terms (issue 14): with eqs. 8-10 alone the network regressed to the mean pose: the wrists are
+Why the two extra terms: with eqs. 8-10 alone the network regressed to the mean pose: the wrists are
 4 of 23 joints in the position and angle sums, and where the beat phase is uncertain the squared error is smallest
 for a damped, averaged stroke. Generated gestures moved at about half the corpus' wrist speed and their peak speed
 hardly followed arousal. Seed 003 section 4 trains on velocities as well; :func:`velocity_loss` is that term on
@@ -12,7 +12,7 @@ joint positions, and :func:`liveliness_loss` compares each sequence's wrist-spee
 RMS), which do not depend on the phase, so an averaged, motionless answer is no longer the cheapest one.
 
 ``LossWeights.liveliness_form = "log_peak"`` (opt-in, not what the shipped weights were trained with) adds the
-faster wrist's clip mean and 90th percentile (the statistics issue 14 is judged on) and compares all of them as
+faster wrist's clip mean and 90th percentile (the statistics the liveliness benchmark judges) and compares all of them as
 squared log ratios, since the goal is a ratio: a squared difference in m/s lets a slow emotion's too-high peak
 (neutral: 0.54 vs 0.43 m/s) cost a fifth of a fast one's shortfall. It brought neutral's peak into the goal band but
 not joyous' mean (docs/benchmarks/gesture.md, liveliness section).

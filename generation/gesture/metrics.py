@@ -56,7 +56,7 @@ def dataset_pose_error(pred: list[np.ndarray], data, idx) -> dict[str, float]:
 
 
 def emotion_speed_gap(speeds: np.ndarray, emotions: list[str]) -> float:
-    """Issue 14's criterion as one number: per emotion, the generated / corpus ratio of the mean over its examples
+    """The liveliness criterion as one number: per emotion, the generated / corpus ratio of the mean over its examples
     of the clip's mean and of its peak wrist speed; returns the largest |log ratio| (0.22 = 25% too slow or fast).
 
     speeds (N, 4) = [generated mean, generated peak, corpus mean, corpus peak] m/s; emotions (N,) labels.
@@ -75,7 +75,7 @@ def selection_score(rollout_error: dict[str, float], emotion_gap: bool = False) 
     Pose error alone rewards regression to the mean pose (a damped gesture has a small average error when the
     stroke phase is uncertain); speed_log_ratio makes a gesture at half the corpus' wrist speed cost 1.7x as much;
     emotion_speed_gap (:func:`emotion_speed_gap`) charges the worst emotion's speed ratio, which the per-sequence
-    average lets one emotion hide (issue 14: joyous at 0.67 with the average gap at 0.2).
+    average lets one emotion hide (e.g. joyous at 0.67 with the average gap at 0.2).
     """
     gap = rollout_error.get("emotion_speed_gap", 0.0) if emotion_gap else 0.0
     return float(rollout_error["pose_error"] * (1.0 + rollout_error.get("speed_log_ratio", 0.0) + gap))

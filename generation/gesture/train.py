@@ -12,7 +12,7 @@ autoregressively from text and attributes; their pose error times (1 + their wri
 repeatable; checkpoints (model, optimiser, epoch, history) are written every epoch and ``--resume`` continues from
 the last one. The best model is saved as plain weights (config + CPU state dict, float32).
 
-Devices (issue 19): ``--device auto|cpu|cuda[:N]`` (:func:`generation.core.device.resolve_device`); the corpus is
+Devices: ``--device auto|cpu|cuda[:N]`` (:func:`generation.core.device.resolve_device`); the corpus is
 moved to the device once (:class:`generation.gesture.data.DeviceCorpus`) and batches are cut there; every random
 draw (batch order, input noise, self-fed picks) comes from one CPU generator, so a seed gives the same run on any
 device up to float rounding. ``--amp`` runs the forward passes under CUDA autocast (ignored on the CPU).
@@ -208,7 +208,7 @@ def _restore(path: Path, cfg: TrainConfig, net, optimizer, scheduler, generator,
     if ckpt["model_config"] != cfg.model.to_dict():
         raise ValueError(f"{path}: checkpoint model config {ckpt['model_config']} differs from the "
                          f"requested {cfg.model.to_dict()}")
-    if ckpt.get("data", _data_options(cfg)) != _data_options(cfg):  # older checkpoints have no "data": not checked
+    if ckpt.get("data", _data_options(cfg)) != _data_options(cfg):  # a checkpoint without "data" is not checked
         raise ValueError(f"{path}: checkpoint was trained on data {ckpt['data']}, not the requested "
                          f"{_data_options(cfg)}")
     net.load_state_dict(ckpt["state_dict"])

@@ -1,6 +1,6 @@
 """The clip catalogue file ``clips.csv`` (DESIGN.md "Interchange formats"): write, read, check against files.
 
-One row per clip, columns :data:`CLIP_COLUMNS` then the quality columns :data:`QA_COLUMNS` (issue 14; files
+One row per clip, columns :data:`CLIP_COLUMNS` then the quality columns :data:`QA_COLUMNS` (files
 without them still read, their rows get blank quality cells); blank cells are missing values. ``clip_id`` is the
 clip's content hash, which is also the stem of its files ``clips/<clip_id>.mp4|.webm|.png``.
 """

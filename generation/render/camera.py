@@ -208,7 +208,7 @@ def project(points: np.ndarray, pose: CameraPose, width: int, height: int) -> tu
     return px, depth, float(f)
 
 
-#: Smallest figure height as a fraction of the frame height, in every frame (issue 13).
+#: Smallest figure height as a fraction of the frame height, in every frame.
 MIN_FIGURE_FRACTION = {"walk": 0.50, "seated": 0.60}
 #: What the follow camera aims for (the whole body stays in frame first).
 FOLLOW_TARGET_FRACTION = {"walk": 0.70, "seated": 0.78}
