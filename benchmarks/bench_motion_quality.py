@@ -1,4 +1,4 @@
-"""Motion quality of the seed 000 plan's generated gaits before and after the foot clean-up (issue 14).
+"""Motion quality of the seed 000 plan's generated gaits before and after the foot clean-up.
 
 For every ``gait_net`` entry of the built-in ``seed000`` plan (made as the study makes it:
 ``generation.plans.clipgen.resolve`` + ``make_motion``, no video), the raw network output

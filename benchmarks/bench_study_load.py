@@ -21,8 +21,7 @@ fields are kept, redirects are followed whatever their target), so the driver do
 sequence. An answer POST is acknowledged by a redirect or, as the clip page's form asks for it
 (studyapp.views.INLINE_NEXT_FIELD), by the next clip page itself, whose form action is then the page's URL (as the
 browser's study.js does). The locust driver (benchmarks/locustfile.py: gevent users, so the generator is not the
-bottleneck) is the default; --driver threads runs one Python thread per participant with `requests` (the issue-8
-driver).
+bottleneck) is the default; --driver threads runs one Python thread per participant with `requests`.
 
 Reports answers per second (answer POSTs accepted / wall time, and answers stored / wall time), p50/p99 latency
 of answer POSTs and of clip pages (GETs of a clip page: reloads, and after a redirect), the healthz ceiling and the
@@ -416,7 +415,7 @@ def in_process_only(args) -> dict:
 
 
 def run_threads(args, base: str, slug: str) -> list[dict]:
-    """The issue-8 driver: one thread per participant, started evenly over --arrival seconds."""
+    """The thread driver: one thread per participant, started evenly over --arrival seconds."""
     start = time.time() + 0.5
     deadline = start + args.arrival + args.time_limit
     records: list[dict] = []

@@ -1,4 +1,4 @@
-"""Benchmark of the participant flow (issue 16): SQL statements per answered clip, and concurrent starts.
+"""Benchmark of the participant flow: SQL statements per answered clip, and concurrent starts.
 
     DATA_DIR=$(mktemp -d) .venv/bin/python benchmarks/flow_answer_and_start.py [--starts 200] [--threads 16]
         [--out docs/benchmarks/flow.md]
@@ -16,7 +16,7 @@ Runs on a fresh SQLite file database under DATA_DIR (WAL, the app's default), wi
    left unstarted, and the per-clip spread.
 --db-url postgres://user@host:port/db runs everything on a scratch PostgreSQL database made next to that one
 (<db>_flowbench_<pid>_<time>, dropped afterwards) instead of SQLite; --starts-only skips part 1.
-Works on the code before issue 16 too (no Assignment.seq): run it from an older checkout for "before" figures.
+Works without Assignment.seq too, so an older checkout can be measured the same way.
 """
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""Issue 18 (keyboard and access) and issue 13 (player shape), in real headless Chromium.
+"""Keyboard use, accessibility and the player's shape, in real headless Chromium.
 
 A participant takes the German demo study with the keyboard only: Tab and Space on the consent page, number keys
 for every answer, Enter to continue, Tab to the text box of the feedback page. On the way:

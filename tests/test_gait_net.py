@@ -427,7 +427,7 @@ def test_shipped_weights_load_and_generate():
         pytest.skip(f"shipped weights absent: {DEFAULT_WEIGHTS} (train with `python -m generation.gait.train`)")
     assert DEFAULT_WEIGHTS.stat().st_size < 10 * 2 ** 20
     net = load_default_model()
-    # Fine-tuned from the previous (gait_net/1) weights with the style term (docs/benchmarks/gait.md, issue 14).
+    # Fine-tuned from the previous weights with the style term (docs/benchmarks/gait.md).
     assert net.config.model == GaitNetConfig().model and net.fps == 7.5
     assert net.config.loss.style > 0 and net.config.train.extra_steps > 0
     assert net.info["trained_on"] == "synthetic procedural corpus" and net.device.type == "cpu"

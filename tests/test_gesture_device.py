@@ -1,4 +1,4 @@
-"""Issue 19 for the gesture network: --device / --amp, device-independent weights, CPU vs GPU agreement, the
+"""Devices of the gesture network: --device / --amp, device-independent weights, CPU vs GPU agreement, the
 paper-size preset."""
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""Issue 14: the shipped gesture network must stay lively.
+"""The shipped gesture network must stay lively.
 
 Before the fix, generated gestures barely moved (an "afraid" gesture at half the corpus' wrist speed) and their
 peak wrist speed followed arousal with r = 0.13 against 0.52 in the training data. These tests generate held-out
@@ -16,7 +16,7 @@ from generation.gesture import config
 from study_protocol import GESTURE_EMOTIONS
 
 N_SENTENCES = 11  # held-out sentences (one per emotion); each is also generated with all 11 emotions
-R_MIN = 0.4  # issue 14's goal for r(peak wrist speed, arousal)
+R_MIN = 0.4  # the liveliness goal for r(peak wrist speed, arousal)
 SPEED_RATIO = (0.75, 1.33)  # generated / corpus mean and peak wrist speed, pooled over the held-out sentences
 
 

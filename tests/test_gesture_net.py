@@ -228,7 +228,7 @@ def _wrist_positions(rotations: torch.Tensor) -> torch.Tensor:
 
 
 def test_liveliness_loss_punishes_a_still_answer_but_not_a_phase_shift():
-    """Issue 14: a motionless (mean) pose has a small pose error when the stroke phase is uncertain; the
+    """A motionless (mean) pose has a small pose error when the stroke phase is uncertain; the
     liveliness term compares wrist-speed statistics, so it is large for the still answer and about zero for the
     same motion shifted in time (whose pose error is large)."""
     from generation.gesture.losses import liveliness_loss, velocity_loss
@@ -249,7 +249,7 @@ def test_liveliness_loss_punishes_a_still_answer_but_not_a_phase_shift():
 
 
 def test_peak_wrist_speed_is_the_benchmark_statistic():
-    """The loss's faster-wrist mean and 90th percentile equal the numpy metric the issue-14 table reports, padding
+    """The loss's faster-wrist mean and 90th percentile equal the numpy metric the liveliness table reports, padding
     excluded, and the log-ratio liveliness loss charges a too-fast answer about as a too-slow one."""
     from generation.gesture.losses import liveliness_loss, peak_wrist_speed
     from generation.gesture.metrics import wrist_speed_of_positions
@@ -451,7 +451,7 @@ def test_shipped_network_expands_for_dominant_emotions(shipped):
 
 def test_liveliness_options_are_opt_in():
     """The default command trains the shipped recipe (mean/RMS liveliness in m/s, selection without the per-emotion
-    gap); --liveliness-form log_peak and --select-emotion-gap switch the issue-14 second-pass variants on."""
+    gap); --liveliness-form log_peak and --select-emotion-gap switch the two alternative variants on."""
     from generation.gesture.metrics import selection_score
     from generation.gesture.train import build_parser, config_from_args
 

@@ -1,4 +1,4 @@
-"""Issue 18, languages: every participant-facing string is marked and has a German translation; a German study's
+"""Languages: every participant-facing string is marked and has a German translation; a German study's
 pages are German from consent to the last page, while the stored and exported answers stay the protocol's labels;
 the study's language never leaks into the next request."""
 from __future__ import annotations

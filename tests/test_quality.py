@@ -1,4 +1,4 @@
-"""Per-clip quality record (issue 14): measures, thresholds, plan `qa:` blocks, clips.csv columns, old files."""
+"""Per-clip quality record: measures, thresholds, plan `qa:` blocks, clips.csv columns, old files."""
 from __future__ import annotations
 
 import csv

@@ -1,4 +1,4 @@
-"""Quality flags in the study app (issue 14): Clip.qa/qa_flag from records, flagged clips out of pools unless a pool
+"""Quality flags in the study app: Clip.qa/qa_flag from records, flagged clips out of pools unless a pool
 includes them, the admin filter, generate_clips' summary, and rendering on a Dask cluster."""
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""Issue 13: the mannequin and the other looks, body choice validation, framing measured from decoded video."""
+"""The mannequin and the other looks, body choice validation, framing measured from decoded video."""
 from __future__ import annotations
 
 import numpy as np

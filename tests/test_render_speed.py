@@ -1,4 +1,4 @@
-"""Renderer speed-ups keep the pictures (issue 13): the merged mannequin mesh, anti-aliasing "auto"."""
+"""Renderer speed-ups keep the pictures: the merged mannequin mesh, anti-aliasing "auto"."""
 from __future__ import annotations
 
 import numpy as np

@@ -1,4 +1,4 @@
-"""Issue 18 (study app part): attention checks, practice trials, counterbalanced section order, honest duration."""
+"""Study extras in the study app: attention checks, practice trials, counterbalanced section order, honest duration."""
 from __future__ import annotations
 
 import csv

@@ -1,4 +1,4 @@
-"""Issue 16: the attacks found by probing the demo, each tried again here.
+"""The attacks found by probing the demo, each tried again here.
 
 DEBUG off by default, no hard-coded SECRET_KEY, Prolific resume only on the full (PID, STUDY_ID, SESSION_ID)
 triple, non-finite response times, CSV formula injection, over-long link parameters, double consent, echoed
