@@ -1,0 +1,303 @@
+"""The real-capture gait observer on held-out real takes, the demo and seed000 plans' gait clips read by it and by the
+synthetic observer, and the realism measures of real walks beside the generated ones.
+
+    python benchmarks/bench_real_observer.py [--corpus var/mocap/bandai-namco.npz] [--plans demo seed000]
+        [--json docs/benchmarks/real_observer.json] [--md docs/benchmarks/mocap.md]
+
+1. Held-out takes: the observer (generation/quality/real_observer.py) is fitted on the corpus's training split and
+   read on its test split (held out by take): the four gait emotions on dataset 1 (happy, sad, angry, normal =
+   neutral), confusion matrix per take and per window; the theme pairs on both datasets.
+2. Plans: every gait entry of each plan made as ``generate_clips`` makes it (no video, no figure-height projection)
+   and checked by the quality gate (:func:`generation.pipeline.plan_qa.run`) once with the real-capture observer
+   and once with the synthetic one (``QA_GAIT_OBSERVER=synthetic``), grouped by the intended dominant emotion.
+3. Realism: the measures of :mod:`generation.quality.realism` per real style (all gait takes) beside the plans'
+   generated clips (and the plans' real source walks, cut as rendered).
+
+Writes the JSON and replaces the section between the ``real-observer`` markers of the Markdown file.
+Real capture: Bandai Namco Research Motion Dataset (Kobayashi et al. 2023, arXiv:2306.08861), CC BY-NC 4.0.
+"""
+from __future__ import annotations
+
+import argparse
+import datetime
+import json
+import os
+import platform
+import re
+import sys
+import time
+from collections import defaultdict
+from pathlib import Path
+
+os.environ.setdefault("OMP_NUM_THREADS", "1")
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))
+
+import numpy as np  # noqa: E402
+
+from generation.mocap.real_corpus import load_real_corpus, real_corpus_path  # noqa: E402
+from generation.quality import real_observer as ro  # noqa: E402
+from generation.quality.realism import MEASURES  # noqa: E402
+from generation.quality.realism_ranges import load_ranges, measure_corpus  # noqa: E402
+from study_protocol import CAPTURE_GAIT_EMOTIONS, GAIT_EMOTIONS  # noqa: E402
+
+START, END = "<!-- real-observer:start -->", "<!-- real-observer:end -->"
+
+
+def held_out(obs: ro.RealGaitObserver, test) -> dict:
+    """Emotion confusion (per take and per window) and theme-pair accuracy on held-out CorpusClips."""
+    emo = [c for c in test if c.dataset == ro.EMOTION_DATASET and c.style in CAPTURE_GAIT_EMOTIONS]
+    takes = np.zeros((4, 4), int)
+    windows = np.zeros((4, 4), int)
+    rows = []
+    for c in emo:
+        k = GAIT_EMOTIONS.index(CAPTURE_GAIT_EMOTIONS[c.style])
+        p = obs.proba(c.motion)
+        takes[k, int(p.argmax())] += 1
+        for w in obs.clf.predict(ro.window_descriptors(c.motion)):
+            windows[k, int(w)] += 1
+        rows.append({"take": c.name, "intended": GAIT_EMOTIONS[k], "read": GAIT_EMOTIONS[int(p.argmax())],
+                     "p": round(float(p.max()), 3)})
+    themes = {}
+    for name, (first, second) in ro.THEME_PAIRS.items():
+        sel = [c for c in test if c.style in first + second]
+        if not sel or name not in obs.themes:
+            continue
+        y = np.array([int(c.style in second) for c in sel])
+        p = np.array([obs.theme_proba(c.motion, name) for c in sel])
+        themes[name] = {"n": len(sel), "accuracy": round(float(((p > 0.5) == y).mean()), 3),
+                        "per_dataset": {d: int(sum(c.dataset == d for c in sel)) for d in sorted({c.dataset
+                                                                                                  for c in sel})},
+                        "wrong": [c.name for c, yy, pp in zip(sel, y, p) if (pp > 0.5) != yy]}
+    return {"n_takes": len(emo), "accuracy_takes": round(float(np.trace(takes) / max(takes.sum(), 1)), 3),
+            "recall_takes": {e: round(float(takes[i, i] / max(takes[i].sum(), 1)), 3) for i, e in
+                             enumerate(GAIT_EMOTIONS)},
+            "confusion_takes": takes.tolist(), "accuracy_windows": round(float(np.trace(windows) / windows.sum()), 3),
+            "recall_windows": {e: round(float(windows[i, i] / max(windows[i].sum(), 1)), 3) for i, e in
+                               enumerate(GAIT_EMOTIONS)},
+            "confusion_windows": windows.tolist(), "takes": rows, "themes": themes}
+
+
+def dominant(vec) -> str | None:
+    from generation.quality.checks import _dominant
+
+    return _dominant(vec)
+
+
+def plan_rows(plan: str, kind: str) -> list[dict]:
+    """plan_qa rows of the plan's gait entries read by the ``kind`` gait observer, with ``intended_dominant`` and
+    ``origin``/``theme`` from the plan."""
+    from generation.pipeline import plan_qa
+    from generation.plans.schema import load_plan
+
+    os.environ["QA_GAIT_OBSERVER"] = kind
+    try:
+        rows = plan_qa.run(plan, modality="gait", figure_height=False, log=lambda *a: None)
+    finally:
+        os.environ.pop("QA_GAIT_OBSERVER", None)
+    entries = {e.id: e for e in load_plan(plan).entries}
+    for r in rows:
+        e = entries[r["entry"]]
+        r["intended_dominant"] = dominant(e.inputs.get("emotion"))
+        r["origin"] = e.origin
+        r["theme"] = e.inputs.get("theme")
+    return rows
+
+
+def readings(real_rows: list[dict], synth_rows: list[dict]) -> dict:
+    """Per intended emotion: clips, read as intended by each observer, their labels and median p."""
+    synth = {r["entry"]: r for r in synth_rows}
+    out = defaultdict(lambda: {"n": 0, "real_read": [], "real_p": [], "synthetic_read": [], "synthetic_p": [],
+                               "flag_observer_real": 0, "origins": []})
+    for r in real_rows:
+        key = r["intended_dominant"] or ("(theme " + r["theme"] + ")" if r.get("theme") else "(none)")
+        g = out[key]
+        g["n"] += 1
+        g["origins"].append(f"{r['origin']} {r['generator']}")
+        g["real_read"].append(r["observed"])
+        g["real_p"].append(r["observed_p"])
+        g["flag_observer_real"] += "observer" in (r["flag"] or "").split(";")
+        s = synth.get(r["entry"], {})
+        g["synthetic_read"].append(s.get("observed"))
+        g["synthetic_p"].append(s.get("observed_p"))
+    return dict(out)
+
+
+def _stat(values) -> dict:
+    v = np.asarray([x for x in values if x is not None], dtype=float)
+    if not v.size:
+        return {"n": 0}
+    return {"n": int(v.size), "median": round(float(np.median(v)), 3), "min": round(float(v.min()), 3),
+            "max": round(float(v.max()), 3), "p5": round(float(np.percentile(v, 5)), 3),
+            "p95": round(float(np.percentile(v, 95)), 3)}
+
+
+def realism_table(real: list[dict], plans: dict[str, list[dict]]) -> dict:
+    """{group: {measure: stats}}: real takes per (dataset, style) and pooled, then per plan generated / source."""
+    out = {}
+    groups = defaultdict(list)
+    for r in real:
+        groups[f"real {r['dataset'].removeprefix('bandai-namco-')}: {r['style']}"].append(r)
+    for name in sorted(groups):
+        out[name] = {m: _stat(r[m] for r in groups[name]) for m in MEASURES}
+    out["real: all takes"] = {m: _stat(r[m] for r in real) for m in MEASURES}
+    for plan, rows in plans.items():
+        for origin in ("generated", "source"):
+            sel = [r for r in rows if r["origin"] == origin]
+            if sel:
+                gens = ", ".join(f"{g} {n}" for g, n in sorted(_count(r["generator"] for r in sel).items()))
+                key = f"{plan} {origin} ({gens})"
+                out[key] = {m: _stat(r[m] for r in sel) for m in MEASURES}
+                out[key]["realism_flagged"] = sum("realism" in (r["flag"] or "").split(";") for r in sel)
+                out[key]["bounds_broken"] = _count(re.sub(r"[\d.]+$", "", b) for r in sel
+                                                   for b in (r["realism_out"] or "").split(";") if b)
+    return out
+
+
+def _cm_table(cm, title: str) -> list[str]:
+    head = "| intended \\ read | " + " | ".join(GAIT_EMOTIONS) + " | recall |"
+    lines = [f"**{title}**", "", head, "|" + "---|" * (len(GAIT_EMOTIONS) + 2)]
+    for i, e in enumerate(GAIT_EMOTIONS):
+        row = cm[i]
+        rec = f"{row[i] / sum(row):.2f}" if sum(row) else "-"
+        lines.append(f"| {e} | " + " | ".join(str(x) for x in row) + f" | {rec} |")
+    return lines + [""]
+
+
+def _fmt(s: dict) -> str:
+    if not s or not s.get("n"):
+        return "-"
+    if s["n"] < 5:
+        return f"{s['median']:.3g} ({s['min']:.3g}-{s['max']:.3g})"
+    return f"{s['median']:.3g} ({s['p5']:.3g}-{s['p95']:.3g})"
+
+
+def markdown(res: dict) -> str:
+    h = res["held_out"]
+    lines = [START, "", "## Real-capture gait observer and realism measures (`benchmarks/bench_real_observer.py`)", "",
+             f"{res['date']}, {res['machine']}, {res['commit']}; {res['seconds']:.0f} s. Real capture: Bandai "
+             "Namco Research Motion Dataset (Kobayashi et al. 2023, arXiv:2306.08861), CC BY-NC 4.0, retargeted "
+             f"onto the 21-joint gait skeleton ({res['corpus']}). Observer: {res['observer_source']}; descriptors "
+             "and classifier in `generation/quality/real_observer.py` (2 s windows: 18 affective-feature means "
+             "and standard deviations, root speed and vertical range per body height; standardised logistic "
+             "regression, C = 0.1, takes weighted equally; a clip's probabilities are the mean over its windows).",
+             "",
+             "### Held-out takes (split by take, `split == test`)", "",
+             f"Emotions: dataset 1 only (happy, sad, angry, normal = neutral; {sum(res['train_takes'].values())} "
+             f"training takes, {h['n_takes']} held-out takes). Accuracy {h['accuracy_takes']:.2f} per take, "
+             f"{h['accuracy_windows']:.2f} per 2 s window.", ""]
+    lines += _cm_table(h["confusion_takes"], "Per take (rows: intended style, columns: observer's top label)")
+    lines += _cm_table(h["confusion_windows"], "Per window")
+    lines += ["Theme pairs (binary classifiers on the same descriptors, both datasets' takes of those styles; "
+              "held-out takes):", "", "| pair | held-out takes | accuracy | takes per dataset | wrong |",
+              "|---|---|---|---|---|"]
+    for name, t in h["themes"].items():
+        lines.append(f"| {name.replace('_', ' ')} | {t['n']} | {t['accuracy']:.2f} | "
+                     f"{', '.join(f'{k}: {v}' for k, v in t['per_dataset'].items())} | "
+                     f"{', '.join(t['wrong']) or '-'} |")
+    lines += ["", "### The plans' gait clips read by the real-capture and the synthetic observer", "",
+              "Every gait entry made as `generate_clips` makes it and checked by `generation.pipeline.plan_qa` "
+              "(no video). Grouped by the entry's dominant intended emotion (share >= 0.5; transitions, themes "
+              "and the neutral base have none). `read` lists each clip's top label; p is the median top "
+              "probability. The synthetic observer: " + res["synthetic_source"] + ".", "",
+              "| plan | intended | clips | origin and generator used | real-capture: read (median p) | "
+              "synthetic: read (median p) | "
+              "observer flags (real) |", "|---|---|---|---|---|---|---|"]
+    for plan, groups in res["plans"].items():
+        for key, g in sorted(groups.items()):
+            def summary(labels, ps):
+                if not any(labels):
+                    return "no reading"
+                counts = defaultdict(int)
+                for lab in labels:
+                    counts[lab or "none"] += 1
+                med = np.median([p for p in ps if p is not None]) if any(p is not None for p in ps) else float("nan")
+                return ", ".join(f"{k} {v}" for k, v in sorted(counts.items(), key=lambda kv: -kv[1])) + \
+                    f" ({med:.2f})"
+            origins = ", ".join(f"{o} {n}" for o, n in sorted(_count(g["origins"]).items()))
+            lines.append(f"| {plan} | {key} | {g['n']} | {origins} | {summary(g['real_read'], g['real_p'])} | "
+                         f"{summary(g['synthetic_read'], g['synthetic_p'])} | {g['flag_observer_real']} |")
+    lines += ["", "### Realism: real walks per style beside the plans' clips", "",
+              "Median (5th-95th percentile; min-max under 5 clips) per group, measured as the quality gate "
+              "measures (`generation/quality/realism.py`; plan clips resampled and cut as rendered, real takes "
+              "whole). Thresholds (`generation/quality/realism_ranges.json`, " + res["ranges_rule"] + "): " +
+              ", ".join(f"{k} {v:g}" for k, v in res["thresholds"].items()) +
+              f". Held-out real takes outside them: {res['ranges_test_flagged']:.0%}.", "",
+              "| group | " + " | ".join(MEASURES) + " | realism flags (bounds broken: clips) |",
+              "|---|" + "---|" * (len(MEASURES) + 1)]
+    for name, row in res["realism"].items():
+        flags = row.get("realism_flagged", "")
+        if row.get("bounds_broken"):
+            flags = f"{flags} (" + ", ".join(f"{k} {v}" for k, v in sorted(row["bounds_broken"].items())) + ")"
+        lines.append(f"| {name} | " + " | ".join(_fmt(row[m]) for m in MEASURES) + f" | {flags} |")
+    lines += ["", END]
+    return "\n".join(lines) + "\n"
+
+
+def _count(items) -> dict:
+    out = defaultdict(int)
+    for x in items:
+        out[x] += 1
+    return dict(out)
+
+
+def _commit() -> str:
+    """'commit <short hash>' of the repository, '+ uncommitted changes' when the tree is not clean."""
+    import subprocess
+
+    def git(*args):
+        return subprocess.run(["git", *args], cwd=ROOT, capture_output=True, text=True).stdout.strip()
+
+    dirty = git("status", "--porcelain", "--untracked-files=no")
+    return f"commit {git('rev-parse', '--short', 'HEAD')}" + (" + uncommitted changes" if dirty else "")
+
+
+def write_markdown(path: Path, text: str) -> None:
+    """Replace the block between the markers in ``path`` (append it when absent)."""
+    old = path.read_text(encoding="utf-8") if path.is_file() else ""
+    pattern = re.compile(re.escape(START) + ".*?" + re.escape(END) + "\n?", re.S)
+    new = pattern.sub(lambda _: text, old) if pattern.search(old) else old.rstrip("\n") + "\n\n" + text
+    path.write_text(new, encoding="utf-8")
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--corpus", default=None)
+    ap.add_argument("--plans", nargs="*", default=["demo", "seed000"])
+    ap.add_argument("--json", default=str(ROOT / "docs" / "benchmarks" / "real_observer.json"))
+    ap.add_argument("--md", default=str(ROOT / "docs" / "benchmarks" / "mocap.md"))
+    args = ap.parse_args(argv)
+    t0 = time.perf_counter()
+    path = Path(args.corpus) if args.corpus else real_corpus_path()
+    obs = ro.default_real_observer(path)
+    if obs is None or not path.is_file():
+        raise SystemExit(f"{path}: no real-capture corpus; build it with `python -m generation.mocap dataset "
+                         "bandai-namco DIR --out PATH`")
+    test = load_real_corpus(path, skeleton="gait", split="test")
+    real = measure_corpus(load_real_corpus(path, skeleton="gait"))
+    from generation.quality.observer import default_observer
+
+    synth = default_observer()
+    plans_real = {p: plan_rows(p, "real") for p in args.plans}
+    plans_synth = {p: plan_rows(p, "synthetic") for p in args.plans}
+    ranges = load_ranges()
+    res = {"date": datetime.date.today().isoformat(), "commit": _commit(),
+           "machine": f"{platform.machine()}, {os.cpu_count()} CPUs (shared), Python {platform.python_version()}",
+           "corpus": path.name, "observer_source": obs.source, "train_takes": dict(obs.train_takes),
+           "synthetic_source": ("logistic regression on the SYNTHETIC procedural gait corpus (var/corpus/)"
+                                if synth is not None else "not available (no synthetic gait corpus in var/corpus/)"),
+           "held_out": held_out(obs, test),
+           "plans": {p: readings(plans_real[p], plans_synth[p]) for p in args.plans},
+           "plan_rows": plans_real, "realism": realism_table(real, plans_real),
+           "thresholds": ranges["thresholds"], "ranges_rule": ranges["rule"],
+           "ranges_test_flagged": ranges["test_flagged_share"]}
+    res["seconds"] = time.perf_counter() - t0
+    Path(args.json).parent.mkdir(parents=True, exist_ok=True)
+    Path(args.json).write_text(json.dumps(res, indent=1, default=str) + "\n", encoding="utf-8")
+    write_markdown(Path(args.md), markdown(res))
+    print(markdown(res))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
