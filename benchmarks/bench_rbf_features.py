@@ -2,7 +2,10 @@
 and the contact sheet docs/img/rbf_contact_sheet.png.
 
 Run:  OMP_NUM_THREADS=1 python benchmarks/bench_rbf_features.py [--out docs/benchmarks/rbf_results.json]
-          [--sheet docs/img/rbf_contact_sheet.png] [--shapes docs/img/rbf_shapes.png]
+          [--sheet docs/img/rbf_contact_sheet.png] [--shapes docs/img/rbf_shapes.png] [--base real|procedural]
+
+The neutral base is the shipped cycle averaged from real normal walks (``--base real``, the seed004 plan's default;
+Bandai Namco, CC BY-NC 4.0, Kobayashi et al. 2023) or the averaged procedural walks (``--base procedural``).
 
 For every theme at w = +0.7 and w = -0.7 (all ten features) it measures, over one cycle, the mean change of
 each gait affective feature (generation.core.features.np_gait_affective_features) against the neutral base and
@@ -28,6 +31,7 @@ import torch  # noqa: E402
 
 from generation.core.features import GAIT_FEATURE_NAMES, foot_joints, np_gait_affective_features  # noqa: E402
 from generation.rbf.neutral_base import neutral_cycle  # noqa: E402
+from generation.rbf.real_neutral import load_cycle  # noqa: E402
 from generation.rbf.stylise import stylise, stylised_cycle  # noqa: E402
 from generation.rbf.themes import THEME_NAMES, THEMES  # noqa: E402
 
@@ -142,8 +146,8 @@ def evaluate(nc) -> dict:
             "feature_names": list(GAIT_FEATURE_NAMES)}
 
 
-def timing(nc, repeats: int = 7) -> dict:
-    """Median wall time of one 4-cycle 30 fps clip (all ten happy features) and of building the neutral base."""
+def timing(nc, build, repeats: int = 7) -> dict:
+    """Median wall time of one 4-cycle 30 fps clip (all ten happy features) and of ``build()``ing the neutral base."""
     stylise(nc, "happy", 0.7, 10)  # warm-up
     times = []
     for _ in range(repeats):
@@ -151,7 +155,7 @@ def timing(nc, repeats: int = 7) -> dict:
         clip = stylise(nc, "happy", 0.7, 10, speed=1.0, n_cycles=4, fps=30.0)
         times.append(time.perf_counter() - t0)
     t0 = time.perf_counter()
-    neutral_cycle()
+    build()
     base = time.perf_counter() - t0
     return {"stylise_clip_s": float(np.median(times)), "clip_frames": clip.num_frames, "neutral_base_s": base}
 
@@ -223,8 +227,9 @@ def markdown_tables(result: dict) -> str:
 def benchmark_page(result: dict) -> str:
     """docs/benchmarks/rbf.md: how the numbers were made, then the tables."""
     base = result["neutral_base"]
-    used = [u for u in base["sources"] if u["cycles"]]
-    rejected = sum(u.get("rejected_cycles", 0) for u in base["sources"])
+    sources = base.get("sources", base.get("captured_sources", []))
+    used = [u for u in sources if u["cycles"]]
+    rejected = sum(u.get("rejected_cycles", 0) for u in sources)
     held = {k: (sum(c["holds"] for r in result["rows"] for c in r[k]), sum(len(r[k]) for r in result["rows"]))
             for k in ("checks", "measures")}
     t = result["timing"]
@@ -237,14 +242,14 @@ def benchmark_page(result: dict) -> str:
     lines = [
         "# RBF styliser (seed 004): measured effects",
         "",
-        "Machine: 2-core CI VM, no GPU. Date: 2026-11-27. Command:",
+        f"Machine: 2-core CI VM, no GPU. Date: {time.strftime('%Y-%m-%d')}. Command:",
         "",
         "```",
         "OMP_NUM_THREADS=1 python benchmarks/bench_rbf_features.py --doc docs/benchmarks/rbf.md \\",
         "    --sheet docs/img/rbf_contact_sheet.png --shapes docs/img/rbf_shapes.png",
         "```",
         "",
-        f"Neutral base: `generation.rbf.neutral_base.neutral_cycle()`, {base['n_cycles']} cycle(s) averaged, "
+        f"Neutral base: `{result['base_function']}`, {base['n_cycles']} cycle(s) averaged, "
         f"{rejected} rejected as glitches, cycle {base['cycle_duration_s']:.2f} s, stride "
         f"{base['stride_m'][2]:.2f} m, synthetic: {base['synthetic']}. Sources used: "
         + "; ".join(f"{u['name']} ({u['cycles']})" for u in used) + "."
@@ -266,7 +271,9 @@ def benchmark_page(result: dict) -> str:
         f"- Floor: lowest foot joint {lowest_ours * 1000:+.1f} mm relative to the neutral floor with our fit, "
         f"{lowest_dir * 1000:+.1f} mm with `generation.core.ik.fit_positions_to_skeleton` (direction-only).",
         f"- Speed: {t['stylise_clip_s'] * 1000:.0f} ms per 4-cycle clip at 30 fps ({t['clip_frames']} frames, "
-        f"median of 7, one core); building the neutral base {t['neutral_base_s']:.2f} s.",
+        f"median of 7, one core, on a machine shared with other jobs); "
+        f"{'loading' if 'load_cycle' in result['base_function'] else 'building'} the neutral base "
+        f"{t['neutral_base_s']:.2f} s.",
         "- Scaling: the mean joint displacement grows with w and, mostly, with n (last table), as the paper's "
         "ratings did (Fig. 7). It is not strictly proportional to w after the fit: bones cannot stretch, a chest "
         "without clavicles moves as one piece, and feet are kept above the floor.",
@@ -374,6 +381,17 @@ def shapes_figure(path: Path) -> None:
     plt.close(fig)
 
 
+def keep_marked_blocks(doc: Path, page: str) -> str:
+    """The new page plus any ``<!-- name:start -->`` ... ``<!-- name:end -->`` blocks other benchmarks wrote into
+    ``doc`` (e.g. benchmarks/bench_rbf_real.py's section), kept at the end."""
+    import re
+
+    old = doc.read_text(encoding="utf-8") if doc.is_file() else ""
+    blocks = re.findall(r"<!-- ([\w-]+):start -->.*?<!-- \1:end -->", old, flags=re.S)
+    kept = [re.search(rf"<!-- {name}:start -->.*?<!-- {name}:end -->", old, flags=re.S).group(0) for name in blocks]
+    return page.rstrip("\n") + "".join("\n\n" + b for b in kept) + "\n"
+
+
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--out", type=Path, default=None, help="write all numbers as JSON here")
@@ -381,12 +399,17 @@ def main(argv=None) -> int:
     parser.add_argument("--doc", type=Path, default=None, help="write the benchmark page (e.g. docs/benchmarks/rbf.md)")
     parser.add_argument("--sheet", type=Path, default=Path("docs/img/rbf_contact_sheet.png"))
     parser.add_argument("--shapes", type=Path, default=Path("docs/img/rbf_shapes.png"))
+    parser.add_argument("--base", choices=("real", "procedural"), default="real",
+                        help="neutral base: averaged real normal walks (shipped) or averaged procedural walks")
     args = parser.parse_args(argv)
     torch.set_num_threads(1)
     warnings.filterwarnings("ignore", message="The given NumPy array is not writable")
-    nc = neutral_cycle()
+    build = load_cycle if args.base == "real" else neutral_cycle
+    nc = build()
     result = evaluate(nc)
-    result["timing"] = timing(nc)
+    result["base_function"] = ("generation.rbf.real_neutral.load_cycle()" if args.base == "real"
+                               else "generation.rbf.neutral_base.neutral_cycle()")
+    result["timing"] = timing(nc, build)
     result["neutral_base"] = {k: v for k, v in nc.metadata.items()}
     result["movement_share_top10"] = {t: 100.0 * sum(f.kind == "swing" for f in THEMES[t]) / 10 for t in THEMES}
     result["scaling"] = scaling(nc)
@@ -397,7 +420,7 @@ def main(argv=None) -> int:
         args.tables.write_text(markdown_tables(result))
     if args.doc:
         args.doc.parent.mkdir(parents=True, exist_ok=True)
-        args.doc.write_text(benchmark_page(result))
+        args.doc.write_text(keep_marked_blocks(args.doc, benchmark_page(result)))
     args.sheet.parent.mkdir(parents=True, exist_ok=True)
     contact_sheet(nc, args.sheet)
     shapes_figure(args.shapes)

@@ -251,7 +251,9 @@ def markdown(result: dict) -> str:
         lines.append(f"| {theme} | " + " | ".join(f"{row[f'{f}_{w}_emotion_p']:.2f}" for w in WEIGHTS
                                                   for f in ("expert", "data"))
                      + f" | {row['real_test_emotion_p']:.2f} |")
-    lines += ["", MARK_END]
+    lines += ["", "Contact sheets (neutral, expert-styled w = 1, data-styled w = 1, a real themed test take; what they "
+              "show is described in docs/rbf.md): "
+              + ", ".join(f"[{t}](../img/rbf_real_{t}.png)" for t in THEME_NAMES) + ".", "", MARK_END]
     return "\n".join(lines) + "\n"
 
 

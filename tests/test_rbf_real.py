@@ -170,3 +170,18 @@ def test_plan_entries_name_base_and_features():
     data_plan = load_plan("seed004_data")
     assert sorted(e.inputs["features"] for e in data_plan.entries if e.generator == "rbf") == ["data"] * 6 + [
         "expert"] * 6
+
+
+def test_a_damaged_features_file_is_an_error(tmp_path):
+    import json
+
+    data = DF.load_data_features()
+    data["themes"]["sad"]["dofs"][0]["rbfs"] = [[0.01, 50.0, -1.0]]
+    path = tmp_path / "bad.json"
+    path.write_text(json.dumps(data))
+    with pytest.raises(ValueError, match="variances must be positive"):
+        DF.load_data_features(path)
+    del data["themes"]["tired"]
+    path.write_text(json.dumps(data))
+    with pytest.raises(ValueError, match=r"no data-driven features for themes \['tired'\]"):
+        DF.load_data_features(path)

@@ -30,7 +30,7 @@ import numpy as np
 
 from study_protocol import CAPTURE_THEMES
 
-from .basis import MAX_RBFS_PER_DOF, rbf_sum
+from .basis import MAX_RBFS_PER_DOF, rbf_sum, validate_params
 from .real_neutral import steady_cycles
 from .themes import AXES, BODY_PARTS, THEME_NAMES
 
@@ -208,6 +208,9 @@ def load_data_features(path: str | Path = SHIPPED_PATH) -> dict:
     missing = set(THEME_NAMES) - set(data.get("themes", {}))
     if missing:
         raise ValueError(f"{path}: no data-driven features for themes {sorted(missing)}")
+    for theme, entry in data["themes"].items():
+        for d in entry["dofs"]:
+            validate_params(np.asarray(d["rbfs"]).reshape(-1, 3), f"{path}: {theme} {d['joint']} {d['axis']}")
     return data
 
 
