@@ -9,7 +9,7 @@ Bandai Namco Research Motion Dataset 1 and 2 (Kobayashi et al. 2023, arXiv:2306.
 
 - Neutral: the shipped averaged cycle (``generation.rbf.real_neutral.load_cycle``) walked for 4 cycles at 30 fps
   (``neutral_walk``), beside the procedural base; measures: walking speed (median over 1 s windows of the root's
-  ground-plane speed), cadence (steps/min, from the median interval between heel strikes), stance knee flexion and
+  ground-plane speed), cadence (steps/min: two steps per mean steady cycle), stance knee flexion and
   pelvis bounce (``generation.quality.realism``), compared with every real normal walk (both datasets, all splits).
 - Expert vs data (``generation.rbf.compare.compare_theme``): per theme the top DOFs by amplitude.
 - Observers (``generation.quality.real_observer``): the four-emotion classifier and the theme-pair classifiers,
@@ -35,8 +35,8 @@ from generation.mocap.real_corpus import load_real_corpus, real_corpus_path  # n
 from generation.quality.real_observer import THEME_PAIRS, default_real_observer  # noqa: E402
 from generation.quality.realism import realism_measures  # noqa: E402
 from generation.rbf.compare import compare_theme  # noqa: E402
-from generation.rbf.neutral_base import heel_strikes, neutral_cycle  # noqa: E402
-from generation.rbf.real_neutral import load_cycle  # noqa: E402
+from generation.rbf.neutral_base import neutral_cycle  # noqa: E402
+from generation.rbf.real_neutral import load_cycle, steady_cycles  # noqa: E402
 from generation.rbf.stylise import neutral_walk, stylise  # noqa: E402
 from generation.rbf.themes import THEME_NAMES  # noqa: E402
 from study_protocol import CAPTURE_THEMES, GAIT_EMOTIONS  # noqa: E402
@@ -55,9 +55,8 @@ def walk_measures(motion) -> dict:
     w = max(1, int(round(fps)))
     root = P[:, 0, [0, 2]]
     speeds = np.linalg.norm(root[w:] - root[:-w], axis=-1) * fps / w
-    left, right = heel_strikes(P, fps, motion.skeleton)
-    strikes = np.sort(np.concatenate([left, right]))
-    cadence = 60.0 * fps / float(np.median(np.diff(strikes))) if len(strikes) > 2 else float("nan")
+    cycles = steady_cycles(motion)
+    cadence = 120.0 / float(np.mean([c.duration_s for c in cycles])) if cycles else float("nan")
     r = realism_measures(motion)
     return {"speed_m_s": float(np.median(speeds)), "cadence_steps_min": cadence,
             "stance_knee_deg": r["stance_knee_deg"], "pelvis_bounce_cm": r["pelvis_bounce_cm"]}

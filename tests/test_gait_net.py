@@ -81,38 +81,29 @@ def test_model_shapes_and_unit_quaternions():
     assert one["q"].shape == (N, 21, 4)
 
 
-# The flat config dict of the shipped weights (format gait_net/1, written before the config was split).
-FLAT_V1 = {"enc1_sizes": [16, 16, 8], "enc2_sizes": [16, 16, 8], "gru_hidden": 256, "gru_layers": 2,
-           "root_hidden": 32, "versor_hidden": 128, "residual": True, "use_affective": True, "emotion_skip": True,
-           "num_joints": 21, "num_emotions": 4, "seq_len": 60, "frame_step": 4, "prefix_frac": 0.3,
-           "batch_size": 64, "epochs": 28, "lr": 0.001, "lr_decay": 0.999, "tf_decay": 0.91, "grad_clip": 1.0,
-           "lambda_motion": 1.0, "lambda_versor": 1.0, "lambda_pose": 1.0, "lambda_aff": 1.0, "lambda_root": 1.0,
-           "lambda_fctc": 1.0, "lambda_phase": 1.0, "pos_scale_m": 0.1, "splice_frac": 0.3, "euler_order": "zyx",
-           "seed": 0, "notes": {}}
-
-
-def test_flat_configs_of_old_checkpoints_map_onto_the_sections():
-    cfg = GaitNetConfig.from_dict(FLAT_V1)
-    # The previous shipped weights were trained with the CPU default of before the style term and the free-running
-    # continuation: a stored config without those fields describes a run without them.
-    assert cfg == GaitNetConfig().with_overrides(lambda_style=0.0, extra_steps=0)
-    sectioned = GaitNetConfig().to_dict()
-    del sectioned["loss"]["style"], sectioned["train"]["extra_steps"]
-    assert GaitNetConfig.from_dict(sectioned) == cfg
-    odd = GaitNetConfig.from_dict({**FLAT_V1, "gru_hidden": 64, "lambda_root": 0.0, "tf_decay": 0.5,
-                                   "frame_step": 2, "pos_scale_m": 0.2, "notes": {"run": "x"}})
+def test_config_dicts_round_trip_by_section_and_name_bad_keys():
+    odd = GaitNetConfig().with_overrides(gru_hidden=64, lambda_root=0.0, tf_decay=0.5, frame_step=2,
+                                         pos_scale_m=0.2, notes={"run": "x"})
     assert odd.model == GaitModelConfig(gru_hidden=64)
-    assert odd.loss == GaitLossWeights(root=0.0, pos_scale_m=0.2, style=0.0)
-    assert odd.train == GaitTrainConfig(tf_decay=0.5, extra_steps=0) and odd.data == GaitDataConfig(frame_step=2)
-    assert odd.notes == {"run": "x"}
+    assert odd.loss == GaitLossWeights(root=0.0, pos_scale_m=0.2)
+    assert odd.train == GaitTrainConfig(tf_decay=0.5) and odd.data == GaitDataConfig(frame_step=2)
     # The split form round-trips, tuples included.
     assert GaitNetConfig.from_dict(odd.to_dict()) == odd
     assert set(odd.to_dict()) == {"model", "data", "train", "loss", "notes"}
     assert GaitNetConfig.from_dict(GaitNetConfig.tiny().to_dict()).model.enc1_sizes == (8, 8)
+    # A field missing from a stored section takes its default.
+    partial = GaitNetConfig.tiny().to_dict()
+    del partial["loss"]["class_style"]
+    assert GaitNetConfig.from_dict(partial).loss.class_style == GaitLossWeights().class_style
     with pytest.raises(ValueError, match="unknown GaitModelConfig fields"):
         GaitNetConfig.from_dict({"model": {"gru_hiden": 3}})
     with pytest.raises(ValueError, match="unknown GaitNetConfig fields"):
         GaitNetConfig.from_dict({"model": {}, "optimiser": {}})
+    # A flat dict (not split by section) is not a config.
+    with pytest.raises(ValueError, match=r"unknown GaitNetConfig fields \['enc1_sizes'"):
+        GaitNetConfig.from_dict({"enc1_sizes": [16, 16, 8], "gru_hidden": 256, "lambda_root": 1.0})
+    with pytest.raises(ValueError, match=r"sections \['model'\] must be mappings"):
+        GaitNetConfig.from_dict({"model": [1, 2]})
 
 
 def test_config_overrides_take_flat_and_section_names():
@@ -130,12 +121,7 @@ def test_config_overrides_take_flat_and_section_names():
         GaitNet(GaitNetConfig.tiny())
 
 
-def test_emotion_skip_wiring_and_old_configs():
-    old = GaitNetConfig.tiny(emotion_skip=False).to_dict()
-    flat = {**old["model"], **old["data"], **old["train"], **{f"lambda_{k}": v for k, v in old["loss"].items()
-                                                              if k not in ("pos_scale_m", "euler_order")}}
-    del flat["emotion_skip"]
-    assert GaitNetConfig.from_dict(flat).model.emotion_skip is False   # checkpoints from before the field
+def test_emotion_skip_wiring():
     net = GaitNet(GaitModelConfig.tiny(emotion_skip=True))
     q, zeros = torch.randn(2, 3, 21, 4), (torch.zeros(2, 3, 18), torch.zeros(2, 3, 5), torch.zeros(2, 3, 3))
     a = net(q, *zeros, torch.eye(4)[[0, 0]][:, None].expand(2, 3, 4))
@@ -411,15 +397,12 @@ def test_save_and_load_model(tiny_net, tmp_path):
     for p, q in zip(loaded.model.parameters(), tiny_net.model.parameters()):
         assert torch.equal(p, q)
     assert loaded.config == tiny_net.config
-    # A checkpoint of before the config split (flat config, format gait_net/1) loads the same way.
+    # A file of another format is refused, naming the format.
     payload = torch.load(path, weights_only=False)
-    c = tiny_net.config
-    flat = {**c.model.to_dict(), **c.data.to_dict(), **c.train.to_dict(), "notes": c.notes,
-            "pos_scale_m": c.loss.pos_scale_m, "euler_order": c.loss.euler_order,
-            **{f"lambda_{k}": v for k, v in c.loss.to_dict().items() if k not in ("pos_scale_m", "euler_order")}}
-    old = tmp_path / "old.pt"
-    torch.save({**payload, "format": "gait_net/1", "config": flat}, old)
-    assert load_model(old).config == tiny_net.config
+    other = tmp_path / "other.pt"
+    torch.save({**payload, "format": "gait_net/1"}, other)
+    with pytest.raises(ValueError, match="checkpoint format 'gait_net/1', expected 'gait_net/2'"):
+        load_model(other)
 
 
 def test_shipped_weights_load_and_generate():

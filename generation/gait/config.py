@@ -13,10 +13,10 @@ As on the gesture side, the settings are split by what they configure:
 so both are the same code path.
 
 Weights files store ``GaitNetConfig.to_dict()``: {"model": {...}, "data": {...}, "train": {...}, "loss": {...},
-"notes": {...}} (format ``gait_net/2``). Files written before the split (format ``gait_net/1``, such as the
-shipped ``gait_net_default.pt``) store one flat dict; :meth:`GaitNetConfig.from_dict` reads both, mapping the
-flat names with :data:`FLAT_NAMES`. The flat names also serve ``--set FIELD=JSON`` and the keyword overrides of
-:meth:`GaitNetConfig.paper` / :meth:`GaitNetConfig.tiny`.
+"notes": {...}} (format ``gait_net/2``), every field written out; :meth:`GaitNetConfig.from_dict` reads that form
+only. A field added later takes its default in files written before it, so a new field whose default changes
+what a stored run means must come with the shipped weights re-saved. The flat names of :data:`FLAT_NAMES` serve
+``--set FIELD=JSON`` and the keyword overrides of :meth:`GaitNetConfig.paper` / :meth:`GaitNetConfig.tiny`.
 """
 from __future__ import annotations
 
@@ -59,8 +59,7 @@ class GaitModelConfig:
         (QuaterNet-style); False predicts absolute rotations.
     use_affective: False gives the ablation without affective inputs (FC_enc1) and without L_aff (seed 000 5.6).
     emotion_skip: the emotion m also enters GRU_versors and FC_versors directly at every step (not only
-        through the 8-unit encoders), so the label can steer the pose; False is the paper's wiring (and that of
-        checkpoints saved before this field existed).
+        through the 8-unit encoders), so the label can steer the pose; False is the paper's wiring.
     num_joints: J, joints of the gait skeleton; num_emotions: C, components of m (``GAIT_EMOTIONS``).
     """
 
@@ -194,7 +193,7 @@ class GaitLossWeights:
     fctc: L_fctc (eq. 12, foot contact); phase: the step-phase head (an addition of this implementation).
     style: L_style (an addition): the time mean and spread of the affective features and the motion amplitude of
         the predicted window and of the free-running continuation match the ground truth's
-        (``losses.style_loss``; 0 leaves it out, as in the paper and in checkpoints saved before the field).
+        (``losses.style_loss``; 0 leaves it out, as in the paper).
     class_style: L_class (an addition, default off): the batch's per-emotion mean offset of the walks' time-mean
         affective features from the ground truth's, in walk-to-walk units (``losses.class_style_loss``). The
         per-walk style term weighs a shift shared by every walk of an emotion no more than walk-level noise,
@@ -239,12 +238,8 @@ FLAT_NAMES: dict[str, tuple[str, str]] = {
     "pos_scale_m": ("loss", "pos_scale_m"),
     "euler_order": ("loss", "euler_order"),
 }
-"""Field names of the single flat config used before the split (``gait_net/1`` checkpoints, ``--set``, the
-overrides of ``paper``/``tiny``) -> (section, field). ``notes`` kept its name."""
-
-BEFORE_FIELD: tuple[tuple[str, str, object], ...] = (("loss", "style", 0.0), ("train", "extra_steps", 0))
-"""(section, field, value) of fields added after checkpoints were written: a stored config without the field
-describes a run made without it (the paper's loss and rollout)."""
+"""Flat field names (``--set``, the overrides of ``paper``/``tiny``) -> (section, field); loss weights take a
+``lambda_`` prefix."""
 
 
 @dataclass
@@ -309,23 +304,15 @@ class GaitNetConfig:
 
     @classmethod
     def from_dict(cls, d: dict) -> GaitNetConfig:
-        """Rebuild from :meth:`to_dict`, or from the flat dict of checkpoints saved before the split (unknown
-        keys raise a ValueError naming them; a flat dict without ``emotion_skip`` predates that field and gets the
-        paper's wiring)."""
-        if any(isinstance(d.get(name), dict) for name in SECTIONS):
-            unknown = sorted(set(d) - set(SECTIONS) - {"notes"})
-            if unknown:
-                raise ValueError(f"unknown GaitNetConfig fields {unknown}")
-            sections = {name: dict(d.get(name, {})) for name in SECTIONS}
-            for section, name, old in BEFORE_FIELD:   # files saved before these fields existed
-                if section in d:
-                    sections[section].setdefault(name, old)
-            return cls(**{name: SECTIONS[name].from_dict(sections[name]) for name in SECTIONS},
-                       notes=dict(d.get("notes", {})))
-        flat = dict(d)
-        flat.setdefault("emotion_skip", False)  # checkpoints saved before the field existed
-        for section, name, old in BEFORE_FIELD:
-            names = {flat_name for flat_name, where in FLAT_NAMES.items() if where == (section, name)}
-            if not names & set(flat) and f"{section}.{name}" not in flat:
-                flat[f"{section}.{name}"] = old
-        return cls().with_overrides(**flat)
+        """Rebuild from :meth:`to_dict` ({"model": {...}, "data": {...}, "train": {...}, "loss": {...}, "notes"});
+        a missing field takes its default. Unknown keys, or a dict that is not split by section, raise a
+        ValueError naming them."""
+        unknown = sorted(set(d) - set(SECTIONS) - {"notes"})
+        if unknown:
+            raise ValueError(f"unknown GaitNetConfig fields {unknown} (expected the sections {sorted(SECTIONS)} "
+                             "and notes, as GaitNetConfig.to_dict writes them)")
+        not_sections = sorted(name for name in SECTIONS if name in d and not isinstance(d[name], dict))
+        if not_sections:
+            raise ValueError(f"GaitNetConfig sections {not_sections} must be mappings of fields")
+        return cls(**{name: SECTIONS[name].from_dict(dict(d.get(name, {}))) for name in SECTIONS},
+                   notes=dict(d.get("notes", {})))

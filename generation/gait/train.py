@@ -282,8 +282,7 @@ def save_checkpoint(path: Path, model: GaitNet, norm: Normalizer, config: GaitNe
     """Write model weights, config and normaliser (plus any training state in ``extra``), device-independent:
     the weights and every tensor of ``extra`` (optimizer state) are copied to the CPU first.
 
-    Format ``gait_net/2`` stores the config split by section (``GaitNetConfig.to_dict``); ``gait_net/1`` files
-    (the flat config of before the split) are still read by :func:`load_checkpoint`.
+    Format ``gait_net/2`` (:data:`CHECKPOINT_FORMAT`) stores the config split by section (``GaitNetConfig.to_dict``).
     """
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
@@ -295,7 +294,7 @@ def save_checkpoint(path: Path, model: GaitNet, norm: Normalizer, config: GaitNe
 
 
 def load_checkpoint(path: str | Path, device: str | torch.device | None = "cpu") -> tuple[GaitNet, Normalizer, dict]:
-    """Load a file written by :func:`save_checkpoint` (either format; read onto the CPU whatever device wrote it);
+    """Load a file written by :func:`save_checkpoint` (read onto the CPU whatever device wrote it);
     returns (model in eval mode on ``device``, normaliser, payload). ``GaitNetConfig.from_dict(payload["config"])``
     is the full config."""
     path = Path(path)
@@ -308,6 +307,8 @@ def load_checkpoint(path: str | Path, device: str | torch.device | None = "cpu")
     for key in ("config", "normalizer", "model"):
         if key not in payload:
             raise ValueError(f"{path}: checkpoint lacks field {key!r}")
+    if payload.get("format") != CHECKPOINT_FORMAT:
+        raise ValueError(f"{path}: checkpoint format {payload.get('format')!r}, expected {CHECKPOINT_FORMAT!r}")
     model = GaitNet(GaitNetConfig.from_dict(payload["config"]).model)
     model.load_state_dict(payload["model"])
     model.to(resolve_device(device))
