@@ -35,10 +35,11 @@ from generation.mocap.real_corpus import load_real_corpus, real_corpus_path  # n
 from generation.quality.real_observer import THEME_PAIRS, default_real_observer  # noqa: E402
 from generation.quality.realism import realism_measures  # noqa: E402
 from generation.rbf.compare import compare_theme  # noqa: E402
+from generation.rbf.data_features import PART_OF  # noqa: E402
 from generation.rbf.neutral_base import neutral_cycle  # noqa: E402
 from generation.rbf.real_neutral import load_cycle, steady_cycles  # noqa: E402
 from generation.rbf.stylise import neutral_walk, stylise  # noqa: E402
-from generation.rbf.themes import THEME_NAMES  # noqa: E402
+from generation.rbf.themes import THEME_NAMES, theme_features  # noqa: E402
 from study_protocol import CAPTURE_THEMES, GAIT_EMOTIONS  # noqa: E402
 
 MARK_START, MARK_END = "<!-- rbf-real:start -->", "<!-- rbf-real:end -->"
@@ -128,6 +129,37 @@ def observer_section(observer, corpus: Path, base) -> dict:
             row["real_test_emotion_p"] = float(np.mean([observer.proba(c.motion)[GAIT_EMOTIONS.index(theme)]
                                                         for c in real if c.dataset == "bandai-namco-1"]))
         out[theme] = row
+    return out
+
+
+def disputed_rows(compare: dict, theme: str) -> list[tuple]:
+    """Expert features the data dispute: (rank, wording, why) for Table III rows outside the data's first ten rows or
+    holding a shared DOF whose sign the data reverse."""
+    reversed_rows = {(PART_OF[r["joint"]], r["axis"]) for r in compare["rows"] if r["sign_agree"] is False}
+    data_rows = set(compare["data_features"])
+    out = []
+    for f in theme_features(theme):
+        key = (f.part, f.axis)
+        if key in reversed_rows:
+            out.append((f.rank, f.describe(), "data reverse its sign"))
+        elif key not in data_rows:
+            out.append((f.rank, f.describe(), "not in the data's first ten rows"))
+    return out
+
+
+def ablation_section(observer, base, compare: dict, weight: float = 1.0, tie: float = 0.02) -> dict:
+    """Per theme and disputed expert feature: the theme observer's p(intended) with all ten expert features and
+    without that one; removing it raising p by more than ``tie`` means the observer sides with the data."""
+    out = {}
+    for theme in THEME_NAMES:
+        full = intended_p(observer, stylise(base, theme, weight, 10, n_cycles=4, fps=30.0), theme)
+        rows = []
+        for rank, wording, why in disputed_rows(compare[theme], theme):
+            clip = stylise(base, theme, weight, 10, n_cycles=4, fps=30.0, exclude=(rank,))
+            p = intended_p(observer, clip, theme)
+            side = "data" if p > full + tie else "expert" if p < full - tie else "neither"
+            rows.append({"rank": rank, "feature": wording, "why": why, "p_without": p, "sides_with": side})
+        out[theme] = {"p_full": full, "rows": rows}
     return out
 
 
@@ -242,6 +274,18 @@ def markdown(result: dict) -> str:
         lines.append(f"| {theme} ({row['pair']}) | {row['neutral']:.2f} | {row['expert_0.7']:.2f} | "
                      f"{row['data_0.7']:.2f} | {row['expert_1.0']:.2f} | {row['data_1.0']:.2f} | "
                      f"{row['real_test']:.2f} ({row['real_test_takes']}) | {better} |")
+    lines += ["", "Disputed expert features, one at a time (w = 1, all other nine kept): the theme observer's "
+              "p(intended) without the feature; higher than with it (by > 0.02) = the observer sides with the data, "
+              "lower = with the expert:", "",
+              "| theme | p (all ten) | Table III feature (rank) | why disputed | p without it | sides with |",
+              "|---|---|---|---|---|---|"]
+    for theme, ab in result["ablation"].items():
+        for r in ab["rows"]:
+            lines.append(f"| {theme} | {ab['p_full']:.2f} | {r['feature']} ({r['rank']}) | {r['why']} | "
+                         f"{r['p_without']:.2f} | {r['sides_with']} |")
+    counts = {side: sum(r["sides_with"] == side for ab in result["ablation"].values() for r in ab["rows"])
+              for side in ("data", "expert", "neither")}
+    lines += ["", "Totals: " + ", ".join(f"{k} {v}" for k, v in counts.items()) + "."]
     lines += ["", "Four-emotion observer (trained on dataset 1 only), probability of the theme's emotion:", "",
               "| theme | expert 0.7 | data 0.7 | expert 1.0 | data 1.0 | real dataset-1 test take |",
               "|---|---|---|---|---|---|"]
@@ -289,6 +333,7 @@ def main(argv=None) -> int:
               "neutral": neutral_section(corpus, observer), "accuracy": pair_accuracy(observer, corpus),
               "compare": {t: compare_theme(base, t) for t in THEME_NAMES},
               "observers": observer_section(observer, corpus, base)}
+    result["ablation"] = ablation_section(observer, base, result["compare"])
     a.out.parent.mkdir(parents=True, exist_ok=True)
     a.out.write_text(json.dumps(result, indent=1, default=float) + "\n", encoding="utf-8")
     block = markdown(result)

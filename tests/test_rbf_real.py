@@ -185,3 +185,14 @@ def test_a_damaged_features_file_is_an_error(tmp_path):
     path.write_text(json.dumps(data))
     with pytest.raises(ValueError, match=r"no data-driven features for themes \['tired'\]"):
         DF.load_data_features(path)
+
+
+def test_excluding_expert_features(base):
+    P, _ = walker_frame_positions(base)
+    skel = base.skeleton
+    masculine = theme_rbfs(P, skel, "masculine", 10)
+    without = theme_rbfs(P, skel, "masculine", 10, exclude=(5,))  # Ankles: increased swing along Y
+    assert set(masculine) - set(without) == {("left_heel", "Y"), ("right_heel", "Y")}
+    assert theme_rbfs(P, skel, "masculine", 10, exclude=tuple(range(1, 11))) == {}
+    clip = stylise(base, "masculine", 1.0, 10, n_cycles=2, fps=30.0, exclude=(5,))
+    assert clip.metadata["excluded_ranks"] == [5]

@@ -95,7 +95,7 @@ def walker_frame_positions(neutral: Motion) -> tuple[np.ndarray, np.ndarray]:
 # Secondary features S
 # --------------------------------------------------------------------------------------------------
 def theme_rbfs(P: np.ndarray, skeleton: Skeleton, theme: str, n_features: int,
-               height: float | None = None) -> dict[tuple[str, str], np.ndarray]:
+               height: float | None = None, exclude: tuple[int, ...] = ()) -> dict[tuple[str, str], np.ndarray]:
     """RBF parameters per degree of freedom for the first ``n_features`` of a theme.
 
     Args:
@@ -104,6 +104,7 @@ def theme_rbfs(P: np.ndarray, skeleton: Skeleton, theme: str, n_features: int,
         theme: one of :data:`generation.rbf.themes.THEME_NAMES`.
         n_features: how many of Table III's features, in frequency order (0..10).
         height: walker height in metres for de-normalising intensities (default ``skeleton.height``).
+        exclude: Table III ranks (1..10) to leave out of the first ``n_features`` (for ablations).
 
     Returns:
         {(joint name, axis "X"|"Y"|"Z"): (M, 3) rows (alpha metres, mu frames, sigma2 frames^2)}, M <= 3.
@@ -114,6 +115,8 @@ def theme_rbfs(P: np.ndarray, skeleton: Skeleton, theme: str, n_features: int,
     root = skeleton.index("root")
     dofs: dict[tuple[str, str], np.ndarray] = {}
     for feat in theme_features(theme, n_features):
+        if feat.rank in exclude:
+            continue
         for joint, sign in feat.joint_signs():
             j = skeleton.index(joint)
             a = AXES[feat.axis]
@@ -131,7 +134,8 @@ def theme_rbfs(P: np.ndarray, skeleton: Skeleton, theme: str, n_features: int,
 
 
 def theme_displacement(P: np.ndarray, skeleton: Skeleton, theme: str, n_features: int,
-                       height: float | None = None, propagate: bool = True) -> np.ndarray:
+                       height: float | None = None, propagate: bool = True,
+                       exclude: tuple[int, ...] = ()) -> np.ndarray:
     """Secondary features S of the first ``n_features``: (m, J, 3) metres, for weight 1 (linear in the RBFs).
 
     The paper moved each marker independently (its bones stretched). With exact bone lengths an isolated knee
@@ -141,7 +145,7 @@ def theme_displacement(P: np.ndarray, skeleton: Skeleton, theme: str, n_features
     per-marker displacement. The root's (pelvis) edits are not passed on, as that would only translate the
     body. Without ``propagate`` only joints outside the paper's model (toes, hand tips) follow their parent.
     """
-    return rbf_displacement(P, skeleton, theme_rbfs(P, skeleton, theme, n_features, height), propagate)
+    return rbf_displacement(P, skeleton, theme_rbfs(P, skeleton, theme, n_features, height, exclude), propagate)
 
 
 def rbf_displacement(P: np.ndarray, skeleton: Skeleton, dofs: dict[tuple[str, str], np.ndarray],
@@ -373,7 +377,7 @@ def warp_and_repeat_cycle(rotations: np.ndarray, root: np.ndarray, stride: np.nd
 # Public entry point
 # --------------------------------------------------------------------------------------------------
 def stylised_cycle(neutral_cycle: Motion, theme: str, weight: float, n_features: int,
-                   keep_ground: bool = True, features: str = "expert") -> dict:
+                   keep_ground: bool = True, features: str = "expert", exclude: tuple[int, ...] = ()) -> dict:
     """One stylised cycle on the skeleton, with the intermediate arrays.
 
     Returns a dict with ``P`` (m, J, 3) neutral walker-frame positions, ``S`` (m, J, 3) secondary
@@ -384,7 +388,8 @@ def stylised_cycle(neutral_cycle: Motion, theme: str, weight: float, n_features:
     :func:`keep_feet_above_ground` (when ``keep_ground``), all metres.
 
     ``features``: "expert" (Table III, :func:`theme_displacement`) or "data" (RBFs fitted to real themed walks,
-    :func:`generation.rbf.data_features.data_rbfs`, applied to their own DOFs without propagation).
+    :func:`generation.rbf.data_features.data_rbfs`, applied to their own DOFs without propagation). ``exclude``:
+    expert features (Table III ranks) to leave out, for ablations.
     """
     if features not in FEATURE_SOURCES:
         raise ValueError(f"features must be one of {list(FEATURE_SOURCES)}, got {features!r}")
@@ -395,7 +400,7 @@ def stylised_cycle(neutral_cycle: Motion, theme: str, weight: float, n_features:
     skel = neutral_cycle.skeleton
     P, progression = walker_frame_positions(neutral_cycle)
     if features == "expert":
-        S = theme_displacement(P, skel, theme, n_features)
+        S = theme_displacement(P, skel, theme, n_features, exclude=exclude)
     else:
         from .data_features import data_rbfs
 
@@ -433,7 +438,7 @@ def keep_feet_above_ground(Y: np.ndarray, P: np.ndarray, skeleton: Skeleton) -> 
 
 def stylise(neutral_cycle: Motion, theme: str, weight: float, n_features: int, speed: float = 1.0,
             n_cycles: int = 4, fps: float = 30.0, keep_ground: bool = True, plant: bool = True,
-            features: str = "expert") -> Motion:
+            features: str = "expert", exclude: tuple[int, ...] = ()) -> Motion:
     """Apply a seed 004 theme to a neutral walk cycle and walk it along a straight line.
 
     Args:
@@ -450,6 +455,7 @@ def stylise(neutral_cycle: Motion, theme: str, weight: float, n_features: int, s
         plant: plant the feet of the walked result (:func:`plant_walk_feet`): the features move the feet (tired
             shortens the ankle swing while the body keeps the neutral stride), so without it they slide.
         features: "expert" (Table III) or "data" (fitted to real themed walks; see :func:`stylised_cycle`).
+        exclude: expert features (Table III ranks) to leave out (ablations; recorded in the metadata when given).
 
     Returns:
         Motion on the neutral cycle's skeleton, round(n_cycles * cycle duration / speed * fps) frames, with
@@ -463,7 +469,7 @@ def stylise(neutral_cycle: Motion, theme: str, weight: float, n_features: int, s
         raise ValueError(f"fps must be positive, got {fps!r}")
     if isinstance(n_cycles, bool) or not isinstance(n_cycles, int) or n_cycles < 1:
         raise ValueError(f"n_cycles must be a positive integer, got {n_cycles!r}")
-    result = stylised_cycle(neutral_cycle, theme, weight, n_features, keep_ground, features)
+    result = stylised_cycle(neutral_cycle, theme, weight, n_features, keep_ground, features, tuple(exclude))
     stride = cycle_stride(neutral_cycle)
     rotations, root = warp_and_repeat_cycle(result["rotations"], result["root"], stride, neutral_cycle.duration,
                                             speed, n_cycles, fps)
@@ -483,6 +489,8 @@ def stylise(neutral_cycle: Motion, theme: str, weight: float, n_features: int, s
         "fit_residual_max_m": result["residual"],
         "ground_lift_max_m": result["ground_lift"],
     }
+    if exclude:
+        metadata["excluded_ranks"] = sorted(exclude)
     metadata.update(base_provenance(base_meta))
     if features == "data" and "licence" not in metadata:
         from .data_features import load_data_features
