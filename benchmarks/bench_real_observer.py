@@ -287,7 +287,8 @@ def markdown(res: dict) -> str:
               "Median (5th-95th percentile; min-max under 5 clips) per group, measured as the quality gate "
               "measures (`generation/quality/realism.py`; plan clips resampled and cut as rendered, real takes "
               "whole). Thresholds (`generation/quality/realism_ranges.json`, " + res["ranges_rule"] + "): " +
-              ", ".join(f"{k} {v:g}" for k, v in res["thresholds"].items()) +
+              ", ".join(f"{k} {v:g}" + (" (not applied)" if k in res["not_applied"] else "")
+                        for k, v in res["thresholds"].items()) +
               f". Held-out real takes outside them: {res['ranges_test_flagged']:.0%}.", "",
               "| group | " + " | ".join(MEASURES) + " | realism flags (bounds broken: clips) |",
               "|---|" + "---|" * (len(MEASURES) + 1)]
@@ -358,7 +359,8 @@ def main(argv=None) -> int:
            "themes_in_plans": {p: theme_rows(p, obs) for p in args.plans},
            "plans": {p: readings(plans_real[p], plans_synth[p]) for p in args.plans},
            "plan_rows": plans_real, "realism": realism_table(real, plans_real),
-           "thresholds": ranges["thresholds"], "ranges_rule": ranges["rule"],
+           "thresholds": ranges["thresholds"], "not_applied": ranges.get("not_applied", {}),
+           "ranges_rule": ranges["rule"],
            "ranges_test_flagged": ranges["test_flagged_share"]}
     res["seconds"] = time.perf_counter() - t0
     Path(args.json).parent.mkdir(parents=True, exist_ok=True)

@@ -128,7 +128,7 @@ def compute_ranges(rows: list[dict]) -> dict:
     test = [r for r in rows if r["split"] == "test"]
     applied = {k: None if k in NOT_APPLIED else v for k, v in thresholds.items()}
     flagged = [bool(out_of_range(r, applied)) for r in test]
-    return {"rule": f"pooled {LOW_PCT:g}th-{HIGH_PCT:g}th percentiles over the real training takes (one value per "
+    return {"rule": f"pooled percentiles {LOW_PCT:g} and {HIGH_PCT:g} over the real training takes (one value per "
                     f"take); upper bound only for {', '.join(m for m in MEASURES if m not in TWO_SIDED)}",
             "units": UNITS, "thresholds": thresholds, "not_applied": NOT_APPLIED, "pooled": pooled,
             "per_style": {s: {m: _percentiles([r[m] for r in rs]) for m in MEASURES}
