@@ -66,9 +66,10 @@ def world_positions(q_heading, ref, root_xz, root_y, offsets):
     return forward_kinematics(rot, root, offsets[:, None], GAIT_PARENTS), rot
 
 
-def pose_rotation_errors(q_pred, h_pred, test) -> dict:
-    """Errors over the 42 predicted steps. q_pred (N, 42, J, 4) heading frame; h_pred (N, 42) metres."""
-    sl = slice(PREFIX, PREFIX + HORIZON)
+def pose_rotation_errors(q_pred, h_pred, test, prefix: int = PREFIX, horizon: int = HORIZON) -> dict:
+    """Errors over the ``horizon`` (42) predicted steps after ``prefix`` (18) given ones. q_pred (N, horizon, J, 4)
+    heading frame; h_pred (N, horizon) metres. Also the error of the first predicted step and of steps 2-5."""
+    sl = slice(prefix, prefix + horizon)
     ref = test.ref[:, sl]
     xz = test.root_pos[:, sl][..., [0, 2]]
     pos_p, rot_p = world_positions(q_pred, ref, xz, test.mean_height[:, None] + h_pred, test.offsets)
@@ -84,39 +85,42 @@ def pose_rotation_errors(q_pred, h_pred, test) -> dict:
             "pose_error_cm": float(100 * err.mean()),
             "rotation_error_deg": float(torch.rad2deg(ang).mean()), "rotation_error_rad": float(ang.mean()),
             "rotation_error_deg_per_joint": torch.rad2deg(ang).mean((0, 1)).tolist(),
+            "pose_error_body_diag_step1": float((err / diag)[:, 0].mean()),
+            "pose_error_body_diag_steps2_5": float((err / diag)[:, 1:5].mean()),
+            "pose_error_body_diag_later": float((err / diag)[:, 5:].mean()),
             "pose_error_first10_cm": float(100 * err[:, :10].mean()),
             "pose_error_last10_cm": float(100 * err[:, -10:].mean())}
 
 
-def network_errors(net, test) -> dict:
+def network_errors(net, test, prefix: int = PREFIX, horizon: int = HORIZON) -> dict:
     with torch.no_grad():
-        pred = rollout(net.model, net.normalizer, test.batch(np.arange(len(test))), 0.0, PREFIX)
-    return pose_rotation_errors(pred["q"][:, PREFIX - 1:], pred["h"][:, PREFIX - 1:], test)
+        pred = rollout(net.model, net.normalizer, test.batch(np.arange(len(test))), 0.0, prefix)
+    return pose_rotation_errors(pred["q"][:, prefix - 1:], pred["h"][:, prefix - 1:], test, prefix, horizon)
 
 
-def zero_velocity_errors(test) -> dict:
-    q = test.q[:, PREFIX - 1:PREFIX].expand(-1, HORIZON, -1, -1)
-    h = test.root[:, PREFIX - 1:PREFIX, 0].expand(-1, HORIZON)
-    return pose_rotation_errors(q, h, test)
+def zero_velocity_errors(test, prefix: int = PREFIX, horizon: int = HORIZON) -> dict:
+    q = test.q[:, prefix - 1:prefix].expand(-1, horizon, -1, -1)
+    h = test.root[:, prefix - 1:prefix, 0].expand(-1, horizon)
+    return pose_rotation_errors(q, h, test, prefix, horizon)
 
 
-def nearest_neighbour_errors(train, test, window: int = 6) -> dict:
+def nearest_neighbour_errors(train, test, window: int = 6, prefix: int = PREFIX, horizon: int = HORIZON) -> dict:
     """Continue each test prefix with the training sequence window whose last ``window`` poses match best."""
     T = train.q.shape[1]
-    ends = list(range(window - 1, T - HORIZON))                        # window end index j, copy j+1..j+42
+    ends = list(range(window - 1, T - horizon))                        # window end index j, copy j+1..j+42
     lib = torch.stack([train.q[:, j - window + 1:j + 1].reshape(len(train), -1) for j in ends], 1)  # (M, E, D)
     lib = lib.reshape(-1, lib.shape[-1])
     qs, hs = [], []
     for i in range(len(test)):
-        key = test.q[i, PREFIX - window:PREFIX].reshape(-1)
+        key = test.q[i, prefix - window:prefix].reshape(-1)
         # quaternion sign: compare absolute dot products per joint via squared distance of both signs
         d = torch.minimum(((lib - key) ** 2).sum(-1), ((lib + key) ** 2).sum(-1))
         k = int(d.argmin())
         m, e = divmod(k, len(ends))
         j = ends[e]
-        qs.append(train.q[m, j + 1:j + 1 + HORIZON])
-        hs.append(train.root[m, j + 1:j + 1 + HORIZON, 0])
-    return pose_rotation_errors(torch.stack(qs), torch.stack(hs), test)
+        qs.append(train.q[m, j + 1:j + 1 + horizon])
+        hs.append(train.root[m, j + 1:j + 1 + horizon, 0])
+    return pose_rotation_errors(torch.stack(qs), torch.stack(hs), test, prefix, horizon)
 
 
 # ---- 2. emotion expressiveness --------------------------------------------------------------------

@@ -55,6 +55,8 @@ from .data import (
 )
 from .losses import total_loss
 from .model import GaitNet
+from .real_data import STAGES as REAL_STAGES
+from .real_data import load_real_sequences
 
 DEFAULT_WEIGHTS = Path(__file__).resolve().parent.parent / "data" / "weights" / "gait_net_default.pt"
 CHECKPOINT_DIR = Path("var/gait_runs")
@@ -409,7 +411,7 @@ def _resume(path: Path, step: _Step, sched, rng, gen, log) -> tuple[list, int]:
 def train(config: GaitNetConfig, data: GaitSequences, out_path: str | Path, checkpoint_path: str | Path | None = None,
           resume: bool = False, max_minutes: float | None = None, progress: bool = True, log=print,
           device: str | torch.device | None = "auto", amp: bool = False, init: str | Path | None = None,
-          keep_epochs: bool = False) -> dict:
+          keep_epochs: bool = False, refit_normalizer: bool = False) -> dict:
     """Train on ``data`` (its "train" split; "val" for validation); returns the history.
 
     Writes ``checkpoint_path`` (full training state) after every epoch and the final small weights file
@@ -421,7 +423,8 @@ def train(config: GaitNetConfig, data: GaitSequences, out_path: str | Path, chec
     passes (bf16 autocast, fp16 with a gradient scaler on GPUs without bf16). ``init``: start from the weights
     and normaliser of this weights file (same architecture; fine-tuning) instead of a random initialisation.
     ``keep_epochs``: also write the weights after every epoch to ``<out stem>_eNN.pt`` (for choosing an epoch on
-    the validation walks afterwards).
+    the validation walks afterwards). ``refit_normalizer``: with ``init``, standardise with this run's training
+    walks instead of the initial file's statistics (another corpus, such as real capture after procedural walks).
     """
     tc = config.train
     dev = resolve_device(device)
@@ -437,7 +440,10 @@ def train(config: GaitNetConfig, data: GaitSequences, out_path: str | Path, chec
     sched = torch.optim.lr_scheduler.ExponentialLR(opt, gamma=tc.lr_decay)
     scaler = torch.amp.GradScaler("cuda") if needs_grad_scaler(dev, amp) else None
     step = _Step(model, fit_normalizer(train_set), opt, config, scaler, amp)
+    fitted = step.norm
     init_info = _initialise_from(init, step, log) if init else None
+    if refit_normalizer:
+        step.norm = fitted
     history: list[dict] = []
     start_epoch = 0
     # Training state lives under var/ (not next to the shipped weights) unless a path is given.
@@ -476,7 +482,8 @@ def train(config: GaitNetConfig, data: GaitSequences, out_path: str | Path, chec
 def _save_weights(path: Path, model: GaitNet, norm: Normalizer, config: GaitNetConfig, history: list[dict],
                   data: GaitSequences, init_info: dict | None) -> None:
     """The small, device-independent weights file (model, config, normaliser, history, provenance)."""
-    save_checkpoint(path, model, norm, config, history=history, trained_on="synthetic procedural corpus",
+    save_checkpoint(path, model, norm, config, history=history,
+                    trained_on=getattr(data, "trained_on", "synthetic procedural corpus"),
                     num_parameters=model.num_parameters(), corpus=getattr(data, "source", None),
                     initialised_from=init_info)
 
@@ -507,6 +514,13 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--corpus", default=None, help="corpus .npz (default var/corpus/gait_corpus_synthetic.npz; "
                                                   "built with --num-sequences when missing)")
     p.add_argument("--num-sequences", type=int, default=1000)
+    p.add_argument("--real", choices=REAL_STAGES, default=None,
+                   help="train on the real-capture corpus instead (generation.gait.real_data): pretrain = forward "
+                        "locomotion of both Bandai Namco datasets, labelled where the style is a gait emotion; "
+                        "finetune = dataset 1's happy/sad/angry/normal walks; --corpus then names the real corpus "
+                        "file (default var/mocap/bandai-namco.npz)")
+    p.add_argument("--refit-normalizer", action="store_true",
+                   help="with --init: standardise with this run's training walks, not the initial file's")
     p.add_argument("--out", default=str(DEFAULT_WEIGHTS), help="weights file to write")
     p.add_argument("--checkpoint", default=None,
                    help="training-state checkpoint for --resume (default var/gait_runs/<OUT name>.ckpt)")
@@ -578,14 +592,18 @@ def run(args, log=print) -> dict:
         raise SystemExit(f"--device: {exc}") from None
     amp = amp_for(device, getattr(args, "amp", False), log)
     config = config_from_args(args)
-    data = load_corpus_sequences(args.corpus, num_sequences=args.num_sequences, seed=0,
-                                 frame_step=config.data.frame_step, seq_len=config.data.seq_len,
-                                 offsets=tuple(range(args.offsets)))
+    if getattr(args, "real", None):
+        data = load_real_sequences(args.real, config.data, path=args.corpus)
+    else:
+        data = load_corpus_sequences(args.corpus, num_sequences=args.num_sequences, seed=0,
+                                     frame_step=config.data.frame_step, seq_len=config.data.seq_len,
+                                     offsets=tuple(range(args.offsets)))
     counts = ", ".join(f"{s}: {int(((data.split == s) & (data.offset == 0)).sum())}" for s in ("train", "val", "test"))
     log(f"{len(data)} sequences ({counts}), network {GaitNet(config.model).num_parameters()} parameters")
     result = train(config, data, args.out, args.checkpoint, args.resume, args.max_minutes, progress=not args.quiet,
                    log=log, device=device, amp=amp, init=getattr(args, "init", None),
-                   keep_epochs=getattr(args, "keep_epochs", False))
+                   keep_epochs=getattr(args, "keep_epochs", False),
+                   refit_normalizer=getattr(args, "refit_normalizer", False))
     log(f"wrote {args.out}")
     return result
 
