@@ -117,7 +117,7 @@ def cached_encodings(sentences: list[str], cache_path: str | Path) -> list[np.nd
         for k, s in missing:
             cache[k] = encoder.encode(s)
         cache_path.parent.mkdir(parents=True, exist_ok=True)
-        tmp = cache_path.with_suffix(".tmp.npz")
+        tmp = cache_path.with_name(f".{cache_path.stem}.{os.getpid()}.tmp.npz")   # one per process: xdist workers
         np.savez_compressed(tmp, **cache)
         tmp.replace(cache_path)
     return [cache[k] for k in keys]
