@@ -74,3 +74,29 @@ def test_without_a_corpus_it_falls_back_to_the_shipped_takes_or_says_there_is_no
     assert ro.default_real_observer() is None and observer_for("gait", "real") is None
     line = unread_line([{"modality": "gait", "qa": {"observed": None}}], "real")
     assert "no real-capture observer" in line
+
+
+def test_a_stored_gait_record_from_another_observer_is_measured_again(shipped, tmp_path, monkeypatch):
+    import json
+
+    from generation.pipeline import runner
+    from generation.pipeline.jobs import plan_jobs
+    from generation.plans.schema import validate_plan
+
+    plan = {"name": "p", "render": {"width": 160, "height": 120, "fps": 25, "duration_s": 3.0},
+            "clips": [{"id": "w", "generator": "procedural_walk", "emotion": [0, 1, 0, 0], "seed": 1}]}
+    (job,), _ = plan_jobs(validate_plan(plan))
+    obs = ro.RealGaitObserver(shipped, source="test")
+    monkeypatch.setattr(runner, "observer_for", lambda modality, kind=None: obs)
+    # a record written before the realism measures, read by the synthetic observer, with the render's camera
+    done = {"clip_id": job.clip_id, "qa": {"foot_skate_cm_s": 1.0, "observed": "sad", "observed_p": 0.99, "flag": ""},
+            "metadata": {"camera": {"rule": "fixed", "min_figure_fraction": 0.7, "seated": False}}}
+    assert runner._stale_qa(done, job)
+    batch = runner._Batch(tmp_path, tmp_path, lambda kind, info: None, runner.BatchResult())
+    runner._remeasure_qa(done, job, batch)
+    assert done["qa"]["observer"] == "real" and done["qa"]["skate_cm_s"] is not None
+    assert done["qa"]["figure_height_frac"] == 0.7                      # the render's camera is kept
+    assert json.loads((tmp_path / f"{job.clip_id}.json").read_text())["qa"] == done["qa"]
+    assert not runner._stale_qa(done, job)
+    (synthetic,), _ = plan_jobs(validate_plan({**plan, "qa": {"observer": "synthetic"}}))
+    assert runner._stale_qa(done, synthetic)

@@ -164,6 +164,28 @@ def _add_qa(record: dict, job: Job, motion, camera: dict) -> None:
     record["qa_flag"] = result.flag
 
 
+def _stale_qa(done: dict, job: Job) -> bool:
+    """Whether a stored gait clip's quality record predates the realism measures or was read by another gait
+    observer than the plan's (``qa: {observer: ...}``; real by default): then it is measured again."""
+    if job.run_entry.modality != "gait":
+        return False
+    qa = done.get("qa") or {}
+    return "skate_cm_s" not in qa or qa.get("observer") != (job.qa_thresholds or {}).get("observer")
+
+
+def _remeasure_qa(done: dict, job: Job, batch: _Batch) -> None:
+    """Make the clip's motion again (no video) and replace the stored record's quality record, on disk too; the
+    render's camera (figure height) is kept. A motion that cannot be made keeps the old record and says why."""
+    try:
+        motion = make_motion(job.run_entry, requested=job.entry.generator, fallback_reason=job.fallback_reason)
+        _add_qa(done, job, motion, (done.get("metadata") or {}).get("camera"))
+    except Exception as exc:  # noqa: BLE001 - the clip's files are fine; only its quality record stays old
+        batch.emit("warn", {"clip_id": job.clip_id, "entry": job.entry.id,
+                            "message": f"quality record not re-measured ({type(exc).__name__}: {exc})"})
+        return
+    _write_json_atomic(done, batch.records_dir / f"{job.clip_id}.json")
+
+
 def _recheck_qa(rec: dict, done: dict, job: Job) -> None:
     """A stored record's quality values, re-checked against the plan's current thresholds."""
     stored = QAResult.from_dict(done.get("qa") or {})
@@ -217,6 +239,8 @@ def _select_todo(batch: _Batch, jobs: list[Job], plan: Plan, media_prefix: str, 
             for key in ("duration_s",):
                 rec[key] = done.get(key)
             rec["metadata"] = {**done.get("metadata", {}), **rec["metadata"]}
+            if _stale_qa(done, job):
+                _remeasure_qa(done, job, batch)
             _recheck_qa(rec, done, job)
             batch.by_id[job.clip_id] = rec
             batch.result.skipped.append(job.clip_id)
