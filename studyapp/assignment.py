@@ -39,8 +39,8 @@ from study_pools import SUB_POOLS
 
 from .counterbalance import SectionInfo, section_order
 from .models import Assignment, Clip, Participant, Section, SectionClipCount, Study, StudyCounter
+from .page_reads import open_assignments
 from .pool_cache import SectionPool, load_section_pool, section_pools
-from .precompiled import PrecompiledSelect
 from .trial_extras import PlannedItem, gesture_options, with_extras
 
 __all__ = ["PlannedItem", "Step", "StudyUnavailable", "active_count", "check_open", "current_step",
@@ -372,27 +372,10 @@ class Step:
     next_assignment: Assignment | None = None     # the clip after this one (preloaded by the page), if asked for
 
 
-STEP_FIELDS = ("id", "participant_id", "section", "position", "clip", "options", "shown_at", "answered_at", "seq",
-               "kind", "instructed", *(f"clip__{f}" for f in ("id", "clip_id", "theme", "duration_s", "media_key",
-                                                              "video", "webm", "poster", "loop")))
-"""What a clip page reads of an assignment and its clip (its section is read whole: one small row)."""
-
-
-def _open_items_queryset(participant_id: int, n: int):
-    return (Assignment.objects.filter(participant_id=participant_id, answered_at__isnull=True)
-            .select_related("section", "clip").only(*STEP_FIELDS).order_by("seq")[:n])
-
-
-# The clip pages' read, compiled to SQL once per process (studyapp.precompiled) for 1 and 2 items.
-_OPEN_ITEMS = {n: PrecompiledSelect(lambda pk, n=n: _open_items_queryset(pk, n), -987_654_321) for n in (1, 2)}
-
-
 def open_items(participant: Participant, n: int = 1) -> list[Assignment]:
-    """The participant's first ``n`` unanswered assignments by seq: one indexed query (partial index on
-    (participant, seq) where answered_at is null), whatever the size of the study."""
-    if n in _OPEN_ITEMS:
-        return _OPEN_ITEMS[n](participant.pk)
-    return list(_open_items_queryset(participant.pk, n))
+    """The participant's first ``n`` unanswered assignments by seq, with section and clip: one indexed query
+    (partial index on (participant, seq) where answered_at is null), whatever the size of the study."""
+    return open_assignments(participant.pk, n)
 
 
 def current_step(participant: Participant, lookahead: bool = False) -> Step:

@@ -31,7 +31,7 @@ from .i18n import activate_study_language
 from .item_questions import questions_html
 from .media import media_path, ranged_file_response
 from .models import Assignment, Clip, Participant, Response, Study
-from .precompiled import PrecompiledSelect
+from .page_reads import participant_by_token
 from .questions import AnswerError, clean_answers, questions_for
 from .viewing import VIEWING_FORM_FIELDS, parse_viewing, player_options
 
@@ -193,17 +193,11 @@ def _store_missing_ids(participant: Participant, params: dict[str, str]) -> None
         Participant.objects.filter(pk=participant.pk).update(**updates)
 
 
-# Every participant page's first read, compiled to SQL once per process (studyapp.precompiled).
-_PARTICIPANT_BY_TOKEN = PrecompiledSelect(
-    lambda token: Participant.objects.select_related("study").filter(token=token), "\0token-sentinel")
-
-
 def _participant(token: str) -> Participant:
     """The participant of a URL token with its study (404 if none), the study's language activated."""
-    found = _PARTICIPANT_BY_TOKEN(token)
-    if not found:
+    participant = participant_by_token(token)
+    if participant is None:
         raise Http404("No participant with this token")
-    participant = found[0]
     activate_study_language(participant.study)
     return participant
 

@@ -1,4 +1,4 @@
-"""studyapp.precompiled: a SELECT compiled once gives exactly what its queryset gives (issue 16)."""
+"""studyapp.page_reads: the participant pages' two plain-SQL reads give what the ORM querysets give."""
 from __future__ import annotations
 
 import threading
@@ -7,9 +7,9 @@ import pytest
 from django.db import connection
 from django.test.utils import CaptureQueriesContext
 
-from studyapp.assignment import STEP_FIELDS, open_items, start_participant
+from studyapp.assignment import open_items, start_participant
 from studyapp.models import Assignment, Participant, Study
-from studyapp.precompiled import PrecompiledSelect
+from studyapp.page_reads import ASSIGNMENT_FIELDS, CLIP_FIELDS, open_assignments, participant_by_token
 from studyapp.presets import create_study_from_preset
 from studyapp.testing import make_catalogue
 
@@ -27,76 +27,78 @@ def people(settings, tmp_path):
         start_participant(p)
         out.append(p)
     Assignment.objects.filter(participant=out[1], seq__lte=2).update(answered_at="2026-01-01T00:00:00Z")
+    Assignment.objects.filter(participant=out[2], seq=1).update(shown_at="2026-01-02T03:04:05Z",
+                                                                options={"shown": ["happy", "sad"]})
     return out
 
 
-def as_rows(objects, fields) -> list[tuple]:
-    return [tuple(getattr(o, f) for f in fields) for o in objects]
+def values(obj, model) -> dict:
+    """Every loaded (not deferred) concrete field value of an instance."""
+    deferred = obj.get_deferred_fields()
+    return {f.attname: getattr(obj, f.attname) for f in model._meta.concrete_fields if f.attname not in deferred}
 
 
-def queryset(pk):
-    return (Assignment.objects.filter(participant_id=pk, answered_at__isnull=True)
-            .select_related("section", "clip").only(*STEP_FIELDS).order_by("seq")[:3])
+def orm_assignments(pk, n):
+    only = (*ASSIGNMENT_FIELDS, "section", "clip", *(f"clip__{f}" for f in CLIP_FIELDS))
+    return list(Assignment.objects.filter(participant_id=pk, answered_at__isnull=True)
+                .select_related("section", "clip").only(*only).order_by("seq")[:n])
 
 
-def test_same_objects_and_same_sql_as_the_queryset(people):
-    pre = PrecompiledSelect(queryset, -1)
+@pytest.mark.parametrize("n", [1, 2, 3])
+def test_assignments_equal_the_querysets(people, n):
+    from studyapp.models import Clip, Section
+
     for p in people:
-        with CaptureQueriesContext(connection) as plain_q:
-            plain = list(queryset(p.pk))
-        with CaptureQueriesContext(connection) as pre_q:
-            got = pre(p.pk)
-        assert [q["sql"] for q in pre_q] == [q["sql"] for q in plain_q]
-        fields = ("pk", "seq", "position", "options", "shown_at", "answered_at", "kind", "instructed")
-        assert as_rows(got, fields) == as_rows(plain, fields)
-        assert as_rows([a.section for a in got], ("pk", "section_type", "options", "title")) == as_rows(
-            [a.section for a in plain], ("pk", "section_type", "options", "title"))
-        assert as_rows([a.clip for a in got], ("pk", "clip_id", "media_key", "duration_s", "loop")) == as_rows(
-            [a.clip for a in plain], ("pk", "clip_id", "media_key", "duration_s", "loop"))
-        assert got[0].get_deferred_fields() == plain[0].get_deferred_fields()
-    assert open_items(people[1], 2)[0].seq == 3              # the participant who answered two clips
+        plain = orm_assignments(p.pk, n)
+        with CaptureQueriesContext(connection) as q:
+            got = open_assignments(p.pk, n)
+        assert len(q) == 1 and len(got) == len(plain) == n
+        for a, b in zip(got, plain):
+            assert values(a, Assignment) == values(b, Assignment)
+            assert a.get_deferred_fields() == b.get_deferred_fields()
+            assert values(a.section, Section) == values(b.section, Section)
+            assert values(a.clip, Clip) == values(b.clip, Clip)
+            assert a.clip.get_deferred_fields() == b.clip.get_deferred_fields() != set()
+    # typed values, as the ORM gives them on every backend
+    first = open_assignments(people[2].pk, 1)[0]
+    assert first.options == {"shown": ["happy", "sad"]} and first.shown_at.tzinfo is not None
+    assert isinstance(first.section.require_full_play, bool) and isinstance(first.clip.loop, bool)
+    assert [a.seq for a in open_items(people[1], 2)] == [3, 4]          # the participant who answered two clips
 
 
-def test_related_study_and_missing_rows(people):
-    pre = PrecompiledSelect(lambda token: Participant.objects.select_related("study").filter(token=token), "\0t")
+def test_participant_with_its_study_and_missing_tokens(people):
     study = Study.objects.get(slug="pre")
-    p = pre(people[0].token)[0]
+    plain = Participant.objects.select_related("study").get(pk=people[0].pk)
     with CaptureQueriesContext(connection) as q:
+        p = participant_by_token(people[0].token)
         assert p.study.slug == "pre" and p.study.feedback_questions == study.feedback_questions
-    assert len(q) == 0                                        # the study came with the participant
-    assert pre("no-such-token") == []
+    assert len(q) == 1                                        # the study came with the participant
+    assert values(p, Participant) == values(plain, Participant)
+    assert values(p.study, Study) == values(plain.study, Study)
+    assert p._state.adding is False and p._state.db == "default"
+    p.save(update_fields=["demographics_done"])               # a normal, saveable instance
+    assert participant_by_token("no-such-token") is None
+    assert open_assignments(10 ** 9, 2) == []
+    with pytest.raises(ValueError, match="n must be >= 1"):
+        open_assignments(people[0].pk, 0)
 
 
 @pytest.mark.django_db(transaction=True)
 def test_each_thread_uses_its_own_connection(people):
-    pre = PrecompiledSelect(queryset, -1)
-    pre(people[0].pk)                                          # compiled in this thread
+    if connection.vendor == "sqlite":
+        pytest.skip("SQLite's in-memory test database is not shared with other threads")
+    open_assignments(people[0].pk, 1)                          # SQL written in this thread
     seen, errors = [], []
 
     def run():
         try:
-            seen.append([a.seq for a in pre(people[1].pk)])
+            seen.append([a.seq for a in open_assignments(people[1].pk, 3)])
         except Exception as exc:  # noqa: BLE001 - reported below
             errors.append(repr(exc))
         finally:
             connection.close()
 
-    if connection.vendor == "sqlite":
-        pytest.skip("SQLite's in-memory test database is not shared with other threads")
     t = threading.Thread(target=run)
     t.start()
     t.join(30)
     assert not errors and seen == [[3, 4, 5]]
-
-
-def test_bad_sentinels_and_arguments_are_refused(people):
-    twice = PrecompiledSelect(lambda pk: Assignment.objects.filter(participant_id=pk, section__study__pk=pk), 7)
-    with pytest.raises(ValueError, match="appears 2 times"):
-        twice(1)
-    absent = PrecompiledSelect(lambda pk: Assignment.objects.filter(participant_id=1), 123456)
-    with pytest.raises(ValueError, match="appears 0 times"):
-        absent(1)
-    with pytest.raises(TypeError):
-        PrecompiledSelect(queryset, -1)(1, 2)
-    with pytest.raises(ValueError):
-        PrecompiledSelect(queryset)
