@@ -1,10 +1,15 @@
-"""Per-clip quality checks of stimulus motions (issue 14): foot skate, floor penetration, jerk, bone length
-error, figure height in frame, and a synthetic observer's reading of the emotion.
+"""Per-clip quality checks of stimulus motions: foot skate, floor penetration, jerk, bone length error, figure
+height in frame, realism against real capture, and an observer's reading of the emotion.
 
 Public interface:
     motion_metrics(motion) -> dict          the motion measures (units in the keys)
     evaluate(motion, ...) -> QAResult       measures + failed checks against thresholds
     resolve_thresholds(plan_qa) -> dict     QA_THRESHOLDS (study_protocol) overridden by a plan's ``qa:`` block
+    realism.realism_measures(motion)        foot skate / skating ratio / toe skim with height-only contact, stance
+                                            knee flexion, pelvis bounce, speed variability (realism.py)
+    realism_ranges.realism_thresholds()     the real corpus's ranges of those measures (realism_ranges.json)
+    RealGaitObserver                        logistic regression over the 4 gait emotions trained on real captured
+                                            walks (real_observer.py; the default gait observer of the gate)
     GaitObserver                            logistic regression on the 18 gait affective features (synthetic)
     GestureObserver                         multinomial logistic regression over the 11 gesture emotions on gesture
                                             motion descriptors (synthetic; gesture_observer.py)

@@ -42,7 +42,9 @@ def motion_metrics(motion: Motion) -> dict:
     """The motion part of a clip's quality record.
 
     Returns ``foot_skate_cm_s`` (mean ground-plane speed of the feet while in contact, see
-    :func:`generation.core.features.foot_skate`), ``penetration_cm``, ``jerk`` (m/s^3) and ``bone_error_mm``.
+    :func:`generation.core.features.foot_skate`; its contact detector requires a slow foot, so a foot sliding
+    faster than 0.45 m/s is not counted: :mod:`generation.quality.realism`'s ``skate_cm_s`` and ``skate_ratio``
+    use height-only contact), ``penetration_cm``, ``jerk`` (m/s^3) and ``bone_error_mm``.
     """
     P = motion.positions()
     sk = motion.skeleton
