@@ -11,6 +11,7 @@ sub-pools (filters of the same kind) for its two halves. Options are type-specif
 from __future__ import annotations
 
 import math
+from typing import NamedTuple
 
 from study_protocol import (
     CLIP_THEMES,
@@ -65,6 +66,29 @@ ATTENTION_KEYS = ("count", "answer", "positions", "question")
 DEFAULT_GESTURE_OPTIONS = 4
 
 
+class SectionError(NamedTuple):
+    """One problem of a section: the Section ``field`` it is about (section_type, pool, options or
+    clips_per_participant), the ``message``, and the ``keys`` of that field's JSON the message is about, dotted into
+    a sub-pool or an option object (``"weight__gte"``, ``"generated.weight__gte"``, ``"attention_checks.answer"``;
+    empty for the field as a whole)."""
+
+    field: str
+    message: str
+    keys: tuple[str, ...] = ()
+
+
+Found = list[tuple[tuple[str, ...], str]]
+"""(keys, message) pairs: the problems of one field's JSON, each with the keys it is about."""
+
+
+def _messages(found: Found) -> list[str]:
+    return [message for _, message in found]
+
+
+def _at(key: str, messages: list[str]) -> Found:
+    return [((key,), message) for message in messages]
+
+
 class PoolError(ValueError):
     """A pool or options that cannot be used; ``errors`` maps a Section field to its messages."""
 
@@ -102,6 +126,7 @@ def _value_error(key: str, name: str, lookup: str, value) -> str | None:
 
 
 def _filter_errors(key: str, value) -> list[str]:
+    """The problems of one pool filter ``key: value`` (each about ``key``)."""
     name, _, lookup = key.partition("__")
     if name not in POOL_FIELDS:
         return [f"unknown filter {key!r}: {name!r} is not a catalogue field (fields: {', '.join(sorted(POOL_FIELDS))}; "
@@ -117,8 +142,8 @@ def _filter_errors(key: str, value) -> list[str]:
     return [msg] if msg else []
 
 
-def pool_errors(pool, section_type: str | None = None, sub_pools: bool = True) -> list[str]:
-    """Every problem of a pool filter, each message naming its key; [] when the pool is usable.
+def pool_problems(pool, section_type: str | None = None, sub_pools: bool = True) -> Found:
+    """Every problem of a pool filter as (keys, message), each message naming its key; [] when usable.
 
     section_type: also check that sub-pools belong to a naturalness section and that a ``modality`` filter agrees
     with the section type; sub_pools: whether ``generated``/``source`` keys are allowed at all.
@@ -126,25 +151,32 @@ def pool_errors(pool, section_type: str | None = None, sub_pools: bool = True) -
     if pool is None or pool == {}:
         return []
     if not isinstance(pool, dict):
-        return [f"the pool must be a JSON object of filters, got {type(pool).__name__}"]
-    errors = []
+        return [((), f"the pool must be a JSON object of filters, got {type(pool).__name__}")]
+    found: Found = []
     for key, value in pool.items():
         if key in FLAGS or key == INCLUDE_FLAGGED:
             if not isinstance(value, bool):
-                errors.append(f"{key!r} takes true or false, got {value!r}")
+                found.append(((key,), f"{key!r} takes true or false, got {value!r}"))
         elif key in SUB_POOLS and sub_pools:
             if section_type not in (None, "naturalness"):
-                errors.append(f"sub-pool {key!r} is only for naturalness sections")
+                found.append(((key,), f"sub-pool {key!r} is only for naturalness sections"))
             elif not isinstance(value, dict):
-                errors.append(f"sub-pool {key!r} must be a JSON object of filters, got {value!r}")
+                found.append(((key,), f"sub-pool {key!r} must be a JSON object of filters, got {value!r}"))
             else:
-                errors += [f"sub-pool {key!r}: {msg}" for msg in pool_errors(value, None, sub_pools=False)]
+                found += [(tuple(f"{key}.{k}" for k in keys) or (key,), f"sub-pool {key!r}: {msg}")
+                          for keys, msg in pool_problems(value, None, sub_pools=False)]
         else:
-            errors += _filter_errors(key, value)
+            found += _at(key, _filter_errors(key, value))
     wanted = SECTION_MODALITY.get(section_type or "")
     if wanted and isinstance(pool.get("modality"), str) and pool["modality"] != wanted:
-        errors.append(f"'modality' is {pool['modality']!r} but {section_type} sections show {wanted} clips")
-    return errors
+        found.append((("modality",), f"'modality' is {pool['modality']!r} but {section_type} sections show {wanted} "
+                                     "clips"))
+    return found
+
+
+def pool_errors(pool, section_type: str | None = None, sub_pools: bool = True) -> list[str]:
+    """The messages of :func:`pool_problems` (each naming its key); [] when the pool is usable."""
+    return _messages(pool_problems(pool, section_type, sub_pools))
 
 
 def pool_lookups(pool: dict | None) -> list[tuple[str, dict]]:
@@ -177,75 +209,81 @@ def _count_error(options: dict, key: str, low: int, high: int | None = None) -> 
     return None
 
 
-def _naturalness_errors(options: dict, clips_per_participant: int | None) -> list[str]:
-    errors = []
+def _naturalness_errors(options: dict, clips_per_participant: int | None) -> Found:
+    found: Found = []
     anchors = options.get("anchors")
     scale = answer_values(NATURALNESS)
     if "anchors" in options:
         if not isinstance(anchors, dict):
-            errors.append(f"'anchors' must map scale values ({', '.join(scale)}) to labels, got {anchors!r}")
+            found.append((("anchors",), f"'anchors' must map scale values ({', '.join(scale)}) to labels, got "
+                                        f"{anchors!r}"))
         else:
-            errors += [f"'anchors': {k!r} is not a value of the naturalness scale ({', '.join(scale)})"
-                       for k in anchors if str(k) not in scale]
-            errors += [f"'anchors': the label of {k!r} must be text" for k, v in anchors.items()
-                       if not isinstance(v, str)]
+            found += [((f"anchors.{k}",), f"'anchors': {k!r} is not a value of the naturalness scale "
+                                          f"({', '.join(scale)})") for k in anchors if str(k) not in scale]
+            found += [((f"anchors.{k}",), f"'anchors': the label of {k!r} must be text") for k, v in anchors.items()
+                      if not isinstance(v, str)]
     if "question" in options and not (isinstance(options["question"], str) and options["question"].strip()):
-        errors.append(f"'question' must be non-empty text, got {options['question']!r}")
+        found.append((("question",), f"'question' must be non-empty text, got {options['question']!r}"))
     counts = [k for k in ("n_generated", "n_source") if k in options]
-    count_errors = [msg for k in counts if (msg := _count_error(options, k, 0))]
-    errors += count_errors
+    count_errors = [((k,), msg) for k in counts if (msg := _count_error(options, k, 0))]
+    found += count_errors
     if counts and not count_errors:
         given = {k: options[k] for k in counts}
+        both = ("n_generated", "n_source")
         if len(counts) == 1 and not clips_per_participant:
-            errors.append("give both 'n_generated' and 'n_source' when every clip of the pool is shown")
+            found.append((both, "give both 'n_generated' and 'n_source' when every clip of the pool is shown"))
         elif len(counts) == 2 and clips_per_participant and sum(given.values()) != clips_per_participant:
-            errors.append(f"'n_generated' + 'n_source' = {sum(given.values())} must equal the clips per "
-                          f"participant ({clips_per_participant})")
+            found.append((both, f"'n_generated' + 'n_source' = {sum(given.values())} must equal the clips per "
+                                f"participant ({clips_per_participant})"))
         elif len(counts) == 2 and sum(given.values()) == 0:
-            errors.append("'n_generated' + 'n_source' must be at least 1")
-    return errors
+            found.append((both, "'n_generated' + 'n_source' must be at least 1"))
+    return found
 
 
-def _gesture_errors(options: dict) -> list[str]:
-    errors = []
+def _gesture_errors(options: dict) -> Found:
+    found: Found = []
     categories = options.get("categories", list(GESTURE_EMOTIONS))
     if not isinstance(categories, list) or not categories or not all(isinstance(c, str) for c in categories):
-        errors.append(f"'categories' must be a non-empty list of gesture emotions, got {categories!r}")
+        found.append((("categories",), f"'categories' must be a non-empty list of gesture emotions, got "
+                                       f"{categories!r}"))
         categories = list(GESTURE_EMOTIONS)
     else:
-        errors += [f"'categories': {c!r} is not one of {', '.join(GESTURE_EMOTIONS)}" for c in categories
-                   if c not in GESTURE_EMOTIONS]
+        found += _at("categories", [f"'categories': {c!r} is not one of {', '.join(GESTURE_EMOTIONS)}"
+                                    for c in categories if c not in GESTURE_EMOTIONS])
         if len(set(categories)) != len(categories):
-            errors.append("'categories' lists an emotion twice")
+            found.append((("categories",), "'categories' lists an emotion twice"))
     if "n_options" in options:
         msg = _count_error(options, "n_options", 2, len(set(categories)))
-        errors += [msg] if msg else []
+        found += _at("n_options", [msg] if msg else [])
     elif len(set(categories)) < DEFAULT_GESTURE_OPTIONS:
-        errors.append(f"'categories' needs at least {DEFAULT_GESTURE_OPTIONS} emotions (or set 'n_options')")
-    return errors
+        found.append((("categories",), f"'categories' needs at least {DEFAULT_GESTURE_OPTIONS} emotions (or set "
+                                       "'n_options')"))
+    return found
 
 
-def _attention_errors(section_type: str, config, clips_per_participant: int | None, categories) -> list[str]:
-    """Problems of Section.options["attention_checks"], each naming 'attention_checks' and the bad field."""
+def _attention_errors(section_type: str, config, clips_per_participant: int | None, categories) -> Found:
+    """Problems of Section.options["attention_checks"], each naming 'attention_checks' and the bad field (keys
+    ``attention_checks.<field>``)."""
     name = "'attention_checks'"
     if not isinstance(config, dict):
-        return [f"{name} must be an object like {{\"count\": 1, \"answer\": \"sad\", \"positions\": \"random\"}}, "
-                f"got {config!r}"]
-    errors = [f"{name}: unknown field {k!r} (fields: {', '.join(ATTENTION_KEYS)})" for k in config
-              if k not in ATTENTION_KEYS]
+        return [(("attention_checks",), f"{name} must be an object like {{\"count\": 1, \"answer\": \"sad\", "
+                                        f"\"positions\": \"random\"}}, got {config!r}")]
+    errors = [((f"attention_checks.{k}",), f"{name}: unknown field {k!r} (fields: {', '.join(ATTENTION_KEYS)})")
+              for k in config if k not in ATTENTION_KEYS]
     questions = SECTION_QUESTIONS.get(section_type, {})
     key = config.get("question", next(iter(questions), ""))
     if key not in questions:
-        return errors + [f"{name}: 'question' {key!r} is not a question of {section_type} sections "
-                         f"({', '.join(questions)})"]
+        return errors + [(("attention_checks.question",), f"{name}: 'question' {key!r} is not a question of "
+                                                          f"{section_type} sections ({', '.join(questions)})")]
     allowed = list(categories) if section_type == "gesture_emotion" else list(answer_values(questions[key]))
     answer = config.get("answer")
     if not isinstance(answer, (str, int)) or isinstance(answer, bool) or str(answer) not in allowed:
-        errors.append(f"{name}: 'answer' must be one of the answers to {key!r} ({', '.join(allowed)}), "
-                      f"got {answer!r}")
+        errors.append((("attention_checks.answer",), f"{name}: 'answer' must be one of the answers to {key!r} "
+                                                     f"({', '.join(allowed)}), got {answer!r}"))
     count = config.get("count", 1)
     if not _is_int(count) or count < 1:
-        errors.append(f"{name}: 'count' must be an integer 1 or more, got {count!r}")
+        errors.append((("attention_checks.count",), f"{name}: 'count' must be an integer 1 or more, got "
+                                                    f"{count!r}"))
         count = 1
     positions = config.get("positions", "random")
     if positions != "random":
@@ -253,62 +291,85 @@ def _attention_errors(section_type: str, config, clips_per_participant: int | No
         if (not isinstance(positions, list) or len(positions) != count
                 or not all(_is_int(p) and p >= 1 and (longest is None or p <= longest) for p in positions)):
             where = f" from 1 to {longest}" if longest else " of 1 or more"
-            errors.append(f"{name}: 'positions' must be \"random\" or a list of {count} integer place(s){where}, "
-                          f"got {positions!r}")
+            errors.append((("attention_checks.positions",), f"{name}: 'positions' must be \"random\" or a list of "
+                                                            f"{count} integer place(s){where}, got {positions!r}"))
     return errors
 
 
-def _extras_errors(section_type: str, options: dict, clips_per_participant: int | None) -> list[str]:
+def _extras_errors(section_type: str, options: dict, clips_per_participant: int | None) -> Found:
     """Problems of the options every section type takes (COMMON_OPTIONS)."""
-    errors = []
+    found: Found = []
     if "attention_checks" in options:
         categories = options.get("categories") if isinstance(options.get("categories"), list) else GESTURE_EMOTIONS
-        errors += _attention_errors(section_type, options["attention_checks"], clips_per_participant, categories)
+        found += _attention_errors(section_type, options["attention_checks"], clips_per_participant, categories)
     if "practice" in options and not isinstance(options["practice"], bool):
-        errors.append(f"'practice' takes true or false, got {options['practice']!r}")
+        found.append((("practice",), f"'practice' takes true or false, got {options['practice']!r}"))
     if "practice_clip" in options and not (isinstance(options["practice_clip"], str)
                                            and options["practice_clip"].strip()):
-        errors.append(f"'practice_clip' must be the clip_id of a catalogue clip, got {options['practice_clip']!r}")
-    return errors + player_errors(options)
+        found.append((("practice_clip",), f"'practice_clip' must be the clip_id of a catalogue clip, got "
+                                          f"{options['practice_clip']!r}"))
+    return found + _player_problems(options)
+
+
+def _player_problems(options: dict) -> Found:
+    found: Found = []
+    if "controls" in options and options["controls"] not in PLAYER_CONTROLS:
+        found.append((("controls",), f"'controls' must be one of {', '.join(PLAYER_CONTROLS)}, got "
+                                     f"{options['controls']!r}"))
+    if options.get("max_replays") is not None:
+        msg = _count_error(options, "max_replays", 0, MAX_REPLAYS_LIMIT)
+        found += _at("max_replays", [f"{msg} (blank or null: unlimited)"] if msg else [])
+    return found
 
 
 def player_errors(options: dict) -> list[str]:
     """Problems of the clip player's options (PLAYER_OPTIONS), each message naming its key."""
-    errors = []
-    if "controls" in options and options["controls"] not in PLAYER_CONTROLS:
-        errors.append(f"'controls' must be one of {', '.join(PLAYER_CONTROLS)}, got {options['controls']!r}")
-    if options.get("max_replays") is not None:
-        msg = _count_error(options, "max_replays", 0, MAX_REPLAYS_LIMIT)
-        errors += [f"{msg} (blank or null: unlimited)"] if msg else []
-    return errors
+    return _messages(_player_problems(options))
 
 
-def options_errors(section_type: str, options, clips_per_participant: int | None = None) -> list[str]:
-    """Every problem of a section's type-specific options, each message naming its key."""
+def options_problems(section_type: str, options, clips_per_participant: int | None = None) -> Found:
+    """Every problem of a section's options as (keys, message), each message naming its key."""
     if options is None or options == {}:
         return []
     if not isinstance(options, dict):
-        return [f"the options must be a JSON object, got {type(options).__name__}"]
+        return [((), f"the options must be a JSON object, got {type(options).__name__}")]
     own = SECTION_OPTIONS.get(section_type, ())
     known = (*own, *COMMON_OPTIONS)
     listed = (f"options: {', '.join(known)}" if own else
               f"this section type takes no options of its own; every section takes {', '.join(COMMON_OPTIONS)}")
-    errors = [f"unknown option {key!r} for {section_type} sections ({listed})" for key in options if key not in known]
-    errors += _extras_errors(section_type, options, clips_per_participant)
+    found: Found = [((key,), f"unknown option {key!r} for {section_type} sections ({listed})")
+                    for key in options if key not in known]
+    found += _extras_errors(section_type, options, clips_per_participant)
     if section_type == "naturalness":
-        errors += _naturalness_errors(options, clips_per_participant)
+        found += _naturalness_errors(options, clips_per_participant)
     elif section_type == "gesture_emotion":
-        errors += _gesture_errors(options)
-    return errors
+        found += _gesture_errors(options)
+    return found
+
+
+def options_errors(section_type: str, options, clips_per_participant: int | None = None) -> list[str]:
+    """The messages of :func:`options_problems` (each naming its key); [] when the options are usable."""
+    return _messages(options_problems(section_type, options, clips_per_participant))
 
 
 def validate_section(section_type: str, pool, options, clips_per_participant: int | None = None
-                     ) -> dict[str, list[str]]:
-    """Section field -> messages for everything wrong with a section's type, pool and options ({} when none)."""
+                     ) -> list[SectionError]:
+    """Everything wrong with a section's type, pool, options and clip count ([] when nothing), each error with its
+    Section field and the JSON keys it is about (:class:`SectionError`)."""
     if section_type not in SECTION_TYPES:
-        return {"section_type": [f"{section_type!r} is not a section type ({', '.join(SECTION_TYPES)})"]}
-    errors = {"pool": pool_errors(pool, section_type), "options": options_errors(section_type, options,
-                                                                                  clips_per_participant)}
+        return [SectionError("section_type", f"{section_type!r} is not a section type ({', '.join(SECTION_TYPES)})")]
+    errors = [SectionError("pool", msg, keys) for keys, msg in pool_problems(pool, section_type)]
+    errors += [SectionError("options", msg, keys)
+               for keys, msg in options_problems(section_type, options, clips_per_participant)]
     if clips_per_participant is not None and (not _is_int(clips_per_participant) or clips_per_participant < 0):
-        errors["clips_per_participant"] = [f"must be an integer 0 or more, got {clips_per_participant!r}"]
-    return {field: msgs for field, msgs in errors.items() if msgs}
+        errors.append(SectionError("clips_per_participant",
+                                   f"must be an integer 0 or more, got {clips_per_participant!r}"))
+    return errors
+
+
+def errors_by_field(errors: list[SectionError]) -> dict[str, list[str]]:
+    """Section field -> messages (the form Django's ValidationError takes)."""
+    out: dict[str, list[str]] = {}
+    for error in errors:
+        out.setdefault(error.field, []).append(error.message)
+    return out

@@ -12,7 +12,7 @@ from django.core.exceptions import ValidationError
 from django.db import models
 from django.utils import timezone
 
-from study_pools import validate_section
+from study_pools import errors_by_field, validate_section
 from study_protocol import ATTENTION_CHECK, MODALITIES, ORIGINS
 
 from .permissions import STUDY_PERMISSIONS
@@ -192,7 +192,8 @@ class Section(models.Model):
 
     def protocol_errors(self) -> dict[str, list[str]]:
         """Field -> messages for a bad pool, options or count (study_pools; no database query)."""
-        return validate_section(self.section_type, self.pool, self.options, self.clips_per_participant)
+        return errors_by_field(validate_section(self.section_type, self.pool, self.options,
+                                                self.clips_per_participant))
 
     def clean(self):
         errors: dict[str, list[str]] = dict(self.protocol_errors())

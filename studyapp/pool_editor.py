@@ -148,8 +148,9 @@ class ChoiceSpec:
             return {}
         return {self.key: chosen[0] if len(chosen) == 1 else chosen}
 
-    def owner(self, message: str) -> str | None:
-        return self.field if repr(self.key) in message or repr(f"{self.key}__in") in message else None
+    def owner(self, keys: tuple[str, ...]) -> str | None:
+        """The form field of an error about these JSON keys (study_pools.SectionError.keys), or None."""
+        return self.field if self.key in keys or f"{self.key}__in" in keys else None
 
     def check(self, values: dict) -> dict[str, str]:
         return {}
@@ -216,8 +217,8 @@ class SignSpec(ChoiceSpec):
         name = values.get(self.field) or ANY
         return {} if name == ANY else {self.key + SIGNS[name][0]: 0}
 
-    def owner(self, message: str) -> str | None:
-        return self.field if any(repr(self.key + lookup) in message for lookup, _ in SIGNS.values()) else None
+    def owner(self, keys: tuple[str, ...]) -> str | None:
+        return self.field if any(self.key + lookup in keys for lookup, _ in SIGNS.values()) else None
 
 
 class RangeSpec(ChoiceSpec):
@@ -258,10 +259,10 @@ class RangeSpec(ChoiceSpec):
         out = {f"{self.key}__gte": low, f"{self.key}__lte": high}
         return {k: v for k, v in out.items() if v is not None}
 
-    def owner(self, message: str) -> str | None:
-        if repr(f"{self.key}__lte") in message:
+    def owner(self, keys: tuple[str, ...]) -> str | None:
+        if f"{self.key}__lte" in keys:
             return self.high
-        return self.low if repr(f"{self.key}__gte") in message or repr(self.key) in message else None
+        return self.low if f"{self.key}__gte" in keys or self.key in keys else None
 
     def check(self, values: dict) -> dict[str, str]:
         low, high = values.get(self.low), values.get(self.high)
@@ -330,11 +331,9 @@ class SubPoolSpec(ChoiceSpec):
         sub = write_specs(self.inner, values)
         return {self.key: sub} if sub else {}
 
-    def owner(self, message: str) -> str | None:
-        prefix = f"sub-pool {self.key!r}: "
-        if not message.startswith(prefix):
-            return None
-        return next((field for spec in self.inner if (field := spec.owner(message[len(prefix):]))), None)
+    def owner(self, keys: tuple[str, ...]) -> str | None:
+        inner = tuple(k.removeprefix(f"{self.key}.") for k in keys if k.startswith(f"{self.key}."))
+        return next((field for spec in self.inner if (field := spec.owner(inner))), None) if inner else None
 
     def check(self, values: dict) -> dict[str, str]:
         return {k: v for spec in self.inner for k, v in spec.check(values).items()}
@@ -363,8 +362,11 @@ class AnchorsSpec(ChoiceSpec):
         anchors = {v: values[f"{self.field}_{v}"] for v in self.vocabulary if values.get(f"{self.field}_{v}")}
         return {self.key: anchors} if anchors else {}
 
-    def owner(self, message: str) -> str | None:
-        return f"{self.field}_{self.vocabulary[0]}" if repr(self.key) in message else None
+    def owner(self, keys: tuple[str, ...]) -> str | None:
+        value = next((k.removeprefix(f"{self.key}.") for k in keys if k.startswith(f"{self.key}.")), None)
+        if value in self.vocabulary:
+            return f"{self.field}_{value}"
+        return f"{self.field}_{self.vocabulary[0]}" if self.key in keys or value is not None else None
 
 
 class ValueSpec(ChoiceSpec):
@@ -444,11 +446,11 @@ class AttentionSpec(ChoiceSpec):
         config = {k: v for k, v in config.items() if v not in (None, "")}
         return {self.key: config} if config else {}
 
-    def owner(self, message: str) -> str | None:
-        if repr(self.key) not in message:
+    def owner(self, keys: tuple[str, ...]) -> str | None:
+        parts = [k.removeprefix(f"{self.key}.") for k in keys if k == self.key or k.startswith(f"{self.key}.")]
+        if not parts:
             return None
-        part = next((k for k in self.PARTS if repr(k) in message), "answer")
-        return f"{self.field}_{part}"
+        return f"{self.field}_{next((p for p in parts if p in self.PARTS), 'answer')}"
 
     def check(self, values: dict) -> dict[str, str]:
         positions = (values.get(f"{self.field}_positions") or "").strip()
@@ -629,21 +631,19 @@ def touched_groups(changed: list[str] | set[str]) -> dict[str, bool]:
     return {group: bool(changed & set(fields)) for group, (fields, *_rest) in GROUPS.items()}
 
 
-def _owner(specs: list[ChoiceSpec], message: str, values: dict) -> str | None:
-    """The structured field a study_pools message is about: the spec that wrote the key the message names
-    (a key that came from the raw JSON's leftover is the raw field's)."""
+def _owner(specs: list[ChoiceSpec], keys: tuple[str, ...], values: dict) -> str | None:
+    """The structured field an error about these JSON keys (study_pools.SectionError.keys) belongs to: the spec
+    that wrote the key (a key that came from the raw JSON's leftover is the raw field's)."""
     for spec in specs:
         if isinstance(spec, SubPoolSpec):
-            prefix = f"sub-pool {spec.key!r}: "
-            if not message.startswith(prefix):
-                continue
-            text, parts = message[len(prefix):], spec.inner
-        elif message.startswith("sub-pool "):
-            continue
+            prefix = f"{spec.key}."
+            inner = tuple(k.removeprefix(prefix) for k in keys if k.startswith(prefix))
+            parts = spec.inner
         else:
-            text, parts = message, [spec]
+            inner, parts = tuple(k for k in keys if "." not in k or k.split(".")[0] not in SUB_POOLS), [spec]
+        tops = {k.split(".")[0] for k in inner}
         for part in parts:
-            if any(repr(key) in text for key in part.write(values)) and (field := part.owner(text)):
+            if tops & set(part.write(values)) and (field := part.owner(inner)):
                 return field
     return None
 
@@ -682,11 +682,12 @@ def resolve_section_json(form, cleaned: dict, touched: dict[str, bool]) -> None:
             _build_group(form, cleaned, group, section_type)
     errors = validate_section(section_type, cleaned.get("pool"), cleaned.get("options"),
                               cleaned.get("clips_per_participant"))
-    for name, messages in errors.items():
+    for name in dict.fromkeys(error.field for error in errors):
         if name not in form.fields or form.has_error(name):
             continue
         specs = GROUPS[name][3](section_type) if touched.get(name) and name in GROUPS else []
         values = {field: cleaned.get(field) for field in _names(specs)}
-        for message in messages:
-            form.add_error(_owner(specs, message, values) or name, message)
+        for error in errors:
+            if error.field == name:
+                form.add_error(_owner(specs, error.keys, values) or name, error.message)
         cleaned.pop(name, None)

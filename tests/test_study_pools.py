@@ -10,7 +10,7 @@ import pytest
 from django.contrib.auth.models import User
 from django.test import Client
 
-from study_pools import validate_section
+from study_pools import SectionError, errors_by_field, validate_section
 from study_protocol import SECTION_TYPES
 from studyapp.models import Section, Study
 from studyapp.presets import PRESETS, create_study_from_preset
@@ -45,7 +45,7 @@ def test_every_preset_section_is_valid(preset):
     for sec in PRESETS[preset]["sections"]:
         assert sec["section_type"] in SECTION_TYPES
         assert validate_section(sec["section_type"], sec.get("pool", {}), sec.get("options", {}),
-                                sec.get("clips_per_participant", 6)) == {}, sec
+                                sec.get("clips_per_participant", 6)) == [], sec
 
 
 GOOD = [
@@ -62,7 +62,7 @@ GOOD = [
 
 @pytest.mark.parametrize("stype,pool,options", GOOD)
 def test_good_sections(stype, pool, options):
-    assert validate_section(stype, pool, options, 6) == {}
+    assert validate_section(stype, pool, options, 6) == []
 
 
 BAD = [  # (section_type, pool, options, clips, field, words the message must contain)
@@ -104,11 +104,32 @@ BAD = [  # (section_type, pool, options, clips, field, words the message must co
 
 @pytest.mark.parametrize("stype,pool,options,clips,field,words", BAD)
 def test_bad_sections_name_the_field(stype, pool, options, clips, field, words):
-    errors = validate_section(stype, pool, options, clips)
+    errors = errors_by_field(validate_section(stype, pool, options, clips))
     assert field in errors, errors
     message = " | ".join(errors[field])
     for word in words:
         assert word in message, (word, message)
+
+
+def test_errors_carry_their_field_and_json_keys():
+    errors = validate_section(
+        "naturalness",
+        {"weight__gte": "x", "generated": {"theme": "sleepy"}, "rbf": 1},
+        {"n_generated": 2, "n_source": 2, "anchors": {"9": "odd"},
+         "attention_checks": {"answer": "7", "count": 0}, "max_replays": -1, "colour": 1}, 6)
+    assert all(isinstance(e, SectionError) for e in errors)
+    keys = {(e.field, e.keys) for e in errors}
+    assert {("pool", ("weight__gte",)), ("pool", ("generated.theme",)), ("pool", ("rbf",)),
+            ("options", ("n_generated", "n_source")), ("options", ("anchors.9",)),
+            ("options", ("attention_checks.answer",)), ("options", ("attention_checks.count",)),
+            ("options", ("max_replays",)), ("options", ("colour",))} == keys
+    # every message still names its key, so a reader of the plain text knows what to fix
+    by_keys = {e.keys: e.message for e in errors}
+    assert "'weight__gte'" in by_keys[("weight__gte",)] and "sub-pool 'generated'" in by_keys[("generated.theme",)]
+    assert validate_section("dance", {}, {}) == [SectionError("section_type", validate_section("dance", {}, {})[0]
+                                                              .message)]
+    assert errors_by_field(validate_section("emotion_choice", {"origin": 3}, {}, -1)) == {
+        "pool": ["'origin' takes text, got 3"], "clips_per_participant": ["must be an integer 0 or more, got -1"]}
 
 
 def test_section_clean_needs_no_database():
