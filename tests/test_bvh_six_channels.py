@@ -132,3 +132,25 @@ def test_a_body_the_solve_cannot_reproduce_is_an_error_row(tmp_path):
     row = import_file(path, ImportOptions(skeleton="gait")).row
     assert row["status"] == "error" and "import error" in row["message"]
     assert float(row["import_error_cm"]) > 3.0
+
+
+def _knee_flexion_deg(P: np.ndarray, hip: int, knee: int, ankle: int) -> np.ndarray:
+    u, v = P[:, hip] - P[:, knee], P[:, ankle] - P[:, knee]
+    cos = (u * v).sum(-1) / np.linalg.norm(u, axis=-1) / np.linalg.norm(v, axis=-1)
+    return 180.0 - np.degrees(np.arccos(np.clip(cos, -1.0, 1.0)))
+
+
+def test_real_walk_keeps_its_knee_flexion_on_our_skeleton():
+    """Our hips hang lower below the root than this rig's: the root is moved to the source hips, so the knees
+    straighten as the actor's do instead of staying bent by the leg's missing reach."""
+    from generation.mocap.bandai_namco import shipped_takes
+
+    path = next(t.path for t in shipped_takes() if t.content == "walk" and t.style == "feminine")
+    data = parse_bvh(path)
+    n = data.names.index
+    source = _knee_flexion_deg(data.global_positions(0.01), n("UpperLeg_L"), n("LowerLeg_L"), n("Foot_L"))
+    motion = import_file(path, ImportOptions(skeleton="gait")).motion
+    j = motion.skeleton.index
+    ours = _knee_flexion_deg(motion.positions(), j("left_hip"), j("left_knee"), j("left_heel"))
+    assert abs(np.median(ours) - np.median(source)) < 4.0
+    assert ours.min() < source.min() + 5.0

@@ -30,7 +30,7 @@ from generation.formats.bvh import parse_bvh
 
 from .labels import Label
 from .positions import LAYOUT_MAPS, read_positions
-from .retarget import fill_unmapped_joints, fit_proportions, place_feet_on_source
+from .retarget import align_root_to_hips, fill_unmapped_joints, fit_proportions, place_feet_on_source
 from .rigs import auto_joint_map, check_joint_map
 
 BVH_SUFFIXES = (".bvh",)
@@ -201,7 +201,9 @@ def _solve(P: np.ndarray, known: np.ndarray, mapped: np.ndarray, target: Skeleto
     fill_unmapped_joints(P, known, target)
     if fit:
         target = fit_proportions(P, known, target)
-    rotations = place_feet_on_source(solve_rotations(P, target, known), P, known, target, joint_map)
+    rotations = solve_rotations(P, target, known)
+    P[:, 0] = align_root_to_hips(rotations, P, known, target)
+    rotations = place_feet_on_source(rotations, P, known, target, joint_map)
     motion = Motion(target, rotations, P[:, 0].copy(), 1.0, {})
     err = np.linalg.norm(motion.positions()[:, mapped] - P[:, mapped], axis=-1)
     return motion, float(err.max())

@@ -138,6 +138,7 @@ def retarget(motion: Motion, target_skeleton: Skeleton, joint_map: dict[str, str
         known[tgt.index(t_name)] = True
     fill_unmapped_joints(P, known, tgt)
     rotations = solve_rotations(P, tgt, known)
+    P[:, 0] = align_root_to_hips(rotations, P, known, tgt)
     if foot_ik:
         rotations = place_feet_on_source(rotations, P, known, tgt, joint_map)
     meta = dict(motion.metadata)
@@ -148,6 +149,21 @@ def retarget(motion: Motion, target_skeleton: Skeleton, joint_map: dict[str, str
     meta["retarget"] = {"source_skeleton": src.name, "scale": scale, "joint_map": joint_map,
                         "max_error_m": float(err.max()), "mean_error_m": float(err.mean())}
     return out
+
+
+def align_root_to_hips(rotations: np.ndarray, P: np.ndarray, known: np.ndarray, tgt: Skeleton) -> np.ndarray:
+    """Root positions (T, 3) that put our hip joints where the source's are.
+
+    Rigs place the hip joints at different depths below the pelvis root (ours 5 cm, the Bandai Namco rig 2.3 cm):
+    keeping the source's root position would leave our legs that much short of (or past) the feet, so knees
+    never straighten. The root is moved, per frame, by the mean offset between the source hips and ours.
+    ``P`` (T, J, 3) holds the source positions on our joints; unmapped hips leave the root where it is.
+    """
+    hips = [tgt.index(n) for n in ("left_hip", "right_hip") if n in tgt.joints and known[tgt.index(n)]]
+    if not hips:
+        return P[:, 0].copy()
+    Q = np_forward_kinematics(rotations, P[:, 0], tgt)
+    return P[:, 0] + (P[:, hips] - Q[:, hips]).mean(axis=1)
 
 
 def place_feet_on_source(rotations: np.ndarray, P: np.ndarray, known: np.ndarray, tgt: Skeleton,
