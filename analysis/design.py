@@ -28,7 +28,7 @@ from study_protocol import CLIP_COLUMNS, FINAL_EMOTION_COLUMNS, GESTURE_EMOTIONS
 
 PAPER_PRESETS = ("gait_ismar2020", "gestures_ieeevr2021", "rbf_thms2016")
 """The three papers' studies; simulated one after the other as one SYNTHETIC study by default."""
-EXTRA_COLUMNS = ("plan", "entry_id", "source_clip_id")
+EXTRA_COLUMNS = ("plan", "entry_id", "source_clip_id", "sections")
 """Columns of a planned clips table and of :attr:`StudyDesign.clips` after CLIP_COLUMNS (not clips.csv's)."""
 PLANNED_CLIPS = Path(__file__).resolve().parent / "data" / "planned_clips.csv"
 """The planned clips of every preset's plan (written by ``python -m generation.plans.planned``)."""
@@ -107,7 +107,8 @@ class StudyDesign:
 # ---- planned clips ------------------------------------------------------------------------------------------------
 def read_planned_clips(path: str | Path = PLANNED_CLIPS) -> pd.DataFrame:
     """A planned clips table (CSV): CLIP_COLUMNS + :data:`EXTRA_COLUMNS`, numbers as floats (blank NaN), blank
-    ``emotion_label``/``theme`` None, blank ``source_clip_id`` "". Raises DesignError naming missing columns."""
+    ``emotion_label``/``theme`` None, blank ``source_clip_id``/``sections`` "". Raises DesignError naming missing
+    columns."""
     try:
         raw = pd.read_csv(path, dtype=str, keep_default_na=False)
     except (OSError, pd.errors.ParserError, pd.errors.EmptyDataError) as exc:
@@ -121,13 +122,14 @@ def read_planned_clips(path: str | Path = PLANNED_CLIPS) -> pd.DataFrame:
 
 def clip_table(clips: pd.DataFrame) -> pd.DataFrame:
     """The design's clip table from planned clip rows: numeric columns as floats (blank NaN), text columns as
-    strings with blanks missing (``source_clip_id`` keeps "" for none), rows renumbered from 0."""
+    strings with blanks missing (``source_clip_id`` and ``sections`` keep "" for none), rows renumbered from 0."""
     out = {}
     for c in clips.columns:
         if c not in TEXT_COLUMNS:
             out[c] = pd.to_numeric(clips[c], errors="coerce").to_numpy(float)
         else:
-            out[c] = [v if isinstance(v, str) and (v or c == "source_clip_id") else None for v in clips[c]]
+            out[c] = [v if isinstance(v, str) and (v or c in ("source_clip_id", "sections")) else None
+                      for v in clips[c]]
     return pd.DataFrame(out, columns=list(clips.columns))
 
 

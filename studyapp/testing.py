@@ -82,9 +82,10 @@ def make_catalogue(media_root: Path, video_bytes: bytes | None = None, duration_
                             **gait(GAIT_VECTORS[(i + 1) % 4], "final_")))
     for i in range(n_gesture):
         label = GESTURE_EMOTIONS[i % len(GESTURE_EMOTIONS)]
-        records.append(base(f"gest_src_{i:02d}", "gesture", "source", emotion_label=label))
+        records.append(base(f"gest_src_{i:02d}", "gesture", "source", emotion_label=label, sections="naturalness"))
         records.append(base(f"gest_gen_{i:02d}", "gesture", "generated", emotion_label=label,
-                            source_clip_id=f"gest_src_{i:02d}", valence=0.5, arousal=0.5, dominance=0.5))
+                            source_clip_id=f"gest_src_{i:02d}", valence=0.5, arousal=0.5, dominance=0.5,
+                            sections="gesture_emotion,naturalness"))     # the plans' section hints
     records.append(base("rbf_neutral", "gait", "source", theme=NEUTRAL_THEME, weight=0.0,
                         n_features=0))
     for theme in THEMES:

@@ -377,9 +377,10 @@ def item(request, token: str, n: int):
 
 def _show_item(request, participant: Participant, step):
     """The clip page of `step` as first shown (no answer selected), recording shown_at the first time it is
-    shown (a GET; a HEAD, e.g. an uptime monitor's, shows nothing and records nothing)."""
+    shown (a GET, or the answer POST that brings the next clip page; a HEAD, e.g. an uptime monitor's, shows
+    nothing and records nothing)."""
     assignment = step.assignment
-    if assignment.shown_at is None and request.method == "GET":
+    if assignment.shown_at is None and request.method != "HEAD":
         Assignment.objects.filter(pk=assignment.pk, shown_at__isnull=True).update(shown_at=timezone.now())
     return _render_item(request, participant, step, posted=None)
 

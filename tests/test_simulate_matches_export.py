@@ -29,7 +29,7 @@ def catalogue_from_design(design, media_root) -> int:
     for row in design.clips.to_dict("records"):
         rec = {c: (None if isinstance(v, float) and pd.isna(v) else v) for c, v in row.items() if c in CLIP_COLUMNS}
         rec.update(video=write_media(media_root, f"placeholder {row['clip_id']}".encode()), webm="", poster="",
-                   plan=row["plan"], loop=False, source_clip_id=row["source_clip_id"],
+                   plan=row["plan"], loop=False, source_clip_id=row["source_clip_id"], sections=row["sections"],
                    metadata={"synthetic": True, "entry_id": row["entry_id"], "note": "test placeholder"})
         records.append(rec)
     return upsert_clips(records)

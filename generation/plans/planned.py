@@ -2,9 +2,9 @@
 
 Each plan entry becomes one SYNTHETIC clip row with id ``sim-<plan>-<entry id>``: the public clips.csv columns
 (``study_protocol.CLIP_COLUMNS``; intent columns as the renderer records them, :func:`schema.intent_fields`) plus
-:data:`EXTRA_COLUMNS` (the plan's name, the entry id and the id of the entry's source clip). Its ``duration_s`` is
-the planned one: the entry's ``duration_s`` input, else its pair's (a generated gesture and its source), else the
-plan's render duration -- a rendered clip's real length may differ a little.
+:data:`EXTRA_COLUMNS` (the plan's name, the entry id, the id of the entry's source clip and its section hints).
+Its ``duration_s`` is the planned one: the entry's ``duration_s`` input, else its pair's (a generated gesture and
+its source), else the plan's render duration -- a rendered clip's real length may differ a little.
 
 The analysis reads these rows from a CSV file and never imports this package; the table it ships for the preset
 plans (``analysis/data/planned_clips.csv``) is written with
@@ -24,8 +24,9 @@ from study_protocol import CLIP_COLUMNS
 
 from .schema import ClipEntry, Plan, PlanError, intent_fields, load_plan
 
-EXTRA_COLUMNS = ("plan", "entry_id", "source_clip_id")
-"""Columns after CLIP_COLUMNS in a planned clips table."""
+EXTRA_COLUMNS = ("plan", "entry_id", "source_clip_id", "sections")
+"""Columns after CLIP_COLUMNS in a planned clips table (``sections``: the entry's section-type hints joined by
+commas, as the study app's catalogue stores them)."""
 PLANNED_COLUMNS = (*CLIP_COLUMNS, *EXTRA_COLUMNS)
 
 
@@ -49,7 +50,7 @@ def planned_clip_rows(plan: Plan) -> list[dict]:
         row.update(intent_fields(e))
         row.update(clip_id=f"sim-{plan.name}-{e.id}", modality=e.modality, origin=e.origin,
                    duration_s=round(_duration(e, by_id), 3), plan=plan.name, entry_id=e.id,
-                   source_clip_id=f"sim-{plan.name}-{e.pair}" if e.pair else "")
+                   source_clip_id=f"sim-{plan.name}-{e.pair}" if e.pair else "", sections=",".join(e.sections))
         rows.append(row)
     return rows
 
