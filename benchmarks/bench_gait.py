@@ -14,7 +14,8 @@ Measures, on the held-out test split of the synthetic gait corpus:
 6. the contact sheet docs/img/gait_contact_sheet.png and docs/img/gait_trajectories.png.
 
 Usage: python benchmarks/bench_gait.py [--full W.pt] [--no-affect W.pt] [--no-root W.pt] [--quick]
-Results go to var/gait_runs/bench_gait.json and are printed as markdown.
+Results go to docs/benchmarks/gait.json (``--out``); the tables are printed and rendered into the marked blocks of
+docs/benchmarks/gait.md (benchmarks/doc_tables.py; the narrative there is written by hand).
 """
 from __future__ import annotations
 
@@ -28,7 +29,9 @@ from pathlib import Path
 import numpy as np
 import torch
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+sys.path[:0] = [str(Path(__file__).resolve().parents[1]), str(Path(__file__).resolve().parent)]
+
+import doc_tables  # noqa: E402
 
 from generation.core.kinematics import forward_kinematics  # noqa: E402
 from generation.core.motion import Motion  # noqa: E402
@@ -39,6 +42,7 @@ from generation.gait.data import load_corpus_sequences, world_rotations  # noqa:
 from generation.gait.generate import distance_to_path, emotion_transition, load_model  # noqa: E402
 from generation.gait.generate import generate_gaits as _generate_gaits  # noqa: E402
 from generation.gait.train import DEFAULT_WEIGHTS, rollout  # noqa: E402
+from generation.procedural.corpus import GaitCorpus  # noqa: E402
 from generation.quality.gait_guidance import (  # noqa: E402
     HELDOUT_SEED,
     heldout_corpus,
@@ -366,7 +370,7 @@ def trajectory_figure(paths, runs: dict, path: Path):
     plt.close(fig)
 
 
-def main(argv=None) -> int:
+def _args(argv):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--full", default=str(DEFAULT_WEIGHTS))
     ap.add_argument("--full-short", default="var/gait_runs/full12.pt", help="full model on the ablations' schedule")
@@ -375,17 +379,128 @@ def main(argv=None) -> int:
     ap.add_argument("--corpus", default="var/corpus/gait_corpus_synthetic.npz")
     ap.add_argument("--steps", type=int, default=200)
     ap.add_argument("--quick", action="store_true", help="fewer sequences (smoke run)")
-    ap.add_argument("--out", default="var/gait_runs/bench_gait.json")
-    args = ap.parse_args(argv)
-    torch.set_num_threads(1)
-    t_start = time.time()
+    ap.add_argument("--out", default=str(doc_tables.DOCS / "gait.json"), help="JSON results")
+    return ap.parse_args(argv)
 
-    from generation.procedural.corpus import GaitCorpus
-    nets = {"full": args.full, "full, 12 epochs": args.full_short, "no affective (QuaterNet-like)": args.no_affect,
-            "no root loss": args.no_root}
-    nets = {k: load_model(v) for k, v in nets.items() if Path(v).exists()}
+
+def _print_table(title: str, name: str, results: dict) -> None:
+    print(f"\n## {title}")
+    print("\n".join(doc_tables.render_tables("gait", results)[name]))
+
+
+def _load(args) -> tuple[dict, dict]:
+    """The networks that exist (by row name) and the results' model and corpus records."""
+    paths = {"full": args.full, "full, 12 epochs": args.full_short, "no affective (QuaterNet-like)": args.no_affect,
+             "no root loss": args.no_root}
+    nets = {k: load_model(v) for k, v in paths.items() if Path(v).exists()}
     results: dict = {"models": {k: {"path": n.path, "epochs": n.info.get("epochs"),
                                     "parameters": n.model.num_parameters()} for k, n in nets.items()}}
+    return nets, results
+
+
+def _prediction(nets, train, test, results) -> None:
+    """1. prediction error (18 steps given, 42 predicted) of the networks and two baselines."""
+    table = {name: network_errors(net, test) for name, net in nets.items()}
+    table["last pose held"] = zero_velocity_errors(test)
+    table["nearest neighbour (train)"] = nearest_neighbour_errors(train, test)
+    results["prediction"] = table
+    _print_table(f"prediction (18 given, 42 predicted), test split n = {len(test)}", "gait.prediction", results)
+
+
+def _expressiveness(nets, observer, corpus, test, args, results) -> dict:
+    """2. the synthetic observer's reading of generated gaits; returns the full model's motions by kind."""
+    gt_pred = observer.clf.predict(Observer.summarise_seq(test.aff.numpy()))
+    results["observer_on_test_corpus"] = accuracy_table(gt_pred, test.emotion.numpy().argmax(1))
+    test_emotion = test.emotion.numpy().astype(np.float64)
+    expr, motions = {}, {}
+    for name, net in nets.items():
+        if name == "no root loss":
+            continue
+        r = expressiveness(net, observer, corpus, test.base_index, test_emotion, args.steps,
+                           np.random.default_rng(3))
+        motions[name] = r.pop("_motions")
+        expr[name] = r
+    results["expressiveness"] = expr
+    results["expressiveness_procedural_seeds"] = {
+        name: expressiveness_procedural_seeds(net, observer, args.steps, 4 if args.quick else 10)
+        for name, net in nets.items() if name != "no root loss"}
+    _print_table("synthetic observer accuracy (chance 0.25)", "gait.expressiveness", results)
+    return motions
+
+
+def _heldout(nets, observer, args, results) -> None:
+    """Own-emotion recognition seeded by the walks of the second held-out corpus."""
+    held_path = heldout_corpus(Path(__file__).resolve().parents[1])
+    held_corpus, held = GaitCorpus.load(held_path), load_corpus_sequences(held_path)
+    held = held.subset(np.flatnonzero(held.offset == 0)[: 40 if args.quick else None])
+    results["own_emotion_heldout_corpus"] = {name: heldout_recognition(net, observer, held_corpus, held, args.steps)
+                                             for name, net in nets.items() if name != "no root loss"}
+    results["heldout_corpus_seed"] = HELDOUT_SEED
+    _print_table(f"own emotion per class (second held-out corpus: seed {HELDOUT_SEED}, {len(held)} walks)",
+                 "gait.own_emotion", results)
+
+
+def _trajectory(nets, corpus, test, args, results) -> tuple[list, dict]:
+    """3. distance from unseen random paths; returns the paths and each model's motions."""
+    path_rng = np.random.default_rng(2026)
+    n_traj = 12 if args.quick else 30
+    kinds = ["straight", "curved", "sharp_turn"]
+    # 50 m paths: longer than 200 steps of the fastest gaits, so the walk ends on the path itself.
+    tpaths = [random_path(path_rng, 50.0, kinds[i % 3]) for i in range(n_traj)]
+    rows = np.arange(n_traj) % len(test.base_index)
+    tseeds = test_seeds(corpus, test.base_index[rows])
+    temo = test.emotion.numpy().astype(np.float64)[rows]
+    traj, traj_motions = {}, {}
+    for name, net in nets.items():
+        r = trajectory_following(net, tseeds, temo, tpaths, args.steps)
+        traj_motions[name] = r.pop("_motions")
+        traj[name] = r
+    results["trajectory"] = traj
+    results["corpus_facing_vs_travel_deg"] = float(torch.rad2deg(test.root[:, 1:, 2].abs()).mean())
+    _print_table("distance of the root from the desired path (unseen random paths, 200 steps)", "gait.trajectory",
+                 results)
+    print(f"corpus test walks, facing vs travel: {results['corpus_facing_vs_travel_deg']:.1f} deg")
+    return tpaths, traj_motions
+
+
+def _long_horizon_and_speed(net, corpus, test, args, results) -> None:
+    """4. 400 steps on a straight path, foot skate; 5. speed."""
+    n_long = 4 if args.quick else 8
+    lseeds = test_seeds(corpus, test.base_index[:n_long])
+    results["long_horizon"] = long_horizon(net, lseeds, test.emotion.numpy().astype(np.float64)[:n_long],
+                                           2 * args.steps)
+    results["foot_skate_corpus_cm_s"] = float(np.mean([foot_skate_cm_s(corpus.motion(int(i)))
+                                                       for i in test.base_index[:20]]))
+    _print_table("long horizon (full model, straight path, 400 steps = 53 s)", "gait.long_horizon", results)
+    print(f"foot skate (low feet ground speed): generated {results['long_horizon']['foot_skate_cm_s']:.1f} cm/s, "
+          f"corpus {results['foot_skate_corpus_cm_s']:.1f} cm/s")
+    results["speed"] = speed(net, lseeds[0])
+    _print_table("speed", "gait.speed", results)
+
+
+def _figures(net, corpus, test, motions, tpaths, traj_motions, args) -> None:
+    """6. the contact sheet (own emotions and a sad -> happy transition) and the trajectory figure."""
+    test_emotion = test.emotion.numpy().astype(np.float64)
+    rows = []
+    for k, e in enumerate(GAIT_EMOTIONS):
+        idx = int(np.flatnonzero(test_emotion.argmax(1) == k)[np.argmax(test_emotion[test_emotion.argmax(1) == k, k])])
+        rows.append((f"{e} (own)", motions["own"][idx]))
+    sad_seed = int(np.flatnonzero(test_emotion.argmax(1) == 1)[0])
+    tr = generate_gaits(test_seeds(corpus, [test.base_index[sad_seed]]), [straight(60.0)],
+                        emotion_transition(test_emotion[sad_seed], [1, 0, 0, 0], args.steps)[None], steps=args.steps,
+                        model=net)[0]
+    rows.append(("transition sad->happy\n(colour = intended)", tr))
+    contact_sheet(rows, Path("docs/img/gait_contact_sheet.png"))
+    pick = [1, 2, 4, 5]  # two curved and two sharp-turn paths
+    trajectory_figure([tpaths[i] for i in pick], {k: [v[i] for i in pick] for k, v in traj_motions.items()},
+                      Path("docs/img/gait_trajectories.png"))
+
+
+def main(argv=None) -> int:
+    args = _args(argv)
+    torch.set_num_threads(1)
+    t_start = time.time()
+    nets, results = _load(args)
     corpus = GaitCorpus.load(args.corpus)
     data = load_corpus_sequences(args.corpus)
     results["corpus"] = data.source
@@ -398,135 +513,20 @@ def main(argv=None) -> int:
     test = data.subset((data.split == "test") & (data.offset == 0))
     if args.quick:
         test = test.subset(np.arange(12))
-    test_rows = test.base_index
-
-    # 1. prediction error
-    table = {name: network_errors(net, test) for name, net in nets.items()}
-    table["last pose held"] = zero_velocity_errors(test)
-    table["nearest neighbour (train)"] = nearest_neighbour_errors(train, test)
-    results["prediction"] = table
-    print("## prediction (18 given, 42 predicted), test split n =", len(test))
-    print("| method | pose err / body diag | pose err cm | first 10 / last 10 steps cm | rot err deg (rad) |")
-    print("|---|---|---|---|---|")
-    for k, v in table.items():
-        print(f"| {k} | {v['pose_error_body_diag']:.3f} | {v['pose_error_cm']:.1f} | {v['pose_error_first10_cm']:.1f}"
-              f" / {v['pose_error_last10_cm']:.1f} | {v['rotation_error_deg']:.1f} ({v['rotation_error_rad']:.3f}) |")
-
-    # 2. expressiveness
+    _prediction(nets, train, test, results)
     observer = Observer(train)
-    gt_pred = observer.clf.predict(Observer.summarise_seq(test.aff.numpy()))
-    results["observer_on_test_corpus"] = accuracy_table(gt_pred, test.emotion.numpy().argmax(1))
-    test_emotion = test.emotion.numpy().astype(np.float64)
-    expr, motions = {}, {}
-    for name, net in nets.items():
-        if name == "no root loss":
-            continue
-        r = expressiveness(net, observer, corpus, test_rows, test_emotion, args.steps, np.random.default_rng(3))
-        motions[name] = r.pop("_motions")
-        expr[name] = r
-    results["expressiveness"] = expr
-    results["expressiveness_procedural_seeds"] = {
-        name: expressiveness_procedural_seeds(net, observer, args.steps, 4 if args.quick else 10)
-        for name, net in nets.items() if name != "no root loss"}
-    print("\n## synthetic observer accuracy (chance 0.25); on the test corpus itself:",
-          {k: (round(v, 2) if isinstance(v, float) else v) for k, v in results["observer_on_test_corpus"].items()})
-    print("| model | own emotion | other mixture (whole / last third) | transition start / end | P(target) "
-          "transition first / last 50 steps (no transition) |")
-    print("|---|---|---|---|---|")
-    for k, v in expr.items():
-        pt = v["transition_p_target"]
-        print(f"| {k} | {v['own_emotion']['overall']:.2f} | {v['other_mixture']['overall']:.2f} / "
-              f"{v['other_mixture_last_third']['overall']:.2f} | {v['transition_start']['overall']:.2f} / "
-              f"{v['transition_end']['overall']:.2f} | {pt['first_50_steps']:.2f} / {pt['last_50_steps']:.2f} "
-              f"({pt['constant_seed_emotion_last_50']:.2f}) |")
-        print("  own emotion per class, walks with one dominant label "
-              f"({v['own_emotion_untied']['left_out_tied']} tied left out):",
-              {e: round(v["own_emotion_untied"][e], 2) for e in GAIT_EMOTIONS})
-        print("  own emotion per class:", {e: round(v["own_emotion"][e], 2) for e in GAIT_EMOTIONS},
-              "confusion (rows intended h/s/a/n, cols observed):", v["own_emotion"]["confusion"])
-
-    held_path = heldout_corpus(Path(__file__).resolve().parents[1])
-    held_corpus, held = GaitCorpus.load(held_path), load_corpus_sequences(held_path)
-    held = held.subset(np.flatnonzero(held.offset == 0)[: 40 if args.quick else None])
-    results["own_emotion_heldout_corpus"] = {name: heldout_recognition(net, observer, held_corpus, held, args.steps)
-                                             for name, net in nets.items() if name != "no root loss"}
-    print(f"\nown emotion, seeds = the {len(held)} walks of the second held-out corpus (seed {HELDOUT_SEED}):")
-    for k, v in results["own_emotion_heldout_corpus"].items():
-        for part in ("all", "untied", "untied_even", "untied_odd", "walks_themselves_untied"):
-            t = v[part]
-            print(f"  {k} {part} (n {t['n']}): {t['overall']:.2f}", {e: round(t[e], 2) for e in GAIT_EMOTIONS},
-                  t["confusion"])
-
-    print("\nseeds made from the intended emotion (seeds=None), observer accuracy:")
-    for k, v in results["expressiveness_procedural_seeds"].items():
-        for kind, t in v.items():
-            print(f"  {k} {kind}: {t['overall']:.2f}", {e: round(t[e], 2) for e in GAIT_EMOTIONS}, t["confusion"])
-
-    # 3. trajectory following on unseen paths
-    path_rng = np.random.default_rng(2026)
-    n_traj = 12 if args.quick else 30
-    kinds = ["straight", "curved", "sharp_turn"]
-    # 50 m paths: longer than 200 steps of the fastest gaits, so the walk ends on the path itself.
-    tpaths = [random_path(path_rng, 50.0, kinds[i % 3]) for i in range(n_traj)]
-    tseeds = test_seeds(corpus, test_rows[np.arange(n_traj) % len(test_rows)])
-    temo = test_emotion[np.arange(n_traj) % len(test_rows)]
-    traj, traj_motions = {}, {}
-    for name, net in nets.items():
-        r = trajectory_following(net, tseeds, temo, tpaths, args.steps)
-        traj_motions[name] = r.pop("_motions")
-        traj[name] = r
-    results["trajectory"] = traj
-    d = test.root[:, 1:, 2].abs()
-    results["corpus_facing_vs_travel_deg"] = float(torch.rad2deg(d).mean())
-    print("\n## distance of the root from the desired path (unseen random paths, 200 steps)")
-    print("| model | mean m | p95 m | max m | at end m | facing vs travel deg |")
-    print("|---|---|---|---|---|---|")
-    for k, v in traj.items():
-        print(f"| {k} | {v['mean_m']:.3f} | {v['p95_m']:.3f} | {v['max_m']:.3f} | {v['end_mean_m']:.3f} | "
-              f"{v['facing_vs_travel_deg']:.1f} |")
-    print(f"corpus test walks, facing vs travel: {results['corpus_facing_vs_travel_deg']:.1f} deg")
-
-    # 4. long horizon + foot skate
-    n_long = 4 if args.quick else 8
-    lseeds = test_seeds(corpus, test_rows[:n_long])
-    results["long_horizon"] = long_horizon(nets["full"], lseeds, test_emotion[:n_long], 2 * args.steps)
-    corpus_skate = [foot_skate_cm_s(corpus.motion(int(i))) for i in test_rows[:20]]
-    results["foot_skate_corpus_cm_s"] = float(np.mean(corpus_skate))
-    print("\n## long horizon (full model, straight path, 400 steps = 53 s)")
-    print("| steps | root speed m/s | pose variance cm^2 | path distance m | root height m |")
-    print("|---|---|---|---|---|")
-    for row in results["long_horizon"]["windows"]:
-        print(f"| {row['steps']} | {row['root_speed_m_s']:.2f} | {row['pose_variance_cm2']:.0f} | "
-              f"{row['path_distance_m']:.3f} | {row['root_height_m']:.3f} |")
-    print(f"foot skate (low feet ground speed): generated {results['long_horizon']['foot_skate_cm_s']:.1f} cm/s, "
-          f"corpus {results['foot_skate_corpus_cm_s']:.1f} cm/s")
-
-    # 5. speed
-    results["speed"] = speed(nets["full"], lseeds[0])
-    print("\n## speed")
-    for k, v in results["speed"].items():
-        print(k, {kk: round(vv, 2) if isinstance(vv, float) else vv for kk, vv in v.items()})
-
-    # 6. figures
-    full = motions["full"]
-    rows = []
-    for k, e in enumerate(GAIT_EMOTIONS):
-        idx = int(np.flatnonzero(test_emotion.argmax(1) == k)[np.argmax(test_emotion[test_emotion.argmax(1) == k, k])])
-        rows.append((f"{e} (own)", full["own"][idx]))
-    sad_seed = int(np.flatnonzero(test_emotion.argmax(1) == 1)[0])
-    tr = generate_gaits(test_seeds(corpus, [test_rows[sad_seed]]), [straight(60.0)],
-                        emotion_transition(test_emotion[sad_seed], [1, 0, 0, 0], args.steps)[None], steps=args.steps,
-                        model=nets["full"])[0]
-    rows.append(("transition sad->happy\n(colour = intended)", tr))
-    contact_sheet(rows, Path("docs/img/gait_contact_sheet.png"))
-    pick = [1, 2, 4, 5]  # two curved and two sharp-turn paths
-    trajectory_figure([tpaths[i] for i in pick], {k: [v[i] for i in pick] for k, v in traj_motions.items()},
-                      Path("docs/img/gait_trajectories.png"))
-
+    motions = _expressiveness(nets, observer, corpus, test, args, results)
+    _heldout(nets, observer, args, results)
+    tpaths, traj_motions = _trajectory(nets, corpus, test, args, results)
+    _long_horizon_and_speed(nets["full"], corpus, test, args, results)
+    _figures(nets["full"], corpus, test, motions["full"], tpaths, traj_motions, args)
     results["seconds"] = time.time() - t_start
-    Path(args.out).parent.mkdir(parents=True, exist_ok=True)
-    Path(args.out).write_text(json.dumps(results, indent=1, default=float))
-    print(f"\nwrote {args.out} in {results['seconds']:.0f} s")
+    out = Path(args.out)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    out.write_text(json.dumps(results, indent=1, default=float) + "\n")
+    print(f"\nwrote {out} in {results['seconds']:.0f} s")
+    if out.resolve() == (doc_tables.DOCS / "gait.json").resolve():
+        print("docs/benchmarks/gait.md tables:", ", ".join(doc_tables.update_doc("gait")) or "none marked")
     return 0
 
 
