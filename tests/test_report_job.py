@@ -27,7 +27,9 @@ from studyapp.testing import make_catalogue
 pytestmark = pytest.mark.django_db
 
 ROOT = Path(__file__).resolve().parent.parent
-SLEEPER = "import time, sys; time.sleep(float(sys.argv[1]))"
+# A stand-in build that holds the inherited lock until its gate file exists (or 60 s pass), and writes no zip.
+GATED = "import os, sys, time\nend = time.time() + 60\nwhile not os.path.exists(sys.argv[1]) and time.time() < end:\n" \
+        "    time.sleep(0.05)"
 
 
 @pytest.fixture
@@ -51,17 +53,29 @@ def reports_dir(settings, tmp_path):
     return settings.REPORTS_DIR
 
 
-@pytest.fixture
-def fake_builds(monkeypatch):
-    """Replace the spawned command by a process that only sleeps (holding the inherited lock); records calls."""
-    calls = []
+class FakeBuilds(list):
+    """The calls of the stand-in build command; ``release()`` lets the waiting builds end."""
 
-    def command(study_id, version, lock_fd, seconds=3.0):
+    def __init__(self, gate: Path):
+        super().__init__()
+        self.gate = gate
+
+    def release(self) -> None:
+        self.gate.touch()
+
+
+@pytest.fixture
+def fake_builds(monkeypatch, tmp_path):
+    """Replace the spawned command by a process that waits for a gate file (holding the inherited lock)."""
+    calls = FakeBuilds(tmp_path / "gate")
+
+    def command(study_id, version, lock_fd):
         calls.append((study_id, version, lock_fd))
-        return [sys.executable, "-c", SLEEPER, str(seconds)]
+        return [sys.executable, "-c", GATED, str(calls.gate)]
 
     monkeypatch.setattr(reports, "build_command", command)
-    return calls
+    yield calls
+    calls.release()
 
 
 def _wait_not_running(study, version, timeout=20.0):
@@ -87,18 +101,19 @@ def test_data_version_follows_the_data(gait_study):
     assert reports.data_version(gait_study) not in (v0, v1, v2)
 
 
-def test_starting_a_build_returns_at_once_and_never_twice(gait_study, fake_builds):
-    t = time.perf_counter()
+def test_starting_a_build_does_not_wait_for_it_and_never_starts_two(gait_study, fake_builds):
     state = reports.start_build(gait_study)
-    elapsed = time.perf_counter() - t
-    assert state.status == "running" and elapsed < 2.0, elapsed      # the build itself sleeps 3 s
+    # start_build returned while the build still waits for its gate (it cannot end before release()); how fast it
+    # returns is measured by benchmarks/bench_report_start.py
+    assert state.status == "running" and not fake_builds.gate.exists()
     assert reports.report_state(gait_study).status == "running"
     again = reports.start_build(gait_study)
     assert again.status == "running" and len(fake_builds) == 1       # the lock is held: no second build
     with pytest.raises(CommandError, match="already running"):
         call_command("build_report", str(gait_study.pk), stdout=io.StringIO())
+    fake_builds.release()
     done = _wait_not_running(gait_study, state.version)
-    assert done.status == "failed" and "stopped without finishing" in done.error     # the sleeper wrote no zip
+    assert done.status == "failed" and "stopped without finishing" in done.error     # the stand-in wrote no zip
 
 
 def test_command_builds_the_zip_and_the_button_reuses_it(gait_study, staff, fake_builds, reports_dir):
@@ -139,6 +154,7 @@ def test_new_data_makes_a_new_version_and_drops_the_old(gait_study, staff, fake_
     r = staff.post(reverse("studyapp:report_zip", args=[gait_study.pk]))
     assert r.status_code == 302 and len(fake_builds) == 1 and fake_builds[0][1] == new.version
     assert 'data-status="running"' in staff.get(r["Location"]).content.decode()
+    fake_builds.release()
     _wait_not_running(gait_study, new.version)
     _call("build_report", str(gait_study.pk), "--force")
     assert reports.report_state(gait_study).status == "ready"
@@ -179,7 +195,7 @@ def test_the_real_detached_command_runs(tmp_path):
         "from studyapp.models import Study\n"
         "from studyapp import reports\n"
         "study = Study.objects.create(slug='empty', title='synthetic empty study')\n"
-        "t = time.perf_counter(); state = reports.start_build(study); print('start_s', time.perf_counter() - t)\n"
+        "state = reports.start_build(study)\n"
         "print('first', state.status)\n"
         "end = time.time() + 120\n"
         "while reports.report_state(study).status == 'running' and time.time() < end: time.sleep(0.2)\n"
@@ -190,7 +206,7 @@ def test_the_real_detached_command_runs(tmp_path):
                          timeout=240)
     assert out.returncode == 0, out.stderr[-2000:]
     lines = dict(line.split(" ", 1) for line in out.stdout.splitlines() if " " in line)
-    assert lines["first"] == "running" and float(lines["start_s"]) < 2.0
+    assert lines["first"] == "running"
     assert lines["final"] in ("ready", "failed")
     if lines["final"] == "failed":
         assert "stopped without finishing" not in lines["error"] and lines["error"].strip()

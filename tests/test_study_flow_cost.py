@@ -1,4 +1,4 @@
-"""Issue 16: the answer path at constant cost, and starts without a lock pile-up.
+"""The answer path at constant cost, and starts without a lock pile-up.
 
 - answering a clip (GET the clip page + POST the answer) takes the same number of SQL queries with 10 and with
   2,000 participants in the study, and goes straight to the next clip (no /resume hop);
@@ -12,7 +12,6 @@ from __future__ import annotations
 
 import re
 import threading
-import time
 from collections import Counter
 
 import pytest
@@ -149,15 +148,15 @@ def test_many_starts_at_once_all_start_and_stay_balanced(settings, tmp_path):
         finally:
             connection.close()
 
-    t0 = time.perf_counter()
     threads = [threading.Thread(target=run, args=(p,)) for p in people]
     for t in threads:
         t.start()
     for t in threads:
         t.join(120)
-    elapsed = time.perf_counter() - t0
+    # every start finished (none stuck behind a lock) and succeeded; how long concurrent starts take is measured by
+    # benchmarks/flow_answer_and_start.py
+    assert not any(t.is_alive() for t in threads)
     assert Counter(results) == {"ok": len(people)}, Counter(results)
-    assert elapsed < 60
     for section in study.sections.filter(reuse_section__isnull=True):
         rows = Assignment.objects.filter(section=section, kind="")
         counts = Counter(rows.values_list("clip_id", flat=True))
