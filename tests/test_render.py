@@ -8,6 +8,7 @@ from generation.core.motion import Motion
 from generation.core.skeleton import gait_skeleton, gesture_skeleton
 from generation.render import RenderSettings, RenderSettingsError, contact_sheet, render_clip, render_frames
 from generation.render.camera import fit_distance, fixed_camera, view_offset
+from generation.render.clip import plan_cameras, prepare
 from generation.render.encode import probe_video
 from generation.render.scene import LEFT_COLOUR, RIGHT_COLOUR, bone_matrices
 
@@ -105,10 +106,30 @@ def test_short_motion_gives_short_clip_and_resampling(tmp_path):
     assert result.n_frames == 4
 
 
-def test_tracking_camera_renders(tmp_path):
-    frames = list(render_frames(swinging_walk(T=5), RenderSettings(width=160, height=120, fps=10, camera="tracking",
-                                                                   body="stick")))
-    assert len(frames) == 5 and all(_colour_pixels(f, LEFT_COLOUR) > 5 for f in frames)
+def _colour_centre_x(img: np.ndarray, colour, tol: int = 60) -> float:
+    ys, xs = np.nonzero(np.abs(img.astype(int) - np.array(colour)).max(-1) < tol)
+    return float(xs.mean())
+
+
+def test_tracking_camera_follows_the_walker_and_fixed_does_not():
+    """A walk 6 m along +z: the tracking camera's focal point moves with the root and keeps the figure in the
+    middle of the frame; the fixed camera stays put, so the figure crosses the frame."""
+    motion = swinging_walk(T=50, fps=10.0)                   # 5 s at 1.2 m/s
+    settings = {mode: RenderSettings(width=160, height=120, fps=10, camera=mode, body="stick")
+                for mode in ("tracking", "fixed")}
+    clip, positions = prepare(motion, settings["tracking"])
+    poses, info, _ = plan_cameras(clip, positions, settings["tracking"])
+    assert info["rule"] == "follow" and len(poses) == 50
+    focal_z = np.array([p.focal_point[2] for p in poses])
+    root_z = positions[:, 0, 2]
+    moved = focal_z[-1] - focal_z[0]
+    assert moved == pytest.approx(root_z[-1] - root_z[0], rel=0.25) and np.all(np.diff(focal_z) >= -1e-9)
+    fixed, fixed_info, _ = plan_cameras(clip, positions, settings["fixed"])
+    assert fixed_info["rule"] == "fixed" and all(np.array_equal(p.focal_point, fixed[0].focal_point) for p in fixed)
+    centres = {mode: [_colour_centre_x(f, LEFT_COLOUR) for f in render_frames(motion, settings[mode])][::49]
+               for mode in settings}
+    assert abs(centres["tracking"][1] - centres["tracking"][0]) < 0.15 * 160
+    assert abs(centres["fixed"][1] - centres["fixed"][0]) > abs(centres["tracking"][1] - centres["tracking"][0])
 
 
 def test_fixed_camera_keeps_every_joint_in_view():

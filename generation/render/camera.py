@@ -158,39 +158,6 @@ def _centred_fit(points: np.ndarray, focal: np.ndarray, offset: np.ndarray, view
     return focal, dist
 
 
-def tracking_cameras(positions: np.ndarray, fps: float, aspect: float, body_height: float,
-                     azimuth_deg: float = 35.0, elevation_deg: float = 10.0, view_angle: float = 30.0,
-                     smooth_s: float = 0.5) -> list[CameraPose]:
-    """A camera per frame that follows the (low-passed) root at a fixed world-space offset.
-
-    The offset direction comes from the path's first second, the distance frames a box of about
-    two body heights around the root. Returns T poses.
-    """
-    T = positions.shape[0]
-    root = positions[:, 0]
-    n_start = max(2, min(T, int(fps)))
-    travel = travel_direction(root[:n_start, [0, 2]])
-    if travel is None:
-        travel = travel_direction(root[:, [0, 2]])
-    forward = travel if travel is not None else np.array([0.0, 0.0, 1.0])
-    offset = view_offset(forward, azimuth_deg, elevation_deg)
-    half = body_height
-    box = np.array([[sx, sy, sz] for sx in (-half, half) for sy in (0.0, 1.15 * body_height)
-                    for sz in (-half, half)])
-    base_focal = np.array([0.0, 0.55 * body_height, 0.0])
-    dist = fit_distance(box, base_focal, offset, view_angle, aspect, margin=1.0)
-    k = max(1, int(round(smooth_s * fps)))
-    kernel = np.ones(k) / k
-    padded = np.pad(root[:, [0, 2]], ((k // 2, k - 1 - k // 2), (0, 0)), mode="edge")
-    smooth = np.stack([np.convolve(padded[:, i], kernel, mode="valid") for i in range(2)], axis=1)
-    ground = positions[..., 1].min()
-    poses = []
-    for t in range(T):
-        focal = np.array([smooth[t, 0], ground + 0.55 * body_height, smooth[t, 1]])
-        poses.append(CameraPose(focal + offset * dist, focal, view_angle=view_angle))
-    return poses
-
-
 def project(points: np.ndarray, pose: CameraPose, width: int, height: int) -> tuple[np.ndarray, np.ndarray, float]:
     """Pixel coordinates of points (N, 3) seen by ``pose`` in a width x height image.
 
