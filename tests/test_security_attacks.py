@@ -217,9 +217,20 @@ def test_exports_neutralise_participant_text_but_keep_negative_ratings(study):
                 assert not cell.startswith(("+", "-")) or re.fullmatch(r"[+-][\d.eE+-]+", cell), (kind, cell)
 
 
-def test_docs_tell_researchers_about_the_quote():
+def test_the_documented_quoting_is_what_exports_do():
+    """docs/study.md's rule, checked on the exporter: its example comes out as documented, every listed first
+    character is quoted, plain numbers are not, and removing the one leading quote gives the typed text back."""
+    from studyapp.export import safe_cell
+
     doc = (ROOT / "docs" / "study.md").read_text()
-    assert "formula" in doc.lower() and "single quote" in doc.lower()
+    example = re.search(r"`(=HYPERLINK\(\"x\"\))` is exported as\s+`([^`]+)`", doc)
+    assert example, "docs/study.md no longer shows the quoting example"
+    assert safe_cell(example.group(1)) == example.group(2)
+    for typed in ("=1+1", "+A1", "-A1", "@SUM(A1)", "\tx", "\rx", "\uff1d1+1"):
+        quoted = safe_cell(typed)
+        assert quoted == "'" + typed and quoted[1:] == typed
+    for number in ("-7", "-0.25", "+3", "12", 7, -0.25):
+        assert safe_cell(number) == number
 
 
 # ---- consent page: link parameters, double submit ----------------------------------------------------------
