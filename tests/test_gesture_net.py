@@ -67,15 +67,28 @@ def test_missing_text_package_gives_clear_error(monkeypatch):
         text.model_dir()
 
 
-def test_encoding_cache_round_trip(tmp_path, encoder):
-    from generation.gesture.text import cached_encodings
+def test_encoding_cache_is_read_and_extended(tmp_path, encoder, monkeypatch):
+    from generation.gesture import text
 
     sentences = ["Hello there.", "How are you today?"]
-    first = cached_encodings(sentences, tmp_path / "cache.npz")
-    assert (tmp_path / "cache.npz").is_file()
-    second = cached_encodings(sentences, tmp_path / "cache.npz")
-    for x, y in zip(first, second):
+    path = tmp_path / "cache.npz"
+    first = text.cached_encodings(sentences, path)
+    # with no encoder at all, cached sentences still come back: from the file
+    monkeypatch.setattr(text, "get_encoder", lambda: pytest.fail("encoded again instead of reading the cache"))
+    for x, y in zip(first, text.cached_encodings(sentences, path)):
         np.testing.assert_array_equal(x, y)
+    # what the file holds is what is returned (a changed entry comes back changed)
+    with np.load(path) as data:
+        stored = {k: data[k] for k in data.files}
+    stored[text.sentence_key(sentences[0])] = np.zeros((2, 384), np.float32)
+    np.savez(path, **stored)
+    assert not text.cached_encodings(sentences[:1], path)[0].any()
+    # a new sentence is encoded once and added; the old entries stay
+    monkeypatch.setattr(text, "get_encoder", lambda: encoder)
+    third = text.cached_encodings([sentences[1], "A new one."], path)
+    np.testing.assert_array_equal(third[0], first[1])
+    with np.load(path) as data:
+        assert set(data.files) == {text.sentence_key(s) for s in (*sentences, "A new one.")}
 
 
 # ---- model -------------------------------------------------------------------------------------
