@@ -30,11 +30,13 @@ EMOTIONS = (("happy", "happy", [1, 0, 0, 0]), ("sad", "sad", [0, 1, 0, 0]), ("an
             ("neutral", "normal", [0, 0, 0, 1]))
 
 
-def generated_walks(seconds: float) -> dict[str, object]:
-    """emotion -> generated Motion (plan entries resolved as generate_clips resolves them)."""
+def generated_walks(seconds: float, weights: str | None = None) -> dict[str, object]:
+    """emotion -> generated Motion (plan entries resolved as generate_clips resolves them; ``weights`` names the
+    gait network's weights, None the default)."""
+    chosen = {} if weights is None else {"weights": weights}
     plan = validate_plan({"name": "sheet", "render": {"fps": 30, "duration_s": seconds}, "clips": [
         {"id": f"gen_{emotion}", "generator": "gait_net", "fallback": "procedural_walk", "origin": "generated",
-         "emotion": vector, "trajectory": {"kind": "straight", "length_m": 10}, "seed": 7}
+         "emotion": vector, "trajectory": {"kind": "straight", "length_m": 10}, "seed": 7, **chosen}
         for emotion, _, vector in EMOTIONS]})
     out = {}
     for entry, (emotion, _, _) in zip(plan.entries, EMOTIONS):
@@ -62,12 +64,14 @@ def main() -> None:
     ap.add_argument("--out", type=Path, default=ROOT / "docs" / "img" / "real_vs_generated_gait.png")
     ap.add_argument("--step", type=float, default=0.4)
     ap.add_argument("--columns", type=int, default=6)
+    ap.add_argument("--weights", choices=("real", "procedural"), default=None,
+                    help="gait network weights of the generated walks (default: the plans' default, real)")
     a = ap.parse_args()
     from PIL import Image
 
     times = [0.5 + a.step * k for k in range(a.columns)]
     settings = RenderSettings(width=320, height=400, fps=30, duration_s=times[-1] + 0.2, camera="tracking")
-    generated = generated_walks(settings.duration_s)
+    generated = generated_walks(settings.duration_s, a.weights)
     posters, labels = [], []
     with tempfile.TemporaryDirectory() as tmp:
         for emotion, style, _ in EMOTIONS:
@@ -76,7 +80,8 @@ def main() -> None:
             if real.motion is None:
                 raise SystemExit(f"{path}: {real.row['message']}")
             gen = generated[emotion]
-            rows = ((f"REAL {style} t{a.take[-1]}", real.motion), (f"{gen.metadata.get('generator', '?')} {emotion}", gen))
+            name = f"{gen.metadata.get('generator', '?')} ({gen.metadata.get('weights_name', '?')})"
+            rows = ((f"REAL {style} t{a.take[-1]}", real.motion), (f"{name} {emotion}", gen))
             for label, motion in rows:
                 for t, img in zip(times, frames_of(motion, times, settings)):
                     p = Path(tmp) / f"{len(posters):03d}.png"

@@ -44,7 +44,9 @@ from .data import (
     wrap,
 )
 from .model import GaitNet
-from .train import DEFAULT_WEIGHTS, load_checkpoint
+from .real_seeds import real_seed
+from .train import load_checkpoint
+from .weights import DEFAULT_WEIGHTS_NAME, is_real, weights_path
 
 
 @dataclass
@@ -96,7 +98,7 @@ class LoadedGaitNet:
         return copies[str(dev)]
 
 
-_DEFAULT: LoadedGaitNet | None = None
+_DEFAULT: dict[str, LoadedGaitNet] = {}
 
 
 def load_model(path: str | Path, device: str | torch.device | None = "cpu") -> LoadedGaitNet:
@@ -105,19 +107,22 @@ def load_model(path: str | Path, device: str | torch.device | None = "cpu") -> L
     info = {k: payload[k] for k in ("trained_on", "num_parameters", "corpus", "initialised_from", "emotion_guidance")
             if k in payload}
     info["epochs"] = len(payload.get("history", []))
+    info["weights_name"] = next((n for n in ("real", "procedural") if Path(path).name == weights_path(n).name),
+                                Path(path).stem)
     return LoadedGaitNet(model, norm, str(path), info, GaitNetConfig.from_dict(payload["config"]))
 
 
-def load_default_model(device: str | torch.device | None = None) -> LoadedGaitNet:
-    """The shipped weights ``generation/data/weights/gait_net_default.pt`` (cached after the first call, on the
-    CPU; with ``device``, a copy on that device, also cached)."""
-    global _DEFAULT
-    if _DEFAULT is None:
-        if not DEFAULT_WEIGHTS.exists():
+def load_default_model(device: str | torch.device | None = None, weights: str | None = None) -> LoadedGaitNet:
+    """Shipped weights by name (``generation.gait.weights``: "real", the default, or "procedural"), cached after
+    the first call, on the CPU; with ``device``, a copy on that device, also cached."""
+    name = DEFAULT_WEIGHTS_NAME if weights is None else weights
+    path = weights_path(name)
+    if name not in _DEFAULT:
+        if not path.exists():
             raise FileNotFoundError(
-                f"default gait weights missing: {DEFAULT_WEIGHTS}; train them with `python -m generation.gait.train`")
-        _DEFAULT = load_model(DEFAULT_WEIGHTS)
-    return _DEFAULT if device is None else _DEFAULT.on(device)
+                f"{name} gait weights missing: {path}; docs/benchmarks/gait.md has the training commands")
+        _DEFAULT[name] = load_model(path)
+    return _DEFAULT[name] if device is None else _DEFAULT[name].on(device)
 
 
 # ---- emotions --------------------------------------------------------------------------------
@@ -144,10 +149,13 @@ def emotion_transition(initial, final, steps: int) -> np.ndarray:
 
 
 # ---- seeds -----------------------------------------------------------------------------------
-def _seed_motion(seed, emotion0: np.ndarray, n_frames: int, rng: np.random.Generator) -> Motion:
-    """A Motion from a seed given as Motion, WalkParams, a params dict, or None (procedural seed)."""
+def _seed_motion(seed, emotion0: np.ndarray, n_frames: int, rng: np.random.Generator, real: bool = False) -> Motion:
+    """A Motion from a seed given as Motion, WalkParams, a params dict, or None (with ``real``, a stretch of the
+    shipped captured walk of the emotion, :func:`generation.gait.real_seeds.real_seed`; else a procedural walk)."""
     if isinstance(seed, Motion):
         return seed
+    if seed is None and real:
+        return real_seed(emotion0, n_frames, rng)
     if seed is None:
         params = gait_params_for_emotion(emotion0, rng)
     elif isinstance(seed, WalkParams):
@@ -237,13 +245,13 @@ def _check_inputs(seeds, paths: list[GroundPath], emotions, steps: int) -> tuple
 _SEED_KEYS = ("q", "root", "theta", "omega", "sbar", "kappa", "ref", "aff", "offsets", "mean_height", "root_pos")
 
 
-def _seed_batch(seeds: list, emotions: np.ndarray, data: GaitDataConfig, rng: np.random.Generator
-                ) -> tuple[list[Motion], dict]:
+def _seed_batch(seeds: list, emotions: np.ndarray, data: GaitDataConfig, rng: np.random.Generator,
+                real: bool = False) -> tuple[list[Motion], dict]:
     """The seed Motions and one batch of their network-rate features, each cut to the last L steps, L being
     the shortest seed's length (at most ``data.seq_len``): dict of tensors (N, L, ...) (offsets (N, J, 3),
     mean_height (N,))."""
     n_frames = data.frame_step * (data.seq_len - 1) + 1
-    motions = [_seed_motion(s, emotions[i, 0], n_frames, rng) for i, s in enumerate(seeds)]
+    motions = [_seed_motion(s, emotions[i, 0], n_frames, rng, real) for i, s in enumerate(seeds)]
     seqs = [_seed_sequence(m, data.frame_step, data.seq_len, data.prefix_len, i) for i, m in enumerate(motions)]
     L = min(s.q.shape[1] for s in seqs)
     batch = {k: torch.cat([getattr(s, k)[:, -L:] if getattr(s, k).dim() > 1 and k != "offsets" else getattr(s, k)
@@ -384,15 +392,21 @@ def _with_seed(seed: dict, placement: _Placement, i: int, rot: np.ndarray, root:
 def _metadata(net: LoadedGaitNet, emotions: np.ndarray, path: GroundPath, seed_motion: Motion) -> dict:
     """Metadata of one generated gait with per-step emotions (steps, 4)."""
     first, last = emotions[0], emotions[-1]
+    real = is_real(net.info)
+    credit = {"training_data_licence": "CC BY-NC 4.0",
+              "training_data_citation": "Kobayashi et al. 2023, arXiv:2306.08861"} if real else {}
+    seed_take = seed_motion.metadata.get("seed_take")
     return {
         "origin": "generated", "generator": "gait_net",
         "emotion": [round(float(v), 6) for v in first],
         "final_emotion": None if np.allclose(first, last, atol=1e-6) else [round(float(v), 6) for v in last],
-        "trained_on": "synthetic procedural corpus",
+        "trained_on": net.info.get("trained_on", "synthetic procedural corpus"),
         "synthetic": True,
         "path_kind": path.kind, "steps": len(emotions), "network_fps": net.fps,
         "seed_origin": seed_motion.metadata.get("origin", "unknown"),
-        "weights": Path(net.path).name,
+        **({"seed_take": seed_take} if seed_take else {}),
+        "weights": Path(net.path).name, "weights_name": net.info.get("weights_name", Path(net.path).stem),
+        **credit,
     }
 
 
@@ -437,7 +451,8 @@ def generate_gaits(seeds, paths: list[GroundPath], emotions, steps: int = 200, f
     if device is not None:
         net = net.on(device)
     seeds, emotions = _check_inputs(seeds, paths, emotions, steps)
-    seed_motions, seed = _seed_batch(seeds, emotions, net.config.data, np.random.default_rng(rng_seed))
+    seed_motions, seed = _seed_batch(seeds, emotions, net.config.data, np.random.default_rng(rng_seed),
+                                     is_real(net.info))
     placement = _Placement.onto_paths(paths, seed)
     guidance = net.emotion_guidance if emotion_guidance is None else float(emotion_guidance)
     if guidance < 0 or not math.isfinite(guidance):

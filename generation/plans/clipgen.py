@@ -70,7 +70,7 @@ GENERATOR_MODULES = {
 WEIGHTS_DIR = Path(__file__).resolve().parent.parent / "data" / "weights"
 #: Weights files of the network generators (shipped defaults).
 GENERATOR_WEIGHTS = {
-    "gait_net": WEIGHTS_DIR / "gait_net_default.pt",
+    "gait_net": WEIGHTS_DIR / "gait_net_real.pt",   # the default of generation.gait.weights (real capture)
     "gesture_net": WEIGHTS_DIR / "gesture_net_default.pt",
 }
 
@@ -230,8 +230,8 @@ def generation_device(device: str | None = None) -> str:
 def _gait_net(entry: ClipEntry, fps: float) -> Motion:
     from generation.gait.generate import emotion_transition, generate_gaits, load_default_model  # heavy: torch
 
-    net = load_default_model(generation_device())
     inp = entry.inputs
+    net = load_default_model(generation_device(), weights=inp.get("weights"))
     steps = int(math.ceil(inp["duration_s"] * net.fps)) + 1
     if "transition" in inp:
         emotions = emotion_transition(inp["transition"]["initial"], inp["transition"]["final"], steps)[None]

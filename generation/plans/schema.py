@@ -58,6 +58,9 @@ from .captured_file import CapturedFileError, captured_file_inputs
 
 PLANS_DIR = Path(__file__).resolve().parent
 TRAJECTORY_KINDS = ("straight", "curved", "sharp_turn")
+#: Named weights of the gait network (generation.gait.weights.NAMED_WEIGHTS; named here so that validating a plan
+#: does not load torch): a gait_net entry's optional ``weights`` field, default real.
+GAIT_WEIGHTS = ("real", "procedural")
 #: Splits of the gesture network's sentence corpus (generation.gesture.data.split_sentences); a gesture_net
 #: entry may say which one its sentence comes from (a record for the study: held-out inputs are "test").
 SENTENCE_SPLITS = ("train", "val", "test")
@@ -84,7 +87,7 @@ GENERATORS: dict[str, tuple[str | None, tuple[str, ...], tuple[str, ...]]] = {
 COMMON_FIELDS = {"id", "modality", "generator", "fallback", "origin", "seed", "sections", "render", "loop", "pair",
                  "note"}
 GENERATOR_FIELDS: dict[str, set[str]] = {
-    "gait_net": {"emotion", "transition", "trajectory", "duration_s"},
+    "gait_net": {"emotion", "transition", "trajectory", "duration_s", "weights"},
     "procedural_walk": {"emotion", "transition", "trajectory", "duration_s"},
     "captured": {"clip", "cycles"},
     "neutral_walk": {"n_cycles", "speed", "base"},
@@ -260,6 +263,8 @@ def _generator_inputs(gen: str, raw: dict, duration_default: float) -> dict:
                                  "final": _emotion("transition.final", t["final"])}
         out["trajectory"] = _trajectory(raw.get("trajectory"))
         out["duration_s"] = _number("duration_s", raw.get("duration_s", duration_default), 1.0, 120.0)
+        if gen == "gait_net" and "weights" in raw:
+            out["weights"] = _choice("weights", raw["weights"], GAIT_WEIGHTS)
     elif gen == "captured_file":
         try:
             out.update(captured_file_inputs(raw))

@@ -1,0 +1,279 @@
+"""Benchmark of the gait network on held-out REAL captured walks (docs/benchmarks/gait.md, "Trained on real capture").
+
+Real data: the Bandai Namco Research Motion Dataset (Kobayashi et al. 2023, arXiv:2306.08861, CC BY-NC 4.0), via
+the real-capture corpus (``generation.mocap.real_corpus``); only its held-out ``test`` takes are measured here.
+
+1. Prediction error (seed 000 Table 1 layout) on windows of every held-out forward-locomotion take (both datasets):
+   the first ``prefix`` network steps given, the rest predicted free-running on the true ground track; mean joint
+   error over the body's bounding-box diagonal at the first predicted step, steps 2-5 and the later steps, for the
+   real-trained network, the procedural-trained network and three baselines: nearest-neighbour continuation from
+   the real training windows, constant velocity (each joint rotation and the root height continue at the last
+   step's rate) and the last pose held. Also on the emotion takes alone (dataset 1 happy/sad/angry take 2 and
+   dataset 2 normal test takes).
+2. Emotion carried, read by the real-capture observer (``generation.quality.real_observer``): generated walks of the
+   seed000 plan's gait_net entries, and walks generated from held-out seed walks (each held-out emotion take's
+   first seconds as seed, each of the four emotions asked): recognition per class, and how often each class is read
+   as neutral.
+3. Realism (``generation.quality.realism``) per asked emotion of those generated walks, beside the real takes of
+   that emotion (dataset 1 walks, both takes; dataset 2 normal walks for neutral) and the corpus's pooled range.
+
+Usage: python benchmarks/bench_gait_real.py [--real W.pt] [--procedural W.pt] [--steps 100] [--skip-plan]
+Results: var/gait_runs/bench_gait_real.json, printed as markdown.
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import sys
+import time
+from collections import defaultdict
+from pathlib import Path
+
+import numpy as np
+import torch
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))
+sys.path.insert(0, str(ROOT / "benchmarks"))
+
+from bench_gait import nearest_neighbour_errors, network_errors, pose_rotation_errors, zero_velocity_errors  # noqa: E402
+
+from generation.core.quaternion import qmul  # noqa: E402
+from generation.gait.generate import generate_gaits, load_model  # noqa: E402
+from generation.gait.real_data import RealAugment, clip_sequences, stage_clips  # noqa: E402
+from generation.gait.weights import weights_path  # noqa: E402
+from generation.mocap.real_corpus import load_real_corpus  # noqa: E402
+from generation.plans.clipgen import make_path  # noqa: E402
+from generation.quality.real_observer import default_real_observer  # noqa: E402
+from generation.quality.realism import MEASURES, realism_measures  # noqa: E402
+from generation.quality.realism_ranges import load_ranges  # noqa: E402
+from study_protocol import CAPTURE_GAIT_EMOTIONS, GAIT_EMOTIONS  # noqa: E402
+
+
+# ---- 1. prediction error -------------------------------------------------------------------------
+def constant_velocity_errors(test, prefix: int, horizon: int) -> dict:
+    """Each joint rotation keeps turning by its last step's rotation q_{P-1} q_{P-2}^-1, the root height keeps its
+    last step's rate."""
+    q1, q0 = test.q[:, prefix - 1].double(), test.q[:, prefix - 2].double()
+    conj = q0 * torch.tensor([1.0, -1.0, -1.0, -1.0], dtype=q0.dtype)
+    dq = qmul(q1, conj)
+    dq = dq * torch.sign(dq[..., :1] + 1e-12)                          # shortest arc
+    angle = 2 * torch.atan2(dq[..., 1:].norm(dim=-1), dq[..., 0])    # (N, J)
+    axis = dq[..., 1:] / dq[..., 1:].norm(dim=-1, keepdim=True).clamp_min(1e-12)
+    qs = []
+    for k in range(1, horizon + 1):
+        half = 0.5 * angle * k
+        qs.append(qmul(torch.cat((torch.cos(half)[..., None], torch.sin(half)[..., None] * axis), -1), q1))
+    h1, h0 = test.root[:, prefix - 1, 0].double(), test.root[:, prefix - 2, 0].double()
+    h = torch.stack([h1 + (h1 - h0) * k for k in range(1, horizon + 1)], 1)
+    return pose_rotation_errors(torch.stack(qs, 1).float(), h.float(), test, prefix, horizon)
+
+
+def prediction_table(nets: dict, train, test, prefix: int) -> dict:
+    horizon = test.q.shape[1] - prefix
+    out = {name: network_errors(net, test, prefix, horizon) for name, net in nets.items()}
+    out["nearest neighbour (real training windows)"] = nearest_neighbour_errors(train, test, 6, prefix, horizon)
+    out["constant velocity"] = constant_velocity_errors(test, prefix, horizon)
+    out["last pose held"] = zero_velocity_errors(test, prefix, horizon)
+    return out
+
+
+# ---- 2. emotion carried ------------------------------------------------------------------------
+def heldout_emotion_takes(max_neutral: int = 3) -> list:
+    """Held-out takes of the four emotions: dataset 1 walk take 2 (happy, sad, angry, normal where long enough) and
+    the first ``max_neutral`` dataset-2 normal walk test takes."""
+    clips = load_real_corpus(skeleton="gait", split="test", contents="walk",
+                             styles=tuple(CAPTURE_GAIT_EMOTIONS))
+    d1 = [c for c in clips if c.dataset == "bandai-namco-1"]
+    d2 = [c for c in clips if c.dataset == "bandai-namco-2"][:max_neutral]
+    return d1 + d2
+
+
+def generated_from_seeds(net, takes: list, steps: int, seed_s: float = 1.2) -> list[dict]:
+    """One walk per (held-out take, asked emotion): the take's first ``seed_s`` seconds as seed, a straight path."""
+    rows, seeds, paths, emotions = [], [], [], []
+    need = net.config.data.frame_step * (net.config.prefix_len - 1) + 1
+    for take in takes:
+        n = max(need, int(round(seed_s * take.motion.fps)))
+        if take.motion.num_frames < n:
+            continue
+        for k, emotion in enumerate(GAIT_EMOTIONS):
+            seeds.append(take.motion.slice(0, n))
+            paths.append(make_path({"kind": "straight", "length_m": 30.0}))
+            emotions.append(np.eye(4)[k])
+            rows.append({"seed": take.name, "seed_label": take.label, "asked": emotion})
+    motions = generate_gaits(seeds, paths, np.array(emotions), steps=steps, model=net)
+    for r, m in zip(rows, motions):
+        r["motion"] = m
+    return rows
+
+
+def plan_walks(weights: str) -> list[dict]:
+    """The seed000 plan's gait_net clips made with the named weights (not rendered)."""
+    import yaml
+
+    from generation.plans.clipgen import make_motion
+    from generation.plans.schema import plan_path, validate_plan
+
+    plan = yaml.safe_load(plan_path("seed000").read_text())
+    raw = [{**e, "weights": weights} for e in plan["clips"] if e.get("generator") == "gait_net"]
+    sub = validate_plan({"name": "seed000-gait", "render": plan.get("render", {}), "clips": raw})
+    rows = []
+    for entry in sub.entries:
+        inp = entry.inputs
+        vec = inp["emotion"] if "emotion" in inp else inp["transition"]["final"]
+        rows.append({"seed": entry.id, "asked": GAIT_EMOTIONS[int(np.argmax(vec))], "motion": make_motion(entry),
+                     "transition": "transition" in inp})
+    return rows
+
+
+def recognition(observer, rows: list[dict]) -> dict:
+    """Per asked emotion: share read as itself, share read as neutral, n; plus the confusion matrix."""
+    conf = np.zeros((4, 4), dtype=int)
+    for r in rows:
+        p = observer.proba(r["motion"] if "motion" in r else r)
+        r["read"] = GAIT_EMOTIONS[int(np.argmax(p))]
+        r["p"] = p.round(3).tolist()
+        conf[GAIT_EMOTIONS.index(r["asked"]), int(np.argmax(p))] += 1
+    per = {}
+    for k, e in enumerate(GAIT_EMOTIONS):
+        n = int(conf[k].sum())
+        per[e] = {"n": n, "own": conf[k, k] / n if n else None,
+                  "as_neutral": conf[k, 3] / n if n else None}
+    return {"per_class": per, "confusion": conf.tolist(),
+            "all_ge_0.8": all(v["own"] is not None and v["own"] >= 0.8 for v in per.values()),
+            "none_neutral_over_own": all(v["own"] is None or v["as_neutral"] <= v["own"] for k, v in per.items()
+                                         if k != "neutral")}
+
+
+# ---- 3. realism --------------------------------------------------------------------------------
+def real_realism() -> dict:
+    """Per emotion, the realism measures of the real forward walks of that style (all splits) as min / median /
+    max."""
+    clips = load_real_corpus(skeleton="gait", contents="walk", styles=tuple(CAPTURE_GAIT_EMOTIONS))
+    out = {}
+    for style, emotion in CAPTURE_GAIT_EMOTIONS.items():
+        vals = [realism_measures(c.motion) for c in clips if c.style == style]
+        out[emotion] = summarise(vals) | {"takes": len(vals)}
+    return out
+
+
+def summarise(vals: list[dict]) -> dict:
+    out = {}
+    for m in MEASURES:
+        v = np.array([x[m] for x in vals if x.get(m) is not None], dtype=float)
+        out[m] = None if not v.size else {"min": float(v.min()), "median": float(np.median(v)), "max": float(v.max())}
+    return out
+
+
+def generated_realism(rows: list[dict], real: dict) -> dict:
+    """Per asked emotion: the measures' medians over the generated walks, and the share of walks whose value lies in
+    the real takes' [min, max] of that emotion widened to the quality gate's bounds (the corpus's pooled 1st-99th
+    percentiles; no lower bound for the one-sided skate, skate ratio and toe skim)."""
+    thresholds = load_ranges()["thresholds"]
+    by = defaultdict(list)
+    for r in rows:
+        by[r["asked"]].append(realism_measures(r["motion"]))
+    out = {}
+    for emotion, vals in by.items():
+        s = summarise(vals)
+        inside = {}
+        for m in MEASURES:
+            ref = real[emotion].get(m)
+            # one-sided measures (skate, toe skim) have no lower bound: less sliding is never unrealistic
+            lo = -math.inf if ref is None or f"{m}_min" not in thresholds else min(ref["min"], thresholds[f"{m}_min"])
+            hi = math.inf if ref is None else max(ref["max"], thresholds.get(f"{m}_max", -math.inf))
+            v = [x[m] for x in vals if x.get(m) is not None]
+            inside[m] = float(np.mean([lo <= x <= hi for x in v])) if v else None
+        out[emotion] = {"n": len(vals), "measures": s, "inside_share": inside}
+    return out
+
+
+# ---- report ------------------------------------------------------------------------------------
+def fmt(x, nd=3):
+    return "-" if x is None else f"{x:.{nd}f}"
+
+
+def markdown(res: dict) -> str:
+    lines = []
+    for subset, table in res["prediction"].items():
+        lines += [f"\n**Prediction error, {subset}** ({table['n']} windows; prefix {res['prefix']} steps, "
+                  f"{res['horizon']} predicted)\n",
+                  "| method | pose error / body diagonal | step 1 | steps 2-5 | later steps | cm | rotation deg |",
+                  "|---|---|---|---|---|---|---|"]
+        for name, e in table["methods"].items():
+            lines.append(f"| {name} | {fmt(e['pose_error_body_diag'])} | {fmt(e['pose_error_body_diag_step1'])} | "
+                         f"{fmt(e['pose_error_body_diag_steps2_5'])} | {fmt(e['pose_error_body_diag_later'])} | "
+                         f"{fmt(e['pose_error_cm'], 1)} | {fmt(e['rotation_error_deg'], 1)} |")
+    for name, rec in res["recognition"].items():
+        lines += [f"\n**Real-capture observer, {name}**\n", "| asked | n | read as asked | read as neutral |",
+                  "|---|---|---|---|"]
+        for e, v in rec["per_class"].items():
+            lines.append(f"| {e} | {v['n']} | {fmt(v['own'], 2)} | {fmt(v['as_neutral'], 2)} |")
+    lines += ["\n**Realism per asked emotion (median of generated walks; real takes' min-max in brackets; share of "
+              "walks inside)**\n", "| weights | emotion | " + " | ".join(MEASURES) + " |",
+              "|---|---|" + "---|" * len(MEASURES)]
+    for name, table in res["realism"].items():
+        for e, v in table.items():
+            cells = []
+            for m in MEASURES:
+                g, r = v["measures"].get(m), res["real_realism"][e].get(m)
+                cells.append(f"{fmt(g and g['median'], 2)} [{fmt(r and r['min'], 2)}-{fmt(r and r['max'], 2)}] "
+                             f"{fmt(v['inside_share'][m], 2)}")
+            lines.append(f"| {name} | {e} | " + " | ".join(cells) + " |")
+    return "\n".join(lines)
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--real", default=str(weights_path("real")))
+    ap.add_argument("--procedural", default=str(weights_path("procedural")))
+    ap.add_argument("--steps", type=int, default=100, help="network steps of each generated walk (7.5 per second)")
+    ap.add_argument("--skip-plan", action="store_true")
+    ap.add_argument("--out", default="var/gait_runs/bench_gait_real.json")
+    ap.add_argument("--threads", type=int, default=1)
+    a = ap.parse_args(argv)
+    torch.set_num_threads(a.threads)
+    t0 = time.time()
+    nets = {"real-trained": load_model(a.real), "procedural-trained": load_model(a.procedural)}
+    data_cfg = nets["real-trained"].config.data
+    prefix = data_cfg.prefix_len
+    # nearest-neighbour library: every training take's windows as captured, a window every 16 frames
+    train = clip_sequences(stage_clips("pretrain", "train"), data_cfg,
+                           RealAugment(mirror=False, speed_factors=(1.0,), stride_frames=16, offsets=(0,)))
+    test_clips = stage_clips("pretrain", "test")
+    emotion_clips = [c for c in test_clips if c.style in CAPTURE_GAIT_EMOTIONS and c.content == "walk"]
+    res = {"prefix": prefix, "horizon": data_cfg.seq_len - prefix, "weights": {k: v.path for k, v in nets.items()},
+           "prediction": {}, "recognition": {}, "realism": {}}
+    for subset, clips in (("all held-out forward locomotion", test_clips), ("held-out emotion walks", emotion_clips)):
+        test = clip_sequences(clips, data_cfg, RealAugment.none())
+        res["prediction"][subset] = {"n": len(test), "takes": len(clips),
+                                     "methods": prediction_table(nets, train, test, prefix)}
+        print(f"prediction {subset}: {time.time() - t0:.0f} s", flush=True)
+    observer = default_real_observer()
+    res["observer"] = observer.source
+    res["real_realism"] = real_realism()
+    takes = heldout_emotion_takes()
+    res["seed_takes"] = [t.name for t in takes]
+    for name, net in nets.items():
+        rows = generated_from_seeds(net, takes, a.steps)
+        res["recognition"][f"{name}, held-out seed walks"] = recognition(observer, rows)
+        res["recognition"][f"{name}, held-out seed walks, seed of another emotion"] = recognition(
+            observer, [r for r in rows if r["seed_label"] != r["asked"]])
+        res["realism"][f"{name}, held-out seeds"] = generated_realism(rows, res["real_realism"])
+        res.setdefault("walks", {})[name] = [{k: v for k, v in r.items() if k != "motion"} for r in rows]
+        if not a.skip_plan:
+            plan = plan_walks("real" if name == "real-trained" else "procedural")
+            res["recognition"][f"{name}, seed000 plan"] = recognition(observer, plan)
+            res["realism"][f"{name}, seed000 plan"] = generated_realism(plan, res["real_realism"])
+        print(f"{name}: {time.time() - t0:.0f} s", flush=True)
+    res["elapsed_s"] = time.time() - t0
+    Path(a.out).parent.mkdir(parents=True, exist_ok=True)
+    Path(a.out).write_text(json.dumps(res, indent=1, default=float))
+    print(markdown(res))
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
