@@ -17,20 +17,18 @@ Prints and (``--json``) writes the median over rounds of each mode's per-round m
 from __future__ import annotations
 
 import argparse
-import json
 import os
-import platform
 import statistics
 import sys
 import tempfile
 import time
-from datetime import UTC, datetime
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
 sys.path[:0] = [str(ROOT), str(ROOT / "benchmarks")]
 
 import bench_study_load as load  # noqa: E402
+from bench_record import record  # noqa: E402
 
 KINDS = ("answer POST", "clip page")      # take_study's names of the answer POST and the clip page GET
 
@@ -120,15 +118,8 @@ def main(argv=None) -> dict:
     finally:
         if name:
             load.drop_db(args.db_url, name)
-    result = {"benchmark": "bench_page_reads", "database": "sqlite" if args.sqlite else "postgresql",
-              "participants_per_round": args.participants, "rounds": args.rounds,
-              "machine": f"{platform.node()} {platform.machine()}, {os.cpu_count()} CPUs",
-              "load_average_1m": round(os.getloadavg()[0], 1),
-              "date": datetime.now(UTC).strftime("%Y-%m-%d %H:%M UTC"), **summary(runs)}
-    print(json.dumps(result, indent=1))
-    if args.json:
-        Path(args.json).write_text(json.dumps(result, indent=1) + "\n")
-    return result
+    return record({"benchmark": "bench_page_reads", "database": "sqlite" if args.sqlite else "postgresql",
+                   "participants_per_round": args.participants, "rounds": args.rounds, **summary(runs)}, args.json)
 
 
 if __name__ == "__main__":

@@ -10,14 +10,11 @@ wall time of ``start_build`` and waits for the build to end before the next roun
 from __future__ import annotations
 
 import argparse
-import json
 import os
-import platform
 import statistics
 import sys
 import tempfile
 import time
-from datetime import UTC, datetime
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -33,6 +30,7 @@ def main(argv=None) -> dict:
     os.environ.update(DATA_DIR=str(data), REPORTS_DIR=str(data / "reports"))
     os.environ.pop("DATABASE_URL", None)
     import bench_study_load as load
+    from bench_record import record
 
     study = load.setup_django(f"sqlite:///{data / 'db.sqlite3'}", data / "media")
     from studyapp import reports
@@ -48,14 +46,8 @@ def main(argv=None) -> dict:
         build_s.append(time.perf_counter() - t)
     result = {"benchmark": "bench_report_start", "rounds": args.rounds,
               "start_build_ms": {"median": round(statistics.median(start_ms), 1), "max": round(max(start_ms), 1)},
-              "whole_build_s_median": round(statistics.median(build_s), 1),
-              "machine": f"{platform.node()} {platform.machine()}, {os.cpu_count()} CPUs",
-              "load_average_1m": round(os.getloadavg()[0], 1),
-              "date": datetime.now(UTC).strftime("%Y-%m-%d %H:%M UTC")}
-    print(json.dumps(result, indent=1))
-    if args.json:
-        Path(args.json).write_text(json.dumps(result, indent=1) + "\n")
-    return result
+              "whole_build_s_median": round(statistics.median(build_s), 1)}
+    return record(result, args.json)
 
 
 if __name__ == "__main__":

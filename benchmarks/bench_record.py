@@ -1,0 +1,21 @@
+"""The record every benchmark result carries (machine, load, date), printed and optionally written as JSON."""
+from __future__ import annotations
+
+import json
+import os
+import platform
+from datetime import UTC, datetime
+from pathlib import Path
+
+
+def record(result: dict, json_path: str | Path | None = None) -> dict:
+    """``result`` with ``machine``, ``load_average_1m`` and ``date`` added; printed, and written to ``json_path``
+    when given. Returns the completed record."""
+    result = {**result, "machine": f"{platform.node()} {platform.machine()}, {os.cpu_count()} CPUs",
+              "load_average_1m": round(os.getloadavg()[0], 1),
+              "date": datetime.now(UTC).strftime("%Y-%m-%d %H:%M UTC")}
+    text = json.dumps(result, indent=1)
+    print(text)
+    if json_path:
+        Path(json_path).write_text(text + "\n")
+    return result
