@@ -154,7 +154,7 @@ class StudyAdminForm(forms.ModelForm):
         rules = self.cleaned_data.get("exclusion_rules")
         rules = {} if rules is None else rules
         try:
-            from analysis.exclusion import rule_errors
+            from analysis.exclusion import rule_errors  # optional: the analysis library may be absent
         except ImportError as exc:
             raise forms.ValidationError(
                 "analysis library not installed: the exclusion rules cannot be checked (analysis.exclusion."

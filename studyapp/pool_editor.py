@@ -23,6 +23,7 @@ they own and the raw JSON contributes only its leftover keys.
 from __future__ import annotations
 
 from django import forms
+from django.utils.html import format_html, format_html_join
 
 from study_pools import (
     COMMON_OPTIONS,
@@ -105,8 +106,6 @@ class DatalistInput(forms.TextInput):
         self.suggestions = list(suggestions)
 
     def render(self, name, value, attrs=None, renderer=None):
-        from django.utils.html import format_html, format_html_join
-
         list_id = f"{(attrs or {}).get('id', name)}_suggestions"
         box = super().render(name, value, {**(attrs or {}), "list": list_id}, renderer)
         options = format_html_join("", '<option value="{}">', ((s,) for s in self.suggestions))

@@ -11,6 +11,7 @@ import hashlib
 import math
 import secrets
 
+from django.conf import settings
 from django.db import IntegrityError, transaction
 from django.http import Http404, HttpResponse
 from django.shortcuts import get_object_or_404, redirect, render
@@ -29,7 +30,7 @@ from .duration import expected_minutes
 from .forms import PARAM_MAX_LENGTH, PARAM_TOO_LONG, ConsentForm, DemographicsForm, FeedbackForm
 from .i18n import activate_study_language
 from .item_questions import questions_html
-from .media import media_path, ranged_file_response
+from .media import accel_redirect_response, media_path, ranged_file_response
 from .models import Assignment, Clip, Participant, Response, Study
 from .page_reads import participant_by_token
 from .questions import AnswerError, clean_answers, questions_for
@@ -460,9 +461,7 @@ def done(request, token: str):
 def media(request, key: str, ext: str):
     """A clip's MP4/WebM/poster by its opaque media key, with HTTP Range support; behind nginx
     (settings.MEDIA_ACCEL_REDIRECT) the bytes are handed to nginx with X-Accel-Redirect after this lookup."""
-    from django.conf import settings
 
-    from .media import accel_redirect_response
 
     clip = get_object_or_404(Clip, media_key=key)
     relative = {"mp4": clip.video, "webm": clip.webm, "png": clip.poster}.get(ext, "")

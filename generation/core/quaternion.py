@@ -17,7 +17,7 @@ if TYPE_CHECKING:
 
 def qmul(q: torch.Tensor, r: torch.Tensor) -> torch.Tensor:
     """Hamilton product q * r, shapes (..., 4) broadcast."""
-    import torch
+    import torch  # heavy: only the torch functions load torch
     w1, x1, y1, z1 = q.unbind(-1)
     w2, x2, y2, z2 = r.unbind(-1)
     return torch.stack(
@@ -43,7 +43,7 @@ def qnormalize(q: torch.Tensor, eps: float = 1e-8) -> torch.Tensor:
 
 def qrot(q: torch.Tensor, v: torch.Tensor) -> torch.Tensor:
     """Rotate vectors v (..., 3) by unit quaternions q (..., 4); leading shapes broadcast."""
-    import torch
+    import torch  # heavy: only the torch functions load torch
     qvec = q[..., 1:]
     uv = torch.cross(qvec.expand(torch.broadcast_shapes(qvec.shape, v.shape)),
                      v.expand(torch.broadcast_shapes(qvec.shape, v.shape)), dim=-1)
@@ -53,7 +53,7 @@ def qrot(q: torch.Tensor, v: torch.Tensor) -> torch.Tensor:
 
 def qfrom_axis_angle(axis: torch.Tensor, angle: torch.Tensor) -> torch.Tensor:
     """Quaternion from axis (..., 3) (normalised here) and angle (...) in radians."""
-    import torch
+    import torch  # heavy: only the torch functions load torch
     axis = axis / axis.norm(dim=-1, keepdim=True).clamp_min(1e-12)
     half = 0.5 * angle
     return torch.cat((torch.cos(half)[..., None], torch.sin(half)[..., None] * axis), dim=-1)
@@ -61,7 +61,7 @@ def qfrom_axis_angle(axis: torch.Tensor, angle: torch.Tensor) -> torch.Tensor:
 
 def qbetween(u: torch.Tensor, v: torch.Tensor) -> torch.Tensor:
     """Shortest-arc unit quaternion rotating direction u (..., 3) onto direction v (..., 3)."""
-    import torch
+    import torch  # heavy: only the torch functions load torch
     u = u / u.norm(dim=-1, keepdim=True).clamp_min(1e-12)
     v = v / v.norm(dim=-1, keepdim=True).clamp_min(1e-12)
     dot = (u * v).sum(-1, keepdim=True)
@@ -79,7 +79,7 @@ def qbetween(u: torch.Tensor, v: torch.Tensor) -> torch.Tensor:
 
 def qfix(q: torch.Tensor) -> torch.Tensor:
     """Flip signs along time (dim -3 of (..., T, J, 4)) so consecutive quaternions have w-continuity."""
-    import torch
+    import torch  # heavy: only the torch functions load torch
     out = q.clone()
     dots = (out[..., 1:, :, :] * out[..., :-1, :, :]).sum(-1)
     flips = (torch.cumsum((dots < 0).to(torch.int64), dim=-2) % 2).bool()
@@ -89,7 +89,7 @@ def qfix(q: torch.Tensor) -> torch.Tensor:
 
 def qslerp(q0: torch.Tensor, q1: torch.Tensor, t: torch.Tensor | float) -> torch.Tensor:
     """Spherical interpolation between unit quaternions (..., 4) at fraction t (broadcast (...))."""
-    import torch
+    import torch  # heavy: only the torch functions load torch
     t = torch.as_tensor(t, dtype=q0.dtype, device=q0.device)
     dot = (q0 * q1).sum(-1, keepdim=True)
     q1 = torch.where(dot < 0, -q1, q1)
@@ -113,7 +113,7 @@ def qeuler(q: torch.Tensor, order: str = "zyx", eps: float = 1e-7) -> torch.Tens
     the result [a, b, c] satisfies q = R_order[0](a) * R_order[1](b) * R_order[2](c) for "xyz"
     style orders. Supported: xyz, yzx, zxy, xzy, yxz, zyx.
     """
-    import torch
+    import torch  # heavy: only the torch functions load torch
     q0, q1, q2, q3 = q[..., 0], q[..., 1], q[..., 2], q[..., 3]
     if order == "xyz":
         x = torch.atan2(2 * (q0 * q1 - q2 * q3), 1 - 2 * (q1 * q1 + q2 * q2))
@@ -163,7 +163,7 @@ def qfrom_euler(angles: torch.Tensor, order: str = "zyx") -> torch.Tensor:
 
 def qto_matrix(q: torch.Tensor) -> torch.Tensor:
     """Unit quaternions (..., 4) to rotation matrices (..., 3, 3)."""
-    import torch
+    import torch  # heavy: only the torch functions load torch
     w, x, y, z = q.unbind(-1)
     return torch.stack(
         (
@@ -177,7 +177,7 @@ def qto_matrix(q: torch.Tensor) -> torch.Tensor:
 
 def qangle(q: torch.Tensor, r: torch.Tensor) -> torch.Tensor:
     """Geodesic angle in radians between unit quaternions (..., 4), in [0, pi]."""
-    import torch
+    import torch  # heavy: only the torch functions load torch
     dot = (q * r).sum(-1).abs().clamp(max=1.0)
     return 2.0 * torch.acos(dot)
 

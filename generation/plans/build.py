@@ -31,7 +31,7 @@ import yaml
 
 from generation.gesture.config import gesture_seconds
 from generation.gesture.text import count_words
-from study_protocol import GAIT_EMOTIONS, GESTURE_EMOTIONS, GESTURE_TASKS, THEMES
+from study_protocol import CAPTURE_GESTURE_EMOTIONS, GAIT_EMOTIONS, GESTURE_EMOTIONS, GESTURE_TASKS, THEMES
 
 from .schema import CAPTURED_CLIPS
 
@@ -144,7 +144,6 @@ def real_source_gestures(content: str = REAL_SOURCE_CONTENT, styles=None) -> lis
     """``captured_file`` entries of the shipped real ``content`` takes (take 001) in each captured style that names a
     gesture emotion (``study_protocol.CAPTURE_GESTURE_EMOTIONS``; default all five), seated on the chair, labelled
     with that emotion, for the naturalness and gesture-emotion sections."""
-    from study_protocol import CAPTURE_GESTURE_EMOTIONS
 
     styles = tuple(CAPTURE_GESTURE_EMOTIONS) if styles is None else tuple(styles)
     return [{"id": f"real_{content}_{style}", "generator": "captured_file", "modality": "gesture", "origin": "source",

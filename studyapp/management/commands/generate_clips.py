@@ -15,6 +15,17 @@ from pathlib import Path
 
 from django.conf import settings
 from django.core.management.base import BaseCommand, CommandError
+from tqdm import tqdm
+
+from generation.core.device import resolve_device
+from generation.pipeline.plan_qa import summary_line, unread_line
+from generation.pipeline.runner import run_plan
+from generation.plans.catalogue import write_clips_csv
+from generation.plans.clipgen import DEVICE_ENV
+from generation.plans.schema import PlanError, load_plan
+from generation.quality.checks import resolve_thresholds
+from generation.render import contact_sheet
+from studyapp.catalogue import clip_label, retire_superseded, upsert_clips
 
 
 class Command(BaseCommand):
@@ -40,10 +51,6 @@ class Command(BaseCommand):
                                  "of local worker processes")
 
     def handle(self, *args, **opts):
-        from generation.pipeline.runner import run_plan
-        from generation.plans.catalogue import write_clips_csv
-        from generation.plans.schema import PlanError, load_plan
-
         if opts["workers"] < 1:
             raise CommandError(f"--workers must be at least 1, got {opts['workers']}")
         if opts["limit"] is not None and opts["limit"] < 1:
@@ -53,8 +60,6 @@ class Command(BaseCommand):
         except PlanError as exc:
             raise CommandError(str(exc)) from None
         os.environ.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow")
-        from generation.core.device import resolve_device
-        from generation.plans.clipgen import DEVICE_ENV
 
         try:
             os.environ[DEVICE_ENV] = str(resolve_device(opts["device"]))  # inherited by the render workers
@@ -79,11 +84,6 @@ class Command(BaseCommand):
         if records:
             write_clips_csv(records, csv_path)
         if records and not opts["no_db"]:
-            try:
-                from studyapp.catalogue import retire_superseded, upsert_clips
-            except ImportError as exc:
-                raise CommandError(f"clips rendered and {csv_path} written, but the database catalogue is not "
-                                   f"available ({exc})") from None
             upsert_clips(records)
             complete = opts["limit"] is None and not result.failed
             entries = None if complete else {str(r.get("metadata", {}).get("entry_id")) for r in records}
@@ -94,16 +94,10 @@ class Command(BaseCommand):
         self.stdout.write(f"plan {plan.name}: {len(result.rendered)} rendered, {len(result.skipped)} already done, "
                           f"{len(result.failed)} failed, {result.seconds:.1f} s; catalogue {csv_path}")
         if records:
-            from generation.pipeline.plan_qa import summary_line, unread_line
-            from generation.quality.checks import resolve_thresholds
-
             self.stdout.write(f"plan {plan.name}: " + summary_line(r.get("qa_flag", "") for r in records))
             if unread := unread_line(records, resolve_thresholds(plan.qa)["observer"]):
                 self.stdout.write(f"plan {plan.name}: {unread}")
         if opts["contact_sheet"] is not None and records:
-            from generation.render import contact_sheet
-            from studyapp.catalogue import clip_label
-
             out = Path(opts["contact_sheet"]) if opts["contact_sheet"] else (
                 Path(settings.DATA_DIR) / "contact_sheets" / f"{plan.name}.png")
             labels = [clip_label(r) for r in records]
@@ -128,7 +122,6 @@ class _Bars:
     def event(self, kind: str, info: dict) -> None:
         if self.disabled:
             return
-        from tqdm import tqdm
 
         if kind == "plan":
             self.overall = tqdm(total=info["todo"], desc=f"clips ({info['skipped']} already done)", unit="clip",
