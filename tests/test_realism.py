@@ -113,12 +113,12 @@ def test_realism_bounds_come_from_one_file_and_plans_override_them():
     assert th["observer"] in ("real", "synthetic")
     values = {"pelvis_bounce_cm": th["pelvis_bounce_cm_max"] + 5, "speed_cv": th["speed_cv_min"] / 2,
               "stance_knee_deg": 170.0}
-    # the knee bounds are recorded but not applied (see realism_ranges.NOT_APPLIED); a plan may set them
-    assert th["stance_knee_deg_max"] is None and th["stance_knee_deg_min"] is None
-    assert out_of_range(values, th) == [f"pelvis_bounce_cm>{th['pelvis_bounce_cm_max']:g}",
+    assert out_of_range(values, th) == [f"stance_knee_deg>{th['stance_knee_deg_max']:g}",
+                                        f"pelvis_bounce_cm>{th['pelvis_bounce_cm_max']:g}",
                                         f"speed_cv<{th['speed_cv_min']:g}"]
     assert "realism" in failed_checks(values, th)
-    relaxed = resolve_thresholds({"pelvis_bounce_cm_max": None, "speed_cv_min": 0, "observer": "synthetic"})
+    relaxed = resolve_thresholds({"pelvis_bounce_cm_max": None, "speed_cv_min": 0, "stance_knee_deg_max": None,
+                                  "observer": "synthetic"})
     assert "realism" not in failed_checks(values, relaxed) and relaxed["observer"] == "synthetic"
     assert out_of_range(values, resolve_thresholds({"stance_knee_deg_max": 60})) == [
         "stance_knee_deg>60", f"pelvis_bounce_cm>{th['pelvis_bounce_cm_max']:g}", f"speed_cv<{th['speed_cv_min']:g}"]

@@ -14,10 +14,8 @@ Threshold keys (the plan's ``qa:`` block overrides them; null switches a bound o
 measure and ``<measure>_min`` for the two-sided ones, e.g. ``stance_knee_deg_max``.
 
 Bounds listed in :data:`NOT_APPLIED` are computed and recorded but not applied (None) until their reason is gone; a
-plan may still set them. The stance-knee bounds are there: the retargeted real walks never straighten the knee
-(smallest knee flexion 25-29 degrees in each of the 8 shipped walks, where the source BVH of the same takes reaches
-0-5 degrees; median +9 to +12 degrees), so the corpus's knee range says more about the retargeting than about the
-actors.
+plan may still set them. None are listed now: the stance-knee bounds apply since the retargeting puts our hips on
+the source's (before, the legs fell short of the feet and real knees stayed 9-12 degrees too bent).
 
     python -m generation.quality.realism_ranges [--corpus PATH] [--out JSON]   # recompute from the corpus
 """
@@ -39,10 +37,8 @@ TWO_SIDED = ("stance_knee_deg", "pelvis_bounce_cm", "speed_cv")
 LOW_PCT, HIGH_PCT = 1.0, 99.0
 REPORT_PCTS = (1, 5, 50, 95, 99)
 _CACHE: dict[str, dict] = {}
-_KNEE_REASON = ("retargeted real walks never straighten the knee (min flexion 25-29 deg vs 0-5 deg in the source "
-                "BVH of the same takes); the corpus's knee range reflects the retargeting")
 #: Bounds recorded but not applied, with the reason (kept in the ranges file's ``not_applied``).
-NOT_APPLIED = {"stance_knee_deg_min": _KNEE_REASON, "stance_knee_deg_max": _KNEE_REASON}
+NOT_APPLIED: dict[str, str] = {}
 
 
 def threshold_keys() -> tuple[str, ...]:
