@@ -59,7 +59,8 @@ def frames_of(motion, times, settings) -> list:
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--takes", type=Path, default=ROOT / "generation" / "data" / "mocap" / "bandai-namco")
+    ap.add_argument("--takes", type=Path, default=ROOT / "generation" / "data" / "mocap" / "bandai-namco"
+                    / "Bandai-Namco-Research-Motiondataset-1" / "data")
     ap.add_argument("--take", default="001", help="take number of the real files (default 001)")
     ap.add_argument("--out", type=Path, default=ROOT / "docs" / "img" / "real_vs_generated_gait.png")
     ap.add_argument("--step", type=float, default=0.4)

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 import torch
 
-from generation.core.paths import straight
+from generation.core.paths import curved, straight
 from generation.core.skeleton import gait_skeleton
 from generation.gait.config import GaitDataConfig, GaitNetConfig
 from generation.gait.real_data import (
@@ -164,7 +164,7 @@ def test_real_seed_is_a_stretch_of_the_shipped_walk_of_the_emotion():
 
 @pytest.mark.slow
 def test_shipped_real_weights_are_the_default_and_generate():
-    from generation.gait.generate import generate_gaits, load_default_model
+    from generation.gait.generate import emotion_transition, generate_gaits, load_default_model
     if not weights_path("real").exists():
         pytest.fail(f"real-trained weights missing: {weights_path('real')}")
     net = load_default_model()
@@ -174,6 +174,13 @@ def test_shipped_real_weights_are_the_default_and_generate():
     assert meta["weights_name"] == "real" and meta["seed_origin"] == "captured" and "angry" in meta["seed_take"]
     assert meta["training_data_licence"] == "CC BY-NC 4.0"
     assert np.linalg.norm(m.root_positions[-1, [0, 2]] - m.root_positions[0, [0, 2]]) > 1.0   # it walks
+    # a 210-step (28 s) transition on a curved path: finite, planted feet, keeps walking to the end
+    em = emotion_transition([1, 0, 0, 0], [0, 1, 0, 0], 210)[None]
+    (long,) = generate_gaits(None, [curved(5.0, 1.0, 40.0)], em, steps=210, model=net, rng_seed=2)
+    assert long.num_frames == 209 * 4 + 1 and np.isfinite(long.rotations).all() and "foot_cleanup" in long.metadata
+    assert long.metadata["final_emotion"] == [0.0, 1.0, 0.0, 0.0]
+    last = np.linalg.norm(np.diff(long.root_positions[-60:, [0, 2]], axis=0), axis=1).sum()
+    assert last > 1.0                                                                   # still walking at the end
     proc = load_default_model(weights="procedural")
     assert proc.info["weights_name"] == "procedural" and proc.info["trained_on"] == "synthetic procedural corpus"
     (p,) = generate_gaits(None, [straight(20.0)], np.array([[0, 0, 1.0, 0]]), steps=10, model=proc)
