@@ -14,6 +14,7 @@ A plan is a YAML (or JSON) file::
         origin: generated           # generated | source
         emotion: [1, 0, 0, 0]       # happy, sad, angry, neutral (l1-normalised)
         trajectory: {kind: straight, length_m: 12}
+        weights: real               # optional, gait_net: real (default, trained on real capture) | procedural
         seed: 1
         sections: [emotion_choice]  # optional hint for the study set-up
         render: {camera: tracking}  # optional per-clip render overrides
