@@ -407,6 +407,16 @@ def arousal_sheet(net, path: Path, sentence: str = AROUSAL_SHEET_SENTENCE) -> li
     return info
 
 
+REAL_SECTION_MARKER = "<!-- real-capture section (benchmarks/bench_gesture_real.py); kept by bench_gesture.py -->"
+
+
+def keep_real_section(old: str, new: str) -> str:
+    """``new`` followed by the real-capture section of ``old`` (from REAL_SECTION_MARKER on), so a rerun of this
+    benchmark keeps the section written from benchmarks/bench_gesture_real.py's measurements."""
+    at = old.find(REAL_SECTION_MARKER)
+    return new if at < 0 else new.rstrip("\n") + "\n\n" + old[at:]
+
+
 # ---- main -------------------------------------------------------------------------------------------
 def _args(argv):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
@@ -501,7 +511,8 @@ def main(argv=None):
     results["arousal_sheet"] = arousal_sheet(net, Path(args.arousal_sheet))
     config.VAR_DIR.mkdir(parents=True, exist_ok=True)
     (config.VAR_DIR / "bench.json").write_text(json.dumps(results, indent=1, default=float))
-    Path(args.out).write_text(render_markdown(results))
+    out = Path(args.out)
+    out.write_text(keep_real_section(out.read_text() if out.is_file() else "", render_markdown(results)))
     print(f"wrote {args.out}")
 
 

@@ -72,23 +72,38 @@ def medians(rows: list[dict]) -> dict:
             for e in EMOTIONS if any(r["emotion"] == e for r in rows)}
 
 
-def network_report(path: str, data, real_obs: RealGestureObserver, ranges: dict, fps_passes: int) -> dict:
+def network_report(path: str, data, real_obs: RealGestureObserver, ranges: dict,
+                   limit: int | None = None) -> dict:
+    """The real-vs-generated statistics, pose error, r and speed of one weights file on the test split (its first
+    ``limit`` examples when given, for a quick check)."""
     torch.set_num_threads(1)
     net = load_model(path)
-    test = data.indices("test")
+    test = data.indices("test")[:limit]
     gen = generated_stats(net, data, test)
     pose = dataset_pose_error(decode_examples(net, data, test), data, test)
     live = liveliness(net, data, test)
     X = np.stack([features_of_positions(r["P"], data.fps) for r in gen])
     read = real_obs.predict(X)
     truth = np.array([r["emotion"] for r in gen])
-    speed = speed_benchmark(net, n_sentences=10, repeats=fps_passes)
     return {"weights": path, "medians": medians(gen), "in_range": in_range_share(gen, ranges),
-            "pose_error": pose["pose_error"], "r_peak_arousal": live["r_gen"], "output_fps": speed["output_fps"],
-            "output_fps_range": [speed["output_fps_min"], speed["output_fps_max"]],
+            "pose_error": pose["pose_error"], "r_peak_arousal": live["r_gen"],
             "real_observer_on_generated": {"accuracy": float((read == truth).mean()),
                                            "per_emotion": {e: {lab: int(((truth == e) & (read == lab)).sum())
                                                                for lab in real_obs.labels} for e in EMOTIONS}}}
+
+
+def interleaved_speed(report: dict, passes: int) -> None:
+    """Generation speed (bench_gesture.speed_benchmark, 10 sentences, output 30 fps) of every measured network,
+    one pass of each in turn, ``passes`` times, so that the shared CPU's load falls alike on all; adds
+    output_fps (median over passes) and output_fps_range to each network's report."""
+    entries = {"before": report["before"], "after": report["after"], **report["candidates"]}
+    nets = {k: load_model(v["weights"]) for k, v in entries.items()}
+    runs: dict[str, list[float]] = {k: [] for k in entries}
+    for _ in range(passes):
+        for k, net in nets.items():
+            runs[k].append(speed_benchmark(net, n_sentences=10, repeats=1)["output_fps"])
+    for k, v in entries.items():
+        v["output_fps"], v["output_fps_range"] = float(np.median(runs[k])), [min(runs[k]), max(runs[k])]
 
 
 def contact_sheet(nets: dict, real: dict, path: Path) -> list[str]:
@@ -146,7 +161,9 @@ def main(argv=None) -> dict:
     p.add_argument("--before", required=True)
     p.add_argument("--after", required=True)
     p.add_argument("--sheet", default=None, help="write the contact sheet PNG here")
+    p.add_argument("--candidates", nargs="*", default=[], help="more weights to measure (the runs not chosen)")
     p.add_argument("--fps-passes", type=int, default=3)
+    p.add_argument("--limit", type=int, default=None, help="only the first N test examples (a quick check)")
     p.add_argument("--out", default=str(ROOT / "var" / "gesture" / "bench_real.json"))
     args = p.parse_args(argv)
 
@@ -163,7 +180,9 @@ def main(argv=None) -> dict:
     report = {"real": {"n": len(rows), "medians": medians(rows), "ranges": ranges, "takes": [r["name"] for r in rows]},
               "observer_emotions": obs_eval, "observer_styles": style_eval, "gate_ready": gate_ready(obs_eval)}
     for who in ("before", "after"):
-        report[who] = network_report(getattr(args, who), data, real_obs, ranges, args.fps_passes)
+        report[who] = network_report(getattr(args, who), data, real_obs, ranges, args.limit)
+    report["candidates"] = {c: network_report(c, data, real_obs, ranges, args.limit) for c in args.candidates}
+    interleaved_speed(report, args.fps_passes)
     if args.sheet:
         nets = {"before": load_model(args.before), "after": load_model(args.after)}
         bye = {CAPTURE_GESTURE_EMOTIONS[s]: (n, m) for n, s, m in real if n.split("_")[1] == "bye"}
@@ -171,6 +190,10 @@ def main(argv=None) -> dict:
     Path(args.out).parent.mkdir(parents=True, exist_ok=True)
     Path(args.out).write_text(json.dumps(report, indent=1, default=float), encoding="utf-8")
     print(render_markdown(report))
+    for c, v in report["candidates"].items():
+        share = np.mean([x for e in EMOTIONS for x in v["in_range"][e].values()])
+        print(f"candidate {c}: share in real range {share:.3f}, pose error {v['pose_error']:.4f}, "
+              f"r {v['r_peak_arousal']:.3f}, fps {v['output_fps']:.0f}")
     return report
 
 

@@ -97,7 +97,7 @@ def held_out_accuracy(X: np.ndarray, y: np.ndarray, groups: np.ndarray, C: float
     for g in np.unique(groups):
         test = groups == g
         pred[test] = RealGestureObserver(X[~test], y[~test], C).predict(X[test])
-    labels = sorted(np.unique(y))
+    labels = [str(v) for v in sorted(np.unique(y))]
     confusion = [[int(((y == a) & (pred == b)).sum()) for b in labels] for a in labels]
     return {"accuracy": float((pred == y).mean()), "n": int(len(y)),
             "per_group": {str(g): float((pred[groups == g] == y[groups == g]).mean()) for g in np.unique(groups)},
