@@ -174,6 +174,12 @@ CLIP_INT_COLUMNS = ("n_features",)
 QA_CHECKS = ("foot_skate", "penetration", "jerk", "bone_error", "figure_height", "observer", "realism")
 """Quality checks; a clip's ``qa_flag`` joins the names of those it failed with ';' (empty = passed)."""
 
+QA_ADVISORY_CHECKS = ("realism",)
+"""Checks that flag a clip for the researcher without keeping it out of study pools. ``realism`` compares a clip's
+foot skate, toe skimming, stance knee, pelvis bounce and speed variability with the real corpus's 1st-99th
+percentiles over whole takes: it also flags 10 % of held-out real takes and some real source clips cut to the render
+length, so it informs (the admin's quality filter, clips.csv) rather than excludes."""
+
 QA_REALISM_COLUMNS = ("qa_skate_cm_s", "qa_skate_ratio", "qa_toe_skim", "qa_stance_knee_deg", "qa_pelvis_bounce_cm",
                       "qa_speed_cv")
 """Realism measures of gait clips (generation/quality/realism.py): foot speed near the floor (cm/s), GMD's

@@ -10,14 +10,28 @@ record, a dict: generation.quality) and `qa_flag` (failed checks joined by ';', 
 from __future__ import annotations
 
 import math
+from itertools import combinations
 
 from django.db import transaction
 from django.db.models import QuerySet
 
 from study_pools import INCLUDE_FLAGGED, PoolError, pool_lookups
-from study_protocol import CLIP_FLOAT_COLUMNS, CLIP_THEMES, GESTURE_EMOTIONS, MODALITIES, ORIGINS, QA_CHECKS
+from study_protocol import (
+    CLIP_FLOAT_COLUMNS,
+    CLIP_THEMES,
+    GESTURE_EMOTIONS,
+    MODALITIES,
+    ORIGINS,
+    QA_ADVISORY_CHECKS,
+    QA_CHECKS,
+)
 
 from .models import Clip
+
+#: ``qa_flag`` values that keep a clip in pools: passed, or failed only advisory checks (in QA_CHECKS order).
+ADVISORY_FLAGS = ("", *(";".join(c for c in QA_CHECKS if c in subset)
+                        for n in range(1, len(QA_ADVISORY_CHECKS) + 1)
+                        for subset in combinations(QA_ADVISORY_CHECKS, n)))
 
 TEXT_FIELDS = ("emotion_label", "theme", "webm", "poster", "plan", "source_clip_id")
 
@@ -146,8 +160,8 @@ def pool_queryset(pool: dict | None, include_flagged: bool | None = None) -> Que
 
     Clips that failed a quality check (``qa_flag`` not empty) are left out unless the pool says
     ``"include_flagged": true`` or ``include_flagged`` is given (True for a sub-pool, which only narrows its
-    section's pool). Raises CatalogueError naming the filter when the pool is not valid; sub-pools are left to the
-    assignment.
+    section's pool); failing only advisory checks (``study_protocol.QA_ADVISORY_CHECKS``) does not count.
+    Raises CatalogueError naming the filter when the pool is not valid; sub-pools are left to the assignment.
     """
     try:
         calls = pool_lookups(pool)
@@ -157,7 +171,7 @@ def pool_queryset(pool: dict | None, include_flagged: bool | None = None) -> Que
     if include_flagged is None:
         include_flagged = bool((pool or {}).get(INCLUDE_FLAGGED, False))
     if not include_flagged:
-        qs = qs.filter(qa_flag="")
+        qs = qs.filter(qa_flag__in=ADVISORY_FLAGS)
     for method, kwargs in calls:
         qs = getattr(qs, method)(**kwargs)
     return qs

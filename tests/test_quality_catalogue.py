@@ -37,6 +37,14 @@ def test_flagged_clip_stays_out_of_pools_unless_included():
     assert pool_queryset({}).count() == 2
 
 
+@pytest.mark.django_db
+def test_advisory_realism_flag_keeps_a_clip_in_pools():
+    upsert_clips([rec("real_like", "realism"), rec("off_emotion", "observer;realism"), rec("good")])
+    assert set(pool_queryset({"modality": "gait"}).values_list("clip_id", flat=True)) == {"real_like", "good"}
+    flagged = pool_queryset({"modality": "gait", "include_flagged": True})
+    assert set(flagged.values_list("clip_id", flat=True)) == {"real_like", "off_emotion", "good"}
+
+
 def test_include_flagged_is_a_boolean_pool_switch():
     assert pool_errors({"include_flagged": True, "modality": "gait"}) == []
     assert any("include_flagged" in e for e in pool_errors({"include_flagged": "yes"}))
@@ -114,7 +122,10 @@ def test_generate_clips_flags_feet_through_the_floor_and_prints_a_summary(settin
     settings.MEDIA_ROOT = tmp_path / "media"
     settings.DATA_DIR = tmp_path / "data"
     plan = tmp_path / "qa.yaml"
-    plan.write_text(yaml.safe_dump({"name": "qa", "render": TINY, "clips": PLAN_CLIPS}))
+    from generation.quality.realism_ranges import threshold_keys
+
+    no_realism = {k: None for k in threshold_keys()}    # this test is about the floor: procedural walks crouch
+    plan.write_text(yaml.safe_dump({"name": "qa", "render": TINY, "clips": PLAN_CLIPS, "qa": no_realism}))
     _sink_entry(monkeypatch, "walk_sunk")
     out = io.StringIO()
     call_command("generate_clips", "--plan", str(plan), "--no-progress", stdout=out, stderr=io.StringIO())
@@ -127,7 +138,8 @@ def test_generate_clips_flags_feet_through_the_floor_and_prints_a_summary(settin
     assert sunk.metadata["entry_id"] == "walk_sunk" and sunk.qa["penetration_cm"] > 4
     assert list(pool_queryset({"plan": "qa"}).values_list("metadata__entry_id", flat=True)) == ["walk_ok"]
     # A rerun renders nothing; a plan threshold that tolerates the depth re-checks the stored record.
-    plan.write_text(yaml.safe_dump({"name": "qa", "render": TINY, "clips": PLAN_CLIPS, "qa": {"penetration_cm": 10}}))
+    plan.write_text(yaml.safe_dump({"name": "qa", "render": TINY, "clips": PLAN_CLIPS,
+                                    "qa": {"penetration_cm": 10, **no_realism}}))
     out = io.StringIO()
     call_command("generate_clips", "--plan", str(plan), "--no-progress", stdout=out, stderr=io.StringIO())
     assert "0 rendered, 2 already done" in out.getvalue() and "QA: 2 passed, 0 flagged" in out.getvalue()
