@@ -132,10 +132,10 @@ def test_loss_statistics_match_the_measured_ones_and_loss_is_zero_in_range():
         if k != "hold_share":                                           # the loss's hold share is a soft count
             assert v == pytest.approx(ref[k], rel=1e-3, abs=1e-4), k
     x = torch.tensor(got[None])
-    assert float(real_range_loss(Pt, mask, 10.0, x * 0.9, x * 1.1 + 1e-3)) == 0.0
+    assert float(real_range_loss(Pt, mask, 10.0, x * 0.9, x * 1.1 + 1e-3).detach()) == 0.0
     loss = real_range_loss(Pt, mask, 10.0, x * 2 + 0.1, x * 3 + 0.2)    # everything too small: pushed up
     loss.backward()
-    assert float(loss) > 0 and torch.isfinite(Pt.grad).all() and Pt.grad.abs().sum() > 0
+    assert float(loss.detach()) > 0 and torch.isfinite(Pt.grad).all() and Pt.grad.abs().sum() > 0
 
 
 def test_shipped_ranges_are_per_emotion_with_all_for_the_rest():
