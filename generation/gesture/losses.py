@@ -12,8 +12,8 @@ joint positions, and :func:`liveliness_loss` compares each sequence's wrist-spee
 RMS), which do not depend on the phase, so an averaged, motionless answer is no longer the cheapest one.
 
 ``LossWeights.liveliness_form = "log_peak"`` (opt-in, not what the shipped weights were trained with) adds the
-faster wrist's clip mean and 90th percentile (the statistics the liveliness benchmark judges) and compares all of them as
-squared log ratios, since the goal is a ratio: a squared difference in m/s lets a slow emotion's too-high peak
+faster wrist's clip mean and 90th percentile (the statistics the liveliness benchmark judges) and compares all of
+them as squared log ratios, since the goal is a ratio: a squared difference in m/s lets a slow emotion's too-high peak
 (neutral: 0.54 vs 0.43 m/s) cost a fifth of a fast one's shortfall. It brought neutral's peak into the goal band but
 not joyous' mean (docs/benchmarks/gesture.md, liveliness section).
 """
