@@ -23,7 +23,7 @@ export DEBUG="${DEBUG:-0}"
 echo "==> database migrations"
 $PY manage.py migrate --noinput -v 0
 
-echo "==> synthetic gait corpus (built once, about 20 s; the gait clips' quality check reads them with an observer trained on it)"
+echo "==> synthetic gait corpus (built once, about 20 s; for the synthetic gait observer, a quality-gate option beside the default real-capture observer)"
 [ -f var/corpus/gait_corpus_synthetic.npz ] || $PY manage.py build_corpus -v 0 > /dev/null
 
 echo "==> demo clips (rendered once; unchanged clips are never rendered again)"
