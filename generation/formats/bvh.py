@@ -31,7 +31,7 @@ from pathlib import Path
 import numpy as np
 
 from generation.core.motion import Motion, MotionFormatError
-from generation.core.quaternion import np_qfix, qeuler, qfrom_euler
+from generation.core.quaternion import np_qfix, np_qmul, np_qto_matrix, qeuler, qfrom_euler
 from generation.core.skeleton import Skeleton
 
 _CHANNELS = ("Xposition", "Yposition", "Zposition", "Xrotation", "Yrotation", "Zrotation")
@@ -205,22 +205,6 @@ class BvhData:
         """(T, J, 3) world positions by forward kinematics with the per-frame translations, times ``scale``."""
         return _fk_with_translations(self.rotations, self.translations, self.parents)[0] * scale
 
-    def height_extent(self) -> float:
-        """Median over frames of the posed body's largest axis extent, file units (the unit guess uses it: the
-        rest pose of some rigs lies along one axis and says nothing about the standing height)."""
-        P = self.global_positions()
-        return float(np.median((P.max(1) - P.min(1)).max(-1)))
-
-
-def _quat_to_matrix(q: np.ndarray) -> np.ndarray:
-    """(..., 4) unit quaternions (w, x, y, z) -> (..., 3, 3) rotation matrices."""
-    w, x, y, z = np.moveaxis(q, -1, 0)
-    return np.stack([
-        np.stack([1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)], -1),
-        np.stack([2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)], -1),
-        np.stack([2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)], -1),
-    ], -2)
-
 
 def _fk_with_translations(rotations: np.ndarray, translations: np.ndarray, parents) -> tuple[np.ndarray, np.ndarray]:
     """Forward kinematics with a local translation per joint and frame.
@@ -231,7 +215,7 @@ def _fk_with_translations(rotations: np.ndarray, translations: np.ndarray, paren
     Returns:
         world positions (T, J, 3) and world rotation matrices (T, J, 3, 3).
     """
-    local = _quat_to_matrix(rotations)
+    local = np_qto_matrix(rotations)
     world_R = np.empty_like(local)
     world_P = np.empty_like(translations)
     for j, p in enumerate(parents):
@@ -273,23 +257,15 @@ def _fold_static_root(rotations: np.ndarray, translations: np.ndarray, names: li
     if len(parents) < 3 or len(children) != 1 or not static:
         return None
     c = children[0]
-    R0 = _quat_to_matrix(rotations[0, 0])
+    R0 = np_qto_matrix(rotations[0, 0])
     translations = translations.copy()
     rotations = rotations.copy()
     translations[:, c] = translations[:, 0] + translations[:, c] @ R0.T
-    rotations[:, c] = qmul_np(rotations[:, 0], rotations[:, c])
+    rotations[:, c] = np_qmul(rotations[:, 0], rotations[:, c])
     keep = [j for j in range(len(names)) if j != 0]
     new_index = {old: new for new, old in enumerate(keep)}
     new_parents = [new_index.get(parents[j], -1) for j in keep]
     return rotations[:, keep], translations[:, keep], [names[j] for j in keep], new_parents
-
-
-def qmul_np(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """Hamilton product of (..., 4) quaternions (w, x, y, z), numpy."""
-    aw, ax, ay, az = np.moveaxis(a, -1, 0)
-    bw, bx, by, bz = np.moveaxis(b, -1, 0)
-    return np.stack([aw * bw - ax * bx - ay * by - az * bz, aw * bx + ax * bw + ay * bz - az * by,
-                     aw * by - ax * bz + ay * bw + az * bx, aw * bz + ax * by - ay * bx + az * bw], -1)
 
 
 def read_bvh(path: str | Path, scale: float | None = None) -> Motion:
@@ -314,32 +290,34 @@ def read_bvh(path: str | Path, scale: float | None = None) -> Motion:
     """
     data = parse_bvh(path)
     path = data.path
+    exact = data.global_positions()                       # (T, J, 3) file units, the file's own FK
+    # the posed body's largest extent (median over frames) gives the units: some rigs' rest pose lies along one axis
+    extent = max(float(np.median((exact.max(1) - exact.min(1)).max(-1))), 1e-9)
     guess = "given"
     if scale is None:
-        scale, guess = _guess_scale(data.height_extent())
+        scale, guess = _guess_scale(extent)
     if not scale > 0:
         raise MotionFormatError(f"{path}: scale must be positive, got {scale}")
     names, parents = list(data.names), list(data.parents)
     rotations, translations = data.rotations, data.translations
-    extent = max(data.height_extent(), 1e-9)
     folded = _fold_static_root(rotations, translations, names, parents, 1e-6 * extent)
     if folded is not None:
         rotations, translations, names, parents = folded
+        exact = exact[:, 1:]                              # world positions do not change when the root is folded
     offsets = np.median(translations, axis=0)
     offsets[0] = 0.0
     skeleton = Skeleton(path.stem, tuple(names), tuple(parents), offsets * scale,
                         height=extent * scale)
     motion = Motion(skeleton, rotations, translations[:, 0] * scale, data.fps, {})
-    exact = _fk_with_translations(rotations, translations, parents)[0] * scale
-    residual = float(np.linalg.norm(motion.positions() - exact, axis=-1).max())
-    metadata = {"source": path.name, "format": "bvh", "bvh_scale": scale, "bvh_scale_guess": guess,
+    residual = float(np.linalg.norm(motion.positions() - exact * scale, axis=-1).max())
+    motion.metadata = metadata = {"source": path.name, "format": "bvh", "bvh_scale": scale, "bvh_scale_guess": guess,
                 "bvh_channels": {data.names[j]: chans for j, chans in enumerate(data.channels)
                                  if not data.end_site[j]}}
     if folded is not None:
         metadata["folded_root"] = data.names[0]
     if residual > 1e-6:
         metadata["translation_residual_m"] = residual
-    return Motion(skeleton, rotations, translations[:, 0] * scale, data.fps, metadata)
+    return motion
 
 
 def _read_frames(tk: _Tokens, n_ch: int) -> tuple[np.ndarray, float]:

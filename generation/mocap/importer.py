@@ -56,23 +56,21 @@ def standing_height_m(P: np.ndarray, names, joint_map: dict[str, str]) -> float:
     """Estimated standing height (head top to sole), metres, of a body given as (T, K, 3) positions, y-up.
 
     Rigs place their head joint anywhere from the neck to mid-head and few mark the head top, but hip joint
-    centres are anatomical: the standing hip height is thigh + shin (median bone lengths over the frames) + the
-    ankle's lowest height above the floor (the lowest foot point of the clip), divided by
+    centres are anatomical: the standing hip height is thigh + shin (:func:`_leg_length`) + the ankle's lowest
+    height (5th percentile) above the floor (the lowest point of the clip), divided by
     :data:`HIP_HEIGHT_FRACTION`. 0 when the legs are not mapped.
     """
     idx = {n: k for k, n in enumerate(names)}
-    legs = []
-    floor = float(P[..., 1].min())
-    for side in ("left", "right"):
-        chain = [joint_map.get(f"{side}_{j}") for j in ("hip", "knee")]
-        ankle = joint_map.get(f"{side}_heel") or joint_map.get(f"{side}_ankle")
-        if None in chain or ankle is None:
-            continue
-        hip, knee, foot = idx[chain[0]], idx[chain[1]], idx[ankle]
-        thigh = np.median(np.linalg.norm(P[:, hip] - P[:, knee], axis=-1))
-        shin = np.median(np.linalg.norm(P[:, knee] - P[:, foot], axis=-1))
-        legs.append(thigh + shin + float(np.percentile(P[:, foot, 1], 5)) - floor)
-    return float(np.mean(legs)) / HIP_HEIGHT_FRACTION if legs else 0.0
+    end = "heel" if "left_heel" in joint_map or "right_heel" in joint_map else "ankle"
+    index = {ours: idx[theirs] for ours, theirs in joint_map.items()}
+    leg = _leg_length(P, index, end)
+    ankles = [index[f"{s}_{end}"] for s in ("left", "right")
+              if all(f"{s}_{j}" in index for j in ("hip", "knee", end))]
+    if not ankles or leg <= 0:
+        return 0.0
+    ankle_height = np.mean([np.percentile(P[:, a, 1], 5) for a in ankles]) - float(P[..., 1].min())
+    return (leg + float(ankle_height)) / HIP_HEIGHT_FRACTION
+
 
 # proper rotations taking each world axis (with sign) onto +y
 _UP_TO_Y = {

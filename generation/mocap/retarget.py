@@ -11,6 +11,7 @@ import numpy as np
 from generation.core.ik import bend_limb_to_target, solve_rotations
 from generation.core.kinematics import np_forward_kinematics
 from generation.core.motion import Motion
+from generation.core.quaternion import np_qto_matrix
 from generation.core.skeleton import Skeleton
 
 #: Candidate source names per gait-skeleton joint (first present wins): Mixamo/Unity-style, CMU-style
@@ -253,12 +254,7 @@ def fit_proportions(P: np.ndarray, known: np.ndarray, target: Skeleton, iteratio
 
 def _world_matrices(rotations: np.ndarray, parents) -> np.ndarray:
     """(T, J, 4) local rotations (w, x, y, z) -> (T, J, 3, 3) world rotation matrices."""
-    w, x, y, z = np.moveaxis(rotations, -1, 0)
-    local = np.stack([
-        np.stack([1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)], -1),
-        np.stack([2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)], -1),
-        np.stack([2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)], -1),
-    ], -2)
+    local = np_qto_matrix(rotations)
     world = np.empty_like(local)
     for j, p in enumerate(parents):
         world[:, j] = local[:, j] if p < 0 else world[:, p] @ local[:, j]
