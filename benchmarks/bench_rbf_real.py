@@ -167,7 +167,7 @@ def contact_sheets(base, corpus: Path, out_dir: Path, weight: float = 1.0) -> li
     """docs/img/rbf_real_<theme>.png: neutral, expert-styled, data-styled, a real themed test take; 5 frames each."""
     from PIL import Image
 
-    from generation.render.clip import render_frames
+    from generation.render.clip import render_frames_at
     from generation.render.contact_sheet import contact_sheet
     from generation.render.settings import RenderSettings
 
@@ -187,14 +187,11 @@ def contact_sheets(base, corpus: Path, out_dir: Path, weight: float = 1.0) -> li
         with tempfile.TemporaryDirectory() as tmp:
             for label, motion in rows:
                 wanted = [int(round(t * settings.fps)) for t in times]
-                for k, img in enumerate(render_frames(motion, settings, patches=False)):
-                    if k in wanted:
-                        p = Path(tmp) / f"{len(posters):03d}.png"
-                        Image.fromarray(img).save(p)
-                        posters.append(p)
-                        labels.append(f"{label}, {k / settings.fps:.2f} s")
-                    if k >= wanted[-1]:
-                        break
+                for k, img in render_frames_at(motion, settings, wanted):
+                    p = Path(tmp) / f"{len(posters):03d}.png"
+                    Image.fromarray(img).save(p)
+                    posters.append(p)
+                    labels.append(f"{label}, {k / settings.fps:.2f} s")
             path = out_dir / f"rbf_real_{theme}.png"
             contact_sheet(posters, labels, path, columns=len(times), thumb_width=170)
         Image.open(path).quantize(96).save(path, optimize=True)  # a 96-colour palette: a third of the bytes

@@ -29,7 +29,7 @@ import numpy as np  # noqa: E402
 from generation.mocap import ImportOptions, import_file  # noqa: E402
 from generation.mocap.captured import WALK_FILES, captured_walks, chain_clip_repeats  # noqa: E402
 from generation.mocap.conventions import export_as  # noqa: E402
-from generation.render.clip import render_frames  # noqa: E402
+from generation.render.clip import render_frames_at  # noqa: E402
 from generation.render.contact_sheet import contact_sheet  # noqa: E402
 from generation.render.settings import RenderSettings  # noqa: E402
 
@@ -58,17 +58,6 @@ def imported_motions(motion, folder: Path) -> list[tuple[str, object]]:
     return out
 
 
-def render_at(motion, frames, settings: RenderSettings) -> list[np.ndarray]:
-    """The rendered images (H, W, 3) of ``frames`` (indices at the render frame rate)."""
-    wanted, images = set(frames), {}
-    for t, img in enumerate(render_frames(motion, settings, patches=False)):
-        if t in wanted:
-            images[t] = img.copy()
-        if t >= max(frames):
-            break
-    return [images[t] for t in frames]
-
-
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--out", type=Path, default=ROOT / "docs" / "img" / "mocap_import_sheet.png")
@@ -84,7 +73,7 @@ def main() -> None:
         posters, labels = [], []
         for label, motion in rows:
             P = motion.resample(original.fps).positions()
-            for t, img in zip(FRAMES, render_at(motion, FRAMES, settings)):
+            for t, img in zip(FRAMES, (img for _, img in render_frames_at(motion, settings, FRAMES))):
                 path = Path(tmp) / f"{len(posters):03d}.png"
                 Image.fromarray(img).save(path)
                 posters.append(path)

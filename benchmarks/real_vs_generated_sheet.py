@@ -22,7 +22,7 @@ sys.path.insert(0, str(ROOT))
 from generation.mocap.importer import ImportOptions, import_file  # noqa: E402
 from generation.plans.clipgen import make_motion, resolve  # noqa: E402
 from generation.plans.schema import validate_plan  # noqa: E402
-from generation.render.clip import render_frames  # noqa: E402
+from generation.render.clip import render_frames_at  # noqa: E402
 from generation.render.contact_sheet import contact_sheet  # noqa: E402
 from generation.render.settings import RenderSettings  # noqa: E402
 
@@ -44,17 +44,6 @@ def generated_walks(seconds: float, weights: str | None = None) -> dict[str, obj
         motion = make_motion(run_entry, requested=entry.generator if reason else None, fallback_reason=reason)
         out[emotion] = motion
     return out
-
-
-def frames_of(motion, times, settings) -> list:
-    wanted = {int(round(t * settings.fps)) for t in times}
-    images = {}
-    for k, img in enumerate(render_frames(motion, settings, patches=False)):
-        if k in wanted:
-            images[k] = img.copy()
-        if k >= max(wanted):
-            break
-    return [images[k] for k in sorted(images)]
 
 
 def main() -> None:
@@ -84,7 +73,8 @@ def main() -> None:
             name = f"{gen.metadata.get('generator', '?')} ({gen.metadata.get('weights_name', '?')})"
             rows = ((f"REAL {style} t{a.take[-1]}", real.motion), (f"{name} {emotion}", gen))
             for label, motion in rows:
-                for t, img in zip(times, frames_of(motion, times, settings)):
+                frames = [round(t * settings.fps) for t in times]
+                for t, (_, img) in zip(times, render_frames_at(motion, settings, frames)):
                     p = Path(tmp) / f"{len(posters):03d}.png"
                     Image.fromarray(img).save(p)
                     posters.append(p)

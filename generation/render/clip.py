@@ -153,6 +153,21 @@ def render_frames(motion: Motion, settings: RenderSettings, patches: bool = True
     yield from _frames(clip, positions, settings, patches)
 
 
+def render_frames_at(motion: Motion, settings: RenderSettings, indices) -> list[tuple[int, np.ndarray]]:
+    """(frame index, (height, width, 3) uint8 image) for the wanted frame indices (at ``settings.fps``) that the
+    clip reaches, in index order; every frame rendered whole, none after the last wanted one (contact sheets)."""
+    wanted = sorted(set(int(k) for k in indices))
+    out = []
+    if not wanted:
+        return out
+    for k, img in enumerate(render_frames(motion, settings, patches=False)):
+        if k in wanted:
+            out.append((k, img.copy()))
+        if k >= wanted[-1]:
+            break
+    return out
+
+
 def render_clip(motion: Motion, out_dir: str | Path, name: str, settings: RenderSettings | None = None,
                 progress: Callable[[int, int], None] | None = None) -> RenderResult:
     """Render ``motion`` to ``out_dir/name.mp4`` (+ ``.webm``) and ``name.png``.
