@@ -50,3 +50,17 @@ def test_class_style_loss_costs_a_shared_offset_not_walk_noise():
     assert class_style_loss([true + shared], true, emotion, scale).item() == pytest.approx(1.0 / 4)
     absent = torch.tensor([[1.0, 0, 0, 0]] * 8)          # classes absent from the batch add nothing
     assert class_style_loss([true + 0.5], true, absent).item() == pytest.approx(0.25 / 4)
+
+
+def test_bounce_loss_sees_the_root_height_amplitude_not_its_phase():
+    from generation.gait.losses import bounce_loss, root_bounce, style_loss
+    t = torch.linspace(0, 4 * math.pi, 40)
+    pos = torch.zeros(2, 40, 21, 3)
+    pos[..., 1] = 0.9 + 0.05 * torch.sin(2 * t)[None, :, None]          # the whole body bounces 5 cm
+    assert root_bounce(pos).tolist() == pytest.approx([0.05 / math.sqrt(2) / 0.1] * 2, rel=5e-2)
+    damped = pos.clone()
+    damped[..., 1] = 0.9 + 0.02 * torch.sin(2 * t)[None, :, None]
+    aff = torch.zeros(2, 40, 18)
+    assert style_loss([(aff, damped)], aff, pos).item() < 1e-6           # root-relative statistics are blind to it
+    assert bounce_loss([pos.roll(7, 1)], pos).item() < 1e-4              # the same bounce at another phase
+    assert bounce_loss([damped], pos).item() == pytest.approx((0.03 / math.sqrt(2) / 0.1) ** 2, rel=0.05)

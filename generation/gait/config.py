@@ -194,6 +194,9 @@ class GaitLossWeights:
     style: L_style (an addition): the time mean and spread of the affective features and the motion amplitude of
         the predicted window and of the free-running continuation match the ground truth's
         (``losses.style_loss``; 0 leaves it out, as in the paper).
+    bounce: L_bounce (an addition, default off): the pelvis bounce (standard deviation of the root height over the
+        window) of the predicted window and of the free-running continuation matches the ground truth's
+        (``losses.bounce_loss``); root-relative style statistics do not see it.
     class_style: L_class (an addition, default off): the batch's per-emotion mean offset of the walks' time-mean
         affective features from the ground truth's, in walk-to-walk units (``losses.class_style_loss``). The
         per-walk style term weighs a shift shared by every walk of an emotion no more than walk-level noise,
@@ -211,6 +214,7 @@ class GaitLossWeights:
     phase: float = 1.0
     style: float = 1.0
     class_style: float = 0.0
+    bounce: float = 0.0
     pos_scale_m: float = 0.1
     euler_order: str = "zyx"
 
@@ -234,7 +238,7 @@ FLAT_NAMES: dict[str, tuple[str, str]] = {
                                           "splice_frac", "extra_steps", "tf_start", "uniform_label_frac",
                                           "seed")},
     **{f"lambda_{name}": ("loss", name) for name in ("motion", "versor", "pose", "aff", "root", "fctc", "phase",
-                                                                  "style", "class_style")},
+                                                                  "style", "class_style", "bounce")},
     "pos_scale_m": ("loss", "pos_scale_m"),
     "euler_order": ("loss", "euler_order"),
 }

@@ -104,6 +104,23 @@ def style_loss(pred_windows: list[tuple[torch.Tensor, torch.Tensor]], aff_true: 
     return torch.stack(terms).mean()
 
 
+def root_bounce(pos: torch.Tensor, scale_m: float = 0.1) -> torch.Tensor:
+    """(N,) standard deviation over time of the root height in a window of positions (N, L, J, 3; root = joint 0,
+    y up), in units of ``scale_m``: the pelvis bounce that root-relative statistics cannot see."""
+    return ((pos[..., 0, 1] / scale_m).var(dim=1, unbiased=False) + STD_EPS).sqrt()
+
+
+def bounce_loss(pred_pos: list[torch.Tensor], pos_true: torch.Tensor, scale_m: float = 0.1) -> torch.Tensor:
+    """Phase-free pelvis-bounce term (an addition of this implementation): squared difference of
+    :func:`root_bounce` of each predicted window (N, L, J, 3) from the ground-truth window's, averaged over windows.
+
+    A per-step height loss is minimised by a damped bounce when the step phase is uncertain (free-running
+    prediction); the amplitude, compared over the window, is not.
+    """
+    target = root_bounce(pos_true, scale_m)
+    return torch.stack([((root_bounce(p, scale_m) - target) ** 2).mean() for p in pred_pos]).mean()
+
+
 def class_style_loss(pred_aff: list[torch.Tensor], aff_true: torch.Tensor, emotion: torch.Tensor,
                      mean_scale: torch.Tensor | None = None) -> torch.Tensor:
     """Per-emotion offset of the time-mean affective features (an addition of this implementation).
@@ -131,7 +148,8 @@ def total_loss(pred: dict, true: dict, weights: GaitLossWeights, use_affective: 
     root height, ``aff`` (N, L, 18), ``root`` (N, L, 3) and ``omega`` (N, L), all for the same target steps.
     ``use_affective`` (``GaitModelConfig.use_affective``) adds L_aff. With ``weights.style`` > 0, L_style
     (:func:`style_loss`) compares the windows ``[style_from:]`` of ``pred`` and ``true`` and, when ``pred`` has
-    ``ext_aff`` / ``ext_pos`` (steps predicted past the ground truth), that continuation too; ``true`` may carry
+    ``ext_aff`` / ``ext_pos`` (steps predicted past the ground truth), that continuation too (and so does
+    :func:`bounce_loss` with ``weights.bounce`` > 0); ``true`` may carry
     ``aff_style_scale`` (18,) for the feature means (:meth:`generation.gait.data.Normalizer.style_scale`).
     With ``weights.class_style`` > 0, ``true["emotion"]`` (N, C) gives the classes of :func:`class_style_loss`
     over the same windows. Terms with weight 0 are left out of the total. Returns the weighted total and a dict
@@ -153,6 +171,8 @@ def total_loss(pred: dict, true: dict, weights: GaitLossWeights, use_affective: 
     if w.style != 0.0:
         terms["style"] = style_loss(windows, true["aff"][:, style_from:], true["pos"][:, style_from:],
                                     w.pos_scale_m, true.get("aff_style_scale"))
+    if w.bounce != 0.0:
+        terms["bounce"] = bounce_loss([pos for _, pos in windows], true["pos"][:, style_from:], w.pos_scale_m)
     if w.class_style != 0.0:
         terms["class_style"] = class_style_loss([aff for aff, _ in windows], true["aff"][:, style_from:],
                                                 true["emotion"], true.get("aff_style_scale"))
