@@ -139,3 +139,11 @@ def test_gesture_tables_render_the_figures():
     assert t["gesture.speed"][2:] == ["| 20 | 3 | 3114 | 1851-3207 | 0.32 | 1052 |"]
     assert t["gesture.training_speed"][2:] == ["| small | 269,772 | 0.12 (mean of 3 timed batches) | 50 | 6 | 400 |"]
 
+
+def test_the_gesture_doc_marks_every_gesture_table_and_matches_its_json():
+    """Every gesture table is marked once in gesture.md, and the blocks there are what gesture.json renders."""
+    text = (doc_tables.DOCS / "gesture.md").read_text()
+    names = [m.group("name") for m in doc_tables.BLOCK_RE.finditer(text)]
+    assert sorted(names) == sorted(doc_tables.TABLES["gesture"])
+    tables = doc_tables.render_tables("gesture", json.loads((doc_tables.DOCS / "gesture.json").read_text()))
+    assert doc_tables.fill_doc(text, tables)[0] == text
