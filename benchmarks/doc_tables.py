@@ -1,7 +1,8 @@
 """Markdown tables of the benchmarks' JSON results, and their place in the docs.
 
 Benchmarks write their figures as JSON (``docs/benchmarks/<area>.json``); the narrative lives in
-``docs/benchmarks/<area>.md``. A doc marks where a rendered table goes::
+``docs/benchmarks/<area>.md`` (``FILES`` names the areas whose JSON and doc are named otherwise, e.g. rbf_real.json
+-> rbf.md). A doc marks where a rendered table goes::
 
     <!-- table: gait.prediction -->
     ...replaced by the table...
@@ -12,6 +13,7 @@ are left as they are)::
 
     python benchmarks/doc_tables.py gait            # docs/benchmarks/gait.json -> the marked tables of gait.md
     python benchmarks/doc_tables.py gesture         # docs/benchmarks/gesture.json -> gesture.md
+    python benchmarks/doc_tables.py rbf_real        # docs/benchmarks/rbf_real.json -> rbf.md
     python benchmarks/doc_tables.py gait --print    # print every table of the JSON instead
 """
 from __future__ import annotations
@@ -19,6 +21,7 @@ from __future__ import annotations
 import argparse
 import json
 import re
+import statistics
 import sys
 from collections.abc import Callable
 from pathlib import Path
@@ -226,6 +229,330 @@ def gesture_training_speed(r: dict) -> list[str]:
                    t["batches_per_epoch"], f"{t['seconds_per_epoch']:.0f}", t["epochs"]] for t in r["epoch_timing"]])
 
 
+# ---- runs of any area: the keys at the top level of its JSON ----------------------------------------------------
+def _run(r: dict, *extra: tuple[str, str]) -> list[str]:
+    """Machine, date, commit, command and duration where recorded, then ``extra`` (label, value) rows and the
+    source of transcribed figures (``r["meta"]["transcribed_from"]``)."""
+    rows = [[key, r[key]] for key in ("machine", "date") if r.get(key)]
+    if r.get("commit"):
+        rows.append(["commit", r["commit"].removeprefix("commit ")])
+    if r.get("command"):
+        rows.append(["command", f"`{r['command']}`"])
+    if r.get("seconds") is not None:
+        rows.append(["duration", f"{r['seconds']:.0f} s"])
+    rows += [list(row) for row in extra]
+    if r.get("meta", {}).get("transcribed_from"):
+        rows.append(["transcribed from", r["meta"]["transcribed_from"]])
+    return table(["run", "value"], rows)
+
+
+def _opt(v, fmt: str = "{:.2f}") -> str:
+    return "-" if v is None else fmt.format(v)
+
+
+# ---- RBF styliser, synthetic measures (benchmarks/bench_rbf_features.py; docs/benchmarks/rbf.md) ----------------
+def _w(row: dict) -> str:
+    return f"{row['weight']:+.1f}"
+
+
+def _sign(s: int) -> str:
+    return "+" if s > 0 else "-"
+
+
+def _yes(holds: bool) -> str:
+    return "yes" if holds else "**no**"
+
+
+def rbf_features_run(r: dict) -> list[str]:
+    return _run(r)
+
+
+def rbf_features_neutral_base(r: dict) -> list[str]:
+    """The neutral cycle the themes edit: where it comes from, its size and sources."""
+    base = r["neutral_base"]
+    sources = base.get("sources", base.get("captured_sources", []))
+    rejected = sum(u.get("rejected_cycles", 0) for u in sources)
+    return table(["neutral base", "value"], [
+        ["function", f"`{r['base_function']}`"], ["cycles averaged", base["n_cycles"]],
+        ["cycles rejected as glitches", rejected], ["cycle", f"{base['cycle_duration_s']:.2f} s"],
+        ["stride", f"{base['stride_m'][2]:.2f} m"], ["synthetic", base["synthetic"]],
+        ["sources used (cycles)", "; ".join(f"{u['name']} ({u['cycles']})" for u in sources if u["cycles"])]])
+
+
+def rbf_features_summary(r: dict) -> list[str]:
+    """Checks that hold, bone-length and floor extremes, speed (``r["summary"]``, from every theme and weight)."""
+    s, t = r["summary"], r["timing"]
+    verb = "loading" if "load_cycle" in r["base_function"] else "building"
+    return table(["measure", "value"], [
+        ["expected directions that hold, 18 gait affective features", f"{s['checks_held']} of {s['checks']}"],
+        ["expected directions that hold, direct geometric measures", f"{s['measures_held']} of {s['measures']}"],
+        ["not holding", ", ".join(s["failed"]) or "none"],
+        ["largest bone-length deviation of the edited positions Y", f"{s['bone_error_before_max_m'] * 1000:.0f} mm"],
+        ["largest bone-length deviation after the fit", f"{s['bone_error_after_max_m'] * 1000:.1e} mm"],
+        ["lowest foot joint relative to the neutral floor: our fit / `generation.core.ik.fit_positions_to_skeleton` "
+         "(direction-only)",
+         f"{s['lowest_foot_m'] * 1000:+.1f} mm / {s['lowest_foot_direction_only_m'] * 1000:+.1f} mm"],
+        ["stylising one 4-cycle clip at 30 fps", f"{t['stylise_clip_s'] * 1000:.0f} ms ({t['clip_frames']} frames)"],
+        [f"{verb} the neutral base", f"{t['neutral_base_s']:.2f} s"]])
+
+
+def rbf_features_feature_key(r: dict) -> list[str]:
+    """One line: f<i> = name of each gait affective feature."""
+    return ["Feature key: " + "; ".join(f"f{i} = {n}" for i, n in enumerate(r["feature_names"]))]
+
+
+def rbf_features_mean_change(r: dict) -> list[str]:
+    return table(["theme", "w", *(f"f{i}" for i in range(len(r["feature_names"])))],
+                 [[row["theme"], _w(row), *(f"{v:+.3f}" for v in row["mean_change"])] for row in r["rows"]])
+
+
+def rbf_features_feature_checks(r: dict) -> list[str]:
+    return table(["theme", "w", "feature", "aggregate", "expected", "change", "holds", "why"],
+                 [[row["theme"], _w(row), c["feature"], c["aggregate"], _sign(c["expected_sign"]),
+                   f"{c['change']:+.4f}", _yes(c["holds"]),
+                   c["reason"] if row["weight"] > 0 else "inverse of: " + c["reason"]]
+                  for row in r["rows"] for c in row["checks"]])
+
+
+def rbf_features_measure_checks(r: dict) -> list[str]:
+    return table(["theme", "w", "measure", "expected", "change (mm)", "holds"],
+                 [[row["theme"], _w(row), c["measure"], _sign(c["expected_sign"]), f"{c['change_m'] * 1000:+.1f}",
+                   _yes(c["holds"])] for row in r["rows"] for c in row["measures"]])
+
+
+def rbf_features_bones_floor(r: dict) -> list[str]:
+    return table(["theme", "w", "before", "after (ours)", "after (ik.fit_positions_to_skeleton)", "lowest foot ours",
+                  "lowest foot direction-only", "max lift by floor clamp"],
+                 [[row["theme"], _w(row), f"{row['bone_error_before_m'] * 1000:.1f}",
+                   f"{row['bone_error_after_m'] * 1000:.1e}", f"{row['ik_direction_only_after_m'] * 1000:.1e}",
+                   f"{row['lowest_foot_m'] * 1000:+.1f}", f"{row['lowest_foot_direction_only_m'] * 1000:+.1f}",
+                   f"{row['ground_lift_m'] * 1000:.1f}"] for row in r["rows"]])
+
+
+def rbf_features_scaling(r: dict) -> list[str]:
+    """Mean joint displacement (cm) per theme on the n x w grid of ``r["scaling_axes"]``."""
+    axes = r["scaling_axes"]
+    return table(["theme", "n", *(f"w {w}" for w in axes["w"])],
+                 [[theme, n, *(f"{v:.2f}" for v in row)] for theme, grid in r["scaling"].items()
+                  for n, row in zip(axes["n"], grid)])
+
+
+# ---- RBF styliser on real capture (benchmarks/bench_rbf_real.py; docs/benchmarks/rbf.md) ------------------------
+RBF_REAL_CHECKED = ("speed_m_s", "cadence_steps_min", "stance_knee_deg", "pelvis_bounce_cm")
+
+
+def _rbf_weights(row: dict) -> list[str]:
+    """The styling weights of an observers row, as its keys spell them ('0.7', '1.0')."""
+    return [k.removeprefix("expert_") for k in row if k.startswith("expert_") and not k.endswith("_emotion_p")]
+
+
+def rbf_real_run(r: dict) -> list[str]:
+    return _run(r)
+
+
+def rbf_real_neutral_cycle(r: dict) -> list[str]:
+    """The averaged neutral cycle: its sources, alignment, spread and size."""
+    md = r["neutral"]["metadata"]
+    per_ds: dict[str, list[int]] = {}
+    for s in md["captured_sources"]:
+        if s["cycles"]:
+            d = per_ds.setdefault(s["dataset"], [0, 0])
+            d[0] += 1
+            d[1] += s["cycles"]
+    return table(["averaged neutral cycle", "value"], [
+        ["steady two-step cycles", f"{md['n_cycles']} from {md['n_takes']} train-split normal walks"],
+        ["per dataset", ", ".join(f"{ds}: {v[1]} cycles from {v[0]} takes" for ds, v in sorted(per_ds.items()))],
+        ["time warping", md["time_warping"]],
+        ["cycle spread (mean per-frame standard deviation, walker heights) after contact warping / after DTW",
+         f"{md['dtw_spread']['before']:.4f} / {md['dtw_spread']['after']:.4f}"],
+        ["cycle", f"{md['cycle_duration_s']:.3f} s"], ["stride", f"{md['stride_m'][2]:.3f} m"],
+        ["IK re-fit error (max)", f"{md['ik_error_max_m'] * 1000:.1f} mm"]])
+
+
+def rbf_real_neutral_checks(r: dict) -> list[str]:
+    """The averaged and the procedural base walked, against the range of the real normal walks."""
+    n = r["neutral"]
+    rows = []
+    for name, row in n["bases"].items():
+        rows.append([name, *(f"{row[k]:.2f}{'' if row['inside'][k] else ' **(outside)**'}" for k in RBF_REAL_CHECKED),
+                     "/".join(f"{row['observer'][e]:.2f}" for e in EMOTIONS)])
+    rr = n["real_ranges"]
+    rows.append([f"real normal walks (range of {n['real_takes']})",
+                 *(f"{rr[k][0]:.2f}-{rr[k][1]:.2f}" for k in RBF_REAL_CHECKED),
+                 "test takes: " + "/".join(f"{n['real_test_normal_read'][e]:.2f}" for e in EMOTIONS)])
+    return table(["base", "speed (m/s)", "cadence (steps/min)", "stance knee (deg)", "pelvis bounce (cm)",
+                  "real observer (happy/sad/angry/neutral)"], rows)
+
+
+def rbf_real_accuracy(r: dict) -> list[str]:
+    return table(["classifier", "test takes", "accuracy"],
+                 [[k, v["takes"], _opt(v["accuracy"])] for k, v in r["accuracy"].items()])
+
+
+def rbf_real_compare(r: dict) -> list[str]:
+    return table(["theme", "rows in common", "shared DOFs", "sign agree", "median ratio", "data's first five rows"],
+                 [[theme, f"{c['used_overlap']} of {len(c['expert_features'])}", c["shared_dofs"],
+                   _opt(c["sign_agreement"]), _opt(c["median_ratio"]),
+                   ", ".join(f"{p} {a}" for p, a in c["data_features"][:5])] for theme, c in r["compare"].items()])
+
+
+def rbf_real_top_dofs(r: dict, per_theme: int = 6) -> list[str]:
+    """The first ``per_theme`` DOFs of each theme (largest amplitude of either set)."""
+    rows = []
+    for theme, c in r["compare"].items():
+        for d in c["rows"][:per_theme]:
+            sa = "-" if d["sign_agree"] is None else _yes(d["sign_agree"])
+            rows.append([theme, f"{d['joint']} {d['axis']}", _opt(d["expert_peak"], "{:+.3f}"),
+                         _opt(d["data_peak"], "{:+.3f}"), sa, _opt(d["peak_shift"]), _opt(d["ratio"]),
+                         _opt(d["corr"])])
+    return table(["theme", "DOF", "expert peak", "data peak", "sign agree", "peak shift (cycle)", "ratio", "corr"],
+                 rows)
+
+
+def rbf_real_observers(r: dict) -> list[str]:
+    """p(intended theme) per feature set and weight; 'observer prefers' data when data win at every weight."""
+    rows, weights = [], []
+    for theme, row in r["observers"].items():
+        weights = _rbf_weights(row)
+        data_wins = [row[f"data_{w}"] > row[f"expert_{w}"] for w in weights]
+        better = "data" if all(data_wins) else "expert" if not any(data_wins) else "mixed"
+        rows.append([f"{theme} ({row['pair']})", f"{row['neutral']:.2f}",
+                     *(f"{row[f'{f}_{w}']:.2f}" for w in weights for f in ("expert", "data")),
+                     f"{row['real_test']:.2f} ({row['real_test_takes']})", better])
+    return table(["theme (pair)", "neutral", *(f"{f} {w}" for w in weights for f in ("expert", "data")),
+                  "real test takes", "observer prefers"], rows)
+
+
+def rbf_real_ablation(r: dict) -> list[str]:
+    return table(["theme", "p (all ten)", "Table III feature (rank)", "why disputed", "p without it", "sides with"],
+                 [[theme, f"{ab['p_full']:.2f}", f"{d['feature']} ({d['rank']})", d["why"], f"{d['p_without']:.2f}",
+                   d["sides_with"]] for theme, ab in r["ablation"].items() for d in ab["rows"]])
+
+
+def rbf_real_ablation_totals(r: dict) -> list[str]:
+    """How many disputed expert features the observers side on, over every theme."""
+    sides = [d["sides_with"] for ab in r["ablation"].values() for d in ab["rows"]]
+    return table(["sides with", "data", "expert", "neither", "all"],
+                 [["disputed expert features", *(sides.count(s) for s in ("data", "expert", "neither")), len(sides)]])
+
+
+def rbf_real_emotion_observer(r: dict) -> list[str]:
+    """The four-emotion observer's probability of the theme's emotion (themes that are emotions)."""
+    rows, weights = [], []
+    for theme, row in r["observers"].items():
+        if "real_test_emotion_p" not in row:
+            continue
+        weights = _rbf_weights(row)
+        rows.append([theme, *(f"{row[f'{f}_{w}_emotion_p']:.2f}" for w in weights for f in ("expert", "data")),
+                     f"{row['real_test_emotion_p']:.2f}"])
+    return table(["theme", *(f"{f} {w}" for w in weights for f in ("expert", "data")), "real dataset-1 test take"],
+                 rows)
+
+
+# ---- real-capture observer and realism (benchmarks/bench_real_observer.py; docs/benchmarks/mocap.md) ------------
+def real_observer_run(r: dict) -> list[str]:
+    return _run(r, ("corpus", r["corpus"]), ("real-capture observer", r["observer_source"]),
+                ("synthetic observer", r["synthetic_source"]))
+
+
+def real_observer_emotion_accuracy(r: dict) -> list[str]:
+    """Four-emotion accuracy on the held-out takes and with leave one take out."""
+    h, lo = r["held_out"], r["leave_one_take_out"]
+    return table(["emotion classifier", "training takes", "takes read", "accuracy per take", "per 2 s window"], [
+        ["held out (test split)", sum(r["train_takes"].values()), h["n_takes"], f"{h['accuracy_takes']:.2f}",
+         f"{h['accuracy_windows']:.2f}"],
+        ["leave one take out (train and test split)", lo["n_takes"] - 1, lo["n_takes"], f"{lo['accuracy']:.2f}", "-"]])
+
+
+def _confusion(cm: list[list[int]]) -> list[str]:
+    """Rows: intended emotion, columns: the observer's top label, and the recall of each row."""
+    return table(["intended \\ read", *EMOTIONS, "recall"],
+                 [[e, *cm[i], f"{cm[i][i] / sum(cm[i]):.2f}" if sum(cm[i]) else "-"] for i, e in enumerate(EMOTIONS)])
+
+
+def real_observer_confusion_takes(r: dict) -> list[str]:
+    return _confusion(r["held_out"]["confusion_takes"])
+
+
+def real_observer_confusion_windows(r: dict) -> list[str]:
+    return _confusion(r["held_out"]["confusion_windows"])
+
+
+def real_observer_confusion_loto(r: dict) -> list[str]:
+    return _confusion(r["leave_one_take_out"]["confusion"])
+
+
+def real_observer_themes(r: dict) -> list[str]:
+    return table(["pair", "held-out takes", "accuracy", "takes per dataset", "wrong"],
+                 [[name.replace("_", " "), t["n"], f"{t['accuracy']:.2f}",
+                   ", ".join(f"{k}: {v}" for k, v in t["per_dataset"].items()), ", ".join(t["wrong"]) or "-"]
+                  for name, t in r["held_out"]["themes"].items()])
+
+
+def real_observer_plan_themes(r: dict) -> list[str]:
+    return table(["plan", "entry", "generator", "theme", "weight", "pair", "p(theme)"],
+                 [[plan, t["entry"], t["generator"], t["theme"], t["weight"], t["pair"].replace("_", " "),
+                   f"{t['p_theme']:.2f}"] for plan, rows in r["themes_in_plans"].items() for t in rows])
+
+
+def _counts(items) -> dict:
+    out: dict = {}
+    for x in items:
+        out[x] = out.get(x, 0) + 1
+    return out
+
+
+def _readings(labels: list, ps: list) -> str:
+    """'label count, ...' most frequent first, and the median top probability in brackets."""
+    if not any(labels):
+        return "no reading"
+    counts = _counts(lab or "none" for lab in labels)
+    ps = [p for p in ps if p is not None]
+    med = statistics.median(ps) if ps else float("nan")
+    return ", ".join(f"{k} {v}" for k, v in sorted(counts.items(), key=lambda kv: -kv[1])) + f" ({med:.2f})"
+
+
+def real_observer_plans(r: dict) -> list[str]:
+    """Per plan and intended dominant emotion: the clips' readings by the real-capture and the synthetic observer."""
+    rows = []
+    for plan, groups in r["plans"].items():
+        for key, g in sorted(groups.items()):
+            origins = ", ".join(f"{o} {n}" for o, n in sorted(_counts(g["origins"]).items()))
+            rows.append([plan, key, g["n"], origins, _readings(g["real_read"], g["real_p"]),
+                         _readings(g["synthetic_read"], g["synthetic_p"]), g["flag_observer_real"]])
+    return table(["plan", "intended", "clips", "origin and generator used", "real-capture: read (median p)",
+                  "synthetic: read (median p)", "observer flags (real)"], rows)
+
+
+def real_observer_thresholds(r: dict) -> list[str]:
+    """The quality gate's realism bounds and how many held-out real takes break them."""
+    rows = [[k, f"{v:g}" + (" (not applied)" if k in r["not_applied"] else "")] for k, v in r["thresholds"].items()]
+    return table(["realism bound (`generation/quality/realism_ranges.json`)", "value"],
+                 [["rule", r["ranges_rule"]], *rows,
+                  ["held-out real takes outside the bounds", f"{r['ranges_test_flagged']:.0%}"]])
+
+
+def _stat(s: dict) -> str:
+    """Median (5th-95th percentile), or (min-max) under 5 values."""
+    if not s or not s.get("n"):
+        return "-"
+    lo, hi = ("min", "max") if s["n"] < 5 else ("p5", "p95")
+    return f"{s['median']:.3g} ({s[lo]:.3g}-{s[hi]:.3g})"
+
+
+def real_observer_realism(r: dict) -> list[str]:
+    """Realism measures per group; plan groups add their realism flags and the bounds broken."""
+    groups = r["realism"]
+    measures = [m for m in next(iter(groups.values())) if m not in ("realism_flagged", "bounds_broken")]
+    rows = []
+    for name, row in groups.items():
+        flags = row.get("realism_flagged", "")
+        if row.get("bounds_broken"):
+            flags = f"{flags} (" + ", ".join(f"{k} {v}" for k, v in sorted(row["bounds_broken"].items())) + ")"
+        rows.append([name, *(_stat(row[m]) for m in measures), flags])
+    return table(["group", *measures, "realism flags (bounds broken: clips)"], rows)
+
+
 TABLES: dict[str, dict[str, tuple[str, Callable[[dict], list[str]]]]] = {
     "gait": {"gait.prediction": ("prediction", gait_prediction),
              "gait.expressiveness": ("expressiveness", gait_expressiveness),
@@ -243,8 +570,49 @@ TABLES: dict[str, dict[str, tuple[str, Callable[[dict], list[str]]]]] = {
                 "gesture.expressiveness_per_emotion": ("expressiveness", gesture_expressiveness_per_emotion),
                 "gesture.speed": ("speed", gesture_speed),
                 "gesture.training_speed": ("epoch_timing", gesture_training_speed)},
+    "rbf_features": {"rbf_features.run": ("date", rbf_features_run),
+                     "rbf_features.neutral_base": ("neutral_base", rbf_features_neutral_base),
+                     "rbf_features.summary": ("summary", rbf_features_summary),
+                     "rbf_features.feature_key": ("feature_names", rbf_features_feature_key),
+                     "rbf_features.mean_change": ("rows", rbf_features_mean_change),
+                     "rbf_features.feature_checks": ("rows", rbf_features_feature_checks),
+                     "rbf_features.measure_checks": ("rows", rbf_features_measure_checks),
+                     "rbf_features.bones_floor": ("rows", rbf_features_bones_floor),
+                     "rbf_features.scaling": ("scaling", rbf_features_scaling)},
+    "rbf_real": {"rbf_real.run": ("date", rbf_real_run),
+                 "rbf_real.neutral_cycle": ("neutral", rbf_real_neutral_cycle),
+                 "rbf_real.neutral_checks": ("neutral", rbf_real_neutral_checks),
+                 "rbf_real.accuracy": ("accuracy", rbf_real_accuracy),
+                 "rbf_real.compare": ("compare", rbf_real_compare),
+                 "rbf_real.top_dofs": ("compare", rbf_real_top_dofs),
+                 "rbf_real.observers": ("observers", rbf_real_observers),
+                 "rbf_real.ablation": ("ablation", rbf_real_ablation),
+                 "rbf_real.ablation_totals": ("ablation", rbf_real_ablation_totals),
+                 "rbf_real.emotion_observer": ("observers", rbf_real_emotion_observer)},
+    "real_observer": {"real_observer.run": ("date", real_observer_run),
+                      "real_observer.emotion_accuracy": ("held_out", real_observer_emotion_accuracy),
+                      "real_observer.confusion_takes": ("held_out", real_observer_confusion_takes),
+                      "real_observer.confusion_windows": ("held_out", real_observer_confusion_windows),
+                      "real_observer.themes": ("held_out", real_observer_themes),
+                      "real_observer.confusion_loto": ("leave_one_take_out", real_observer_confusion_loto),
+                      "real_observer.plan_themes": ("themes_in_plans", real_observer_plan_themes),
+                      "real_observer.plans": ("plans", real_observer_plans),
+                      "real_observer.thresholds": ("thresholds", real_observer_thresholds),
+                      "real_observer.realism": ("realism", real_observer_realism)},
 }
 """area -> table name -> (the JSON key it needs, renderer)."""
+
+
+FILES: dict[str, tuple[str, str]] = {"rbf_features": ("rbf_features.json", "rbf.md"),
+                                     "rbf_real": ("rbf_real.json", "rbf.md"),
+                                     "real_observer": ("real_observer.json", "mocap.md")}
+"""area -> (its JSON, its doc) in docs/benchmarks/, where they are not <area>.json and <area>.md."""
+
+
+def area_files(area: str) -> tuple[Path, Path]:
+    """(JSON results, Markdown doc) of ``area``."""
+    results, doc = FILES.get(area, (f"{area}.json", f"{area}.md"))
+    return DOCS / results, DOCS / doc
 
 
 def render_tables(area: str, results: dict) -> dict[str, list[str]]:
@@ -270,8 +638,8 @@ def fill_doc(text: str, tables: dict[str, list[str]]) -> tuple[str, list[str]]:
 
 def update_doc(area: str, results_path: Path | None = None, doc_path: Path | None = None) -> list[str]:
     """Render ``area``'s tables from its JSON into the marked blocks of its doc; returns the tables written."""
-    results_path = results_path or DOCS / f"{area}.json"
-    doc_path = doc_path or DOCS / f"{area}.md"
+    results_path = results_path or area_files(area)[0]
+    doc_path = doc_path or area_files(area)[1]
     tables = render_tables(area, json.loads(results_path.read_text()))
     text, done = fill_doc(doc_path.read_text(), tables)
     doc_path.write_text(text)
@@ -281,11 +649,11 @@ def update_doc(area: str, results_path: Path | None = None, doc_path: Path | Non
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("area", choices=sorted(TABLES))
-    ap.add_argument("--results", type=Path, help="JSON results (default docs/benchmarks/<area>.json)")
-    ap.add_argument("--doc", type=Path, help="Markdown doc (default docs/benchmarks/<area>.md)")
+    ap.add_argument("--results", type=Path, help="JSON results (default docs/benchmarks/<area>.json or FILES)")
+    ap.add_argument("--doc", type=Path, help="Markdown doc (default docs/benchmarks/<area>.md or FILES)")
     ap.add_argument("--print", action="store_true", help="print the tables instead of writing the doc")
     args = ap.parse_args(argv)
-    results_path = args.results or DOCS / f"{args.area}.json"
+    results_path = args.results or area_files(args.area)[0]
     if not results_path.is_file():
         print(f"error: no results file {results_path} (run the area's benchmark first)", file=sys.stderr)
         return 2
@@ -294,7 +662,7 @@ def main(argv=None) -> int:
             print(f"\n{name}\n" + "\n".join(lines))
         return 0
     done = update_doc(args.area, results_path, args.doc)
-    print(f"{args.doc or DOCS / (args.area + '.md')}: {len(done)} table(s) written "
+    print(f"{args.doc or area_files(args.area)[1]}: {len(done)} table(s) written "
           f"({', '.join(done) or 'none marked'})")
     return 0
 

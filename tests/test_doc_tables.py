@@ -147,3 +147,247 @@ def test_the_gesture_doc_marks_every_gesture_table_and_matches_its_json():
     assert sorted(names) == sorted(doc_tables.TABLES["gesture"])
     tables = doc_tables.render_tables("gesture", json.loads((doc_tables.DOCS / "gesture.json").read_text()))
     assert doc_tables.fill_doc(text, tables)[0] == text
+
+
+def test_area_files_name_the_json_and_doc_of_each_area():
+    assert doc_tables.area_files("gait") == (doc_tables.DOCS / "gait.json", doc_tables.DOCS / "gait.md")
+    assert doc_tables.area_files("rbf_real") == (doc_tables.DOCS / "rbf_real.json", doc_tables.DOCS / "rbf.md")
+    assert doc_tables.area_files("real_observer") == (doc_tables.DOCS / "real_observer.json",
+                                                      doc_tables.DOCS / "mocap.md")
+
+
+def _dof(joint, axis, expert, data, agree, shift, ratio, corr):
+    return {"joint": joint, "axis": axis, "expert_peak": expert, "data_peak": data, "sign_agree": agree,
+            "peak_shift": shift, "ratio": ratio, "corr": corr}
+
+
+def _ablated(rank, p_without, sides_with):
+    return {"rank": rank, "feature": f"feature {rank}", "why": "data reverse its sign", "p_without": p_without,
+            "sides_with": sides_with}
+
+
+RBF_REAL = {
+    "machine": "test VM", "date": "2026-12-03", "command": "python benchmarks/bench_rbf_real.py --doc d.md",
+    "meta": {"transcribed_fields": ["command"], "transcribed_from": "a doc"},
+    "neutral": {
+        "metadata": {"n_cycles": 6, "n_takes": 3, "time_warping": "DTW", "dtw_spread": {"before": 0.00912,
+                                                                                     "after": 0.00833},
+                     "stride_m": [0.0, 0.0, 1.3482], "cycle_duration_s": 1.10185, "ik_error_max_m": 0.00667,
+                     "captured_sources": [{"dataset": "bandai-namco-2", "cycles": 4},
+                                          {"dataset": "bandai-namco-1", "cycles": 2},
+                                          {"dataset": "bandai-namco-2", "cycles": 0}]},
+        "bases": {"real (averaged)": {
+            "speed_m_s": 1.2294, "cadence_steps_min": 109.0909, "stance_knee_deg": 39.903, "pelvis_bounce_cm": 3.7915,
+            "observer": {"happy": 0.181, "sad": 0.135, "angry": 0.176, "neutral": 0.508},
+            "inside": {"speed_m_s": True, "cadence_steps_min": True, "stance_knee_deg": False,
+                       "pelvis_bounce_cm": True}}},
+        "real_ranges": {"speed_m_s": [1.12, 1.34], "cadence_steps_min": [106.4, 112.5],
+                        "stance_knee_deg": [32.96, 41.71], "pelvis_bounce_cm": [3.18, 4.79]},
+        "real_takes": 26, "real_test_normal_read": {"happy": 0.171, "sad": 0.144, "angry": 0.175, "neutral": 0.509}},
+    "accuracy": {"happy_vs_sad": {"takes": 2, "accuracy": 1.0}, "empty": {"takes": 0, "accuracy": None}},
+    "compare": {"happy": {"used_overlap": 3, "expert_features": [["wrists", "Z"]] * 10, "shared_dofs": 6,
+                          "sign_agreement": 0.6667, "median_ratio": None,
+                          "data_features": [["wrists", "Y"], ["elbows", "Z"]],
+                          "rows": [_dof("left_hand", "Y", None, 0.129, None, None, None, None),
+                                   _dof("right_hand", "X", -0.025, 0.078, False, 0.22, 3.12, -0.32)]}},
+    "observers": {
+        "happy": {"pair": "happy_vs_sad", "neutral": 0.61, "real_test": 0.8175, "real_test_takes": 1,
+                  "expert_0.7": 0.64, "expert_0.7_emotion_p": 0.18, "data_0.7": 0.67, "data_0.7_emotion_p": 0.276,
+                  "expert_1.0": 0.676, "expert_1.0_emotion_p": 0.174, "data_1.0": 0.71, "data_1.0_emotion_p": 0.314,
+                  "real_test_emotion_p": 0.799},
+        "tired": {"pair": "energetic_vs_tired", "neutral": 0.909, "real_test": 0.933, "real_test_takes": 5,
+                  "expert_0.7": 0.916, "data_0.7": 0.717, "expert_1.0": 0.5, "data_1.0": 0.555}},
+    "ablation": {"happy": {"p_full": 0.676, "rows": [_ablated(1, 0.656, "neither"), _ablated(4, 0.61, "expert")]},
+                 "masculine": {"p_full": 0.592, "rows": [_ablated(5, 0.914, "data")]}},
+}
+
+
+def test_rbf_real_tables_render_the_figures():
+    t = doc_tables.render_tables("rbf_real", RBF_REAL)
+    assert set(t) == set(doc_tables.TABLES["rbf_real"])
+    assert t["rbf_real.run"][2:] == ["| machine | test VM |", "| date | 2026-12-03 |",
+                                     "| command | `python benchmarks/bench_rbf_real.py --doc d.md` |",
+                                     "| transcribed from | a doc |"]
+    cycle = t["rbf_real.neutral_cycle"]
+    assert "| steady two-step cycles | 6 from 3 train-split normal walks |" in cycle
+    # sources without a steady cycle are not counted; datasets in name order
+    assert "| per dataset | bandai-namco-1: 2 cycles from 1 takes, bandai-namco-2: 4 cycles from 1 takes |" in cycle
+    assert cycle[-4:] == ["| cycle spread (mean per-frame standard deviation, walker heights) after contact warping / "
+                          "after DTW | 0.0091 / 0.0083 |", "| cycle | 1.102 s |", "| stride | 1.348 m |",
+                          "| IK re-fit error (max) | 6.7 mm |"]
+    assert t["rbf_real.neutral_checks"][2:] == [
+        "| real (averaged) | 1.23 | 109.09 | 39.90 **(outside)** | 3.79 | 0.18/0.14/0.18/0.51 |",
+        "| real normal walks (range of 26) | 1.12-1.34 | 106.40-112.50 | 32.96-41.71 | 3.18-4.79 "
+        "| test takes: 0.17/0.14/0.17/0.51 |"]
+    assert t["rbf_real.accuracy"][2:] == ["| happy_vs_sad | 2 | 1.00 |", "| empty | 0 | - |"]
+    assert t["rbf_real.compare"][2:] == ["| happy | 3 of 10 | 6 | 0.67 | - | wrists Y, elbows Z |"]
+    assert t["rbf_real.top_dofs"][2:] == ["| happy | left_hand Y | - | +0.129 | - | - | - | - |",
+                                          "| happy | right_hand X | -0.025 | +0.078 | **no** | 0.22 | 3.12 | -0.32 |"]
+    # data preferred only where they win at every weight
+    assert t["rbf_real.observers"][0] == ("| theme (pair) | neutral | expert 0.7 | data 0.7 | expert 1.0 | data 1.0 "
+                                          "| real test takes | observer prefers |")
+    assert t["rbf_real.observers"][2:] == [
+        "| happy (happy_vs_sad) | 0.61 | 0.64 | 0.67 | 0.68 | 0.71 | 0.82 (1) | data |",
+        "| tired (energetic_vs_tired) | 0.91 | 0.92 | 0.72 | 0.50 | 0.56 | 0.93 (5) | mixed |"]
+    assert t["rbf_real.ablation"][2:] == [
+        "| happy | 0.68 | feature 1 (1) | data reverse its sign | 0.66 | neither |",
+        "| happy | 0.68 | feature 4 (4) | data reverse its sign | 0.61 | expert |",
+        "| masculine | 0.59 | feature 5 (5) | data reverse its sign | 0.91 | data |"]
+    assert t["rbf_real.ablation_totals"][2:] == ["| disputed expert features | 1 | 1 | 1 | 3 |"]
+    # only themes that are emotions have the four-emotion observer's reading
+    assert t["rbf_real.emotion_observer"][0] == ("| theme | expert 0.7 | data 0.7 | expert 1.0 | data 1.0 "
+                                                 "| real dataset-1 test take |")
+    assert t["rbf_real.emotion_observer"][2:] == ["| happy | 0.18 | 0.28 | 0.17 | 0.31 | 0.80 |"]
+
+
+def _check(feature, sign, change, holds):
+    return {"feature": feature, "aggregate": "mean", "expected_sign": sign, "change": change, "holds": holds,
+            "reason": "head down"}
+
+
+RBF_FEATURES = {
+    "machine": "test VM", "date": "2026-12-03", "command": "python benchmarks/bench_rbf_features.py",
+    "feature_names": ["ang:a-b-c", "dist:d-e/f-g"],
+    "rows": [{"theme": "sad", "weight": 0.7, "mean_change": [-0.0, 0.01234],
+              "checks": [_check("ang:a-b-c", -1, -0.02131, True)],
+              "measures": [{"measure": "head_height", "expected_sign": -1, "change_m": -0.01234, "holds": True}],
+              "bone_error_before_m": 0.0266, "bone_error_after_m": 4.2e-16, "ik_direction_only_after_m": 1.7e-16,
+              "lowest_foot_m": -1e-6, "lowest_foot_direction_only_m": -0.0184, "ground_lift_m": 0.0},
+             {"theme": "sad", "weight": -0.7, "mean_change": [0.0, -0.5],
+              "checks": [_check("ang:a-b-c", 1, -0.001, False)],
+              "measures": [{"measure": "head_height", "expected_sign": 1, "change_m": 0.0021, "holds": True}],
+              "bone_error_before_m": 0.0295, "bone_error_after_m": 5.3e-16, "ik_direction_only_after_m": 1.7e-16,
+              "lowest_foot_m": 0.0012, "lowest_foot_direction_only_m": 0.0184, "ground_lift_m": 0.0423}],
+    "summary": {"checks_held": 1, "checks": 2, "measures_held": 2, "measures": 2,
+                "failed": ["sad w = -0.7: ang:a-b-c"], "bone_error_before_max_m": 0.0295,
+                "bone_error_after_max_m": 5.3e-16, "lowest_foot_m": -1e-6, "lowest_foot_direction_only_m": -0.0184},
+    "base_function": "generation.rbf.real_neutral.load_cycle()",
+    "timing": {"stylise_clip_s": 0.1504, "clip_frames": 132, "neutral_base_s": 0.0123},
+    "neutral_base": {"n_cycles": 72, "cycle_duration_s": 1.1019, "stride_m": [0.0, 0.0, 1.348], "synthetic": False,
+                     "captured_sources": [{"name": "a", "cycles": 4}, {"name": "b", "cycles": 0,
+                                                                        "rejected_cycles": 2}]},
+    "scaling": {"sad": [[0.3, 0.5], [1.0, 1.5]]}, "scaling_axes": {"n": [1, 10], "w": [0.4, 1.3]},
+}
+
+
+def test_rbf_features_tables_render_the_figures():
+    t = doc_tables.render_tables("rbf_features", RBF_FEATURES)
+    assert set(t) == set(doc_tables.TABLES["rbf_features"])
+    assert "| command | `python benchmarks/bench_rbf_features.py` |" in t["rbf_features.run"]
+    base = t["rbf_features.neutral_base"]
+    assert "| function | `generation.rbf.real_neutral.load_cycle()` |" in base
+    assert base[4:] == ["| cycles rejected as glitches | 2 |", "| cycle | 1.10 s |", "| stride | 1.35 m |",
+                        "| synthetic | False |", "| sources used (cycles) | a (4) |"]
+    assert t["rbf_features.summary"][2:] == [
+        "| expected directions that hold, 18 gait affective features | 1 of 2 |",
+        "| expected directions that hold, direct geometric measures | 2 of 2 |",
+        "| not holding | sad w = -0.7: ang:a-b-c |",
+        "| largest bone-length deviation of the edited positions Y | 30 mm |",
+        "| largest bone-length deviation after the fit | 5.3e-13 mm |",
+        "| lowest foot joint relative to the neutral floor: our fit / `generation.core.ik.fit_positions_to_skeleton` "
+        "(direction-only) | -0.0 mm / -18.4 mm |",
+        "| stylising one 4-cycle clip at 30 fps | 150 ms (132 frames) |",
+        "| loading the neutral base | 0.01 s |"]
+    assert t["rbf_features.feature_key"] == ["Feature key: f0 = ang:a-b-c; f1 = dist:d-e/f-g"]
+    assert t["rbf_features.mean_change"] == ["| theme | w | f0 | f1 |", "|---|---|---|---|",
+                                             "| sad | +0.7 | -0.000 | +0.012 |", "| sad | -0.7 | +0.000 | -0.500 |"]
+    assert t["rbf_features.feature_checks"][2:] == [
+        "| sad | +0.7 | ang:a-b-c | mean | - | -0.0213 | yes | head down |",
+        "| sad | -0.7 | ang:a-b-c | mean | + | -0.0010 | **no** | inverse of: head down |"]
+    assert t["rbf_features.measure_checks"][2:] == ["| sad | +0.7 | head_height | - | -12.3 | yes |",
+                                                    "| sad | -0.7 | head_height | + | +2.1 | yes |"]
+    assert t["rbf_features.bones_floor"][2:] == ["| sad | +0.7 | 26.6 | 4.2e-13 | 1.7e-13 | -0.0 | -18.4 | 0.0 |",
+                                                 "| sad | -0.7 | 29.5 | 5.3e-13 | 1.7e-13 | +1.2 | +18.4 | 42.3 |"]
+    assert t["rbf_features.scaling"] == ["| theme | n | w 0.4 | w 1.3 |", "|---|---|---|---|",
+                                         "| sad | 1 | 0.30 | 0.50 |", "| sad | 10 | 1.00 | 1.50 |"]
+    procedural = dict(RBF_FEATURES, base_function="generation.rbf.neutral_base.neutral_cycle()",
+                      summary=dict(RBF_FEATURES["summary"], failed=[]))
+    t = doc_tables.render_tables("rbf_features", procedural)
+    assert "| not holding | none |" in t["rbf_features.summary"]
+    assert t["rbf_features.summary"][-1] == "| building the neutral base | 0.01 s |"
+
+
+def _group(real_read, real_p, synthetic_read, synthetic_p, origins, flags):
+    return {"n": len(real_read), "origins": origins, "real_read": real_read, "real_p": real_p,
+            "synthetic_read": synthetic_read, "synthetic_p": synthetic_p, "flag_observer_real": flags}
+
+
+def _stats(n, median, lo, hi, p5, p95):
+    return {"n": n, "median": median, "min": lo, "max": hi, "p5": p5, "p95": p95}
+
+
+REAL_OBSERVER = {
+    "date": "2026-12-03", "commit": "commit abc1234 + uncommitted changes", "machine": "test VM", "seconds": 107.8,
+    "corpus": "c.npz", "observer_source": "real corpus", "synthetic_source": "synthetic corpus",
+    "train_takes": {"happy": 3, "sad": 2},
+    "held_out": {"n_takes": 8, "accuracy_takes": 0.875, "accuracy_windows": 0.846,
+                 "confusion_takes": [[2, 0, 0, 0], [0, 2, 0, 0], [0, 0, 1, 1], [0, 0, 0, 0]],
+                 "confusion_windows": [[14, 0, 0, 0], [0, 49, 0, 0], [0, 0, 7, 14], [0, 0, 0, 7]],
+                 "themes": {"energetic_vs_tired": {"n": 44, "accuracy": 0.977, "wrong": ["t1"],
+                                                   "per_dataset": {"bandai-namco-1": 4, "bandai-namco-2": 40}}}},
+    "leave_one_take_out": {"n_takes": 20, "accuracy": 0.75,
+                           "confusion": [[4, 0, 0, 1], [0, 4, 0, 1], [1, 0, 3, 1], [0, 1, 0, 4]]},
+    "themes_in_plans": {"demo": [{"entry": "tired_w0.7", "generator": "rbf", "theme": "tired", "weight": 0.7,
+                                  "pair": "energetic_vs_tired", "p_theme": 0.948}], "seed000": []},
+    "plans": {"demo": {
+        "sad": _group(["sad", "neutral"], [0.45, 0.49], [None, None], [None, None],
+                      ["source captured_file", "generated gait_net"], 1),
+        "(none)": _group(["neutral", "angry", "neutral"], [0.4, 0.5, 0.3], ["sad", None, "sad"], [0.7, None, 0.9],
+                         ["generated gait_net", "source neutral_walk", "generated gait_net"], 0)}},
+    "thresholds": {"skate_cm_s_max": 100.8371, "speed_cv_min": 0.0164}, "not_applied": {"speed_cv_min": "why"},
+    "ranges_rule": "pooled percentiles", "ranges_test_flagged": 0.1046,
+    "realism": {"real 1: happy": {"skate_cm_s": _stats(5, 26.491, 19.263, 74.39, 20.474, 73.027),
+                                  "speed_cv": _stats(3, 0.034, 0.021, 0.035, 0.022, 0.035)},
+                "demo generated (gait_net 6)": {"skate_cm_s": {"n": 0},
+                                                "speed_cv": _stats(9, 0.013, 0.005, 0.143, 0.007, 0.107),
+                                                "realism_flagged": 7, "bounds_broken": {"toe_skim>": 4,
+                                                                                        "speed_cv<": 6}}},
+}
+
+
+def test_real_observer_tables_render_the_figures():
+    t = doc_tables.render_tables("real_observer", REAL_OBSERVER)
+    assert set(t) == set(doc_tables.TABLES["real_observer"])
+    assert t["real_observer.run"][2:] == ["| machine | test VM |", "| date | 2026-12-03 |",
+                                          "| commit | abc1234 + uncommitted changes |", "| duration | 108 s |",
+                                          "| corpus | c.npz |", "| real-capture observer | real corpus |",
+                                          "| synthetic observer | synthetic corpus |"]
+    assert t["real_observer.emotion_accuracy"][2:] == ["| held out (test split) | 5 | 8 | 0.88 | 0.85 |",
+                                                       "| leave one take out (train and test split) | 19 | 20 | 0.75 "
+                                                       "| - |"]
+    assert t["real_observer.confusion_takes"] == ["| intended \\ read | happy | sad | angry | neutral | recall |",
+                                                  "|---|---|---|---|---|---|",
+                                                  "| happy | 2 | 0 | 0 | 0 | 1.00 |", "| sad | 0 | 2 | 0 | 0 | 1.00 |",
+                                                  "| angry | 0 | 0 | 1 | 1 | 0.50 |", "| neutral | 0 | 0 | 0 | 0 | - |"]
+    assert t["real_observer.confusion_windows"][4] == "| angry | 0 | 0 | 7 | 14 | 0.33 |"
+    assert t["real_observer.confusion_loto"][4] == "| angry | 1 | 0 | 3 | 1 | 0.60 |"
+    assert t["real_observer.themes"][2:] == ["| energetic vs tired | 44 | 0.98 | bandai-namco-1: 4, bandai-namco-2: 40 "
+                                             "| t1 |"]
+    assert t["real_observer.plan_themes"][2:] == ["| demo | tired_w0.7 | rbf | tired | 0.7 | energetic vs tired "
+                                                  "| 0.95 |"]
+    # groups in name order; labels most frequent first, a missing label as 'none'; median of the known p
+    assert t["real_observer.plans"][2:] == [
+        "| demo | (none) | 3 | generated gait_net 2, source neutral_walk 1 | neutral 2, angry 1 (0.40) "
+        "| sad 2, none 1 (0.80) | 0 |",
+        "| demo | sad | 2 | generated gait_net 1, source captured_file 1 | sad 1, neutral 1 (0.47) | no reading | 1 |"]
+    assert t["real_observer.thresholds"][2:] == ["| rule | pooled percentiles |", "| skate_cm_s_max | 100.837 |",
+                                                 "| speed_cv_min | 0.0164 (not applied) |",
+                                                 "| held-out real takes outside the bounds | 10% |"]
+    # median (p5-p95), or (min-max) under 5 values; bounds broken in name order
+    assert t["real_observer.realism"] == [
+        "| group | skate_cm_s | speed_cv | realism flags (bounds broken: clips) |", "|---|---|---|---|",
+        "| real 1: happy | 26.5 (20.5-73) | 0.034 (0.021-0.035) |  |",
+        "| demo generated (gait_net 6) | - | 0.013 (0.007-0.107) | 7 (speed_cv< 6, toe_skim> 4) |"]
+
+
+def test_two_areas_share_a_doc_without_touching_each_others_blocks(tmp_path):
+    doc = tmp_path / "rbf.md"
+    doc.write_text("<!-- table: rbf_features.feature_key -->\nold key\n<!-- /table -->\n\n"
+                   "<!-- table: rbf_real.ablation_totals -->\nold totals\n<!-- /table -->\n")
+    (tmp_path / "rbf_real.json").write_text(json.dumps(RBF_REAL))
+    assert doc_tables.update_doc("rbf_real", tmp_path / "rbf_real.json", doc) == ["rbf_real.ablation_totals"]
+    assert "old key" in doc.read_text() and "old totals" not in doc.read_text()
+    (tmp_path / "rbf_features.json").write_text(json.dumps(RBF_FEATURES))
+    assert doc_tables.update_doc("rbf_features", tmp_path / "rbf_features.json", doc) == ["rbf_features.feature_key"]
+    assert "Feature key: f0 = ang:a-b-c" in doc.read_text() and "| disputed expert features | 1 | 1 | 1 | 3 |" \
+        in doc.read_text()
