@@ -1,8 +1,12 @@
 """Seed 004 RBF styliser: effect of each theme on the 18 gait affective features, bone lengths, speed,
 and the contact sheet docs/img/rbf_contact_sheet.png.
 
-Run:  OMP_NUM_THREADS=1 python benchmarks/bench_rbf_features.py [--out docs/benchmarks/rbf_results.json]
-          [--sheet docs/img/rbf_contact_sheet.png] [--shapes docs/img/rbf_shapes.png] [--base real|procedural]
+Run:  OMP_NUM_THREADS=1 python benchmarks/bench_rbf_features.py [--out docs/benchmarks/rbf_features.json]
+          [--doc docs/benchmarks/rbf.md] [--sheet docs/img/rbf_contact_sheet.png] [--shapes docs/img/rbf_shapes.png]
+          [--base real|procedural]
+
+Writes its figures to the JSON (--out); with --doc it renders them into that page's ``rbf_features.*`` tables
+(benchmarks/doc_tables.py; the narrative there is written by hand).
 
 The neutral base is the shipped cycle averaged from real normal walks (``--base real``, the seed004 plan's default;
 Bandai Namco, CC BY-NC 4.0, Kobayashi et al. 2023) or the averaged procedural walks (``--base procedural``).
@@ -32,8 +36,11 @@ import torch  # noqa: E402
 from generation.core.features import GAIT_FEATURE_NAMES, foot_joints, np_gait_affective_features  # noqa: E402
 from generation.rbf.neutral_base import neutral_cycle  # noqa: E402
 from generation.rbf.real_neutral import load_cycle  # noqa: E402
-from generation.rbf.stylise import stylise, stylised_cycle  # noqa: E402
+from generation.rbf.stylise import PAPER_FEATURE_COUNTS, PAPER_WEIGHTS, stylise, stylised_cycle  # noqa: E402
 from generation.rbf.themes import THEME_NAMES, THEMES  # noqa: E402
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+import doc_tables  # noqa: E402
 
 WEIGHTS = (0.7, -0.7)
 
@@ -162,8 +169,6 @@ def timing(nc, build, repeats: int = 7) -> dict:
 
 def scaling(nc) -> dict:
     """Mean joint displacement from the neutral (cm, fitted skeleton) for the Fig. 7 grid of w x n."""
-    from generation.rbf.stylise import PAPER_FEATURE_COUNTS, PAPER_WEIGHTS
-
     out = {}
     for theme in THEME_NAMES:
         grid = []
@@ -177,115 +182,20 @@ def scaling(nc) -> dict:
     return out
 
 
-def markdown_tables(result: dict) -> str:
-    names = result["feature_names"]
-    short = [f"f{i}" for i in range(len(names))]
-    lines = ["Feature key: " + "; ".join(f"f{i} = {n}" for i, n in enumerate(names)), ""]
-    lines.append("Change of the cycle mean of each gait affective feature against the neutral base "
-                 "(angles in radians, ratios dimensionless):")
-    lines.append("")
-    lines.append("| theme | w | " + " | ".join(short) + " |")
-    lines.append("|---|---|" + "---|" * len(short))
-    for row in result["rows"]:
-        lines.append(f"| {row['theme']} | {row['weight']:+.1f} | "
-                     + " | ".join(f"{v:+.3f}" for v in row["mean_change"]) + " |")
-    lines += ["", "Expected directions (18 gait features):", "",
-              "| theme | w | feature | aggregate | expected | change | holds | why |",
-              "|---|---|---|---|---|---|---|---|"]
-    for row in result["rows"]:
-        for c in row["checks"]:
-            lines.append(f"| {row['theme']} | {row['weight']:+.1f} | {c['feature']} | {c['aggregate']} | "
-                         f"{'+' if c['expected_sign'] > 0 else '-'} | {c['change']:+.4f} | "
-                         f"{'yes' if c['holds'] else '**no**'} | "
-                         f"{c['reason'] if row['weight'] > 0 else 'inverse of: ' + c['reason']} |")
-    lines += ["", "Expected directions (direct measures in the walker frame, mm):", "",
-              "| theme | w | measure | expected | change (mm) | holds |", "|---|---|---|---|---|---|"]
-    for row in result["rows"]:
-        for c in row["measures"]:
-            lines.append(f"| {row['theme']} | {row['weight']:+.1f} | {c['measure']} | "
-                         f"{'+' if c['expected_sign'] > 0 else '-'} | {c['change_m'] * 1000:+.1f} | "
-                         f"{'yes' if c['holds'] else '**no**'} |")
-    lines += ["", "Bone lengths and floor (mm): largest bone-length deviation of the edited positions Y, of our fit, "
-              "of `generation.core.ik.fit_positions_to_skeleton` (direction-only projection); lowest foot joint "
-              "relative to the neutral floor for ours / the direction-only projection:", "",
-              "| theme | w | before | after (ours) | after (ik.fit_positions_to_skeleton) | lowest foot ours | "
-              "lowest foot direction-only | max lift by floor clamp |", "|---|---|---|---|---|---|---|---|"]
-    for row in result["rows"]:
-        lines.append(f"| {row['theme']} | {row['weight']:+.1f} | {row['bone_error_before_m'] * 1000:.1f} | "
-                     f"{row['bone_error_after_m'] * 1000:.1e} | {row['ik_direction_only_after_m'] * 1000:.1e} | "
-                     f"{row['lowest_foot_m'] * 1000:+.1f} | {row['lowest_foot_direction_only_m'] * 1000:+.1f} | "
-                     f"{row['ground_lift_m'] * 1000:.1f} |")
-    lines += ["", "Mean joint displacement from the neutral walk (cm) on the Fig. 7 grid (rows n = 1, 4, 7, 10; "
-              "columns w = 0.4, 0.7, 1.0, 1.3):", "", "| theme | n | w 0.4 | w 0.7 | w 1.0 | w 1.3 |",
-              "|---|---|---|---|---|---|"]
-    for theme, grid in result["scaling"].items():
-        for n, row in zip((1, 4, 7, 10), grid):
-            lines.append(f"| {theme} | {n} | " + " | ".join(f"{v:.2f}" for v in row) + " |")
-    return "\n".join(lines) + "\n"
-
-
-def benchmark_page(result: dict) -> str:
-    """docs/benchmarks/rbf.md: how the numbers were made, then the tables."""
-    base = result["neutral_base"]
-    sources = base.get("sources", base.get("captured_sources", []))
-    used = [u for u in sources if u["cycles"]]
-    rejected = sum(u.get("rejected_cycles", 0) for u in sources)
-    held = {k: (sum(c["holds"] for r in result["rows"] for c in r[k]), sum(len(r[k]) for r in result["rows"]))
-            for k in ("checks", "measures")}
-    t = result["timing"]
-    worst_before = max(r["bone_error_before_m"] for r in result["rows"])
-    worst_after = max(r["bone_error_after_m"] for r in result["rows"])
-    lowest_ours = min(r["lowest_foot_m"] for r in result["rows"])
-    lowest_dir = min(r["lowest_foot_direction_only_m"] for r in result["rows"])
-    failed = [f"{r['theme']} w = {r['weight']:+.1f}: {c.get('feature', c.get('measure'))}"
-              for r in result["rows"] for k in ("checks", "measures") for c in r[k] if not c["holds"]]
-    lines = [
-        "# RBF styliser (seed 004): measured effects",
-        "",
-        f"Machine: 2-core CI VM, no GPU. Date: {time.strftime('%Y-%m-%d')}. Command:",
-        "",
-        "```",
-        "OMP_NUM_THREADS=1 python benchmarks/bench_rbf_features.py --doc docs/benchmarks/rbf.md \\",
-        "    --sheet docs/img/rbf_contact_sheet.png --shapes docs/img/rbf_shapes.png",
-        "```",
-        "",
-        f"Neutral base: `{result['base_function']}`, {base['n_cycles']} cycle(s) averaged, "
-        f"{rejected} rejected as glitches, cycle {base['cycle_duration_s']:.2f} s, stride "
-        f"{base['stride_m'][2]:.2f} m, synthetic: {base['synthetic']}. Sources used: "
-        + "; ".join(f"{u['name']} ({u['cycles']})" for u in used) + "."
-        + (f" {rejected} cycle(s) were left out because a joint moved faster than 10 m/s between two frames (on "
-           "2026-11-27 `generation.procedural.walk.walk` made each knee jump about 13 cm within one frame once per "
-           "cycle, so every procedural cycle was rejected and the base is the captured cycle alone; rerun this "
-           "benchmark once the walker is fixed)." if rejected else ""),
-        "",
-        "Every theme uses all ten Table III features. Changes are the stylised cycle (after it is put back on the "
-        "skeleton) minus the neutral cycle, over one 100-frame cycle.",
-        "",
-        "## Summary",
-        f"- Expected directions hold for {held['checks'][0]} of {held['checks'][1]} checks on the 18 gait affective "
-        f"features and {held['measures'][0]} of {held['measures'][1]} checks on direct geometric measures"
-        + (f"; not holding: {', '.join(failed)}." if failed else "."),
-        f"- Bone lengths: the edited positions Y deviate from the skeleton's bone lengths by up to "
-        f"{worst_before * 1000:.0f} mm (the paper's stated limitation); after the fit the largest deviation is "
-        f"{worst_after * 1000:.1e} mm.",
-        f"- Floor: lowest foot joint {lowest_ours * 1000:+.1f} mm relative to the neutral floor with our fit, "
-        f"{lowest_dir * 1000:+.1f} mm with `generation.core.ik.fit_positions_to_skeleton` (direction-only).",
-        f"- Speed: {t['stylise_clip_s'] * 1000:.0f} ms per 4-cycle clip at 30 fps ({t['clip_frames']} frames, "
-        f"median of 7, one core, on a machine shared with other jobs); "
-        f"{'loading' if 'load_cycle' in result['base_function'] else 'building'} the neutral base "
-        f"{t['neutral_base_s']:.2f} s.",
-        "- Scaling: the mean joint displacement grows with w and, mostly, with n (last table), as the paper's "
-        "ratings did (Fig. 7). It is not strictly proportional to w after the fit: bones cannot stretch, a chest "
-        "without clavicles moves as one piece, and feet are kept above the floor.",
-        "",
-        "Reading the checks: sad and tired are checked on the head-neck-shoulder angles only at w = +0.7, because "
-        "those angles shrink when the head pitches away from upright in either direction; the knee check uses the "
-        "minimum knee angle (peak swing flexion), since a lowered knee straightens the leg to pi at heel strike. "
-        "A head cannot rise above upright on a fixed-length neck, so 'head tilted along +Y' (tired at w = -0.7) "
-        "moves it back rather than up.",
-        "",
-    ]
-    return "\n".join(lines) + "\n" + markdown_tables(result)
+def summary(result: dict) -> dict:
+    """Over every theme and weight: expected directions that hold, the failures, the largest bone-length deviation
+    before and after the fit (m) and the lowest foot joint relative to the neutral floor (m)."""
+    rows = result["rows"]
+    return {"checks_held": sum(c["holds"] for r in rows for c in r["checks"]),
+            "checks": sum(len(r["checks"]) for r in rows),
+            "measures_held": sum(c["holds"] for r in rows for c in r["measures"]),
+            "measures": sum(len(r["measures"]) for r in rows),
+            "failed": [f"{r['theme']} w = {r['weight']:+.1f}: {c.get('feature', c.get('measure'))}"
+                       for r in rows for k in ("checks", "measures") for c in r[k] if not c["holds"]],
+            "bone_error_before_max_m": max(r["bone_error_before_m"] for r in rows),
+            "bone_error_after_max_m": max(r["bone_error_after_m"] for r in rows),
+            "lowest_foot_m": min(r["lowest_foot_m"] for r in rows),
+            "lowest_foot_direction_only_m": min(r["lowest_foot_direction_only_m"] for r in rows)}
 
 
 # ---- contact sheet --------------------------------------------------------------------------------
@@ -381,50 +291,10 @@ def shapes_figure(path: Path) -> None:
     plt.close(fig)
 
 
-def keep_marked_blocks(doc: Path, page: str) -> str:
-    """The new page plus any ``<!-- name:start -->`` ... ``<!-- name:end -->`` blocks other benchmarks wrote into
-    ``doc`` (e.g. benchmarks/bench_rbf_real.py's section), kept at the end."""
-    import re
-
-    old = doc.read_text(encoding="utf-8") if doc.is_file() else ""
-    blocks = re.findall(r"<!-- ([\w-]+):start -->.*?<!-- \1:end -->", old, flags=re.S)
-    kept = [re.search(rf"<!-- {name}:start -->.*?<!-- {name}:end -->", old, flags=re.S).group(0) for name in blocks]
-    return page.rstrip("\n") + "".join("\n\n" + b for b in kept) + "\n"
-
-
-def main(argv=None) -> int:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--out", type=Path, default=None, help="write all numbers as JSON here")
-    parser.add_argument("--tables", type=Path, default=None, help="write the markdown tables here")
-    parser.add_argument("--doc", type=Path, default=None, help="write the benchmark page (e.g. docs/benchmarks/rbf.md)")
-    parser.add_argument("--sheet", type=Path, default=Path("docs/img/rbf_contact_sheet.png"))
-    parser.add_argument("--shapes", type=Path, default=Path("docs/img/rbf_shapes.png"))
-    parser.add_argument("--base", choices=("real", "procedural"), default="real",
-                        help="neutral base: averaged real normal walks (shipped) or averaged procedural walks")
-    args = parser.parse_args(argv)
-    torch.set_num_threads(1)
-    warnings.filterwarnings("ignore", message="The given NumPy array is not writable")
-    build = load_cycle if args.base == "real" else neutral_cycle
-    nc = build()
-    result = evaluate(nc)
-    result["base_function"] = ("generation.rbf.real_neutral.load_cycle()" if args.base == "real"
-                               else "generation.rbf.neutral_base.neutral_cycle()")
-    result["timing"] = timing(nc, build)
-    result["neutral_base"] = {k: v for k, v in nc.metadata.items()}
-    result["movement_share_top10"] = {t: 100.0 * sum(f.kind == "swing" for f in THEMES[t]) / 10 for t in THEMES}
-    result["scaling"] = scaling(nc)
-    if args.out:
-        args.out.parent.mkdir(parents=True, exist_ok=True)
-        args.out.write_text(json.dumps(result, indent=1))
-    if args.tables:
-        args.tables.write_text(markdown_tables(result))
-    if args.doc:
-        args.doc.parent.mkdir(parents=True, exist_ok=True)
-        args.doc.write_text(keep_marked_blocks(args.doc, benchmark_page(result)))
-    args.sheet.parent.mkdir(parents=True, exist_ok=True)
-    contact_sheet(nc, args.sheet)
-    shapes_figure(args.shapes)
-    print(f"neutral base: {nc.metadata['n_cycles']} cycles, IK error {nc.metadata['ik_error_max_m'] * 1000:.1f} mm")
+def print_report(result: dict) -> None:
+    """The console summary: bone errors and floor per theme and weight, every check, the totals and the timing."""
+    base, s, t = result["neutral_base"], result["summary"], result["timing"]
+    print(f"neutral base: {base['n_cycles']} cycles, IK error {base['ik_error_max_m'] * 1000:.1f} mm")
     print("theme       w     bone err before -> after (mm)   ik.fit after   lowest foot ours / direction-only (mm)")
     for row in result["rows"]:
         print(f"{row['theme']:10s} {row['weight']:+.1f}   {row['bone_error_before_m'] * 1000:7.1f} -> "
@@ -436,13 +306,55 @@ def main(argv=None) -> int:
         for c in row["measures"]:
             print(f"    {c['measure']:34s} expected {c['expected_sign']:+d} "
                   f"change {c['change_m'] * 1000:+.1f} mm {'OK' if c['holds'] else 'FAILS'}")
-    for key in ("checks", "measures"):
-        held = sum(c["holds"] for r in result["rows"] for c in r[key])
-        total = sum(len(r[key]) for r in result["rows"])
-        print(f"expected directions hold ({'18 gait features' if key == 'checks' else 'direct measures'}): "
-              f"{held}/{total}")
-    print(f"timing: stylise 4-cycle clip {result['timing']['stylise_clip_s'] * 1000:.1f} ms "
-          f"({result['timing']['clip_frames']} frames), neutral base {result['timing']['neutral_base_s']:.2f} s")
+    print(f"expected directions hold (18 gait features): {s['checks_held']}/{s['checks']}")
+    print(f"expected directions hold (direct measures): {s['measures_held']}/{s['measures']}")
+    print(f"timing: stylise 4-cycle clip {t['stylise_clip_s'] * 1000:.1f} ms ({t['clip_frames']} frames), "
+          f"neutral base {t['neutral_base_s']:.2f} s")
+
+
+def main(argv=None) -> int:
+    import datetime
+    import os
+    import platform
+    import shlex
+
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--out", type=Path, default=doc_tables.area_files("rbf_features")[0],
+                        help="write all numbers as JSON here")
+    parser.add_argument("--doc", type=Path, default=None, help="render the rbf_features tables marked in this page")
+    parser.add_argument("--sheet", type=Path, default=Path("docs/img/rbf_contact_sheet.png"))
+    parser.add_argument("--shapes", type=Path, default=Path("docs/img/rbf_shapes.png"))
+    parser.add_argument("--base", choices=("real", "procedural"), default="real",
+                        help="neutral base: averaged real normal walks (shipped) or averaged procedural walks")
+    args = parser.parse_args(argv)
+    torch.set_num_threads(1)
+    warnings.filterwarnings("ignore", message="The given NumPy array is not writable")
+    build = load_cycle if args.base == "real" else neutral_cycle
+    nc = build()
+    threads = f"OMP_NUM_THREADS={os.environ['OMP_NUM_THREADS']} " if "OMP_NUM_THREADS" in os.environ else ""
+    result = {"machine": f"{platform.machine()} {platform.system()}, {os.cpu_count()} CPUs (shared), no GPU",
+              "date": datetime.date.today().isoformat(),
+              "command": threads + shlex.join(["python", "benchmarks/bench_rbf_features.py",
+                                               *(sys.argv[1:] if argv is None else argv)]),
+              **evaluate(nc)}
+    result["summary"] = summary(result)
+    result["base_function"] = ("generation.rbf.real_neutral.load_cycle()" if args.base == "real"
+                               else "generation.rbf.neutral_base.neutral_cycle()")
+    result["timing"] = timing(nc, build)
+    result["neutral_base"] = {k: v for k, v in nc.metadata.items()}
+    result["movement_share_top10"] = {t: 100.0 * sum(f.kind == "swing" for f in THEMES[t]) / 10 for t in THEMES}
+    result["scaling"] = scaling(nc)
+    result["scaling_axes"] = {"n": list(PAPER_FEATURE_COUNTS), "w": list(PAPER_WEIGHTS)}
+    args.out.parent.mkdir(parents=True, exist_ok=True)
+    args.out.write_text(json.dumps(result, indent=1) + "\n")
+    print(f"wrote {args.out}")
+    if args.doc:
+        print(f"{args.doc} tables:", ", ".join(doc_tables.update_doc("rbf_features", args.out, args.doc))
+              or "none marked")
+    args.sheet.parent.mkdir(parents=True, exist_ok=True)
+    contact_sheet(nc, args.sheet)
+    shapes_figure(args.shapes)
+    print_report(result)
     return 0
 
 
