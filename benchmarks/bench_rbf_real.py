@@ -4,6 +4,9 @@ RBF features per theme, what the real-capture observers read, and a contact shee
 Run:  OMP_NUM_THREADS=1 python benchmarks/bench_rbf_real.py [--corpus var/mocap/bandai-namco.npz]
           [--out docs/benchmarks/rbf_real.json] [--doc docs/benchmarks/rbf.md] [--sheets docs/img]
 
+Writes its figures to the JSON (--out); with --doc it renders them into that page's ``rbf_real.*`` tables
+(benchmarks/doc_tables.py; the narrative there is written by hand).
+
 Needs the real-capture corpus (``python -m generation.mocap dataset bandai-namco DIR --out CORPUS``). Real data:
 Bandai Namco Research Motion Dataset 1 and 2 (Kobayashi et al. 2023, arXiv:2306.08861; CC BY-NC 4.0).
 
@@ -42,7 +45,9 @@ from generation.rbf.stylise import neutral_walk, stylise  # noqa: E402
 from generation.rbf.themes import THEME_NAMES, theme_features  # noqa: E402
 from study_protocol import CAPTURE_THEMES, GAIT_EMOTIONS  # noqa: E402
 
-MARK_START, MARK_END = "<!-- rbf-real:start -->", "<!-- rbf-real:end -->"
+sys.path.insert(0, str(ROOT / "benchmarks"))
+import doc_tables  # noqa: E402
+
 CHECKED = ("speed_m_s", "cadence_steps_min", "stance_knee_deg", "pelvis_bounce_cm")
 WEIGHTS = (0.7, 1.0)
 PAIR_OF = {theme: (pair, side) for pair, sides in THEME_PAIRS.items()
@@ -199,124 +204,16 @@ def contact_sheets(base, corpus: Path, out_dir: Path, weight: float = 1.0) -> li
     return written
 
 
-def _f(v, fmt="{:.2f}"):
-    return "-" if v is None else fmt.format(v)
-
-
-def markdown(result: dict) -> str:
-    n = result["neutral"]
-    md = n["metadata"]
-    takes = [s for s in md["captured_sources"] if s["cycles"]]
-    per_ds = {}
-    for s in takes:
-        d = per_ds.setdefault(s["dataset"], [0, 0])
-        d[0] += 1
-        d[1] += s["cycles"]
-    lines = [MARK_START, "## Seed 004 on real capture (`benchmarks/bench_rbf_real.py`)", "",
-             f"Machine: {result['machine']}. Date: {result['date']}. Command: "
-             "`OMP_NUM_THREADS=1 python benchmarks/bench_rbf_real.py --doc docs/benchmarks/rbf.md --sheets docs/img`. "
-             "Real data: Bandai Namco Research Motion Dataset 1 and 2 (Kobayashi et al. 2023, arXiv:2306.08861; "
-             "CC BY-NC 4.0).", "",
-             "### The averaged neutral walk", "",
-             f"{md['n_cycles']} steady two-step cycles from {md['n_takes']} train-split normal walks ("
-             + ", ".join(f"{ds}: {v[1]} cycles from {v[0]} takes" for ds, v in sorted(per_ds.items()))
-             + f"), at most 4 per take; time warping: {md['time_warping']}. Cycle spread across the cycles "
-             f"(mean per-frame standard deviation, walker heights): {md['dtw_spread']['before']:.4f} after contact "
-             f"warping, {md['dtw_spread']['after']:.4f} after DTW. Cycle {md['cycle_duration_s']:.3f} s, stride "
-             f"{md['stride_m'][2]:.3f} m, IK re-fit error {md['ik_error_max_m'] * 1000:.1f} mm.", "",
-             f"Walked for 4 cycles at 30 fps (feet planted), against the range (min-max) of all {n['real_takes']} "
-             "real normal walks (both datasets, all splits):", "",
-             "| base | speed (m/s) | cadence (steps/min) | stance knee (deg) | pelvis bounce (cm) | real observer "
-             "(happy/sad/angry/neutral) |", "|---|---|---|---|---|---|"]
-    for name, row in n["bases"].items():
-        cells = [f"{row[k]:.2f}{'' if row['inside'][k] else ' **(outside)**'}" for k in CHECKED]
-        obs = "/".join(f"{row['observer'][e]:.2f}" for e in GAIT_EMOTIONS)
-        lines.append(f"| {name} | " + " | ".join(cells) + f" | {obs} |")
-    rr = n["real_ranges"]
-    lines.append("| real normal walks (range) | " + " | ".join(f"{rr[k][0]:.2f}-{rr[k][1]:.2f}" for k in CHECKED)
-                 + " | test takes: " + "/".join(f"{n['real_test_normal_read'][e]:.2f}" for e in GAIT_EMOTIONS)
-                 + " |")
-    acc = result["accuracy"]
-    lines += ["", "### Real-capture observers: held-out accuracy (test-split takes)", "",
-              "| classifier | test takes | accuracy |", "|---|---|---|"]
-    lines += [f"| {k} | {v['takes']} | {_f(v['accuracy'])} |" for k, v in acc.items()]
-    lines += ["", "### Expert vs data-driven features per theme", "",
-              "w = 1, displacement / walker height over one cycle. `shared`: DOFs both edit; `sign`: share of "
-              "shared DOFs where the data move the expert's way at the expert's peak; `ratio`: median data/expert "
-              "amplitude; `rows in common`: of the experts' Table III rows (body part x axis), how many are among "
-              "the data's first ten.", "",
-              "| theme | rows in common | shared DOFs | sign agree | median ratio | data's first five rows |",
-              "|---|---|---|---|---|---|"]
-    for theme, c in result["compare"].items():
-        lines.append(f"| {theme} | {c['used_overlap']} of {len(c['expert_features'])} | {c['shared_dofs']} | "
-                     f"{_f(c['sign_agreement'])} | {_f(c['median_ratio'])} | "
-                     + ", ".join(f"{p} {a}" for p, a in c["data_features"][:5]) + " |")
-    lines += ["", "Top DOFs per theme (largest amplitude of either set; peaks in walker heights, signed):", "",
-              "| theme | DOF | expert peak | data peak | sign agree | peak shift (cycle) | ratio | corr |",
-              "|---|---|---|---|---|---|---|---|"]
-    for theme, c in result["compare"].items():
-        for r in c["rows"][:6]:
-            sa = "-" if r["sign_agree"] is None else ("yes" if r["sign_agree"] else "**no**")
-            lines.append(f"| {theme} | {r['joint']} {r['axis']} | {_f(r['expert_peak'], '{:+.3f}')} | "
-                         f"{_f(r['data_peak'], '{:+.3f}')} | {sa} | {_f(r['peak_shift'])} | {_f(r['ratio'])} | "
-                         f"{_f(r['corr'])} |")
-    lines += ["", "### Which features the real-capture theme observers agree with", "",
-              "Probability of the intended theme from the theme-pair classifier (its pair in brackets; held-out "
-              "accuracy above), all ten features; real = mean over the real themed test takes:", "",
-              "| theme (pair) | neutral | expert 0.7 | data 0.7 | expert 1.0 | data 1.0 | real test takes | "
-              "observer prefers |", "|---|---|---|---|---|---|---|---|"]
-    for theme, row in result["observers"].items():
-        data_wins = [row[f"data_{w}"] > row[f"expert_{w}"] for w in WEIGHTS]
-        better = "data" if all(data_wins) else "expert" if not any(data_wins) else "mixed"
-        lines.append(f"| {theme} ({row['pair']}) | {row['neutral']:.2f} | {row['expert_0.7']:.2f} | "
-                     f"{row['data_0.7']:.2f} | {row['expert_1.0']:.2f} | {row['data_1.0']:.2f} | "
-                     f"{row['real_test']:.2f} ({row['real_test_takes']}) | {better} |")
-    lines += ["", "Disputed expert features, one at a time (w = 1, all other nine kept): the theme observer's "
-              "p(intended) without the feature; higher than with it (by > 0.02) = the observer sides with the data, "
-              "lower = with the expert:", "",
-              "| theme | p (all ten) | Table III feature (rank) | why disputed | p without it | sides with |",
-              "|---|---|---|---|---|---|"]
-    for theme, ab in result["ablation"].items():
-        for r in ab["rows"]:
-            lines.append(f"| {theme} | {ab['p_full']:.2f} | {r['feature']} ({r['rank']}) | {r['why']} | "
-                         f"{r['p_without']:.2f} | {r['sides_with']} |")
-    counts = {side: sum(r["sides_with"] == side for ab in result["ablation"].values() for r in ab["rows"])
-              for side in ("data", "expert", "neither")}
-    lines += ["", "Totals: " + ", ".join(f"{k} {v}" for k, v in counts.items()) + "."]
-    lines += ["", "Four-emotion observer (trained on dataset 1 only), probability of the theme's emotion:", "",
-              "| theme | expert 0.7 | data 0.7 | expert 1.0 | data 1.0 | real dataset-1 test take |",
-              "|---|---|---|---|---|---|"]
-    for theme in ("happy", "sad"):
-        row = result["observers"][theme]
-        lines.append(f"| {theme} | " + " | ".join(f"{row[f'{f}_{w}_emotion_p']:.2f}" for w in WEIGHTS
-                                                  for f in ("expert", "data"))
-                     + f" | {row['real_test_emotion_p']:.2f} |")
-    lines += ["", "Contact sheets (neutral, expert-styled w = 1, data-styled w = 1, a real themed test take; what they "
-              "show is described in docs/rbf.md): "
-              + ", ".join(f"[{t}](../img/rbf_real_{t}.png)" for t in THEME_NAMES) + ".", "", MARK_END]
-    return "\n".join(lines) + "\n"
-
-
-def write_block(doc: Path, block: str) -> None:
-    """Replace the marked block in ``doc`` (or append it)."""
-    text = doc.read_text(encoding="utf-8") if doc.is_file() else ""
-    if MARK_START in text and MARK_END in text:
-        head, rest = text.split(MARK_START, 1)
-        tail = rest.split(MARK_END, 1)[1].lstrip("\n")
-        text = head + block + tail
-    else:
-        text = text.rstrip("\n") + "\n\n" + block
-    doc.write_text(text, encoding="utf-8")
-
-
 def main(argv=None) -> int:
     import datetime
+    import os
     import platform
+    import shlex
 
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--corpus", type=Path, default=None)
-    ap.add_argument("--out", type=Path, default=ROOT / "docs" / "benchmarks" / "rbf_real.json")
-    ap.add_argument("--doc", type=Path, default=None, help="write the marked section into this page")
+    ap.add_argument("--out", type=Path, default=doc_tables.area_files("rbf_real")[0])
+    ap.add_argument("--doc", type=Path, default=None, help="render the rbf_real tables marked in this page")
     ap.add_argument("--sheets", type=Path, default=None, help="write rbf_real_<theme>.png into this folder")
     a = ap.parse_args(argv)
     warnings.filterwarnings("ignore", message="The given NumPy array is not writable")
@@ -325,18 +222,20 @@ def main(argv=None) -> int:
         raise SystemExit(f"no real-capture corpus at {corpus}; build it with python -m generation.mocap dataset ...")
     observer = default_real_observer(corpus)
     base = load_cycle()
-    result = {"machine": f"{platform.machine()} {platform.system()}, 2 shared cores, no GPU",
+    threads = f"OMP_NUM_THREADS={os.environ['OMP_NUM_THREADS']} " if "OMP_NUM_THREADS" in os.environ else ""
+    result = {"machine": f"{platform.machine()} {platform.system()}, {os.cpu_count()} CPUs (shared), no GPU",
               "date": datetime.date.today().isoformat(),
+              "command": threads + shlex.join(["python", "benchmarks/bench_rbf_real.py",
+                                               *(sys.argv[1:] if argv is None else argv)]),
               "neutral": neutral_section(corpus, observer), "accuracy": pair_accuracy(observer, corpus),
               "compare": {t: compare_theme(base, t) for t in THEME_NAMES},
               "observers": observer_section(observer, corpus, base)}
     result["ablation"] = ablation_section(observer, base, result["compare"])
     a.out.parent.mkdir(parents=True, exist_ok=True)
     a.out.write_text(json.dumps(result, indent=1, default=float) + "\n", encoding="utf-8")
-    block = markdown(result)
-    print(block)
+    print(f"wrote {a.out}")
     if a.doc:
-        write_block(a.doc, block)
+        print(f"{a.doc} tables:", ", ".join(doc_tables.update_doc("rbf_real", a.out, a.doc)) or "none marked")
     if a.sheets:
         for p in contact_sheets(base, corpus, a.sheets):
             print(f"wrote {p}")
