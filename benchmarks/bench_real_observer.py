@@ -13,7 +13,8 @@ synthetic observer, and the realism measures of real walks beside the generated 
 3. Realism: the measures of :mod:`generation.quality.realism` per real style (all gait takes) beside the plans'
    generated clips (and the plans' real source walks, cut as rendered).
 
-Writes the JSON and replaces the section between the ``real-observer`` markers of the Markdown file.
+Writes the JSON, then renders it into the ``real_observer.*`` tables marked in the Markdown file
+(benchmarks/doc_tables.py; the narrative there is written by hand).
 Real capture: Bandai Namco Research Motion Dataset (Kobayashi et al. 2023, arXiv:2306.08861), CC BY-NC 4.0.
 """
 from __future__ import annotations
@@ -24,6 +25,7 @@ import json
 import os
 import platform
 import re
+import shlex
 import sys
 import time
 from collections import defaultdict
@@ -41,7 +43,8 @@ from generation.quality.realism import MEASURES  # noqa: E402
 from generation.quality.realism_ranges import load_ranges, measure_corpus  # noqa: E402
 from study_protocol import CAPTURE_GAIT_EMOTIONS, GAIT_EMOTIONS  # noqa: E402
 
-START, END = "<!-- real-observer:start -->", "<!-- real-observer:end -->"
+sys.path.insert(0, str(ROOT / "benchmarks"))
+import doc_tables  # noqa: E402
 
 
 def held_out(obs: ro.RealGaitObserver, test) -> dict:
@@ -205,102 +208,6 @@ def realism_table(real: list[dict], plans: dict[str, list[dict]]) -> dict:
     return out
 
 
-def _cm_table(cm, title: str) -> list[str]:
-    head = "| intended \\ read | " + " | ".join(GAIT_EMOTIONS) + " | recall |"
-    lines = [f"**{title}**", "", head, "|" + "---|" * (len(GAIT_EMOTIONS) + 2)]
-    for i, e in enumerate(GAIT_EMOTIONS):
-        row = cm[i]
-        rec = f"{row[i] / sum(row):.2f}" if sum(row) else "-"
-        lines.append(f"| {e} | " + " | ".join(str(x) for x in row) + f" | {rec} |")
-    return lines + [""]
-
-
-def _fmt(s: dict) -> str:
-    if not s or not s.get("n"):
-        return "-"
-    if s["n"] < 5:
-        return f"{s['median']:.3g} ({s['min']:.3g}-{s['max']:.3g})"
-    return f"{s['median']:.3g} ({s['p5']:.3g}-{s['p95']:.3g})"
-
-
-def markdown(res: dict) -> str:
-    h = res["held_out"]
-    lines = [START, "", "## Real-capture gait observer and realism measures (`benchmarks/bench_real_observer.py`)", "",
-             f"{res['date']}, {res['machine']}, {res['commit']}; {res['seconds']:.0f} s. Real capture: Bandai "
-             "Namco Research Motion Dataset (Kobayashi et al. 2023, arXiv:2306.08861), CC BY-NC 4.0, retargeted "
-             f"onto the 21-joint gait skeleton ({res['corpus']}). Observer: {res['observer_source']}; descriptors "
-             "and classifier in `generation/quality/real_observer.py` (2 s windows: 18 affective-feature means "
-             "and standard deviations, root speed and vertical range per body height; standardised logistic "
-             "regression, C = 0.1, takes weighted equally; a clip's probabilities are the mean over its windows).",
-             "",
-             "### Held-out takes (split by take, `split == test`)", "",
-             f"Emotions: dataset 1 only (happy, sad, angry, normal = neutral; {sum(res['train_takes'].values())} "
-             f"training takes, {h['n_takes']} held-out takes). Accuracy {h['accuracy_takes']:.2f} per take, "
-             f"{h['accuracy_windows']:.2f} per 2 s window.", ""]
-    lines += _cm_table(h["confusion_takes"], "Per take (rows: intended style, columns: observer's top label)")
-    lines += _cm_table(h["confusion_windows"], "Per window")
-    lines += ["Theme pairs (binary classifiers on the same descriptors, both datasets' takes of those styles; "
-              "held-out takes):", "", "| pair | held-out takes | accuracy | takes per dataset | wrong |",
-              "|---|---|---|---|---|"]
-    for name, t in h["themes"].items():
-        lines.append(f"| {name.replace('_', ' ')} | {t['n']} | {t['accuracy']:.2f} | "
-                     f"{', '.join(f'{k}: {v}' for k, v in t['per_dataset'].items())} | "
-                     f"{', '.join(t['wrong']) or '-'} |")
-    lo = res["leave_one_take_out"]
-    lines += ["", f"Leave one take out over all {lo['n_takes']} dataset-1 emotion takes (train and test split; each "
-              f"take read by an observer fitted on the other {lo['n_takes'] - 1}): accuracy {lo['accuracy']:.2f}.",
-              ""]
-    lines += _cm_table(lo["confusion"], "Leave one take out, per take")
-    if res["themes_in_plans"]:
-        lines += ["The plans' gait theme clips read by the theme pair's classifier (p of the clip's own theme; "
-                  "an inverted clip, weight < 0, aims at the other theme of the pair, so there a low p is the "
-                  "intended reading):", "", "| plan | entry | generator | theme | weight | pair | p(theme) |",
-                  "|---|---|---|---|---|---|---|"]
-        for plan, rows in res["themes_in_plans"].items():
-            for r in rows:
-                lines.append(f"| {plan} | {r['entry']} | {r['generator']} | {r['theme']} | {r['weight']} | "
-                             f"{r['pair'].replace('_', ' ')} | {r['p_theme']:.2f} |")
-        lines.append("")
-    lines += ["", "### The plans' gait clips read by the real-capture and the synthetic observer", "",
-              "Every gait entry made as `generate_clips` makes it and checked by `generation.pipeline.plan_qa` "
-              "(no video). Grouped by the entry's dominant intended emotion (share >= 0.5; transitions, themes "
-              "and the neutral base have none). `read` lists each clip's top label; p is the median top "
-              "probability. The synthetic observer: " + res["synthetic_source"] + ".", "",
-              "| plan | intended | clips | origin and generator used | real-capture: read (median p) | "
-              "synthetic: read (median p) | "
-              "observer flags (real) |", "|---|---|---|---|---|---|---|"]
-    for plan, groups in res["plans"].items():
-        for key, g in sorted(groups.items()):
-            def summary(labels, ps):
-                if not any(labels):
-                    return "no reading"
-                counts = defaultdict(int)
-                for lab in labels:
-                    counts[lab or "none"] += 1
-                med = np.median([p for p in ps if p is not None]) if any(p is not None for p in ps) else float("nan")
-                return ", ".join(f"{k} {v}" for k, v in sorted(counts.items(), key=lambda kv: -kv[1])) + \
-                    f" ({med:.2f})"
-            origins = ", ".join(f"{o} {n}" for o, n in sorted(_count(g["origins"]).items()))
-            lines.append(f"| {plan} | {key} | {g['n']} | {origins} | {summary(g['real_read'], g['real_p'])} | "
-                         f"{summary(g['synthetic_read'], g['synthetic_p'])} | {g['flag_observer_real']} |")
-    lines += ["", "### Realism: real walks per style beside the plans' clips", "",
-              "Median (5th-95th percentile; min-max under 5 clips) per group, measured as the quality gate "
-              "measures (`generation/quality/realism.py`; plan clips resampled and cut as rendered, real takes "
-              "whole). Thresholds (`generation/quality/realism_ranges.json`, " + res["ranges_rule"] + "): " +
-              ", ".join(f"{k} {v:g}" + (" (not applied)" if k in res["not_applied"] else "")
-                        for k, v in res["thresholds"].items()) +
-              f". Held-out real takes outside them: {res['ranges_test_flagged']:.0%}.", "",
-              "| group | " + " | ".join(MEASURES) + " | realism flags (bounds broken: clips) |",
-              "|---|" + "---|" * (len(MEASURES) + 1)]
-    for name, row in res["realism"].items():
-        flags = row.get("realism_flagged", "")
-        if row.get("bounds_broken"):
-            flags = f"{flags} (" + ", ".join(f"{k} {v}" for k, v in sorted(row["bounds_broken"].items())) + ")"
-        lines.append(f"| {name} | " + " | ".join(_fmt(row[m]) for m in MEASURES) + f" | {flags} |")
-    lines += ["", END]
-    return "\n".join(lines) + "\n"
-
-
 def _count(items) -> dict:
     out = defaultdict(int)
     for x in items:
@@ -319,20 +226,13 @@ def _commit() -> str:
     return f"commit {git('rev-parse', '--short', 'HEAD')}" + (" + uncommitted changes" if dirty else "")
 
 
-def write_markdown(path: Path, text: str) -> None:
-    """Replace the block between the markers in ``path`` (append it when absent)."""
-    old = path.read_text(encoding="utf-8") if path.is_file() else ""
-    pattern = re.compile(re.escape(START) + ".*?" + re.escape(END) + "\n?", re.S)
-    new = pattern.sub(lambda _: text, old) if pattern.search(old) else old.rstrip("\n") + "\n\n" + text
-    path.write_text(new, encoding="utf-8")
-
-
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--corpus", default=None)
     ap.add_argument("--plans", nargs="*", default=["demo", "seed000"])
-    ap.add_argument("--json", default=str(ROOT / "docs" / "benchmarks" / "real_observer.json"))
-    ap.add_argument("--md", default=str(ROOT / "docs" / "benchmarks" / "mocap.md"))
+    ap.add_argument("--json", default=str(doc_tables.area_files("real_observer")[0]))
+    ap.add_argument("--md", default=str(doc_tables.area_files("real_observer")[1]),
+                    help="render the real_observer tables marked in this page")
     args = ap.parse_args(argv)
     t0 = time.perf_counter()
     path = Path(args.corpus) if args.corpus else real_corpus_path()
@@ -349,6 +249,8 @@ def main(argv=None) -> int:
     plans_synth = {p: plan_rows(p, "synthetic") for p in args.plans}
     ranges = load_ranges()
     res = {"date": datetime.date.today().isoformat(), "commit": _commit(),
+           "command": shlex.join(["python", "benchmarks/bench_real_observer.py",
+                                  *(sys.argv[1:] if argv is None else argv)]),
            "machine": f"{platform.machine()}, {os.cpu_count()} CPUs (shared), Python {platform.python_version()}",
            "corpus": path.name, "observer_source": obs.source, "train_takes": dict(obs.train_takes),
            "synthetic_source": ("logistic regression on the SYNTHETIC procedural gait corpus (var/corpus/)"
@@ -365,8 +267,9 @@ def main(argv=None) -> int:
     res["seconds"] = time.perf_counter() - t0
     Path(args.json).parent.mkdir(parents=True, exist_ok=True)
     Path(args.json).write_text(json.dumps(res, indent=1, default=str) + "\n", encoding="utf-8")
-    write_markdown(Path(args.md), markdown(res))
-    print(markdown(res))
+    print(f"wrote {args.json}")
+    print(f"{args.md} tables:", ", ".join(doc_tables.update_doc("real_observer", Path(args.json), Path(args.md)))
+          or "none marked")
     return 0
 
 
