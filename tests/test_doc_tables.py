@@ -156,6 +156,18 @@ def test_area_files_name_the_json_and_doc_of_each_area():
                                                       doc_tables.DOCS / "mocap.md")
 
 
+@pytest.mark.parametrize("area", ["rbf_features", "rbf_real", "real_observer"])
+def test_each_doc_marks_every_table_of_the_area_once_and_matches_its_json(area):
+    """The area's doc marks each of its tables once, and the blocks there are what the committed JSON renders."""
+    results, doc = doc_tables.area_files(area)
+    text = doc.read_text()
+    names = [m.group("name") for m in doc_tables.BLOCK_RE.finditer(text) if m.group("name").startswith(area + ".")]
+    assert sorted(names) == sorted(doc_tables.TABLES[area])
+    tables = doc_tables.render_tables(area, json.loads(results.read_text()))
+    assert set(tables) == set(doc_tables.TABLES[area])
+    assert doc_tables.fill_doc(text, tables)[0] == text
+
+
 def _dof(joint, axis, expert, data, agree, shift, ratio, corr):
     return {"joint": joint, "axis": axis, "expert_peak": expert, "data_peak": data, "sign_agree": agree,
             "peak_shift": shift, "ratio": ratio, "corr": corr}
