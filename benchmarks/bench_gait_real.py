@@ -17,17 +17,26 @@ the real-capture corpus (``generation.mocap.real_corpus``); only its held-out ``
 3. Realism (``generation.quality.realism``) per asked emotion of those generated walks, beside the real takes of
    that emotion (dataset 1 walks, both takes; dataset 2 normal walks for neutral) and the corpus's pooled range.
 
-Usage: python benchmarks/bench_gait_real.py [--real W.pt] [--procedural W.pt] [--steps 100] [--skip-plan]
-Results: var/gait_runs/bench_gait_real.json, printed as markdown.
+Usage: python benchmarks/bench_gait_real.py [--real W.pt] [--before W.pt] [--procedural W.pt] [--steps 100]
+       [--skip-plan]
+``--before`` measures a previous real-trained weights file in the same run (rows "real-trained (before)").
+Results: docs/benchmarks/gait_real.json (``--out``) with the run's machine, date, commit, command, duration, weights
+and corpus hashes; the tables are printed and, with the default ``--out``, rendered into the marked ``gait_real.*``
+blocks of docs/benchmarks/gait.md (benchmarks/doc_tables.py; the narrative there is written by hand).
 """
 from __future__ import annotations
 
 import argparse
+import datetime
 import json
 import math
+import os
+import platform
+import shlex
 import sys
 import time
 from collections import defaultdict
+from contextlib import contextmanager
 from pathlib import Path
 
 import numpy as np
@@ -37,13 +46,15 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 sys.path.insert(0, str(ROOT / "benchmarks"))
 
+import doc_tables  # noqa: E402
 from bench_gait import nearest_neighbour_errors, network_errors, pose_rotation_errors, zero_velocity_errors  # noqa: E402
 
 from generation.core.quaternion import qmul  # noqa: E402
+from generation.gait.data import file_sha256  # noqa: E402
 from generation.gait.generate import generate_gaits, load_model  # noqa: E402
 from generation.gait.real_data import RealAugment, clip_sequences, stage_clips  # noqa: E402
 from generation.gait.weights import weights_path  # noqa: E402
-from generation.mocap.real_corpus import load_real_corpus  # noqa: E402
+from generation.mocap.real_corpus import load_real_corpus, real_corpus_path  # noqa: E402
 from generation.plans.clipgen import make_path  # noqa: E402
 from generation.quality.real_observer import default_real_observer  # noqa: E402
 from generation.quality.realism import MEASURES, realism_measures  # noqa: E402
@@ -109,8 +120,27 @@ def generated_from_seeds(net, takes: list, steps: int, seed_s: float = 1.2) -> l
     return rows
 
 
-def plan_walks(weights: str) -> list[dict]:
-    """The seed000 plan's gait_net clips made with the named weights (not rendered)."""
+@contextmanager
+def _named_weights(name: str, net):
+    """While inside, the named shipped weights ``name`` are ``net`` (a LoadedGaitNet of another file) for
+    everything that loads them by name (plan clips); the cached shipped network comes back afterwards."""
+    from generation.gait import generate
+
+    missing = object()
+    saved = generate._DEFAULT.get(name, missing)
+    generate._DEFAULT[name] = net
+    try:
+        yield
+    finally:
+        if saved is missing:
+            generate._DEFAULT.pop(name, None)
+        else:
+            generate._DEFAULT[name] = saved
+
+
+def plan_walks(weights: str, net=None) -> list[dict]:
+    """The seed000 plan's gait_net clips made with the named weights (not rendered), as ``plan_qa`` makes them;
+    with ``net``, that network in place of the named one."""
     import yaml
 
     from generation.plans.clipgen import make_motion
@@ -120,12 +150,18 @@ def plan_walks(weights: str) -> list[dict]:
     raw = [{**e, "weights": weights} for e in plan["clips"] if e.get("generator") == "gait_net"]
     sub = validate_plan({"name": "seed000-gait", "render": plan.get("render", {}), "clips": raw})
     rows = []
-    for entry in sub.entries:
-        inp = entry.inputs
-        vec = inp["emotion"] if "emotion" in inp else inp["transition"]["final"]
-        rows.append({"seed": entry.id, "asked": GAIT_EMOTIONS[int(np.argmax(vec))], "motion": make_motion(entry),
-                     "transition": "transition" in inp})
+    with _named_weights(weights, net) if net is not None else _nothing():
+        for entry in sub.entries:
+            inp = entry.inputs
+            vec = inp["emotion"] if "emotion" in inp else inp["transition"]["final"]
+            rows.append({"seed": entry.id, "asked": GAIT_EMOTIONS[int(np.argmax(vec))],
+                         "motion": make_motion(entry), "transition": "transition" in inp})
     return rows
+
+
+@contextmanager
+def _nothing():
+    yield
 
 
 def recognition(observer, rows: list[dict]) -> dict:
@@ -190,53 +226,64 @@ def generated_realism(rows: list[dict], real: dict) -> dict:
     return out
 
 
-# ---- report ------------------------------------------------------------------------------------
-def fmt(x, nd=3):
-    return "-" if x is None else f"{x:.{nd}f}"
+# ---- run ---------------------------------------------------------------------------------------
+def _commit() -> str:
+    """'commit <short hash>' of the repository, '+ uncommitted changes' when the tree is not clean."""
+    import subprocess
+
+    def git(*args):
+        return subprocess.run(["git", *args], cwd=ROOT, capture_output=True, text=True).stdout.strip()
+
+    dirty = git("status", "--porcelain", "--untracked-files=no")
+    return f"commit {git('rev-parse', '--short', 'HEAD')}" + (" + uncommitted changes" if dirty else "")
 
 
-def markdown(res: dict) -> str:
-    lines = []
-    for subset, table in res["prediction"].items():
-        lines += [f"\n**Prediction error, {subset}** ({table['n']} windows; prefix {res['prefix']} steps, "
-                  f"{res['horizon']} predicted)\n",
-                  "| method | pose error / body diagonal | step 1 | steps 2-5 | later steps | cm | rotation deg |",
-                  "|---|---|---|---|---|---|---|"]
-        for name, e in table["methods"].items():
-            lines.append(f"| {name} | {fmt(e['pose_error_body_diag'])} | {fmt(e['pose_error_body_diag_step1'])} | "
-                         f"{fmt(e['pose_error_body_diag_steps2_5'])} | {fmt(e['pose_error_body_diag_later'])} | "
-                         f"{fmt(e['pose_error_cm'], 1)} | {fmt(e['rotation_error_deg'], 1)} |")
-    for name, rec in res["recognition"].items():
-        lines += [f"\n**Real-capture observer, {name}**\n", "| asked | n | read as asked | read as neutral |",
-                  "|---|---|---|---|"]
-        for e, v in rec["per_class"].items():
-            lines.append(f"| {e} | {v['n']} | {fmt(v['own'], 2)} | {fmt(v['as_neutral'], 2)} |")
-    lines += ["\n**Realism per asked emotion (median of generated walks; real takes' min-max in brackets; share of "
-              "walks inside)**\n", "| weights | emotion | " + " | ".join(MEASURES) + " |",
-              "|---|---|" + "---|" * len(MEASURES)]
-    for name, table in res["realism"].items():
-        for e, v in table.items():
-            cells = []
-            for m in MEASURES:
-                g, r = v["measures"].get(m), res["real_realism"][e].get(m)
-                cells.append(f"{fmt(g and g['median'], 2)} [{fmt(r and r['min'], 2)}-{fmt(r and r['max'], 2)}] "
-                             f"{fmt(v['inside_share'][m], 2)}")
-            lines.append(f"| {name} | {e} | " + " | ".join(cells) + " |")
-    return "\n".join(lines)
+def _file_record(path) -> dict:
+    """{path (relative to the repository where inside it), sha256} of a file."""
+    p = Path(path).resolve()
+    rel = p.relative_to(ROOT) if p.is_relative_to(ROOT) else p
+    return {"path": str(rel), "sha256": file_sha256(p)}
 
 
-def main(argv=None) -> int:
+def _args(argv):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--real", default=str(weights_path("real")))
+    ap.add_argument("--before", default=None, help="a previous real-trained weights file, measured in the same run "
+                    "(rows 'real-trained (before)')")
     ap.add_argument("--procedural", default=str(weights_path("procedural")))
     ap.add_argument("--steps", type=int, default=100, help="network steps of each generated walk (7.5 per second)")
     ap.add_argument("--skip-plan", action="store_true")
-    ap.add_argument("--out", default="var/gait_runs/bench_gait_real.json")
+    ap.add_argument("--out", default=str(doc_tables.area_files("gait_real")[0]),
+                    help="JSON results; the default also renders the gait_real tables of docs/benchmarks/gait.md")
     ap.add_argument("--threads", type=int, default=1)
-    a = ap.parse_args(argv)
-    torch.set_num_threads(a.threads)
+    return ap.parse_args(argv)
+
+
+def load_nets(a) -> dict:
+    """Row name -> network: the real-trained weights, the previous real-trained ones (``--before``) and the
+    procedural-trained ones."""
+    paths = {"real-trained": a.real, "real-trained (before)": a.before, "procedural-trained": a.procedural}
+    return {name: load_model(path) for name, path in paths.items() if path}
+
+
+def _plan(name: str, net) -> list[dict]:
+    """seed000 plan walks of the network named ``name`` (its own file for the (before) weights)."""
+    if name == "procedural-trained":
+        return plan_walks("procedural")
+    return plan_walks("real", net if name == "real-trained (before)" else None)
+
+
+def run(a, argv) -> dict:
+    """Every measurement into one results dict (the run's record first)."""
     t0 = time.time()
-    nets = {"real-trained": load_model(a.real), "procedural-trained": load_model(a.procedural)}
+    nets = load_nets(a)
+    corpus = real_corpus_path()
+    res = {"date": datetime.date.today().isoformat(), "commit": _commit(),
+           "command": shlex.join(["python", "benchmarks/bench_gait_real.py", *argv]),
+           "machine": f"{platform.machine()}, {os.cpu_count()} CPUs (shared), Python {platform.python_version()}, "
+                      f"{a.threads} torch thread(s)",
+           "corpus": _file_record(corpus) if corpus.is_file() else {"path": str(corpus), "sha256": None},
+           "weights": {name: _file_record(net.path) for name, net in nets.items()}}
     data_cfg = nets["real-trained"].config.data
     prefix = data_cfg.prefix_len
     # nearest-neighbour library: every training take's windows as captured, a window every 16 frames
@@ -244,9 +291,10 @@ def main(argv=None) -> int:
                            RealAugment(mirror=False, speed_factors=(1.0,), stride_frames=16, offsets=(0,)))
     test_clips = stage_clips("pretrain", "test")
     emotion_clips = [c for c in test_clips if c.style in CAPTURE_GAIT_EMOTIONS and c.content == "walk"]
-    res = {"prefix": prefix, "horizon": data_cfg.seq_len - prefix, "weights": {k: v.path for k, v in nets.items()},
-           "prediction": {}, "recognition": {}, "realism": {}}
-    for subset, clips in (("all held-out forward locomotion", test_clips), ("held-out emotion walks", emotion_clips)):
+    res |= {"prefix": prefix, "horizon": data_cfg.seq_len - prefix, "prediction": {}, "recognition": {},
+            "realism": {}}
+    for subset, clips in ((doc_tables.GAIT_REAL_SUBSETS["all"], test_clips),
+                          (doc_tables.GAIT_REAL_SUBSETS["emotion"], emotion_clips)):
         test = clip_sequences(clips, data_cfg, RealAugment.none())
         res["prediction"][subset] = {"n": len(test), "takes": len(clips),
                                      "methods": prediction_table(nets, train, test, prefix)}
@@ -264,14 +312,27 @@ def main(argv=None) -> int:
         res["realism"][f"{name}, held-out seeds"] = generated_realism(rows, res["real_realism"])
         res.setdefault("walks", {})[name] = [{k: v for k, v in r.items() if k != "motion"} for r in rows]
         if not a.skip_plan:
-            plan = plan_walks("real" if name == "real-trained" else "procedural")
+            plan = _plan(name, net)
             res["recognition"][f"{name}, seed000 plan"] = recognition(observer, plan)
             res["realism"][f"{name}, seed000 plan"] = generated_realism(plan, res["real_realism"])
         print(f"{name}: {time.time() - t0:.0f} s", flush=True)
-    res["elapsed_s"] = time.time() - t0
-    Path(a.out).parent.mkdir(parents=True, exist_ok=True)
-    Path(a.out).write_text(json.dumps(res, indent=1, default=float))
-    print(markdown(res))
+    res["seconds"] = time.time() - t0
+    return res
+
+
+def main(argv=None) -> int:
+    argv = sys.argv[1:] if argv is None else list(argv)
+    a = _args(argv)
+    torch.set_num_threads(a.threads)
+    res = run(a, argv)
+    out = Path(a.out)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    out.write_text(json.dumps(res, indent=1, default=float) + "\n")
+    for name, lines in doc_tables.render_tables("gait_real", res).items():
+        print(f"\n{name}\n" + "\n".join(lines))
+    print(f"\nwrote {out} in {res['seconds']:.0f} s")
+    if out.resolve() == doc_tables.area_files("gait_real")[0].resolve():
+        print("docs/benchmarks/gait.md tables:", ", ".join(doc_tables.update_doc("gait_real")) or "none marked")
     return 0
 
 
