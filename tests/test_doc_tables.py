@@ -48,10 +48,14 @@ def test_marked_blocks_get_the_rendered_tables(tmp_path):
     assert (tmp_path / "gait.md").read_text() == text
 
 
-def test_the_gait_doc_marks_every_gait_table():
-    text = (doc_tables.DOCS / "gait.md").read_text()
-    marked = {m.group("name") for m in doc_tables.BLOCK_RE.finditer(text)}
-    assert marked == set(doc_tables.TABLES["gait"])
+def test_the_gait_doc_marks_every_gait_table_and_matches_its_json():
+    """gait.md marks each gait table once; what the committed gait.json renders is what the blocks hold (the
+    JSON holds no run yet, so the blocks stay as they are)."""
+    results, doc = doc_tables.area_files("gait")
+    text = doc.read_text()
+    names = [m.group("name") for m in doc_tables.BLOCK_RE.finditer(text) if m.group("name").startswith("gait.")]
+    assert sorted(names) == sorted(doc_tables.TABLES["gait"])
+    assert doc_tables.fill_doc(text, doc_tables.render_tables("gait", json.loads(results.read_text())))[0] == text
 
 
 def test_unknown_area_and_missing_results(tmp_path, capsys):
@@ -154,9 +158,10 @@ def test_area_files_name_the_json_and_doc_of_each_area():
     assert doc_tables.area_files("rbf_real") == (doc_tables.DOCS / "rbf_real.json", doc_tables.DOCS / "rbf.md")
     assert doc_tables.area_files("real_observer") == (doc_tables.DOCS / "real_observer.json",
                                                       doc_tables.DOCS / "mocap.md")
+    assert doc_tables.area_files("gait_real") == (doc_tables.DOCS / "gait_real.json", doc_tables.DOCS / "gait.md")
 
 
-@pytest.mark.parametrize("area", ["rbf_features", "rbf_real", "real_observer"])
+@pytest.mark.parametrize("area", ["rbf_features", "rbf_real", "real_observer", "gait_real"])
 def test_each_doc_marks_every_table_of_the_area_once_and_matches_its_json(area):
     """The area's doc marks each of its tables once, and the blocks there are what the committed JSON renders."""
     results, doc = doc_tables.area_files(area)
@@ -403,3 +408,87 @@ def test_two_areas_share_a_doc_without_touching_each_others_blocks(tmp_path):
     assert doc_tables.update_doc("rbf_features", tmp_path / "rbf_features.json", doc) == ["rbf_features.feature_key"]
     assert "Feature key: f0 = ang:a-b-c" in doc.read_text() and "| disputed expert features | 1 | 1 | 1 | 3 |" \
         in doc.read_text()
+
+
+def _errors(diag, step1, steps2_5, later, cm, deg):
+    return {"pose_error_body_diag": diag, "pose_error_body_diag_step1": step1,
+            "pose_error_body_diag_steps2_5": steps2_5, "pose_error_body_diag_later": later, "pose_error_cm": cm,
+            "rotation_error_deg": deg}
+
+
+def _recognition(ns, own, as_neutral):
+    return {"per_class": {e: {"n": n, "own": o, "as_neutral": a}
+                          for e, n, o, a in zip(doc_tables.EMOTIONS, ns, own, as_neutral)}}
+
+
+def _realism(n, medians, inside):
+    return {"n": n, "measures": {m: None if v is None else {"min": 0.0, "median": v, "max": 9.0}
+                                 for m, v in zip(("skate_cm_s", "speed_cv"), medians)},
+            "inside_share": dict(zip(("skate_cm_s", "speed_cv"), inside))}
+
+
+GAIT_REAL = {
+    "date": "2026-12-05", "machine": "test VM", "commit": "commit abc1234", "seconds": 241.4,
+    "command": "python benchmarks/bench_gait_real.py --before old.pt",
+    "corpus": {"path": "var/mocap/c.npz", "sha256": "0123456789abcdef"},
+    "weights": {"real-trained": {"path": "new.pt", "sha256": "fedcba9876543210"},
+                "real-trained (before)": {"path": "old.pt", "sha256": None}},
+    "prefix": 9, "horizon": 21,
+    "prediction": {"all held-out forward locomotion": {"n": 567, "takes": 138, "methods": {
+        "real-trained": _errors(0.0524, 0.0226, 0.0384, 0.0575, 9.74, 14.46),
+        "real-trained (before)": _errors(0.061, 0.03, 0.04, 0.07, 11.0, None)}},
+        "held-out emotion walks": {"n": 54, "takes": 8, "methods": {
+            "last pose held": _errors(0.066, 0.039, 0.082, 0.064, 12.2, 8.4)}}},
+    "recognition": {"real-trained, held-out seed walks": _recognition([6, 6, 6, 6], [0.0, 0.5, 1.0, 0.8333],
+                                                                      [1 / 3, 0.5, 0.0, 0.8333]),
+                    "real-trained (before), seed000 plan": _recognition([8, 8, 6, None], [0.0, 0.25, 2 / 3, None],
+                                                                        [0.625, 0.75, 1 / 3, None])},
+    "real_realism": {"happy": {"skate_cm_s": {"min": 67.61, "median": 70.0, "max": 74.44}, "speed_cv": None,
+                               "takes": 2},
+                     "sad": {"skate_cm_s": {"min": 30.4, "median": None, "max": 46.5},
+                             "speed_cv": {"min": 0.061, "median": 0.08, "max": 0.114}, "takes": None}},
+    "realism": {"real-trained, seed000 plan": {"happy": _realism(8, [36.04, 0.0312], [1.0, 0.625]),
+                                               "sad": _realism(8, [52.3, None], [0.875, None])},
+                "real-trained (before), seed000 plan": {"sad": _realism(8, [50.0, 0.06], [None, 0.375])}},
+}
+
+
+def test_gait_real_tables_render_the_figures():
+    t = doc_tables.render_tables("gait_real", GAIT_REAL)
+    assert set(t) == set(doc_tables.TABLES["gait_real"])
+    assert t["gait_real.run"][2:] == [
+        "| machine | test VM |", "| date | 2026-12-05 |", "| commit | abc1234 |",
+        "| command | `python benchmarks/bench_gait_real.py --before old.pt` |", "| duration | 241 s |",
+        "| corpus | `var/mocap/c.npz` (sha256 0123456789ab...) |",
+        "| weights 'real-trained' | `new.pt` (sha256 fedcba987654...) |",
+        "| weights 'real-trained (before)' | `old.pt` |"]
+    # each subset its own table, methods in the JSON's order, a missing figure as '-'
+    assert t["gait_real.prediction_all"][0] == "567 windows of 138 test takes; 9 network steps given, 21 predicted:"
+    assert t["gait_real.prediction_all"][4:] == ["| real-trained | 0.052 | 0.023 | 0.038 | 0.058 | 9.7 | 14.5 |",
+                                                 "| real-trained (before) | 0.061 | 0.030 | 0.040 | 0.070 | 11.0 | - |"]
+    assert t["gait_real.prediction_emotion"][0] == "54 windows of 8 test takes; 9 network steps given, 21 predicted:"
+    assert t["gait_real.prediction_emotion"][4:] == ["| last pose held | 0.066 | 0.039 | 0.082 | 0.064 | 12.2 | 8.4 |"]
+    # one row per set of walks; read as asked / as neutral, neutral only as asked; n as a range
+    assert t["gait_real.emotion"][0] == ("| walks | n per emotion | happy: as asked / as neutral "
+                                         "| sad: as asked / as neutral | angry: as asked / as neutral | neutral |")
+    assert t["gait_real.emotion"][2:] == [
+        "| real-trained, held-out seed walks | 6 | 0.00 / 0.33 | 0.50 / 0.50 | 1.00 / 0.00 | 0.83 |",
+        "| real-trained (before), seed000 plan | 6-8 | 0.00 / 0.62 | 0.25 / 0.75 | 0.67 / 0.33 | - |"]
+    # grouped by emotion: the real takes' range first, then each set of walks' median (share inside)
+    assert t["gait_real.realism"] == [
+        "| emotion | walks | n | foot skate cm/s | speed CV |", "|---|---|---|---|---|",
+        "| happy | real takes (min-max) | 2 | 67.6-74.4 | - |",
+        "| happy | real-trained, seed000 plan | 8 | 36.0 (1.00) | 0.03 (0.62) |",
+        "| sad | real takes (min-max) | - | 30.4-46.5 | 0.06-0.11 |",
+        "| sad | real-trained, seed000 plan | 8 | 52.3 (0.88) | - |",
+        "| sad | real-trained (before), seed000 plan | 8 | 50.0 | 0.06 (0.38) |"]
+
+
+def test_the_gait_doc_holds_the_real_capture_tables_in_their_section():
+    """The gait_real blocks sit in gait.md's 'Trained on real capture' section, the synthetic gait blocks outside."""
+    text = (doc_tables.DOCS / "gait.md").read_text()
+    start = text.index("### Trained on real capture")
+    end = text.index("\n### ", start + 1)
+    for m in doc_tables.BLOCK_RE.finditer(text):
+        inside = start < m.start() < end
+        assert inside == m.group("name").startswith("gait_real."), m.group("name")
