@@ -267,10 +267,11 @@ def load_nets(a) -> dict:
 
 
 def _plan(name: str, net) -> list[dict]:
-    """seed000 plan walks of the network named ``name`` (its own file for the (before) weights)."""
-    if name == "procedural-trained":
-        return plan_walks("procedural")
-    return plan_walks("real", net if name == "real-trained (before)" else None)
+    """seed000 plan walks of the network named ``name``: the plan's named weights (procedural for the
+    procedural-trained row, real otherwise), replaced by ``net`` when it is another file than the named one."""
+    named = "procedural" if name == "procedural-trained" else "real"
+    same = Path(net.path).resolve() == weights_path(named).resolve()
+    return plan_walks(named, None if same else net)
 
 
 def run(a, argv) -> dict:
