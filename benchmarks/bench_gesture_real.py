@@ -26,12 +26,12 @@ sys.path.insert(0, str(ROOT / "benchmarks"))
 
 import numpy as np  # noqa: E402
 import torch  # noqa: E402
-from bench_gesture import all_emotion_examples, liveliness, onion_skin, speed_benchmark  # noqa: E402
+from bench_gesture import liveliness, onion_skin, speed_benchmark  # noqa: E402
 
-from generation.gesture.data import build_dataset  # noqa: E402
+from generation.gesture.data import build_dataset, with_emotions  # noqa: E402
 from generation.gesture.generate import decode_examples, generate_gesture, load_model  # noqa: E402
 from generation.gesture.metrics import dataset_pose_error, positions  # noqa: E402
-from generation.gesture.real_stats import STAT_NAMES, gesture_stats, real_ranges  # noqa: E402
+from generation.gesture.real_stats import STAT_NAMES, gesture_stats, in_range_shares, real_ranges  # noqa: E402
 from generation.quality.real_gesture_observer import (  # noqa: E402
     STYLES_15,
     RealGestureObserver,
@@ -51,20 +51,13 @@ TABLE_STATS = ("wrist_mean", "wrist_p90", "elbow_mean", "reach_p90", "lean_mean"
 
 def generated_stats(net, data, idx) -> list[dict]:
     """Each example of ``idx`` said with each of EMOTIONS: [{"emotion", **gesture_stats}] (len(idx) x 5)."""
-    rows, fake = all_emotion_examples(data, idx)
-    keep = [n for n, (_, e, _) in enumerate(rows) if e in EMOTIONS]
-    gen = decode_examples(net, fake, np.array(keep))
+    fake = with_emotions(data, idx, EMOTIONS)
+    gen = decode_examples(net, fake, np.arange(len(fake)))
     out = []
-    for n, g in zip(keep, gen):
+    for n, g in enumerate(gen):
         P = positions(g, str(fake.gender[n]), fake.root[n])
-        out.append({"emotion": rows[n][1], "P": P, **gesture_stats(P, fake.fps)})
+        out.append({"emotion": str(fake.emotion[n]), "P": P, **gesture_stats(P, fake.fps)})
     return out
-
-
-def in_range_share(rows: list[dict], ranges: dict) -> dict:
-    """Per emotion and statistic, the share of generated clips inside the real [min, max] of their emotion."""
-    return {e: {k: float(np.mean([ranges[e][k][0] <= r[k] <= ranges[e][k][1] for r in rows if r["emotion"] == e]))
-                for k in STAT_NAMES} for e in EMOTIONS}
 
 
 def medians(rows: list[dict]) -> dict:
@@ -85,7 +78,7 @@ def network_report(path: str, data, real_obs: RealGestureObserver, ranges: dict,
     X = np.stack([features_of_positions(r["P"], data.fps) for r in gen])
     read = real_obs.predict(X)
     truth = np.array([r["emotion"] for r in gen])
-    return {"weights": path, "medians": medians(gen), "in_range": in_range_share(gen, ranges),
+    return {"weights": path, "medians": medians(gen), "in_range": in_range_shares(gen, ranges),
             "pose_error": pose["pose_error"], "r_peak_arousal": live["r_gen"],
             "real_observer_on_generated": {"accuracy": float((read == truth).mean()),
                                            "per_emotion": {e: {lab: int(((truth == e) & (read == lab)).sum())

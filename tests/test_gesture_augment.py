@@ -157,7 +157,7 @@ def test_training_keeps_the_best_epochs_weights_not_the_last(small, tmp_path, mo
 
     seen = {}
 
-    def fake_score(net, data, val_idx, cfg, epoch, last_epoch, va, entry):
+    def fake_score(net, data, val_idx, cfg, epoch, last_epoch, va, entry, ranges=None):
         seen[epoch] = {k: v.detach().clone() for k, v in net.state_dict().items()}
         return [3.0, 1.0, 2.0][epoch]
 

@@ -354,6 +354,26 @@ class GestureDataset:
         return DeviceCorpus(self, torch.device(device))
 
 
+def with_emotions(data: GestureDataset, idx, emotions) -> GestureDataset:
+    """Each example of ``idx`` (its sentence, task, body and handedness) said with each of ``emotions``, example
+    by example (len(idx) x len(emotions) entries, the emotions varying fastest), as a :class:`GestureDataset` to
+    decode from: attributes carry the emotion's VAD (:func:`nrc_vad`), ``emotion`` names it; the rotations are the
+    example's own, not a gesture of the new emotion, and every entry is in the "test" split."""
+    idx = np.asarray(idx)
+    emotions = tuple(emotions)
+    src = np.repeat(idx, len(emotions))
+    emo = np.array(emotions * len(idx))
+    vad = np.array([nrc_vad(e) for e in emo], dtype=np.float32).reshape(len(src), 3)
+    attrs = np.stack([attribute_vector(data.row(i).task, v, str(data.gender[i]), str(data.handedness[i]))
+                      for i, v in zip(src, vad)]).astype(np.float32).reshape(len(src), -1)
+    return GestureDataset(tokens=data.tokens[src], token_lengths=data.token_lengths[src],
+                          rotations=data.rotations[src], lengths=data.lengths[src], attributes=attrs,
+                          offsets=data.offsets[src], rest=data.rest[src], root=data.root[src], vad=vad,
+                          sentence_index=data.sentence_index[src], split=np.array(["test"] * len(src)),
+                          gender=data.gender[src], handedness=data.handedness[src], rows=data.rows, fps=data.fps,
+                          emotion=emo)
+
+
 class DeviceCorpus:
     """A :class:`GestureDataset`'s training arrays as tensors on one device, so batches are cut there.
 

@@ -37,7 +37,8 @@ def dataset_pose_error(pred: list[np.ndarray], data, idx) -> dict[str, float]:
     """Seed 003 Table 1: the mean over sequences ``idx`` of :func:`sequence_pose_error` (pred[k] for idx[k]),
     plus the mean :func:`upper_body_acceleration` of the predictions and their liveliness against the ground
     truth: ``speed_log_ratio`` = mean over sequences of |log(generated / true)| of the mean and of the peak wrist
-    speed (:func:`wrist_speed`), averaged; 0 = as lively as the corpus, 0.69 = half or twice as fast."""
+    speed (:func:`wrist_speed`), averaged; 0 = as lively as the corpus, 0.69 = half or twice as fast; and
+    ``r_peak_arousal``, Pearson r of the generated peak wrist speed with the examples' arousal."""
     rows, accel, ratio, speeds = [], [], [], []
     for p, i in zip(pred, idx):
         L = int(data.lengths[i])
@@ -52,7 +53,15 @@ def dataset_pose_error(pred: list[np.ndarray], data, idx) -> dict[str, float]:
             "rotation_error_deg": float(np.mean([r["rotation_deg"] for r in rows])),
             "acceleration": float(np.mean(accel)), "speed_log_ratio": float(np.mean(ratio)),
             "emotion_speed_gap": emotion_speed_gap(np.array(speeds), [str(data.emotion[i]) for i in idx]),
-            "n": len(rows)}
+            "r_peak_arousal": pearson_r([s[1] for s in speeds], data.vad[np.asarray(idx), 1]), "n": len(rows)}
+
+
+def pearson_r(x, y) -> float:
+    """Pearson r of two equal-length sequences; nan when either is constant or shorter than 2."""
+    x, y = np.asarray(x, dtype=np.float64), np.asarray(y, dtype=np.float64)
+    if len(x) < 2 or x.std() == 0 or y.std() == 0:
+        return float("nan")
+    return float(np.corrcoef(x, y)[0, 1])
 
 
 def emotion_speed_gap(speeds: np.ndarray, emotions: list[str]) -> float:

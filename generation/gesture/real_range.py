@@ -13,6 +13,7 @@ statistic outside its [min, max] (0 inside the range), with a floor added to bot
 """
 from __future__ import annotations
 
+import hashlib
 import json
 from pathlib import Path
 
@@ -38,6 +39,15 @@ def load_ranges(path: str | Path = RANGES_FILE) -> dict:
     if "ranges" not in data or "all" not in data["ranges"]:
         raise ValueError(f"{path}: expected an object with 'ranges' holding at least 'all'")
     return data
+
+
+def provenance(path: str | Path = RANGES_FILE) -> dict:
+    """What a weights file trained or selected with the real ranges records about them: {"file", "sha256", "source",
+    "licence", "citation"} (the ranges are statistics of real capture and keep its licence)."""
+    path = Path(path)
+    data = load_ranges(path)
+    return {"file": path.name, "sha256": hashlib.sha256(path.read_bytes()).hexdigest(),
+            **{k: data.get(k) for k in ("source", "licence", "citation")}}
 
 
 def range_arrays(emotions, ranges: dict | None = None) -> tuple[np.ndarray, np.ndarray]:

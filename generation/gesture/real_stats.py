@@ -83,3 +83,20 @@ def real_ranges(rows: list[dict], stats=STAT_NAMES) -> dict[str, dict[str, tuple
         out[name] = {k: (float(min(r[k] for r in group)), float(max(r[k] for r in group))) for k in stats}
     return out
 
+
+
+def in_range_shares(rows: list[dict], ranges: dict, stats=STAT_NAMES) -> dict[str, dict[str, float]]:
+    """Per emotion of ``rows`` that ``ranges`` has (``real_ranges``'s {emotion: {stat: (min, max)}}), per statistic,
+    the share of its rows ({"emotion", stat: value, ...}, e.g. generated clips) inside the real [min, max]."""
+    out: dict[str, dict[str, float]] = {}
+    for e in dict.fromkeys(str(r["emotion"]) for r in rows):
+        if e in ranges and e != "all":
+            group = [r for r in rows if r["emotion"] == e]
+            out[e] = {k: float(np.mean([ranges[e][k][0] <= r[k] <= ranges[e][k][1] for r in group])) for k in stats}
+    return out
+
+
+def mean_share(shares: dict[str, dict[str, float]]) -> float:
+    """The share over all (emotion, statistic) cells of :func:`in_range_shares` (each cell weighted alike)."""
+    cells = [v for per in shares.values() for v in per.values()]
+    return float(np.mean(cells)) if cells else float("nan")

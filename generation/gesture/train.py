@@ -8,7 +8,10 @@ generation sees; small Gaussian noise on the teacher-forced input poses and para
 the inputs, up to all of them, are the network's own predictions, refined over a few no-grad passes) train it on
 inputs like the ones it feeds itself at generation time. Every 5 epochs the validation gestures are generated
 autoregressively from text and attributes; their pose error times (1 + their wrist-speed gap to the corpus)
-(:func:`generation.gesture.metrics.selection_score`) decides which weights are kept. A fixed seed makes runs
+(:func:`generation.gesture.metrics.selection_score`) decides which weights are kept; with ``--select real-range``
+the kept epoch is the one whose validation gestures, generated with each emotion of the real capture, are most often
+inside the real captured range, among the epochs whose rollout pose error is at most ``--max-pose-error``
+(:mod:`generation.gesture.selection`). A fixed seed makes runs
 repeatable; checkpoints (model, optimiser, epoch, history) are written every epoch and ``--resume`` continues from
 the last one. The best model is saved as plain weights (config + CPU state dict, float32).
 
@@ -51,9 +54,12 @@ from .generate import decode_examples
 from .losses import LIVELINESS_FORMS, LossWeights, total_loss
 from .metrics import dataset_pose_error, selection_score
 from .model import MODEL_PRESETS, GestureNet, GestureNetConfig
-from .real_range import range_arrays
+from .real_range import load_ranges, range_arrays
+from .real_range import provenance as real_range_provenance
+from .selection import history_score, real_range_rollout
 
 PRESETS = tuple(MODEL_PRESETS)
+SELECTIONS = ("pose", "real-range")
 
 
 @dataclass
@@ -90,6 +96,12 @@ class TrainConfig:
     # add the worst per-emotion wrist-speed ratio on the validation split to the selection score
     # (metrics.selection_score); off for the shipped weights
     select_emotion_gap: bool = False
+    # which rollout epoch is kept: "pose" (the score above) or "real-range" (generation.gesture.selection: the largest
+    # in-real-range share among epochs with rollout pose error <= max_pose_error, else the lowest pose error)
+    select: str = "pose"
+    max_pose_error: float = 0.00715
+    min_arousal_r: float | None = None  # real-range rule: also require this validation r(peak wrist speed, arousal)
+    keep_rollouts: str | None = None  # also write the weights of every rollout epoch into this folder
     init_from: str | None = None  # start from these weights (fine-tuning) instead of a random initialisation
     device: str = "auto"
     amp: bool = False
@@ -275,11 +287,17 @@ def train(cfg: TrainConfig, data: GestureDataset | None = None, progress: bool =
     if cfg.loss.real_range:
         corpus.real_bounds = tuple(torch.from_numpy(a).to(device) for a in range_arrays(data.emotion))
     net, optimizer, scheduler, generator = _build(cfg, device)
-    selected_by = ("val_loss" if cfg.rollout_every <= 0 else "val_rollout_pose_error_x_emotion_liveliness"
-                   if cfg.select_emotion_gap else "val_rollout_pose_error_x_liveliness")
+    selected_by = _selected_by(cfg)
+    ranges = load_ranges()["ranges"] if cfg.select == "real-range" else None
     ckpt_path = Path(cfg.checkpoint)
     run = (_restore(ckpt_path, cfg, net, optimizer, scheduler, generator, selected_by)
            if cfg.resume and ckpt_path.is_file() else _Run())
+    if ranges is not None and cfg.init_from and not run.history and len(val_idx):
+        # the weights fine-tuning starts from are a candidate too ("epoch" -1)
+        entry = {"epoch": -1, "init_from": str(cfg.init_from)}
+        run.best_val = _score(net, data, val_idx, cfg, -1, True, {}, entry, ranges)
+        run.best_state, run.best_epoch = cpu_state_dict(net), -1
+        run.history.append(entry)
     t0 = time.time()
     bar = tqdm(range(run.start_epoch, cfg.epochs), desc=f"gesture net on {describe(device)}", disable=not progress,
                unit="epoch")
@@ -295,10 +313,14 @@ def train(cfg: TrainConfig, data: GestureDataset | None = None, progress: bool =
                  "epoch_seconds": time.time() - t_epoch}
         last_epoch = epoch == cfg.epochs - 1 or (cfg.max_minutes is not None
                                                  and (time.time() - t0) > 60 * cfg.max_minutes)
-        score = _score(net, data, val_idx, cfg, epoch, last_epoch, va, entry)
+        score = _score(net, data, val_idx, cfg, epoch, last_epoch, va, entry, ranges)
         run.history.append(entry)
         if score is not None and score < run.best_val:
             run.best_val, run.best_state, run.best_epoch = score, cpu_state_dict(net), epoch
+        if score is not None and cfg.keep_rollouts:
+            save_weights(net, Path(cfg.keep_rollouts) / f"epoch{epoch:03d}.pt",
+                         {"epoch": epoch, "val_rollout": entry.get("val_rollout"),
+                          "val_real_range": entry.get("val_real_range")})
         bar.set_postfix(train=f"{tr['total']:.4f}", val=f"{va['total']:.4f}", best=f"{run.best_val:.4f}")
         _save_checkpoint(ckpt_path, epoch, net, optimizer, scheduler, generator, run, cfg, selected_by,
                          run.seconds_before + time.time() - t0)
@@ -307,11 +329,29 @@ def train(cfg: TrainConfig, data: GestureDataset | None = None, progress: bool =
     return _finish(net, cfg, run, epoch, selected_by, run.seconds_before + time.time() - t0, device)
 
 
-def _score(net, data, val_idx, cfg: TrainConfig, epoch: int, last_epoch: bool, va: dict, entry: dict):
-    """The model-selection score of this epoch (None when not measured this epoch); adds "val_rollout"."""
+def _selected_by(cfg: TrainConfig) -> str:
+    """The name of the selection rule (a checkpoint made under another rule restarts the selection)."""
+    if cfg.select not in SELECTIONS:
+        raise ValueError(f"select must be one of {SELECTIONS}, got {cfg.select!r}")
+    if cfg.select == "real-range":
+        if cfg.rollout_every <= 0:
+            raise ValueError("select real-range needs rollouts (rollout_every > 0)")
+        r_bound = "" if cfg.min_arousal_r is None else f"_arousal_r_{cfg.min_arousal_r:g}"
+        return f"val_rollout_real_range_share_within_pose_error_{cfg.max_pose_error:g}{r_bound}"
+    return ("val_loss" if cfg.rollout_every <= 0 else "val_rollout_pose_error_x_emotion_liveliness"
+            if cfg.select_emotion_gap else "val_rollout_pose_error_x_liveliness")
+
+
+def _score(net, data, val_idx, cfg: TrainConfig, epoch: int, last_epoch: bool, va: dict, entry: dict,
+           ranges: dict | None = None):
+    """The model-selection score of this epoch (None when not measured this epoch); adds "val_rollout" (and
+    "val_real_range" when ``ranges`` are given: the real-range rule)."""
     if cfg.rollout_every > 0 and len(val_idx) and ((epoch + 1) % cfg.rollout_every == 0 or last_epoch):
         net.eval()
         entry["val_rollout"] = dataset_pose_error(decode_examples(net, data, val_idx), data, val_idx)
+        if ranges is not None:
+            entry["val_real_range"] = real_range_rollout(net, data, val_idx, ranges)
+            return history_score(entry, cfg.max_pose_error, cfg.min_arousal_r)
         return selection_score(entry["val_rollout"], emotion_gap=cfg.select_emotion_gap)
     if cfg.rollout_every <= 0:
         return va["total"]
@@ -326,8 +366,14 @@ def _finish(net, cfg: TrainConfig, run: _Run, epoch: int, selected_by: str, seco
     summary = {"epochs_run": epoch + 1, "best_val": run.best_val, "best_epoch": run.best_epoch,
                "selected_by": selected_by, "seconds": seconds, "device": str(device), "preset": cfg.preset,
                "out": cfg.out}
-    save_weights(net, cfg.out, {"loss_weights": dataclasses.asdict(cfg.loss), "train_config": _jsonable(cfg),
-                                "history": run.history, **{k: v for k, v in summary.items() if k != "out"}})
+    extra = {"loss_weights": dataclasses.asdict(cfg.loss), "train_config": _jsonable(cfg), "history": run.history,
+             **{k: v for k, v in summary.items() if k != "out"}}
+    if cfg.loss.real_range or cfg.select == "real-range":
+        # the motion is still learnt from synthetic gestures only; the real-capture statistics shaped the loss or the
+        # choice of epoch, so their source, licence and citation go with the weights
+        used = [u for u, on in (("loss", cfg.loss.real_range), ("epoch selection", cfg.select == "real-range")) if on]
+        extra["real_statistics"] = {"used_for": used, **real_range_provenance()}
+    save_weights(net, cfg.out, extra)
     summary["history"] = run.history
     return summary
 
@@ -379,6 +425,18 @@ def build_parser() -> argparse.ArgumentParser:
                    "motion within the real captured range of its emotion (generation.gesture.real_range; 0 = off)")
     p.add_argument("--select-emotion-gap", action="store_true",
                    help="choose the kept weights by pose error x (1 + speed gap + worst per-emotion speed gap)")
+    p.add_argument("--select", choices=SELECTIONS, default=d.select,
+                   help="pose: keep the rollout epoch with the lowest pose error x liveliness (the shipped weights); "
+                   "real-range: the one whose validation gestures, generated with each emotion of the real capture, "
+                   "are most often inside the real range, among epochs with rollout pose error <= --max-pose-error "
+                   "(else the lowest pose error; with --init-from the starting weights are a candidate)")
+    p.add_argument("--max-pose-error", type=float, default=d.max_pose_error,
+                   help="bound on the validation rollout pose error for --select real-range")
+    p.add_argument("--min-arousal-r", type=float, default=None,
+                   help="--select real-range: also require r(peak wrist speed, arousal) of the validation gestures "
+                   ">= this (default: no bound)")
+    p.add_argument("--keep-rollouts", default=None,
+                   help="also write the weights of every rollout epoch into this folder (epochNNN.pt)")
     p.add_argument("--d-model", type=int, default=None, help="default: the preset's (64 small, 992 paper)")
     p.add_argument("--init-from", default=None, help="start from these weights (fine-tuning; same model config)")
     p.add_argument("--out", default=d.out, help="where the best weights go")
@@ -414,7 +472,11 @@ def config_from_args(args: argparse.Namespace) -> TrainConfig:
                      sampling_passes=args.sampling_passes, input_noise=args.input_noise, model=model, out=args.out,
                      checkpoint=args.checkpoint, resume=args.resume, threads=args.threads,
                      init_from=args.init_from, device=args.device, amp=bool(args.amp),
-                     rollout_every=args.rollout_every, select_emotion_gap=bool(args.select_emotion_gap))
+                     rollout_every=args.rollout_every, select_emotion_gap=bool(args.select_emotion_gap),
+                     select=args.select, max_pose_error=args.max_pose_error, min_arousal_r=args.min_arousal_r,
+                     keep_rollouts=args.keep_rollouts)
+    if args.select == "real-range" and args.rollout_every <= 0:
+        raise ValueError("--select real-range needs --rollout-every > 0")
     if args.epochs is not None:
         overrides["epochs"] = args.epochs
     if args.max_minutes is not None:
