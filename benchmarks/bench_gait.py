@@ -20,7 +20,6 @@ docs/benchmarks/gait.md (benchmarks/doc_tables.py; the narrative there is writte
 from __future__ import annotations
 
 import argparse
-import json
 import math
 import sys
 import time
@@ -521,12 +520,7 @@ def main(argv=None) -> int:
     _long_horizon_and_speed(nets["full"], corpus, test, args, results)
     _figures(nets["full"], corpus, test, motions["full"], tpaths, traj_motions, args)
     results["seconds"] = time.time() - t_start
-    out = Path(args.out)
-    out.parent.mkdir(parents=True, exist_ok=True)
-    out.write_text(json.dumps(results, indent=1, default=float) + "\n")
-    print(f"\nwrote {out} in {results['seconds']:.0f} s")
-    if out.resolve() == (doc_tables.DOCS / "gait.json").resolve():
-        print("docs/benchmarks/gait.md tables:", ", ".join(doc_tables.update_doc("gait")) or "none marked")
+    doc_tables.write_results("gait", args.out, results, results["seconds"])
     return 0
 
 

@@ -28,7 +28,6 @@ from __future__ import annotations
 
 import argparse
 import datetime
-import json
 import math
 import os
 import platform
@@ -326,14 +325,9 @@ def main(argv=None) -> int:
     a = _args(argv)
     torch.set_num_threads(a.threads)
     res = run(a, argv)
-    out = Path(a.out)
-    out.parent.mkdir(parents=True, exist_ok=True)
-    out.write_text(json.dumps(res, indent=1, default=float) + "\n")
     for name, lines in doc_tables.render_tables("gait_real", res).items():
         print(f"\n{name}\n" + "\n".join(lines))
-    print(f"\nwrote {out} in {res['seconds']:.0f} s")
-    if out.resolve() == doc_tables.area_files("gait_real")[0].resolve():
-        print("docs/benchmarks/gait.md tables:", ", ".join(doc_tables.update_doc("gait_real")) or "none marked")
+    doc_tables.write_results("gait_real", a.out, res, res["seconds"])
     return 0
 
 

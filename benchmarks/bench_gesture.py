@@ -563,12 +563,7 @@ def main(argv=None) -> int:
     results: dict = {}
     _measure(net, args, results)
     results = {"meta": _meta(args, argv, time.time() - t_start), **results}
-    out = Path(args.out)
-    out.parent.mkdir(parents=True, exist_ok=True)
-    out.write_text(json.dumps(results, indent=1, default=_json_default) + "\n")
-    print(f"\nwrote {out} in {results['meta']['seconds']:.0f} s")
-    if out.resolve() == (doc_tables.DOCS / "gesture.json").resolve():
-        print("docs/benchmarks/gesture.md tables:", ", ".join(doc_tables.update_doc("gesture")) or "none marked")
+    doc_tables.write_results("gesture", args.out, results, results["meta"]["seconds"], default=_json_default)
     return 0
 
 

@@ -743,6 +743,17 @@ def update_doc(area: str, results_path: Path | None = None, doc_path: Path | Non
     return done
 
 
+def write_results(area: str, out: Path, results: dict, seconds: float, default=float) -> None:
+    """Write a benchmark's ``results`` as JSON to ``out``; when ``out`` is the area's own JSON file, also render the
+    area's tables into its doc (a run written elsewhere, e.g. a candidate's, leaves the docs alone)."""
+    out = Path(out)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    out.write_text(json.dumps(results, indent=1, default=default) + "\n")
+    print(f"\nwrote {out} in {seconds:.0f} s")
+    if out.resolve() == area_files(area)[0].resolve():
+        print(f"{area_files(area)[1].name} tables:", ", ".join(update_doc(area)) or "none marked")
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("area", choices=sorted(TABLES))

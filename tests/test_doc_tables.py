@@ -492,3 +492,14 @@ def test_the_gait_doc_holds_the_real_capture_tables_in_their_section():
     for m in doc_tables.BLOCK_RE.finditer(text):
         inside = start < m.start() < end
         assert inside == m.group("name").startswith("gait_real."), m.group("name")
+
+
+def test_write_results_renders_the_doc_only_for_the_areas_own_json(tmp_path, monkeypatch):
+    own, doc = tmp_path / "gait.json", tmp_path / "gait.md"
+    doc.write_text(DOC)
+    monkeypatch.setattr(doc_tables, "area_files", lambda area: (own, doc))
+    doc_tables.write_results("gait", tmp_path / "candidate.json", RESULTS, 1.0)
+    assert json.loads((tmp_path / "candidate.json").read_text()) == RESULTS
+    assert doc.read_text() == DOC                                  # a candidate's run leaves the doc alone
+    doc_tables.write_results("gait", own, RESULTS, 1.0)
+    assert "| stale | table |" not in doc.read_text() and "0.023" in doc.read_text()
