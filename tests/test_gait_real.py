@@ -185,3 +185,7 @@ def test_shipped_real_weights_are_the_default_and_generate():
     assert proc.info["weights_name"] == "procedural" and proc.info["trained_on"] == "synthetic procedural corpus"
     (p,) = generate_gaits(None, [straight(20.0)], np.array([[0, 0, 1.0, 0]]), steps=10, model=proc)
     assert p.metadata["weights_name"] == "procedural" and p.metadata["seed_origin"] != "captured"
+    # the real-trained walks' clean-up may lower the pelvis where a planted foot is out of reach (it does on the
+    # angry walk, whose locked stance leg was pulled straight otherwise); the procedural walks' clean-up never does
+    assert meta["foot_cleanup"]["pelvis_drop_max_m"] > 0.0
+    assert p.metadata["foot_cleanup"]["pelvis_drop_max_m"] == 0.0

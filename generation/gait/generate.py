@@ -433,7 +433,10 @@ def generate_gaits(seeds, paths: list[GroundPath], emotions, steps: int = 200, f
         rng_seed: seeds the procedural seed walks (their parameters and phase).
         foot_cleanup: plant the feet after generation (:func:`generation.core.foot_contact.plant_feet`: contacts
             detected in the output, the planted foot locked, legs solved with two-bone IK, no floor
-            penetration); False returns the network's raw output (resampled).
+            penetration); False returns the network's raw output (resampled). With real-trained weights the
+            pelvis is also lowered where a planted ankle is out of the leg's reach (``lower_pelvis``): their raw
+            stance knees are already the actors' (18-25 degrees), and locking the feet without it pulled the
+            stance leg straight (angry and neutral 9 degrees, actors 14-30).
         device: where the network runs: None keeps the model where it is (the default model loads on the CPU),
             or "auto" / "cpu" / "cuda" / "cuda:N" (:func:`generation.core.device.resolve_device`; the model is
             copied there, the caller's is not moved). Path steering, resampling and foot planting stay on the CPU.
@@ -451,8 +454,9 @@ def generate_gaits(seeds, paths: list[GroundPath], emotions, steps: int = 200, f
     if device is not None:
         net = net.on(device)
     seeds, emotions = _check_inputs(seeds, paths, emotions, steps)
+    real_weights = is_real(net.info)
     seed_motions, seed = _seed_batch(seeds, emotions, net.config.data, np.random.default_rng(rng_seed),
-                                     is_real(net.info))
+                                     real_weights)
     placement = _Placement.onto_paths(paths, seed)
     guidance = net.emotion_guidance if emotion_guidance is None else float(emotion_guidance)
     if guidance < 0 or not math.isfinite(guidance):
@@ -465,7 +469,7 @@ def generate_gaits(seeds, paths: list[GroundPath], emotions, steps: int = 200, f
         m = Motion(seed_motions[i].skeleton, wrap_quaternions(r), rt, net.fps,
                    _metadata(net, emotions[i], path, seed_motions[i]))
         m = m.resample(fps_out)
-        motions.append(plant_feet(m) if foot_cleanup else m)
+        motions.append(plant_feet(m, lower_pelvis=real_weights) if foot_cleanup else m)
     return motions
 
 
