@@ -158,3 +158,13 @@ def test_held_out_evaluation_leaves_whole_groups_out():
     assert gate_ready(ev) and not gate_ready({"accuracy": 0.45})
     noise = held_out_accuracy(rng.normal(0, 1, (16, 3)), y, groups)
     assert np.asarray(noise["confusion"]).sum() == 16 and noise["accuracy"] < 1.0
+
+
+def test_clips_of_the_shipped_weights_credit_the_real_capture_behind_their_statistics():
+    from generation.gesture import config
+    from generation.gesture.generate import generate_gesture, load_model
+    net = load_model(config.DEFAULT_WEIGHTS)
+    assert net.real_statistics and net.real_statistics["licence"] == "CC BY-NC 4.0"
+    meta = generate_gesture("Look at that!", emotion="sad", model=net, fps=10.0).metadata
+    assert meta["real_statistics_licence"] == "CC BY-NC 4.0" and "2306.08861" in meta["real_statistics_citation"]
+    assert meta["trained_on"].lower().startswith("synthetic")

@@ -50,8 +50,18 @@ def load_model(path: str | Path, device: torch.device | str | None = "cpu") -> G
     except (KeyError, TypeError, RuntimeError, OSError) as exc:
         raise GestureModelUnavailable(f"{path}: not a gesture network weights file ({exc})") from exc
     net.train_fps = float(blob.get("train_fps", config.TRAIN_FPS))
+    net.real_statistics = blob.get("real_statistics")   # real-capture ranges the training used, with their licence
     net.eval()
     return net.to(resolve_device(device))
+
+
+def _real_statistics_credit(net: GestureNet) -> dict:
+    """Clip metadata crediting the real capture whose statistics shaped the weights (loss, selection), if any."""
+    stats = getattr(net, "real_statistics", None)
+    if not stats:
+        return {}
+    return {"real_statistics_source": stats.get("source", ""), "real_statistics_licence": stats.get("licence", ""),
+            "real_statistics_citation": stats.get("citation", "")}
 
 
 _DEFAULT: GestureNet | None = None
@@ -221,6 +231,7 @@ def generate_gestures(sentence: str, emotions, task: str = "narration", gender: 
             "origin": "generated", "generator": "gesture_net", "sentence": sentence, "task": task,
             "emotion_label": emotion, "valence": vad[0], "arousal": vad[1], "dominance": vad[2], "gender": gender,
             "handedness": handedness, "trained_on": SYNTHETIC_LABEL, "network_fps": net_fps, "seed": seed,
+            **_real_statistics_credit(net),
         })
         out.append(motion.resample(fps) if abs(fps - net_fps) > 1e-9 else motion)
     return out
