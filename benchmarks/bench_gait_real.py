@@ -35,7 +35,7 @@ import shlex
 import sys
 import time
 from collections import defaultdict
-from contextlib import contextmanager
+from contextlib import contextmanager, nullcontext
 from pathlib import Path
 
 import numpy as np
@@ -47,6 +47,7 @@ sys.path.insert(0, str(ROOT / "benchmarks"))
 
 import doc_tables  # noqa: E402
 from bench_gait import nearest_neighbour_errors, network_errors, pose_rotation_errors, zero_velocity_errors  # noqa: E402
+from bench_record import commit_label  # noqa: E402
 
 from generation.core.quaternion import qmul  # noqa: E402
 from generation.gait.data import file_sha256  # noqa: E402
@@ -149,18 +150,13 @@ def plan_walks(weights: str, net=None) -> list[dict]:
     raw = [{**e, "weights": weights} for e in plan["clips"] if e.get("generator") == "gait_net"]
     sub = validate_plan({"name": "seed000-gait", "render": plan.get("render", {}), "clips": raw})
     rows = []
-    with _named_weights(weights, net) if net is not None else _nothing():
+    with _named_weights(weights, net) if net is not None else nullcontext():
         for entry in sub.entries:
             inp = entry.inputs
             vec = inp["emotion"] if "emotion" in inp else inp["transition"]["final"]
             rows.append({"seed": entry.id, "asked": GAIT_EMOTIONS[int(np.argmax(vec))],
                          "motion": make_motion(entry), "transition": "transition" in inp})
     return rows
-
-
-@contextmanager
-def _nothing():
-    yield
 
 
 def recognition(observer, rows: list[dict]) -> dict:
@@ -226,17 +222,6 @@ def generated_realism(rows: list[dict], real: dict) -> dict:
 
 
 # ---- run ---------------------------------------------------------------------------------------
-def _commit() -> str:
-    """'commit <short hash>' of the repository, '+ uncommitted changes' when the tree is not clean."""
-    import subprocess
-
-    def git(*args):
-        return subprocess.run(["git", *args], cwd=ROOT, capture_output=True, text=True).stdout.strip()
-
-    dirty = git("status", "--porcelain", "--untracked-files=no")
-    return f"commit {git('rev-parse', '--short', 'HEAD')}" + (" + uncommitted changes" if dirty else "")
-
-
 def _file_record(path) -> dict:
     """{path (relative to the repository where inside it), sha256} of a file."""
     p = Path(path).resolve()
@@ -278,7 +263,7 @@ def run(a, argv) -> dict:
     t0 = time.time()
     nets = load_nets(a)
     corpus = real_corpus_path()
-    res = {"date": datetime.date.today().isoformat(), "commit": _commit(),
+    res = {"date": datetime.date.today().isoformat(), "commit": commit_label(),
            "command": shlex.join(["python", "benchmarks/bench_gait_real.py", *argv]),
            "machine": f"{platform.machine()}, {os.cpu_count()} CPUs (shared), Python {platform.python_version()}, "
                       f"{a.threads} torch thread(s)",

@@ -38,7 +38,7 @@ from scipy import stats  # noqa: E402
 from generation.core.quaternion import np_qnormalize  # noqa: E402
 from generation.core.skeleton import gesture_skeleton  # noqa: E402
 from generation.gesture import config  # noqa: E402
-from generation.gesture.data import GestureDataset, attribute_vector, build_dataset, nrc_vad  # noqa: E402
+from generation.gesture.data import GestureDataset, build_dataset, nrc_vad, with_emotions  # noqa: E402
 from generation.gesture.generate import decode_examples, generate_gesture, load_model  # noqa: E402
 from generation.gesture.losses import LossWeights  # noqa: E402
 from generation.gesture.metrics import (  # noqa: E402
@@ -114,20 +114,11 @@ def fit_observers(data: GestureDataset) -> dict:
 
 def all_emotion_examples(data: GestureDataset, idx: np.ndarray) -> tuple[list, GestureDataset]:
     """Each example of ``idx`` (its sentence, task, body and handedness) with each of the 11 emotions:
-    ([(example index, emotion, vad)], a GestureDataset of those len(idx) x 11 inputs; its rotations are the
-    example's own, not a gesture of the new emotion)."""
+    ([(example index, emotion, vad)], a GestureDataset of those len(idx) x 11 inputs from
+    :func:`generation.gesture.data.with_emotions`; its rotations are the example's own, not a gesture of the new
+    emotion)."""
     rows = [(i, emo, nrc_vad(emo)) for i in idx for emo in GESTURE_EMOTIONS]
-    tokens = np.stack([data.tokens[i] for i, _, _ in rows])
-    attrs = np.stack([attribute_vector(data.row(i).task, vad, str(data.gender[i]), str(data.handedness[i]))
-                      for i, _, vad in rows]).astype(np.float32)
-    src = np.array([i for i, _, _ in rows])
-    fake = GestureDataset(tokens=tokens, token_lengths=data.token_lengths[src], rotations=data.rotations[src],
-                          lengths=data.lengths[src], attributes=attrs, offsets=data.offsets[src], rest=data.rest[src],
-                          root=data.root[src], vad=np.array([v for _, _, v in rows], dtype=np.float32),
-                          sentence_index=data.sentence_index[src], split=np.array(["test"] * len(rows)),
-                          gender=data.gender[src], handedness=data.handedness[src], rows=data.rows, fps=data.fps,
-                          emotion=np.array([e for _, e, _ in rows]))
-    return rows, fake
+    return rows, with_emotions(data, idx, GESTURE_EMOTIONS)
 
 
 def all_emotion_corpus_speeds(data: GestureDataset, rows: list) -> list[dict]:

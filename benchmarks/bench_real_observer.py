@@ -45,6 +45,7 @@ from study_protocol import CAPTURE_GAIT_EMOTIONS, GAIT_EMOTIONS  # noqa: E402
 
 sys.path.insert(0, str(ROOT / "benchmarks"))
 import doc_tables  # noqa: E402
+from bench_record import commit_label  # noqa: E402
 
 
 def held_out(obs: ro.RealGaitObserver, test) -> dict:
@@ -215,17 +216,6 @@ def _count(items) -> dict:
     return dict(out)
 
 
-def _commit() -> str:
-    """'commit <short hash>' of the repository, '+ uncommitted changes' when the tree is not clean."""
-    import subprocess
-
-    def git(*args):
-        return subprocess.run(["git", *args], cwd=ROOT, capture_output=True, text=True).stdout.strip()
-
-    dirty = git("status", "--porcelain", "--untracked-files=no")
-    return f"commit {git('rev-parse', '--short', 'HEAD')}" + (" + uncommitted changes" if dirty else "")
-
-
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--corpus", default=None)
@@ -248,7 +238,7 @@ def main(argv=None) -> int:
     plans_real = {p: plan_rows(p, "real") for p in args.plans}
     plans_synth = {p: plan_rows(p, "synthetic") for p in args.plans}
     ranges = load_ranges()
-    res = {"date": datetime.date.today().isoformat(), "commit": _commit(),
+    res = {"date": datetime.date.today().isoformat(), "commit": commit_label(),
            "command": shlex.join(["python", "benchmarks/bench_real_observer.py",
                                   *(sys.argv[1:] if argv is None else argv)]),
            "machine": f"{platform.machine()}, {os.cpu_count()} CPUs (shared), Python {platform.python_version()}",

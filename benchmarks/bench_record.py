@@ -4,8 +4,11 @@ from __future__ import annotations
 import json
 import os
 import platform
+import subprocess
 from datetime import UTC, datetime
 from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
 
 
 def record(result: dict, json_path: str | Path | None = None) -> dict:
@@ -19,3 +22,12 @@ def record(result: dict, json_path: str | Path | None = None) -> dict:
     if json_path:
         Path(json_path).write_text(text + "\n")
     return result
+
+
+def commit_label() -> str:
+    """'commit <short hash>' of the repository, '+ uncommitted changes' when tracked files differ from it."""
+    def git(*args):
+        return subprocess.run(["git", *args], cwd=ROOT, capture_output=True, text=True).stdout.strip()
+
+    dirty = git("status", "--porcelain", "--untracked-files=no")
+    return f"commit {git('rev-parse', '--short', 'HEAD')}" + (" + uncommitted changes" if dirty else "")

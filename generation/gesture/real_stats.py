@@ -84,7 +84,6 @@ def real_ranges(rows: list[dict], stats=STAT_NAMES) -> dict[str, dict[str, tuple
     return out
 
 
-
 def in_range_shares(rows: list[dict], ranges: dict, stats=STAT_NAMES) -> dict[str, dict[str, float]]:
     """Per emotion of ``rows`` that ``ranges`` has (``real_ranges``'s {emotion: {stat: (min, max)}}), per statistic,
     the share of its rows ({"emotion", stat: value, ...}, e.g. generated clips) inside the real [min, max]."""

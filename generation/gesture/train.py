@@ -270,6 +270,7 @@ def _build(cfg: TrainConfig, device: torch.device):
 def train(cfg: TrainConfig, data: GestureDataset | None = None, progress: bool = True) -> dict:
     """Train and save; returns {"history": [...], "best_val", "epochs_run", "seconds", "device", "out"}."""
 
+    selected_by = _selected_by(cfg)  # an unusable selection rule fails before any data is built
     torch.set_num_threads(cfg.threads)
     device = resolve_device(cfg.device)
     amp = bool(cfg.amp) and device.type == "cuda"
@@ -287,7 +288,6 @@ def train(cfg: TrainConfig, data: GestureDataset | None = None, progress: bool =
     if cfg.loss.real_range:
         corpus.real_bounds = tuple(torch.from_numpy(a).to(device) for a in range_arrays(data.emotion))
     net, optimizer, scheduler, generator = _build(cfg, device)
-    selected_by = _selected_by(cfg)
     ranges = load_ranges()["ranges"] if cfg.select == "real-range" else None
     ckpt_path = Path(cfg.checkpoint)
     run = (_restore(ckpt_path, cfg, net, optimizer, scheduler, generator, selected_by)
@@ -335,7 +335,7 @@ def _selected_by(cfg: TrainConfig) -> str:
         raise ValueError(f"select must be one of {SELECTIONS}, got {cfg.select!r}")
     if cfg.select == "real-range":
         if cfg.rollout_every <= 0:
-            raise ValueError("select real-range needs rollouts (rollout_every > 0)")
+            raise ValueError("select real-range needs rollouts: --rollout-every (rollout_every) > 0")
         r_bound = "" if cfg.min_arousal_r is None else f"_arousal_r_{cfg.min_arousal_r:g}"
         return f"val_rollout_real_range_share_within_pose_error_{cfg.max_pose_error:g}{r_bound}"
     return ("val_loss" if cfg.rollout_every <= 0 else "val_rollout_pose_error_x_emotion_liveliness"
@@ -475,14 +475,14 @@ def config_from_args(args: argparse.Namespace) -> TrainConfig:
                      rollout_every=args.rollout_every, select_emotion_gap=bool(args.select_emotion_gap),
                      select=args.select, max_pose_error=args.max_pose_error, min_arousal_r=args.min_arousal_r,
                      keep_rollouts=args.keep_rollouts)
-    if args.select == "real-range" and args.rollout_every <= 0:
-        raise ValueError("--select real-range needs --rollout-every > 0")
     if args.epochs is not None:
         overrides["epochs"] = args.epochs
     if args.max_minutes is not None:
         overrides["max_minutes"] = args.max_minutes or None
     resolve_device(args.device)  # an unknown or unavailable device fails here, before any data is built
-    return dataclasses.replace(cfg, **overrides)
+    cfg = dataclasses.replace(cfg, **overrides)
+    _selected_by(cfg)  # so does a selection rule the options cannot serve (real-range without rollouts)
+    return cfg
 
 
 def main(argv: list[str] | None = None) -> dict:
