@@ -82,3 +82,16 @@ def test_command_line_options_build_the_config():
     assert paper.model == GaitModelConfig.paper() and paper.train.epochs == 5
     with pytest.raises(SystemExit):
         config_from_args(build_parser().parse_args(["--set", "no_such_field=1"]))
+
+
+def test_loss_weights_and_set_values_refuse_junk():
+    from generation.gait.config import GaitLossWeights
+    from generation.gait.train import build_parser, config_from_args
+    assert GaitLossWeights(bounce=40.0).bounce == 40.0
+    for bad in ({"bounce": -1.0}, {"style": float("nan")}, {"pos_scale_m": 0.0}, {"pose": "1"}):
+        with pytest.raises(ValueError, match="loss"):
+            GaitLossWeights(**bad)
+    with pytest.raises(SystemExit, match="bounce must be a finite number >= 0"):
+        config_from_args(build_parser().parse_args(["--set", "loss.bounce=-1"]))
+    with pytest.raises(SystemExit, match="must be JSON"):
+        config_from_args(build_parser().parse_args(["--set", "loss.bounce=abc"]))

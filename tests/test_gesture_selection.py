@@ -139,3 +139,12 @@ def test_shipped_weights_record_the_real_statistics_they_were_chosen_with():
         real = blob["real_statistics"]
         assert real["licence"] == "CC BY-NC 4.0" and "arXiv:2306.08861" in real["citation"]
         assert real["sha256"] == provenance()["sha256"]  # the shipped ranges are the ones it was trained with
+
+
+def test_weight_average_command_names_missing_inputs(tmp_path):
+    from generation.gesture.average import main
+    with pytest.raises(SystemExit, match="--run: no such file"):
+        main(["--run", str(tmp_path / "none.pt"), "--epochs-dir", str(tmp_path), "--out", str(tmp_path / "o.pt")])
+    (tmp_path / "run.pt").write_bytes(b"")
+    with pytest.raises(SystemExit, match="--epochs-dir: no such file or folder"):
+        main(["--run", str(tmp_path / "run.pt"), "--epochs-dir", str(tmp_path / "nope"), "--out", str(tmp_path / "o")])

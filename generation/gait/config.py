@@ -20,6 +20,7 @@ what a stored run means must come with the shipped weights re-saved. The flat na
 """
 from __future__ import annotations
 
+import math
 from dataclasses import asdict, dataclass, field, fields, replace
 
 from study_protocol import GAIT_EMOTIONS
@@ -217,6 +218,16 @@ class GaitLossWeights:
     bounce: float = 0.0
     pos_scale_m: float = 0.1
     euler_order: str = "zyx"
+
+    def __post_init__(self):
+        for f in fields(self):
+            v = getattr(self, f.name)
+            if f.name == "euler_order":
+                continue
+            if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v) or v < 0:
+                raise ValueError(f"loss weight {f.name} must be a finite number >= 0, got {v!r}")
+        if self.pos_scale_m <= 0:
+            raise ValueError(f"loss pos_scale_m must be > 0 metres, got {self.pos_scale_m!r}")
 
     def to_dict(self) -> dict:
         return _to_dict(self)

@@ -568,7 +568,11 @@ def config_from_args(args) -> GaitNetConfig:
         if "=" not in item:
             raise SystemExit(f"--set expects FIELD=JSON, got {item!r}")
         key, value = item.split("=", 1)
-        overrides[key] = json.loads(value)
+        try:
+            overrides[key] = json.loads(value)
+        except json.JSONDecodeError:
+            raise SystemExit(f"--set {key}: the value must be JSON (a number, true/false, a list or a quoted "
+                             f"string), got {value!r}") from None
     try:
         config = config.with_overrides(**overrides)
     except ValueError as exc:

@@ -49,6 +49,9 @@ def main(argv: list[str] | None = None) -> dict:
     p.add_argument("--init", default=None, help="the starting weights (default: the run's init_from)")
     p.add_argument("--out", required=True)
     args = p.parse_args(argv)
+    for what, path in (("--run", Path(args.run)), ("--epochs-dir", Path(args.epochs_dir))):
+        if not path.exists():
+            raise SystemExit(f"{what}: no such file or folder {str(path)!r}")
     run = torch.load(args.run, map_location="cpu", weights_only=False)
     files = sorted(Path(args.epochs_dir).glob("epoch*.pt"))
     epochs = [int(f.stem[5:]) for f in files]
@@ -59,6 +62,8 @@ def main(argv: list[str] | None = None) -> dict:
     init = args.init or run["train_config"].get("init_from")
     if not 0.0 <= args.init_share < 1.0 or (args.init_share and not init):
         raise SystemExit("--init-share must be in [0, 1) and needs the starting weights (--init or the run's)")
+    if args.init_share and not Path(init).is_file():
+        raise SystemExit(f"--init: the starting weights {str(init)!r} are not a file")
     states = [_state(f) for _, f in window]
     shares = [(1.0 - args.init_share) / len(window)] * len(window)
     if args.init_share:
