@@ -111,6 +111,40 @@ def test_motion_npz_round_trip_and_resample(tmp_path):
     np.testing.assert_allclose(fast.positions()[::2], motion.normalized().positions(), atol=1e-9)
 
 
+def _swinging_arm(fps: float, seconds: float = 4.0) -> Motion:
+    """A gait skeleton whose shoulders swing about x at 1 Hz (+-30 degrees, the arms of a walk) while the root
+    walks 1.4 m/s."""
+    skeleton = gait_skeleton()
+    t = np.arange(int(seconds * fps) + 1) / fps
+    half = 0.5 * np.radians(30.0) * np.sin(2 * np.pi * 1.0 * t)
+    q = np.zeros((len(t), skeleton.num_joints, 4))
+    q[..., 0] = 1.0
+    arms = [k for k, name in enumerate(skeleton.joints) if "shoulder" in name]
+    q[:, arms, 0], q[:, arms, 1] = np.cos(half)[:, None], np.sin(half)[:, None]
+    root = np.stack([np.zeros_like(t), 0.9 + 0.02 * np.sin(2 * np.pi * 2 * t), 1.4 * t], -1)
+    return Motion(skeleton, q, root, fps)
+
+
+def test_smooth_resample_keeps_the_key_poses_and_removes_the_knot_jerk():
+    from generation.quality.metrics import mean_jerk
+
+    keys, truth = _swinging_arm(7.5), _swinging_arm(30.0)
+    linear, smooth = keys.resample(30.0), keys.resample(30.0, smooth=True)
+    assert smooth.num_frames == linear.num_frames == truth.num_frames
+    np.testing.assert_allclose(smooth.positions()[::4], keys.positions(), atol=1e-9)   # through every key pose
+    jerk = {name: mean_jerk(m.positions(), 30.0) for name, m in
+            (("truth", truth), ("linear", linear), ("smooth", smooth))}
+    assert jerk["linear"] > 3 * jerk["truth"]                  # velocity jumps at each 7.5 Hz key
+    assert jerk["smooth"] < 1.5 * jerk["truth"]
+    err = np.abs(smooth.positions() - truth.positions()).max()
+    assert err < 0.5 * np.abs(linear.positions() - truth.positions()).max()
+
+
+def test_smooth_resample_of_a_short_motion_falls_back_to_slerp():
+    m = _swinging_arm(7.5, seconds=0.3)                      # 3 frames: too few for a cubic
+    np.testing.assert_allclose(m.resample(30.0, smooth=True).rotations, m.resample(30.0).rotations)
+
+
 def test_motion_rejects_bad_shapes_and_files(tmp_path):
     skeleton = gait_skeleton()
     with pytest.raises(MotionFormatError, match="rotations must be"):

@@ -75,13 +75,20 @@ class Motion:
         return Motion(self.skeleton, self.rotations[start:stop].copy(), self.root_positions[start:stop].copy(),
                       self.fps, dict(self.metadata))
 
-    def resample(self, fps: float) -> Motion:
-        """Motion at another frame rate: slerp for rotations, linear for root positions."""
+    def resample(self, fps: float, smooth: bool = False) -> Motion:
+        """Motion at another frame rate: slerp for rotations, linear for root positions; with ``smooth``, cubic
+        splines through the frames instead (:func:`_spline_resample`), for upsampling coarse key poses.
+
+        Linear interpolation keeps each source frame's velocity constant until the next frame, so the joint
+        velocity jumps at every source frame: upsampling a network's 7.5 Hz output that way gives a jerk
+        (third derivative) of the order of the velocity change times the output rate squared."""
         if abs(fps - self.fps) < 1e-9:
             return self
         t_src = np.arange(self.num_frames) / self.fps
         n_out = max(1, int(np.floor(t_src[-1] * fps + 1e-9)) + 1)
         t_out = np.arange(n_out) / fps
+        if smooth and self.num_frames >= 4:
+            return _spline_resample(self, t_src, t_out, fps)
         idx = np.clip(np.searchsorted(t_src, t_out, side="right") - 1, 0, self.num_frames - 1)
         nxt = np.minimum(idx + 1, self.num_frames - 1)
         frac = np.where(nxt > idx, (t_out - t_src[idx]) * self.fps, 0.0)
@@ -135,3 +142,20 @@ class Motion:
             return cls(skeleton, data["rotations"], data["root_positions"], float(data["fps"]), metadata)
         except MotionFormatError as exc:
             raise MotionFormatError(f"{path}: {exc}") from None
+
+
+def _spline_resample(motion: Motion, t_src: np.ndarray, t_out: np.ndarray, fps: float) -> Motion:
+    """Rotations through ``scipy.spatial.transform.RotationSpline`` (cubic in the rotation vector, continuous angular
+    rate and acceleration) per joint, root positions through a cubic spline (``CubicSpline``, not-a-knot ends); times
+    in seconds, ``t_out`` inside ``t_src``."""
+    from scipy.interpolate import CubicSpline
+    from scipy.spatial.transform import Rotation, RotationSpline
+
+    T, J = motion.rotations.shape[:2]
+    wxyz = np_qnormalize(motion.rotations)
+    out = np.empty((len(t_out), J, 4))
+    for j in range(J):
+        spline = RotationSpline(t_src, Rotation.from_quat(wxyz[:, j][:, [1, 2, 3, 0]]))
+        out[:, j] = spline(t_out).as_quat()[:, [3, 0, 1, 2]]
+    root = CubicSpline(t_src, motion.root_positions, axis=0)(t_out)
+    return Motion(motion.skeleton, np_qfix(out), root, fps, dict(motion.metadata))

@@ -468,7 +468,7 @@ def generate_gaits(seeds, paths: list[GroundPath], emotions, steps: int = 200, f
         r, rt = _with_seed(seed, placement, i, rot[i], root[i]) if include_seed else (rot[i], root[i])
         m = Motion(seed_motions[i].skeleton, wrap_quaternions(r), rt, net.fps,
                    _metadata(net, emotions[i], path, seed_motions[i]))
-        m = m.resample(fps_out)
+        m = m.resample(fps_out, smooth=True)
         motions.append(plant_feet(m, lower_pelvis=real_weights) if foot_cleanup else m)
     return motions
 
