@@ -155,8 +155,64 @@ def plan_walks(weights: str, net=None) -> list[dict]:
             inp = entry.inputs
             vec = inp["emotion"] if "emotion" in inp else inp["transition"]["final"]
             rows.append({"seed": entry.id, "asked": GAIT_EMOTIONS[int(np.argmax(vec))],
-                         "motion": make_motion(entry), "transition": "transition" in inp})
+                         "motion": make_motion(entry), "transition": "transition" in inp,
+                         "vectors": [inp["emotion"]] if "emotion" in inp else
+                         [inp["transition"]["initial"], inp["transition"]["final"]]})
     return rows
+
+
+def dominant(vec) -> str | None:
+    """The emotion of the largest share of an emotion vector (4,); None when the two largest shares tie."""
+    v = np.asarray(vec, dtype=float)
+    top = np.sort(v)[-2:]
+    return None if np.isclose(top[0], top[1]) else GAIT_EMOTIONS[int(np.argmax(v))]
+
+
+def clip_kind(vectors: list) -> str:
+    """"transition" (two vectors), "pure" (one emotion only) or "mixture"."""
+    if len(vectors) == 2:
+        return "transition"
+    return "pure" if np.count_nonzero(np.asarray(vectors[0], dtype=float)) == 1 else "mixture"
+
+
+def plan_readings(rows: list[dict], window_s: float = 4.0) -> list[dict]:
+    """The parts of the plan's clips read for what each asks, as the seed 000 study compares intended with
+    perceived emotion per clip (section 6.3) and a transition's initial and final emotions separately (6.3.2):
+    a pure or mixed clip whole, asked = its dominant emotion; a transition's first and last ``window_s`` seconds,
+    asked = the initial / final vector's dominant emotion. A part whose vector has no single dominant emotion (a
+    50/50 mixture) has ``asked`` None and is scored by whether it is read as one of its components."""
+    parts = []
+    for r in rows:
+        m, kind = r["motion"], clip_kind(r["vectors"])
+        n = min(m.num_frames, int(round(window_s * m.fps)))
+        pieces = ([("whole", m, r["vectors"][0])] if kind != "transition" else
+                  [(f"first {window_s:g} s", m.slice(0, n), r["vectors"][0]),
+                   (f"last {window_s:g} s", m.slice(m.num_frames - n, m.num_frames), r["vectors"][1])])
+        for part, motion, vec in pieces:
+            parts.append({"clip": r["seed"], "kind": kind, "part": part, "asked": dominant(vec),
+                          "components": [e for e, v in zip(GAIT_EMOTIONS, vec) if v > 0], "motion": motion})
+    return parts
+
+
+def plan_recognition(observer, rows: list[dict], window_s: float = 4.0) -> dict:
+    """:func:`recognition` of :func:`plan_readings` (parts with a dominant emotion), the share read as asked per
+    kind of clip, and each part's reading."""
+    parts = plan_readings(rows, window_s)
+    asked = [p for p in parts if p["asked"] is not None]
+    out = recognition(observer, asked)
+    for p in parts:
+        if p["asked"] is None:
+            prob = observer.proba(p["motion"])
+            p["read"], p["p"] = GAIT_EMOTIONS[int(np.argmax(prob))], prob.round(3).tolist()
+    by_kind = {}
+    for kind in ("pure", "mixture", "transition"):
+        mine = [p for p in parts if p["kind"] == kind]
+        hit = [p["read"] == p["asked"] if p["asked"] else p["read"] in p["components"] for p in mine]
+        by_kind[kind] = {"n": len(mine), "read_as_asked": float(np.mean(hit)) if hit else None}
+    out["by_kind"] = by_kind
+    out["window_s"] = window_s
+    out["parts"] = [{k: v for k, v in p.items() if k != "motion"} for p in parts]
+    return out
 
 
 def recognition(observer, rows: list[dict]) -> dict:
@@ -176,6 +232,18 @@ def recognition(observer, rows: list[dict]) -> dict:
             "all_ge_0.8": all(v["own"] is not None and v["own"] >= 0.8 for v in per.values()),
             "none_neutral_over_own": all(v["own"] is None or v["as_neutral"] <= v["own"] for k, v in per.items()
                                          if k != "neutral")}
+
+
+def real_take_recognition(observer, split: str) -> dict:
+    """:func:`recognition` of dataset 1's real happy / sad / angry / normal forward walks of ``split`` read whole:
+    what the observer makes of the actors themselves (the reference for the generated walks; the observer is
+    trained on the ``train`` split)."""
+    clips = load_real_corpus(skeleton="gait", split=split, contents="walk", styles=tuple(CAPTURE_GAIT_EMOTIONS))
+    rows = [{"seed": c.name, "asked": c.label, "motion": c.motion} for c in clips if c.dataset == "bandai-namco-1"]
+    out = recognition(observer, rows)
+    out["parts"] = [{"clip": r["seed"], "kind": "real take", "part": "whole", "asked": r["asked"],
+                     "components": [r["asked"]], "read": r["read"], "p": r["p"]} for r in rows]
+    return out
 
 
 # ---- 3. realism --------------------------------------------------------------------------------
@@ -289,6 +357,8 @@ def run(a, argv) -> dict:
     res["real_realism"] = real_realism()
     takes = heldout_emotion_takes()
     res["seed_takes"] = [t.name for t in takes]
+    res["real_take_reading"] = {f"real takes, {split} split": real_take_recognition(observer, split)
+                                for split in ("test", "train")}
     for name, net in nets.items():
         rows = generated_from_seeds(net, takes, a.steps)
         res["recognition"][f"{name}, held-out seed walks"] = recognition(observer, rows)
@@ -299,6 +369,7 @@ def run(a, argv) -> dict:
         if not a.skip_plan:
             plan = _plan(name, net)
             res["recognition"][f"{name}, seed000 plan"] = recognition(observer, plan)
+            res.setdefault("plan_reading", {})[name] = plan_recognition(observer, plan)
             res["realism"][f"{name}, seed000 plan"] = generated_realism(plan, res["real_realism"])
         print(f"{name}: {time.time() - t0:.0f} s", flush=True)
     res["seconds"] = time.time() - t0

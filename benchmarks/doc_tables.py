@@ -644,6 +644,30 @@ def gait_real_realism(r: dict) -> list[str]:
     return table(["emotion", "walks", "n", *(REALISM_LABELS.get(m, m) for m in measures)], rows)
 
 
+def gait_real_plan_reading(r: dict) -> list[str]:
+    """The real takes (read whole), then per weights the seed000 plan's clips read for what each asks (transitions
+    by their first and last window): per asked emotion (as asked / as neutral) and per kind of clip (share read as
+    asked)."""
+    rows = []
+    for name, rec in {**r.get("real_take_reading", {}), **r["plan_reading"]}.items():
+        per, kinds = rec["per_class"], rec.get("by_kind", {})
+        rows.append([name, *(_opt(per[e]["own"]) if e == "neutral" else
+                             f"{_opt(per[e]['own'])} / {_opt(per[e]['as_neutral'])} (n {per[e]['n']})"
+                             for e in EMOTIONS),
+                     *(f"{_opt(kinds[k]['read_as_asked'])} (n {kinds[k]['n']})" if k in kinds else "-"
+                       for k in ("pure", "mixture", "transition"))])
+    return table(["walks", *(f"{e}: as asked / as neutral" if e != "neutral" else e for e in EMOTIONS),
+                  "pure clips", "mixtures", "transition ends"], rows)
+
+
+def gait_real_plan_parts(r: dict) -> list[str]:
+    """Each part of the plan's clips read by the real-capture observer (the first weights of ``plan_reading``)."""
+    name, rec = next(iter(r["plan_reading"].items()))
+    rows = [[p["clip"], p["part"], p["asked"] or "tie: " + "/".join(p["components"]), p["read"],
+             " ".join(f"{v:.2f}" for v in p["p"])] for p in rec["parts"]]
+    return table(["clip", "part", "asked", f"read ({name})", "p " + " ".join(EMOTIONS)], rows)
+
+
 TABLES: dict[str, dict[str, tuple[str, Callable[[dict], list[str]]]]] = {
     "gait": {"gait.prediction": ("prediction", gait_prediction),
              "gait.expressiveness": ("expressiveness", gait_expressiveness),
@@ -694,7 +718,9 @@ TABLES: dict[str, dict[str, tuple[str, Callable[[dict], list[str]]]]] = {
                   "gait_real.prediction_all": ("prediction", gait_real_prediction_all),
                   "gait_real.prediction_emotion": ("prediction", gait_real_prediction_emotion),
                   "gait_real.emotion": ("recognition", gait_real_emotion),
-                  "gait_real.realism": ("realism", gait_real_realism)},
+                  "gait_real.realism": ("realism", gait_real_realism),
+                  "gait_real.plan_reading": ("plan_reading", gait_real_plan_reading),
+                  "gait_real.plan_parts": ("plan_reading", gait_real_plan_parts)},
 }
 """area -> table name -> (the JSON key it needs, renderer)."""
 

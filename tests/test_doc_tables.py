@@ -450,6 +450,18 @@ GAIT_REAL = {
     "realism": {"real-trained, seed000 plan": {"happy": _realism(8, [36.04, 0.0312], [1.0, 0.625]),
                                                "sad": _realism(8, [52.3, None], [0.875, None])},
                 "real-trained (before), seed000 plan": {"sad": _realism(8, [50.0, 0.06], [None, 0.375])}},
+    "real_take_reading": {"real takes, test split": _recognition([1, 1, 1, 1], [1.0, 1.0, 0.0, 1.0],
+                                                                 [0.0, 0.0, 1.0, 1.0])},
+    "plan_reading": {"real-trained": {
+        **_recognition([10, 10, 9, 11], [0.4, 0.7, 4 / 9, 1.0], [0.6, 0.3, 5 / 9, 1.0]),
+        "by_kind": {"pure": {"n": 8, "read_as_asked": 1.0}, "mixture": {"n": 8, "read_as_asked": 0.625},
+                    "transition": {"n": 24, "read_as_asked": 0.5}},
+        "parts": [{"clip": "single_happy_loop", "kind": "pure", "part": "whole", "asked": "happy",
+                   "components": ["happy"], "read": "happy", "p": [0.361, 0.082, 0.27, 0.288]},
+                  {"clip": "single_happy_angry", "kind": "mixture", "part": "whole", "asked": None,
+                   "components": ["happy", "angry"], "read": "angry", "p": [0.307, 0.065, 0.34, 0.288]},
+                  {"clip": "transition_sad_to_happy", "kind": "transition", "part": "last 4 s", "asked": "happy",
+                   "components": ["happy", "neutral"], "read": "neutral", "p": [0.247, 0.207, 0.173, 0.372]}]}},
 }
 
 
@@ -482,6 +494,21 @@ def test_gait_real_tables_render_the_figures():
         "| sad | real takes (min-max) | - | 30.4-46.5 | 0.06-0.11 |",
         "| sad | real-trained, seed000 plan | 8 | 52.3 (0.88) | - |",
         "| sad | real-trained (before), seed000 plan | 8 | 50.0 | 0.06 (0.38) |"]
+
+
+def test_gait_real_plan_tables_put_the_real_takes_first_and_name_each_part():
+    t = doc_tables.render_tables("gait_real", GAIT_REAL)
+    assert t["gait_real.plan_reading"][0] == (
+        "| walks | happy: as asked / as neutral | sad: as asked / as neutral | angry: as asked / as neutral "
+        "| neutral | pure clips | mixtures | transition ends |")
+    assert t["gait_real.plan_reading"][2:] == [
+        "| real takes, test split | 1.00 / 0.00 (n 1) | 1.00 / 0.00 (n 1) | 0.00 / 1.00 (n 1) | 1.00 | - | - | - |",
+        "| real-trained | 0.40 / 0.60 (n 10) | 0.70 / 0.30 (n 10) | 0.44 / 0.56 (n 9) | 1.00 | 1.00 (n 8) "
+        "| 0.62 (n 8) | 0.50 (n 24) |"]
+    assert t["gait_real.plan_parts"][2:] == [
+        "| single_happy_loop | whole | happy | happy | 0.36 0.08 0.27 0.29 |",
+        "| single_happy_angry | whole | tie: happy/angry | angry | 0.31 0.07 0.34 0.29 |",
+        "| transition_sad_to_happy | last 4 s | happy | neutral | 0.25 0.21 0.17 0.37 |"]
 
 
 def test_the_gait_doc_holds_the_real_capture_tables_in_their_section():
