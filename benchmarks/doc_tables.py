@@ -668,6 +668,36 @@ def gait_real_plan_parts(r: dict) -> list[str]:
     return table(["clip", "part", "asked", f"read ({name})", "p " + " ".join(EMOTIONS)], rows)
 
 
+# ---- upsampling the gait network's output (benchmarks/bench_gait_upsampling.py; docs/benchmarks/gait.md) --------
+UPSAMPLING = ("slerp", "spline")
+
+
+def gait_upsampling_run(r: dict) -> list[str]:
+    return _run(r)
+
+
+def gait_upsampling_real(r: dict) -> list[str]:
+    """Per real take: its capture's jerk, then per method the position error and jerk after the round trip."""
+    rows = []
+    for emotion, row in r["real_round_trip"].items():
+        rows.append([emotion, f"{row['take']} ({row['seconds']:.1f} s)", f"{row['capture']['jerk']:.0f}",
+                     *(f"{row[m]['position_error_cm']:.2f}" for m in UPSAMPLING),
+                     *(f"{row[m]['jerk']:.0f}" for m in UPSAMPLING)])
+    return table(["emotion", "real take", "jerk of the capture", *(f"error cm, {m}" for m in UPSAMPLING),
+                  *(f"jerk, {m}" for m in UPSAMPLING)], rows)
+
+
+def gait_upsampling_generated(r: dict) -> list[str]:
+    """Per emotion and path: jerk, toe skim and skate of the generated walk, slerp -> spline."""
+    rows = []
+    for emotion, per_path in r["generated"].items():
+        for path, row in per_path.items():
+            rows.append([emotion, path, *(f"{_opt(row['slerp'][k], fmt)} -> {_opt(row['spline'][k], fmt)}"
+                                          for k, fmt in (("jerk", "{:.0f}"), ("toe_skim", "{:.2f}"),
+                                                         ("skate_cm_s", "{:.0f}")))])
+    return table(["emotion", "path", "jerk m/s^3, slerp -> spline", "toe skim", "skate cm/s"], rows)
+
+
 TABLES: dict[str, dict[str, tuple[str, Callable[[dict], list[str]]]]] = {
     "gait": {"gait.prediction": ("prediction", gait_prediction),
              "gait.expressiveness": ("expressiveness", gait_expressiveness),
@@ -721,6 +751,9 @@ TABLES: dict[str, dict[str, tuple[str, Callable[[dict], list[str]]]]] = {
                   "gait_real.realism": ("realism", gait_real_realism),
                   "gait_real.plan_reading": ("plan_reading", gait_real_plan_reading),
                   "gait_real.plan_parts": ("plan_reading", gait_real_plan_parts)},
+    "gait_upsampling": {"gait_upsampling.run": ("date", gait_upsampling_run),
+                        "gait_upsampling.real": ("real_round_trip", gait_upsampling_real),
+                        "gait_upsampling.generated": ("generated", gait_upsampling_generated)},
 }
 """area -> table name -> (the JSON key it needs, renderer)."""
 
@@ -728,7 +761,8 @@ TABLES: dict[str, dict[str, tuple[str, Callable[[dict], list[str]]]]] = {
 FILES: dict[str, tuple[str, str]] = {"rbf_features": ("rbf_features.json", "rbf.md"),
                                      "rbf_real": ("rbf_real.json", "rbf.md"),
                                      "real_observer": ("real_observer.json", "mocap.md"),
-                                     "gait_real": ("gait_real.json", "gait.md")}
+                                     "gait_real": ("gait_real.json", "gait.md"),
+                                     "gait_upsampling": ("gait_upsampling.json", "gait.md")}
 """area -> (its JSON, its doc) in docs/benchmarks/, where they are not <area>.json and <area>.md."""
 
 
