@@ -113,6 +113,16 @@ def test_bad_plan_is_refused_before_rendering(media, tmp_path):
 
 
 @pytest.mark.django_db
+def test_an_unmigrated_database_is_refused_before_rendering(media, tmp_path, monkeypatch):
+    from django.db.migrations.executor import MigrationExecutor
+
+    monkeypatch.setattr(MigrationExecutor, "migration_plan", lambda self, targets: [("studyapp.0001", False)])
+    with pytest.raises(CommandError, match=r"1 unapplied migration\(s\): run `python manage.py migrate` first"):
+        _run("--plan", str(_write_plan(tmp_path)))
+    assert not (media / "clips").exists()
+
+
+@pytest.mark.django_db
 def test_limit_webm_and_contact_sheet(media, tmp_path):
     plan = _write_plan(tmp_path, CLIPS[2:])
     sheet = tmp_path / "sheet.png"

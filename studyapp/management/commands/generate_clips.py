@@ -15,6 +15,8 @@ from pathlib import Path
 
 from django.conf import settings
 from django.core.management.base import BaseCommand, CommandError
+from django.db import DEFAULT_DB_ALIAS, connections
+from django.db.migrations.executor import MigrationExecutor
 from tqdm import tqdm
 
 from generation.core.device import resolve_device
@@ -26,6 +28,18 @@ from generation.plans.schema import PlanError, load_plan
 from generation.quality.checks import resolve_thresholds
 from generation.render import contact_sheet
 from studyapp.catalogue import clip_label, retire_superseded, upsert_clips
+
+
+def _require_migrated_database() -> None:
+    """CommandError before anything renders when the database lacks migrations (the Clip rows are written after
+    the whole plan has rendered, which can take many minutes)."""
+    connection = connections[DEFAULT_DB_ALIAS]
+    executor = MigrationExecutor(connection)
+    pending = executor.migration_plan(executor.loader.graph.leaf_nodes())
+    if pending:
+        raise CommandError(f"the database {connection.settings_dict['NAME']} has {len(pending)} unapplied "
+                           "migration(s): run `python manage.py migrate` first, or pass --no-db to write only the "
+                           "files and clips.csv")
 
 
 class Command(BaseCommand):
@@ -59,6 +73,8 @@ class Command(BaseCommand):
             plan = load_plan(opts["plan"])
         except PlanError as exc:
             raise CommandError(str(exc)) from None
+        if not opts["no_db"]:
+            _require_migrated_database()
         os.environ.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow")
 
         try:
