@@ -668,15 +668,26 @@ def gait_real_plan_parts(r: dict) -> list[str]:
     return table(["clip", "part", "asked", f"read ({name})", "p " + " ".join(EMOTIONS)], rows)
 
 
-# ---- upsampling the gait network's output (benchmarks/bench_gait_upsampling.py; docs/benchmarks/gait.md) --------
+# ---- upsampling the networks' output (benchmarks/bench_upsampling.py; docs/benchmarks/gait.md) ------------------
 UPSAMPLING = ("slerp", "spline")
 
 
-def gait_upsampling_run(r: dict) -> list[str]:
-    return _run(r)
+def upsampling_run(r: dict) -> list[str]:
+    ms = r.get("call_ms")
+    extra = [("one call, 10 s walk at 7.5 Hz to 30 fps", " / ".join(f"{m} {ms[m]:.1f} ms" for m in UPSAMPLING))
+             ] if ms else []
+    return _run(r, *extra)
 
 
-def gait_upsampling_real(r: dict) -> list[str]:
+def upsampling_gestures(r: dict) -> list[str]:
+    """Per gesture emotion: jerk and peak hand speed, slerp -> spline."""
+    rows = [[emotion, f"{v['slerp']['jerk']:.0f} -> {v['spline']['jerk']:.0f}",
+             f"{v['slerp']['peak_hand_speed']:.2f} -> {v['spline']['peak_hand_speed']:.2f}"]
+            for emotion, v in r["gestures"].items()]
+    return table(["emotion", "jerk m/s^3, slerp -> spline", "peak hand speed m/s"], rows)
+
+
+def upsampling_real(r: dict) -> list[str]:
     """Per real take: its capture's jerk, then per method the position error and jerk after the round trip."""
     rows = []
     for emotion, row in r["real_round_trip"].items():
@@ -687,7 +698,7 @@ def gait_upsampling_real(r: dict) -> list[str]:
                   *(f"jerk, {m}" for m in UPSAMPLING)], rows)
 
 
-def gait_upsampling_generated(r: dict) -> list[str]:
+def upsampling_generated(r: dict) -> list[str]:
     """Per emotion and path: jerk, toe skim and skate of the generated walk, slerp -> spline."""
     rows = []
     for emotion, per_path in r["generated"].items():
@@ -751,9 +762,10 @@ TABLES: dict[str, dict[str, tuple[str, Callable[[dict], list[str]]]]] = {
                   "gait_real.realism": ("realism", gait_real_realism),
                   "gait_real.plan_reading": ("plan_reading", gait_real_plan_reading),
                   "gait_real.plan_parts": ("plan_reading", gait_real_plan_parts)},
-    "gait_upsampling": {"gait_upsampling.run": ("date", gait_upsampling_run),
-                        "gait_upsampling.real": ("real_round_trip", gait_upsampling_real),
-                        "gait_upsampling.generated": ("generated", gait_upsampling_generated)},
+    "upsampling": {"upsampling.run": ("date", upsampling_run),
+                   "upsampling.real": ("real_round_trip", upsampling_real),
+                   "upsampling.generated": ("generated", upsampling_generated),
+                   "upsampling.gestures": ("gestures", upsampling_gestures)},
 }
 """area -> table name -> (the JSON key it needs, renderer)."""
 
@@ -762,7 +774,7 @@ FILES: dict[str, tuple[str, str]] = {"rbf_features": ("rbf_features.json", "rbf.
                                      "rbf_real": ("rbf_real.json", "rbf.md"),
                                      "real_observer": ("real_observer.json", "mocap.md"),
                                      "gait_real": ("gait_real.json", "gait.md"),
-                                     "gait_upsampling": ("gait_upsampling.json", "gait.md")}
+                                     "upsampling": ("upsampling.json", "gait.md")}
 """area -> (its JSON, its doc) in docs/benchmarks/, where they are not <area>.json and <area>.md."""
 
 

@@ -140,6 +140,19 @@ def test_smooth_resample_keeps_the_key_poses_and_removes_the_knot_jerk():
     assert err < 0.5 * np.abs(linear.positions() - truth.positions()).max()
 
 
+def test_smooth_resample_agrees_with_scipys_rotation_spline():
+    from scipy.spatial.transform import Rotation, RotationSpline
+
+    keys = _swinging_arm(7.5)
+    ours = keys.resample(30.0, smooth=True)
+    t_keys, t_out = np.arange(keys.num_frames) / 7.5, np.arange(ours.num_frames) / 30.0
+    arm = keys.skeleton.joints.index("left_shoulder")
+    ref = RotationSpline(t_keys, Rotation.from_quat(keys.rotations[:, arm][:, [1, 2, 3, 0]]))(t_out)
+    ref_wxyz = ref.as_quat()[:, [3, 0, 1, 2]]
+    angle = 2 * np.degrees(np.arccos(np.clip(np.abs((ref_wxyz * ours.rotations[:, arm]).sum(-1)), 0, 1)))
+    assert angle.max() < 1.0 and angle.mean() < 0.2         # degrees, on a 60-degree swing
+
+
 def test_smooth_resample_of_a_short_motion_falls_back_to_slerp():
     m = _swinging_arm(7.5, seconds=0.3)                      # 3 frames: too few for a cubic
     np.testing.assert_allclose(m.resample(30.0, smooth=True).rotations, m.resample(30.0).rotations)

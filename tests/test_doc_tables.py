@@ -161,7 +161,7 @@ def test_area_files_name_the_json_and_doc_of_each_area():
     assert doc_tables.area_files("gait_real") == (doc_tables.DOCS / "gait_real.json", doc_tables.DOCS / "gait.md")
 
 
-@pytest.mark.parametrize("area", ["rbf_features", "rbf_real", "real_observer", "gait_real", "gait_upsampling"])
+@pytest.mark.parametrize("area", ["rbf_features", "rbf_real", "real_observer", "gait_real", "upsampling"])
 def test_each_doc_marks_every_table_of_the_area_once_and_matches_its_json(area):
     """The area's doc marks each of its tables once, and the blocks there are what the committed JSON renders."""
     results, doc = doc_tables.area_files(area)
@@ -511,17 +511,22 @@ def test_gait_real_plan_tables_put_the_real_takes_first_and_name_each_part():
         "| transition_sad_to_happy | last 4 s | happy | neutral | 0.25 0.21 0.17 0.37 |"]
 
 
-def test_gait_upsampling_tables_compare_the_two_methods():
+def test_upsampling_tables_compare_the_two_methods():
     r = {"date": "2026-12-05", "seconds": 9.6,
          "real_round_trip": {"angry": {"take": "walk_angry_001.bvh", "seconds": 4.73, "capture": {"jerk": 398.4},
                                        "slerp": {"jerk": 711.2, "position_error_cm": 1.918},
                                        "spline": {"jerk": 284.6, "position_error_cm": 0.994}}},
          "generated": {"sad": {"straight 10 m": {"slerp": {"jerk": 61.7, "toe_skim": 0.342, "skate_cm_s": 54.4},
-                                                 "spline": {"jerk": 25.2, "toe_skim": None, "skate_cm_s": 53.1}}}}}
-    t = doc_tables.render_tables("gait_upsampling", r)
-    assert t["gait_upsampling.run"][2:] == ["| date | 2026-12-05 |", "| duration | 10 s |"]
-    assert t["gait_upsampling.real"][2:] == ["| angry | walk_angry_001.bvh (4.7 s) | 398 | 1.92 | 0.99 | 711 | 285 |"]
-    assert t["gait_upsampling.generated"][2:] == ["| sad | straight 10 m | 62 -> 25 | 0.34 -> - | 54 -> 53 |"]
+                                                 "spline": {"jerk": 25.2, "toe_skim": None, "skate_cm_s": 53.1}}}},
+         "gestures": {"afraid": {"slerp": {"jerk": 17.6, "peak_hand_speed": 1.361},
+                                 "spline": {"jerk": 5.8, "peak_hand_speed": 1.528}}},
+         "call_ms": {"slerp": 1.04, "spline": 2.26, "frames_in": 49}}
+    t = doc_tables.render_tables("upsampling", r)
+    assert t["upsampling.run"][2:] == ["| date | 2026-12-05 |", "| duration | 10 s |",
+                                       "| one call, 10 s walk at 7.5 Hz to 30 fps | slerp 1.0 ms / spline 2.3 ms |"]
+    assert t["upsampling.gestures"][2:] == ["| afraid | 18 -> 6 | 1.36 -> 1.53 |"]
+    assert t["upsampling.real"][2:] == ["| angry | walk_angry_001.bvh (4.7 s) | 398 | 1.92 | 0.99 | 711 | 285 |"]
+    assert t["upsampling.generated"][2:] == ["| sad | straight 10 m | 62 -> 25 | 0.34 -> - | 54 -> 53 |"]
 
 
 def test_the_gait_doc_holds_the_real_capture_tables_in_their_section():

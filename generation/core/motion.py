@@ -77,7 +77,8 @@ class Motion:
 
     def resample(self, fps: float, smooth: bool = False) -> Motion:
         """Motion at another frame rate: slerp for rotations, linear for root positions; with ``smooth``, cubic
-        splines through the frames instead (:func:`_spline_resample`), for upsampling coarse key poses.
+        splines through the frames instead (:func:`_spline_resample`; motions of 4 frames or more), for
+        upsampling coarse key poses.
 
         Linear interpolation keeps each source frame's velocity constant until the next frame, so the joint
         velocity jumps at every source frame: upsampling a network's 7.5 Hz output that way gives a jerk
@@ -145,17 +146,15 @@ class Motion:
 
 
 def _spline_resample(motion: Motion, t_src: np.ndarray, t_out: np.ndarray, fps: float) -> Motion:
-    """Rotations through ``scipy.spatial.transform.RotationSpline`` (cubic in the rotation vector, continuous angular
-    rate and acceleration) per joint, root positions through a cubic spline (``CubicSpline``, not-a-knot ends); times
-    in seconds, ``t_out`` inside ``t_src``."""
+    """Cubic splines (``scipy.interpolate.CubicSpline``, not-a-knot ends) through the sign-continuous quaternion
+    components of every joint, renormalised, and through the root positions; times in seconds, ``t_out`` inside
+    ``t_src``. The curve passes through every source pose and has continuous angular velocity and acceleration
+    (normalising a smooth non-zero curve keeps it smooth). On real walks kept at every 4th frame it restores the
+    capture as well as scipy's ``RotationSpline`` (mean joint error 0.13-1.02 cm against 0.13-0.99; slerp
+    0.32-1.92) in one vectorised call, about 20 times faster than that spline's one call per joint
+    (benchmarks/bench_upsampling.py)."""
     from scipy.interpolate import CubicSpline
-    from scipy.spatial.transform import Rotation, RotationSpline
 
-    T, J = motion.rotations.shape[:2]
-    wxyz = np_qnormalize(motion.rotations)
-    out = np.empty((len(t_out), J, 4))
-    for j in range(J):
-        spline = RotationSpline(t_src, Rotation.from_quat(wxyz[:, j][:, [1, 2, 3, 0]]))
-        out[:, j] = spline(t_out).as_quat()[:, [3, 0, 1, 2]]
+    q = CubicSpline(t_src, np_qfix(np_qnormalize(motion.rotations)), axis=0)(t_out)
     root = CubicSpline(t_src, motion.root_positions, axis=0)(t_out)
-    return Motion(motion.skeleton, np_qfix(out), root, fps, dict(motion.metadata))
+    return Motion(motion.skeleton, np_qfix(np_qnormalize(q)), root, fps, dict(motion.metadata))

@@ -233,5 +233,5 @@ def generate_gestures(sentence: str, emotions, task: str = "narration", gender: 
             "handedness": handedness, "trained_on": SYNTHETIC_LABEL, "network_fps": net_fps, "seed": seed,
             **_real_statistics_credit(net),
         })
-        out.append(motion.resample(fps) if abs(fps - net_fps) > 1e-9 else motion)
+        out.append(motion.resample(fps, smooth=True) if abs(fps - net_fps) > 1e-9 else motion)
     return out

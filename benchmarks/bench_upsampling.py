@@ -1,6 +1,6 @@
-"""Benchmark: upsampling the gait network's 7.5 Hz poses to 30 fps by slerp (linear in time) or by cubic splines
-(``Motion.resample(fps, smooth=True)``), on real captured walks and on generated ones (docs/benchmarks/gait.md,
-"Upsampling the network's output").
+"""Benchmark: upsampling the networks' poses (gait 7.5 Hz, gesture 10 Hz) to 30 fps by slerp (linear in time) or by
+cubic splines (``Motion.resample(fps, smooth=True)``), on real captured walks and on generated walks and gestures
+(docs/benchmarks/gait.md, "Upsampling the networks' output").
 
 1. Real walks (the shipped dataset-1 forward walks, take 1 of happy, sad, angry and normal; Bandai Namco Research
    Motion Dataset, Kobayashi et al. 2023, arXiv:2306.08861, CC BY-NC 4.0): every 4th frame kept (the network's
@@ -10,12 +10,14 @@
    and a 2.5 m curve per emotion): the network's raw 7.5 Hz output upsampled both ways, then the foot clean-up
    generation applies (``plant_feet(lower_pelvis=True)``); mean joint jerk, toe skim and skate speed
    (``generation.quality.realism``) per emotion, beside the same measures of the real take.
-3. A figure: the right hand's speed over 3 s of a generated angry walk, both ways, above the same for the real
-   angry take subsampled and upsampled (docs/img/gait_upsampling_hand_speed.png).
+3. Generated gestures (the shipped gesture weights, three sentences per emotion, female, right-handed,
+   narration): mean joint jerk and peak hand speed, both ways, per emotion.
+4. A figure: the right hand's speed over 3 s of a generated angry walk, both ways, above the same for the real
+   angry take subsampled and upsampled (docs/img/upsampling_hand_speed.png).
 
-Usage: OMP_NUM_THREADS=1 python benchmarks/bench_gait_upsampling.py [--out JSON] [--figure PNG]
-Results: docs/benchmarks/gait_upsampling.json, rendered into the marked ``gait_upsampling.*`` tables of
-docs/benchmarks/gait.md (benchmarks/doc_tables.py).
+Usage: OMP_NUM_THREADS=1 python benchmarks/bench_upsampling.py [--out JSON] [--figure PNG]
+Results: docs/benchmarks/upsampling.json, rendered into the marked ``upsampling.*`` tables of
+docs/benchmarks/gait.md (benchmarks/doc_tables.py); also the time of one upsampling call per method.
 """
 from __future__ import annotations
 
@@ -99,6 +101,52 @@ def generated(steps: int) -> dict:
     return out
 
 
+GESTURE_SENTENCES = ("We waited at the station for hours, and then the last train finally arrived.",
+                     "I cannot believe you did that to me again.",
+                     "Please put the books back on the shelf when you are done.")
+GESTURE_EMOTIONS = ("joyous", "sad", "angry", "proud", "neutral", "afraid")
+
+
+def gestures() -> dict:
+    """Per gesture emotion: the mean over GESTURE_SENTENCES of the jerk (m/s^3) and the peak hand speed (m/s) of
+    the network's 10 Hz gesture upsampled to 30 fps each way (hands: the wrist joints)."""
+    from generation.gesture.config import TRAIN_FPS
+    from generation.gesture.generate import generate_gesture
+    from generation.gesture.generate import load_default_model as load_gesture_model
+
+    net = load_gesture_model()
+    net_fps = float(getattr(net, "train_fps", TRAIN_FPS))
+    out = {}
+    for emotion in GESTURE_EMOTIONS:
+        vals: dict = {m: {"jerk": [], "peak_hand_speed": []} for m in METHODS}
+        for sentence in GESTURE_SENTENCES:
+            keys = generate_gesture(sentence, task="narration", emotion=emotion, gender="female",
+                                    handedness="right", fps=net_fps, model=net)
+            hands = [keys.skeleton.joints.index(j) for j in ("left_wrist", "right_wrist")]
+            for method, smooth in METHODS.items():
+                P = keys.resample(FPS, smooth=smooth).positions()
+                vals[method]["jerk"].append(mean_jerk(P, FPS))
+                vals[method]["peak_hand_speed"].append(
+                    float(np.linalg.norm(np.diff(P[:, hands], axis=0), axis=-1).max() * FPS))
+        out[emotion] = {m: {k: float(np.mean(v)) for k, v in d.items()} for m, d in vals.items()}
+    return out
+
+
+def call_ms(repeats: int = 20) -> dict:
+    """Milliseconds of one upsampling call per method: a 10 s walk at 7.5 Hz (21 joints) to 30 fps."""
+    take = shipped_walk(STYLE_OF_EMOTION["neutral"])
+    keys = Motion(take.skeleton, take.rotations[::FRAME_STEP], take.root_positions[::FRAME_STEP],
+                  take.fps / FRAME_STEP)
+    out = {}
+    for method, smooth in METHODS.items():
+        t0 = time.perf_counter()
+        for _ in range(repeats):
+            keys.resample(FPS, smooth=smooth)
+        out[method] = 1e3 * (time.perf_counter() - t0) / repeats
+    out["frames_in"] = keys.num_frames
+    return out
+
+
 def hand_speed(motion: Motion, seconds: float = 3.0) -> np.ndarray:
     """(T,) speed of the right hand, m/s, over the first ``seconds``."""
     hand = motion.skeleton.joints.index("right_hand")
@@ -142,21 +190,22 @@ def main(argv=None) -> int:
     argv = sys.argv[1:] if argv is None else list(argv)
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--steps", type=int, default=76, help="network steps of each generated walk (7.5 per second)")
-    ap.add_argument("--out", default=str(doc_tables.area_files("gait_upsampling")[0]))
-    ap.add_argument("--figure", type=Path, default=ROOT / "docs" / "img" / "gait_upsampling_hand_speed.png")
+    ap.add_argument("--out", default=str(doc_tables.area_files("upsampling")[0]))
+    ap.add_argument("--figure", type=Path, default=ROOT / "docs" / "img" / "upsampling_hand_speed.png")
     a = ap.parse_args(argv)
     torch.set_num_threads(1)
     t0 = time.time()
     res = {"date": datetime.date.today().isoformat(), "commit": commit_label(),
-           "command": shlex.join(["python", "benchmarks/bench_gait_upsampling.py", *argv]),
+           "command": shlex.join(["python", "benchmarks/bench_upsampling.py", *argv]),
            "machine": f"{platform.machine()}, {os.cpu_count()} CPUs (shared), Python {platform.python_version()}, "
                       "1 torch thread",
-           "real_round_trip": real_round_trip(), "generated": generated(a.steps)}
+           "real_round_trip": real_round_trip(), "generated": generated(a.steps), "gestures": gestures(),
+           "call_ms": call_ms()}
     figure(a.figure, a.steps)
     res["seconds"] = time.time() - t0
-    for name, lines in doc_tables.render_tables("gait_upsampling", res).items():
+    for name, lines in doc_tables.render_tables("upsampling", res).items():
         print(f"\n{name}\n" + "\n".join(lines))
-    doc_tables.write_results("gait_upsampling", Path(a.out), res, res["seconds"])
+    doc_tables.write_results("upsampling", Path(a.out), res, res["seconds"])
     return 0
 
 
