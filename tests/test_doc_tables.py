@@ -1,7 +1,9 @@
 """benchmarks/doc_tables.py: tables rendered from benchmark JSON replace exactly their marked blocks in a doc."""
 from __future__ import annotations
 
+import importlib
 import json
+import pkgutil
 import sys
 from pathlib import Path
 
@@ -9,6 +11,7 @@ import pytest
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "benchmarks"))
 
+import doc_renderers  # noqa: E402
 import doc_tables  # noqa: E402
 
 RESULTS = {
@@ -56,6 +59,18 @@ def test_the_gait_doc_marks_every_gait_table_and_matches_its_json():
     names = [m.group("name") for m in doc_tables.BLOCK_RE.finditer(text) if m.group("name").startswith("gait.")]
     assert sorted(names) == sorted(doc_tables.TABLES["gait"])
     assert doc_tables.fill_doc(text, doc_tables.render_tables("gait", json.loads(results.read_text())))[0] == text
+
+
+def test_each_renderer_module_is_one_area_of_the_tables():
+    """Every area module of benchmarks/doc_renderers/ gives doc_tables.TABLES the area named after it, and its table
+    names start with that area; doc_tables still exports every name it lists."""
+    areas = sorted(m.name for m in pkgutil.iter_modules(doc_renderers.__path__) if m.name != "common")
+    assert areas == sorted(doc_tables.TABLES)
+    for area in areas:
+        module = importlib.import_module(f"doc_renderers.{area}")
+        assert doc_tables.TABLES[area] is module.TABLES
+        assert module.TABLES and all(name.startswith(area + ".") for name in module.TABLES)
+    assert all(hasattr(doc_tables, name) for name in doc_tables.__all__)
 
 
 def test_unknown_area_and_missing_results(tmp_path, capsys):
