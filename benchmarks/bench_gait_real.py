@@ -13,7 +13,8 @@ the real-capture corpus (``generation.mocap.real_corpus``); only its held-out ``
 2. Emotion carried, read by the real-capture observer (``generation.quality.real_observer``): generated walks of the
    seed000 plan's gait_net entries, and walks generated from held-out seed walks (each held-out emotion take's
    first seconds as seed, each of the four emotions asked): recognition per class, and how often each class is read
-   as neutral.
+   as neutral. Also how the reading follows the share of an emotion mixed with neutral (0 to 1, real-trained
+   weights).
 3. Realism (``generation.quality.realism``) per asked emotion of those generated walks, beside the real takes of
    that emotion (dataset 1 walks, both takes; dataset 2 normal walks for neutral) and the corpus's pooled range.
 
@@ -234,6 +235,34 @@ def recognition(observer, rows: list[dict]) -> dict:
                                          if k != "neutral")}
 
 
+MIX_SHARES = (0.0, 0.2, 0.4, 0.5, 0.6, 0.8, 1.0)
+MIX_PATHS = ({"kind": "straight", "length_m": 10.0},
+             {"kind": "curved", "radius_m": 2.5, "angle_deg": 300.0, "length_m": 10.0})
+
+
+def mixture_response(net, observer, steps: int = 76, shares=MIX_SHARES) -> dict:
+    """How much of an emotion a walk must be asked for before the observer reads it: per emotion (happy, sad,
+    angry) and share w, walks asked w of the emotion and 1 - w neutral (real seeds as in plans: the dominant
+    emotion's shipped take; one straight and one curved 10 m path) -> the mean observer probability of the emotion
+    and of neutral, and the share of walks read as the emotion / as neutral."""
+    asks = [(e, w, path) for e in GAIT_EMOTIONS[:3] for w in shares for path in MIX_PATHS]
+    vecs = [np.eye(4)[GAIT_EMOTIONS.index(e)] * w + np.eye(4)[3] * (1 - w) for e, w, _ in asks]
+    motions = generate_gaits([None] * len(asks), [make_path(p) for _, _, p in asks], np.array(vecs), steps=steps,
+                             model=net)
+    out: dict = {}
+    for (emotion, w, _), m in zip(asks, motions):
+        p = observer.proba(m)
+        cell = out.setdefault(emotion, {}).setdefault(f"{w:g}", {"p_emotion": [], "p_neutral": [], "read": []})
+        cell["p_emotion"].append(float(p[GAIT_EMOTIONS.index(emotion)]))
+        cell["p_neutral"].append(float(p[3]))
+        cell["read"].append(GAIT_EMOTIONS[int(np.argmax(p))])
+    return {e: {w: {"n": len(c["read"]), "p_emotion": float(np.mean(c["p_emotion"])),
+                    "p_neutral": float(np.mean(c["p_neutral"])),
+                    "as_emotion": float(np.mean([r == e for r in c["read"]])),
+                    "as_neutral": float(np.mean([r == "neutral" for r in c["read"]]))} for w, c in per.items()}
+            for e, per in out.items()}
+
+
 def real_take_recognition(observer, split: str) -> dict:
     """:func:`recognition` of dataset 1's real happy / sad / angry / normal forward walks of ``split`` read whole:
     what the observer makes of the actors themselves (the reference for the generated walks; the observer is
@@ -359,6 +388,7 @@ def run(a, argv) -> dict:
     res["seed_takes"] = [t.name for t in takes]
     res["real_take_reading"] = {f"real takes, {split} split": real_take_recognition(observer, split)
                                 for split in ("test", "train")}
+    res["mixture_response"] = mixture_response(nets["real-trained"], observer)
     for name, net in nets.items():
         rows = generated_from_seeds(net, takes, a.steps)
         res["recognition"][f"{name}, held-out seed walks"] = recognition(observer, rows)

@@ -65,3 +65,20 @@ def test_a_transition_that_never_arrives_is_a_miss():
     rec = bench.plan_recognition(MajorityObserver(), [stuck], window_s=4.0)
     assert rec["by_kind"]["transition"]["read_as_asked"] == pytest.approx(0.5)
     assert rec["per_class"]["happy"]["own"] == 0.0
+
+
+class ConstantObserver:
+    """Reads every walk happy 0.4, sad 0.1, angry 0.2, neutral 0.3."""
+
+    def proba(self, motion: Motion) -> np.ndarray:
+        return np.array([0.4, 0.1, 0.2, 0.3])
+
+
+def test_mixture_response_asks_each_share_of_each_emotion_on_both_paths():
+    from generation.gait.generate import load_default_model
+
+    out = bench.mixture_response(load_default_model(weights="real"), ConstantObserver(), steps=20,
+                                 shares=(0.0, 1.0))
+    assert set(out) == {"happy", "sad", "angry"} and set(out["sad"]) == {"0", "1"}
+    assert out["happy"]["1"] == {"n": 2, "p_emotion": 0.4, "p_neutral": 0.3, "as_emotion": 1.0, "as_neutral": 0.0}
+    assert out["sad"]["0"]["as_emotion"] == 0.0 and out["sad"]["0"]["p_emotion"] == pytest.approx(0.1)

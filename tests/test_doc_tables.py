@@ -465,6 +465,10 @@ GAIT_REAL = {
     "realism": {"real-trained, seed000 plan": {"happy": _realism(8, [36.04, 0.0312], [1.0, 0.625]),
                                                "sad": _realism(8, [52.3, None], [0.875, None])},
                 "real-trained (before), seed000 plan": {"sad": _realism(8, [50.0, 0.06], [None, 0.375])}},
+    "mixture_response": {"happy": {"0": {"n": 2, "p_emotion": 0.131, "p_neutral": 0.503, "as_emotion": 0.0,
+                                         "as_neutral": 1.0},
+                                   "0.8": {"n": 2, "p_emotion": 0.352, "p_neutral": 0.318, "as_emotion": 0.5,
+                                           "as_neutral": 0.5}}},
     "real_take_reading": {"real takes, test split": _recognition([1, 1, 1, 1], [1.0, 1.0, 0.0, 1.0],
                                                                  [0.0, 0.0, 1.0, 1.0])},
     "plan_reading": {"real-trained": {
@@ -509,6 +513,12 @@ def test_gait_real_tables_render_the_figures():
         "| sad | real takes (min-max) | - | 30.4-46.5 | 0.06-0.11 |",
         "| sad | real-trained, seed000 plan | 8 | 52.3 (0.88) | - |",
         "| sad | real-trained (before), seed000 plan | 8 | 50.0 | 0.06 (0.38) |"]
+
+
+def test_gait_real_mixture_table_has_a_column_per_share():
+    t = doc_tables.render_tables("gait_real", GAIT_REAL)["gait_real.mixture_response"]
+    assert t == ["| emotion | share 0 | share 0.8 |", "|---|---|---|",
+                 "| happy | 0.13 / 0.50 (0 of 2) | 0.35 / 0.32 (1 of 2) |"]
 
 
 def test_gait_real_plan_tables_put_the_real_takes_first_and_name_each_part():

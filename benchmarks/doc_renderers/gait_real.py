@@ -116,6 +116,16 @@ def gait_real_plan_parts(r: dict) -> list[str]:
     return table(["clip", "part", "asked", f"read ({name})", "p " + " ".join(EMOTIONS)], rows)
 
 
+def gait_real_mixture_response(r: dict) -> list[str]:
+    """Per emotion mixed with neutral, per share of the emotion: the observer's mean p of the emotion / of
+    neutral, and how many walks are read as the emotion."""
+    resp = r["mixture_response"]
+    shares = list(next(iter(resp.values())))
+    rows = [[e, *(f"{c['p_emotion']:.2f} / {c['p_neutral']:.2f} ({round(c['as_emotion'] * c['n'])} of {c['n']})"
+                  for c in (per[w] for w in shares))] for e, per in resp.items()]
+    return table(["emotion", *(f"share {w}" for w in shares)], rows)
+
+
 TABLES: dict[str, tuple[str, Renderer]] = {
     "gait_real.run": ("date", gait_real_run),
     "gait_real.prediction_all": ("prediction", gait_real_prediction_all),
@@ -124,5 +134,6 @@ TABLES: dict[str, tuple[str, Renderer]] = {
     "gait_real.realism": ("realism", gait_real_realism),
     "gait_real.plan_reading": ("plan_reading", gait_real_plan_reading),
     "gait_real.plan_parts": ("plan_reading", gait_real_plan_parts),
+    "gait_real.mixture_response": ("mixture_response", gait_real_mixture_response),
 }
 """Table name -> (the JSON key it needs, renderer)."""
