@@ -426,7 +426,8 @@ def generate_gaits(seeds, paths: list[GroundPath], emotions, steps: int = 200, f
         emotions: (N, 4) constant emotion per agent, or (N, steps, 4) per step (e.g. from
             :func:`emotion_transition`); l1-normalised here.
         steps: number of network steps to generate (1/7.5 s each with the default frame step of 4).
-        fps_out: frame rate of the returned motions (interpolated).
+        fps_out: frame rate of the returned motions (cubic splines through the network's poses,
+            :meth:`Motion.resample` with ``smooth``).
         model: a :class:`LoadedGaitNet`; default :func:`load_default_model`.
         lookahead_m: pure-pursuit look-ahead along the path, metres.
         include_seed: prepend the (moved) seed steps to the output.
