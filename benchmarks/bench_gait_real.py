@@ -30,8 +30,6 @@ from __future__ import annotations
 import argparse
 import datetime
 import math
-import os
-import platform
 import shlex
 import sys
 import time
@@ -48,7 +46,7 @@ sys.path.insert(0, str(ROOT / "benchmarks"))
 
 import doc_tables  # noqa: E402
 from bench_gait import nearest_neighbour_errors, network_errors, pose_rotation_errors, zero_velocity_errors  # noqa: E402
-from bench_record import commit_label  # noqa: E402
+from bench_record import commit_label, machine_label  # noqa: E402
 
 from generation.core.quaternion import qmul  # noqa: E402
 from generation.gait.data import file_sha256  # noqa: E402
@@ -263,15 +261,20 @@ def mixture_response(net, observer, steps: int = 76, shares=MIX_SHARES) -> dict:
             for e, per in out.items()}
 
 
-def real_take_recognition(observer, split: str) -> dict:
-    """:func:`recognition` of dataset 1's real happy / sad / angry / normal forward walks of ``split`` read whole:
-    what the observer makes of the actors themselves (the reference for the generated walks; the observer is
-    trained on the ``train`` split)."""
-    clips = load_real_corpus(skeleton="gait", split=split, contents="walk", styles=tuple(CAPTURE_GAIT_EMOTIONS))
-    rows = [{"seed": c.name, "asked": c.label, "motion": c.motion} for c in clips if c.dataset == "bandai-namco-1"]
-    out = recognition(observer, rows)
-    out["parts"] = [{"clip": r["seed"], "kind": "real take", "part": "whole", "asked": r["asked"],
-                     "components": [r["asked"]], "read": r["read"], "p": r["p"]} for r in rows]
+def real_take_recognition(observer) -> dict:
+    """Per split (test, train): :func:`recognition` of dataset 1's real happy / sad / angry / normal forward walks
+    read whole: what the observer makes of the actors themselves (the reference for the generated walks; the
+    observer is trained on the ``train`` split)."""
+    clips = load_real_corpus(skeleton="gait", split=("test", "train"), contents="walk",
+                             styles=tuple(CAPTURE_GAIT_EMOTIONS))
+    out = {}
+    for split in ("test", "train"):
+        rows = [{"seed": c.name, "asked": c.label, "motion": c.motion} for c in clips
+                if c.dataset == "bandai-namco-1" and c.split == split]
+        rec = recognition(observer, rows)
+        rec["parts"] = [{"clip": r["seed"], "kind": "real take", "part": "whole", "asked": r["asked"],
+                         "components": [r["asked"]], "read": r["read"], "p": r["p"]} for r in rows]
+        out[f"real takes, {split} split"] = rec
     return out
 
 
@@ -362,8 +365,7 @@ def run(a, argv) -> dict:
     corpus = real_corpus_path()
     res = {"date": datetime.date.today().isoformat(), "commit": commit_label(),
            "command": shlex.join(["python", "benchmarks/bench_gait_real.py", *argv]),
-           "machine": f"{platform.machine()}, {os.cpu_count()} CPUs (shared), Python {platform.python_version()}, "
-                      f"{a.threads} torch thread(s)",
+           "machine": machine_label(f"{a.threads} torch thread(s)"),
            "corpus": _file_record(corpus) if corpus.is_file() else {"path": str(corpus), "sha256": None},
            "weights": {name: _file_record(net.path) for name, net in nets.items()}}
     data_cfg = nets["real-trained"].config.data
@@ -386,8 +388,7 @@ def run(a, argv) -> dict:
     res["real_realism"] = real_realism()
     takes = heldout_emotion_takes()
     res["seed_takes"] = [t.name for t in takes]
-    res["real_take_reading"] = {f"real takes, {split} split": real_take_recognition(observer, split)
-                                for split in ("test", "train")}
+    res["real_take_reading"] = real_take_recognition(observer)
     res["mixture_response"] = mixture_response(nets["real-trained"], observer)
     for name, net in nets.items():
         rows = generated_from_seeds(net, takes, a.steps)

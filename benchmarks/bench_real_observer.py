@@ -23,7 +23,6 @@ import argparse
 import datetime
 import json
 import os
-import platform
 import re
 import shlex
 import sys
@@ -45,7 +44,7 @@ from study_protocol import CAPTURE_GAIT_EMOTIONS, GAIT_EMOTIONS  # noqa: E402
 
 sys.path.insert(0, str(ROOT / "benchmarks"))
 import doc_tables  # noqa: E402
-from bench_record import commit_label  # noqa: E402
+from bench_record import commit_label, machine_label  # noqa: E402
 
 
 def held_out(obs: ro.RealGaitObserver, test) -> dict:
@@ -241,7 +240,7 @@ def main(argv=None) -> int:
     res = {"date": datetime.date.today().isoformat(), "commit": commit_label(),
            "command": shlex.join(["python", "benchmarks/bench_real_observer.py",
                                   *(sys.argv[1:] if argv is None else argv)]),
-           "machine": f"{platform.machine()}, {os.cpu_count()} CPUs (shared), Python {platform.python_version()}",
+           "machine": machine_label(),
            "corpus": path.name, "observer_source": obs.source, "train_takes": dict(obs.train_takes),
            "synthetic_source": ("logistic regression on the SYNTHETIC procedural gait corpus (var/corpus/)"
                                 if synth is not None else "not available (no synthetic gait corpus in var/corpus/)"),

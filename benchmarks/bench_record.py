@@ -24,6 +24,13 @@ def record(result: dict, json_path: str | Path | None = None) -> dict:
     return result
 
 
+def machine_label(torch_threads: str | None = None) -> str:
+    """'<arch>, <n> CPUs (shared), Python <version>', then ', <torch_threads>' when given (e.g. "1 torch
+    thread"): the machine line of the JSON-writing benchmarks' run records."""
+    label = f"{platform.machine()}, {os.cpu_count()} CPUs (shared), Python {platform.python_version()}"
+    return label if torch_threads is None else f"{label}, {torch_threads}"
+
+
 def commit_label() -> str:
     """'commit <short hash>' of the repository, '+ uncommitted changes' when tracked files differ from it."""
     def git(*args):

@@ -24,8 +24,6 @@ from __future__ import annotations
 import argparse
 import datetime
 import math
-import os
-import platform
 import shlex
 import sys
 import time
@@ -39,7 +37,7 @@ sys.path.insert(0, str(ROOT))
 sys.path.insert(0, str(ROOT / "benchmarks"))
 
 import doc_tables  # noqa: E402
-from bench_record import commit_label  # noqa: E402
+from bench_record import commit_label, machine_label  # noqa: E402
 
 from generation.core import paths  # noqa: E402
 from generation.core.foot_contact import plant_feet  # noqa: E402
@@ -59,6 +57,12 @@ PATHS = {"straight 10 m": lambda: paths.straight(10.0),
          "curve r 2.5 m": lambda: paths.curved(2.5, math.radians(300.0), 10.0)}
 
 
+def network_rate(motion: Motion) -> Motion:
+    """Every FRAME_STEP-th frame of a 30 fps capture: the capture at the gait network's rate."""
+    return Motion(motion.skeleton, motion.rotations[::FRAME_STEP], motion.root_positions[::FRAME_STEP],
+                  motion.fps / FRAME_STEP, dict(motion.metadata))
+
+
 def feet_and_jerk(motion: Motion) -> dict:
     """Mean joint jerk (m/s^3), toe skim and skate speed (cm/s) of a 30 fps motion."""
     r = realism_measures(motion)
@@ -73,8 +77,7 @@ def real_round_trip() -> dict:
         take = shipped_walk(STYLE_OF_EMOTION[emotion])
         n = (take.num_frames - 1) // FRAME_STEP * FRAME_STEP + 1                  # end on a kept frame
         truth = take.slice(0, n)
-        keys = Motion(truth.skeleton, truth.rotations[::FRAME_STEP], truth.root_positions[::FRAME_STEP],
-                      truth.fps / FRAME_STEP, dict(truth.metadata))
+        keys = network_rate(truth)
         P = truth.positions()
         row = {"take": take.metadata.get("source", emotion), "seconds": n / truth.fps,
                "capture": feet_and_jerk(truth)}
@@ -134,9 +137,7 @@ def gestures() -> dict:
 
 def call_ms(repeats: int = 20) -> dict:
     """Milliseconds of one upsampling call per method: a 10 s walk at 7.5 Hz (21 joints) to 30 fps."""
-    take = shipped_walk(STYLE_OF_EMOTION["neutral"])
-    keys = Motion(take.skeleton, take.rotations[::FRAME_STEP], take.root_positions[::FRAME_STEP],
-                  take.fps / FRAME_STEP)
+    keys = network_rate(shipped_walk(STYLE_OF_EMOTION["neutral"]))
     out = {}
     for method, smooth in METHODS.items():
         t0 = time.perf_counter()
@@ -165,8 +166,7 @@ def figure(path: Path, steps: int) -> None:
     raw = generate_gaits([None], [paths.straight(10.0)], np.eye(4)[[GAIT_EMOTIONS.index("angry")]], steps=steps,
                          fps_out=net.fps, model=net, foot_cleanup=False)[0]
     take = shipped_walk(STYLE_OF_EMOTION["angry"])
-    keys = Motion(take.skeleton, take.rotations[::FRAME_STEP], take.root_positions[::FRAME_STEP],
-                  take.fps / FRAME_STEP)
+    keys = network_rate(take)
     fig, axes = plt.subplots(2, 1, figsize=(8, 5.5), sharex=True)
     for ax, (title, source) in zip(axes, (("generated angry walk (real-trained weights)", raw),
                                           ("real angry take, every 4th frame kept", keys))):
@@ -197,8 +197,7 @@ def main(argv=None) -> int:
     t0 = time.time()
     res = {"date": datetime.date.today().isoformat(), "commit": commit_label(),
            "command": shlex.join(["python", "benchmarks/bench_upsampling.py", *argv]),
-           "machine": f"{platform.machine()}, {os.cpu_count()} CPUs (shared), Python {platform.python_version()}, "
-                      "1 torch thread",
+           "machine": machine_label("1 torch thread"),
            "real_round_trip": real_round_trip(), "generated": generated(a.steps), "gestures": gestures(),
            "call_ms": call_ms()}
     figure(a.figure, a.steps)
