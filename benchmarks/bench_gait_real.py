@@ -48,13 +48,13 @@ import doc_tables  # noqa: E402
 from bench_gait import nearest_neighbour_errors, network_errors, pose_rotation_errors, zero_velocity_errors  # noqa: E402
 from bench_record import commit_label, machine_label  # noqa: E402
 
+from generation.core.paths import path_from_spec as make_path  # noqa: E402
 from generation.core.quaternion import qmul  # noqa: E402
 from generation.gait.data import file_sha256  # noqa: E402
 from generation.gait.generate import generate_gaits, load_model  # noqa: E402
 from generation.gait.real_data import RealAugment, clip_sequences, stage_clips  # noqa: E402
 from generation.gait.weights import weights_path  # noqa: E402
 from generation.mocap.real_corpus import load_real_corpus, real_corpus_path  # noqa: E402
-from generation.plans.clipgen import make_path  # noqa: E402
 from generation.quality.real_observer import default_real_observer  # noqa: E402
 from generation.quality.realism import MEASURES, realism_measures  # noqa: E402
 from generation.quality.realism_ranges import load_ranges  # noqa: E402

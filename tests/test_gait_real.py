@@ -138,7 +138,8 @@ def test_training_on_real_windows_records_the_data(corpus, tmp_path):
 
 
 def test_plan_weights_option():
-    from generation.plans.schema import GAIT_WEIGHTS, PlanError, validate_plan
+    from generation.plans.generators.gait_net import GAIT_WEIGHTS
+    from generation.plans.schema import PlanError, validate_plan
     assert GAIT_WEIGHTS == tuple(NAMED_WEIGHTS)
     entry = {"id": "a", "generator": "gait_net", "origin": "generated", "emotion": [1, 0, 0, 0],
              "trajectory": {"kind": "straight", "length_m": 5}}

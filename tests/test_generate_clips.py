@@ -147,10 +147,10 @@ def test_two_workers(media, tmp_path):
 
 @pytest.mark.django_db
 def test_unavailable_generator_fails_only_its_entries(media, tmp_path, monkeypatch):
-    import generation.plans.clipgen as clipgen
+    from generation.plans.generators import gesture_net
 
     missing = tmp_path / "no_such_weights.pt"
-    monkeypatch.setitem(clipgen.GENERATOR_WEIGHTS, "gesture_net", missing)
+    monkeypatch.setattr(gesture_net, "WEIGHTS_FILE", missing)
     gesture = {"id": "g", "generator": "gesture_net", "sentence": "I did it.", "emotion_label": "proud"}
     plan = _write_plan(tmp_path, [gesture, dict(gesture, id="g_fb", fallback="procedural_gesture", seed=1), CLIPS[2]])
     err = io.StringIO()

@@ -157,7 +157,7 @@ def test_source_json_beside_the_file_gives_licence_citation_and_take(walk_files,
 
 
 def test_relative_file_falls_back_to_the_repository_root(walk_files, monkeypatch, tmp_path):
-    from generation.plans import captured_file
+    from generation.plans.generators import captured_file
 
     monkeypatch.chdir(tmp_path)
     monkeypatch.setattr(captured_file, "REPO_ROOT", walk_files)

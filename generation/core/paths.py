@@ -182,6 +182,19 @@ def sharp_turn(angle_rad: float, length_m: float = 10.0, at_fraction: float = 0.
 PATH_KINDS = ("straight", "curved", "sharp_turn")
 
 
+def path_from_spec(spec) -> GroundPath:
+    """A GroundPath from a plan's trajectory mapping: ``kind`` (straight | curved | sharp_turn), ``length_m``;
+    curves ``radius_m`` and ``angle_deg`` (swept, degrees); sharp turns ``angle_deg`` and ``at_fraction``."""
+    kind, length = spec["kind"], spec["length_m"]
+    if kind == "straight":
+        return straight(length)
+    if kind == "curved":
+        return curved(spec["radius_m"], float(np.radians(spec["angle_deg"])), length)
+    if kind == "sharp_turn":
+        return sharp_turn(float(np.radians(spec["angle_deg"])), length, spec["at_fraction"])
+    raise ValueError(f"unknown trajectory kind {kind!r} (straight, curved, sharp_turn)")
+
+
 def random_path(rng: np.random.Generator, length_m: float = 10.0, kind: str | None = None) -> GroundPath:
     """A random straight, curved or sharp-turn path of ``length_m`` metres starting along +z.
 

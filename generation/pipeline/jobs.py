@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from generation.plans.clipgen import ClipGenerationError, generation_device, generator_version, resolve
+from generation.plans.clipgen import ClipGenerationError, generator_version, resolve
 from generation.plans.schema import ClipEntry, Plan, clip_hash
 from generation.quality.checks import resolve_thresholds
 
@@ -19,13 +19,14 @@ class Job:
     generator_version: str
     fallback_reason: str | None = None
     qa_thresholds: dict | None = None  # the plan's quality thresholds (resolved); None = study_protocol defaults
-    # torch device of the network generators, fixed where the jobs are planned so that Dask workers on other
-    # machines use it too (they do not inherit the submitting process's $GENERATION_DEVICE).
-    device: str | None = None
+    # torch device of the network generators, fixed where the jobs are planned and carried to every worker
+    # (local processes and Dask workers on other machines alike)
+    device: str = "cpu"
 
 
-def plan_jobs(plan: Plan, limit: int | None = None) -> tuple[list[Job], list[tuple[str, str]]]:
-    """Jobs for the plan's entries (first ``limit``), and (entry, message) for entries that cannot run."""
+def plan_jobs(plan: Plan, limit: int | None = None, device: str = "cpu") -> tuple[list[Job], list[tuple[str, str]]]:
+    """Jobs for the plan's entries (first ``limit``) with the network generators on ``device``, and (entry,
+    message) for entries that cannot run."""
     thresholds = resolve_thresholds(plan.qa)
     jobs, failures = [], []
     for entry in plan.entries[:limit] if limit else plan.entries:
@@ -34,7 +35,7 @@ def plan_jobs(plan: Plan, limit: int | None = None) -> tuple[list[Job], list[tup
         except ClipGenerationError as exc:
             failures.append((entry.where, str(exc)))
             continue
-        version = generator_version(run_entry.generator)
+        version = generator_version(run_entry.generator, run_entry.inputs)
         jobs.append(Job(entry, run_entry, clip_hash(run_entry, run_entry.generator, version), version, reason,
-                        thresholds, generation_device()))
+                        thresholds, device))
     return jobs, failures

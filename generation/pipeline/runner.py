@@ -24,7 +24,7 @@ from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from generation.plans.clipgen import DEVICE_ENV, make_motion, write_motion_bvh
+from generation.plans.clipgen import make_motion, write_motion_bvh
 from generation.plans.schema import ClipEntry, Plan, intent_fields
 from generation.quality.checks import QAResult, failed_checks
 from generation.render.clip import clip_files_complete, render_clip
@@ -62,7 +62,7 @@ def base_record(job: Job, plan: Plan, pair_ids: dict[str, str], media_prefix: st
            "plan": plan.name, "loop": e.loop, "source_clip_id": pair_ids.get(e.pair, "") if e.pair else ""}
     rec["metadata"] = {
         "entry_id": e.id, "plan": plan.name, "generator": r.generator, "requested_generator": e.generator,
-        "generator_version": job.generator_version, "inputs": _json_safe(r.inputs), "seed": e.seed,
+        "generator_version": job.generator_version, "inputs": r.inputs.as_dict(), "seed": e.seed,
         "sections": list(e.sections), "render": e.render.content_dict(), "note": e.note,
         "pair": e.pair, "source_clip_id": rec["source_clip_id"],
     }
@@ -125,10 +125,9 @@ def _init_worker(progress_queue, threads: int, parent_pid: int | None = None) ->
 
 def render_job(job: Job, record: dict, clips_dir: str, records_dir: str) -> dict:
     """Make the motion, render its files, write the record last. Runs in a worker (or inline)."""
-    if job.device:
-        os.environ[DEVICE_ENV] = job.device
     t0 = time.perf_counter()
-    motion = make_motion(job.run_entry, requested=job.entry.generator, fallback_reason=job.fallback_reason)
+    motion = make_motion(job.run_entry, requested=job.entry.generator, fallback_reason=job.fallback_reason,
+                         device=job.device)
     write_motion_bvh(motion, Path(clips_dir).parent / "motions", job.clip_id)
     t_gen = time.perf_counter() - t0
     q = _PROGRESS_QUEUE
@@ -177,7 +176,8 @@ def _remeasure_qa(done: dict, job: Job, batch: _Batch) -> None:
     """Make the clip's motion again (no video) and replace the stored record's quality record, on disk too; the
     render's camera (figure height) is kept. A motion that cannot be made keeps the old record and says why."""
     try:
-        motion = make_motion(job.run_entry, requested=job.entry.generator, fallback_reason=job.fallback_reason)
+        motion = make_motion(job.run_entry, requested=job.entry.generator, fallback_reason=job.fallback_reason,
+                             device=job.device)
         _add_qa(done, job, motion, (done.get("metadata") or {}).get("camera"))
     except Exception as exc:  # noqa: BLE001 - the clip's files are fine; only its quality record stays old
         batch.emit("warn", {"clip_id": job.clip_id, "entry": job.entry.id,
@@ -339,7 +339,7 @@ def _render_dask(batch: _Batch, todo: list[Job], scheduler, threads_per_worker: 
 def run_plan(plan: Plan, clips_dir: str | Path, records_dir: str | Path, media_prefix: str = "clips/",
              workers: int = 1, webm: bool = False, limit: int | None = None,
              on_event: Callable[[str, dict], None] | None = None, threads_per_worker: int = 1,
-             scheduler=None) -> BatchResult:
+             scheduler=None, device: str = "cpu") -> BatchResult:
     """Render every entry of ``plan`` that is not already complete.
 
     Args:
@@ -354,6 +354,7 @@ def run_plan(plan: Plan, clips_dir: str | Path, records_dir: str | Path, media_p
             "done", "fail"} (the command draws tqdm bars from it).
         scheduler: a Dask distributed scheduler address (``tcp://host:port``) or Client: render there instead of
             in local processes (``workers`` is then ignored; the workers need the shared media folder).
+        device: torch device of the network generators (gait_net, gesture_net), carried to every worker.
     Returns a BatchResult with the records of every clip of the plan that exists now.
     """
     t0 = time.perf_counter()
@@ -361,7 +362,7 @@ def run_plan(plan: Plan, clips_dir: str | Path, records_dir: str | Path, media_p
     clips_dir.mkdir(parents=True, exist_ok=True)
     records_dir.mkdir(parents=True, exist_ok=True)
     emit = on_event or (lambda kind, info: None)
-    jobs, failures = plan_jobs(plan, limit)
+    jobs, failures = plan_jobs(plan, limit, device)
     batch = _Batch(clips_dir, records_dir, emit, BatchResult(failed=list(failures)))
     for where, msg in failures:
         emit("fail", {"entry": where, "error": msg})

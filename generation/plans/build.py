@@ -33,7 +33,7 @@ from generation.gesture.config import gesture_seconds
 from generation.gesture.text import count_words
 from study_protocol import CAPTURE_GESTURE_EMOTIONS, GAIT_EMOTIONS, GESTURE_EMOTIONS, GESTURE_TASKS, THEMES
 
-from .schema import CAPTURED_CLIPS
+from .generators.captured import CAPTURED_CLIPS
 
 HERE = Path(__file__).resolve().parent
 SENTENCES = HERE.parent / "data" / "sentences_synthetic.csv"

@@ -23,7 +23,6 @@ from generation.core.device import resolve_device
 from generation.pipeline.plan_qa import summary_line, unread_line
 from generation.pipeline.runner import run_plan
 from generation.plans.catalogue import write_clips_csv
-from generation.plans.clipgen import DEVICE_ENV
 from generation.plans.schema import PlanError, load_plan
 from generation.quality.checks import resolve_thresholds
 from generation.render import contact_sheet
@@ -78,7 +77,7 @@ class Command(BaseCommand):
         os.environ.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow")
 
         try:
-            os.environ[DEVICE_ENV] = str(resolve_device(opts["device"]))  # inherited by the render workers
+            device = str(resolve_device(opts["device"]))
         except ValueError as exc:
             raise CommandError(f"--device: {exc}") from None
         media_root = Path(settings.MEDIA_ROOT)
@@ -88,7 +87,7 @@ class Command(BaseCommand):
         try:
             result = run_plan(plan, clips_dir, records_dir, media_prefix="clips/", workers=opts["workers"],
                               webm=opts["webm"], limit=opts["limit"], on_event=bars.event,
-                              scheduler=opts["scheduler"])
+                              scheduler=opts["scheduler"], device=device)
         except OSError as exc:  # e.g. no Dask scheduler at that address
             raise CommandError(f"cannot render: {exc}") from None
         finally:

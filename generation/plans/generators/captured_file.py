@@ -37,6 +37,7 @@ import hashlib
 import json
 import math
 import re
+from dataclasses import dataclass
 from pathlib import Path
 
 from generation.core.motion import Motion, MotionFormatError
@@ -44,8 +45,11 @@ from generation.mocap import ImportOptions, import_file
 from generation.mocap.seated_gesture import seat_gesture
 from study_protocol import GAIT_EMOTIONS, GESTURE_VAD, MODALITIES
 
+from .fields import FieldError
+from .registry import ClipGenerationError, GeneratorSpec, InputContext, MakeContext, PlanInputs, register
+
 SUFFIXES = (".npz", ".bvh")
-REPO_ROOT = Path(__file__).resolve().parents[2]
+REPO_ROOT = Path(__file__).resolve().parents[3]
 PROVENANCE_FILE = "SOURCE.json"
 
 
@@ -241,3 +245,46 @@ def captured_file_motion(inputs: dict, modality: str, fps: float):
             meta[key] = dict(zip(GAIT_EMOTIONS, inputs[key])) if key == "emotion" else inputs[key]
     motion.metadata = meta
     return motion
+
+
+@dataclass(frozen=True)
+class CapturedFileInputs(PlanInputs):
+    """An imported motion file as the plan names it, its SHA-256 (16 hex digits) and format (npz | bvh), where the
+    clip starts (s), whether a standing gesture is seated, and its labels (given in the entry or stored in the
+    file, ``labels_from``)."""
+
+    PLAN_FIELDS = frozenset({"file", "start_s", "emotion", "emotion_label", "vad", "seated"})
+
+    file: str
+    sha256: str
+    format: str
+    start_s: float = 0.0
+    seated: bool | None = None
+    emotion: tuple[float, ...] | None = None
+    emotion_label: str | None = None
+    vad: tuple[float, float, float] | None = None
+    labels_from: str | None = None
+
+    @classmethod
+    def parse(cls, raw: dict, context: InputContext) -> CapturedFileInputs:
+        try:
+            out = captured_file_inputs({**raw, "modality": context.modality})
+        except CapturedFileError as exc:
+            raise FieldError(exc.field, exc.message) from None
+        for key in ("emotion", "vad"):
+            if key in out:
+                out[key] = tuple(out[key])
+        return cls(**out)
+
+
+def make_captured_file(entry, context: MakeContext) -> Motion:
+    try:
+        return captured_file_motion(entry.inputs, entry.modality, context.fps)
+    except CapturedFileError as exc:
+        raise ClipGenerationError(f"{entry.where}: {exc}") from None
+
+
+SPEC = register(GeneratorSpec(
+    name="captured_file", summary="an imported motion-capture file (Motion .npz or .bvh), any modality",
+    modality=None, origins=("source",), inputs=CapturedFileInputs, make=make_captured_file,
+    requires=("generation.mocap.importer",), captured=True))
