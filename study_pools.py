@@ -14,11 +14,11 @@ import math
 from typing import NamedTuple
 
 from study_protocol import (
+    CLIP_MODALITIES,
     CLIP_THEMES,
     FINAL_EMOTION_COLUMNS,
     GAIT_EMOTIONS,
     GESTURE_EMOTIONS,
-    MODALITIES,
     NATURALNESS,
     ORIGINS,
     SECTION_MODALITY,
@@ -29,7 +29,7 @@ from study_protocol import (
 )
 
 TEXT_FIELDS: dict[str, tuple[str, ...] | None] = {
-    "clip_id": None, "plan": None, "modality": MODALITIES, "origin": ORIGINS, "emotion_label": GESTURE_EMOTIONS,
+    "clip_id": None, "plan": None, "modality": CLIP_MODALITIES, "origin": ORIGINS, "emotion_label": GESTURE_EMOTIONS,
     "theme": CLIP_THEMES, "sections": SECTION_TYPES}
 """Catalogue text fields a pool may filter on -> the protocol vocabulary of their values (None: free text)."""
 

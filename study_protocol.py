@@ -94,8 +94,19 @@ GESTURE_TASKS = ("narration", "conversation")
 """Seed 003's speaking tasks: a gesture accompanies a narration or a conversation."""
 
 MODALITIES = ("gait", "gesture")
-ORIGINS = ("generated", "source")
-"""``origin`` of a clip: made by a generator, or the source motion a generator started from."""
+"""The two motion skeletons and the modality of generated and captured clips."""
+
+OTHER_MODALITY = "other"
+"""``modality`` of an imported video that is neither a walk nor a gesture (a face, a scene): shown only in sections
+that take either modality (``SECTION_MODALITY`` None, i.e. naturalness)."""
+
+CLIP_MODALITIES = (*MODALITIES, OTHER_MODALITY)
+"""Values the ``modality`` column of clips.csv may take."""
+
+IMPORTED = "imported"
+ORIGINS = ("generated", "source", IMPORTED)
+"""``origin`` of a clip: made by a generator, the source motion a generator started from, or a researcher's own
+stimulus brought in with ``manage.py import_clips`` (a video or motion file made elsewhere)."""
 
 # ---- sections and their answers ----------------------------------------------------------------------
 SECTION_TYPES = ("emotion_choice", "emotion_transition", "affect_likert", "naturalness", "gesture_emotion",
@@ -166,6 +177,10 @@ FINAL_EMOTION_COLUMNS = tuple(f"final_{e}" for e in GAIT_EMOTIONS)
 CLIP_COLUMNS = ("clip_id", "modality", "origin", *GAIT_EMOTIONS, *FINAL_EMOTION_COLUMNS, "emotion_label",
                 *VAD_DIMENSIONS, "theme", "weight", "n_features", "duration_s")
 """clips.csv, in order. Readers ignore extra columns after these."""
+
+CLIP_PROVENANCE_COLUMNS = ("title", "licence", "citation")
+"""Optional extra columns of clips.csv after the quality columns: a clip's title and the licence and citation of
+what it was made from (imported files, captured data)."""
 
 CLIP_FLOAT_COLUMNS = (*GAIT_EMOTIONS, *FINAL_EMOTION_COLUMNS, *VAD_DIMENSIONS, "weight", "duration_s")
 CLIP_INT_COLUMNS = ("n_features",)

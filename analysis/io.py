@@ -21,6 +21,7 @@ from study_protocol import (
     ATTENTION_CHECK,
     ATTENTION_COLUMNS,
     CLIP_COLUMNS,
+    CLIP_MODALITIES,
     CLIP_THEMES,
     FINAL_EMOTION_COLUMNS,
     GAIT_EMOTIONS,
@@ -28,7 +29,6 @@ from study_protocol import (
     GESTURE_EMOTIONS,
     INTEGER_RANGES,
     LABEL_CHOICES,
-    MODALITIES,
     MULTI_SELECT_KINDS,
     ORIGINS,
     PARTICIPANT_COLUMNS,
@@ -153,8 +153,8 @@ def read_clips(src) -> pd.DataFrame:
     col.add_mask(df, _blank(df["clip_id"]), "clip_id", "clip_id is empty")
     dup = df["clip_id"].duplicated(keep="first").to_numpy() & ~_blank(df["clip_id"])
     col.add_mask(df, dup, "clip_id", lambda v: f"duplicate clip_id {v!r}")
-    col.add_mask(df, ~df["modality"].isin(MODALITIES), "modality",
-                 lambda v: f"{v!r} is not one of {', '.join(MODALITIES)}")
+    col.add_mask(df, ~df["modality"].isin(CLIP_MODALITIES), "modality",
+                 lambda v: f"{v!r} is not one of {', '.join(CLIP_MODALITIES)}")
     col.add_mask(df, ~df["origin"].isin(ORIGINS), "origin",
                  lambda v: f"{v!r} is not one of {', '.join(ORIGINS)}")
 

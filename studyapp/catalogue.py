@@ -1,11 +1,12 @@
-"""The clip catalogue: import rendered clips (upsert by clip_id) and select clip pools by catalogue fields.
+"""The catalogue: import rendered clips (upsert by clip_id) and select clip pools by catalogue fields.
 
-`upsert_clips(records)` is the interface used by the renderer's `generate_clips` command. A record carries the
-DESIGN.md clips.csv fields plus `video` (MP4 path relative to MEDIA_ROOT), `webm` (or ""), `poster`, `plan`,
-`loop` (bool) and `metadata` (dict); optional `source_clip_id` (the clip_id of the source clip a generated clip was
-made from; also read from `pair` or metadata["source_clip_id"] / metadata["pair"]) and `sections` (the plan's
-section-type hints, a list or comma-separated; also read from metadata["sections"]); optional `qa` (the quality
-record, a dict: generation.quality) and `qa_flag` (failed checks joined by ';', also read from qa["flag"]).
+`upsert_clips(records)` is the interface used by the renderer's `generate_clips` command and by `import_clips`. A
+record carries the DESIGN.md clips.csv fields (``licence`` and ``citation`` too, else read from its metadata) plus
+`video` (MP4 path relative to MEDIA_ROOT), `webm` (or ""), `poster`, `plan`, `loop` (bool) and `metadata` (dict);
+optional `source_clip_id` (the clip_id of the source clip a generated clip was made from; also read from `pair` or
+metadata["source_clip_id"] / metadata["pair"]) and `sections` (the plan's section-type hints, a list or
+comma-separated; also read from metadata["sections"]); optional `qa` (the quality record, a dict: generation.quality)
+and `qa_flag` (failed checks joined by ';', also read from qa["flag"]).
 """
 from __future__ import annotations
 
@@ -18,9 +19,9 @@ from django.db.models import QuerySet
 from study_pools import INCLUDE_FLAGGED, PoolError, pool_lookups
 from study_protocol import (
     CLIP_FLOAT_COLUMNS,
+    CLIP_MODALITIES,
     CLIP_THEMES,
     GESTURE_EMOTIONS,
-    MODALITIES,
     ORIGINS,
     QA_ADVISORY_CHECKS,
     QA_CHECKS,
@@ -62,8 +63,9 @@ def clean_record(rec: dict, index: int = 0) -> dict:
     if not clip_id:
         raise CatalogueError(f"{where}: field 'clip_id' is required")
     modality = str(rec.get("modality") or "").strip()
-    if modality not in MODALITIES:
-        raise CatalogueError(f"{where}: field 'modality' must be one of {', '.join(MODALITIES)}, got {modality!r}")
+    if modality not in CLIP_MODALITIES:
+        raise CatalogueError(f"{where}: field 'modality' must be one of {', '.join(CLIP_MODALITIES)}, "
+                             f"got {modality!r}")
     origin = str(rec.get("origin") or "").strip()
     if origin not in ORIGINS:
         raise CatalogueError(f"{where}: field 'origin' must be one of {', '.join(ORIGINS)}, got {origin!r}")
@@ -107,6 +109,9 @@ def clean_record(rec: dict, index: int = 0) -> dict:
     if isinstance(sections, str):
         sections = [s for s in sections.split(",")]
     out["sections"] = ",".join(str(s).strip() for s in sections if str(s).strip())
+    for name in ("licence", "citation"):
+        value = rec.get(name, metadata.get(name))
+        out[name] = "" if _blank(value) else str(value).strip()
     out["qa"], out["qa_flag"] = _qa(rec, where)
     return out
 

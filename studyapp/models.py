@@ -13,7 +13,7 @@ from django.db import models
 from django.utils import timezone
 
 from study_pools import errors_by_field, validate_section
-from study_protocol import ATTENTION_CHECK, MODALITIES, ORIGINS
+from study_protocol import ATTENTION_CHECK, CLIP_MODALITIES, ORIGINS
 
 from .permissions import STUDY_PERMISSIONS
 from .questions import section_type_choices
@@ -46,7 +46,7 @@ class Clip(models.Model):
     """One pre-rendered stimulus; fields follow the `clips.csv` columns of DESIGN.md."""
 
     clip_id = models.CharField(max_length=200, unique=True)
-    modality = models.CharField(max_length=10, choices=[(m, m) for m in MODALITIES])
+    modality = models.CharField(max_length=10, choices=[(m, m) for m in CLIP_MODALITIES])
     origin = models.CharField(max_length=10, choices=[(o, o) for o in ORIGINS])
     happy = models.FloatField(null=True, blank=True)
     sad = models.FloatField(null=True, blank=True)
@@ -77,6 +77,10 @@ class Clip(models.Model):
     # Per-clip quality record: the qa_* values of clips.csv without the prefix, e.g.
     # {"foot_skate_cm_s": 0.4, "figure_height_frac": 0.62, "observed": "sad", "observed_p": 0.91}.
     qa = models.JSONField(default=dict, blank=True)
+    # What the clip was made from may only be used under its licence and with its citation (imported files,
+    # captured data): kept with the clip and written to clips.csv.
+    licence = models.CharField(max_length=300, blank=True)
+    citation = models.TextField(blank=True)
     qa_flag = models.CharField(max_length=300, blank=True, db_index=True,
                                help_text="failed quality checks joined by ';' (empty = passed)")
     retired = models.BooleanField(

@@ -36,7 +36,7 @@ from study_pools import (
     SUB_POOLS,
     validate_section,
 )
-from study_protocol import CLIP_THEMES, GESTURE_EMOTIONS, MODALITIES, NATURALNESS, ORIGINS, answer_values
+from study_protocol import CLIP_MODALITIES, CLIP_THEMES, GESTURE_EMOTIONS, NATURALNESS, ORIGINS, answer_values
 
 ANY = ""
 TRISTATE = [(ANY, "any"), ("yes", "yes"), ("no", "no")]
@@ -483,7 +483,7 @@ SUB_POOL_SECTION_TYPE = "naturalness"
 def _main_pool_specs() -> list[ChoiceSpec]:
     p = POOL_PREFIX
     return [
-        ChoiceSpec(p + "modality", "modality", MODALITIES, "Modality"),
+        ChoiceSpec(p + "modality", "modality", CLIP_MODALITIES, "Modality"),
         ChoiceSpec(p + "origin", "origin", ORIGINS, "Origin", "none ticked: any (naturalness mixes both halves)"),
         TextListSpec(p + "plan", "plan", "Plan", "the catalogue's plan name; several separated by commas; "
                                                   "blank: any plan"),

@@ -9,7 +9,7 @@ import yaml
 from django.core.management import CommandError, call_command
 
 from generation.plans.catalogue import CLIP_COLUMNS, check_catalogue, read_clips_csv
-from study_protocol import QA_COLUMNS
+from study_protocol import CLIP_PROVENANCE_COLUMNS, QA_COLUMNS
 
 TINY_RENDER = {"width": 160, "height": 120, "fps": 10, "duration_s": 1.0}
 CLIPS = [
@@ -64,7 +64,7 @@ def test_plan_renders_once_then_nothing(media, tmp_path):
     assert check_catalogue(csv_path, clips_dir) == []
     rows = read_clips_csv(csv_path)
     assert len(rows) == 4
-    assert csv_path.read_text().splitlines()[0] == ",".join((*CLIP_COLUMNS, *QA_COLUMNS))  # quality columns last
+    assert csv_path.read_text().splitlines()[0] == ",".join((*CLIP_COLUMNS, *QA_COLUMNS, *CLIP_PROVENANCE_COLUMNS))
     assert Clip.objects.count() == 4
     for row in rows:
         clip = Clip.objects.get(clip_id=row["clip_id"])

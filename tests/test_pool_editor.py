@@ -20,6 +20,7 @@ from studyapp.forms import SectionForm, SectionPreviewForm
 from studyapp.models import Clip, Section, Study
 from studyapp.presets import create_study_from_preset
 from studyapp.testing import admin_form_data, make_catalogue
+from studyapp.views_pool import HALVES
 
 COUNT_URL = "admin:studyapp_pool_count"
 
@@ -426,7 +427,7 @@ def test_count_updates_as_a_field_changes_in_chromium(chromium, live_server, set
     Select(added.find_element(By.NAME, "sections-2-section_type")).select_by_value("naturalness")
     assert added.find_element(By.CSS_SELECTOR, "fieldset.only-naturalness").is_displayed()
     added.find_element(By.NAME, "sections-2-pool_plan").send_keys("test")
-    halves = {o: Clip.objects.filter(plan="test", origin=o).count() for o in ORIGINS}
+    halves = {o: Clip.objects.filter(plan="test", origin=o).count() for o in HALVES}
     added_count = added.find_element(By.CSS_SELECTOR, ".pool-count")
     wait_for(driver, lambda d: f"({', '.join(f'{o} {n}' for o, n in halves.items())})" in added_count.text,
              what="the added section's count")

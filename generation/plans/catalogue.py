@@ -1,7 +1,8 @@
 """The clip catalogue file ``clips.csv`` (DESIGN.md "Interchange formats"): write, read, check against files.
 
-One row per clip, columns :data:`CLIP_COLUMNS` then the quality columns :data:`QA_COLUMNS` (files
-without them still read, their rows get blank quality cells); blank cells are missing values. ``clip_id`` is the
+One row per clip, columns :data:`CLIP_COLUMNS`, the quality columns :data:`QA_COLUMNS`, then the provenance
+columns :data:`CLIP_PROVENANCE_COLUMNS` (title, licence, citation; files without the extra columns still read, their
+rows get blank cells); blank cells are missing values. ``clip_id`` is the
 clip's content hash, which is also the stem of its files ``clips/<clip_id>.mp4|.webm|.png``.
 """
 from __future__ import annotations
@@ -17,13 +18,14 @@ from study_protocol import (
     CLIP_COLUMNS,
     CLIP_FLOAT_COLUMNS,
     CLIP_INT_COLUMNS,
-    MODALITIES,
+    CLIP_MODALITIES,
+    CLIP_PROVENANCE_COLUMNS,
     ORIGINS,
     QA_COLUMNS,
     QA_FLOAT_COLUMNS,
 )
 
-ALL_COLUMNS = (*CLIP_COLUMNS, *QA_COLUMNS)
+ALL_COLUMNS = (*CLIP_COLUMNS, *QA_COLUMNS, *CLIP_PROVENANCE_COLUMNS)
 
 
 class CatalogueFormatError(ValueError):
@@ -69,7 +71,7 @@ def read_clips_csv(path: str | Path) -> list[dict]:
                     row[col] = text
             if not row["clip_id"]:
                 raise CatalogueFormatError(f"{path}: line {line_no}: field 'clip_id' is empty")
-            for col, allowed in (("modality", MODALITIES), ("origin", ORIGINS)):
+            for col, allowed in (("modality", CLIP_MODALITIES), ("origin", ORIGINS)):
                 if row[col] not in allowed:
                     raise CatalogueFormatError(f"{path}: line {line_no}: field {col!r}: expected "
                                                f"{' or '.join(allowed)}, got {row[col]!r}")
@@ -81,7 +83,8 @@ def write_clips_csv(records: Iterable[dict], path: str | Path, merge: bool = Tru
     """Write clip records (dicts with at least the CLIP_COLUMNS keys) to ``path`` atomically.
 
     The quality columns come from a record's ``qa`` dict (:func:`generation.quality.qa_columns`) or, for rows
-    read back from the file, from their own qa_ keys.
+    read back from the file, from their own qa_ keys; title, licence and citation from the record's own keys, else
+    its ``metadata`` (captured data keeps its licence there).
 
     With ``merge``, rows already in the file whose clip_id is not among ``records`` are kept (the
     catalogue collects every plan rendered into this media folder); rows with the same clip_id are
@@ -94,7 +97,9 @@ def write_clips_csv(records: Iterable[dict], path: str | Path, merge: bool = Tru
             rows[row["clip_id"]] = row
     for rec in records:
         qa = qa_columns(rec["qa"]) if isinstance(rec.get("qa"), dict) else {c: rec.get(c) for c in QA_COLUMNS}
-        rows[str(rec["clip_id"])] = {**{c: rec.get(c) for c in CLIP_COLUMNS}, **qa}
+        meta = rec.get("metadata") if isinstance(rec.get("metadata"), dict) else {}
+        provenance = {c: rec.get(c) or meta.get(c) for c in CLIP_PROVENANCE_COLUMNS}
+        rows[str(rec["clip_id"])] = {**{c: rec.get(c) for c in CLIP_COLUMNS}, **qa, **provenance}
     path.parent.mkdir(parents=True, exist_ok=True)
     tmp = path.with_name(f".{path.name}.tmp{os.getpid()}")
     with tmp.open("w", newline="", encoding="utf-8") as f:
