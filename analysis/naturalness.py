@@ -1,8 +1,8 @@
 """Naturalness / plausibility ratings (seed 000 section 6.3.4, seed 003 section 6.3.2 and Fig. 8).
 
-Section ``naturalness``: each answer is a 1..5 rating of one clip; the clip's ``origin`` (generated | source) and
-``modality`` (gait | gesture) come from clips.csv. A rating >= 3 counts as "satisfactory" / "plausible", the
-criterion both papers use.
+Section ``naturalness``: each answer is a 1..5 rating of one clip; the clip's ``origin`` (generated | source |
+imported: a researcher's own stimulus) and ``modality`` (gait | gesture | other) come from clips.csv. A rating
+>= 3 counts as "satisfactory" / "plausible", the criterion both papers use.
 """
 
 from __future__ import annotations

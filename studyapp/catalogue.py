@@ -160,6 +160,16 @@ def retire_superseded(plan: str, current_clip_ids: set[str], entry_ids: set[str]
     return stale.update(retired=True)
 
 
+def retire_replaced(plan: str, entry_id: str, clip_id: str) -> list[str]:
+    """Retire the clips of ``plan`` made for the same entry (``metadata["entry_id"]``: an imported file's path in
+    its manifest) that ``clip_id`` replaces, e.g. after the file changed; returns their clip ids. Retired clips keep
+    their rows and files (earlier answers stay valid) and are left out of new assignments."""
+    stale = Clip.objects.filter(plan=plan, retired=False, metadata__entry_id=entry_id).exclude(clip_id=clip_id)
+    ids = sorted(stale.values_list("clip_id", flat=True))
+    Clip.objects.filter(clip_id__in=ids).update(retired=True)
+    return ids
+
+
 def pool_queryset(pool: dict | None, include_flagged: bool | None = None) -> QuerySet:
     """Clips (not retired) matching a section's pool filter (see study_pools for the filter language).
 

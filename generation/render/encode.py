@@ -19,7 +19,9 @@ def temp_path(final: Path) -> Path:
     return final.with_name(f".{final.stem}.tmp{os.getpid()}{final.suffix}")
 
 
-def _codec_params(kind: str, crf: int, preset: str, threads: int) -> tuple[str, list[str]]:
+def codec_params(kind: str, crf: int = 23, preset: str = "veryfast", threads: int = 0) -> tuple[str, list[str]]:
+    """(ffmpeg encoder, output options) of a delivery format, ``kind`` "mp4" (H.264) or "webm" (VP9): the settings
+    of every clip the platform serves, generated or imported."""
     thread_args = ["-threads", str(threads)] if threads else []
     if kind == "mp4":
         return "libx264", ["-preset", preset, "-crf", str(crf), "-movflags", "+faststart", *thread_args]
@@ -44,7 +46,7 @@ class VideoWriter:
         self.path = Path(path)
         self.kind = self.path.suffix.lstrip(".").lower()
         self.tmp = temp_path(self.path)
-        codec, params = _codec_params(self.kind, crf, preset, threads)
+        codec, params = codec_params(self.kind, crf, preset, threads)
         self.size = (width, height)
         self._gen = imageio_ffmpeg.write_frames(
             str(self.tmp), (width, height), fps=fps, codec=codec, pix_fmt_in="rgb24", pix_fmt_out="yuv420p",

@@ -1,0 +1,118 @@
+"""Import a researcher's own videos and motion files into the clip catalogue (origin ``imported``).
+
+    python manage.py import_clips MANIFEST.csv [--dry-run] [--report PATH] [--keep-audio] [--webm]
+                                  [--max-duration S] [--max-size-mb MB] [--name NAME]
+
+Thin wrapper over :mod:`generation.imports`: every manifest row is checked, its file probed (videos) or imported and
+rendered (BVH), and committed all-or-nothing with its Clip row; the report ``import_report.csv`` (row, path,
+status, clip_id, message) goes beside the manifest unless ``--report`` says elsewhere. ``--dry-run`` checks every
+row and writes nothing (the report is printed, and written only where ``--report`` names a file). The manifest
+format is in docs/study.md ("Bring your own stimuli").
+"""
+from __future__ import annotations
+
+import contextlib
+import os
+from pathlib import Path
+
+from django.conf import settings
+from django.core.management.base import BaseCommand, CommandError
+from django.db import transaction
+
+from generation.imports import ImportSettings, ManifestError, import_manifest, write_report
+from generation.imports.run import REPORT_NAME
+from generation.imports.video import VideoLimits
+from generation.render.settings import RenderSettings, RenderSettingsError
+from studyapp.catalogue import retire_replaced, upsert_clips
+
+from .generate_clips import _require_migrated_database
+
+PLAN_PREFIX = "import:"
+
+
+def plan_name(manifest: Path, name: str | None = None) -> str:
+    """The catalogue ``plan`` of a manifest's clips: ``import:<name>``, by default ``import:<folder>/<stem>``."""
+    name = name or f"{manifest.resolve().parent.name}/{manifest.stem}"
+    return (PLAN_PREFIX + name)[:100]
+
+
+@contextlib.contextmanager
+def catalogue_step(record: dict, notes: list):
+    """The Clip row of one imported clip, in one transaction with its files (generation.imports.run.commit_row);
+    the older clip of the same manifest path is retired when the file changed."""
+    with transaction.atomic():
+        upsert_clips([record])
+        retired = retire_replaced(record["plan"], record["metadata"]["entry_id"], record["clip_id"])
+        if retired:
+            notes.append(f"the file changed: retired {', '.join(retired)} (kept for earlier answers)")
+        yield
+
+
+def _render_size(text: str | None) -> dict:
+    if not text:
+        return {}
+    try:
+        w, h = (int(v) for v in text.lower().split("x"))
+    except ValueError:
+        raise CommandError(f"--render-size: expected WIDTHxHEIGHT, e.g. 1280x720, got {text!r}") from None
+    return {"width": w, "height": h}
+
+
+class Command(BaseCommand):
+    help = "Import videos and motion files named in a manifest CSV as clips with origin 'imported'."
+
+    def add_arguments(self, parser):
+        parser.add_argument("manifest", help="the manifest CSV (paths in it are relative to its folder)")
+        parser.add_argument("--dry-run", action="store_true", help="check every row, write nothing")
+        parser.add_argument("--report", default=None, help=f"where the report goes (default: {REPORT_NAME} beside "
+                                                           "the manifest)")
+        parser.add_argument("--keep-audio", action="store_true",
+                            help="keep videos' sound (default: stripped; the manifest's keep_audio column wins)")
+        parser.add_argument("--webm", action="store_true", help="also deliver VP9 WebM files")
+        parser.add_argument("--max-duration", type=float, default=VideoLimits.max_duration_s, metavar="S",
+                            help=f"longest file accepted, seconds (default {VideoLimits.max_duration_s:g})")
+        parser.add_argument("--max-size-mb", type=float, default=VideoLimits.max_bytes / 2**20, metavar="MB",
+                            help=f"largest file accepted, MiB (default {VideoLimits.max_bytes / 2**20:g})")
+        parser.add_argument("--name", default=None,
+                            help="catalogue plan name of these clips (default: import:<folder>/<manifest stem>)")
+        parser.add_argument("--render-size", default=None, metavar="WxH",
+                            help="frame size of rendered motion files (default 1280x720, as generated clips)")
+        parser.add_argument("--no-observer", action="store_true",
+                            help="no observer reading in the quality record of motion files")
+        parser.add_argument("--threads", type=int, default=0, help="ffmpeg threads per encode (0: ffmpeg decides)")
+
+    def handle(self, *args, **opts):
+        manifest = Path(opts["manifest"])
+        if not manifest.is_file():
+            raise CommandError(f"{manifest}: no such manifest")
+        if opts["max_duration"] <= 0 or opts["max_size_mb"] <= 0:
+            raise CommandError("--max-duration and --max-size-mb must be positive")
+        try:
+            render = RenderSettings.from_dict(_render_size(opts["render_size"]))
+        except RenderSettingsError as exc:
+            raise CommandError(f"--render-size: {exc}") from None
+        if not opts["dry_run"]:
+            _require_migrated_database()
+        os.environ.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow")
+        config = ImportSettings(limits=VideoLimits(opts["max_duration"], int(opts["max_size_mb"] * 2**20)),
+                                keep_audio=opts["keep_audio"], webm=opts["webm"], render=render,
+                                observer=not opts["no_observer"], threads=opts["threads"],
+                                plan=plan_name(manifest, opts["name"]))
+
+        def show(out):
+            self.stdout.write(f"row {out.row} {out.status:5s} {out.clip_id or '-':16s} {out.path}: {out.message}")
+
+        try:
+            outcomes = import_manifest(manifest, Path(settings.MEDIA_ROOT), config, catalogue_step,
+                                       dry_run=opts["dry_run"], on_row=show)
+        except ManifestError as exc:
+            raise CommandError(str(exc)) from None
+        report = Path(opts["report"]) if opts["report"] else manifest.parent / REPORT_NAME
+        if not opts["dry_run"] or opts["report"]:
+            write_report(outcomes, report)
+        ok = sum(o.status == "ok" for o in outcomes)
+        self.stdout.write(f"{ok} of {len(outcomes)} row(s) imported{' (dry run: nothing written)' * opts['dry_run']}"
+                          f"; plan {config.plan}" + ("" if opts["dry_run"] and not opts["report"]
+                                                     else f"; report {report}"))
+        if ok < len(outcomes):
+            raise CommandError(f"{len(outcomes) - ok} row(s) failed (see the report); the others are imported")

@@ -1,0 +1,293 @@
+"""The import_clips command: researchers' own videos and BVH files become clips with origin ``imported``.
+
+The videos are synthetic test patterns made here with the bundled ffmpeg (testsrc2 / sine sources); the BVH is the
+shipped Bandai Namco take (CC BY-NC 4.0, generation/data/mocap/bandai-namco).
+"""
+from __future__ import annotations
+
+import csv
+import io
+import os
+import subprocess
+from pathlib import Path
+
+import imageio_ffmpeg
+import pandas as pd
+import pytest
+from django.core.management import CommandError, call_command
+
+from generation.imports import read_manifest
+from generation.imports.manifest import MANIFEST_COLUMNS
+from generation.imports.run import REPORT_COLUMNS
+from generation.plans.catalogue import read_clips_csv
+
+REPO = Path(__file__).resolve().parents[1]
+BVH = (REPO / "generation/data/mocap/bandai-namco/Bandai-Namco-Research-Motiondataset-1/data"
+       / "dataset-1_walk_happy_001.bvh")
+BANDAI_LICENCE = "CC BY-NC 4.0"
+BANDAI_CITATION = ("M. Kobayashi et al. Motion Capture Dataset for Practical Use of AI-based Motion Editing and "
+                   "Stylization. arXiv:2306.08861, 2023")
+
+
+def make_video(path: Path, codec: str = "libx264", seconds: float = 1.0, size: str = "64x48", audio: bool = False,
+               pattern: str = "testsrc2") -> Path:
+    """A synthetic test video (ffmpeg's test pattern, optionally a 440 Hz tone)."""
+    path.parent.mkdir(parents=True, exist_ok=True)
+    cmd = [imageio_ffmpeg.get_ffmpeg_exe(), "-hide_banner", "-v", "error", "-y", "-f", "lavfi", "-i",
+           f"{pattern}=size={size}:rate=15:duration={seconds}"]
+    if audio:
+        cmd += ["-f", "lavfi", "-i", f"sine=frequency=440:duration={seconds}", "-c:a", "aac", "-shortest"]
+    cmd += ["-c:v", codec, *(["-pix_fmt", "yuv420p"] if codec == "libx264" else ["-deadline", "realtime"]),
+            str(path)]
+    subprocess.run(cmd, check=True)
+    return path
+
+
+def write_manifest(folder: Path, rows: list[dict], name: str = "manifest.csv") -> Path:
+    path = folder / name
+    with path.open("w", newline="") as f:
+        w = csv.DictWriter(f, fieldnames=MANIFEST_COLUMNS)
+        w.writeheader()
+        for row in rows:
+            w.writerow(row)
+    return path
+
+
+def read_report(path: Path) -> list[dict]:
+    with path.open(newline="") as f:
+        rows = list(csv.DictReader(f))
+    assert rows and tuple(rows[0]) == REPORT_COLUMNS
+    return rows
+
+
+def run(manifest: Path, *args, fail: bool = False) -> str:
+    out = io.StringIO()
+    if fail:
+        with pytest.raises(CommandError, match="row\\(s\\) failed"):
+            call_command("import_clips", str(manifest), "--no-observer", *args, stdout=out)
+    else:
+        call_command("import_clips", str(manifest), "--no-observer", *args, stdout=out)
+    return out.getvalue()
+
+
+@pytest.fixture
+def media(settings, tmp_path):
+    settings.MEDIA_ROOT = tmp_path / "media"
+    settings.DATA_DIR = tmp_path / "data"
+    return tmp_path / "media"
+
+
+@pytest.fixture
+def lab(tmp_path):
+    """A lab's folder: an H.264 MP4 with sound, a VP9 WebM (needs transcoding) and the Bandai Namco BVH."""
+    folder = tmp_path / "lab"
+    make_video(folder / "videos/walk.mp4", audio=True)
+    make_video(folder / "videos/face.webm", codec="libvpx-vp9", pattern="testsrc")
+    (folder / "mocap").mkdir()
+    (folder / "mocap/walk_happy.bvh").write_bytes(BVH.read_bytes())
+    return folder
+
+
+GOOD = [
+    {"path": "videos/walk.mp4", "modality": "gait", "origin": "imported", "happy": "0.6", "sad": "0", "angry": "0",
+     "neutral": "0.2", "title": "lab walk", "licence": "CC0", "citation": "Our lab 2026"},
+    {"path": "videos/face.webm", "modality": "other", "valence": "0.8", "arousal": "0.3", "dominance": "0.5",
+     "title": "face", "licence": "CC BY 4.0", "keep_audio": "no"},
+    {"path": "mocap/walk_happy.bvh", "modality": "gait", "happy": "1", "sad": "0", "angry": "0", "neutral": "0",
+     "licence": BANDAI_LICENCE, "citation": BANDAI_CITATION, "body": "stick"},
+]
+TINY = ("--render-size", "96x64")
+
+
+def _files(media: Path) -> set[str]:
+    return {str(p.relative_to(media)) for p in media.rglob("*") if p.is_file()} if media.exists() else set()
+
+
+@pytest.mark.django_db
+def test_good_rows_become_first_class_clips(media, lab):
+    from studyapp.catalogue import pool_queryset
+    from studyapp.models import Clip
+
+    out = run(write_manifest(lab, GOOD), *TINY)
+    assert "3 of 3 row(s) imported" in out
+    report = read_report(lab / "import_report.csv")
+    assert [r["status"] for r in report] == ["ok"] * 3, report
+    assert "remux h264" in report[0]["message"] and "audio stripped" in report[0]["message"]
+    assert "transcode vp9" in report[1]["message"]
+    ids = [r["clip_id"] for r in report]
+    assert all(len(i) == 16 for i in ids) and len(set(ids)) == 3
+    clips = {c.clip_id: c for c in Clip.objects.all()}
+    assert set(clips) == set(ids) and {c.origin for c in clips.values()} == {"imported"}
+    walk, face, bvh = (clips[i] for i in ids)
+    assert (walk.happy, walk.neutral, walk.licence, walk.citation) == (0.75, 0.25, "CC0", "Our lab 2026")
+    assert face.modality == "other" and face.valence == 0.8 and face.duration_s == pytest.approx(1.0, abs=0.1)
+    assert bvh.licence == BANDAI_LICENCE and bvh.citation == BANDAI_CITATION and bvh.qa.get("foot_skate_cm_s")
+    assert bvh.metadata["import"]["status"] == "ok" and bvh.metadata["render"]["body"] == "stick"
+    for cid in ids:
+        assert (media / "clips" / f"{cid}.mp4").stat().st_size > 0 and (media / "clips" / f"{cid}.png").is_file()
+        assert (media / "clip_records" / f"{cid}.json").is_file()
+    assert (media / "motions" / f"{ids[2]}.bvh").is_file()
+    # the delivered files: H.264 yuv420p MP4, no sound unless asked
+    from generation.imports.probe import probe_video
+
+    for cid in ids:
+        p = probe_video(media / "clips" / f"{cid}.mp4")
+        assert (p.video_codec, p.pix_fmt, p.has_audio) == ("h264", "yuv420p", False)
+    rows = {r["clip_id"]: r for r in read_clips_csv(media / "clips.csv")}
+    assert rows[ids[2]]["origin"] == "imported" and rows[ids[2]]["licence"] == BANDAI_LICENCE
+    assert not [p for p in _files(media) if "/." in p or p.startswith(".")]     # no staging or temporary files
+    # in pools: by origin, and by modality for the sections that take either modality
+    assert set(pool_queryset({"origin": "imported"}).values_list("clip_id", flat=True)) == set(ids)
+    assert list(pool_queryset({"modality": "other"}).values_list("clip_id", flat=True)) == [ids[1]]
+
+
+@pytest.mark.django_db
+def test_keep_audio(media, lab):
+    from generation.imports.probe import probe_video
+
+    run(write_manifest(lab, [{**GOOD[0], "keep_audio": "yes"}]))
+    cid = read_report(lab / "import_report.csv")[0]["clip_id"]
+    p = probe_video(media / "clips" / f"{cid}.mp4")
+    assert p.has_audio and p.audio_codec == "aac"
+
+
+def _bad_folder(tmp_path: Path) -> tuple[Path, list[dict]]:
+    folder = tmp_path / "lab"
+    make_video(folder / "ok.mp4")
+    (folder / "broken.mp4").write_bytes(os.urandom(4096))             # not a video at all
+    (folder / "empty.mp4").write_bytes(b"")                           # zero-length
+    make_video(tmp_path / "outside.mp4")
+    (folder / "link.mp4").symlink_to(tmp_path / "outside.mp4")        # a symlink out of the folder
+    rows = [
+        {"path": "broken.mp4", "modality": "gait"},
+        {"path": "empty.mp4", "modality": "gait"},
+        {"path": "../outside.mp4", "modality": "gait"},
+        {"path": str(tmp_path / "outside.mp4"), "modality": "gait"},
+        {"path": "link.mp4", "modality": "gait"},
+        {"path": "ok.mp4", "modality": "dance"},
+        {"path": "ok.mp4", "modality": "gesture", "valence": "1.5"},
+        {"path": "ok.mp4", "modality": "gait", "happy": "-1", "sad": "0", "angry": "0", "neutral": "0"},
+        {"path": "ok.mp4", "modality": "gesture", "emotion_label": "bored"},
+    ]
+    return folder, rows
+
+
+@pytest.mark.django_db
+def test_every_bad_row_is_an_error_and_leaves_nothing(media, tmp_path):
+    from studyapp.models import Clip
+
+    folder, rows = _bad_folder(tmp_path)
+    run(write_manifest(folder, rows), fail=True)
+    report = read_report(folder / "import_report.csv")
+    assert [r["status"] for r in report] == ["error"] * len(rows) and all(not r["clip_id"] for r in report)
+    msg = [r["message"] for r in report]
+    assert "cannot be decoded" in msg[0] and "Invalid data" in msg[0]
+    assert "empty file (0 bytes)" in msg[1]
+    assert "field 'path'" in msg[2] and "leaves the manifest's folder" in msg[2]
+    assert "absolute path" in msg[3]
+    assert "leads outside the manifest's folder" in msg[4]
+    assert "field 'modality'" in msg[5] and "'dance'" in msg[5]
+    assert "field 'valence'" in msg[6] and "0..1" in msg[6]
+    assert "field 'happy'" in msg[7] and "0..1" in msg[7]
+    assert "field 'emotion_label'" in msg[8] and "'bored'" in msg[8]
+    assert all("row " in m for m in msg[2:])             # manifest errors name the row
+    assert Clip.objects.count() == 0
+    assert _files(media) == set()                          # no media, no record, no poster, no clips.csv
+
+
+@pytest.mark.django_db
+def test_a_too_long_or_too_large_video_is_an_error(media, tmp_path):
+    folder = tmp_path / "lab"
+    make_video(folder / "long.mp4", seconds=3.0)
+    manifest = write_manifest(folder, [{"path": "long.mp4", "modality": "other"}])
+    run(manifest, "--max-duration", "2", fail=True)
+    assert "longer than the limit of 2 s" in read_report(folder / "import_report.csv")[0]["message"]
+    run(manifest, "--max-size-mb", "0.001", fail=True)
+    assert "larger than the limit" in read_report(folder / "import_report.csv")[0]["message"]
+    assert _files(media) == set()
+
+
+@pytest.mark.django_db
+def test_reimport_is_idempotent(media, lab):
+    from studyapp.models import Clip
+
+    manifest = write_manifest(lab, GOOD[:2])
+    run(manifest)
+    first = read_report(lab / "import_report.csv")
+    mtimes = {p: (media / p).stat().st_mtime_ns for p in _files(media) if p != "clips.csv"}
+    keys = dict(Clip.objects.values_list("clip_id", "media_key"))
+    run(manifest)
+    second = read_report(lab / "import_report.csv")
+    assert [r["clip_id"] for r in second] == [r["clip_id"] for r in first]
+    assert all("already imported" in r["message"] for r in second)
+    assert {p: (media / p).stat().st_mtime_ns for p in _files(media) if p != "clips.csv"} == mtimes
+    assert dict(Clip.objects.values_list("clip_id", "media_key")) == keys and Clip.objects.count() == 2
+    assert len(read_clips_csv(media / "clips.csv")) == 2
+
+
+@pytest.mark.django_db
+def test_a_changed_file_is_a_new_clip_and_retires_the_old_one(media, lab):
+    from studyapp.models import Clip
+
+    manifest = write_manifest(lab, GOOD[:1])
+    run(manifest)
+    old = read_report(lab / "import_report.csv")[0]["clip_id"]
+    make_video(lab / "videos/walk.mp4", pattern="testsrc", audio=True)          # the lab re-exported its video
+    run(manifest)
+    row = read_report(lab / "import_report.csv")[0]
+    new = row["clip_id"]
+    assert new != old and f"retired {old}" in row["message"]
+    assert Clip.objects.get(clip_id=old).retired and not Clip.objects.get(clip_id=new).retired
+    assert (media / "clips" / f"{old}.mp4").is_file()                            # retired, never deleted
+    assert {r["clip_id"] for r in read_clips_csv(media / "clips.csv")} == {old, new}
+
+
+@pytest.mark.django_db
+def test_dry_run_writes_nothing(media, lab):
+    from studyapp.models import Clip
+
+    out = run(write_manifest(lab, GOOD), "--dry-run", *TINY)
+    assert "3 of 3 row(s) imported (dry run: nothing written)" in out and "would transcode vp9" in out
+    assert Clip.objects.count() == 0 and _files(media) == set() and not (lab / "import_report.csv").exists()
+
+
+@pytest.mark.django_db
+def test_a_failing_catalogue_step_undoes_the_row(media, lab, monkeypatch):
+    from studyapp import catalogue
+    from studyapp.models import Clip
+
+    run(write_manifest(lab, GOOD[1:2]))
+    before = _files(media)
+    csv_before = (media / "clips.csv").read_bytes()
+
+    def broken(records):
+        raise RuntimeError("database went away")
+
+    monkeypatch.setattr("studyapp.management.commands.import_clips.upsert_clips", broken)
+    run(write_manifest(lab, GOOD[:1]), fail=True)
+    assert "database went away" in read_report(lab / "import_report.csv")[0]["message"]
+    assert _files(media) == before and (media / "clips.csv").read_bytes() == csv_before
+    assert Clip.objects.count() == 1 and catalogue.Clip is Clip
+
+
+def test_manifest_refuses_unknown_columns(tmp_path):
+    from generation.imports import ManifestError
+
+    (tmp_path / "m.csv").write_text("path,modality,hapy\na.mp4,gait,1\n")
+    with pytest.raises(ManifestError, match="'hapy': not a manifest column"):
+        read_manifest(tmp_path / "m.csv")
+
+
+@pytest.mark.django_db
+def test_imported_clips_in_the_naturalness_analysis(media, lab):
+    from analysis.io import read_clips
+    from analysis.naturalness import naturalness
+
+    run(write_manifest(lab, GOOD[:2]))
+    clips = read_clips(media / "clips.csv")
+    gait, other = (clips.index[clips["modality"] == m][0] for m in ("gait", "other"))
+    responses = pd.DataFrame({"participant_id": ["p1", "p1", "p2"], "section_type": ["naturalness"] * 3,
+                              "clip_id": [gait, other, gait], "value": [4, 2, 5]})
+    table = naturalness(responses, clips)
+    assert set(table["origin"]) == {"imported"} and set(table["modality"]) == {"gait", "other"}
+    assert table.set_index("modality").loc["gait", "n"] == 2
