@@ -7,15 +7,18 @@ from __future__ import annotations
 import json
 
 from django.contrib import admin, messages
+from django.core.exceptions import PermissionDenied
 from django.db import models
 from django.forms import Textarea
+from django.http import Http404, HttpResponseRedirect
+from django.template.response import TemplateResponse
 from django.urls import path, reverse
 from django.utils.html import format_html, format_html_join
 
 from study_pools import SUB_POOLS
 
-from . import admin_clip_qa, pool_editor, views_pool, views_staff
-from .forms import SectionForm, StudyAdminForm
+from . import admin_clip_qa, clip_import, pool_editor, views_pool, views_staff
+from .forms import ClipImportForm, SectionForm, StudyAdminForm
 from .models import Assignment, Clip, Participant, Response, Section, Study
 from .questions import section_type_choices
 from .views_pool import count_pool
@@ -172,9 +175,47 @@ class ClipAdmin(admin.ModelAdmin):
     list_display = ["thumbnail", "clip_id", "modality", "origin", "emotion_label", "theme", "weight", "n_features",
                     "duration_s", "plan", admin_clip_qa.quality_flag, admin_clip_qa.observer_reading]
     list_filter = ["retired", admin_clip_qa.QualityFlagFilter, "modality", "origin", "plan", "theme", "emotion_label"]
-    search_fields = ["clip_id", "plan"]
+    search_fields = ["clip_id", "plan", "licence", "citation"]
     readonly_fields = ["preview", "media_key", "created_at", "updated_at"]
     actions = ["download_contact_sheet"]
+    change_list_template = "admin/studyapp/clip/change_list.html"
+
+    def get_urls(self):
+        custom = [path("import/", self.admin_site.admin_view(self.import_view), name="studyapp_clip_import"),
+                  path("import/<str:job>/", self.admin_site.admin_view(self.import_status_view),
+                       name="studyapp_clip_import_status")]
+        return custom + super().get_urls()
+
+    def import_view(self, request):
+        """Upload a manifest and its files (or a zip); the import runs as ``manage.py import_clips`` outside the
+        request and the status page shows its report."""
+        if not self.has_add_permission(request):
+            raise PermissionDenied
+        form = ClipImportForm(request.POST or None, request.FILES or None)
+        if request.method == "POST" and form.is_valid():
+            data = form.cleaned_data
+            try:
+                job, manifest = clip_import.save_upload(data["manifest"], data["files"], data["archive"])
+            except clip_import.UploadError as exc:
+                form.add_error(None, str(exc))
+            else:
+                clip_import.start_import(manifest, job, f"upload/{data['name']}" if data["name"] else "",
+                                         data["keep_audio"], data["dry_run"])
+                return HttpResponseRedirect(reverse("admin:studyapp_clip_import_status", args=[job]))
+        context = {**self.admin_site.each_context(request), "opts": self.model._meta, "form": form,
+                   "title": "Import clips"}
+        return TemplateResponse(request, "admin/studyapp/clip/import.html", context)
+
+    def import_status_view(self, request, job):
+        if not self.has_add_permission(request):
+            raise PermissionDenied
+        try:
+            state = clip_import.import_state(job)
+        except clip_import.UploadError:
+            raise Http404("no such import") from None
+        context = {**self.admin_site.each_context(request), "opts": self.model._meta, "state": state,
+                   "title": f"Clip import {job}", "ok": sum(r.get("status") == "ok" for r in state.rows)}
+        return TemplateResponse(request, "admin/studyapp/clip/import_status.html", context)
 
     @admin.display(description="poster")
     def thumbnail(self, clip):

@@ -163,3 +163,46 @@ class StudyAdminForm(forms.ModelForm):
         if errors:
             raise forms.ValidationError(errors)
         return rules
+
+
+class MultipleFileInput(forms.ClearableFileInput):
+    allow_multiple_selected = True
+
+
+class MultipleFileField(forms.FileField):
+    """Several uploaded files in one field (a list, possibly empty)."""
+
+    def __init__(self, *args, **kwargs):
+        kwargs.setdefault("widget", MultipleFileInput())
+        super().__init__(*args, **kwargs)
+
+    def clean(self, data, initial=None):
+        if isinstance(data, (list, tuple)):
+            return [super(MultipleFileField, self).clean(d, initial) for d in data if d]
+        return [super().clean(data, initial)] if data else []
+
+
+class ClipImportForm(forms.Form):
+    """The admin's clip import: a manifest CSV and its files, or a zip holding both (docs/study.md, "Bring your own
+    stimuli")."""
+
+    manifest = forms.FileField(required=False, help_text="The manifest CSV; it names each file by its file name.")
+    files = MultipleFileField(required=False, help_text="The videos (.mp4 .mov .webm ...) and motion files (.bvh).")
+    archive = forms.FileField(required=False, label="or a zip",
+                              help_text="A zip of the manifest (manifest.csv, or the only .csv) and its files; the "
+                                        "manifest's paths are relative to the zip's top.")
+    name = forms.CharField(required=False, max_length=80,
+                           help_text="Catalogue plan of these clips: import:upload/<name> (default: the manifest's "
+                                     "name). A changed file retires the older clip of the same plan and path.")
+    keep_audio = forms.BooleanField(required=False, help_text="Keep the videos' sound (default: stripped).")
+    dry_run = forms.BooleanField(required=False, help_text="Only check every row; import nothing.")
+
+    def clean(self):
+        data = super().clean()
+        if not data.get("manifest") and not data.get("archive"):
+            raise forms.ValidationError("Upload a manifest with its files, or a zip of them.")
+        if data.get("manifest") and not data["manifest"].name.lower().endswith(".csv"):
+            self.add_error("manifest", "The manifest must be a .csv file.")
+        if data.get("name") and not all(c.isalnum() or c in "-_." for c in data["name"]):
+            self.add_error("name", "Letters, digits, '-', '_' and '.' only.")
+        return data

@@ -5,6 +5,7 @@ shipped Bandai Namco take (CC BY-NC 4.0, generation/data/mocap/bandai-namco).
 """
 from __future__ import annotations
 
+import contextlib
 import csv
 import io
 import os
@@ -291,3 +292,99 @@ def test_imported_clips_in_the_naturalness_analysis(media, lab):
     table = naturalness(responses, clips)
     assert set(table["origin"]) == {"imported"} and set(table["modality"]) == {"gait", "other"}
     assert table.set_index("modality").loc["gait", "n"] == 2
+
+
+# ---- the admin upload ------------------------------------------------------------------------------------
+@pytest.fixture
+def staff(db):
+    from django.contrib.auth.models import User
+    from django.test import Client
+
+    user = User.objects.create_superuser("importer", "i@example.org", "pw")
+    client = Client()
+    client.force_login(user)
+    return client
+
+
+@pytest.fixture
+def inline_jobs(monkeypatch):
+    """Run the import job in this process (the admin starts it detached; the test waits for nothing)."""
+    from studyapp import clip_import
+
+    def launch(cmd, job):
+        assert cmd[2] == "import_clips" and cmd[1].endswith("manage.py")
+        out = io.StringIO()
+        with contextlib.suppress(CommandError):
+            call_command(*cmd[2:], "--no-observer", "--render-size", "96x64", stdout=out)
+        (clip_import.job_dir(job) / clip_import.LOG_NAME).write_text(out.getvalue())
+
+    monkeypatch.setattr(clip_import, "launch", launch)
+
+
+def _upload(path: Path, name: str | None = None):
+    from django.core.files.uploadedfile import SimpleUploadedFile
+
+    return SimpleUploadedFile(name or path.name, path.read_bytes())
+
+
+@pytest.mark.django_db
+def test_admin_upload_of_a_manifest_and_its_files(media, lab, staff, inline_jobs):
+    from django.urls import reverse
+
+    from studyapp.models import Clip
+
+    changelist = staff.get(reverse("admin:studyapp_clip_changelist")).content.decode()
+    assert reverse("admin:studyapp_clip_import") in changelist
+    rows = [{**GOOD[0], "path": "walk.mp4"}, {**GOOD[1], "path": "face.webm"}, {"path": "missing.mp4",
+                                                                                "modality": "gait"}]
+    manifest = write_manifest(lab, rows, "lab_stimuli.csv")
+    resp = staff.post(reverse("admin:studyapp_clip_import"), {
+        "manifest": _upload(manifest), "files": [_upload(lab / "videos/walk.mp4"), _upload(lab / "videos/face.webm")],
+        "name": "spring"})
+    assert resp.status_code == 302, resp.content.decode()[:2000]
+    page = staff.get(resp["Location"]).content.decode()
+    assert "Status: <strong>done</strong>" in page and "2 of 3 row(s) imported" in page
+    assert "no such file &#x27;missing.mp4&#x27;" in page
+    clips = Clip.objects.filter(origin="imported")
+    assert clips.count() == 2 and {c.plan for c in clips} == {"import:upload/spring"}
+    assert {c.licence for c in clips} == {"CC0", "CC BY 4.0"}
+
+
+@pytest.mark.django_db
+def test_admin_upload_of_a_zip(media, lab, staff, inline_jobs, tmp_path):
+    import zipfile
+
+    from django.urls import reverse
+
+    from studyapp.models import Clip
+
+    manifest = write_manifest(lab, GOOD)
+    archive = tmp_path / "stimuli.zip"
+    with zipfile.ZipFile(archive, "w") as zf:
+        zf.write(manifest, "manifest.csv")
+        for rel in ("videos/walk.mp4", "videos/face.webm", "mocap/walk_happy.bvh"):
+            zf.write(lab / rel, rel)
+    resp = staff.post(reverse("admin:studyapp_clip_import"), {"archive": _upload(archive)})
+    assert resp.status_code == 302
+    page = staff.get(resp["Location"]).content.decode()
+    assert "3 of 3 row(s) imported" in page and Clip.objects.filter(origin="imported").count() == 3
+
+    evil = tmp_path / "evil.zip"
+    with zipfile.ZipFile(evil, "w") as zf:
+        zf.write(manifest, "manifest.csv")
+        zf.writestr("../escape.mp4", b"x")
+    resp = staff.post(reverse("admin:studyapp_clip_import"), {"archive": _upload(evil)})
+    assert resp.status_code == 200 and "must stay inside the upload" in resp.content.decode()
+    assert not (media.parent / "data" / "escape.mp4").exists()
+
+
+@pytest.mark.django_db
+def test_admin_import_needs_the_add_clip_permission(db):
+    from django.contrib.auth.models import User
+    from django.test import Client
+    from django.urls import reverse
+
+    user = User.objects.create_user("viewer", password="pw", is_staff=True)
+    client = Client()
+    client.force_login(user)
+    assert client.get(reverse("admin:studyapp_clip_import")).status_code == 403

@@ -1,0 +1,190 @@
+"""Clip imports from the admin: an uploaded manifest and its files (or a zip of them) saved into a job folder, then
+``manage.py import_clips`` run on it as a detached process (probing, transcoding and rendering never run in a
+request), and the job's state read back for the status page.
+
+    IMPORTS_DIR/<job>/files/...            the uploaded manifest and files (a zip unpacked here)
+                      import_report.csv    the command's report (appears when it is done)
+                      import.log           its output
+                      import.pid           the process id while it is started
+
+``IMPORTS_DIR`` is ``DATA_DIR/imports`` (never served). Zip members and file names that could leave the job
+folder (absolute, ``..``, links) are refused before anything is written; the manifest's own paths are checked
+again by the import (generation.imports.manifest).
+"""
+from __future__ import annotations
+
+import csv
+import os
+import secrets
+import shutil
+import stat
+import subprocess
+import sys
+import threading
+import zipfile
+from dataclasses import dataclass
+from datetime import UTC, datetime
+from pathlib import Path, PurePosixPath
+
+from django.conf import settings
+
+from generation.imports.run import REPORT_NAME
+
+LOG_NAME = "import.log"
+PID_NAME = "import.pid"
+MAX_ZIP_BYTES = 4 * 1024**3
+"""Largest total unpacked size of an uploaded zip."""
+
+
+class UploadError(ValueError):
+    """An upload that cannot be imported (no manifest, a name that leaves the folder, a bad zip); says which."""
+
+
+def imports_dir() -> Path:
+    return Path(settings.DATA_DIR) / "imports"
+
+
+def job_dir(job: str) -> Path:
+    """The folder of an import job; UploadError for a name that is not one of ours."""
+    if not job or not all(c.isalnum() or c == "-" for c in job):
+        raise UploadError(f"no such import {job!r}")
+    return imports_dir() / job
+
+
+def _safe_name(name: str) -> PurePosixPath:
+    pure = PurePosixPath(name.replace("\\", "/"))
+    if not name or pure.is_absolute() or ".." in pure.parts or (len(name) > 1 and name[1] == ":"):
+        raise UploadError(f"{name!r}: a file name must stay inside the upload (no absolute path, no '..')")
+    if any(part.startswith(".") for part in pure.parts):
+        raise UploadError(f"{name!r}: hidden names are not imported")
+    return pure
+
+
+def unpack_zip(archive, dest: Path) -> list[Path]:
+    """Unpack an uploaded zip into ``dest``: every member checked first (relative names, no links, the total size
+    at most MAX_ZIP_BYTES), then written. Returns the files written."""
+    try:
+        zf = zipfile.ZipFile(archive)
+    except zipfile.BadZipFile as exc:
+        raise UploadError(f"the archive is not a zip file ({exc})") from None
+    with zf:
+        members = [m for m in zf.infolist() if not m.is_dir()]
+        total = 0
+        for m in members:
+            _safe_name(m.filename)
+            if stat.S_ISLNK(m.external_attr >> 16):
+                raise UploadError(f"{m.filename!r}: links are not imported")
+            total += m.file_size
+        if total > MAX_ZIP_BYTES:
+            raise UploadError(f"the archive unpacks to {total / 2**30:.1f} GiB, more than "
+                              f"{MAX_ZIP_BYTES / 2**30:.0f} GiB")
+        out = []
+        for m in members:
+            target = dest / Path(*_safe_name(m.filename).parts)
+            target.parent.mkdir(parents=True, exist_ok=True)
+            with zf.open(m) as src, target.open("wb") as dst:
+                shutil.copyfileobj(src, dst, 1 << 20)
+            out.append(target)
+    return out
+
+
+def find_manifest(files: list[Path], root: Path) -> Path:
+    """The manifest among unpacked files: the only .csv, else ``manifest.csv`` nearest the top."""
+    csvs = sorted((f for f in files if f.suffix.lower() == ".csv" and f.name != REPORT_NAME),
+                  key=lambda f: (len(f.relative_to(root).parts), f.name != "manifest.csv", str(f)))
+    if not csvs:
+        raise UploadError("no manifest: the upload holds no .csv file")
+    named = [f for f in csvs if f.name == "manifest.csv"]
+    if len(csvs) > 1 and not named:
+        raise UploadError(f"several .csv files ({', '.join(f.name for f in csvs)}): name the manifest manifest.csv")
+    return named[0] if named else csvs[0]
+
+
+def save_upload(manifest=None, files=(), archive=None) -> tuple[str, Path]:
+    """Save an upload into a new job folder: (job name, manifest path). ``manifest`` and ``files`` are uploaded
+    files (their manifest names the files by their names); ``archive`` a zip holding the manifest and its files.
+    The job folder is removed again when the upload is refused."""
+    if archive is None and manifest is None:
+        raise UploadError("upload a manifest (with its files) or a zip of them")
+    job = f"{datetime.now(UTC):%Y%m%d-%H%M%S}-{secrets.token_hex(4)}"
+    root = job_dir(job) / "files"
+    root.mkdir(parents=True)
+    try:
+        written: list[Path] = []
+        if archive is not None:
+            written += unpack_zip(archive, root)
+        for upload in ([manifest] if manifest is not None else []) + list(files):
+            name = _safe_name(Path(upload.name).name)
+            target = root / name.name
+            with target.open("wb") as dst:
+                for chunk in upload.chunks():
+                    dst.write(chunk)
+            written.append(target)
+        found = (root / _safe_name(Path(manifest.name).name).name) if manifest is not None else find_manifest(
+            written, root)
+    except BaseException:
+        shutil.rmtree(job_dir(job), ignore_errors=True)
+        raise
+    return job, found
+
+
+def import_command(manifest: Path, job: str, name: str, keep_audio: bool, dry_run: bool) -> list[str]:
+    """The ``manage.py import_clips`` command line of a job."""
+    cmd = [sys.executable, str(Path(settings.BASE_DIR) / "manage.py"), "import_clips", str(manifest),
+           "--report", str(job_dir(job) / REPORT_NAME), "--name", name]
+    return cmd + (["--keep-audio"] if keep_audio else []) + (["--dry-run"] if dry_run else [])
+
+
+def launch(cmd: list[str], job: str) -> None:
+    """Run ``cmd`` detached (own session, output to the job's log), recording its pid; returns at once."""
+    folder = job_dir(job)
+    env = dict(os.environ, DJANGO_SETTINGS_MODULE=os.environ.get("DJANGO_SETTINGS_MODULE", "studyapp.settings"),
+               DATA_DIR=str(settings.DATA_DIR), MEDIA_ROOT=str(settings.MEDIA_ROOT))
+    with open(folder / LOG_NAME, "ab") as log:
+        proc = subprocess.Popen(cmd, cwd=settings.BASE_DIR, env=env, stdin=subprocess.DEVNULL, stdout=log,
+                                stderr=subprocess.STDOUT, start_new_session=True)
+    (folder / PID_NAME).write_text(str(proc.pid))
+    threading.Thread(target=proc.wait, name=f"clip-import-{proc.pid}", daemon=True).start()   # no zombie
+
+
+def start_import(manifest: Path, job: str, name: str = "", keep_audio: bool = False, dry_run: bool = False) -> None:
+    """Start ``import_clips`` on a saved upload (catalogue plan ``import:<name>``, by default the manifest's
+    name)."""
+    launch(import_command(manifest, job, name or f"upload/{manifest.stem}", keep_audio, dry_run), job)
+
+
+@dataclass(frozen=True)
+class ImportState:
+    """Where an import job stands: ``status`` running | done | failed, its report rows and its log's tail."""
+
+    job: str
+    status: str
+    rows: list[dict]
+    log: str
+
+
+def _running(folder: Path) -> bool:
+    try:
+        pid = int((folder / PID_NAME).read_text())
+        os.kill(pid, 0)
+    except (OSError, ValueError):
+        return False
+    try:      # a finished child not yet reaped still answers kill(0): read its state
+        return Path(f"/proc/{pid}/stat").read_text().split(")")[-1].split()[0] != "Z"
+    except OSError:
+        return True
+
+
+def import_state(job: str) -> ImportState:
+    folder = job_dir(job)
+    if not folder.is_dir():
+        raise UploadError(f"no such import {job!r}")
+    log = (folder / LOG_NAME).read_text(errors="replace")[-3000:] if (folder / LOG_NAME).is_file() else ""
+    report = folder / REPORT_NAME
+    rows = []
+    if report.is_file():
+        with report.open(newline="", encoding="utf-8") as f:
+            rows = list(csv.DictReader(f))
+    if _running(folder):
+        return ImportState(job, "running", rows, log)
+    return ImportState(job, "done" if report.is_file() else "failed", rows, log)
