@@ -1,7 +1,8 @@
 """In headless Chromium: imported clips (an H.264 MP4 remuxed, a VP9 WebM transcoded, a BVH take rendered) play in
 a study's gait and naturalness sections and their answers are saved with the imported clip ids.
 
-IMPORT_SCREENSHOT=<png> saves the page of the rendered BVH clip while it plays (docs/img/import_clip_playing.png);
+IMPORT_SCREENSHOTS=<folder> saves the pages of the rendered BVH clip and of the transcoded video while they play
+(docs/img/import_clip_playing.png, import_video_playing.png);
 IMPORT_MANIFEST=<csv> imports that manifest instead of the synthetic one (its bad rows are reported, not fatal).
 """
 from __future__ import annotations
@@ -32,10 +33,10 @@ def test_imported_clips_play_in_a_study(chromium, live_server, settings, tmp_pat
 
     settings.MEDIA_ROOT = tmp_path / "media"
     settings.DATA_DIR = tmp_path / "data"
-    screenshot = os.environ.get("IMPORT_SCREENSHOT")
+    shots = os.environ.get("IMPORT_SCREENSHOTS")
     manifest = Path(os.environ["IMPORT_MANIFEST"]) if os.environ.get("IMPORT_MANIFEST") else write_manifest(
         lab, [{**row, "body": "mannequin"} if row.get("body") else row for row in GOOD])
-    _import(manifest, "960x540" if screenshot else "320x180")
+    _import(manifest, "960x540" if shots else "320x180")
     imported = {c.media_key: c for c in Clip.objects.filter(origin="imported")}
     assert len(imported) >= 3 and {c.modality for c in imported.values()} >= {"gait", "other"}
     study = Study.objects.create(slug="own-stimuli", title="Own stimuli", status=Study.Status.OPEN,
@@ -60,8 +61,10 @@ def test_imported_clips_play_in_a_study(chromium, live_server, settings, tmp_pat
         wait_for(driver, lambda d: d.execute_script(
             "var v = document.getElementById('clip'); return v.readyState >= 2 && v.currentTime > 0.4 && "
             "v.videoWidth > 0;"), timeout=30, what=f"clip {clip.clip_id} playing")
-        if screenshot and clip.metadata.get("kind") == "motion":
-            driver.save_screenshot(screenshot)
+        if shots and clip.metadata.get("kind") == "motion":
+            driver.save_screenshot(str(Path(shots) / "import_clip_playing.png"))
+        if shots and clip.metadata.get("action") == "transcode":
+            driver.save_screenshot(str(Path(shots) / "import_video_playing.png"))
         wait_for(driver, lambda d: d.find_element(By.ID, "next").is_enabled(), timeout=40, what="clip played")
         fieldset = driver.find_element(By.CSS_SELECTOR, "#answer-form fieldset.question")
         fieldset.find_elements(By.CSS_SELECTOR, "input")[0].find_element(By.XPATH, "..").click()

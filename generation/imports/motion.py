@@ -96,6 +96,8 @@ def stage_motion(path: Path, stage: Path, stem: str, modality: str, settings: Re
         intended = [labels[e] for e in GAIT_EMOTIONS]
     qa_result, _ = clip_qa(motion, settings, resolve_thresholds(), intended,
                            observer_for(modality) if observer else None, camera_info=result.camera)
+    meta = {k: v for k, v in motion.metadata.items() if k not in ("source_path",)}
+    meta["source_duration_s"] = round(motion.duration, 4)
     return StagedMotion(result.mp4, result.poster, result.webm, bvh, round(result.duration_s, 4), result.n_frames,
                         row, qa_result.as_dict(), qa_result.flag, dict(result.camera),
-                        {k: v for k, v in motion.metadata.items() if k not in ("source_path",)})
+                        meta)

@@ -236,6 +236,19 @@ def commit_row(rec: dict, files: dict[str, Path], media_root: Path, catalogue: C
         raise
 
 
+def _summary(rec: dict) -> str:
+    """The report message of a newly imported clip: what was done, its duration, audio and quality flag."""
+    meta = rec["metadata"]
+    text = meta["action"] + (f" {meta['probe']['video_codec']}" if "probe" in meta else "")
+    text += f", {rec['duration_s']:.2f} s"
+    source_s = (meta.get("motion") or {}).get("source_duration_s")
+    if source_s and source_s > rec["duration_s"] + 0.05:
+        text += f" (the first {rec['duration_s']:.2f} s of {source_s:.2f} s: the render length)"
+    if "audio" in meta:
+        text += f", audio {meta['audio']}"
+    return text + (f", quality flag {rec['qa_flag']}" if rec.get("qa_flag") else "")
+
+
 ROW_ERRORS = (ManifestError, VideoImportError, MotionImportError, OSError)
 
 
@@ -273,10 +286,7 @@ def import_row(row: ManifestRow, media_root: Path, settings: ImportSettings, cat
                 shutil.rmtree(stage, ignore_errors=True)
                 with contextlib.suppress(OSError):
                     stage.parent.rmdir()
-            meta = rec["metadata"]
-            notes.insert(0, f"{meta['action']}{' ' + meta['probe']['video_codec'] if 'probe' in meta else ''}, "
-                            f"{rec['duration_s']:.2f} s" + (f", audio {meta['audio']}" if "audio" in meta else "")
-                         + (f", quality flag {rec['qa_flag']}" if rec.get("qa_flag") else ""))
+            notes.insert(0, _summary(rec))
     except ROW_ERRORS as exc:
         message = str(exc)
         out.message = message if isinstance(exc, ManifestError) else f"{row.path}: {message}"

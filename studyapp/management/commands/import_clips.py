@@ -100,7 +100,8 @@ class Command(BaseCommand):
                                 plan=plan_name(manifest, opts["name"]))
 
         def show(out):
-            self.stdout.write(f"row {out.row} {out.status:5s} {out.clip_id or '-':16s} {out.path}: {out.message}")
+            where = f"{out.path}: " if out.status == "ok" else ""
+            self.stdout.write(f"row {out.row} {out.status:5s} {out.clip_id or '-':16s} {where}{out.message}")
 
         try:
             outcomes = import_manifest(manifest, Path(settings.MEDIA_ROOT), config, catalogue_step,
