@@ -236,7 +236,7 @@ def read_manifest(path: str | Path) -> list[ManifestRow | BadRow]:
         if not any(cells.values()):
             continue
         try:
-            out.append(check_row(cells, row, path.parent, path))
+            out.append(check_row(cells, row, path.parent, path.name))   # the report lies beside the manifest
         except ManifestError as exc:
             out.append(BadRow(row, cells.get("path", ""), exc))
     return out
