@@ -388,3 +388,42 @@ def test_admin_import_needs_the_add_clip_permission(db):
     client = Client()
     client.force_login(user)
     assert client.get(reverse("admin:studyapp_clip_import")).status_code == 403
+
+
+@pytest.mark.django_db
+def test_webm_delivery_and_a_file_given_twice(media, lab):
+    from studyapp.models import Clip
+
+    manifest = write_manifest(lab, [GOOD[1], {**GOOD[1], "title": "again"}])
+    run(manifest, "--webm", fail=True)
+    first, second = read_report(lab / "import_report.csv")
+    assert first["status"] == "ok" and second["status"] == "error" and "the same clip as row 1" in second["message"]
+    clip = Clip.objects.get()
+    assert clip.webm == f"clips/{clip.clip_id}.webm" and (media / clip.webm).stat().st_size > 0
+
+
+def test_other_clips_only_in_sections_that_take_either_modality():
+    from study_pools import pool_errors
+
+    assert pool_errors({"origin": "imported", "modality": "other"}, "naturalness") == []
+    assert any("gait clips" in e for e in pool_errors({"modality": "other"}, "emotion_choice"))
+    assert any("'origin'" in e for e in pool_errors({"origin": "uploaded"}, "naturalness"))
+
+
+def test_zip_members_that_leave_the_upload_are_refused(tmp_path):
+    import zipfile
+
+    from studyapp.clip_import import UploadError, unpack_zip
+
+    archive = tmp_path / "a.zip"
+    with zipfile.ZipFile(archive, "w") as zf:
+        info = zipfile.ZipInfo("videos/link.mp4")
+        info.external_attr = (0o120777 << 16)                       # a symlink member
+        zf.writestr(info, "/etc/passwd")
+    with pytest.raises(UploadError, match="links are not imported"):
+        unpack_zip(archive, tmp_path / "out")
+    with zipfile.ZipFile(archive, "w") as zf:
+        zf.writestr("/abs.mp4", b"x")
+    with pytest.raises(UploadError, match="must stay inside"):
+        unpack_zip(archive, tmp_path / "out")
+    assert not (tmp_path / "out").exists()
