@@ -10,7 +10,7 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
 ORDER = ["core_features", "corpus", "rbf", "gait", "gesture", "device", "motion_quality", "render", "mocap",
-         "mocap_training", "study", "flow", "flow_postgres", "analysis"]
+         "mocap_training", "import", "study", "flow", "flow_postgres", "analysis"]
 TITLES = {
     "core_features": "Motion core: features, IK, BVH, captured walks",
     "corpus": "Procedural motion and the synthetic corpus",
@@ -22,6 +22,7 @@ TITLES = {
     "render": "Rendering, plans and catalogue",
     "mocap": "Motion-capture import",
     "mocap_training": "Training on imported capture",
+    "import": "Importing researchers' own videos and motion files",
     "study": "Study web app under load",
     "flow": "Participant flow: queries per answer, concurrent starts",
     "flow_postgres": "Participant flow on PostgreSQL",
