@@ -427,3 +427,16 @@ def test_zip_members_that_leave_the_upload_are_refused(tmp_path):
     with pytest.raises(UploadError, match="must stay inside"):
         unpack_zip(archive, tmp_path / "out")
     assert not (tmp_path / "out").exists()
+
+
+def test_staging_left_by_a_killed_import_is_removed(tmp_path):
+    from generation.imports.run import STAGING_DIR, remove_stale_staging
+
+    dead = subprocess.Popen(["true"])
+    dead.wait()
+    stale = tmp_path / STAGING_DIR / f"{dead.pid}-abcd1234"
+    stale.mkdir(parents=True)
+    (stale / "x.mp4").write_bytes(b"half a file")
+    mine = tmp_path / STAGING_DIR / f"{os.getpid()}-abcd1234"
+    mine.mkdir()
+    assert remove_stale_staging(tmp_path) == [stale] and mine.is_dir()

@@ -303,6 +303,27 @@ def import_row(row: ManifestRow, media_root: Path, settings: ImportSettings, cat
     return out
 
 
+def _alive(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:
+        return True
+    return True
+
+
+def remove_stale_staging(media_root: Path) -> list[Path]:
+    """Delete staging folders left by an import that was killed (``<pid>-<random>`` of a process that is gone)."""
+    removed = []
+    for folder in sorted((media_root / STAGING_DIR).glob("*-*")):
+        pid = folder.name.split("-", 1)[0]
+        if folder.is_dir() and pid.isdigit() and not _alive(int(pid)):
+            shutil.rmtree(folder, ignore_errors=True)
+            removed.append(folder)
+    return removed
+
+
 def import_manifest(manifest: str | Path, media_root: str | Path, settings: ImportSettings | None = None,
                     catalogue: CatalogueStep | None = None, dry_run: bool = False,
                     on_row: Callable[[RowOutcome], None] | None = None) -> list[RowOutcome]:
@@ -313,6 +334,8 @@ def import_manifest(manifest: str | Path, media_root: str | Path, settings: Impo
     clip: the second is an error naming the first. ManifestError for a manifest that cannot be read at all."""
     settings = settings or ImportSettings()
     media_root = Path(media_root)
+    if not dry_run:
+        remove_stale_staging(media_root)
     outcomes: list[RowOutcome] = []
     seen: dict[str, int] = {}
     for item in read_manifest(manifest):
