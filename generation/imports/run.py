@@ -27,7 +27,7 @@ import time
 import uuid
 from collections.abc import Callable
 from dataclasses import dataclass, field
-from pathlib import Path
+from pathlib import Path, PurePosixPath
 
 from generation.plans.catalogue import write_clips_csv
 from generation.render.settings import RenderSettings
@@ -130,7 +130,8 @@ def base_record(row: ManifestRow, clip_id: str, sha256: str, settings: ImportSet
     rec.update(clip_id=clip_id, modality=row.modality, origin=IMPORTED, video=f"clips/{clip_id}.mp4",
                webm=f"clips/{clip_id}.webm" if settings.webm else "", poster=f"clips/{clip_id}.png",
                plan=settings.plan, loop=False, **{k: row.text[k] for k in ("title", "licence", "citation")})
-    rec["metadata"] = {"entry_id": row.path, "plan": settings.plan, "imported_file": row.path, "kind": row.kind,
+    key = PurePosixPath(row.path.strip().replace("\\", "/")).as_posix()      # "./a.mp4" and "a.mp4" are one entry
+    rec["metadata"] = {"entry_id": key, "plan": settings.plan, "imported_file": row.path, "kind": row.kind,
                        "file_sha256": sha256, "file_bytes": row.file.stat().st_size, **row.text,
                        "import_version": IMPORT_VERSION}
     return rec
