@@ -22,6 +22,7 @@ from study_protocol import (
     ATTENTION_COLUMNS,
     CLIP_COLUMNS,
     CLIP_MODALITIES,
+    CLIP_PROVENANCE_COLUMNS,
     CLIP_THEMES,
     FINAL_EMOTION_COLUMNS,
     GAIT_EMOTIONS,
@@ -202,7 +203,7 @@ def read_clips(src) -> pd.DataFrame:
         raise ValidationError(col.problems, col.total)
     out = out.set_index("clip_id", drop=False)
     out.attrs["ignored_columns"] = [c for c in df.columns if c not in CLIP_COLUMNS and c not in QA_COLUMNS
-                                    and c != "_line"]
+                                    and c not in CLIP_PROVENANCE_COLUMNS and c != "_line"]
     return out
 
 

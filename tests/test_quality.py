@@ -145,7 +145,7 @@ def test_old_clips_csv_without_qa_columns_still_reads(tmp_path):
     write_clips_csv([_record("b", "foot_skate", 9.0)], new)
     df = read_clips(new)
     assert df.loc["b", "qa_flag"] == "foot_skate" and df.loc["b", "qa_foot_skate_cm_s"] == 9.0
-    assert df.attrs["ignored_columns"] == list(CLIP_PROVENANCE_COLUMNS)  # provenance: not read by the analysis
+    assert df.attrs["ignored_columns"] == []          # the provenance columns are known (and not needed)
 
 
 def test_summary_line_counts_clips_per_flag():
