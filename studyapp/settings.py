@@ -136,6 +136,8 @@ INSTALLED_APPS = [
 MIDDLEWARE = [
     "django.middleware.security.SecurityMiddleware",
     "studyapp.security.ContentSecurityPolicyMiddleware",
+    # 400 for a control character (NUL, ...) in the path, a query or form value or a cookie: before any lookup
+    "studyapp.inputs.ControlCharacterMiddleware",
     "whitenoise.middleware.WhiteNoiseMiddleware",
     "django.contrib.sessions.middleware.SessionMiddleware",
     # each request starts in LANGUAGE_CODE; participant views activate their study's language (studyapp.i18n)
