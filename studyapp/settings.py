@@ -13,7 +13,8 @@ Variables (all optional for the demo):
                       requests are then answered with X-Accel-Redirect and nginx sends the bytes (docs/deploy.md);
                       empty (default): the app streams clips itself
     REPORTS_DIR       where finished analysis-report zips are kept (default: DATA_DIR/reports)
-    LOGIN_FAILURE_LIMIT   failed logins after which an account, or an address, is locked out (default 5)
+    LOGIN_FAILURE_LIMIT   failed logins after which an account from one address, or an address, is locked out
+                      (default 5)
     LOGIN_LOCKOUT_MINUTES how long such a lockout lasts (default 15)
     TRUSTED_PROXY_COUNT   reverse proxies in front of the app whose X-Forwarded-For is trusted for the client
                       address of the login throttle (default: 1 with PRODUCTION=1, the nginx recipe; else 0)
@@ -206,15 +207,16 @@ USE_TZ = True
 
 LOGIN_URL = "/admin/login/"
 
-# Login throttling (django-axes, studyapp.login_throttle): failed logins count per account and per address; at
-# the limit that account or address is locked out for the cool-off time, without checking the password.
+# Login throttling (django-axes, studyapp.login_throttle): failed logins count per account-and-address pair and per
+# address; at the limit that pair, or that address, is locked out for the cool-off time without checking the
+# password. Never per account alone: anyone could then lock the admin out from everywhere.
 AUTHENTICATION_BACKENDS = [
     "studyapp.login_throttle.ThrottledLoginBackend",
     "django.contrib.auth.backends.ModelBackend",
 ]
 AXES_FAILURE_LIMIT = env_int("LOGIN_FAILURE_LIMIT", 5, minimum=1)
 AXES_COOLOFF_TIME = timedelta(minutes=env_int("LOGIN_LOCKOUT_MINUTES", 15, minimum=1))
-AXES_LOCKOUT_PARAMETERS = ["username", "ip_address"]
+AXES_LOCKOUT_PARAMETERS = [["username", "ip_address"], "ip_address"]
 AXES_RESET_ON_SUCCESS = True
 AXES_LOCKOUT_CALLABLE = "studyapp.login_throttle.lockout_response"
 AXES_CLIENT_IP_CALLABLE = "studyapp.login_throttle.client_ip"
