@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import secrets
 
+from django.conf import settings
 from django.core.exceptions import ValidationError
 from django.db import models
 from django.utils import timezone
@@ -133,6 +134,12 @@ class Study(models.Model):
         default=dict, blank=True,
         help_text="Rules the analysis applies (raw exports stay unchanged), e.g. "
                   '{"min_rt_fraction": 0.25, "max_straightline": 0.9, "min_attention_pass": 1.0}')
+    # Who may see, preview, export and analyse the study (studyapp.permissions.studies_for); superusers see every
+    # study. Owners also decide who the owners and collaborators are.
+    owners = models.ManyToManyField(settings.AUTH_USER_MODEL, blank=True, related_name="owned_studies",
+                                    help_text="Researchers who run this study and manage who else may see it")
+    collaborators = models.ManyToManyField(settings.AUTH_USER_MODEL, blank=True, related_name="shared_studies",
+                                           help_text="Researchers who may see, preview, export and analyse it")
     created_at = models.DateTimeField(auto_now_add=True)
 
     class Meta:
