@@ -303,6 +303,21 @@ def media_urls(n: int = 4) -> list[str]:
     return [f"/m/{key}.mp4" for key in Clip.objects.order_by("id").values_list("media_key", flat=True)[:n]]
 
 
+def media_session() -> str:
+    """The session key of a staff account that may see the catalogue: the media viewers are no participants, and
+    clips need a session that may see them (studyapp.views.media_allowed)."""
+    from django.contrib.auth import BACKEND_SESSION_KEY, HASH_SESSION_KEY, SESSION_KEY, get_user_model
+    from django.contrib.sessions.backends.db import SessionStore
+
+    user, _ = get_user_model().objects.get_or_create(username="bench-media-viewer",
+                                                     defaults={"is_staff": True, "is_superuser": True})
+    session = SessionStore()
+    session.update({SESSION_KEY: str(user.pk), BACKEND_SESSION_KEY: "django.contrib.auth.backends.ModelBackend",
+                    HASH_SESSION_KEY: user.get_session_auth_hash()})
+    session.create()
+    return session.session_key
+
+
 def start_gunicorn(args, env: dict, log: Path) -> subprocess.Popen:
     """gunicorn on 127.0.0.1:--port (--server: gthread or sync WSGI workers, or asgi: demo.sh's asyncio workers);
     its stderr (warnings, Django's error tracebacks) goes to ``log``."""
@@ -680,7 +695,8 @@ def run_locust_study(args, base: str, env: dict, out: Path, slug: str, meter: Cp
     env = dict(env, STUDY_BENCH_SLUG=slug, STUDY_BENCH_RESULTS=str(results), STUDY_BENCH_VIEWERS=str(args.viewers),
                STUDY_BENCH_PARTICIPANTS=str(args.participants), STUDY_BENCH_TICKETS=str(out / "tickets"),
                STUDY_BENCH_THINK=str(args.think),
-               STUDY_BENCH_MEDIA=",".join(media_urls()), STUDY_BENCH_DEADLINE=str(time.time() + args.arrival +
+               STUDY_BENCH_MEDIA=",".join(media_urls()), STUDY_BENCH_MEDIA_SESSION=media_session(),
+               STUDY_BENCH_DEADLINE=str(time.time() + args.arrival +
                                                                                    args.time_limit + 30))
     users = ["StudyParticipant"] + (["MediaViewer"] if args.viewers else [])
     n_users = args.participants + args.viewers

@@ -285,6 +285,12 @@ class Assignment(models.Model):
     # How the clip was watched before the answer (studyapp.viewing): study_protocol.VIEWING_FIELDS -> int or null;
     # null when the browser sent no record. Exported as viewing.csv.
     viewing = models.JSONField(null=True, blank=True, editable=False)
+    # The clip's playback as the player reported it while the page was open (studyapp.viewing.record_playback), kept
+    # across reloads so a reload neither restarts the count nor resets max_replays: plays started, the ms from
+    # shown_at to the clip's first end (null: not yet), and how often the page was displayed.
+    plays = models.PositiveIntegerField(default=0, editable=False)
+    play_ended_ms = models.PositiveIntegerField(null=True, blank=True, editable=False)
+    shows = models.PositiveIntegerField(default=0, editable=False)
 
     class Meta:
         ordering = ["participant", "seq"]

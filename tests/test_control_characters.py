@@ -12,7 +12,7 @@ from studyapp.assignment import current_step
 from studyapp.forms import ConsentForm, FeedbackForm
 from studyapp.inputs import has_control_character
 from studyapp.models import Participant, Response, Study
-from studyapp.viewing import VIEWING_FORM_FIELDS
+from studyapp.viewing import SCRIPT_FIELD, VIEWING_FORM_FIELDS
 from tests.test_study_flow import answer_for, consent, demographics
 
 pytestmark = pytest.mark.django_db
@@ -103,7 +103,7 @@ def test_clip_answer_rt_and_viewing_fields(client, study, control):
     step = current_step(p)
     url = reverse("studyapp:item", args=[p.token, step.index])
     good = answer_for(step.assignment)
-    for field in [*good, "rt", "inline_next", *VIEWING_FORM_FIELDS]:
+    for field in [*good, "rt", "inline_next", SCRIPT_FIELD, *VIEWING_FORM_FIELDS]:
         data = {**good, "rt": "1200", field: bad("1", control)}
         assert client.post(url, data).status_code == 400, field
     assert not Response.objects.exists()
