@@ -1,8 +1,8 @@
 """In headless Chromium: the replay-only player undoes a seek (script and keyboard), counts a pause, a hidden tab
 and a replay, stops replays at max_replays, and viewing.csv records exactly that; a reload during play keeps the
-plays (max_replays holds across reloads) and a pause the browser makes for a hidden tab is hidden time; the consent
-page's device check
-stops a too-small window and a browser that cannot play the clips before the study starts.
+plays (max_replays holds across reloads) and a pause the browser makes for a hidden tab is hidden time; the
+consent page's device check stops a too-small window and a browser that cannot play the clips before the study
+starts.
 STUDY_SCREENSHOTS=<folder> saves docs/img/study_player_replay_only.png (desktop) and
 study_player_replay_only_360.png (360 px wide) there."""
 from __future__ import annotations
