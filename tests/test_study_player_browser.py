@@ -235,3 +235,31 @@ def test_a_reload_during_play_keeps_the_plays_and_a_hidden_tab_is_no_pause(chrom
     answer(3)
     row = list(csv.DictReader(io.StringIO("".join(stream_csv(study, "viewing")))))[1]
     assert (row["plays"], row["ended_ms"], row["shows"], row["record"]) == ("2", "0", "2", "ok"), row
+
+
+def test_a_reload_mid_play_without_replays_leaves_the_answers_open(chromium, live_server, study):
+    """max_replays 0 and a reload before the clip ended: it may not play again, and the participant is not stuck
+    (the answers are enabled; the record shows no end)."""
+    from selenium.webdriver.common.by import By
+
+    section = study.sections.get(order=1)
+    section.options = {"controls": "replay-only", "max_replays": 0}
+    section.save()
+    driver = chromium
+    driver.get(live_server.url + reverse("studyapp:study_entry", args=[study.slug]) + "?PROLIFIC_PID=v-3")
+    consent_and_demographics(driver)
+    p = Participant.objects.get(external_id="v-3")
+    wait_for(driver, lambda d: p.assignments.get(seq=1).plays == 1, what="the play reported")
+    assert not driver.find_element(By.ID, "next").is_enabled()
+    driver.refresh()
+    time.sleep(1.0)
+    state = player_state(driver)
+    assert state["paused"] and state["t"] < 0.1, state
+    assert driver.find_element(By.ID, "next").is_enabled()
+    assert "used all replays" in driver.find_element(By.ID, "play-note").text
+    time.sleep(CLIP_S)                  # the server still wants the clip's time to pass (require_full_play)
+    driver.find_element(By.CSS_SELECTOR, "#answer-form input[value='sad']").find_element(By.XPATH, "..").click()
+    driver.find_element(By.ID, "next").click()
+    wait_for(driver, lambda d: "/clip/2/" in d.current_url, what="clip 2")
+    row = list(csv.DictReader(io.StringIO("".join(stream_csv(study, "viewing")))))[0]
+    assert (row["plays"], row["ended_ms"], row["shows"], row["record"]) == ("1", "", "2", "ok"), row

@@ -126,7 +126,9 @@
       return true;
     }
     function stopHere() { ownPause = true; video.pause(); }
-    if (endedBefore) {                 // watched to its end before a reload: the answers stay enabled
+    // Watched to its end before a reload, or every play used up before it (a reload mid-play with no replay left
+    // must not leave the participant unable to answer; the record then shows no end): the answers are enabled.
+    if (endedBefore || (priorPlays > 0 && replaysLeft() <= 0)) {
       played = true;
       atEnd = video.paused;
       if (replaysLeft() <= 0 && maxReplays > 0) { say(note.dataset.noReplays); }
