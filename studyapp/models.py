@@ -287,10 +287,12 @@ class Assignment(models.Model):
     viewing = models.JSONField(null=True, blank=True, editable=False)
     # The clip's playback as the player reported it while the page was open (studyapp.viewing.record_playback), kept
     # across reloads so a reload neither restarts the count nor resets max_replays: plays started, the ms from
-    # shown_at to the clip's first end (null: not yet), and how often the page was displayed.
+    # shown_at to the clip's first end (null: not yet), how often the page was displayed, and the counts of the
+    # displays left without an answer (studyapp.viewing.CARRIED_FIELDS -> int), added to the answer's record.
     plays = models.PositiveIntegerField(default=0, editable=False)
     play_ended_ms = models.PositiveIntegerField(null=True, blank=True, editable=False)
     shows = models.PositiveIntegerField(default=0, editable=False)
+    carried = models.JSONField(default=dict, blank=True, editable=False)
 
     class Meta:
         ordering = ["participant", "seq"]

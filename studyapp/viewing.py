@@ -28,8 +28,11 @@ SCRIPT_FIELD = "view_script"
 """Set to "1" by the player's script when it attaches; blank in the page's markup."""
 MAX_COUNT = 1000
 """Highest count accepted (plays, pauses, seeks, stalls, hidden); more in one clip page is not a measurement."""
-PLAYBACK_EVENTS = ("play", "ended")
-"""What the player reports while the page is open: a play from the start (first play or replay), the first end."""
+PLAYBACK_EVENTS = ("play", "ended", "leave")
+"""What the player reports while the page is open: a play from the start (first play or replay), the first end,
+and, when the page is left without an answer (a reload), its counts so far (CARRIED_FIELDS)."""
+CARRIED_FIELDS = ("pauses", "seeks", "stalls", "stall_ms", "hidden", "hidden_ms")
+"""Record fields a display left without an answer hands on to the next (added up on the assignment)."""
 
 
 def field_name(name: str) -> str:
@@ -63,6 +66,19 @@ def max_plays(page_ms: int, duration_s: float | None) -> int | None:
     return int(page_ms // (duration_s * 1000)) + 1
 
 
+def carried_counts(post, page_ms: int, carried: dict | None) -> dict:
+    """The assignment's carried counts plus those a page being left reports (``view_<field>`` of CARRIED_FIELDS):
+    each an integer within its bound (times: page_ms, the ms since the page's first display; counts: MAX_COUNT),
+    anything else is ignored; the sums are capped at the same bounds."""
+    out = {k: v for k, v in (carried or {}).items() if k in CARRIED_FIELDS and isinstance(v, int)}
+    for name in CARRIED_FIELDS:
+        high = page_ms if name in VIEWING_TIME_FIELDS else MAX_COUNT
+        value = _integer(post.get(field_name(name), ""), high)
+        if value:
+            out[name] = min(out.get(name, 0) + value, high)
+    return out
+
+
 def _integer(raw, high: int) -> int | None:
     """A decimal integer 0..high from a form value ("12", "12.0" from a JS number), else None."""
     text = str(raw).strip()[:16]
@@ -82,9 +98,10 @@ def parse_viewing(post, page_ms: int, duration_s: float | None = None, playback:
 
     page_ms: the time from the page's first display to the answer as the server measured it (ms); a posted time
     may exceed it by at most time_slack_ms. duration_s: the clip's duration (s), for the plays bound. playback:
-    what the player reported while the page was open (``{"plays": int, "ended_ms": int | None, "shows": int}``,
-    from the assignment): the plays count is at least its plays, and an end reached before a reload of the page is
-    kept as ``ended_ms`` 0 ("before this display")."""
+    what the player reported while the page was open (``{"plays": int, "ended_ms": int | None, "shows": int,
+    "carried": {field: int}}``, from the assignment): the plays count is at least its plays, an end reached before a
+    reload of the page is kept as ``ended_ms`` 0 ("before this display"), and the counts of displays left without
+    an answer are added to this display's."""
     playback = playback or {}
     record: dict = {name: None for name in VIEWING_FIELDS}
     record.update(page_ms=page_ms, shows=max(1, int(playback.get("shows") or 0)))
@@ -106,6 +123,9 @@ def parse_viewing(post, page_ms: int, duration_s: float | None = None, playback:
     first, ended = record["first_play_ms"], record["ended_ms"]
     if first is not None and ended is not None and ended < first:
         implausible = True                        # a clip ends after it starts
+    for name, value in (playback.get("carried") or {}).items():
+        if name in CARRIED_FIELDS and isinstance(value, int) and value > 0:
+            record[name] = (record[name] or 0) + value
     server_plays = int(playback.get("plays") or 0)
     if server_plays:
         record["plays"] = max(record["plays"] or 0, server_plays)

@@ -41,6 +41,7 @@ from .viewing import (
     PLAYBACK_EVENTS,
     SCRIPT_FIELD,
     VIEWING_FORM_FIELDS,
+    carried_counts,
     parse_viewing,
     player_options,
     plays_left,
@@ -386,7 +387,8 @@ def item(request, token: str, n: int):
         response_ms = server_ms
     viewing = parse_viewing(request.POST, min(MAX_RESPONSE_MS, server_ms), clip.duration_s,
                             {"plays": assignment.plays, "ended_ms": assignment.play_ended_ms,
-                             "shows": assignment.shows}, time_slack_ms=RT_SLACK_MS)
+                             "shows": assignment.shows, "carried": assignment.carried},
+                            time_slack_ms=RT_SLACK_MS)
     save_answers(assignment, answers, response_ms, viewing)
     if request.POST.get(INLINE_NEXT_FIELD) == "1" and n < participant.n_items:
         nxt = current_step(participant, lookahead=True)
@@ -462,9 +464,10 @@ def _render_item(request, participant: Participant, step, status: int = 200, err
 @never_cache
 @require_POST
 def playback(request, token: str, n: int):
-    """The player's report (static/studyapp/study.js) of a play from the start or of the clip's first end on clip
-    page n, counted on the assignment while it is unanswered: a reload then keeps the plays (max_replays holds)
-    and the end. 204; 400 for an unknown event; 404 when page n is not the participant's current page."""
+    """The player's report (static/studyapp/study.js) of a play from the start, of the clip's first end, or of the
+    counts of a display being left without an answer (a reload) on clip page n, kept on the assignment while it is
+    unanswered: a reload then keeps the plays (max_replays holds), the end and the counts. 204; 400 for an unknown
+    event; 404 when page n is not the participant's current page."""
     participant = _participant(token)
     event = request.POST.get("event", "")
     if event not in PLAYBACK_EVENTS:
@@ -480,7 +483,13 @@ def playback(request, token: str, n: int):
         found = shown is not None
         if found:
             ms = min(max(int((timezone.now() - shown).total_seconds() * 1000), 0), 2**31 - 1)
-            pending.filter(play_ended_ms__isnull=True).update(play_ended_ms=ms)
+            if event == "ended":
+                pending.filter(play_ended_ms__isnull=True).update(play_ended_ms=ms)
+            else:
+                with transaction.atomic():
+                    row = pending.select_for_update().only("pk", "carried").first()
+                    if row is not None:
+                        pending.filter(pk=row.pk).update(carried=carried_counts(request.POST, ms, row.carried))
     return HttpResponse(status=204 if found else 404)
 
 

@@ -16,7 +16,7 @@ from study_protocol import VIEWING_COLUMNS, VIEWING_FIELDS
 from studyapp.assignment import current_step
 from studyapp.export import stream_csv
 from studyapp.models import Assignment, Participant, Study
-from studyapp.viewing import MAX_COUNT, SCRIPT_FIELD, field_name, max_plays, parse_viewing
+from studyapp.viewing import MAX_COUNT, SCRIPT_FIELD, carried_counts, field_name, max_plays, parse_viewing
 from tests import test_study_flow as flow
 from tests.test_study_flow import answer_for, consent, cur, demographics
 
@@ -131,6 +131,15 @@ def test_the_servers_playback_counts_survive_a_reload():
     record = parse_viewing(fresh, 20_000, 2.0, {"plays": 3, "ended_ms": 2_500, "shows": 2})
     assert record["plays"] == 3 and record["ended_ms"] == 0 and record["first_play_ms"] == 0
     assert record["shows"] == 2 and record["record"] == "ok"
+
+
+def test_counts_of_displays_left_without_an_answer_are_added():
+    fresh = {SCRIPT_FIELD: "1", field_name("plays"): "1", field_name("pauses"): "1", field_name("hidden"): "0"}
+    record = parse_viewing(fresh, 20_000, 2.0, {"plays": 2, "carried": {"pauses": 2, "hidden": 1, "hidden_ms": 700,
+                                                                         "unknown": 5, "seeks": "x"}})
+    assert (record["pauses"], record["hidden"], record["hidden_ms"], record["seeks"]) == (3, 1, 700, None)
+    assert carried_counts({field_name("pauses"): "2", field_name("hidden_ms"): "99999", field_name("seeks"): "-1"},
+                          5_000, {"pauses": 1}) == {"pauses": 3}        # out of bound values are ignored
 
 
 def test_missing_fields_are_unknown():
@@ -271,6 +280,24 @@ def test_a_reload_keeps_the_plays_and_max_replays_holds(client, study):
     assert report(client, p, 1, "play").status_code == 404
     a.refresh_from_db()
     assert a.plays == 2
+
+
+@pytest.mark.django_db
+def test_a_display_left_without_an_answer_hands_on_its_counts(client, study):
+    p = started(client, study)
+    client.get(reverse("studyapp:item", args=[p.token, 1]))
+    from datetime import timedelta
+
+    from django.utils import timezone
+
+    Assignment.objects.filter(participant=p, seq=1).update(shown_at=timezone.now() - timedelta(seconds=10))
+    leave = {"event": "leave", field_name("pauses"): "2", field_name("hidden"): "1", field_name("hidden_ms"): "400"}
+    assert client.post(reverse("studyapp:playback", args=[p.token, 1]), leave).status_code == 204
+    client.get(reverse("studyapp:item", args=[p.token, 1]))             # the reload
+    a = answer(client, p, 1, posted({**GOOD_RECORD, "hidden": 0, "pauses": 1}))
+    a.refresh_from_db()
+    assert a.carried == {"pauses": 2, "hidden": 1, "hidden_ms": 400}
+    assert (a.viewing["pauses"], a.viewing["hidden"], a.viewing["hidden_ms"]) == (3, 1, 400)
 
 
 @pytest.mark.django_db

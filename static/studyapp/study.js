@@ -80,17 +80,36 @@
     var hiddenSince = null;    // the page is hidden while the clip plays (or was stopped by the hiding)
     var pausedByHiding = false;
     var endReported = endedBefore;
+    var answered = false;      // the form was sent: its record carries the counts, no "leave" report
     function now() { return Math.round(performance.now() - t0); }
     function playsSoFar() { return priorPlays + rec.plays; }
     function replaysLeft() { return playsSoFar() === 0 ? Infinity : maxReplays - (playsSoFar() - 1); }
-    function report(event) {
-      if (!playbackUrl || !window.fetch || !window.FormData) { return; }
+    function reportData(event) {
       var data = new FormData();
       var csrf = form.querySelector("input[name=csrfmiddlewaretoken]");
       if (csrf) { data.append("csrfmiddlewaretoken", csrf.value); }
       data.append("event", event);
-      fetch(playbackUrl, { method: "POST", body: data, credentials: "same-origin", keepalive: true })
+      return data;
+    }
+    function report(event) {
+      if (!playbackUrl || !window.fetch || !window.FormData) { return; }
+      fetch(playbackUrl, { method: "POST", body: reportData(event), credentials: "same-origin", keepalive: true })
         .catch(function () { /* the answer's own record still goes with the form */ });
+    }
+    // Left without an answer (a reload, the back button): this display's counts go to the server, which adds
+    // them to the answer's record (studyapp.viewing.CARRIED_FIELDS).
+    window.addEventListener("pagehide", function () {
+      if (answered || !playbackUrl || !navigator.sendBeacon || !window.FormData) { return; }
+      closeTimers();
+      var data = reportData("leave");
+      ["pauses", "seeks", "stalls", "stall_ms", "hidden", "hidden_ms"].forEach(function (key) {
+        data.append("view_" + key, String(rec[key]));
+      });
+      navigator.sendBeacon(playbackUrl, data);
+    });
+    function closeTimers() {
+      if (stallStart !== null) { rec.stall_ms += now() - stallStart; stallStart = null; }
+      if (hiddenSince !== null) { rec.hidden_ms += now() - hiddenSince; hiddenSince = null; }
     }
     function countPlay() { rec.plays += 1; report("play"); }
     function setEnabled(on) {
@@ -260,8 +279,8 @@
     video.addEventListener("canplaythrough", preloadNext);
     setTimeout(preloadNext, 4000);
     return function fillViewing() {
-      if (stallStart !== null) { rec.stall_ms += now() - stallStart; stallStart = null; }
-      if (hiddenSince !== null) { rec.hidden_ms += now() - hiddenSince; hiddenSince = null; }
+      answered = true;
+      closeTimers();
       Object.keys(rec).forEach(function (key) {
         var input = form.querySelector("input[data-viewing][name='view_" + key + "']");
         if (input) { input.value = rec[key] === null ? "" : String(rec[key]); }

@@ -25,4 +25,9 @@ class Migration(migrations.Migration):
             name='shows',
             field=models.PositiveIntegerField(default=0, editable=False),
         ),
+        migrations.AddField(
+            model_name='assignment',
+            name='carried',
+            field=models.JSONField(blank=True, default=dict, editable=False),
+        ),
     ]
