@@ -77,7 +77,8 @@ def test_consent_key_and_consent_field(client, study, control):
 def test_tokens_and_media_keys_in_the_path(client, study, control):
     p = at_clip(client, study)
     token = bad(p.token, control)
-    for name, kwargs in [("resume", {}), ("demographics", {}), ("item", {"n": 1}), ("feedback", {}), ("done", {})]:
+    for name, kwargs in [("resume", {}), ("demographics", {}), ("item", {"n": 1}), ("playback", {"n": 1}),
+                         ("feedback", {}), ("done", {})]:
         url = reverse(f"studyapp:{name}", kwargs={"token": token, **kwargs})
         assert client.get(url).status_code == 400, name
         assert client.post(url, {"x": "1"}).status_code == 400, name
@@ -107,6 +108,9 @@ def test_clip_answer_rt_and_viewing_fields(client, study, control):
         data = {**good, "rt": "1200", field: bad("1", control)}
         assert client.post(url, data).status_code == 400, field
     assert not Response.objects.exists()
+    playback = reverse("studyapp:playback", args=[p.token, step.index])
+    for data in ({"event": bad("play", control)}, {"event": "leave", "view_pauses": bad("1", control)}):
+        assert client.post(playback, data).status_code == 400
     assert client.post(url, good).status_code == 302        # the same answer without the control character
 
 
