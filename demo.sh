@@ -50,7 +50,7 @@ user.save()
 "
 
 echo "==> demo study"
-PARTICIPANT_URL="$($PY manage.py setup_demo --base-url "http://$HOST:$PORT" | tee /dev/stderr \
+PARTICIPANT_URL="$($PY manage.py setup_demo --base-url "http://$HOST:$PORT" --owner "$ADMIN_USER" | tee /dev/stderr \
     | sed -n 's/^Participant URL: //p' | tail -1)"
 
 cat <<MSG
@@ -61,5 +61,8 @@ cat <<MSG
   Stop the server with Ctrl-C; run 'bash demo.sh' again to restart (nothing is redone).
 
 MSG
-exec .venv/bin/gunicorn studyapp.asgi:application -b "$HOST:$PORT" -w 2 --worker-class asgi \
+# WEB_CONCURRENCY: the worker processes; with DATABASE_URL (PostgreSQL) they share DB_CONNECTIONS (default 20)
+# through Django's connection pool, so a burst of participants never exhausts the server's connections.
+export WEB_CONCURRENCY="${WEB_CONCURRENCY:-2}"
+exec .venv/bin/gunicorn studyapp.asgi:application -b "$HOST:$PORT" -w "$WEB_CONCURRENCY" --worker-class asgi \
     --access-logfile - --logger-class studyapp.gunicorn_logging.RedactingLogger

@@ -273,15 +273,31 @@ ASSIGNMENT_COLUMNS = ("participant_id", "section_type", "section_order", "positi
                       "shown_at", "answered_at")
 """assignments.csv (an extra export): which clips each participant was given, in order."""
 
-VIEWING_TIME_FIELDS = ("first_play_ms", "ended_ms", "stall_ms")
+VIEWING_TIME_FIELDS = ("first_play_ms", "ended_ms", "stall_ms", "startup_ms", "hidden_ms")
 """Viewing-record times in milliseconds: from the clip page's display to the clip's first playing frame and to its
-first end (blank: never played / never reached its end), and the total time playback waited for data."""
+first end (blank: never played / never reached its end), the total time playback waited for data after its first
+frame, the start-up time (from the first request to play to the first frame: buffering before the first frame is
+start-up, not a stall) and the total time the page was hidden while the clip played or was held by the hiding."""
 VIEWING_COUNT_FIELDS = ("plays", "pauses", "seeks", "stalls", "hidden")
-"""Viewing-record counts: plays from the start (the first play and every replay), pauses by the participant, seek
-attempts (blocked or not), stalls (playback waiting for data) and times the page was hidden (another tab, a
-minimised window) while the clip was playing."""
-VIEWING_FIELDS = ("first_play_ms", "ended_ms", "plays", "pauses", "seeks", "stalls", "stall_ms", "hidden")
-"""The fields of a viewing record, in viewing.csv's order."""
-VIEWING_COLUMNS = ("participant_id", "clip_id", "section_type", *VIEWING_FIELDS)
-"""viewing.csv, in order: one row per answered clip page (practice items left out). All fields blank: the browser
-sent no record (no JavaScript, an older page)."""
+"""Viewing-record counts: plays from the start (the first play and every replay, over every display of the page,
+reloads included), pauses by the participant (not those the browser makes when the page is hidden), seek attempts
+(blocked or not), stalls (playback waiting for data after the first frame) and times the page was hidden (another
+tab, a minimised window) while the clip was playing."""
+VIEWING_FIELDS = ("first_play_ms", "ended_ms", "plays", "pauses", "seeks", "stalls", "stall_ms", "hidden",
+                  "startup_ms", "hidden_ms")
+"""The fields of a viewing record the browser measures, in viewing.csv's order (the first eight are the original
+columns; later ones are appended, never inserted)."""
+VIEWING_RECORDS = ("ok", "missing", "no_script", "implausible")
+"""What the server makes of an answer's viewing record (viewing.csv ``record``): ``ok``: the player's script sent
+it and it is plausible; ``missing``: the answer came without the record fields although the page ships the player
+(not from the page: a script, a forged or replayed POST); ``no_script``: the page's fields came back but the
+player's script never ran (a browser without JavaScript); ``implausible``: sent, but impossible for the time the
+page was shown (e.g. more plays than the clip's duration fits into), so not to be trusted."""
+VIEWING_SERVER_FIELDS = ("record", "page_ms", "shows")
+"""Viewing-record fields the server sets: ``record`` (one of VIEWING_RECORDS), ``page_ms`` (ms from the page's first
+display to the answer, measured by the server) and ``shows`` (how often the page was displayed: 1 + reloads)."""
+VIEWING_COLUMNS_V1 = ("participant_id", "clip_id", "section_type", *VIEWING_FIELDS[:8])
+"""The columns of the first viewing.csv version: every reader requires these; the later ones may be absent."""
+VIEWING_COLUMNS = ("participant_id", "clip_id", "section_type", *VIEWING_FIELDS, *VIEWING_SERVER_FIELDS)
+"""viewing.csv, in order: one row per answered clip page (practice items left out). ``record`` says what the server
+made of it; with ``missing`` or ``no_script`` every browser field is blank."""

@@ -34,7 +34,7 @@ def main(argv=None) -> int:
                          "(keys: see analysis.exclusion.RULES)")
     ap.add_argument("--viewing", metavar="VIEWING_CSV",
                     help="viewing.csv (optional): list answers given without a full view of the clip and enable the "
-                         "viewing exclusion rules (max_unended_share, max_hidden_share)")
+                         "viewing exclusion rules (max_unended_share, max_hidden_share, max_untrusted_share)")
     a = ap.parse_args(argv)
     for path in (a.responses, a.clips, a.participants, *([a.viewing] if a.viewing else [])):
         if not os.path.isfile(path):

@@ -23,8 +23,9 @@ when at least this share of their answers in a rating-scale section have one val
 ``min_straight`` (answers a section needs before straight-lining is judged) and ``min_attention_pass``
 (**Failed attention checks**: excluded when ``attention_passed / attention_total`` of participants.csv is below it;
 when the export has no such columns, or a participant met no check, the rule does not apply and the report says so),
-and the two rules on how the clips were watched (viewing.csv, :mod:`analysis.viewing`; off unless set below 1):
-``max_unended_share`` (answered before the clip ended) and ``max_hidden_share`` (tab hidden during playback).
+and the three rules on how the clips were watched (viewing.csv, :mod:`analysis.viewing`; off unless set below 1):
+``max_unended_share`` (answered before the clip ended), ``max_hidden_share`` (tab hidden during playback) and
+``max_untrusted_share`` (viewing record missing or implausible).
 """
 
 from __future__ import annotations
@@ -56,6 +57,8 @@ RULES: dict[str, tuple[type, float, float, float, str]] = {
                                                 "came before the clip ended (1 = off)"),
     "max_hidden_share": (float, 0.0, 1.0, 1.0, "excluded when more than this share of answers with a viewing record "
                                                "had the page hidden while the clip played (1 = off)"),
+    "max_untrusted_share": (float, 0.0, 1.0, 1.0, "excluded when more than this share of answers have their viewing "
+                                                  "record missing or implausible (1 = off)"),
 }
 """Exclusion rule key -> (type, lowest, highest, default, meaning). ``Study.exclusion_rules`` uses these keys."""
 
@@ -181,7 +184,7 @@ def exclusions(responses: pd.DataFrame, clips: pd.DataFrame, fast_fraction: floa
                viewing: pd.DataFrame | None = None) -> pd.DataFrame:
     """Who is excluded and why: one row per participant and rule that applies (a participant may have several).
     Columns participant_id, rule (too_fast | straight_lining | failed_attention | answered_before_end |
-    tab_hidden), detail, n_answers.
+    tab_hidden | record_untrusted), detail, n_answers.
 
     ``rules`` (a ``Study.exclusion_rules`` object, checked by :func:`rule_errors`; ValueError when invalid) replaces
     the keyword thresholds; ``participants`` (participants.csv) enables the attention-check rule and ``viewing``
@@ -192,7 +195,8 @@ def exclusions(responses: pd.DataFrame, clips: pd.DataFrame, fast_fraction: floa
         fast_fraction, max_fast_share, min_straight = r["min_rt_fraction"], r["max_fast_share"], r["min_straight"]
     max_straightline, min_attention = r["max_straightline"], r["min_attention_pass"]
     attention, attention_note = attention_failures(participants, min_attention, responses.attrs.get("attention_checks"))
-    watched, viewing_note = viewing_exclusions(viewing, r["max_unended_share"], r["max_hidden_share"])
+    watched, viewing_note = viewing_exclusions(viewing, r["max_unended_share"], r["max_hidden_share"],
+                                               r["max_untrusted_share"])
     parts = [t for t in (fast_answers(responses, clips, fast_fraction, max_fast_share),
                          straight_lining(responses, min_straight, max_straightline), attention, watched) if len(t)]
     if not parts:

@@ -39,7 +39,10 @@ from study_protocol import (
     SECTION_QUESTIONS,
     VAD_DIMENSIONS,
     VIEWING_COLUMNS,
+    VIEWING_COLUMNS_V1,
     VIEWING_FIELDS,
+    VIEWING_RECORDS,
+    VIEWING_SERVER_FIELDS,
 )
 
 ANSWER_KINDS = tuple(dict.fromkeys(kind for questions in SECTION_QUESTIONS.values() for kind in questions.values()))
@@ -266,13 +269,19 @@ def read_participants(src) -> pd.DataFrame:
 def read_viewing(src, participants: pd.DataFrame | None = None) -> pd.DataFrame:
     """Read and validate viewing.csv (:data:`study_protocol.VIEWING_COLUMNS`, one row per answered clip page).
 
-    ``participant_id`` and ``clip_id`` must be set; every field of :data:`study_protocol.VIEWING_FIELDS` is blank
-    (unknown, or no record) or a non-negative integer (times in ms, counts). With ``participants`` (as from
-    :func:`read_participants`) every participant_id must be one of them. Returns the rows with the fields as floats
-    (NaN where blank); extra columns are kept."""
+    ``participant_id`` and ``clip_id`` must be set; every field of :data:`study_protocol.VIEWING_FIELDS`, and
+    ``page_ms`` and ``shows``, is blank (unknown, or no record) or a non-negative integer (times in ms, counts);
+    ``record`` is blank or one of :data:`study_protocol.VIEWING_RECORDS`. The columns of the first version
+    (:data:`study_protocol.VIEWING_COLUMNS_V1`) are required; a later one that is absent (an older export) reads
+    as blank. With ``participants`` (as from :func:`read_participants`) every participant_id must be one of them.
+    Returns the rows with the numeric fields as floats (NaN where blank) and ``record`` as a string; extra columns
+    are kept."""
     df, name = _read_raw(src, "viewing.csv")
     col = _Collector(name)
-    _check_columns(df, VIEWING_COLUMNS, col)
+    _check_columns(df, VIEWING_COLUMNS_V1, col)
+    for c in VIEWING_COLUMNS:
+        if c not in df.columns:
+            df[c] = ""
     for c in ("participant_id", "clip_id", "section_type"):
         df[c] = df[c].str.strip()
     for c in ("participant_id", "clip_id"):
@@ -281,7 +290,10 @@ def read_viewing(src, participants: pd.DataFrame | None = None) -> pd.DataFrame:
         known = set(participants["participant_id"].astype(str))
         col.add_mask(df, ~df["participant_id"].isin(known).to_numpy() & ~_blank(df["participant_id"]),
                      "participant_id", lambda v: f"unknown participant {v!r} (not in participants.csv)")
-    for c in VIEWING_FIELDS:
+    df["record"] = df["record"].str.strip().str.lower()
+    col.add_mask(df, ~_blank(df["record"]) & ~df["record"].isin(VIEWING_RECORDS).to_numpy(), "record",
+                 lambda v: f"{v!r} is not blank or one of {', '.join(VIEWING_RECORDS)}")
+    for c in (*VIEWING_FIELDS, *(f for f in VIEWING_SERVER_FIELDS if f != "record")):
         value = _numeric(df[c])
         bad = ~_blank(df[c]) & ~(value.notna() & (value >= 0) & (value == value.round())).to_numpy()
         col.add_mask(df, bad, c, lambda v: f"{v!r} is not blank or a non-negative integer")

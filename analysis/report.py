@@ -109,6 +109,9 @@ def _viewing_method(rules: dict) -> str:
             for key, rule, what in (("max_unended_share", "answered_before_end", "given before the clip ended"),
                                     ("max_hidden_share", "tab_hidden", "with the page hidden during playback"))
             if rules[key] < 1]
+    if rules.get("max_untrusted_share", 1.0) < 1:
+        bits.append(f"; with more than {rules['max_untrusted_share']:.0%} of their answers' viewing records missing "
+                    "or implausible (record_untrusted, from viewing.csv)")
     return "".join(bits)
 
 
@@ -216,8 +219,17 @@ def _viewing_sentence(summary: dict) -> str:
     return (f"Viewing: {summary['n_without_full_view']} of {summary['n_recorded']} answers with a viewing record "
             f"were given without a full view of the clip; {summary['n_hidden']} had the page hidden during playback, "
             f"{summary['n_seek_attempts']} a seek attempt, {summary['n_stalled']} a stall"
-            + (f" ({summary['n_answers'] - summary['n_recorded']} answers without a record)"
-               if summary["n_answers"] > summary["n_recorded"] else "") + ".")
+            + (f" ({summary['n_answers'] - summary['n_recorded']} answers without a trusted record"
+               + _untrusted_counts(summary) + ")" if summary["n_answers"] > summary["n_recorded"] else "") + ".")
+
+
+def _untrusted_counts(summary: dict) -> str:
+    """': 2 missing, 1 implausible, 3 without JavaScript' for the record markers that occur ('' for none)."""
+    parts = [f"{summary.get(key, 0)} {what}" for key, what in (("n_record_missing", "missing"),
+                                                                ("n_implausible", "implausible"),
+                                                                ("n_no_script", "without JavaScript"))
+             if summary.get(key, 0)]
+    return (": " + ", ".join(parts)) if parts else ""
 
 
 def _summary(tables: dict, parts: dict, alpha: float, recog: dict | None = None, exclude: bool = True,

@@ -29,6 +29,17 @@ ratio of the study's requests/s to it, lost / duplicated answers found in the da
 responses.csv (all must be 0), and the CPU seconds of the study phase by gunicorn, PostgreSQL (the whole local
 server), the generator and the machine (Linux /proc), also per answered clip.
 
+    python benchmarks/bench_study_load.py --server asgi --participants 0 --burst 3 --burst-size 40 --in-process 0
+    python benchmarks/bench_study_load.py --driver threads --server asgi --participants 55 --kill 1 \
+        [--database sqlite] [--db-connections 20]
+
+--server asgi serves with demo.sh's asyncio workers instead of gthread; --database sqlite uses a scratch SQLite file.
+On PostgreSQL the peak of the server's connections (pg_stat_activity, all databases and the scratch one) is
+reported; the server's pool gets --db-connections over its --workers (DB_CONNECTIONS, WEB_CONCURRENCY). --burst W
+sends W waves of --burst-size page loads released together (consent page, consent POST and its redirects) and
+reports each wave's successes, 5xx and p50/p99. --kill K (threads driver) kills a worker with -9 K times during the
+study; clients resend a request the kill cut off, and lost / duplicated answers and 5xx must still be 0.
+
     python benchmarks/bench_study_load.py --in-process-only --in-process 10 [--profile FILE]
 
 measures only the server time, CPU time and queries of each request kind in-process (Django test client, same
@@ -292,14 +303,33 @@ def media_urls(n: int = 4) -> list[str]:
     return [f"/m/{key}.mp4" for key in Clip.objects.order_by("id").values_list("media_key", flat=True)[:n]]
 
 
+def media_session() -> str:
+    """The session key of a staff account that may see the catalogue: the media viewers are no participants, and
+    clips need a session that may see them (studyapp.views.media_allowed)."""
+    from django.contrib.auth import BACKEND_SESSION_KEY, HASH_SESSION_KEY, SESSION_KEY, get_user_model
+    from django.contrib.sessions.backends.db import SessionStore
+
+    user, _ = get_user_model().objects.get_or_create(username="bench-media-viewer",
+                                                     defaults={"is_staff": True, "is_superuser": True})
+    session = SessionStore()
+    session.update({SESSION_KEY: str(user.pk), BACKEND_SESSION_KEY: "django.contrib.auth.backends.ModelBackend",
+                    HASH_SESSION_KEY: user.get_session_auth_hash()})
+    session.create()
+    return session.session_key
+
+
 def start_gunicorn(args, env: dict, log: Path) -> subprocess.Popen:
-    """gunicorn on 127.0.0.1:--port; its stderr (warnings, Django's error tracebacks) goes to ``log``."""
-    cmd = [sys.executable, "-m", "gunicorn", "studyapp.wsgi", "-w", str(args.workers), "-b",
+    """gunicorn on 127.0.0.1:--port (--server: gthread or sync WSGI workers, or asgi: demo.sh's asyncio workers);
+    its stderr (warnings, Django's error tracebacks) goes to ``log``."""
+    app = "studyapp.asgi:application" if args.server == "asgi" else "studyapp.wsgi"
+    cmd = [sys.executable, "-m", "gunicorn", app, "-w", str(args.workers), "-b",
            f"127.0.0.1:{args.port}", "--log-level", "warning", "--timeout", "60", "--backlog", "2048",
            # Idle keep-alive connections stay open like behind nginx (keepalive_timeout 65s); gunicorn's default
            # of 2 s closes them while a pausing participant's next POST is on its way ("connection closed").
            "--keep-alive", "75"]
-    if args.threads > 1:
+    if args.server == "asgi":
+        cmd += ["--worker-class", "asgi"]
+    elif args.threads > 1:
         cmd += ["--worker-class", "gthread", "--threads", str(args.threads)]
     return subprocess.Popen(cmd, cwd=ROOT, env=env, stderr=open(log, "ab"))
 
@@ -337,16 +367,28 @@ def wait_for_server(base: str, timeout: float = 30) -> None:
 class RequestsHttp:
     """The http object of take_study for the threads driver: one requests.Session (its own cookies)."""
 
-    def __init__(self):
+    def __init__(self, retries: int = 0):
         import requests
 
         self.session = requests.Session()
+        self.retries = retries          # a request cut off (a killed worker) is sent again, as a browser would
+        self.retried = 0
 
     def request(self, method: str, url: str, data: dict | None, name: str):
-        t = time.perf_counter()
-        r = self.session.request(method, url, data=data, headers={"Referer": url}, allow_redirects=False,
-                                 timeout=60, verify=False)       # --nginx: the run's self-signed certificate
-        return r.status_code, r.headers.get("Location"), r.text, 1000 * (time.perf_counter() - t)
+        import requests
+
+        for attempt in range(self.retries + 1):
+            t = time.perf_counter()
+            try:
+                r = self.session.request(method, url, data=data, headers={"Referer": url}, allow_redirects=False,
+                                         timeout=60, verify=False)   # --nginx: the run's self-signed certificate
+            except requests.ConnectionError:
+                if attempt == self.retries:
+                    raise
+                self.retried += 1
+                time.sleep(0.2)
+                continue
+            return r.status_code, r.headers.get("Location"), r.text, 1000 * (time.perf_counter() - t)
 
 
 class DjangoClientHttp:
@@ -414,22 +456,112 @@ def in_process_only(args) -> dict:
             drop_db(args.db_url, name)
 
 
-def run_threads(args, base: str, slug: str) -> list[dict]:
-    """The thread driver: one thread per participant, started evenly over --arrival seconds."""
+def run_threads(args, base: str, slug: str, gunicorn_pid: int | None = None) -> list[dict]:
+    """The thread driver: one thread per participant, started evenly over --arrival seconds. With --kill K a
+    gunicorn worker is killed with SIGKILL K times while answers are in flight (evenly over the arrival time);
+    clients then retry a cut-off request (connection error) up to 5 times."""
     start = time.time() + 0.5
     deadline = start + args.arrival + args.time_limit
     records: list[dict] = []
+    retried = []
 
     def one(i: int):
         time.sleep(max(0.0, start + i * args.arrival / args.participants - time.time()))
-        records.append(take_study(RequestsHttp(), base, slug, i, deadline, args.think))
+        http = RequestsHttp(retries=5 if args.kill else 0)
+        records.append(take_study(http, base, slug, i, deadline, args.think))
+        retried.append(http.retried)
 
     threads = [threading.Thread(target=one, args=(i,), daemon=True) for i in range(args.participants)]
     for t in threads:
         t.start()
+    kills = 0
+    while kills < args.kill and gunicorn_pid and any(t.is_alive() for t in threads):
+        time.sleep(max(0.5, args.arrival / (args.kill + 1)))
+        workers = [int(p) for p in subprocess.run(["pgrep", "-P", str(gunicorn_pid)], capture_output=True,
+                                                  text=True).stdout.split()]
+        if workers:
+            os.kill(workers[kills % len(workers)], signal.SIGKILL)
+            kills += 1
     for t in threads:
         t.join(args.arrival + args.time_limit + 60)
+    if records:
+        records[0]["kills"], records[0]["retried"] = kills, sum(retried)
     return records
+
+
+class ConnectionSampler(threading.Thread):
+    """Polls pg_stat_activity every 50 ms: the peak number of the server's connections (all databases, as
+    max_connections counts them) and of the scratch database's."""
+
+    def __init__(self, admin_url: str, dbname: str):
+        super().__init__(daemon=True)
+        self.admin_url, self.dbname = admin_url, dbname
+        self.stop, self.peak_total, self.peak_db, self.baseline_total = threading.Event(), 0, 0, None
+
+    def run(self):
+        with _admin_connection(self.admin_url) as conn:
+            while not self.stop.is_set():
+                total, ours = conn.execute("SELECT count(*), count(*) FILTER (WHERE datname = %s) "
+                                           "FROM pg_stat_activity", [self.dbname]).fetchone()
+                if self.baseline_total is None:
+                    self.baseline_total = total
+                self.peak_total, self.peak_db = max(self.peak_total, total), max(self.peak_db, ours)
+                time.sleep(0.05)
+
+    def result(self) -> dict:
+        self.stop.set()
+        self.join(5)
+        return {"db_connections_before": self.baseline_total, "db_connections_peak_server": self.peak_total,
+                "db_connections_peak_study_db": self.peak_db,
+                "max_connections": _max_connections(self.admin_url)}
+
+
+def _max_connections(admin_url: str) -> int:
+    with _admin_connection(admin_url) as conn:
+        return int(conn.execute("SHOW max_connections").fetchone()[0])
+
+
+def page_load(base: str, slug: str, index: int) -> tuple[int, float]:
+    """One participant's first page loads: the consent page (a new session), the consent POST and the pages it
+    redirects to (the participant is created and started). (last status, total ms)."""
+    http = RequestsHttp()
+    link = {"PROLIFIC_PID": f"burst{index:05d}{os.getpid()}", "STUDY_ID": "burst", "SESSION_ID": f"b{index}"}
+    t = time.perf_counter()
+    try:
+        page = follow(http, "GET", f"{base}/s/{slug}/?{urlencode(link)}", None, "consent page")
+        if page.status == 200:
+            action, data, _ = fill_form(page.text, page.url)
+            if action:
+                page = follow(http, "POST", action, data, "consent POST")
+        status = page.status
+    except Exception:        # connection refused or reset: counted as a failed load
+        status = 0
+    return status, 1000 * (time.perf_counter() - t)
+
+
+def run_burst(args, base: str, slug: str) -> dict:
+    """--burst W: W waves of --burst-size concurrent page loads (page_load), one wave after the other."""
+    waves = []
+    for w in range(args.burst):
+        results: list[tuple[int, float]] = []
+        barrier = threading.Barrier(args.burst_size)
+
+        def one(i: int, w=w, results=results, barrier=barrier):
+            barrier.wait()
+            results.append(page_load(base, slug, 10_000 * (w + 1) + i))
+
+        threads = [threading.Thread(target=one, args=(i,), daemon=True) for i in range(args.burst_size)]
+        for t in threads:
+            t.start()
+        for t in threads:
+            t.join(120)
+        statuses = [s for s, _ in results]
+        ms = [m for _, m in results]
+        waves.append({"wave": w + 1, "loads": len(results), "ok": statuses.count(200),
+                      "status_5xx": sum(500 <= s < 600 for s in statuses), "failed": sum(s == 0 for s in statuses),
+                      "status_503": statuses.count(503), "ms_p50": round(statistics.median(ms), 1),
+                      "ms_p99": round(percentile(ms, 99), 1)})
+    return {"burst": waves}
 
 
 def _locust(args, base: str, env: dict, users: list[str], n_users: int, rate: float, run_s: float, csv: str,
@@ -563,7 +695,8 @@ def run_locust_study(args, base: str, env: dict, out: Path, slug: str, meter: Cp
     env = dict(env, STUDY_BENCH_SLUG=slug, STUDY_BENCH_RESULTS=str(results), STUDY_BENCH_VIEWERS=str(args.viewers),
                STUDY_BENCH_PARTICIPANTS=str(args.participants), STUDY_BENCH_TICKETS=str(out / "tickets"),
                STUDY_BENCH_THINK=str(args.think),
-               STUDY_BENCH_MEDIA=",".join(media_urls()), STUDY_BENCH_DEADLINE=str(time.time() + args.arrival +
+               STUDY_BENCH_MEDIA=",".join(media_urls()), STUDY_BENCH_MEDIA_SESSION=media_session(),
+               STUDY_BENCH_DEADLINE=str(time.time() + args.arrival +
                                                                                    args.time_limit + 30))
     users = ["StudyParticipant"] + (["MediaViewer"] if args.viewers else [])
     n_users = args.participants + args.viewers
@@ -626,10 +759,14 @@ def summarise(args, records: list[dict], checks: dict, ceiling: dict, stats: dic
     media = stats.get("GET media range", {})
     return {
         "driver": args.driver, "participants": args.participants, "arrival_s": args.arrival, "think_s": args.think,
-        "gunicorn": f"{args.workers} workers x {args.threads} threads" + (" (gthread)" if args.threads > 1 else ""),
+        "gunicorn": (f"{args.workers} ASGI workers" if args.server == "asgi" else
+                     f"{args.workers} workers x {args.threads} threads" + (" (gthread)" if args.threads > 1 else "")),
+        "status_5xx": sum(bool(re.search(r"HTTP 5\d\d", e)) for r in records for e in r["errors"]),
+        "kills": records[0].get("kills", 0) if records else 0,
+        "retried_requests": records[0].get("retried", 0) if records else 0,
         "nginx": bool(args.nginx),
         "locust_processes": args.processes if args.driver == "locust" else None, "viewers": args.viewers,
-        "database": "postgresql", "completed": sum(bool(r["completed"]) for r in records),
+        "database": args.database, "completed": sum(bool(r["completed"]) for r in records),
         "records": len(records), "wall_s": round(wall, 2),
         "answer_posts": len(answers), "answer_posts_per_s": round(len(answers) / wall, 1) if answers else 0,
         "answers_stored_per_s": round(checks["answers_stored"] / wall, 1) if wall == wall else None,
@@ -672,6 +809,17 @@ def parse_args(argv=None):
                     help="mean seconds a participant spends on a clip page before answering (0: as fast as possible)")
     ap.add_argument("--workers", type=int, default=2, help="gunicorn worker processes")
     ap.add_argument("--threads", type=int, default=8, help="threads per worker (gthread; 1 = sync workers)")
+    ap.add_argument("--server", choices=["gthread", "asgi"], default="gthread",
+                    help="gunicorn workers: threaded WSGI (the nginx recipe) or asyncio ASGI (demo.sh)")
+    ap.add_argument("--database", choices=["postgresql", "sqlite"], default="postgresql",
+                    help="sqlite: a scratch SQLite file (no connection figures)")
+    ap.add_argument("--db-connections", type=int, default=20,
+                    help="DB_CONNECTIONS of the server: its PostgreSQL pool over all --workers")
+    ap.add_argument("--burst", type=int, default=0,
+                    help="waves of --burst-size concurrent page loads (consent page + consent) before the study")
+    ap.add_argument("--burst-size", type=int, default=40)
+    ap.add_argument("--kill", type=int, default=0,
+                    help="threads driver: kill a gunicorn worker with -9 this many times during the study")
     ap.add_argument("--ceiling-s", type=float, default=15.0, help="seconds of the /healthz ceiling run")
     ap.add_argument("--ceiling-users", type=int, default=32)
     ap.add_argument("--port", type=int, default=8765)
@@ -688,9 +836,24 @@ def parse_args(argv=None):
     ap.add_argument("--profile", default="", help="with --in-process-only: write cProfile stats to this file")
     ap.add_argument("--json", default="", help="also write the figures to this JSON file")
     args = ap.parse_args(argv)
-    if not 1 <= args.participants <= 400:
-        raise SystemExit("--participants must be 1..400 (bounded load test on loopback)")
+    if not (1 if not args.burst else 0) <= args.participants <= 400 or not 0 <= args.burst * args.burst_size <= 400:
+        raise SystemExit("--participants must be 1..400 (0 with --burst), --burst x --burst-size at most 400 "
+                         "(bounded load test on loopback)")
     return args
+
+
+def stop(proc: subprocess.Popen, grace_s: float = 40) -> None:
+    """SIGTERM, then SIGKILL after grace_s (gunicorn's graceful timeout is 30 s)."""
+    proc.send_signal(signal.SIGTERM)
+    try:
+        proc.wait(grace_s)
+    except subprocess.TimeoutExpired:
+        print(f"pid {proc.pid} did not stop within {grace_s} s of SIGTERM: killed", file=sys.stderr)
+        for pid in [int(p) for p in subprocess.run(["pgrep", "-P", str(proc.pid)], capture_output=True,
+                                                    text=True).stdout.split()]:
+            os.kill(pid, signal.SIGKILL)
+        proc.kill()
+        proc.wait()
 
 
 def main(argv=None) -> dict:
@@ -701,41 +864,62 @@ def main(argv=None) -> dict:
         if args.json:
             Path(args.json).write_text(json.dumps(result, indent=1))
         return result
-    db_url, name = scratch_db_url(args.db_url)
-    recreate_db(args.db_url, name)
+    postgres = args.database == "postgresql"
     out = Path(tempfile.mkdtemp(prefix="studybench-"))
+    if postgres:
+        db_url, name = scratch_db_url(args.db_url)
+        recreate_db(args.db_url, name)
+    else:
+        db_url, name = "", ""
+        os.environ.pop("DATABASE_URL", None)
+        os.environ["DATA_DIR"] = str(out)            # a scratch SQLite file, out/db.sqlite3
     try:
         study = setup_django(db_url, out / "media")
-        env = dict(os.environ, DATABASE_URL=db_url, MEDIA_ROOT=str(out / "media"),
-                   DJANGO_SETTINGS_MODULE="studyapp.settings", OMP_NUM_THREADS="1", MKL_NUM_THREADS="1")
+        env = dict(os.environ, MEDIA_ROOT=str(out / "media"), DATA_DIR=str(out),
+                   DJANGO_SETTINGS_MODULE="studyapp.settings", OMP_NUM_THREADS="1", MKL_NUM_THREADS="1",
+                   DB_CONNECTIONS=str(args.db_connections), WEB_CONCURRENCY=str(args.workers))
+        if postgres:
+            env["DATABASE_URL"] = db_url
+        else:
+            env.pop("DATABASE_URL", None)
         base, nginx = f"http://127.0.0.1:{args.port}", None
         if args.nginx:
             env["MEDIA_ACCEL_REDIRECT"] = "/protected-media/"
             base, nginx = start_local_nginx(args, out)
         gunicorn = start_gunicorn(args, env, out / "gunicorn.log")
+        sampler = ConnectionSampler(args.db_url, name) if postgres else None
+        burst: dict = {}
         try:
             wait_for_server(base)
-            ceiling, stats, meter = {}, {}, None
-            if args.driver == "locust":
+            if sampler is not None:
+                sampler.start()
+            if args.burst:
+                burst = run_burst(args, base, study.slug)
+            ceiling, stats, meter, records = {}, {}, None, []
+            if args.participants and args.driver == "locust":
                 ceiling = run_ceiling(args, base, env, out)
                 meter = CpuMeter(gunicorn.pid)
                 records, stats = run_locust_study(args, base, env, out, study.slug, meter)
                 meter.stop_servers()
-            else:
-                records = run_threads(args, base, study.slug)
+            elif args.participants:
+                records = run_threads(args, base, study.slug, gunicorn.pid)
         finally:
             for proc in (nginx, gunicorn):
                 if proc is not None:
-                    proc.send_signal(signal.SIGTERM)
-                    proc.wait(30)
-        result = summarise(args, records, database_checks(study, records), ceiling, stats)
+                    stop(proc)
+        connections = sampler.result() if sampler is not None else {}
+        result = {"server": args.server, "database": args.database, "workers": args.workers,
+                  "db_connections_setting": args.db_connections if postgres else None, **connections, **burst}
+        if records:
+            result.update(summarise(args, records, database_checks(study, records), ceiling, stats))
         if meter is not None:
             result.update(meter.result, **cpu_per_answered_clip(meter.result, result))
         result["gunicorn_log"] = str(out / "gunicorn.log")
-        if args.in_process:
+        result["gunicorn_log_tracebacks"] = (out / "gunicorn.log").read_text(errors="replace").count("Traceback")
+        if args.in_process and records:
             result["in_process"] = in_process_costs(study.slug, args.in_process)
     finally:
-        if not args.keep_db:
+        if postgres and not args.keep_db:
             drop_db(args.db_url, name)
     print(json.dumps(result, indent=1))
     if args.json:
@@ -744,14 +928,19 @@ def main(argv=None) -> dict:
 
 
 def passed(result: dict) -> bool:
-    return (result["lost"] == 0 and result["duplicated_db"] == 0 and result["duplicated_csv"] == 0
+    if any(w["status_5xx"] or w["failed"] for w in result.get("burst", [])):
+        return False
+    if "lost" not in result:                   # a burst only
+        return True
+    return (result["lost"] == 0 and result["status_5xx"] == 0 and result["duplicated_db"] == 0
+            and result["duplicated_csv"] == 0
             and result["answered_without_rows"] == 0 and not result["errors"]
             and result["completed"] == result["participants"])
 
 
 if __name__ == "__main__":
     res = main()
-    if "lost" not in res:           # --in-process-only
+    if "in_process" in res and "lost" not in res and "burst" not in res:     # --in-process-only
         sys.exit(0)
     if not passed(res):
         print("FAILED: lost, duplicated, incomplete or failed requests", file=sys.stderr)

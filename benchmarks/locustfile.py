@@ -112,12 +112,14 @@ class MediaViewer(FastHttpUser):
             raise StopUser()
         self.url = urls[next(_numbers) % len(urls)]
         self.offset, self.size = 0, None
+        # clips need a session that may see them: the benchmark's staff session
+        self.cookie = {"Cookie": f"sessionid={os.environ.get('STUDY_BENCH_MEDIA_SESSION', '')}"}
 
     @task
     def next_range(self):
         end = self.offset + MEDIA_CHUNK - 1
-        with self.client.get(self.url, name="media range", headers={"Range": f"bytes={self.offset}-{end}"},
-                             catch_response=True) as r:
+        headers = {"Range": f"bytes={self.offset}-{end}", **self.cookie}
+        with self.client.get(self.url, name="media range", headers=headers, catch_response=True) as r:
             if r.status_code != 206:
                 r.failure(f"expected 206, got {r.status_code}")
                 return

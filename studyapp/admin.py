@@ -1,6 +1,8 @@
 """Researcher admin: studies with their ordered sections, the clip catalogue, participants and responses.
 
 Study pages link to the staff views: preview (records nothing), progress, CSV exports and the analysis report.
+Studies, participants and responses are scoped per study (StudyScopedAdmin): a researcher lists, opens, changes
+and deletes only those of the studies they own or collaborate on (superusers: all); the catalogue is shared.
 """
 from __future__ import annotations
 
@@ -20,6 +22,7 @@ from study_pools import SUB_POOLS
 from . import admin_clip_qa, clip_import, pool_editor, views_pool, views_staff
 from .forms import ClipImportForm, SectionForm, StudyAdminForm
 from .models import Assignment, Clip, Participant, Response, Section, Study
+from .permissions import can_access_study, can_manage_study_access, studies_for
 from .questions import section_type_choices
 from .views_pool import count_pool
 
@@ -73,6 +76,46 @@ def pool_notes(section: Section) -> tuple[str, list[str]]:
     return counted.summary(), ([views_pool.REUSED] if section.reuse_section_id else []) + warnings
 
 
+class StudyScopedAdmin(admin.ModelAdmin):
+    """A model admin whose rows belong to a study (``study_field``: the lookup from the row to its study, "" for
+    Study itself): the list holds only the rows of the user's studies, and a row of another study can be neither
+    viewed, changed nor deleted (Django's admin then answers as if it did not exist)."""
+
+    study_field = ""
+
+    def _study_pk(self, obj):
+        if not self.study_field:
+            return obj.pk
+        value = obj
+        for part in self.study_field.split("__"):
+            value = getattr(value, part)
+        return value.pk
+
+    def get_queryset(self, request):
+        queryset = super().get_queryset(request)
+        if request.user.is_superuser:
+            return queryset
+        lookup = f"{self.study_field}__in" if self.study_field else "pk__in"
+        return queryset.filter(**{lookup: studies_for(request.user).values("pk")})
+
+    def _may(self, request, obj) -> bool:
+        return obj is None or request.user.is_superuser or can_access_study(request.user, self._study_pk(obj))
+
+    def has_view_permission(self, request, obj=None):
+        return super().has_view_permission(request, obj) and self._may(request, obj)
+
+    def has_change_permission(self, request, obj=None):
+        return super().has_change_permission(request, obj) and self._may(request, obj)
+
+    def has_delete_permission(self, request, obj=None):
+        return super().has_delete_permission(request, obj) and self._may(request, obj)
+
+    def formfield_for_foreignkey(self, db_field, request, **kwargs):
+        if db_field.related_model is Study:
+            kwargs["queryset"] = studies_for(request.user)
+        return super().formfield_for_foreignkey(db_field, request, **kwargs)
+
+
 class SectionInline(admin.StackedInline):
     model = Section
     form = SectionForm
@@ -87,6 +130,11 @@ class SectionInline(admin.StackedInline):
         js = ["studyapp/admin_pool.js"]
         css = {"all": ["studyapp/admin_pool.css"]}
 
+    def formfield_for_foreignkey(self, db_field, request, **kwargs):
+        if db_field.name == "reuse_section":        # never offer (and so name) another lab's sections
+            kwargs["queryset"] = Section.objects.filter(study__in=studies_for(request.user).values("pk"))
+        return super().formfield_for_foreignkey(db_field, request, **kwargs)
+
     @admin.display(description="matching clips")
     def matching_clips(self, section):
         summary, warnings = pool_notes(section)
@@ -98,7 +146,7 @@ class SectionInline(admin.StackedInline):
 
 
 @admin.register(Study)
-class StudyAdmin(admin.ModelAdmin):
+class StudyAdmin(StudyScopedAdmin):
     list_display = ["title", "slug", "status", "preset", "n_started", "n_completed", "links"]
     list_filter = ["status", "preset"]
     search_fields = ["title", "slug"]
@@ -116,7 +164,29 @@ class StudyAdmin(admin.ModelAdmin):
         ("Analysis", {"fields": ["exclusion_rules"],
                       "description": "Exclusion rules the analysis report applies (checked by analysis.exclusion); "
                                      "the raw exports stay unchanged. Empty: the defaults."}),
+        ("Access", {"fields": ["owners", "collaborators"],
+                    "description": "Who may see, preview, export and analyse this study (superusers see every "
+                                   "study). Only owners and superusers change this; whoever creates a study owns "
+                                   "it."}),
     ]
+
+    def get_readonly_fields(self, request, obj=None):
+        fields = list(super().get_readonly_fields(request, obj))
+        may_manage = request.user.is_superuser if obj is None else can_manage_study_access(request.user, obj)
+        if not may_manage:
+            fields += ["owners", "collaborators"]
+        return fields
+
+    def formfield_for_manytomany(self, db_field, request, **kwargs):
+        if db_field.name in ("owners", "collaborators"):
+            kwargs["queryset"] = db_field.related_model.objects.filter(is_staff=True, is_active=True).order_by(
+                "username")
+        return super().formfield_for_manytomany(db_field, request, **kwargs)
+
+    def save_related(self, request, form, formsets, change):
+        super().save_related(request, form, formsets, change)
+        if not change:
+            form.instance.owners.add(request.user)
 
     def get_urls(self):
         custom = [path("new-from-preset/", self.admin_site.admin_view(views_staff.create_from_preset),
@@ -246,10 +316,11 @@ class AssignmentInline(admin.TabularInline):
 
 
 @admin.register(Participant)
-class ParticipantAdmin(admin.ModelAdmin):
+class ParticipantAdmin(StudyScopedAdmin):
+    study_field = "study"
     list_display = ["public_id", "study", "status", "external_id", "gender", "age_group", "started_at",
                     "completed_at"]
-    list_filter = ["study", "status"]
+    list_filter = [("study", admin.RelatedOnlyFieldListFilter), "status"]
     search_fields = ["public_id", "external_id"]
     readonly_fields = ["token", "public_id", "seed", "consented_at", "started_at", "completed_at", "user_agent",
                        "external_id", "external_study_id", "external_session_id", "feedback"]
@@ -257,10 +328,18 @@ class ParticipantAdmin(admin.ModelAdmin):
 
 
 @admin.register(Response)
-class ResponseAdmin(admin.ModelAdmin):
+class ResponseAdmin(StudyScopedAdmin):
+    study_field = "section__study"
     list_display = ["participant", "section", "clip", "question", "answer", "response_ms", "created_at"]
-    list_filter = ["section__study", "section__section_type", "question"]
+    list_filter = [("section__study", admin.RelatedOnlyFieldListFilter), "section__section_type", "question"]
     search_fields = ["participant__public_id", "clip__clip_id"]
 
     def has_change_permission(self, request, obj=None):
         return False
+
+    def formfield_for_foreignkey(self, db_field, request, **kwargs):
+        if db_field.name == "participant":
+            kwargs["queryset"] = Participant.objects.filter(study__in=studies_for(request.user).values("pk"))
+        elif db_field.name == "section":
+            kwargs["queryset"] = Section.objects.filter(study__in=studies_for(request.user).values("pk"))
+        return super().formfield_for_foreignkey(db_field, request, **kwargs)

@@ -37,6 +37,7 @@ from study_protocol import (
     RESPONSE_COLUMNS,
     VIEWING_COLUMNS,
     VIEWING_FIELDS,
+    VIEWING_SERVER_FIELDS,
     attention_passed,
 )
 
@@ -153,7 +154,8 @@ def assignment_rows(study: Study) -> Iterator[list]:
 
 def viewing_rows(study: Study) -> Iterator[list]:
     """One row per answered clip page (practice items left out): participant, clip, section type, then
-    VIEWING_FIELDS (blank where unknown or when the browser sent no record)."""
+    VIEWING_FIELDS (blank where unknown or when the browser sent none) and VIEWING_SERVER_FIELDS (blank for an
+    answer stored before the server kept them)."""
     qs = (Assignment.objects.filter(section__study=study, answered_at__isnull=False)
           .exclude(kind=Assignment.Kind.PRACTICE)
           .annotate(exported_type=_exported_type())
@@ -161,7 +163,8 @@ def viewing_rows(study: Study) -> Iterator[list]:
           .values_list("participant__public_id", "clip__clip_id", "exported_type", "viewing"))
     for pid, clip_id, stype, viewing in qs.iterator(chunk_size=CHUNK):
         record = viewing if isinstance(viewing, dict) else {}
-        yield [pid, clip_id, stype, *(record.get(f) for f in VIEWING_FIELDS)]
+        yield [pid, clip_id, stype, *(record.get(f) for f in VIEWING_FIELDS),
+               *(record.get(f) for f in VIEWING_SERVER_FIELDS)]
 
 
 def stream_csv(study: Study, kind: str) -> Iterator[str]:

@@ -11,6 +11,7 @@ from study_pools import SUB_POOLS
 
 from . import pool_editor
 from .i18n import display
+from .inputs import refuse_control_characters, refuse_control_characters_in_text
 from .models import Clip, Section, Study
 from .pool_editor import PoolEditorFields
 from .presets import preset_choices
@@ -31,7 +32,8 @@ CHOICE_ERRORS = {"invalid_choice": _("Please choose one of the answers shown."),
 
 
 def _link_param() -> forms.CharField:
-    return forms.CharField(required=False, max_length=PARAM_MAX_LENGTH, widget=forms.HiddenInput)
+    return forms.CharField(required=False, max_length=PARAM_MAX_LENGTH, widget=forms.HiddenInput,
+                           validators=[refuse_control_characters])
 
 
 class ConsentForm(forms.Form):
@@ -67,7 +69,8 @@ class FeedbackForm(forms.Form):
             key = str(q["key"])
             if q.get("kind", "yesno") == "text":
                 self.fields[key] = forms.CharField(label=display(q["text"]), required=False, max_length=2000,
-                                                   widget=forms.Textarea(attrs={"rows": 3}))
+                                                   widget=forms.Textarea(attrs={"rows": 3}),
+                                                   validators=[refuse_control_characters_in_text])
             else:
                 self.fields[key] = forms.ChoiceField(label=display(q["text"]),
                                                      choices=[("yes", gettext("Yes")), ("no", gettext("No"))],

@@ -1,9 +1,11 @@
 """Login throttling glue for django-axes: the client address behind a trusted proxy, the lockout page, and an
 authentication backend that leaves request-less logins (scripts, tests) alone.
 
-Failed admin logins are counted per account and per address (settings.AXES_LOCKOUT_PARAMETERS); after
-LOGIN_FAILURE_LIMIT failures that account, or that address, is refused for LOGIN_LOCKOUT_MINUTES without the
-password being checked (no hashing cost for a flood). Participants never log in, so nothing here touches them.
+Failed admin logins are counted per account-and-address pair and per address (settings.AXES_LOCKOUT_PARAMETERS);
+after LOGIN_FAILURE_LIMIT failures that account from that address, or that address for every account, is refused
+for LOGIN_LOCKOUT_MINUTES without the password being checked (no hashing cost for a flood). The account itself is
+never locked everywhere, so failures from one address cannot lock its owner out from another. Participants
+never log in, so nothing here touches them.
 """
 from __future__ import annotations
 
@@ -11,7 +13,7 @@ from axes.backends import AxesStandaloneBackend
 from django.conf import settings
 from django.shortcuts import render
 
-LOCKED_MESSAGE = ("Too many failed logins for this account or from this address: logging in is locked for now.")
+LOCKED_MESSAGE = ("Too many failed logins from this address: logging in is locked for now.")
 
 
 def client_ip(request) -> str | None:

@@ -95,7 +95,8 @@ def not_modified(request, etag: str, mtime: float) -> bool:
 def _validators(response, etag: str, last_modified: str):
     response["ETag"] = etag
     response["Last-Modified"] = last_modified
-    response["Cache-Control"] = "private, max-age=86400"
+    # revalidated on every use: a clip stops playing for a participant once it is answered (views.media_allowed)
+    response["Cache-Control"] = "private, no-cache"
     return response
 
 

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import secrets
 
+from django.conf import settings
 from django.core.exceptions import ValidationError
 from django.db import models
 from django.utils import timezone
@@ -137,6 +138,12 @@ class Study(models.Model):
         default=dict, blank=True,
         help_text="Rules the analysis applies (raw exports stay unchanged), e.g. "
                   '{"min_rt_fraction": 0.25, "max_straightline": 0.9, "min_attention_pass": 1.0}')
+    # Who may see, preview, export and analyse the study (studyapp.permissions.studies_for); superusers see every
+    # study. Owners also decide who the owners and collaborators are.
+    owners = models.ManyToManyField(settings.AUTH_USER_MODEL, blank=True, related_name="owned_studies",
+                                    help_text="Researchers who run this study and manage who else may see it")
+    collaborators = models.ManyToManyField(settings.AUTH_USER_MODEL, blank=True, related_name="shared_studies",
+                                           help_text="Researchers who may see, preview, export and analyse it")
     created_at = models.DateTimeField(auto_now_add=True)
 
     class Meta:
@@ -282,6 +289,14 @@ class Assignment(models.Model):
     # How the clip was watched before the answer (studyapp.viewing): study_protocol.VIEWING_FIELDS -> int or null;
     # null when the browser sent no record. Exported as viewing.csv.
     viewing = models.JSONField(null=True, blank=True, editable=False)
+    # The clip's playback as the player reported it while the page was open (studyapp.viewing.record_playback), kept
+    # across reloads so a reload neither restarts the count nor resets max_replays: plays started, the ms from
+    # shown_at to the clip's first end (null: not yet), how often the page was displayed, and the counts of the
+    # displays left without an answer (studyapp.viewing.CARRIED_FIELDS -> int), added to the answer's record.
+    plays = models.PositiveIntegerField(default=0, editable=False)
+    play_ended_ms = models.PositiveIntegerField(null=True, blank=True, editable=False)
+    shows = models.PositiveIntegerField(default=0, editable=False)
+    carried = models.JSONField(default=dict, blank=True, editable=False)
 
     class Meta:
         ordering = ["participant", "seq"]

@@ -1,11 +1,15 @@
 """Who may open the researcher pages: the staff-plus-permission decorator, the custom permissions of the study
-models and the permission set of the shipped "researcher" group (created by a data migration)."""
+models, the permission set of the shipped "researcher" group (created by a data migration), and per-study access:
+a researcher sees only the studies they own or collaborate on (superusers see all), everywhere a study's data is
+shown (admin lists and pages, preview, progress, exports, reports)."""
 from __future__ import annotations
 
 from functools import wraps
 
 from django.contrib.admin.views.decorators import staff_member_required
 from django.core.exceptions import PermissionDenied
+from django.db.models import Q
+from django.http import Http404
 
 EXPORT_PERMISSION = "studyapp.export_participant_data"
 """Download a study's CSV exports and analysis report (participant data, Prolific IDs included)."""
@@ -47,3 +51,37 @@ def staff_permission_required(perm: str):
         return staff_member_required(checked)
 
     return decorator
+
+
+def studies_for(user):
+    """The studies ``user`` may see (a Study queryset): every study for an active superuser, else those the user
+    owns or collaborates on; none for anyone else."""
+    from .models import Study
+
+    if not (user.is_authenticated and user.is_active):
+        return Study.objects.none()
+    if user.is_superuser:
+        return Study.objects.all()
+    return Study.objects.filter(pk__in=Study.objects.filter(Q(owners=user) | Q(collaborators=user)).values("pk"))
+
+
+def can_access_study(user, study) -> bool:
+    """True when ``user`` may see ``study`` (a Study or its pk)."""
+    pk = getattr(study, "pk", study)
+    return pk is not None and studies_for(user).filter(pk=pk).exists()
+
+
+def can_manage_study_access(user, study) -> bool:
+    """True when ``user`` may change who owns and collaborates on ``study``: superusers and its owners."""
+    if not (user.is_authenticated and user.is_active):
+        return False
+    return user.is_superuser or (study.pk is not None and study.owners.filter(pk=user.pk).exists())
+
+
+def study_of(request, study_id: int):
+    """The study of a researcher page's URL if the request's user may see it, else Http404 (a study of another
+    lab is not confirmed to exist)."""
+    study = studies_for(request.user).filter(pk=study_id).first()
+    if study is None:
+        raise Http404("No study with this id")
+    return study

@@ -28,10 +28,13 @@ CONTENT_SECURITY_POLICY = "; ".join([
     "form-action 'self'",
 ])
 
+POLICY_FEATURES_OFF = ("accelerometer", "camera", "display-capture", "geolocation", "gyroscope", "hid",
+                       "magnetometer", "microphone", "midi", "payment", "serial", "usb", "xr-spatial-tracking")
+"""Features turned off: only names browsers recognise (an unknown one, such as ambient-light-sensor or bluetooth,
+is a console warning on every page in Chromium)."""
+
 PERMISSIONS_POLICY = ", ".join([
-    *(f"{feature}=()" for feature in ("accelerometer", "ambient-light-sensor", "bluetooth", "camera",
-                                      "display-capture", "geolocation", "gyroscope", "hid", "magnetometer",
-                                      "microphone", "midi", "payment", "serial", "usb", "xr-spatial-tracking")),
+    *(f"{feature}=()" for feature in POLICY_FEATURES_OFF),
     # the clip player may go full screen and play on its own page
     "autoplay=(self)", "fullscreen=(self)", "picture-in-picture=(self)",
 ])

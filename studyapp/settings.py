@@ -6,6 +6,11 @@ Variables (all optional for the demo):
     ALLOWED_HOSTS     comma-separated host names (default: localhost,127.0.0.1,[::1])
     CSRF_TRUSTED_ORIGINS  comma-separated origins, e.g. https://study.example.org
     DATABASE_URL      e.g. postgres://user@127.0.0.1:5432/db; SQLite file var/db.sqlite3 when unset
+    DB_CONNECTIONS    PostgreSQL: the most connections all server processes together open (default 20; keep it
+                      below max_connections minus what migrations, reports and psql need)
+    WEB_CONCURRENCY   server worker processes sharing DB_CONNECTIONS (default 2; gunicorn reads it too)
+    DB_POOL_TIMEOUT   seconds a request waits for a free pooled connection before a 503 (default 5)
+    DB_POOL           "0" turns the pool off: one connection per request, closed at its end
     DATA_DIR          where the SQLite file, media and reports live (default: ./var)
     MEDIA_ROOT        where rendered clips live (default: DATA_DIR/media)
     PRODUCTION        "1" turns on HTTPS-only cookies, HSTS and the other deploy checks
@@ -13,7 +18,8 @@ Variables (all optional for the demo):
                       requests are then answered with X-Accel-Redirect and nginx sends the bytes (docs/deploy.md);
                       empty (default): the app streams clips itself
     REPORTS_DIR       where finished analysis-report zips are kept (default: DATA_DIR/reports)
-    LOGIN_FAILURE_LIMIT   failed logins after which an account, or an address, is locked out (default 5)
+    LOGIN_FAILURE_LIMIT   failed logins after which an account from one address, or an address, is locked out
+                      (default 5)
     LOGIN_LOCKOUT_MINUTES how long such a lockout lasts (default 15)
     TRUSTED_PROXY_COUNT   reverse proxies in front of the app whose X-Forwarded-For is trusted for the client
                       address of the login throttle (default: 1 with PRODUCTION=1, the nginx recipe; else 0)
@@ -136,6 +142,8 @@ INSTALLED_APPS = [
 MIDDLEWARE = [
     "django.middleware.security.SecurityMiddleware",
     "studyapp.security.ContentSecurityPolicyMiddleware",
+    # 400 for a control character (NUL, ...) in the path, a query or form value or a cookie: before any lookup
+    "studyapp.inputs.ControlCharacterMiddleware",
     "whitenoise.middleware.WhiteNoiseMiddleware",
     "django.contrib.sessions.middleware.SessionMiddleware",
     # each request starts in LANGUAGE_CODE; participant views activate their study's language (studyapp.i18n)
@@ -168,11 +176,32 @@ TEMPLATES = [
 ]
 
 
+def postgres_pool_options(budget: int, workers: int, timeout_s: float) -> dict:
+    """Django's PostgreSQL pool (psycopg_pool.ConnectionPool arguments) of one server process: at most
+    budget // workers connections (at least 2), one kept open when idle; a request waits at most timeout_s (s) for
+    a free one, then fails with OperationalError (PoolTimeout), which the app answers with 503 and Retry-After
+    (studyapp.views_health.server_error) instead of opening more."""
+    max_size = max(2, budget // max(1, workers))
+    return {"min_size": 1, "max_size": max_size, "timeout": timeout_s, "max_idle": 300.0}
+
+
 def database_from_env() -> dict:
-    """PostgreSQL (or any dj-database-url URL) when DATABASE_URL is set, else SQLite in WAL mode."""
+    """PostgreSQL (or any dj-database-url URL) when DATABASE_URL is set, else SQLite in WAL mode.
+
+    PostgreSQL goes through Django's connection pool (OPTIONS["pool"]): connections stay bounded however many
+    requests run at once, under gunicorn's threads as under its ASGI workers (which run each request's view in a
+    thread of its own: with persistent per-thread connections they opened one per concurrent request). Sized from
+    DB_CONNECTIONS (all server processes together) and WEB_CONCURRENCY (their number); DB_POOL=0 turns it off
+    (one connection per request, closed at its end, e.g. behind pgbouncer)."""
     url = os.environ.get("DATABASE_URL", "").strip()
     if url:
-        return dj_database_url.parse(url, conn_max_age=60, conn_health_checks=True)
+        config = dj_database_url.parse(url, conn_max_age=0)
+        if config["ENGINE"] == "django.db.backends.postgresql" and env_bool("DB_POOL", True):
+            budget = env_int("DB_CONNECTIONS", 20, minimum=2)
+            workers = env_int("WEB_CONCURRENCY", 2, minimum=1)
+            timeout = env_int("DB_POOL_TIMEOUT", 5, minimum=1)
+            config.setdefault("OPTIONS", {})["pool"] = postgres_pool_options(budget, workers, float(timeout))
+        return config
     return {
         "ENGINE": "django.db.backends.sqlite3",
         "NAME": DATA_DIR / "db.sqlite3",
@@ -204,15 +233,16 @@ USE_TZ = True
 
 LOGIN_URL = "/admin/login/"
 
-# Login throttling (django-axes, studyapp.login_throttle): failed logins count per account and per address; at
-# the limit that account or address is locked out for the cool-off time, without checking the password.
+# Login throttling (django-axes, studyapp.login_throttle): failed logins count per account-and-address pair and per
+# address; at the limit that pair, or that address, is locked out for the cool-off time without checking the
+# password. Never per account alone: anyone could then lock the admin out from everywhere.
 AUTHENTICATION_BACKENDS = [
     "studyapp.login_throttle.ThrottledLoginBackend",
     "django.contrib.auth.backends.ModelBackend",
 ]
 AXES_FAILURE_LIMIT = env_int("LOGIN_FAILURE_LIMIT", 5, minimum=1)
 AXES_COOLOFF_TIME = timedelta(minutes=env_int("LOGIN_LOCKOUT_MINUTES", 15, minimum=1))
-AXES_LOCKOUT_PARAMETERS = ["username", "ip_address"]
+AXES_LOCKOUT_PARAMETERS = [["username", "ip_address"], "ip_address"]
 AXES_RESET_ON_SUCCESS = True
 AXES_LOCKOUT_CALLABLE = "studyapp.login_throttle.lockout_response"
 AXES_CLIENT_IP_CALLABLE = "studyapp.login_throttle.client_ip"

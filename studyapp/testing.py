@@ -99,13 +99,16 @@ def admin_form_data(response) -> dict[str, str]:
     """The POST data an admin change (or add) page would submit unchanged: its main form and every inline
     formset with its management form, from the page's template context (Django test client response)."""
 
-    def fields(form) -> dict[str, str]:
+    def fields(form) -> dict[str, str | list[str]]:
         data = {}
         for bound in form:
             value = bound.value()
             if isinstance(bound.field, forms.BooleanField):
                 if value:
                     data[bound.html_name] = "on"
+                continue
+            if isinstance(bound.field, forms.ModelMultipleChoiceField):      # owners, collaborators
+                data[bound.html_name] = [str(getattr(v, "pk", v)) for v in value or []]
                 continue
             data[bound.html_name] = "" if value is None else str(value)
         return data

@@ -1,5 +1,6 @@
 """Root URL map: the Django admin under /admin/, the liveness probe /healthz and the study app (namespace
-"studyapp") at the root."""
+"studyapp") at the root; server errors go to views_health.server_error (503 + Retry-After when the database could
+not be reached)."""
 from django.contrib import admin
 from django.urls import include, path
 
@@ -10,3 +11,5 @@ urlpatterns = [
     path("healthz", views_health.healthz, name="healthz"),
     path("", include("studyapp.urls_study")),
 ]
+
+handler500 = "studyapp.views_health.server_error"

@@ -12,6 +12,7 @@ urlpatterns = [
     path("p/<str:token>/", views.resume, name="resume"),
     path("p/<str:token>/about-you/", views.demographics, name="demographics"),
     path("p/<str:token>/clip/<int:n>/", views.item, name="item"),
+    path("p/<str:token>/clip/<int:n>/playback", views.playback, name="playback"),
     path("p/<str:token>/feedback/", views.feedback, name="feedback"),
     path("p/<str:token>/done/", views.done, name="done"),
     path("m/<str:key>.<str:ext>", views.media, name="media"),

@@ -13,6 +13,7 @@ import secrets
 
 from django.conf import settings
 from django.db import IntegrityError, transaction
+from django.db.models import F
 from django.http import Http404, HttpResponse
 from django.shortcuts import get_object_or_404, redirect, render
 from django.urls import reverse
@@ -20,7 +21,7 @@ from django.utils import timezone
 from django.utils.crypto import constant_time_compare
 from django.utils.translation import gettext
 from django.views.decorators.cache import never_cache
-from django.views.decorators.http import require_http_methods
+from django.views.decorators.http import require_http_methods, require_POST
 
 from study_protocol import ATTENTION_CHECK
 
@@ -33,8 +34,18 @@ from .item_questions import questions_html
 from .media import accel_redirect_response, media_path, ranged_file_response
 from .models import Assignment, Clip, Participant, Response, Study
 from .page_reads import participant_by_token
+from .permissions import has_staff_permission
 from .questions import AnswerError, clean_answers, questions_for
-from .viewing import VIEWING_FORM_FIELDS, parse_viewing, player_options
+from .viewing import (
+    MAX_COUNT,
+    PLAYBACK_EVENTS,
+    SCRIPT_FIELD,
+    VIEWING_FORM_FIELDS,
+    carried_counts,
+    parse_viewing,
+    player_options,
+    plays_left,
+)
 
 SESSION_KEY = "study_tokens"
 CONSENT_KEYS = "consent_keys"
@@ -250,16 +261,23 @@ def clip_sources(clip: Clip) -> dict:
 
 
 def item_context(section, clip, index: int, total: int, next_clip: Clip | None, options: list[str] | None,
-                 posted=None, kind: str = "", instructed: str = "") -> dict:
+                 posted=None, kind: str = "", instructed: str = "", plays_before: int = 0,
+                 ended_before: bool = False, playback_url: str = "") -> dict:
     """Template context of a clip page (participant and preview share it). kind/instructed: the assignment's
-    (a practice item is marked "Practice"; an attention check asks one question with its instruction)."""
+    (a practice item is marked "Practice"; an attention check asks one question with its instruction).
+    plays_before / ended_before: the plays and the end the player reported during earlier displays of the page
+    (a reload); playback_url: where the player reports them (none in the preview)."""
     questions = item_questions(section, clip, options, kind, instructed)
     fields = [{"q": q, "selected": posted.getlist(q.key) if posted is not None else []} for q in questions]
+    player = player_options(section.options)
+    left = plays_left(plays_before, player["max_replays"])
     return {"section": section, "fields": fields, "questions_html": questions_html(fields),
             "sources": clip_sources(clip),
             "next_sources": clip_sources(next_clip) if next_clip else None,
             "loop": section.loop or clip.loop, "require_play": section.require_full_play,
-            "player": player_options(section.options), "viewing_fields": VIEWING_FORM_FIELDS,
+            "player": player, "viewing_fields": VIEWING_FORM_FIELDS, "script_field": SCRIPT_FIELD,
+            "plays_before": plays_before, "ended_before": ended_before, "playback_url": playback_url,
+            "autoplay": left is None or left > 0,
             "index": index, "total": total, "percent": int(round(100 * (index - 1) / max(total, 1))),
             "practice": kind == Assignment.Kind.PRACTICE, **attention_context(questions, kind, instructed)}
 
@@ -367,7 +385,10 @@ def item(request, token: str, n: int):
     response_ms = client_ms(request.POST.get("rt", ""), server_ms)
     if response_ms is None:
         response_ms = server_ms
-    viewing = parse_viewing(request.POST, min(MAX_RESPONSE_MS, server_ms + RT_SLACK_MS))
+    viewing = parse_viewing(request.POST, min(MAX_RESPONSE_MS, server_ms), clip.duration_s,
+                            {"plays": assignment.plays, "ended_ms": assignment.play_ended_ms,
+                             "shows": assignment.shows, "carried": assignment.carried},
+                            time_slack_ms=RT_SLACK_MS)
     save_answers(assignment, answers, response_ms, viewing)
     if request.POST.get(INLINE_NEXT_FIELD) == "1" and n < participant.n_items:
         nxt = current_step(participant, lookahead=True)
@@ -378,11 +399,18 @@ def item(request, token: str, n: int):
 
 def _show_item(request, participant: Participant, step):
     """The clip page of `step` as first shown (no answer selected), recording shown_at the first time it is
-    shown (a GET, or the answer POST that brings the next clip page; a HEAD, e.g. an uptime monitor's, shows
-    nothing and records nothing)."""
+    shown and counting every display (a GET, or the answer POST that brings the next clip page; a HEAD, e.g. an
+    uptime monitor's, shows nothing and records nothing). The browser session is given the participant, so its
+    player may fetch the clip (``media``)."""
     assignment = step.assignment
-    if assignment.shown_at is None and request.method != "HEAD":
-        Assignment.objects.filter(pk=assignment.pk, shown_at__isnull=True).update(shown_at=timezone.now())
+    if request.method != "HEAD":
+        if assignment.shown_at is None:
+            Assignment.objects.filter(pk=assignment.pk, shown_at__isnull=True).update(
+                shown_at=timezone.now(), shows=F("shows") + 1)
+        else:
+            Assignment.objects.filter(pk=assignment.pk).update(shows=F("shows") + 1)
+        if request.session.get(SESSION_KEY, {}).get(participant.study.slug) != participant.token:
+            _remember(request, participant)
     return _render_item(request, participant, step, posted=None)
 
 
@@ -422,12 +450,47 @@ def _render_item(request, participant: Participant, step, status: int = 200, err
     if posted is _POSTED:
         posted = request.POST if request.method == "POST" else None
     ctx = item_context(assignment.section, assignment.clip, step.index, step.total, nxt.clip if nxt else None,
-                       assignment.options, posted, assignment.kind, assignment.instructed)
+                       assignment.options, posted, assignment.kind, assignment.instructed,
+                       plays_before=assignment.plays, ended_before=assignment.play_ended_ms is not None,
+                       playback_url=reverse("studyapp:playback", kwargs={"token": participant.token,
+                                                                        "n": step.index}))
     ctx.update({"participant": participant, "study": participant.study, "error": error,
                 "first_of_section": assignment.position == 0,
                 "form_action": reverse("studyapp:item", kwargs={"token": participant.token, "n": step.index}),
                 "inline_next_field": INLINE_NEXT_FIELD})
     return render(request, "studyapp/item.html", ctx, status=status)
+
+
+@never_cache
+@require_POST
+def playback(request, token: str, n: int):
+    """The player's report (static/studyapp/study.js) of a play from the start, of the clip's first end, or of the
+    counts of a display being left without an answer (a reload) on clip page n, kept on the assignment while it is
+    unanswered: a reload then keeps the plays (max_replays holds), the end and the counts. 204; 400 for an unknown
+    event; 404 when page n is not the participant's current page."""
+    participant = _participant(token)
+    event = request.POST.get("event", "")
+    if event not in PLAYBACK_EVENTS:
+        return HttpResponse(status=400)
+    unanswered = Assignment.objects.filter(participant=participant, answered_at__isnull=True)
+    if unanswered.filter(seq__lt=n).exists():         # not the page the participant is on
+        return HttpResponse(status=404)
+    pending = unanswered.filter(seq=n)
+    if event == "play":
+        found = pending.filter(plays__lt=MAX_COUNT).update(plays=F("plays") + 1) or pending.exists()
+    else:
+        shown = pending.values_list("shown_at", flat=True).first()
+        found = shown is not None
+        if found:
+            ms = min(max(int((timezone.now() - shown).total_seconds() * 1000), 0), 2**31 - 1)
+            if event == "ended":
+                pending.filter(play_ended_ms__isnull=True).update(play_ended_ms=ms)
+            else:
+                with transaction.atomic():
+                    row = pending.select_for_update().only("pk", "carried").first()
+                    if row is not None:
+                        pending.filter(pk=row.pk).update(carried=carried_counts(request.POST, ms, row.carried))
+    return HttpResponse(status=204 if found else 404)
 
 
 @never_cache
@@ -458,15 +521,29 @@ def done(request, token: str):
                                                   "completion_url": study.completion_url()})
 
 
+def media_allowed(request, clip: Clip) -> bool:
+    """Whether this request may fetch ``clip``: a participant of this browser session (views.SESSION_KEY) has an
+    unanswered page showing it (the current clip or the next one being preloaded), or a staff member who may see
+    the catalogue (admin and preview). The URL alone is never enough, and a clip's URL stops working for a
+    participant once it is answered."""
+    tokens = [t for t in request.session.get(SESSION_KEY, {}).values() if isinstance(t, str)]
+    if tokens and Assignment.objects.filter(participant__token__in=tokens, clip=clip,
+                                            answered_at__isnull=True).exists():
+        return True
+    return has_staff_permission(request.user, "studyapp.view_clip")
+
+
 def media(request, key: str, ext: str):
-    """A clip's MP4/WebM/poster by its opaque media key, with HTTP Range support; behind nginx
-    (settings.MEDIA_ACCEL_REDIRECT) the bytes are handed to nginx with X-Accel-Redirect after this lookup."""
-
-
+    """A clip's MP4/WebM/poster by its opaque media key, for a session that may see it (``media_allowed``, else
+    403), with HTTP Range support; behind nginx (settings.MEDIA_ACCEL_REDIRECT) the bytes are handed to nginx with
+    X-Accel-Redirect after these checks."""
     clip = get_object_or_404(Clip, media_key=key)
     relative = {"mp4": clip.video, "webm": clip.webm, "png": clip.poster}.get(ext, "")
     if not relative:
         return HttpResponse(status=404)
+    if not media_allowed(request, clip):
+        return HttpResponse("This clip is shown on its study page only.", status=403,
+                            content_type="text/plain; charset=utf-8")
     if settings.MEDIA_ACCEL_REDIRECT:
         return accel_redirect_response(media_path(relative), settings.MEDIA_ACCEL_REDIRECT)
     return ranged_file_response(request, media_path(relative))

@@ -1,17 +1,58 @@
-"""A liveness probe: GET (or HEAD, as uptime monitors send) /healthz answers "ok" without touching the database
-or the session.
+"""A liveness probe, and the server-error page that tells a database outage from a bug.
 
-Load balancers poll it, and benchmarks/bench_study_load.py uses it as the requests/s ceiling of the stack (the
-cost of a request through gunicorn and Django's middleware with no view work at all).
+GET (or HEAD, as uptime monitors send) /healthz answers "ok" without touching the database or the session. Load
+balancers poll it, and benchmarks/bench_study_load.py uses it as the requests/s ceiling of the stack (the cost of a
+request through gunicorn and Django's middleware with no view work at all).
+
+``server_error`` is the app's handler500: when the request failed because no database connection could be had
+(the pool's wait ran out, PostgreSQL refused a new connection, SQLite stayed locked) it answers 503 with
+Retry-After, so a browser or a load balancer tries again; anything else gets Django's plain 500 page. Neither
+shows a traceback, and neither touches the database or the session.
 """
 from __future__ import annotations
 
+import sys
+
+from django.db import OperationalError
 from django.http import HttpResponse
+from django.views import defaults
 from django.views.decorators.cache import never_cache
 from django.views.decorators.http import require_safe
+
+RETRY_AFTER_S = 5
+UNAVAILABLE_TEXT = ("The study server is busy right now. Please wait a few seconds and reload the page: your "
+                    "answers so far are saved.")
 
 
 @never_cache
 @require_safe
 def healthz(request):
     return HttpResponse("ok", content_type="text/plain; charset=utf-8")
+
+
+def database_unavailable(exc: BaseException | None) -> bool:
+    """True when ``exc`` (or an exception it was raised from) says no database connection could be had: Django's
+    OperationalError (it wraps psycopg's, and psycopg_pool.PoolTimeout is one) or the driver's own."""
+    seen = 0
+    while exc is not None and seen < 5:
+        if isinstance(exc, OperationalError):
+            return True
+        if type(exc).__name__ in {"PoolTimeout", "TooManyRequests"} and type(exc).__module__.startswith(
+                "psycopg_pool"):
+            return True
+        exc, seen = exc.__cause__ or exc.__context__, seen + 1
+    return False
+
+
+def unavailable_response() -> HttpResponse:
+    response = HttpResponse(UNAVAILABLE_TEXT, status=503, content_type="text/plain; charset=utf-8")
+    response["Retry-After"] = str(RETRY_AFTER_S)
+    response["Cache-Control"] = "no-store"
+    return response
+
+
+def server_error(request, template_name: str = defaults.ERROR_500_TEMPLATE_NAME):
+    """handler500: 503 + Retry-After for a database that could not be reached, else Django's 500 page."""
+    if database_unavailable(sys.exc_info()[1]):
+        return unavailable_response()
+    return defaults.server_error(request, template_name)

@@ -2,7 +2,9 @@
 
 Each page needs a staff account (else the admin login) and one Django permission (else 403): creating a study
 studyapp.add_study, preview and progress studyapp.view_study, CSV exports and the analysis report (participant
-data, Prolific IDs included) studyapp.export_participant_data.
+data, Prolific IDs included) studyapp.export_participant_data. A study's pages also need access to that study
+(its owner or a collaborator, or a superuser): another lab's study is a 404 (studyapp.permissions.study_of). The
+researcher who creates a study from a preset becomes its owner.
 """
 from __future__ import annotations
 
@@ -12,7 +14,7 @@ from pathlib import Path
 from django.contrib import messages
 from django.db.models import Count, Q
 from django.http import FileResponse, Http404, StreamingHttpResponse
-from django.shortcuts import get_object_or_404, redirect, render
+from django.shortcuts import redirect, render
 from django.urls import reverse
 from django.views.decorators.http import require_http_methods
 
@@ -23,7 +25,7 @@ from .export import EXPORT_KINDS, stream_csv
 from .forms import ConsentForm, PresetStudyForm
 from .i18n import activate_study_language
 from .models import Assignment, Participant, Response, Study
-from .permissions import EXPORT_PERMISSION, staff_permission_required
+from .permissions import EXPORT_PERMISSION, staff_permission_required, study_of
 from .presets import create_study_from_preset
 from .questions import AnswerError, clean_answers
 from .reports import report_state, start_build
@@ -37,6 +39,7 @@ def create_from_preset(request):
     if request.method == "POST" and form.is_valid():
         d = form.cleaned_data
         study = create_study_from_preset(d["preset"], d["slug"], d["title"] or None)
+        study.owners.add(request.user)
         messages.success(request, f"Created '{study.title}' from preset {d['preset']} (status: draft).")
         return redirect(reverse("admin:studyapp_study_change", args=[study.pk]))
     return render(request, "studyapp/staff/create_from_preset.html", {"form": form, "title": "New study from preset"})
@@ -69,7 +72,7 @@ def _preview_seed(request) -> int:
 
 @staff_permission_required("studyapp.view_study")
 def preview_start(request, study_id: int):
-    study = get_object_or_404(Study, pk=study_id)
+    study = study_of(request, study_id)
     activate_study_language(study)     # the preview shows the pages as participants see them
     seed = _preview_seed(request)
     return render(request, "studyapp/consent.html", {"study": study, "form": ConsentForm(), "preview": True,
@@ -80,7 +83,7 @@ def preview_start(request, study_id: int):
 @require_http_methods(["GET", "POST"])
 def preview_item(request, study_id: int, n: int):
     """Clip n of a preview participant with the given seed. Answers are validated, never stored."""
-    study = get_object_or_404(Study, pk=study_id)
+    study = study_of(request, study_id)
     activate_study_language(study)     # the preview shows the pages as participants see them
     seed = _preview_seed(request)
     flat = _preview_plan(study, seed)
@@ -107,7 +110,7 @@ def preview_item(request, study_id: int, n: int):
 
 @staff_permission_required("studyapp.view_study")
 def progress(request, study_id: int):
-    study = get_object_or_404(Study, pk=study_id)
+    study = study_of(request, study_id)
     counts = {row["status"]: row["n"] for row in study.participants.values("status").annotate(n=Count("id"))}
     sections = []
     for section in study.sections.order_by("order", "id"):
@@ -128,7 +131,7 @@ def progress(request, study_id: int):
 
 @staff_permission_required(EXPORT_PERMISSION)
 def export_csv(request, study_id: int, kind: str):
-    study = get_object_or_404(Study, pk=study_id)
+    study = study_of(request, study_id)
     if kind not in EXPORT_KINDS:
         raise Http404("unknown export")
     response = StreamingHttpResponse(stream_csv(study, kind), content_type="text/csv; charset=utf-8")
@@ -142,7 +145,7 @@ def report_zip(request, study_id: int):
     """The analysis report of the study's current data. POST starts a detached build (studyapp.reports) and
     returns at once to the progress page, which shows the build's status; GET sends the finished zip of the
     current data version, or goes back to the progress page when there is none yet."""
-    study = get_object_or_404(Study, pk=study_id)
+    study = study_of(request, study_id)
     if request.method == "POST":
         try:
             state = start_build(study)

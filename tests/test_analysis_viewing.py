@@ -14,7 +14,7 @@ from analysis import viewing as V
 from analysis.io import ValidationError, read_viewing
 from analysis.report import write_report
 from analysis.simulate import simulate_study
-from study_protocol import VIEWING_COLUMNS, VIEWING_FIELDS
+from study_protocol import VIEWING_COLUMNS, VIEWING_COLUMNS_V1, VIEWING_FIELDS
 
 FULL = {"first_play_ms": 150, "ended_ms": 3200, "plays": 1, "pauses": 0, "seeks": 0, "stalls": 0, "stall_ms": 0,
         "hidden": 0}
@@ -41,17 +41,37 @@ def to_csv(df: pd.DataFrame) -> io.StringIO:
 # ---- reader -----------------------------------------------------------------------------------------------------
 
 def test_read_viewing_blank_and_integer_fields():
-    text = ",".join(VIEWING_COLUMNS) + "\np1,c1,emotion_choice,120,3000,2,1,0,0,0,1\np1,c2,emotion_choice" \
-        + "," * len(VIEWING_FIELDS) + "\n"
+    """A file of the first version (no record, page_ms, shows, startup_ms, hidden_ms columns) still reads."""
+    text = ",".join(VIEWING_COLUMNS_V1) + "\np1,c1,emotion_choice,120,3000,2,1,0,0,0,1\np1,c2,emotion_choice" \
+        + "," * 8 + "\n"
     df = read_viewing(io.StringIO(text))
     assert df["plays"].tolist()[0] == 2 and np.isnan(df["plays"].iloc[1])
     assert V.recorded(df).tolist() == [True, False]
+    assert df["record"].tolist() == ["", ""] and df["hidden_ms"].isna().all()
+
+
+def test_read_viewing_with_the_record_markers():
+    head = ",".join(VIEWING_COLUMNS)
+    rows = ["p1,c1,emotion_choice,120,3000,1,0,0,0,0,0,80,0,ok,4000,1",
+            "p1,c2,emotion_choice,,,,,,,,,,,missing,3000,1",
+            "p1,c3,emotion_choice,,,,,,,,,,,no_script,3500,1",
+            "p1,c4,emotion_choice,120,3000,999,0,0,0,0,0,,,Implausible,5000,2"]
+    df = read_viewing(io.StringIO(head + "\n" + "\n".join(rows) + "\n"))
+    assert df["record"].tolist() == ["ok", "missing", "no_script", "implausible"]
+    assert V.recorded(df).tolist() == [True, False, False, False]       # only trusted records are judged
+    assert V.untrusted(df).tolist() == [False, True, False, True]
+    assert df["shows"].tolist() == [1, 1, 1, 2] and df["page_ms"].iloc[0] == 4000
+    summary = V.viewing_summary(df)
+    assert (summary["n_recorded"], summary["n_record_missing"], summary["n_implausible"], summary["n_no_script"]) \
+        == (1, 1, 1, 1)
+    with pytest.raises(ValidationError, match="'record'.*'faked' is not blank or one of ok, missing"):
+        read_viewing(io.StringIO(head + "\n" + rows[0].replace(",ok,", ",faked,") + "\n"))
 
 
 @pytest.mark.parametrize("cell,words", [("-1", "non-negative integer"), ("1.5", "non-negative integer"),
                                         ("many", "'many'")])
 def test_read_viewing_names_line_and_column(cell, words):
-    text = ",".join(VIEWING_COLUMNS) + f"\np1,c1,emotion_choice,120,3000,{cell},1,0,0,0,1\n"
+    text = ",".join(VIEWING_COLUMNS_V1) + f"\np1,c1,emotion_choice,120,3000,{cell},1,0,0,0,1\n"
     with pytest.raises(ValidationError) as exc:
         read_viewing(io.StringIO(text))
     message = str(exc.value)
@@ -60,7 +80,7 @@ def test_read_viewing_names_line_and_column(cell, words):
 
 def test_read_viewing_missing_column_and_unknown_participant():
     with pytest.raises(ValidationError, match="'hidden': required column"):
-        read_viewing(io.StringIO(",".join(VIEWING_COLUMNS[:-1]) + "\n"))
+        read_viewing(io.StringIO(",".join(VIEWING_COLUMNS_V1[:-1]) + "\n"))
     participants = pd.DataFrame({"participant_id": ["p1"]})
     text = ",".join(VIEWING_COLUMNS) + "\np2,c1,emotion_choice" + ",1" * len(VIEWING_FIELDS) + "\n"
     with pytest.raises(ValidationError, match="unknown participant 'p2'"):
@@ -98,6 +118,22 @@ def test_viewing_rules_thresholds_and_unrecorded_answers():
     assert "not applicable" in V.viewing_exclusions(pd.DataFrame(_rows("nojs", 3, blank=3)))[1]
     incomplete = V.incomplete_views(v)
     assert len(incomplete) == 6 + 5 + 2 and list(incomplete.columns) == V.INCOMPLETE_COLUMNS
+
+
+def test_untrusted_records_rule():
+    v = pd.DataFrame(_rows("faker", 10) + _rows("honest", 10) + _rows("nojs", 4, blank=4))
+    v["record"] = "ok"
+    v.loc[v["participant_id"] == "faker", "record"] = ["missing"] * 4 + ["implausible"] * 2 + ["ok"] * 4
+    v.loc[v["participant_id"] == "nojs", "record"] = "no_script"
+    table, note = V.viewing_exclusions(v, max_untrusted_share=0.5)
+    assert [(r.participant_id, r.rule) for r in table.itertuples()] == [("faker", "record_untrusted")]
+    assert "6 of 10 answers with the viewing record missing or implausible (limit 50%)" in set(table["detail"])
+    assert "record_untrusted applied to all 24 answers" in note
+    assert V.viewing_exclusions(v)[0].empty                              # off by default
+    # the untrusted answers are not judged by the other rules: the faker's 4 ok answers are full views
+    assert len(V.incomplete_views(v)) == 0
+    assert X.rule_errors({"max_untrusted_share": 0.25}) == []
+    assert X.resolve_rules({"max_untrusted_share": 0.5})["max_untrusted_share"] == 0.5
 
 
 def test_viewing_rule_keys_are_validated():

@@ -151,7 +151,8 @@ def test_whole_demo_study_in_chromium(chromium, live_server, settings, tmp_path)
                 driver.refresh()
                 wait_for(driver, lambda d: "/clip/2/" in d.current_url and d.find_element(By.ID, "answer-form"),
                          what="reloaded clip 2")
-            assert seen and all(method == "GET" for method, _path in seen), seen
+            # (the player's own reports of the replay are POSTs to .../playback)
+            assert seen and all(method == "GET" or path.endswith("/playback") for method, path in seen), seen
             assert any(path.endswith("/clip/2/") for _method, path in seen), seen
             wait_for(driver, lambda d: d.find_element(By.ID, "next").is_enabled(), timeout=10 + 3 * seconds,
                      what="replayed")
@@ -195,8 +196,13 @@ def test_whole_demo_study_in_chromium(chromium, live_server, settings, tmp_path)
     got = [(r["participant_id"], r["section_type"], r["clip_id"], r["question"]) for r in rows]
     assert len(got) == len(set(got)), "an answer was stored twice"
     assert set(got) == set(expected), "an answer is missing or unexpected"
+    reloaded_clip = participant.assignments.get(seq=2).clip.clip_id
     for r in rows:
         q = expected[(r["participant_id"], r["section_type"], r["clip_id"], r["question"])]
         allowed = {c[0] for c in q.choices}
         assert set(r["answer"].split(";")) <= allowed
-        assert int(r["response_ms"]) >= 500           # measured in the browser; clips are 1 s long
+        if r["clip_id"] == reloaded_clip:
+            # watched to its end before the reload: the reloaded page may enable the answers at once
+            assert int(r["response_ms"]) >= 0
+        else:
+            assert int(r["response_ms"]) >= 500       # measured in the browser; clips are 1 s long

@@ -1,5 +1,6 @@
-"""Login throttling (django-axes via studyapp.login_throttle): failed admin logins lock out the account and the
-address for the cool-off time with a clear 429 page; participants' pages are never affected."""
+"""Login throttling (django-axes via studyapp.login_throttle): failed admin logins lock out the account-and-address
+pair and the address for the cool-off time with a clear 429 page, never the account from every address (the right
+password from another address still works); participants' pages are never affected."""
 from __future__ import annotations
 
 from datetime import timedelta
@@ -53,13 +54,31 @@ def test_below_the_limit_the_right_password_still_works():
     assert logged_in(attempt("admin", "right-pw-1", "10.0.0.1"))
 
 
-def test_account_locked_after_failures_from_many_addresses():
-    for i in range(3):
-        attempt("admin", "wrong", f"10.0.1.{i}")
-    locked = attempt("admin", "right-pw-1", "10.0.9.9")        # right password, fresh address
-    assert_locked(locked)
-    assert "_auth_user_id" not in locked.client.session
-    assert logged_in(attempt("other", "other-pw-1", "10.0.9.9"))   # another account from that address is fine
+def test_failures_from_one_address_never_lock_the_account_elsewhere():
+    for _ in range(5):
+        attempt("admin", "wrong", "10.0.1.1")
+    assert_locked(attempt("admin", "right-pw-1", "10.0.1.1"))      # the pair (and the address) is locked
+    assert_locked(attempt("other", "other-pw-1", "10.0.1.1"))      # the address is locked for every account
+    fresh = attempt("admin", "right-pw-1", "10.0.9.9")              # right password from another address
+    assert logged_in(fresh)
+    assert fresh.client.session["_auth_user_id"] == str(User.objects.get(username="admin").pk)
+
+
+def test_failures_spread_over_addresses_lock_no_one():
+    for i in range(6):
+        attempt("admin", "wrong", f"10.0.1.{10 + i}")               # below the limit on every address
+    assert logged_in(attempt("admin", "right-pw-1", "10.0.1.10"))
+    assert logged_in(attempt("admin", "right-pw-1", "10.0.9.8"))
+
+
+def test_pair_lock_ends_after_the_cool_off_and_does_not_reach_the_other_address():
+    for _ in range(3):
+        attempt("admin", "wrong", "10.0.1.2")
+    assert logged_in(attempt("admin", "right-pw-1", "10.0.1.3"))
+    # the success from .3 resets its own count only: .2 stays locked until the cool-off ends
+    assert_locked(attempt("admin", "right-pw-1", "10.0.1.2"))
+    AccessAttempt.objects.update(attempt_time=timezone.now() - timedelta(minutes=16))
+    assert logged_in(attempt("admin", "right-pw-1", "10.0.1.2"))
 
 
 def test_address_locked_after_failures_on_many_accounts():

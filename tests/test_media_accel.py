@@ -15,6 +15,12 @@ PAYLOAD = bytes(range(256)) * 8
 
 
 @pytest.fixture
+def client(admin_client):
+    """Clip media need a session that may see the clip (studyapp.views.media_allowed): here a superuser's."""
+    return admin_client
+
+
+@pytest.fixture
 def clip(settings, tmp_path):
     settings.MEDIA_ROOT = tmp_path / "media"
     rel = write_media(settings.MEDIA_ROOT, PAYLOAD)
@@ -44,6 +50,10 @@ def test_accel_redirect_keeps_the_app_checks(client, clip, settings):
     missing = client.get(reverse("studyapp:media", kwargs={"key": "0" * 32, "ext": "mp4"}))
     assert missing.status_code == 404 and "X-Accel-Redirect" not in missing
     assert client.get(url(clip, "webm")).status_code == 404                 # no WebM for this clip
+    from django.test import Client
+
+    refused = Client().get(url(clip))                    # no session that may see it: nginx is never asked
+    assert refused.status_code == 403 and "X-Accel-Redirect" not in refused
     Clip.objects.filter(pk=clip.pk).update(video="../../etc/passwd")
     escaped = client.get(url(clip))
     assert escaped.status_code == 404 and "X-Accel-Redirect" not in escaped

@@ -38,7 +38,15 @@ from django.conf import settings
 rel = write_media(settings.MEDIA_ROOT, bytes.fromhex(sys.stdin.read().strip()))
 upsert_clips([{"clip_id": "gait_synthetic_nginx", "modality": "gait", "origin": "generated", "video": rel,
                "happy": 1, "sad": 0, "angry": 0, "neutral": 0}])
-print(Clip.objects.get(clip_id="gait_synthetic_nginx").media_key)
+# clips need a session that may see them (studyapp.views.media_allowed): a superuser's
+from django.contrib.auth import BACKEND_SESSION_KEY, HASH_SESSION_KEY, SESSION_KEY, get_user_model
+from django.contrib.sessions.backends.db import SessionStore
+user = get_user_model().objects.create_superuser("nginx-test", password="pw-nginx-test-1")
+session = SessionStore()
+session.update({SESSION_KEY: str(user.pk), BACKEND_SESSION_KEY: "django.contrib.auth.backends.ModelBackend",
+                HASH_SESSION_KEY: user.get_session_auth_hash()})
+session.create()
+print(Clip.objects.get(clip_id="gait_synthetic_nginx").media_key, session.session_key)
 """
 
 
@@ -71,8 +79,9 @@ def stack(tmp_path_factory):
                MEDIA_ACCEL_REDIRECT="/protected-media/", DJANGO_SETTINGS_MODULE="studyapp.settings",
                OMP_NUM_THREADS="1")
     env.pop("DATABASE_URL", None)
-    key = subprocess.run([sys.executable, "-c", SETUP_SCRIPT], input=PAYLOAD.hex(), env=env, cwd=ROOT, check=True,
-                         capture_output=True, text=True).stdout.strip().splitlines()[-1]
+    key, session = subprocess.run([sys.executable, "-c", SETUP_SCRIPT], input=PAYLOAD.hex(), env=env, cwd=ROOT,
+                                  check=True, capture_output=True, text=True).stdout.strip().splitlines()[-1].split()
+    SESSION_COOKIE["sessionid"] = session
     conf = write_local_site(tmp, tmp / "data", app_port, http_port, https_port)   # runs nginx -t
     app = subprocess.Popen([sys.executable, "-m", "gunicorn", "studyapp.wsgi", "-b", f"127.0.0.1:{app_port}", "-w", "1",
                             "--worker-class", "gthread", "--threads", "4", "--log-level", "warning"], cwd=ROOT, env=env)
@@ -89,9 +98,14 @@ def stack(tmp_path_factory):
             proc.wait(20)
 
 
+SESSION_COOKIE: dict[str, str] = {}
+"""The staff session the clip requests carry (set by the stack fixture)."""
+
+
 def get(url: str, **kw):
     import requests
 
+    kw.setdefault("cookies", SESSION_COOKIE)
     return requests.get(url, verify=False, allow_redirects=False, timeout=20, **kw)
 
 
@@ -108,7 +122,8 @@ def test_range_through_nginx(stack):
     assert r.headers["Content-Range"] == f"bytes 1000-1999/{len(PAYLOAD)}"
     assert r.headers["Content-Type"] == "video/mp4"
     assert "X-Accel-Redirect" not in r.headers
-    assert r.headers["Cache-Control"] == "private, max-age=86400"
+    assert r.headers["Cache-Control"] == "private, no-cache"             # revalidated: answered clips stop
+    assert get(f"{stack['https']}/m/{stack['key']}.mp4", cookies={}).status_code == 403     # no session
     assert r.headers["X-Content-Type-Options"] == "nosniff" and "Server" in r.headers
     assert r.headers["Server"] == "nginx"                               # server_tokens off: no version
     suffix = get(f"{stack['https']}/m/{stack['key']}.mp4", headers={"Range": "bytes=-100"})

@@ -98,3 +98,5 @@ def test_permissions_policy_on_every_response(study):
     for url in ("/healthz", reverse("studyapp:study_entry", args=[study.slug]), "/admin/login/", "/nowhere"):
         policy = client.get(url)["Permissions-Policy"]
         assert "camera=()" in policy and "microphone=()" in policy and "geolocation=()" in policy, url
+        # Chromium warns on every page about a feature it does not know
+        assert "ambient-light-sensor" not in policy and "bluetooth" not in policy, url

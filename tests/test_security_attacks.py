@@ -375,7 +375,8 @@ def test_shipped_gunicorn_command_keeps_tokens_out_of_the_logs_and_debug_off(tmp
 
 # ---- clip revalidation -------------------------------------------------------------------------------------
 
-def test_clip_etag_and_304(client, settings, tmp_path):
+def test_clip_etag_and_304(admin_client, settings, tmp_path):
+    client = admin_client              # a session that may see the clip (studyapp.views.media_allowed)
     settings.MEDIA_ROOT = tmp_path / "media"
     rel = write_media(settings.MEDIA_ROOT, b"0123456789" * 100)
     clip = Clip.objects.create(clip_id="c1", modality="gait", origin="generated", video=rel)

@@ -7,6 +7,7 @@ from django.contrib.auth.models import Group, Permission, User
 from django.test import Client
 from django.urls import reverse
 
+from studyapp.models import Study
 from studyapp.permissions import EXPORT_PERMISSION, RESEARCHER_GROUP, RESEARCHER_PERMISSIONS
 from studyapp.presets import create_study_from_preset
 from studyapp.testing import make_catalogue
@@ -42,7 +43,10 @@ def pages(study) -> list[tuple[str, str, set[int]]]:
 
 
 def staff_client(username: str, *perms: str) -> Client:
+    """A staff member holding ``perms`` who owns every study there is (per-study access: tests/test_study_access.py)."""
     user = User.objects.create_user(username, password="pw-" + username + "-1", is_staff=True)
+    for study in Study.objects.all():
+        study.owners.add(user)
     for perm in perms:
         app_label, codename = perm.split(".")
         user.user_permissions.add(Permission.objects.get(content_type__app_label=app_label, codename=codename))
@@ -102,6 +106,7 @@ def test_researcher_group_from_the_migration_opens_every_page(study):
                                                       "delete_response", "change_clip"]).exists()
     user = User.objects.create_user("res", password="pw-res-1", is_staff=True)
     user.groups.add(group)
+    study.collaborators.add(user)
     client = Client()
     client.force_login(user)
     for url, perm, allowed in pages(study):

@@ -183,6 +183,13 @@ def test_export_and_setup_demo_commands(study, tmp_path):
     call_command("setup_demo", stdout=buf)                      # idempotent
     assert Study.objects.filter(slug="demo").count() == 1
     assert "Participant URL: http://127.0.0.1:8000/s/demo/" in buf.getvalue()
+    from django.contrib.auth.models import User
+
+    demo_admin = User.objects.create_user("demo-admin", password="pw-demo-admin-1", is_staff=True)
+    call_command("setup_demo", "--owner", "demo-admin", stdout=buf)     # what demo.sh runs: its admin may see it
+    assert Study.objects.get(slug="demo").owners.filter(pk=demo_admin.pk).exists()
+    with pytest.raises(CommandError, match="no account"):
+        call_command("setup_demo", "--owner", "nobody", stdout=buf)
 
 
 def test_setup_demo_without_clips_says_what_to_run():

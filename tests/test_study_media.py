@@ -15,6 +15,12 @@ PAYLOAD = bytes(range(256)) * 40      # 10240 bytes
 
 
 @pytest.fixture
+def client(admin_client):
+    """Clip media need a session that may see the clip (studyapp.views.media_allowed): here a superuser's."""
+    return admin_client
+
+
+@pytest.fixture
 def clip(settings, tmp_path):
     settings.MEDIA_ROOT = tmp_path / "media"
     rel = write_media(settings.MEDIA_ROOT, PAYLOAD)

@@ -1,6 +1,8 @@
 """In headless Chromium: the replay-only player undoes a seek (script and keyboard), counts a pause, a hidden tab
-and a replay, stops replays at max_replays, and viewing.csv records exactly that; the consent page's device check
-stops a too-small window and a browser that cannot play the clips before the study starts.
+and a replay, stops replays at max_replays, and viewing.csv records exactly that; a reload during play keeps the
+plays (max_replays holds across reloads) and a pause the browser makes for a hidden tab is hidden time; the
+consent page's device check stops a too-small window and a browser that cannot play the clips before the study
+starts.
 STUDY_SCREENSHOTS=<folder> saves docs/img/study_player_replay_only.png (desktop) and
 study_player_replay_only_360.png (360 px wide) there."""
 from __future__ import annotations
@@ -168,3 +170,102 @@ def test_device_check_stops_small_windows_and_unplayable_browsers(chromium, live
     box = driver.find_element(By.ID, "device-check")
     assert box.is_displayed() and "cannot play" in box.text
     assert not driver.find_element(By.ID, "start-study").is_enabled()
+
+
+def test_a_reload_during_play_keeps_the_plays_and_a_hidden_tab_is_no_pause(chromium, live_server, study):
+    """max_replays 1. Clip 1: it plays, is paused and played on, the page is reloaded mid-play (the reload's
+    autoplay is the one replay left), the tab is hidden and the browser pauses the clip, it goes on when shown
+    again, it ends: 2 plays, the one pause from before the reload, the hidden time (not a pause), 2 displays.
+    Clip 2: played and replayed to its end, then reloaded: it stays stopped with the answers enabled."""
+    from selenium.webdriver.common.by import By
+
+    driver = chromium
+    driver.get(live_server.url + reverse("studyapp:study_entry", args=[study.slug]) + "?PROLIFIC_PID=v-2")
+    consent_and_demographics(driver)
+    wait_for(driver, lambda d: player_state(d)["t"] > 0.3, what="clip playing")
+    p = Participant.objects.get(external_id="v-2")
+    wait_for(driver, lambda d: p.assignments.get(seq=1).plays == 1, what="the play reported to the server")
+    play_pause = driver.find_element(By.ID, "play-pause")
+    play_pause.click()                                                   # the participant's pause, before the reload
+    wait_for(driver, lambda d: player_state(d)["paused"], what="paused")
+    play_pause.click()
+    wait_for(driver, lambda d: not player_state(d)["paused"], what="playing again")
+
+    driver.refresh()                                                     # mid-play
+    assert driver.find_element(By.ID, "clip").get_attribute("data-plays-before") == "1"
+    wait_for(driver, lambda d: p.assignments.get(seq=1).carried.get("pauses") == 1, what="the pause handed on")
+    wait_for(driver, lambda d: player_state(d)["t"] > 0.3, what="replaying after the reload")
+    wait_for(driver, lambda d: p.assignments.get(seq=1).plays == 2, what="the replay reported")
+
+    # Hidden: Chromium pauses a background video by itself; that is hidden time, not the participant's pause.
+    set_hidden(driver, True)
+    js(driver, "document.getElementById('clip').pause();")
+    time.sleep(0.6)
+    set_hidden(driver, False)
+    wait_for(driver, lambda d: not player_state(d)["paused"], what="playing on once shown again")
+
+    wait_for(driver, lambda d: d.find_element(By.ID, "next").is_enabled(), timeout=20, what="clip ended")
+    assert not driver.find_element(By.ID, "replay").is_enabled()        # the one replay went on the reload
+    assert "used all replays" in driver.find_element(By.ID, "play-note").text
+
+    def answer(n_next: int) -> None:
+        driver.find_element(By.CSS_SELECTOR, "#answer-form input[value='sad']").find_element(By.XPATH, "..").click()
+        driver.find_element(By.ID, "next").click()
+        wait_for(driver, lambda d: f"/clip/{n_next}/" in d.current_url, what=f"clip {n_next}")
+
+    answer(2)
+    row = list(csv.DictReader(io.StringIO("".join(stream_csv(study, "viewing")))))[0]
+    assert row["record"] == "ok" and row["shows"] == "2", row
+    assert (row["plays"], row["pauses"], row["hidden"]) == ("2", "1", "1"), row     # the pause before the reload
+    assert int(row["hidden_ms"]) >= 500, row
+    assert int(row["ended_ms"]) > int(row["first_play_ms"]), row
+    assert int(row["page_ms"]) >= CLIP_S * 1000, row
+
+    # Clip 2: to its end, the one replay to its end, then a reload: nothing left to play.
+    wait_for(driver, lambda d: d.find_element(By.ID, "next").is_enabled(), timeout=20, what="clip 2 ended")
+    driver.find_element(By.ID, "replay").click()
+    wait_for(driver, lambda d: not player_state(d)["ended"] and player_state(d)["t"] > 0.2, what="replaying")
+    wait_for(driver, lambda d: player_state(d)["ended"], timeout=20, what="replay ended")
+    wait_for(driver, lambda d: p.assignments.get(seq=2).plays == 2, what="both plays reported")
+    driver.refresh()
+    video = driver.find_element(By.ID, "clip")
+    assert video.get_attribute("autoplay") is None and video.get_attribute("data-ended-before") == "1"
+    time.sleep(1.0)
+    state = player_state(driver)
+    assert state["paused"] and state["t"] < 0.1, state
+    assert driver.find_element(By.ID, "next").is_enabled()              # watched to its end before the reload
+    assert not driver.find_element(By.ID, "replay").is_enabled()
+    driver.find_element(By.ID, "play-pause").click()                     # the play button cannot start it either
+    time.sleep(0.5)
+    assert player_state(driver)["paused"]
+    answer(3)
+    row = list(csv.DictReader(io.StringIO("".join(stream_csv(study, "viewing")))))[1]
+    assert (row["plays"], row["ended_ms"], row["shows"], row["record"]) == ("2", "0", "2", "ok"), row
+
+
+def test_a_reload_mid_play_without_replays_leaves_the_answers_open(chromium, live_server, study):
+    """max_replays 0 and a reload before the clip ended: it may not play again, and the participant is not stuck
+    (the answers are enabled; the record shows no end)."""
+    from selenium.webdriver.common.by import By
+
+    section = study.sections.get(order=1)
+    section.options = {"controls": "replay-only", "max_replays": 0}
+    section.save()
+    driver = chromium
+    driver.get(live_server.url + reverse("studyapp:study_entry", args=[study.slug]) + "?PROLIFIC_PID=v-3")
+    consent_and_demographics(driver)
+    p = Participant.objects.get(external_id="v-3")
+    wait_for(driver, lambda d: p.assignments.get(seq=1).plays == 1, what="the play reported")
+    assert not driver.find_element(By.ID, "next").is_enabled()
+    driver.refresh()
+    time.sleep(1.0)
+    state = player_state(driver)
+    assert state["paused"] and state["t"] < 0.1, state
+    assert driver.find_element(By.ID, "next").is_enabled()
+    assert "used all replays" in driver.find_element(By.ID, "play-note").text
+    time.sleep(CLIP_S)                  # the server still wants the clip's time to pass (require_full_play)
+    driver.find_element(By.CSS_SELECTOR, "#answer-form input[value='sad']").find_element(By.XPATH, "..").click()
+    driver.find_element(By.ID, "next").click()
+    wait_for(driver, lambda d: "/clip/2/" in d.current_url, what="clip 2")
+    row = list(csv.DictReader(io.StringIO("".join(stream_csv(study, "viewing")))))[0]
+    assert (row["plays"], row["ended_ms"], row["shows"], row["record"]) == ("1", "", "2", "ok"), row

@@ -13,9 +13,10 @@ from django.urls import reverse
 
 from study_pools import options_errors, player_errors
 from study_protocol import VIEWING_COLUMNS, VIEWING_FIELDS
+from studyapp.assignment import current_step
 from studyapp.export import stream_csv
 from studyapp.models import Assignment, Participant, Study
-from studyapp.viewing import MAX_COUNT, field_name, parse_viewing
+from studyapp.viewing import MAX_COUNT, SCRIPT_FIELD, carried_counts, field_name, max_plays, parse_viewing
 from tests import test_study_flow as flow
 from tests.test_study_flow import answer_for, consent, cur, demographics
 
@@ -24,7 +25,8 @@ GOOD_RECORD = {"first_play_ms": 120, "ended_ms": 2400, "plays": 2, "pauses": 1, 
 
 
 def posted(record: dict) -> dict:
-    return {field_name(k): str(v) for k, v in record.items()}
+    """The record's fields as the player's script posts them."""
+    return {SCRIPT_FIELD: "1", **{field_name(k): str(v) for k, v in record.items()}}
 
 
 # ---- options ---------------------------------------------------------------------------------------------------
@@ -73,37 +75,76 @@ def test_pool_editor_shows_and_writes_the_player_options(stype, options):
 # ---- parsing ---------------------------------------------------------------------------------------------------
 
 def test_parse_keeps_a_plausible_record():
-    assert parse_viewing(posted(GOOD_RECORD), page_ms=10_000) == GOOD_RECORD
+    record = parse_viewing(posted(GOOD_RECORD), page_ms=10_000)
+    assert record == {**GOOD_RECORD, "startup_ms": None, "hidden_ms": None, "record": "ok", "page_ms": 10_000,
+                      "shows": 1}
     assert parse_viewing({**posted(GOOD_RECORD), field_name("plays"): "2.0"}, 10_000)["plays"] == 2
 
 
-def test_a_post_without_record_stores_none():
-    assert parse_viewing({"perceived": "sad", "rt": "900"}, page_ms=10_000) is None
-    blank_form = {field_name(f): "" for f in VIEWING_FIELDS}               # the page without JavaScript
-    assert parse_viewing(blank_form, page_ms=10_000) is None
-    assert parse_viewing({**blank_form, field_name("plays"): "-4"}, page_ms=10_000) is None
+def test_a_post_without_record_is_missing_and_a_page_without_script_says_so():
+    missing = parse_viewing({"perceived": "sad", "rt": "900"}, page_ms=10_000)
+    assert missing["record"] == "missing" and all(missing[f] is None for f in VIEWING_FIELDS)
+    assert missing["page_ms"] == 10_000 and missing["shows"] == 1
+    blank_form = {field_name(f): "" for f in VIEWING_FIELDS} | {SCRIPT_FIELD: ""}   # the page without JavaScript
+    assert parse_viewing(blank_form, page_ms=10_000)["record"] == "no_script"
+    no_script = parse_viewing({**blank_form, field_name("plays"): "4"}, page_ms=10_000)
+    assert no_script["record"] == "no_script" and no_script["plays"] is None       # not the script's: not kept
+    assert parse_viewing({SCRIPT_FIELD: "1"}, page_ms=10_000)["record"] == "ok"
 
 
 @pytest.mark.parametrize("name,raw", [
     ("first_play_ms", "-1"), ("first_play_ms", "nan"), ("first_play_ms", "inf"), ("first_play_ms", "1e400"),
-    ("first_play_ms", "abc"), ("first_play_ms", "12.5"), ("ended_ms", "10001"), ("stall_ms", "99999999"),
+    ("first_play_ms", "abc"), ("first_play_ms", "12.5"), ("ended_ms", "15001"), ("stall_ms", "99999999"),
     ("plays", str(MAX_COUNT + 1)), ("seeks", "-3"), ("hidden", "1;2"), ("pauses", "9" * 40),
 ])
-def test_out_of_bound_or_malformed_fields_become_unknown(name, raw):
+def test_out_of_bound_or_malformed_fields_make_the_record_implausible(name, raw):
     record = parse_viewing({**posted(GOOD_RECORD), field_name(name): raw}, page_ms=10_000)
-    assert record[name] is None
+    assert record["record"] == "implausible"
     assert all(record[k] == v for k, v in GOOD_RECORD.items() if k != name and k != "ended_ms")
 
 
-@pytest.mark.parametrize("change", [{"ended_ms": "100"}, {"first_play_ms": ""}, {"plays": "0"}])
-def test_an_end_before_any_play_is_dropped(change):
+def test_an_end_before_the_first_play_is_implausible():
+    record = parse_viewing({**posted(GOOD_RECORD), field_name("ended_ms"): "100"}, 10_000)
+    assert record["record"] == "implausible"
+
+
+@pytest.mark.parametrize("change", [{"first_play_ms": ""}, {"plays": "0"}])
+def test_an_end_means_it_played(change):
+    """The start may be missed (the clip started before the script attached): the end still counts as a play."""
     record = parse_viewing({**posted(GOOD_RECORD), **{field_name(k): v for k, v in change.items()}}, 10_000)
-    assert record["ended_ms"] is None
+    assert record["ended_ms"] == 2400 and record["plays"] >= 1 and record["record"] == "ok"
+
+
+def test_plays_are_bounded_by_the_page_time_over_the_clip_duration():
+    faked = parse_viewing(posted({**GOOD_RECORD, "plays": 999}), page_ms=5_000, duration_s=1.0, time_slack_ms=0)
+    assert faked["record"] == "implausible" and faked["plays"] == 999       # kept as sent, marked not trusted
+    assert max_plays(5_000, 1.0) == 6 and max_plays(5_000, None) is None
+    fair = parse_viewing(posted({**GOOD_RECORD, "plays": 6}), page_ms=5_000, duration_s=1.0, time_slack_ms=0)
+    assert fair["record"] == "ok"
+    assert parse_viewing(posted({**GOOD_RECORD, "plays": 7}), 5_000, 1.0, time_slack_ms=0)["record"] == "implausible"
+
+
+def test_the_servers_playback_counts_survive_a_reload():
+    """After a reload the page's own record starts from zero; the plays and the end the player reported before
+    are the server's."""
+    fresh = {SCRIPT_FIELD: "1", field_name("plays"): "0", field_name("pauses"): "0"}
+    record = parse_viewing(fresh, 20_000, 2.0, {"plays": 3, "ended_ms": 2_500, "shows": 2})
+    assert record["plays"] == 3 and record["ended_ms"] == 0 and record["first_play_ms"] == 0
+    assert record["shows"] == 2 and record["record"] == "ok"
+
+
+def test_counts_of_displays_left_without_an_answer_are_added():
+    fresh = {SCRIPT_FIELD: "1", field_name("plays"): "1", field_name("pauses"): "1", field_name("hidden"): "0"}
+    record = parse_viewing(fresh, 20_000, 2.0, {"plays": 2, "carried": {"pauses": 2, "hidden": 1, "hidden_ms": 700,
+                                                                         "unknown": 5, "seeks": "x"}})
+    assert (record["pauses"], record["hidden"], record["hidden_ms"], record["seeks"]) == (3, 1, 700, None)
+    assert carried_counts({field_name("pauses"): "2", field_name("hidden_ms"): "99999", field_name("seeks"): "-1"},
+                          5_000, {"pauses": 1}) == {"pauses": 3}        # out of bound values are ignored
 
 
 def test_missing_fields_are_unknown():
-    record = parse_viewing({field_name("plays"): "1"}, page_ms=10_000)
-    assert record == {**{f: None for f in VIEWING_FIELDS}, "plays": 1}
+    record = parse_viewing({SCRIPT_FIELD: "1", field_name("plays"): "1"}, page_ms=10_000)
+    assert {k: record[k] for k in VIEWING_FIELDS} == {**{f: None for f in VIEWING_FIELDS}, "plays": 1}
 
 
 # ---- the answer path -------------------------------------------------------------------------------------------
@@ -135,7 +176,7 @@ def test_record_is_stored_with_the_answer_without_extra_queries(client, study):
         a2 = answer(client, p, 2, {"rt": "900", **posted({**GOOD_RECORD, "ended_ms": 500})})
     assert len(recorded) == len(plain)
     a1 = Assignment.objects.get(participant=p, seq=1)
-    assert a1.viewing is None
+    assert a1.viewing["record"] == "missing" and a1.viewing["plays"] is None     # posted without the page's fields
     a2.refresh_from_db()
     stored = a2.viewing
     assert stored["plays"] == 2 and stored["hidden"] == 1 and stored["seeks"] == 3
@@ -148,7 +189,7 @@ def test_times_beyond_the_page_time_are_not_stored(client, study):
     client.get(reverse("studyapp:item", args=[p.token, 1]))
     a = answer(client, p, 1, posted({**GOOD_RECORD, "ended_ms": 3_000_000, "stall_ms": 2_000_000}))
     a.refresh_from_db()
-    assert a.viewing["ended_ms"] is None and a.viewing["stall_ms"] is None and a.viewing["plays"] == 2
+    assert a.viewing["record"] == "implausible" and a.viewing["plays"] == 2
 
 
 @pytest.mark.django_db
@@ -158,14 +199,17 @@ def test_viewing_csv_has_one_row_per_answered_clip_page(client, study):
         client.get(reverse("studyapp:item", args=[p.token, n]))
     answer(client, p, 1, {})
     client.get(reverse("studyapp:item", args=[p.token, 2]))
+    client.get(reverse("studyapp:item", args=[p.token, 2]))      # a reload
     a2 = answer(client, p, 2, posted(GOOD_RECORD | {"ended_ms": 400}))
     rows = list(csv.reader(io.StringIO("".join(stream_csv(study, "viewing")))))
     assert tuple(rows[0]) == VIEWING_COLUMNS
     assert len(rows) == 3
     first, second = rows[1], rows[2]
-    assert first[:1] == [p.public_id] and first[3:] == [""] * len(VIEWING_FIELDS)
+    n = len(VIEWING_FIELDS)
+    assert first[:1] == [p.public_id] and first[3:3 + n] == [""] * n and first[3 + n] == "missing"
     assert second[1] == a2.clip.clip_id and second[2] == a2.section.section_type
-    assert second[3:] == ["120", "400", "2", "1", "3", "1", "250", "1"]
+    assert second[3:3 + n] == ["120", "400", "2", "1", "3", "1", "250", "1", "", ""]
+    assert second[3 + n] == "ok" and int(second[4 + n]) >= 0 and second[5 + n] == "2"     # shown twice: a reload
 
 
 @pytest.mark.django_db
@@ -200,3 +244,110 @@ def test_player_markup_follows_the_options(client, study, options, native, attrs
         assert f'name="{field_name(name)}"' in html
     if options.get("controls") == "none":
         assert 'id="play-pause"' not in html
+
+
+# ---- playback kept across reloads, media access -----------------------------------------------------------------
+
+def report(client, p, n, event):
+    """What the player's script sends on a play from the start or the clip's first end."""
+    return client.post(reverse("studyapp:playback", args=[p.token, n]), {"event": event})
+
+
+@pytest.mark.django_db
+def test_a_reload_keeps_the_plays_and_max_replays_holds(client, study):
+    for section in study.sections.all():
+        section.options = {**section.options, "max_replays": 1}
+        section.save()
+    p = started(client, study)
+    url = reverse("studyapp:item", args=[p.token, 1])
+    html = client.get(url).content.decode()
+    assert 'data-plays-before="0"' in html and " autoplay" in html
+    assert f'data-playback-url="{reverse("studyapp:playback", args=[p.token, 1])}"' in html
+    assert report(client, p, 1, "play").status_code == 204
+    assert report(client, p, 1, "ended").status_code == 204
+    html = client.get(url).content.decode()                     # a reload: one replay left, it may autoplay
+    assert 'data-plays-before="1"' in html and 'data-ended-before="1"' in html and " autoplay" in html
+    assert report(client, p, 1, "play").status_code == 204
+    html = client.get(url).content.decode()                     # no plays left: the clip does not start again
+    video = html[html.index("<video"):html.index(">", html.index("<video"))]
+    assert 'data-plays-before="2"' in video and " autoplay" not in video
+    a = answer(client, p, 1, posted({"plays": 0, "pauses": 0}))      # the last display's own record: no play
+    a.refresh_from_db()
+    assert a.plays == 2 and a.play_ended_ms is not None and a.shows == 3
+    assert a.viewing["plays"] == 2 and a.viewing["ended_ms"] == 0 and a.viewing["shows"] == 3
+    assert a.viewing["record"] == "ok"
+    # answered: reports for it are refused and change nothing
+    assert report(client, p, 1, "play").status_code == 404
+    a.refresh_from_db()
+    assert a.plays == 2
+
+
+@pytest.mark.django_db
+def test_a_display_left_without_an_answer_hands_on_its_counts(client, study):
+    p = started(client, study)
+    client.get(reverse("studyapp:item", args=[p.token, 1]))
+    from datetime import timedelta
+
+    from django.utils import timezone
+
+    Assignment.objects.filter(participant=p, seq=1).update(shown_at=timezone.now() - timedelta(seconds=10))
+    leave = {"event": "leave", field_name("pauses"): "2", field_name("hidden"): "1", field_name("hidden_ms"): "400"}
+    assert client.post(reverse("studyapp:playback", args=[p.token, 1]), leave).status_code == 204
+    client.get(reverse("studyapp:item", args=[p.token, 1]))             # the reload
+    a = answer(client, p, 1, posted({**GOOD_RECORD, "hidden": 0, "pauses": 1}))
+    a.refresh_from_db()
+    assert a.carried == {"pauses": 2, "hidden": 1, "hidden_ms": 400}
+    assert (a.viewing["pauses"], a.viewing["hidden"], a.viewing["hidden_ms"]) == (3, 1, 400)
+
+
+@pytest.mark.django_db
+def test_playback_reports_are_checked(client, study):
+    p = started(client, study)
+    client.get(reverse("studyapp:item", args=[p.token, 1]))
+    assert report(client, p, 1, "jump").status_code == 400
+    assert report(client, p, 5, "play").status_code == 404          # not the participant's current page
+    assert client.get(reverse("studyapp:playback", args=[p.token, 1])).status_code == 405
+    assert Client(enforce_csrf_checks=True).post(reverse("studyapp:playback", args=[p.token, 1]),
+                                                 {"event": "play"}).status_code == 403
+    other = Client()
+    assert other.post(reverse("studyapp:playback", args=["no-such-token-xyz", 1]),
+                      {"event": "play"}).status_code == 404
+
+
+@pytest.mark.django_db
+def test_media_needs_the_participants_session_and_stops_once_answered(client, study):
+    p = started(client, study)
+    client.get(reverse("studyapp:item", args=[p.token, 1]))
+    p.refresh_from_db()
+    step = current_step(p, lookahead=True)
+    clip_url = reverse("studyapp:media", args=[step.assignment.clip.media_key, "mp4"])
+    next_url = reverse("studyapp:media", args=[step.next_assignment.clip.media_key, "mp4"])
+    assert client.get(clip_url).status_code == 200
+    assert client.get(next_url).status_code == 200                    # the next clip may be preloaded
+    assert Client().get(clip_url).status_code == 403                  # the URL alone (a new browser, a script)
+    p.assignments.exclude(pk=step.assignment.pk).filter(clip=step.assignment.clip).delete()   # shown once only
+    answer(client, p, 1, posted(GOOD_RECORD))
+    assert client.get(clip_url).status_code == 403                    # answered: no more viewing
+
+
+@pytest.mark.django_db
+def test_a_participant_link_opened_in_a_new_browser_can_play_its_clip(client, study):
+    p = started(client, study)
+    step = cur(p)
+    elsewhere = Client()                                             # the /p/<token>/ link on another device
+    assert elsewhere.get(reverse("studyapp:item", args=[p.token, step.index])).status_code == 200
+    assert elsewhere.get(reverse("studyapp:media", args=[step.assignment.clip.media_key, "mp4"])).status_code == 200
+
+
+@pytest.mark.django_db
+def test_staff_who_may_see_the_catalogue_get_media(study, django_user_model):
+    from studyapp.models import Clip
+
+    clip = Clip.objects.first()
+    url = reverse("studyapp:media", args=[clip.media_key, "mp4"])
+    staff = Client()
+    staff.force_login(django_user_model.objects.create_superuser("boss2", "b@example.org", "pw-long-enough-123"))
+    assert staff.get(url).status_code == 200
+    plain = Client()
+    plain.force_login(django_user_model.objects.create_user("member", password="pw-member-12345"))
+    assert plain.get(url).status_code == 403

@@ -1,8 +1,10 @@
 """A gunicorn worker killed with SIGKILL while answer POSTs are in flight loses or duplicates nothing.
 
-A scratch SQLite study (synthetic catalogue, demo preset, every participant already started) is served by gunicorn
-in the demo's configuration (ASGI workers, demo.sh) and in the production recipe's (threaded WSGI workers behind
-nginx). Participants answer every clip over HTTP, each in its own thread; meanwhile a worker is killed with -9
+A scratch study (synthetic catalogue, demo preset, every participant already started) on SQLite and on PostgreSQL
+(a scratch database, when a server answers at DATABASE_URL or 127.0.0.1:5432) is served by gunicorn in the demo's
+configuration (ASGI workers, demo.sh) and in the production recipe's (threaded WSGI workers behind nginx); on
+PostgreSQL the workers share a small connection pool (DB_CONNECTIONS=8), and its peak use is checked.
+Participants answer every clip over HTTP, each in its own thread; meanwhile a worker is killed with -9
 several times. A client whose request fails (connection reset, 5xx) sends the same answer again, as a browser's
 retry would. Then the database must hold every answer exactly once: the kill stored an answer completely or
 not at all, and the retry stored the missing ones once.
@@ -122,12 +124,64 @@ def _answer_all(base: str, participant: dict, stats: dict, lock: threading.Lock)
             stats["posts"] += 1
 
 
+PG_BASE = os.environ.get("DATABASE_URL", "").strip() or "postgres://postgres@127.0.0.1:5432/postgres"
+DB_CONNECTIONS = 8
+
+
+def _pg_admin():
+    from urllib.parse import urlsplit
+
+    import psycopg
+
+    parts = urlsplit(PG_BASE)
+    return psycopg.connect(host=parts.hostname, port=parts.port or 5432, user=parts.username or "postgres",
+                           password=parts.password, dbname=parts.path.lstrip("/") or "postgres", autocommit=True,
+                           connect_timeout=3)
+
+
+@pytest.fixture
+def scratch_postgres():
+    """A scratch PostgreSQL database's URL (dropped afterwards) and a function giving its connection count now."""
+    from urllib.parse import urlsplit, urlunsplit
+
+    try:
+        admin = _pg_admin()
+    except Exception as exc:        # no server here
+        pytest.skip(f"PostgreSQL not reachable at {PG_BASE}: {exc}")
+    name = f"workerkill_{os.getpid()}_{secrets.token_hex(3)}"
+    admin.execute(f'CREATE DATABASE "{name}"')
+    try:
+        yield (urlunsplit(urlsplit(PG_BASE)._replace(path="/" + name)),
+               lambda: admin.execute("SELECT count(*) FROM pg_stat_activity WHERE datname = %s", [name]).fetchone()[0])
+    finally:
+        admin.execute(f'DROP DATABASE IF EXISTS "{name}" WITH (FORCE)')
+        admin.close()
+
+
 @pytest.mark.parametrize("server", sorted(SERVERS))
 def test_killed_worker_stores_each_answer_once(server, tmp_path):
+    run_with_kills(server, tmp_path, database_url="")
+
+
+@pytest.mark.parametrize("server", sorted(SERVERS))
+def test_killed_worker_stores_each_answer_once_on_postgres(server, tmp_path, scratch_postgres):
+    url, connections = scratch_postgres
+    stats = run_with_kills(server, tmp_path, database_url=url, connections=connections)
+    assert not any(e.startswith("status 5") for e in stats["errors"]), stats["errors"]
+    # the pool's bound (plus the set-up and check processes' own connection, never at the same time)
+    assert stats["peak_connections"] <= DB_CONNECTIONS + 1, stats["peak_connections"]
+
+
+def run_with_kills(server: str, tmp_path: Path, database_url: str, connections=None) -> dict:
+    """Serve the scratch study, answer every page while killing workers, check the database; returns the client
+    statistics (with the peak connection count when ``connections`` is given)."""
     env = dict(os.environ, DATA_DIR=str(tmp_path), SECRET_KEY=secrets.token_urlsafe(50), DEBUG="0",
-               ALLOWED_HOSTS="127.0.0.1,localhost", OMP_NUM_THREADS="1")
+               ALLOWED_HOSTS="127.0.0.1,localhost", OMP_NUM_THREADS="1", WEB_CONCURRENCY="2",
+               DB_CONNECTIONS=str(DB_CONNECTIONS))
     env.pop("DATABASE_URL", None)
     env.pop("PRODUCTION", None)
+    if database_url:
+        env["DATABASE_URL"] = database_url
     subprocess.run([sys.executable, str(ROOT / "manage.py"), "migrate", "--noinput", "-v", "0"], env=env, cwd=ROOT,
                    check=True)
     participants = _manage_json(env, SETUP % N_PARTICIPANTS)
@@ -148,26 +202,39 @@ def test_killed_worker_stores_each_answer_once(server, tmp_path):
                 pass
             assert time.monotonic() < deadline, "gunicorn did not start"
             time.sleep(0.3)
-        stats, lock = {"posts": 0, "retries": 0, "errors": {}}, threading.Lock()
+        stats, lock = {"posts": 0, "retries": 0, "errors": {}, "peak_connections": 0}, threading.Lock()
         clients = [threading.Thread(target=_answer_all, args=(base, p, stats, lock), daemon=True)
                    for p in participants]
         for t in clients:
             t.start()
         kills = 0
+
+        def sample():
+            if connections is not None:
+                stats["peak_connections"] = max(stats["peak_connections"], connections())
+
         while kills < KILLS and any(t.is_alive() for t in clients):
-            time.sleep(0.6)
+            for _ in range(6):
+                time.sleep(0.1)
+                sample()
             with lock:
                 in_progress = stats["posts"] > 0
             pids = _workers(master.pid)
             if in_progress and pids:
                 os.kill(pids[kills % len(pids)], signal.SIGKILL)
                 kills += 1
-        for t in clients:
-            t.join(180)
+        end = time.monotonic() + 180
+        while any(t.is_alive() for t in clients) and time.monotonic() < end:
+            time.sleep(0.1)
+            sample()
         assert not any(t.is_alive() for t in clients), "clients did not finish"
     finally:
         master.terminate()
-        master.wait(20)
+        try:
+            master.wait(40)
+        except subprocess.TimeoutExpired:
+            master.kill()
+            master.wait()
     result = _manage_json(env, CHECK)
     expected_pages = sum(len(p["pages"]) for p in participants)
     print(server, "kills", kills, stats, result)
@@ -179,3 +246,4 @@ def test_killed_worker_stores_each_answer_once(server, tmp_path):
     # every page's answers exactly once (a practice item stores none): no lost, partial or doubled answer set
     expected = sum(len(page["answers"]) for p in participants for page in p["pages"] if page["kind"] != "practice")
     assert result["responses"] == expected
+    return stats

@@ -46,7 +46,13 @@
   // - data-max-replays (blank: unlimited) limits the plays after the first.
   // - the viewing record goes with the answer as hidden fields view_<field> (study_protocol.VIEWING_FIELDS; times
   //   in ms from the page's display): first playing frame, first end, plays, pauses, seek attempts, stalls (playback
-  //   waiting for data) and their total time, and how often the page was hidden while the clip played.
+  //   waiting for data after the first frame) and their total time, start-up time (first play request to first
+  //   frame), how often and how long the page was hidden while the clip played; view_script=1 says this ran.
+  // - every play from the start and the first end are reported to the server while the page is open
+  //   (data-playback-url); a reload gets them back (data-plays-before, data-ended-before), so it neither resets
+  //   the replay limit nor forgets that the clip was watched to its end.
+  // - a clip already playing when this script attaches counts as played; a pause the browser makes because the
+  //   page was hidden is hidden time, not a pause, and the clip goes on when the page is shown again.
   function setUpPlayer(video) {
     var fieldsets = form.querySelectorAll("fieldset");
     var note = document.getElementById("play-note");
@@ -56,8 +62,13 @@
     var controls = video.dataset.controls || "full";
     var canSeek = controls === "full";
     var maxReplays = video.dataset.maxReplays ? Number(video.dataset.maxReplays) : Infinity;
+    var priorPlays = Number(video.dataset.playsBefore || 0);     // plays during earlier displays of this page
+    var endedBefore = video.dataset.endedBefore === "1";
+    var playbackUrl = video.dataset.playbackUrl || "";
     var rec = { first_play_ms: null, ended_ms: null, plays: 0, pauses: 0, seeks: 0, stalls: 0, stall_ms: 0,
-                hidden: 0 };
+                hidden: 0, startup_ms: null, hidden_ms: 0 };
+    var scriptField = form.querySelector("input[data-viewing-script]");
+    if (scriptField) { scriptField.value = "1"; }
     var played = false;        // reached its end once: answers enabled
     var atEnd = false;         // ended and not started again yet
     var ownSeeks = 0;          // seeks this script makes (replay, undoing a blocked seek), not counted as attempts
@@ -65,8 +76,42 @@
     var safeTime = 0;          // how far the clip got by playing: where a blocked seek returns to
     var stallStart = null;
     var blocked = false;       // the browser did not let the clip start by itself
+    var playRequested = null;  // when the first play was asked for (start-up time runs from here)
+    var hiddenSince = null;    // the page is hidden while the clip plays (or was stopped by the hiding)
+    var pausedByHiding = false;
+    var endReported = endedBefore;
+    var answered = false;      // the form was sent: its record carries the counts, no "leave" report
     function now() { return Math.round(performance.now() - t0); }
-    function replaysLeft() { return rec.plays === 0 ? Infinity : maxReplays - (rec.plays - 1); }
+    function playsSoFar() { return priorPlays + rec.plays; }
+    function replaysLeft() { return playsSoFar() === 0 ? Infinity : maxReplays - (playsSoFar() - 1); }
+    function reportData(event) {
+      var data = new FormData();
+      var csrf = form.querySelector("input[name=csrfmiddlewaretoken]");
+      if (csrf) { data.append("csrfmiddlewaretoken", csrf.value); }
+      data.append("event", event);
+      return data;
+    }
+    function report(event) {
+      if (!playbackUrl || !window.fetch || !window.FormData) { return; }
+      fetch(playbackUrl, { method: "POST", body: reportData(event), credentials: "same-origin", keepalive: true })
+        .catch(function () { /* the answer's own record still goes with the form */ });
+    }
+    // Left without an answer (a reload, the back button): this display's counts go to the server, which adds
+    // them to the answer's record (studyapp.viewing.CARRIED_FIELDS).
+    window.addEventListener("pagehide", function () {
+      if (answered || !playbackUrl || !navigator.sendBeacon || !window.FormData) { return; }
+      closeTimers();
+      var data = reportData("leave");
+      ["pauses", "seeks", "stalls", "stall_ms", "hidden", "hidden_ms"].forEach(function (key) {
+        data.append("view_" + key, String(rec[key]));
+      });
+      navigator.sendBeacon(playbackUrl, data);
+    });
+    function closeTimers() {
+      if (stallStart !== null) { rec.stall_ms += now() - stallStart; stallStart = null; }
+      if (hiddenSince !== null) { rec.hidden_ms += now() - hiddenSince; hiddenSince = null; }
+    }
+    function countPlay() { rec.plays += 1; report("play"); }
     function setEnabled(on) {
       fieldsets.forEach(function (fs) { fs.disabled = !on; });
       submit.disabled = !on;
@@ -74,6 +119,7 @@
     function say(text) { if (text) { note.textContent = text; } }
     function markPlayed() {
       if (rec.ended_ms === null) { rec.ended_ms = now(); }
+      if (!endReported) { endReported = true; report("ended"); }
       if (played) { return; }
       played = true;
       setEnabled(true);
@@ -92,19 +138,25 @@
     function seekTo(t) { ownSeeks += 1; video.currentTime = t; }
     function startOver() {          // a replay: one more play from the start, if any is left
       if (replaysLeft() <= 0) { return false; }
-      rec.plays += 1;
+      countPlay();
       atEnd = false;
       safeTime = 0;
       seekTo(0);
       return true;
     }
     function stopHere() { ownPause = true; video.pause(); }
-    if (requirePlay && !form.querySelector(".error")) {
+    // Watched to its end before a reload, or every play used up before it (a reload mid-play with no replay left
+    // must not leave the participant unable to answer; the record then shows no end): the answers are enabled.
+    if (endedBefore || (priorPlays > 0 && replaysLeft() <= 0)) {
+      played = true;
+      atEnd = video.paused;
+      if (replaysLeft() <= 0 && maxReplays > 0) { say(note.dataset.noReplays); }
+    } else if (requirePlay && !form.querySelector(".error")) {
       setEnabled(false);
       say(note.dataset.wait);
     }
     replay.addEventListener("click", function () {
-      if (rec.plays === 0) { video.play(); return; }      // autoplay was blocked: this is the first play
+      if (playsSoFar() === 0) { video.play(); return; }   // autoplay was blocked: this is the first play
       if (startOver()) { video.play(); }
       updateButtons();
     });
@@ -114,25 +166,39 @@
         updateButtons();
       });
     }
-    video.addEventListener("playing", function () {
-      if (rec.first_play_ms === null) { rec.first_play_ms = now(); rec.plays = 1; }
+    function onPlaying() {
+      if (rec.first_play_ms === null) {
+        rec.first_play_ms = now();
+        if (playRequested !== null) { rec.startup_ms = rec.first_play_ms - playRequested; }
+        if (rec.plays === 0) { countPlay(); }
+      }
       if (stallStart !== null) { rec.stall_ms += now() - stallStart; stallStart = null; }
       updateButtons();
-    });
+    }
+    video.addEventListener("playing", onPlaying);
     video.addEventListener("play", function () {
+      if (playRequested === null) { playRequested = now(); }
       // The browser's own play button on an ended clip (full controls) starts it over: a replay.
       if (atEnd) {
         if (!startOver()) { stopHere(); }
+      } else if (rec.plays === 0 && replaysLeft() <= 0) {
+        stopHere();                    // every play was used during earlier displays of the page
       }
       updateButtons();
     });
     video.addEventListener("pause", function () {
-      if (!ownPause && !video.ended && !atEnd) { rec.pauses += 1; }
+      if (document.hidden) {
+        pausedByHiding = !ownPause && !video.ended;      // the browser's doing: hidden time, not a pause
+      } else if (!ownPause && !video.ended && !atEnd) {
+        rec.pauses += 1;
+      }
       ownPause = false;
       updateButtons();
     });
     video.addEventListener("ended", function () { atEnd = true; markPlayed(); updateButtons(); });
     video.addEventListener("waiting", function () {
+      // buffering before the first frame is start-up time (startup_ms), not a stall
+      if (rec.first_play_ms === null || document.hidden) { return; }
       if (!video.seeking && !video.paused && stallStart === null) { rec.stalls += 1; stallStart = now(); }
     });
     video.addEventListener("seeking", function () {
@@ -153,9 +219,8 @@
       // replay once it has played through.
       if (video.loop && t + 0.25 < last && last > 0.5 * (video.duration || 0)) {
         markPlayed();
-        rec.plays += 1;
         safeTime = 0;
-        if (rec.plays - 1 > maxReplays) { rec.plays -= 1; stopHere(); atEnd = true; }
+        if (replaysLeft() <= 0) { stopHere(); atEnd = true; } else { countPlay(); }
         updateButtons();
       }
       if (!video.seeking && t >= safeTime && t - safeTime < 1.5) { safeTime = t; }
@@ -183,18 +248,39 @@
       }
     }
     document.addEventListener("visibilitychange", function () {
-      if (document.hidden && !video.paused && !video.ended) { rec.hidden += 1; }
+      if (document.hidden) {
+        if (!video.paused && !video.ended) { rec.hidden += 1; hiddenSince = now(); }
+        if (stallStart !== null) { rec.stall_ms += now() - stallStart; stallStart = null; }
+        return;
+      }
+      if (hiddenSince !== null) { rec.hidden_ms += now() - hiddenSince; hiddenSince = null; }
+      if (pausedByHiding && video.paused && !video.ended) { video.play(); }
+      pausedByHiding = false;
     });
     video.addEventListener("error", function () { setEnabled(true); say(note.dataset.failed); }, true);
+    // The script is deferred: the clip may have started, or even ended, before the listeners above existed.
+    if (video.ended) {
+      onPlaying();
+      atEnd = true;
+      markPlayed();
+    } else if (!video.paused && video.readyState >= 2) {
+      onPlaying();
+    }
     updateButtons();
-    var p = video.play();
-    if (p && p.catch) {
-      p.catch(function () { blocked = true; say(note.dataset.pressPlay); updateButtons(); });
+    if (video.autoplay && video.paused && !video.ended) {
+      if (playRequested === null) { playRequested = now(); }
+      var p = video.play();
+      if (p && p.catch) {
+        p.catch(function () { blocked = true; say(note.dataset.pressPlay); updateButtons(); });
+      }
+    } else if (!video.autoplay && playsSoFar() > 0) {
+      say(replaysLeft() > 0 ? note.dataset.ready : note.dataset.noReplays);
     }
     video.addEventListener("canplaythrough", preloadNext);
     setTimeout(preloadNext, 4000);
     return function fillViewing() {
-      if (stallStart !== null) { rec.stall_ms += now() - stallStart; stallStart = null; }
+      answered = true;
+      closeTimers();
       Object.keys(rec).forEach(function (key) {
         var input = form.querySelector("input[data-viewing][name='view_" + key + "']");
         if (input) { input.value = rec[key] === null ? "" : String(rec[key]); }

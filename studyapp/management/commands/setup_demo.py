@@ -1,4 +1,7 @@
-"""Create (or update) the demo study from the demo preset and print the participant URL. Idempotent."""
+"""Create (or update) the demo study from the demo preset and print the participant URL. Idempotent. --owner
+USERNAME makes that account an owner of the study (per-study access; demo.sh passes its admin, who is also a
+superuser and so sees every study anyway)."""
+from django.contrib.auth import get_user_model
 from django.core.management.base import BaseCommand, CommandError
 
 from studyapp.catalogue import pool_queryset
@@ -13,8 +16,14 @@ class Command(BaseCommand):
         parser.add_argument("--slug", default="demo")
         parser.add_argument("--base-url", default="http://127.0.0.1:8000")
         parser.add_argument("--preset", default="demo", help="preset to build the study from (default: demo)")
+        parser.add_argument("--owner", default="", help="username of an account to make an owner of the study")
 
-    def handle(self, *args, slug, base_url, preset, **options):
+    def handle(self, *args, slug, base_url, preset, owner="", **options):
+        owner_user = None
+        if owner:
+            owner_user = get_user_model().objects.filter(username=owner).first()
+            if owner_user is None:
+                raise CommandError(f"--owner {owner!r}: no account with this username")
         if not Clip.objects.exists():
             raise CommandError("The clip catalogue is empty. Render the demo clips first:\n"
                                "    python manage.py generate_clips --plan demo\n"
@@ -28,6 +37,9 @@ class Command(BaseCommand):
                 study.status = Study.Status.OPEN
                 study.save(update_fields=["status"])
             self.stdout.write(f"Study '{study.title}' (slug {slug}) already exists; left as it is (open).")
+        if owner_user is not None:
+            study.owners.add(owner_user)
+            self.stdout.write(f"  owner: {owner_user.username}")
         for section in study.sections.order_by("order"):
             if section.reuse_section_id:
                 continue
