@@ -7,7 +7,7 @@ from django.db import migrations, models
 class Migration(migrations.Migration):
 
     dependencies = [
-        ('studyapp', '0007_study_permissions_researcher_group'),
+        ('studyapp', '0008_clip_imported_origin_other_modality_licence'),
         migrations.swappable_dependency(settings.AUTH_USER_MODEL),
     ]
 

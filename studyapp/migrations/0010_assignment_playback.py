@@ -6,7 +6,7 @@ from django.db import migrations, models
 class Migration(migrations.Migration):
 
     dependencies = [
-        ('studyapp', '0008_study_owners_collaborators'),
+        ('studyapp', '0009_study_owners_collaborators'),
     ]
 
     operations = [
