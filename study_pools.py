@@ -13,6 +13,7 @@ from __future__ import annotations
 import math
 from typing import NamedTuple
 
+from study_norming import NORMING_OPTION
 from study_protocol import (
     CLIP_THEMES,
     FINAL_EMOTION_COLUMNS,
@@ -46,7 +47,9 @@ SUB_POOLS = ("generated", "source")
 
 SECTION_OPTIONS: dict[str, tuple[str, ...]] = {
     "naturalness": ("anchors", "question", "n_generated", "n_source"),
-    "gesture_emotion": ("n_options", "categories"),
+    "gesture_emotion": ("n_options", "categories", NORMING_OPTION),
+    "emotion_choice": (NORMING_OPTION,),
+    "theme_rating": (NORMING_OPTION,),
 }
 """section_type -> the option keys it understands besides COMMON_OPTIONS."""
 
@@ -311,6 +314,22 @@ def _extras_errors(section_type: str, options: dict, clips_per_participant: int 
     return found + _player_problems(options)
 
 
+MAX_RATINGS_PER_CLIP = 10_000
+
+
+def _norming_errors(config) -> Found:
+    """Problems of Section.options["norming"] (``{"ratings_per_clip": K}``), each naming its field."""
+    if not isinstance(config, dict):
+        return [(("norming",), f"'norming' must be an object like {{\"ratings_per_clip\": 20}}, got {config!r}")]
+    found: Found = [((f"norming.{k}",), f"'norming': unknown field {k!r} (fields: ratings_per_clip)")
+                    for k in config if k != "ratings_per_clip"]
+    k = config.get("ratings_per_clip", 1)
+    if not _is_int(k) or not 1 <= k <= MAX_RATINGS_PER_CLIP:
+        found.append((("norming.ratings_per_clip",), f"'norming': 'ratings_per_clip' must be an integer from 1 to "
+                                                     f"{MAX_RATINGS_PER_CLIP}, got {k!r}"))
+    return found
+
+
 def _player_problems(options: dict) -> Found:
     found: Found = []
     if "controls" in options and options["controls"] not in PLAYER_CONTROLS:
@@ -340,6 +359,8 @@ def options_problems(section_type: str, options, clips_per_participant: int | No
     found: Found = [((key,), f"unknown option {key!r} for {section_type} sections ({listed})")
                     for key in options if key not in known]
     found += _extras_errors(section_type, options, clips_per_participant)
+    if NORMING_OPTION in options and NORMING_OPTION in own:
+        found += _norming_errors(options[NORMING_OPTION])
     if section_type == "naturalness":
         found += _naturalness_errors(options, clips_per_participant)
     elif section_type == "gesture_emotion":

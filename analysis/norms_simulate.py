@@ -125,10 +125,13 @@ def simulate_norming(clips: pd.DataFrame, n_participants: int, m: int, seed: int
         blocks = np.array([[pos[order[b]] for b in cyclic_block(len(order), m, i)] for i in range(n_participants)])
         who = np.repeat(np.arange(n_participants), blocks.shape[1])
         which = blocks.ravel()
-        P = np.stack([perception[r] for r in which])                                   # (A, L)
-        intended = [(_intended_index(clips.loc[r], kind, domain)) for r in which]
-        answers = _draw(rng, kind, P, np.array([-1 if i is None else i for i in intended]), domain,
-                        multi_select_prob, n_options)
+        table = np.zeros((len(clips), len(domain)))
+        table[rows] = np.stack([perception[r] for r in rows])
+        intended_of = np.full(len(clips), -1)
+        for r in rows:
+            j = _intended_index(clips.loc[r], kind, domain)
+            intended_of[r] = -1 if j is None else j
+        answers = _draw(rng, kind, table[which], intended_of[which], domain, multi_select_prob, n_options)
         n = len(which)
         base = {"participant_id": pids[who], "section_type": section_type,
                 "clip_id": clips.loc[which, "clip_id"].to_numpy(), "response_ms": rng.integers(2500, 9000, n)}

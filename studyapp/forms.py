@@ -12,6 +12,7 @@ from study_pools import SUB_POOLS
 from . import pool_editor
 from .i18n import display
 from .models import Clip, Section, Study
+from .norming import open_errors
 from .pool_editor import PoolEditorFields
 from .presets import preset_choices
 from .questions import section_type_choices
@@ -149,6 +150,15 @@ class StudyAdminForm(forms.ModelForm):
         value = (self.cleaned_data.get("completion_redirect") or "").strip()
         check_completion_url(value)
         return value
+
+    def clean(self):
+        """A norming study opens only when its planned N (the participant limit) gives every clip K ratings."""
+        data = super().clean()
+        if self.instance.pk and data.get("status") == Study.Status.OPEN:
+            errors = open_errors(self.instance, n_planned=data.get("max_participants") or 0)
+            if errors:
+                self.add_error("status", errors)
+        return data
 
     def clean_exclusion_rules(self):
         rules = self.cleaned_data.get("exclusion_rules")
