@@ -15,6 +15,7 @@ from django.utils.html import format_html, format_html_join
 from study_pools import SUB_POOLS
 
 from . import admin_clip_qa, pool_editor, views_pool, views_staff
+from .admin_norms import norms_table
 from .forms import SectionForm, StudyAdminForm
 from .models import Assignment, Clip, Participant, Response, Section, Study
 from .norming import design_rows, open_errors
@@ -89,10 +90,10 @@ class SectionInline(admin.StackedInline):
     def matching_clips(self, section):
         summary, warnings = pool_notes(section)
         return format_html('<span class="pool-count" data-url="{}" aria-live="polite">{}</span>'
-                           '<ul class="pool-warnings">{}</ul><code class="pool-json">pool (saved): {}</code>',
+                           '<ul class="pool-warnings">{}</ul><code class="pool-json">pool (saved): {}</code>{}',
                            reverse("admin:studyapp_pool_count"), summary,
                            format_html_join("", '<li class="pool-warning">{}</li>', ((w,) for w in warnings)),
-                           json.dumps(section.pool))
+                           json.dumps(section.pool), norms_table(section.pool))
 
 
 @admin.register(Study)
