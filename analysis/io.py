@@ -451,7 +451,8 @@ def _clip_needs(cu: pd.DataFrame) -> dict[str, tuple[np.ndarray, str]]:
     no_theme = cu["theme"].isin(["", None]).to_numpy() | cu["theme"].isna().to_numpy()
     no_vad = cu[list(VAD_DIMENSIONS)].isna().any(axis=1).to_numpy()
     return {
-        "emotion_choice": (no_intended, f"has no intended emotion vector ({first}..{last}) in clips.csv"),
+        # emotion_choice needs no intended vector: an unlabelled real walk may be rated (norms); the tests of
+        # intended against perceived leave such clips out
         "emotion_transition": (no_intended | cu[FINAL_EMOTION_COLUMNS[0]].isna().to_numpy(),
                                f"needs initial ({first}..{last}) and final_* emotion vectors in clips.csv"),
         "theme_rating": (no_theme | (cu["weight"].isna() | cu["n_features"].isna()).to_numpy(),
