@@ -24,7 +24,7 @@ from studyapp.models import Assignment, Participant, Response, Study
 from studyapp.norming import design_rows, open_errors
 from studyapp.presets import create_study_from_preset
 from studyapp.questions import questions_for
-from studyapp.testing import make_catalogue
+from studyapp.testing import admin_form_data, make_catalogue
 
 pytestmark = pytest.mark.django_db
 
@@ -77,6 +77,23 @@ def test_design_table_and_refusal_to_open(norming, client):
     norming.refresh_from_db()
     assert norming.status == Study.Status.OPEN
     assert StudyAdmin.norming_design.short_description == "norming design"
+
+
+def test_study_form_refuses_to_open_a_norming_study_short_of_participants(norming, client):
+    client.force_login(User.objects.create_superuser("admin", "a@example.org", "pw"))
+    url = reverse("admin:studyapp_study_change", args=[norming.pk])
+    data = admin_form_data(client.get(url))
+    data.update(status="open", max_participants="40")
+    page = client.post(url, data)
+    assert page.status_code == 200                                    # the form again, with the error
+    assert "Norming section 2 (gesture_emotion): 40 participants x 8 clips give the 24 clips at least 13" in (
+        page.content.decode())
+    norming.refresh_from_db()
+    assert norming.status == Study.Status.DRAFT and norming.max_participants == 0
+    data.update(max_participants="60")
+    assert client.post(url, data).status_code == 302
+    norming.refresh_from_db()
+    assert norming.status == Study.Status.OPEN and norming.max_participants == 60
 
 
 def _start(client: Client, study: Study, query: str = "") -> Participant:
