@@ -86,10 +86,12 @@ def _from_study(slug: str) -> tuple[tuple, callable]:
         from analysis.norms import clip_norms
 
         from .export import stream_csv
-        texts = {k: io.StringIO("".join(stream_csv(study, k))) for k in ("responses", "clips", "participants")}
-        data = load_study(texts["responses"], texts["clips"], texts["participants"])
+        texts = {k: io.StringIO("".join(stream_csv(study, k)))
+                 for k in ("responses", "clips", "participants", "viewing")}
+        data = load_study(texts["responses"], texts["clips"], texts["participants"], texts["viewing"])
         rules = exclusion.resolve_rules(study.exclusion_rules)
-        excl = exclusion.exclusions(data.responses, data.clips, participants=data.participants, rules=rules)
+        excl = exclusion.exclusions(data.responses, data.clips, participants=data.participants, rules=rules,
+                                    viewing=data.viewing)
         kept = StudyData(exclusion.apply_exclusions(data.responses, excl), data.clips, data.participants)
         norms = clip_norms(kept.responses, kept.clips)
         if norms.empty:
