@@ -15,8 +15,10 @@ emotions, the neutral validation choice -- and the theme scales), with the colum
   ``emotion_label``; neutral validation: its theme (``neutral``); blank for theme scales and clips without one;
 - ``top_label``, ``top_share``: the most chosen label (the first in the domain's order on a tie) and its share;
 - ``intended_share`` with ``intended_ci_low``, ``intended_ci_high``: the 95 % Wilson score interval (Wilson 1927,
-  statsmodels ``proportion_confint(method="wilson")``) of the intended label's share, taking the summed shares as
-  the count of successes out of n_ratings (exact for single-label answers; a multi-select answer counts 1/k);
+  statsmodels ``proportion_confint(method="wilson")``) of the intended label's share, from the share as the
+  success rate and n_ratings as the trials when every answer chose one label; a multi-select answer counts 1/k
+  per label, and then the trials are Kish's effective sample size (:func:`effective_n`), since fractional shares
+  vary less than 0/1 answers (the plain count over-covers: 98 % instead of 95 % in bench_norms);
 - ``entropy_bits``: Shannon entropy of the share vector in bits (scipy.stats.entropy, base 2; 0 = every answer
   the same single label, log2(L) = uniform);
 - ``ad_statistic``, ``ad_p_value``: seed 000's 2-sample Anderson-Darling test of the 4 intended against the 4
@@ -27,7 +29,7 @@ emotions, the neutral validation choice -- and the theme scales), with the colum
   in the study (a naturalness section's and a norming section's).
 
     E. B. Wilson. "Probable inference, the law of succession, and statistical inference." Journal of the American
-    Statistical Association 22(158), 209-212, 1927.
+    Statistical Association 22(158), 209-212, 1927.  L. Kish. *Survey Sampling*. Wiley, 1965.
 
 :func:`read_clip_norms` reads a clip_norms.csv back (the pool rule ``norms``), checking every cell.
 """
@@ -86,6 +88,22 @@ def _intended(clips: pd.DataFrame, section_type: str, question: str, domain: tup
     return labels.where(labels.isin(domain))
 
 
+def effective_n(p: np.ndarray, variance: np.ndarray, n: np.ndarray) -> np.ndarray:
+    """Kish's effective sample size of a mean share: n * p (1 - p) / variance of the per-answer shares (all (C,)).
+
+    Single-label answers are 0 or 1, their variance is p (1 - p) and n_eff = n, so the interval is the plain
+    Wilson interval. A multi-select answer gives 1/k to each of its k labels; the shares vary less than 0/1
+    answers (variance <= p (1 - p), Bhatia-Davis), so n_eff >= n and the interval is narrower where the plain
+    count would be conservative. Where the variance is 0 (every answer the same) or p is 0 or 1, n is kept.
+
+        L. Kish. *Survey Sampling*. Wiley, 1965 (the design effect, section 8.2).
+    """
+    with np.errstate(divide="ignore", invalid="ignore"):
+        out = n * p * (1 - p) / variance
+    keep = ~np.isfinite(out) | (variance <= 1e-12) | (p <= 0) | (p >= 1)
+    return np.where(keep, n, np.maximum(out, n))
+
+
 def _group_means(codes: np.ndarray, values: np.ndarray, n_groups: int) -> tuple[np.ndarray, np.ndarray]:
     """Per-group (sum, count) of ``values`` (N,) or (N, L) for integer group ``codes`` (N,)."""
     sums = np.zeros((n_groups, *values.shape[1:]))
@@ -121,8 +139,11 @@ def _question_norms(responses: pd.DataFrame, clips: pd.DataFrame, section_type: 
     intended_share = np.where(has, shares[np.arange(len(j)), j], np.nan)
     low, high = np.full(len(j), np.nan), np.full(len(j), np.nan)
     if has.any():
-        low[has], high[has] = proportion_confint(intended_share[has] * n[has], n[has], alpha=1 - CONFIDENCE,
-                                                 method="wilson")
+        x = weights[np.arange(len(weights)), j[clip_codes]]                 # each answer's intended share
+        mean_sq = _group_means(clip_codes, x ** 2, len(clip_ids))[0] / n
+        n_eff = effective_n(intended_share, mean_sq - intended_share ** 2, n)
+        low[has], high[has] = proportion_confint(intended_share[has] * n_eff[has], n_eff[has],
+                                                 alpha=1 - CONFIDENCE, method="wilson")
     top = shares.argmax(axis=1)
     out = pd.DataFrame({
         "clip_id": clip_ids, "modality": c["modality"].to_numpy(), "section_type": section_type,

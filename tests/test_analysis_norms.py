@@ -63,9 +63,20 @@ def test_statistics_match_their_libraries(simulated):
     assert np.allclose(gait["ad_p_value"], ad.loc[gait.index, "p_value"])
     for e in ("happy", "sad", "angry", "neutral"):
         assert np.allclose(gait[f"share_{e}"], ad.loc[gait.index, f"perceived_{e}"])
-    row = norms.iloc[0]
+    # gestures: one label per answer, the plain Wilson interval
+    row = norms[norms["section_type"] == "gesture_emotion"].iloc[0]
     lo, hi = proportion_confint(row["intended_share"] * row["n_ratings"], row["n_ratings"], method="wilson")
     assert (row["intended_ci_low"], row["intended_ci_high"]) == pytest.approx((lo, hi))
+    # walks with two-label answers: Wilson with Kish's effective n (narrower than with n)
+    row = norms.iloc[0]
+    r = data.responses
+    own = r[(r["clip_id"] == row["clip_id"]) & (r["question"] == "perceived")]["answer"].astype(str)
+    x = np.array([(row["intended"] in a.split(";")) / len(a.split(";")) for a in own])
+    n_eff = len(x) * x.mean() * (1 - x.mean()) / x.var()
+    lo, hi = proportion_confint(x.mean() * n_eff, n_eff, method="wilson")
+    assert (row["intended_ci_low"], row["intended_ci_high"]) == pytest.approx((lo, hi))
+    plain = proportion_confint(x.mean() * len(x), len(x), method="wilson")
+    assert hi - lo < plain[1] - plain[0]
     shares = [c for c in norms.columns if c.startswith("share_")]
     p = row[shares].dropna().to_numpy(float)
     assert row["entropy_bits"] == pytest.approx(stats.entropy(p, base=2))
