@@ -119,12 +119,39 @@ def recovery(n_studies: int = 200, multi_select_prob: float = 0.3, plan: str = "
             "mean_ci_width": round(float(np.concatenate(widths).mean()), 3)}
 
 
+def write_sample(out_dir: str, seed: int = 0) -> dict:
+    """One SIMULATED norming study of the demo plan (N and K of the design table) with its norms beside the
+    simulated truth: ``simulated_clip_norms.csv`` (the public format) and ``simulated_truth.csv`` (expected
+    shares), for the docs."""
+    import os
+
+    clips = pd.concat([c for c in norming_candidates("demo").values() if len(c)], ignore_index=True)
+    n = max(r["N"] for r in design_table() if r["plan"] == "demo")
+    m = PRESETS["norming"]["sections"][0]["clips_per_participant"]
+    sim = simulate_norming(clips, n, m, seed=seed)
+    data = load_study(_csv(sim.responses), _csv(sim.clips), _csv(sim.participants))
+    norms = clip_norms(data.responses, data.clips)
+    os.makedirs(out_dir, exist_ok=True)
+    norms.to_csv(os.path.join(out_dir, "simulated_clip_norms.csv"), index=False)
+    sim.truth.to_csv(os.path.join(out_dir, "simulated_truth.csv"), index=False)
+    merged = norms.merge(sim.truth, on=["clip_id", "section_type", "question"], suffixes=("", "_true"))
+    err = pd.concat([(merged[c] - merged[f"{c}_true"]).abs() for c in norms.columns
+                     if c.startswith("share_") and f"{c}_true" in merged]).dropna()
+    return {"participants": n, "rows": len(norms), "share_mae": round(float(err.mean()), 4)}
+
+
 def main(argv=None) -> dict:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--studies", type=int, default=200)
     ap.add_argument("--participants", type=int, default=10_000)
     ap.add_argument("--json", default=None)
+    ap.add_argument("--sample", default=None, metavar="DIR",
+                    help="only write one SIMULATED demo norming study's clip_norms.csv and its truth into DIR")
     args = ap.parse_args(argv)
+    if args.sample:
+        result = write_sample(args.sample)
+        print(result)
+        return result
     table = design_table()
     for row in table:
         assert min_ratings(row["C"], row["M"], row["N"]) >= row["K"]
