@@ -90,7 +90,8 @@ class SectionInline(admin.StackedInline):
     def matching_clips(self, section):
         summary, warnings = pool_notes(section)
         return format_html('<span class="pool-count" data-url="{}" aria-live="polite">{}</span>'
-                           '<ul class="pool-warnings">{}</ul><code class="pool-json">pool (saved): {}</code>{}',
+                           '<ul class="pool-warnings">{}</ul><code class="pool-json">pool (saved): {}</code>'
+                           '<div class="norms-slot">{}</div>',
                            reverse("admin:studyapp_pool_count"), summary,
                            format_html_join("", '<li class="pool-warning">{}</li>', ((w,) for w in warnings)),
                            json.dumps(section.pool), norms_table(section.pool))

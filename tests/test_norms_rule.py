@@ -3,6 +3,8 @@ advisory where people rated a clip, the pool editor's table, and bad input refus
 or field named."""
 from __future__ import annotations
 
+import json
+
 import pandas as pd
 import pytest
 from django.contrib.auth.models import User
@@ -147,3 +149,11 @@ def test_pool_editor_page_shows_norms_and_why_a_clip_is_out(tmp_path, client):
     assert "Norms from <code>" in html and "out: intended share 0.40 &lt; 0.5" in html
     assert "1 clip in the catalogue matches" in html
     assert Study.objects.count() == 1
+    # the live count (a fetch while the researcher edits) answers the same table, and the error of a bad source
+    url = reverse("admin:studyapp_pool_count")
+    pool = {**WALKS, "norms": {"from": path, "min_intended_share": 0.3}}
+    live = client.get(url, {"section_type": "emotion_choice", "pool": json.dumps(pool)}).json()
+    assert live["count"] == 2 and "2 of 10 clips in the pool" in live["norms_html"]
+    pool["norms"]["from"] = "missing.csv"
+    live = client.get(url, {"section_type": "emotion_choice", "pool": json.dumps(pool)}).json()
+    assert live["count"] is None and "pool.norms.from: cannot read 'missing.csv'" in live["errors"][-1]["messages"][0]
