@@ -125,6 +125,50 @@ def test_balanced_over_participants_and_positions(norming):
     assert positions == Counter({(c, first + k): 1 for c in per_clip for k in range(7)})
 
 
+@pytest.mark.django_db(transaction=True)
+def test_concurrent_starts_follow_the_design(settings, tmp_path):
+    """Participants starting at once (threads; PostgreSQL only, as tests/test_study_assignment.py) still get the
+    design: every clip the same number of times, no clip twice for one participant."""
+    import threading
+
+    from django.db import connection
+
+    from studyapp.assignment import start_participant
+    if connection.vendor != "postgresql":
+        pytest.skip("concurrency test needs PostgreSQL (set DATABASE_URL)")
+    settings.MEDIA_ROOT = tmp_path / "media"
+    make_catalogue(settings.MEDIA_ROOT)
+    study = create_study_from_preset("norming", "conc-norming", plan="test", status="open", max_participants=12)
+    walks = study.sections.get(section_type="emotion_choice")
+    study.sections.exclude(pk=walks.pk).delete()
+    walks.clips_per_participant, walks.options = 7, {"norming": {"ratings_per_clip": 6}}
+    walks.save()
+    people = [Participant.objects.create(study=study, demographics_done=True) for _ in range(12)]
+    barrier = threading.Barrier(len(people))
+    errors = []
+
+    def run(p):
+        barrier.wait()
+        try:
+            start_participant(p)
+        except Exception as exc:           # collected: the assertion below names it
+            errors.append(repr(exc))
+        finally:
+            connection.close()
+
+    threads = [threading.Thread(target=run, args=(p,)) for p in people]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join(60)
+    assert errors == []
+    trials = Assignment.objects.filter(section=walks, kind="")
+    assert set(Counter(trials.values_list("clip_id", flat=True)).values()) == {6}       # 12 x 7 / 14
+    for p in people:
+        mine = list(trials.filter(participant=p).values_list("clip_id", flat=True))
+        assert len(mine) == len(set(mine)) == 7
+
+
 def _simulated_answer(rng, a: Assignment, p_true: np.ndarray, multi: float) -> dict:
     """A SIMULATED participant's POST for a trial: the emotion drawn from the clip's simulated perception."""
     section, clip = a.section, a.clip
