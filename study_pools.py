@@ -13,6 +13,7 @@ from __future__ import annotations
 import math
 from typing import NamedTuple
 
+from study_norming import NORMING_OPTION
 from study_protocol import (
     CLIP_MODALITIES,
     CLIP_THEMES,
@@ -41,12 +42,20 @@ NUMBER_LOOKUPS = ("", "in", "lt", "lte", "gt", "gte", "isnull")
 FLAGS = ("transition", "rbf")
 INCLUDE_FLAGGED = "include_flagged"
 """Pool switch: also draw clips that failed a quality check (``Clip.qa_flag`` not empty)."""
+NORMS_RULE = "norms"
+"""Pool rule admitting only clips whose per-clip norms pass: ``{"from": <study slug or clip_norms.csv path>,
+"min_ratings": 10, "min_intended_share": 0.5, "max_entropy_bits": 1.5}`` (studyapp.norms_rule applies it)."""
+NORMS_FIELDS = {"from": None, "min_ratings": (int, 1, 1_000_000), "min_intended_share": (float, 0.0, 1.0),
+                "max_entropy_bits": (float, 0.0, 64.0)}
+"""Fields of the norms rule -> (type, lowest, highest); ``from`` is text."""
 SUB_POOLS = ("generated", "source")
 """Sub-pools of a naturalness section: extra filters for its generated and its source clips."""
 
 SECTION_OPTIONS: dict[str, tuple[str, ...]] = {
     "naturalness": ("anchors", "question", "n_generated", "n_source"),
-    "gesture_emotion": ("n_options", "categories"),
+    "gesture_emotion": ("n_options", "categories", NORMING_OPTION),
+    "emotion_choice": (NORMING_OPTION,),
+    "theme_rating": (NORMING_OPTION,),
 }
 """section_type -> the option keys it understands besides COMMON_OPTIONS."""
 
@@ -154,7 +163,9 @@ def pool_problems(pool, section_type: str | None = None, sub_pools: bool = True)
         return [((), f"the pool must be a JSON object of filters, got {type(pool).__name__}")]
     found: Found = []
     for key, value in pool.items():
-        if key in FLAGS or key == INCLUDE_FLAGGED:
+        if key == NORMS_RULE:
+            found += _norms_rule_problems(value)
+        elif key in FLAGS or key == INCLUDE_FLAGGED:
             if not isinstance(value, bool):
                 found.append(((key,), f"{key!r} takes true or false, got {value!r}"))
         elif key in SUB_POOLS and sub_pools:
@@ -174,6 +185,32 @@ def pool_problems(pool, section_type: str | None = None, sub_pools: bool = True)
     return found
 
 
+def _norms_rule_problems(rule) -> Found:
+    """Problems of a pool's ``norms`` rule as written (the source itself is checked by studyapp.norms_rule)."""
+    example = '{"from": "my-pilot", "min_ratings": 10, "min_intended_share": 0.5}'
+    if not isinstance(rule, dict):
+        return [(("norms",), f"'norms' must be an object like {example}, got {rule!r}")]
+    found: Found = [((f"norms.{k}",), f"'norms': unknown field {k!r} (fields: {', '.join(NORMS_FIELDS)})")
+                    for k in rule if k not in NORMS_FIELDS]
+    source = rule.get("from")
+    if not isinstance(source, str) or not source.strip():
+        found.append((("norms.from",), f"'norms': 'from' must name a study (its slug) or a clip_norms.csv file, "
+                                       f"got {source!r}"))
+    for name, spec in NORMS_FIELDS.items():
+        if spec is None or name not in rule:
+            continue
+        kind, low, high = spec
+        value = rule[name]
+        ok = _is_int(value) if kind is int else _is_number(value)
+        if not ok or not low <= value <= high:
+            what = "an integer" if kind is int else "a number"
+            found.append(((f"norms.{name}",), f"'norms': {name!r} must be {what} from {low:g} to {high:g}, got "
+                                              f"{value!r}"))
+    if not any(k in rule for k in ("min_ratings", "min_intended_share", "max_entropy_bits")):
+        found.append((("norms",), "'norms' needs at least one of min_ratings, min_intended_share, max_entropy_bits"))
+    return found
+
+
 def pool_errors(pool, section_type: str | None = None, sub_pools: bool = True) -> list[str]:
     """The messages of :func:`pool_problems` (each naming its key); [] when the pool is usable."""
     return _messages(pool_problems(pool, section_type, sub_pools))
@@ -188,7 +225,7 @@ def pool_lookups(pool: dict | None) -> list[tuple[str, dict]]:
         raise PoolError({"pool": errors})
     calls = []
     for key, value in (pool or {}).items():
-        if key in SUB_POOLS or key == INCLUDE_FLAGGED:
+        if key in SUB_POOLS or key == INCLUDE_FLAGGED or key == NORMS_RULE:   # NORMS_RULE: studyapp.norms_rule
             continue
         if key == "transition":
             calls.append(("filter", {f"{FINAL_EMOTION_COLUMNS[0]}__isnull": not value}))
@@ -311,6 +348,22 @@ def _extras_errors(section_type: str, options: dict, clips_per_participant: int 
     return found + _player_problems(options)
 
 
+MAX_RATINGS_PER_CLIP = 10_000
+
+
+def _norming_errors(config) -> Found:
+    """Problems of Section.options["norming"] (``{"ratings_per_clip": K}``), each naming its field."""
+    if not isinstance(config, dict):
+        return [(("norming",), f"'norming' must be an object like {{\"ratings_per_clip\": 20}}, got {config!r}")]
+    found: Found = [((f"norming.{k}",), f"'norming': unknown field {k!r} (fields: ratings_per_clip)")
+                    for k in config if k != "ratings_per_clip"]
+    k = config.get("ratings_per_clip", 1)
+    if not _is_int(k) or not 1 <= k <= MAX_RATINGS_PER_CLIP:
+        found.append((("norming.ratings_per_clip",), f"'norming': 'ratings_per_clip' must be an integer from 1 to "
+                                                     f"{MAX_RATINGS_PER_CLIP}, got {k!r}"))
+    return found
+
+
 def _player_problems(options: dict) -> Found:
     found: Found = []
     if "controls" in options and options["controls"] not in PLAYER_CONTROLS:
@@ -340,6 +393,8 @@ def options_problems(section_type: str, options, clips_per_participant: int | No
     found: Found = [((key,), f"unknown option {key!r} for {section_type} sections ({listed})")
                     for key in options if key not in known]
     found += _extras_errors(section_type, options, clips_per_participant)
+    if NORMING_OPTION in options and NORMING_OPTION in own:
+        found += _norming_errors(options[NORMING_OPTION])
     if section_type == "naturalness":
         found += _naturalness_errors(options, clips_per_participant)
     elif section_type == "gesture_emotion":

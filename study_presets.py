@@ -142,9 +142,41 @@ PRESETS["demo"]["sections"][0]["title"] = "Perceived emotion: walks"
 PRESETS["demo"]["sections"][4]["title"] = "Perceived emotion: gestures"
 
 
+# Norming: every candidate clip of a plan rated by at least K participants while each sees M clips per section (the
+# cyclic balanced incomplete design of study_norming); the modality's emotion question, then intensity and
+# naturalness (study_protocol.NORMING_QUESTIONS). Set the participant limit to the planned N before opening: the
+# admin shows K, M and the N needed, and refuses to open a study whose N cannot give K.
+NORMING_RATINGS_PER_CLIP = 20
+_NORMING = {"norming": {"ratings_per_clip": NORMING_RATINGS_PER_CLIP}, "practice": True}
+PRESETS["norming"] = {
+    "title": "Norming the stimuli: how each clip is perceived",
+    "introduction": "Each clip shows a virtual character walking or gesturing. For every clip, tell us which emotion "
+                    "you perceive, how strong it is, and how natural the motion looks. There are no right or wrong "
+                    "answers.",
+    "feedback_questions": [{"key": "comments", "text": "Any other comments (optional)?", "kind": "text"}],
+    "sections": [
+        {"section_type": "emotion_choice", "title": "Walks",
+         "instructions": "Watch each walk. Report the emotion(s) you perceive (more than one is allowed), how "
+                         "intense it looks and how natural the motion looks.",
+         "pool": {"modality": "gait", "transition": False, "rbf": False}, "clips_per_participant": 8,
+         "options": {**_NORMING, "attention_checks": {"count": 1, "answer": "sad", "positions": "random"}}},
+        {"section_type": "gesture_emotion", "title": "Gestures",
+         "instructions": "Watch each clip. Choose the emotion you perceive from the gestures, how intense it looks "
+                         "and how natural the gestures look.",
+         "pool": {"modality": "gesture"}, "clips_per_participant": 8,
+         "options": {**_NORMING, "n_options": 4}},
+        {"section_type": "theme_rating", "title": "Walking styles",
+         "instructions": "Rate the amount of the named style in each walk, how intense the style looks and how "
+                         "natural the motion looks.",
+         "pool": {"rbf": True, "weight__gt": 0}, "clips_per_participant": 8, "loop": True,
+         "options": dict(_NORMING)},
+    ],
+}
+
+
 #: The stimulus plan (generation/plans/<name>.yaml) whose clips each preset's sections draw:
 #: :func:`create_study_from_preset` adds a ``plan`` filter to every section pool, so clips of another plan in the
 #: same catalogue (the demo's, another paper's) never enter a study's pools. A researcher may change the filter in
 #: the admin.
 PRESET_PLANS = {"gait_ismar2020": "seed000", "gestures_ieeevr2021": "seed003", "rbf_thms2016": "seed004",
-                "demo": "demo"}
+                "demo": "demo", "norming": "demo"}

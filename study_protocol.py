@@ -135,8 +135,9 @@ GESTURE_CHOICE = "gesture_choice"  # one gesture emotion category
 NEUTRAL_CHOICE = "neutral_choice"  # neutral or one of the six themes
 THEME_RATING = "theme_rating"      # integer 1..7
 INVERSION = "inversion"            # integer -7..7
+INTENSITY = "intensity"            # integer 1..5
 
-INTEGER_RANGES = {LIKERT: (0, 4), NATURALNESS: (1, 5), THEME_RATING: (1, 7), INVERSION: (-7, 7)}
+INTEGER_RANGES = {LIKERT: (0, 4), NATURALNESS: (1, 5), THEME_RATING: (1, 7), INVERSION: (-7, 7), INTENSITY: (1, 5)}
 """Answer kind -> (lowest, highest) integer, inclusive."""
 
 LABEL_CHOICES = {GAIT_MULTI: GAIT_EMOTIONS, GESTURE_CHOICE: GESTURE_EMOTIONS, NEUTRAL_CHOICE: NEUTRAL_CHOICES}
@@ -161,6 +162,31 @@ SECTION_MODALITY = {"emotion_choice": "gait", "emotion_transition": "gait", "aff
                     "naturalness": None, "gesture_emotion": "gesture", "neutral_validation": "gait",
                     "theme_rating": "gait", "theme_inversion": "gait"}
 """The modality of the clips each section shows (None: either)."""
+
+
+NORMING_SECTION_TYPES = ("emotion_choice", "gesture_emotion", "theme_rating")
+"""Sections a norming study rates its candidate clips in: the emotion question of each modality (gait walks,
+gestures, RBF theme clips)."""
+
+NORMING_QUESTIONS = {"intensity": INTENSITY, "naturalness": NATURALNESS}
+"""Questions a norming section (``Section.options["norming"]``) asks about each clip after its own: how intense the
+perceived emotion is (1 "very weak" .. 5 "very strong") and the naturalness scale (1..5). Stored in responses.csv
+under the section's own section_type with these question keys."""
+
+ANSWER_QUESTIONS: dict[str, dict[str, str]] = {
+    section: {**questions, **(NORMING_QUESTIONS if section in NORMING_SECTION_TYPES else {})}
+    for section, questions in SECTION_QUESTIONS.items()}
+"""section_type -> every question key responses.csv may hold for it -> answer kind: SECTION_QUESTIONS plus the
+norming questions of NORMING_SECTION_TYPES."""
+
+
+def section_questions(section_type: str, norming: bool = False) -> dict[str, str]:
+    """The question keys (-> answer kind) one clip page of ``section_type`` asks: its own, then the norming
+    questions when the section is a norming one."""
+    questions = dict(SECTION_QUESTIONS[section_type])
+    if norming and section_type in NORMING_SECTION_TYPES:
+        questions.update(NORMING_QUESTIONS)
+    return questions
 
 
 def answer_values(kind: str) -> tuple[str, ...]:
@@ -272,6 +298,20 @@ in the order this participant took them, joined by ';' (counterbalanced studies 
 ASSIGNMENT_COLUMNS = ("participant_id", "section_type", "section_order", "position", "clip_id", "options",
                       "shown_at", "answered_at")
 """assignments.csv (an extra export): which clips each participant was given, in order."""
+
+CLIP_NORMS_COLUMNS = ("clip_id", "modality", "section_type", "question", "n_ratings", "intended", "top_label",
+                      "top_share", "intended_share", "intended_ci_low", "intended_ci_high", "entropy_bits",
+                      "ad_statistic", "ad_p_value", "intensity_mean", "naturalness_mean", "naturalness_n")
+"""clip_norms.csv (analysis.norms), in order: one row per clip and question; then one ``share_<label>`` column per
+label of the question domains present (NORMS_SHARE_PREFIX). Readers ignore columns they do not know."""
+NORMS_SHARE_PREFIX = "share_"
+
+
+def norms_domain(section_type: str, question: str) -> tuple[str, ...]:
+    """The labels a clip's perceived shares are taken over for one (section_type, question): the choices of a label
+    question, the points of a scale (theme_rating 1..7)."""
+    return answer_values(SECTION_QUESTIONS[section_type][question])
+
 
 VIEWING_TIME_FIELDS = ("first_play_ms", "ended_ms", "stall_ms", "startup_ms", "hidden_ms")
 """Viewing-record times in milliseconds: from the clip page's display to the clip's first playing frame and to its

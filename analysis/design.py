@@ -22,7 +22,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from study_pools import DEFAULT_GESTURE_OPTIONS, FLAGS, INCLUDE_FLAGGED, SUB_POOLS, pool_errors
+from study_pools import DEFAULT_GESTURE_OPTIONS, FLAGS, INCLUDE_FLAGGED, NORMS_RULE, SUB_POOLS, pool_errors
 from study_presets import PRESET_PLANS, PRESETS
 from study_protocol import CLIP_COLUMNS, FINAL_EMOTION_COLUMNS, GESTURE_EMOTIONS, SECTION_QUESTIONS
 
@@ -171,8 +171,8 @@ def pool_mask(clips: pd.DataFrame, pool: dict | None) -> np.ndarray:
         raise DesignError("; ".join(errors))
     mask = np.ones(len(clips), bool)
     for key, value in (pool or {}).items():
-        if key in SUB_POOLS or key == INCLUDE_FLAGGED:   # simulated clips have no quality flags
-            continue
+        if key in SUB_POOLS or key == INCLUDE_FLAGGED or key == NORMS_RULE:
+            continue     # simulated clips have no quality flags and no norms
         if key not in FLAGS and key.partition("__")[0] not in clips.columns:
             raise DesignError(f"pool filter {key!r}: the simulated catalogue has no such column")
         mask &= _one_filter(clips, key, value)

@@ -120,11 +120,14 @@ def gait_emotion_ad(responses: pd.DataFrame, clips: pd.DataFrame, alpha: float =
     """Seed 000 section 6.3.1 / Table 3: per gait clip of section ``emotion_choice``, 2-sample Anderson-Darling
     test between the intended emotion vector and the l1-normalised mean perceived vector.
 
-    Returns one row per clip: clip_id, statistic, p_value, p_capped, reject, n (answers), p_display, p_perm,
+    Clips without an intended vector (an unlabelled real walk) are left out. Returns one row per clip: clip_id,
+    statistic, p_value, p_capped, reject, n (answers), p_display, p_perm,
     intended_<e>, perceived_<e> for e in (happy, sad, angry, neutral).
     """
     perceived = perceived_by_clip(responses, "emotion_choice", "perceived")
-    return _ad_table(perceived, clips[list(GAIT_EMOTIONS)], alpha, permutations)
+    intended = clips[list(GAIT_EMOTIONS)]
+    labelled = intended.index[intended.notna().all(axis=1)]
+    return _ad_table(perceived[perceived.index.isin(labelled)], intended, alpha, permutations)
 
 
 def transition_ad(responses: pd.DataFrame, clips: pd.DataFrame, alpha: float = 0.05,

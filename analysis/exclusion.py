@@ -119,6 +119,10 @@ def straight_lining(responses: pd.DataFrame, min_straight: int = MIN_STRAIGHT,
     ``min_straight`` answers of a rating-scale section (:data:`SCALE_SECTIONS`). Returns rows participant_id, rule
     ``straight_lining``, detail, n_answers."""
     r = responses[responses["section_type"].isin(SCALE_SECTIONS)]
+    # only each section's own scale questions: a norming section's intensity and naturalness are other scales
+    own = r["section_type"].astype(str).str.cat(r["question"].astype(str), sep="|").isin(
+        {f"{s}|{q}" for s in SCALE_SECTIONS for q in SECTION_QUESTIONS[s]})
+    r = r[own.to_numpy()]
     d = pd.DataFrame({"p": r["participant_id"].astype(str).to_numpy(), "s": r["section_type"].astype(str).to_numpy(),
                       "v": r["value"].to_numpy(float)}).dropna(subset=["v"])
     per_value = d.groupby(["p", "s", "v"], sort=True).size().rename("k").reset_index()

@@ -7,6 +7,7 @@ the table is empty); :func:`save_figure` writes it as PNG and SVG.
 from __future__ import annotations
 
 import os
+import re
 
 import matplotlib
 
@@ -260,4 +261,48 @@ def fig_confusion(results: dict):
         ax.set_title(f"{name}: kappa = {res['kappa']:.2f}, n = {res['n_answers']}", fontsize=8)
     fig.suptitle("Emotion recognition: row shares of the confusion matrix (diagonal = hit rate)")
     fig.subplots_adjust(left=0.12, right=0.98, bottom=0.28, top=0.86, wspace=0.45)
+    return fig
+
+
+def _short_id(clip_id: str) -> str:
+    """A clip id short enough for a tick label: the first 8 digits of a content hash, else its last 14
+    characters (named ids such as sim-demo-happy_loop say most at their end)."""
+    return clip_id[:8] if re.fullmatch(r"[0-9a-f]{16}", clip_id) else clip_id[-14:]
+
+
+def fig_clip_norms(norms: pd.DataFrame, modality: str, max_clips: int = 120):
+    """Per-clip norms of one modality (analysis.norms): for each clip with an intended label, its perceived shares
+    as a stacked bar (one colour per label) and the intended label's share with its 95 % Wilson interval (black
+    point and whiskers), clips ordered by intended share (lowest first; at most ``max_clips``, the lowest kept).
+    None when no clip of the modality has an intended label."""
+    if norms.empty:
+        return None
+    t = norms[(norms["modality"] == modality) & norms["intended"].notna()]
+    if t.empty:
+        return None
+    t = t.sort_values(["intended_share", "clip_id"], kind="stable").head(max_clips).reset_index(drop=True)
+    labels = [c for c in t.columns if c.startswith("share_") and t[c].notna().any()]
+    cmap = plt.get_cmap("tab20")
+    colors = {c: EMOTION_COLORS.get(c[len("share_"):], cmap(i % 20)) for i, c in enumerate(labels)}
+    width = min(16.0, max(7.0, 0.22 * len(t) + 2.5))
+    fig, ax = plt.subplots(figsize=(width, 3.4))
+    x = np.arange(len(t))
+    bottom = np.zeros(len(t))
+    for c in labels:
+        v = t[c].fillna(0).to_numpy(float)
+        ax.bar(x, v, 0.8, bottom=bottom, color=colors[c], label=c[len("share_"):], linewidth=0)
+        bottom += v
+    y = t["intended_share"].to_numpy(float)
+    err = np.vstack([y - t["intended_ci_low"].to_numpy(float), t["intended_ci_high"].to_numpy(float) - y])
+    ax.errorbar(x, y, yerr=err, fmt="o", color="black", ms=3, lw=1, capsize=2, label="intended share (95% CI)")
+    ax.set_xticks(x, [f"{_short_id(cid)} {lab}" for cid, lab in zip(t["clip_id"], t["intended"])], rotation=90,
+                  fontsize=6)
+    ax.set_ylim(0, 1.02)
+    ax.set_xlim(-0.6, len(t) - 0.4)
+    ax.set_ylabel("share of answers")
+    ax.set_title(f"{modality}: perceived shares per clip (bars) and the intended label's share (points),\n"
+                 f"ordered by intended share; {int(t['n_ratings'].min())}..{int(t['n_ratings'].max())} "
+                 "ratings per clip", fontsize=8)
+    ax.legend(loc="upper left", bbox_to_anchor=(1.0, 1.0), fontsize=7, frameon=False)
+    fig.subplots_adjust(left=0.6 / width, right=1 - 1.9 / width, bottom=0.34, top=0.86)
     return fig

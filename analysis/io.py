@@ -18,6 +18,7 @@ import numpy as np
 import pandas as pd
 
 from study_protocol import (
+    ANSWER_QUESTIONS,
     ATTENTION_CHECK,
     ATTENTION_COLUMNS,
     CLIP_COLUMNS,
@@ -36,7 +37,6 @@ from study_protocol import (
     QA_COLUMNS,
     QA_FLOAT_COLUMNS,
     RESPONSE_COLUMNS,
-    SECTION_QUESTIONS,
     VAD_DIMENSIONS,
     VIEWING_COLUMNS,
     VIEWING_COLUMNS_V1,
@@ -45,8 +45,9 @@ from study_protocol import (
     VIEWING_SERVER_FIELDS,
 )
 
-ANSWER_KINDS = tuple(dict.fromkeys(kind for questions in SECTION_QUESTIONS.values() for kind in questions.values()))
-"""Every answer kind the sections use (:data:`study_protocol.SECTION_QUESTIONS`), in first-use order."""
+ANSWER_KINDS = tuple(dict.fromkeys(kind for questions in ANSWER_QUESTIONS.values() for kind in questions.values()))
+"""Every answer kind the sections use (:data:`study_protocol.ANSWER_QUESTIONS`: each section's own questions and
+the norming questions), in first-use order."""
 
 MAX_LISTED = 20
 
@@ -389,11 +390,11 @@ def _check_participants(pid: _CodedColumn, participants: pd.DataFrame | None, ro
 
 def _answer_kinds(sec: _CodedColumn, qst: _CodedColumn) -> np.ndarray:
     """Row -> index into :data:`ANSWER_KINDS` of its (section_type, question) pair, -1 where the pair is not in
-    SECTION_QUESTIONS. Looked up once per distinct pair."""
+    ANSWER_QUESTIONS. Looked up once per distinct pair."""
     table = np.full((len(sec.values), len(qst.values)), -1, dtype=np.int8)
     for i, section in enumerate(sec.values):
         for j, question in enumerate(qst.values):
-            kind = SECTION_QUESTIONS.get(section, {}).get(question)
+            kind = ANSWER_QUESTIONS.get(section, {}).get(question)
             if kind is not None:
                 table[i, j] = ANSWER_KINDS.index(kind)
     return table[sec.codes, qst.codes]
@@ -401,13 +402,13 @@ def _answer_kinds(sec: _CodedColumn, qst: _CodedColumn) -> np.ndarray:
 
 def _check_sections(sec: _CodedColumn, qst: _CodedColumn, kind: np.ndarray, rows: _RowProblems) -> None:
     """A known section_type, and a question of that section."""
-    sections = list(SECTION_QUESTIONS)
+    sections = list(ANSWER_QUESTIONS)
     known = np.isin(sec.values, sections)
     rows.add(sec.mask(~known), "section_type", lambda v: f"{v!r} is not one of {', '.join(sections)}", sec)
     bad_q = sec.mask(known) & (kind < 0)
     if bad_q.any():
         present = set(sec.rows()[bad_q])
-        listed = "; ".join(f"{s}: {', '.join(qs)}" for s, qs in SECTION_QUESTIONS.items() if s in present)
+        listed = "; ".join(f"{s}: {', '.join(qs)}" for s, qs in ANSWER_QUESTIONS.items() if s in present)
         rows.add(bad_q, "question", lambda v: f"{v!r} is not a question of its section_type ({listed})", qst)
 
 
@@ -463,7 +464,8 @@ def _clip_needs(cu: pd.DataFrame) -> dict[str, tuple[np.ndarray, str]]:
     no_theme = cu["theme"].isin(["", None]).to_numpy() | cu["theme"].isna().to_numpy()
     no_vad = cu[list(VAD_DIMENSIONS)].isna().any(axis=1).to_numpy()
     return {
-        "emotion_choice": (no_intended, f"has no intended emotion vector ({first}..{last}) in clips.csv"),
+        # emotion_choice needs no intended vector: an unlabelled real walk may be rated (norms); the tests of
+        # intended against perceived leave such clips out
         "emotion_transition": (no_intended | cu[FINAL_EMOTION_COLUMNS[0]].isna().to_numpy(),
                                f"needs initial ({first}..{last}) and final_* emotion vectors in clips.csv"),
         "theme_rating": (no_theme | (cu["weight"].isna() | cu["n_features"].isna()).to_numpy(),
@@ -494,10 +496,11 @@ def _check_response_ms(rms: _CodedColumn, rows: _RowProblems) -> np.ndarray:
 def read_responses(src, clips: pd.DataFrame, participants: pd.DataFrame | None = None) -> pd.DataFrame:
     """Read and validate responses.csv against validated ``clips`` (and ``participants`` if given).
 
-    Checks: known section_type; question allowed for that section (:data:`SECTION_QUESTIONS`); answer of the right
-    kind and range; clip_id known and carrying what the section needs (an intended vector for emotion_choice, a
-    final vector for emotion_transition, theme/weight/n_features for theme_rating, theme for theme_inversion, an
-    NRC-VAD label or VAD values for gesture_emotion); participant known; response_ms a number >= 0 or blank.
+    Checks: known section_type; question allowed for that section (:data:`study_protocol.ANSWER_QUESTIONS`: its own
+    and, for a norming section type, intensity and naturalness); answer of the right kind and range; clip_id known
+    and carrying what the section needs (an intended vector for emotion_choice, a final vector for
+    emotion_transition, theme/weight/n_features for theme_rating, theme for theme_inversion, an NRC-VAD label or VAD
+    values for gesture_emotion); participant known; response_ms a number >= 0 or blank.
 
     Every column is read as a categorical and each rule is evaluated once per distinct value (or distinct
     (kind, answer) pair), then broadcast to rows: 1.7 million rows validate in about two seconds.

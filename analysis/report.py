@@ -24,7 +24,9 @@ import zipfile
 import numpy as np
 import pandas as pd
 
-from . import agreement, emotion, exclusion, likert, mixed, naturalness, participants, recognition, themes, vad
+from study_protocol import MODALITIES
+
+from . import agreement, emotion, exclusion, likert, mixed, naturalness, norms, participants, recognition, themes, vad
 from . import figures as figure_mod
 from . import viewing as viewing_mod
 from .io import StudyData, load_study
@@ -33,7 +35,7 @@ TABLE_KEYS = ("exclusions", "exclusion_counts", "viewing_incomplete", "gait_emot
               "likert_consistency_ad", "likert_distribution",
               "naturalness", "naturalness_test", "vad_pearson", "theme_anova", "theme_descriptives", "theme_inversion",
               "neutral_validation", "demographic_differences", "agreement",
-              "mixed_models")
+              "mixed_models", "clip_norms")
 """Keys of report.json holding a list of records (one CSV each). ``participants``, ``viewing`` and ``meta`` are
 objects."""
 SCREENING_KEYS = ("exclusions", "exclusion_counts", "viewing_incomplete")
@@ -86,6 +88,14 @@ METHODS = {
                  "participants = raters; only participants who rated every clip of the set; F-based 95% CI as "
                  "pingouin.intraclass_corr). Choices: Fleiss' kappa on the clip x label table (multi-select 1/k), "
                  "95% CI by bootstrap over clips.",
+    "clip_norms": "Per clip and question (analysis.norms): n_ratings; shares = the perceived vector (an answer "
+                  "selecting k labels adds 1/k to each; mean over the clip's answers); intended = the dominant "
+                  "intended label (gait: unique largest component >= 0.5; gesture: emotion_label; neutral "
+                  "validation: the theme); its share with the 95% Wilson score interval (statsmodels "
+                  "proportion_confint, method='wilson'; summed shares as successes); Shannon entropy in bits; "
+                  "seed 000's 2-sample Anderson-Darling test as gait_emotion_ad (gait emotion questions); mean "
+                  "norming intensity of the section; mean and n of the clip's naturalness answers. Written as "
+                  "clip_norms.csv (docs/study.md).",
     "mixed_models": "statsmodels MixedLM (REML), crossed random intercepts for participant and clip as variance "
                     "components of a single group. Theme: rating ~ weight * n_features (centred, numeric) per "
                     "theme; Likert: value ~ dominant intended emotion (reference neutral) per feature. Wald z "
@@ -138,6 +148,7 @@ TITLES = {
     "demographic_differences": "Perceived emotions across gender and age group, chi-square (seed 000 6.2)",
     "agreement": "Agreement between participants: ICC of ratings, Fleiss' kappa of choices",
     "mixed_models": "Mixed models with crossed random intercepts (participant, clip) beside the papers' tests",
+    "clip_norms": "Per-clip norms: perceived shares, intended share with its Wilson interval, entropy",
 }
 
 
@@ -160,6 +171,7 @@ def analyse(data: StudyData, alpha: float = 0.05, permutations: int = 0) -> tupl
         "demographic_differences": participants.demographic_differences(r, p, alpha),
         "agreement": agreement.agreement(r, c),
         "mixed_models": mixed.mixed_models(r, c),
+        "clip_norms": norms.clip_norms(r, c),
     }
     extras = {"participants": participants.participant_summary(p, r), "vad_pairs": vad.vad_pairs(r, c),
               "recognition": {"gait_emotion": recognition.gait_recognition(r, c, alpha),
@@ -397,6 +409,7 @@ def _make_figures(tables: dict, extras: dict) -> dict:
         "fig_inversion": figure_mod.fig_inversion(tables["theme_inversion"]),
         "fig_confusion": figure_mod.fig_confusion({RECOGNITION_KEYS[k].split(" (")[0]: v
                                                    for k, v in extras["recognition"].items()}),
+        **{f"fig_clip_norms_{m}": figure_mod.fig_clip_norms(tables["clip_norms"], m) for m in MODALITIES},
     }
 
 
@@ -458,7 +471,8 @@ text-align:right}th{background:#f3f3f3}.banner{background:#fff3cd;border:1px sol
 font-weight:bold}.fig svg{max-width:100%;height:auto}details{margin:.3em 0}ul.summary li{margin:.2em 0}
 .wide{overflow-x:auto}.method{color:#555;font-size:.85em}.tables{display:flex;flex-wrap:wrap;gap:1.5em;align-items:flex-start}"""
 
-FIG_FOR_TABLE = {"gait_emotion_ad": "fig_emotion_vectors", "transition_ad": "fig_transitions",
+FIG_FOR_TABLE = {"clip_norms": tuple(f"fig_clip_norms_{m}" for m in MODALITIES),
+                 "gait_emotion_ad": "fig_emotion_vectors", "transition_ad": "fig_transitions",
                  "likert_distribution": "fig_likert", "vad_pearson": "fig_vad", "naturalness": "fig_naturalness",
                  "theme_descriptives": "fig_theme_ratings", "theme_inversion": "fig_inversion"}
 MAX_HTML_ROWS = 60
@@ -558,9 +572,10 @@ def render_html(report: dict, tables: dict, figs: dict, extras: dict | None = No
         if df.empty:
             parts.append(EMPTY_TABLE_HTML.get(k, "<p>No data.</p>"))
             continue
-        fig = FIG_FOR_TABLE.get(k)
-        if fig in figs:
-            parts.append(f"<div class='fig'>{_inline_svg(figs[fig]['svg'])}</div>")
+        shown = FIG_FOR_TABLE.get(k, ())
+        for fig in (shown,) if isinstance(shown, str) else shown:
+            if fig in figs:
+                parts.append(f"<div class='fig'>{_inline_svg(figs[fig]['svg'])}</div>")
         if k in ("gait_emotion_ad", "transition_ad"):
             parts.append(f"<p class='method'><b>Read with care:</b> {h(AD_LABEL_BLIND)}</p>")
         parts.append(_table_html(df))

@@ -10,7 +10,7 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
 ORDER = ["core_features", "corpus", "rbf", "gait", "gesture", "device", "motion_quality", "render", "mocap",
-         "mocap_training", "import", "study", "flow", "flow_postgres", "analysis"]
+         "mocap_training", "import", "study", "flow", "flow_postgres", "analysis", "norms"]
 TITLES = {
     "core_features": "Motion core: features, IK, BVH, captured walks",
     "corpus": "Procedural motion and the synthetic corpus",
@@ -27,6 +27,7 @@ TITLES = {
     "flow": "Participant flow: queries per answer, concurrent starts",
     "flow_postgres": "Participant flow on PostgreSQL",
     "analysis": "Analysis and reports",
+    "norms": "Per-clip norms and norming studies",
 }
 
 

@@ -20,7 +20,7 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
 LIBRARIES = ("generation", "analysis", "studyapp")
-TOP_MODULES = ("study_protocol", "study_pools", "study_presets")
+TOP_MODULES = ("study_protocol", "study_pools", "study_presets", "study_norming")
 
 
 def package_of(module: str) -> str | None:

@@ -20,8 +20,10 @@ from django.utils.html import format_html, format_html_join
 from study_pools import SUB_POOLS
 
 from . import admin_clip_qa, clip_import, pool_editor, views_pool, views_staff
+from .admin_norms import norms_table
 from .forms import ClipImportForm, SectionForm, StudyAdminForm
 from .models import Assignment, Clip, Participant, Response, Section, Study
+from .norming import design_rows, open_errors
 from .permissions import can_access_study, can_manage_study_access, studies_for
 from .questions import section_type_choices
 from .views_pool import count_pool
@@ -139,10 +141,11 @@ class SectionInline(admin.StackedInline):
     def matching_clips(self, section):
         summary, warnings = pool_notes(section)
         return format_html('<span class="pool-count" data-url="{}" aria-live="polite">{}</span>'
-                           '<ul class="pool-warnings">{}</ul><code class="pool-json">pool (saved): {}</code>',
+                           '<ul class="pool-warnings">{}</ul><code class="pool-json">pool (saved): {}</code>'
+                           '<div class="norms-slot">{}</div>',
                            reverse("admin:studyapp_pool_count"), summary,
                            format_html_join("", '<li class="pool-warning">{}</li>', ((w,) for w in warnings)),
-                           json.dumps(section.pool))
+                           json.dumps(section.pool), norms_table(section.pool))
 
 
 @admin.register(Study)
@@ -153,13 +156,13 @@ class StudyAdmin(StudyScopedAdmin):
     inlines = [SectionInline]
     formfield_overrides = COMPACT
     actions = ["open_studies", "close_studies"]
-    readonly_fields = ["links", "preset", "created_at"]
+    readonly_fields = ["links", "preset", "created_at", "norming_design"]
     form = StudyAdminForm
     fieldsets = [
         (None, {"fields": ["title", "slug", "status", "preset", "links"]}),
         ("Participant pages", {"fields": ["language", "introduction", "consent_text", "ask_demographics",
                                           "feedback_questions", "counterbalance_sections"]}),
-        ("Recruitment", {"fields": ["max_participants", "abandon_after_minutes", "completion_code",
+        ("Recruitment", {"fields": ["max_participants", "norming_design", "abandon_after_minutes", "completion_code",
                                     "completion_redirect", "redirect_automatically", "created_at"]}),
         ("Analysis", {"fields": ["exclusion_rules"],
                       "description": "Exclusion rules the analysis report applies (checked by analysis.exclusion); "
@@ -231,8 +234,31 @@ class StudyAdmin(StudyScopedAdmin):
 
     @admin.action(description="Open the selected studies to participants")
     def open_studies(self, request, queryset):
-        n = queryset.update(status=Study.Status.OPEN)
-        self.message_user(request, f"Opened {n} stud{'y' if n == 1 else 'ies'}.", messages.SUCCESS)
+        refused = {}
+        for study in queryset:
+            errors = open_errors(study)
+            if errors:
+                refused[study.pk] = errors
+                self.message_user(request, f"Not opened: {study.slug}: {'; '.join(errors)}", messages.ERROR)
+        n = queryset.exclude(pk__in=refused).update(status=Study.Status.OPEN)
+        self.message_user(request, f"Opened {n} stud{'y' if n == 1 else 'ies'}.",
+                          messages.SUCCESS if n else messages.WARNING)
+
+    @admin.display(description="norming design")
+    def norming_design(self, obj):
+        rows = design_rows(obj) if obj.pk else []
+        if not rows:
+            return "-"
+        body = format_html_join("", "<tr><td>{}. {}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td>"
+                                    "<td>{}</td></tr>",
+                                ((r.section.order, r.section.section_type, r.n_clips, r.m, r.k, r.n_needed,
+                                  r.n_planned or "no limit set", "; ".join(r.errors) or
+                                  f"ok: every clip gets at least {r.min_with_planned} ratings") for r in rows))
+        return format_html('<table class="norming-design"><thead><tr><th>section</th><th>clips C</th>'
+                           '<th>per participant M</th><th>ratings per clip K</th><th>participants needed N</th>'
+                           '<th>planned N (participant limit)</th><th>design</th></tr></thead><tbody>{}</tbody>'
+                           '</table><p><a href="{}">ratings per clip so far</a></p>', body,
+                           reverse("studyapp:norming_monitor", args=[obj.pk]))
 
     @admin.action(description="Close the selected studies (no new participants)")
     def close_studies(self, request, queryset):

@@ -2,7 +2,9 @@
 
 Rules (seed 000 section 6.1, seed 003 section 6.1, seed 004 section V):
 - every participant gets a recorded random seed; the clips of each section are drawn with it;
-- balanced: within a section the clips with the fewest assignments so far come first (ties broken at random);
+- balanced: within a section the clips with the fewest assignments so far come first (ties broken at random); a
+  norming section (``options["norming"]``) follows the cyclic balanced incomplete design of study_norming instead,
+  balanced over participants and positions;
 - no clip twice for one participant, except in a section that reuses another section's clips on purpose;
 - naturalness mixes generated and source clips, unlabelled, in random order, and never shows a generated clip
   whose source clip is also shown (seed 003);
@@ -35,7 +37,9 @@ from django.db import OperationalError, connection, transaction
 from django.db.models import F
 from django.utils import timezone
 
+from study_norming import clip_order, cyclic_block, ratings_per_clip
 from study_pools import SUB_POOLS
+from study_protocol import NORMING_SECTION_TYPES
 
 from .counterbalance import SectionInfo, section_order
 from .models import Assignment, Clip, Participant, Section, SectionClipCount, Study, StudyCounter
@@ -88,16 +92,31 @@ def plan_section(section: Section, seed: int, used: set[int], earlier: dict[int,
         chosen = _plan_naturalness(section, rng, base, pool, counts, k)
         rng.shuffle(chosen)          # mixed, unlabelled, random order (seed 003)
         return [PlannedItem(c) for c in chosen]
-    chosen = _balanced_pick(rng, base, counts, k)
-    if section.randomize_order:
-        rng.shuffle(chosen)
+    if section.section_type in NORMING_SECTION_TYPES and ratings_per_clip(section.options) is not None:
+        chosen = _plan_norming(section, pool.clips, used, counts, k)   # the design fixes the order too
     else:
-        chosen.sort(key=lambda c: c.clip_id)
+        chosen = _balanced_pick(rng, base, counts, k)
+        if section.randomize_order:
+            rng.shuffle(chosen)
+        else:
+            chosen.sort(key=lambda c: c.clip_id)
     items = [PlannedItem(c) for c in chosen]
     if section.section_type == "gesture_emotion":
         for it in items:
             it.options = gesture_options(rng, section, it.clip.emotion_label or "neutral")
     return items
+
+
+def _plan_norming(section: Section, clips: list[Clip], used: set[int], counts: dict[int, int], k: int
+                  ) -> list[Clip]:
+    """A norming section's clips for the next participant, in the order shown: the cyclic balanced incomplete
+    design of study_norming over the pool in its fixed order (seeded by the section), the participant's ordinal
+    being the section's trial assignments so far / M. Clips this participant already has are skipped."""
+    by_id = {c.clip_id: c for c in clips}
+    order = clip_order(list(by_id), str(section.pk))
+    m = min(k, len(order)) if k > 0 else len(order)
+    ordinal = sum(counts.get(c.pk, 0) for c in clips) // max(m, 1)
+    return [c for c in (by_id[order[i]] for i in cyclic_block(len(order), m, ordinal)) if c.pk not in used]
 
 
 def _in_sub_pool(pool: SectionPool, key: str, clip: Clip) -> bool:

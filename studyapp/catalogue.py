@@ -14,9 +14,9 @@ import math
 from itertools import combinations
 
 from django.db import transaction
-from django.db.models import QuerySet
+from django.db.models import Q, QuerySet
 
-from study_pools import INCLUDE_FLAGGED, PoolError, pool_lookups
+from study_pools import INCLUDE_FLAGGED, NORMS_RULE, PoolError, pool_lookups
 from study_protocol import (
     CLIP_FLOAT_COLUMNS,
     CLIP_MODALITIES,
@@ -33,6 +33,13 @@ from .models import Clip
 ADVISORY_FLAGS = ("", *(";".join(c for c in QA_CHECKS if c in subset)
                         for n in range(1, len(QA_ADVISORY_CHECKS) + 1)
                         for subset in combinations(QA_ADVISORY_CHECKS, n)))
+
+#: ``qa_flag`` values that keep a clip with norms in a pool with a norms rule: failed only the observer check and
+#: advisory ones (studyapp.norms_rule).
+OBSERVER_ADVISORY_FLAGS = tuple(";".join(c for c in QA_CHECKS if c in subset)
+                                for n in range(1, len(QA_ADVISORY_CHECKS) + 2)
+                                for subset in combinations(("observer", *QA_ADVISORY_CHECKS), n)
+                                if "observer" in subset)
 
 TEXT_FIELDS = ("emotion_label", "theme", "webm", "poster", "plan", "source_clip_id")
 
@@ -176,7 +183,9 @@ def pool_queryset(pool: dict | None, include_flagged: bool | None = None) -> Que
     Clips that failed a quality check (``qa_flag`` not empty) are left out unless the pool says
     ``"include_flagged": true`` or ``include_flagged`` is given (True for a sub-pool, which only narrows its
     section's pool); failing only advisory checks (``study_protocol.QA_ADVISORY_CHECKS``) does not count.
-    Raises CatalogueError naming the filter when the pool is not valid; sub-pools are left to the assignment.
+    A ``norms`` rule (studyapp.norms_rule) keeps only clips whose norms pass, and makes the ``observer`` check
+    advisory for clips that have norms. Raises CatalogueError naming the filter (or the norms source's file, line
+    and column) when the pool is not valid; sub-pools are left to the assignment.
     """
     try:
         calls = pool_lookups(pool)
@@ -185,8 +194,19 @@ def pool_queryset(pool: dict | None, include_flagged: bool | None = None) -> Que
     qs = Clip.objects.filter(retired=False)
     if include_flagged is None:
         include_flagged = bool((pool or {}).get(INCLUDE_FLAGGED, False))
+    normed: set[str] | None = None
+    if isinstance((pool or {}).get(NORMS_RULE), dict):
+        from .norms_rule import NormsSourceError, passing_ids
+        try:
+            passing, normed = passing_ids(pool)
+        except NormsSourceError as exc:
+            raise CatalogueError(str(exc)) from exc
+        qs = qs.filter(clip_id__in=passing)
     if not include_flagged:
-        qs = qs.filter(qa_flag__in=ADVISORY_FLAGS)
+        flags = Q(qa_flag__in=ADVISORY_FLAGS)
+        if normed:      # a norm outranks an observer: its verdict is advisory for clips people rated
+            flags |= Q(qa_flag__in=OBSERVER_ADVISORY_FLAGS, clip_id__in=normed)
+        qs = qs.filter(flags)
     for method, kwargs in calls:
         qs = getattr(qs, method)(**kwargs)
     return qs

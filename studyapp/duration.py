@@ -15,7 +15,8 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from study_protocol import SECTION_QUESTIONS
+from study_norming import ratings_per_clip
+from study_protocol import SECTION_QUESTIONS, section_questions
 
 from .models import Section, Study
 from .pool_cache import SectionPool, section_pools
@@ -70,7 +71,8 @@ def section_times(sections: list[Section], pools: dict[int, SectionPool]) -> lis
         checks = check_count(options["attention_checks"]) if options.get("attention_checks") and items else 0
         practice = 1 if options.get("practice") or options.get("practice_clip") else 0
         out[s.pk] = SectionTime(items, checks, practice, source.mean_clip_s if source else mean_duration(pool),
-                                len(SECTION_QUESTIONS.get(s.section_type, {})))
+                                len(section_questions(s.section_type, ratings_per_clip(options) is not None))
+                                if s.section_type in SECTION_QUESTIONS else 0)
     return [out[s.pk] for s in sections]
 
 

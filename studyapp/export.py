@@ -29,6 +29,7 @@ from pathlib import Path
 
 from django.db.models import Case, F, Q, When
 
+from study_pools import NORMS_RULE
 from study_protocol import (
     ASSIGNMENT_COLUMNS,
     ATTENTION_CHECK,
@@ -103,11 +104,14 @@ def response_rows(study: Study) -> Iterator[list]:
 
 
 def study_clips(study: Study):
-    """Clips assigned in the study plus those in its sections' pools."""
+    """Clips assigned in the study plus those in its sections' pools (a pool's norms rule left out: the export never
+    depends on another study's answers or a norms file, and a study normed from itself cannot recurse)."""
     q = Q(assignments__section__study=study)
     for section in study.sections.all():
         if section.pool:
-            q |= Q(pk__in=pool_queryset(section.pool).values("pk"))
+            pool = {k: v for k, v in section.pool.items() if k != NORMS_RULE} if isinstance(section.pool, dict) \
+                else section.pool
+            q |= Q(pk__in=pool_queryset(pool).values("pk"))
     return Clip.objects.filter(q).distinct().order_by("clip_id")
 
 

@@ -13,6 +13,7 @@ from . import pool_editor
 from .i18n import display
 from .inputs import refuse_control_characters, refuse_control_characters_in_text
 from .models import Clip, Section, Study
+from .norming import open_errors
 from .pool_editor import PoolEditorFields
 from .presets import preset_choices
 from .questions import section_type_choices
@@ -152,6 +153,15 @@ class StudyAdminForm(forms.ModelForm):
         value = (self.cleaned_data.get("completion_redirect") or "").strip()
         check_completion_url(value)
         return value
+
+    def clean(self):
+        """A norming study opens only when its planned N (the participant limit) gives every clip K ratings."""
+        data = super().clean()
+        if self.instance.pk and data.get("status") == Study.Status.OPEN:
+            errors = open_errors(self.instance, n_planned=data.get("max_participants") or 0)
+            if errors:
+                self.add_error("status", errors)
+        return data
 
     def clean_exclusion_rules(self):
         rules = self.cleaned_data.get("exclusion_rules")

@@ -14,11 +14,14 @@ from dataclasses import dataclass, field
 from django.utils.translation import gettext
 from django.utils.translation import gettext_noop as _
 
+from study_norming import ratings_per_clip
 from study_protocol import (
     GESTURE_EMOTIONS,
     INTEGER_RANGES,
     LIKERT_LEVELS,
     MULTI_SELECT_KINDS,
+    NORMING_QUESTIONS,
+    NORMING_SECTION_TYPES,
     OPPOSITE_THEME,
     SECTION_QUESTIONS,
     SECTION_TYPES,
@@ -67,6 +70,14 @@ WORDING: dict[str, SectionWording] = {
         "rating": (_("Does this walk look {opposite} or {theme}?"),
                    _("From -7 (maximum opposite theme) through 0 (neutral) to +7 (maximum {theme})."))}),
 }
+
+
+# The questions a norming section asks after its own (study_protocol.NORMING_QUESTIONS).
+NORMING_WORDING: dict[str, tuple[str, str]] = {
+    "intensity": (_("How intense is the emotion or style you perceive?"), ""),
+    "naturalness": (_("How natural and smooth does this animation look?"), ""),
+}
+INTENSITY_ANCHORS = {"1": _("very weak"), "3": _("moderate"), "5": _("very strong")}
 
 
 def section_type_choices() -> list[tuple[str, str]]:
@@ -170,7 +181,24 @@ def questions_for(section_type: str, options: dict | None = None, clip_theme: st
                    for v in _values(section_type, kind, shown_options)]
         questions.append(Question(key, display(text).format(theme=theme, opposite=opposite), widget, choices,
                                   display(help_text).format(theme=theme, opposite=opposite), kind))
+    if section_type in NORMING_SECTION_TYPES and ratings_per_clip(options) is not None:
+        questions += _norming_questions(section_type)
     return questions
+
+
+def _norming_questions(section_type: str) -> list[Question]:
+    """Intensity (1..5) and naturalness (1..5, the modality's anchors) of a norming section's clip page."""
+    out = []
+    for key, kind in NORMING_QUESTIONS.items():
+        text, help_text = NORMING_WORDING[key]
+        if key == "intensity":
+            anchors = INTENSITY_ANCHORS
+        else:
+            anchors = NATURALNESS_ANCHORS_GESTURE if section_type == "gesture_emotion" else NATURALNESS_ANCHORS_GAIT
+        labels = {v: gettext(a) for v, a in anchors.items()}
+        out.append(Question(key, gettext(text), "scale", [(v, labels.get(v, "")) for v in answer_values(kind)],
+                            gettext(help_text) if help_text else "", kind))
+    return out
 
 
 def _theme_words(section_type: str, clip_theme: str) -> tuple[str, str]:

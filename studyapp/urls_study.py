@@ -2,7 +2,7 @@
 clip media under /m/, researcher pages (staff only) under /staff/."""
 from django.urls import path
 
-from . import views, views_staff
+from . import views, views_norming, views_staff
 
 app_name = "studyapp"
 
@@ -20,6 +20,7 @@ urlpatterns = [
     path("staff/study/<int:study_id>/preview/", views_staff.preview_start, name="preview_start"),
     path("staff/study/<int:study_id>/preview/<int:n>/", views_staff.preview_item, name="preview_item"),
     path("staff/study/<int:study_id>/progress/", views_staff.progress, name="progress"),
+    path("staff/study/<int:study_id>/norming/", views_norming.norming_monitor, name="norming_monitor"),
     path("staff/study/<int:study_id>/export/<str:kind>.csv", views_staff.export_csv, name="export_csv"),
     path("staff/study/<int:study_id>/report.zip", views_staff.report_zip, name="report_zip"),
 ]

@@ -6,7 +6,11 @@ the fields of one section form (names without the formset prefix) and answers JS
 
     {"count": 12, "by_origin": {"generated": 8, "source": 4}, "summary": "12 clips match ...",
      "warnings": [...], "errors": [{"field": "pool_weight_min", "label": "Weight from",
-     "messages": ["Enter a number."]}], "pool": {...}, "options": {...}, "used": {"pool": "fields", ...}}
+     "messages": ["Enter a number."]}], "pool": {...}, "options": {...}, "used": {"pool": "fields", ...},
+     "norms_html": "<details class=\"norms-table\">..."}
+
+``norms_html`` is the norms table of a pool with a ``norms`` rule (studyapp.admin_norms; escaped HTML, "" without
+a rule).
 
 Staff with the permission studyapp.view_clip only (403 JSON otherwise); bad input is an error in the answer
 (status 200), never a 500.
@@ -22,6 +26,7 @@ from django.views.decorators.cache import never_cache
 from study_pools import SUB_POOLS, pool_errors
 from study_protocol import ORIGINS
 
+from .admin_norms import norms_table
 from .catalogue import CatalogueError, pool_queryset
 from .forms import SectionPreviewForm
 from .permissions import has_staff_permission
@@ -111,7 +116,8 @@ def preview(form: SectionPreviewForm, reuse_section: str = "") -> dict:
     if counted.total is None:
         answer["errors"].append({"field": "pool", "label": "pool", "messages": counted.errors})
     answer.update(count=counted.total, by_origin=counted.by_origin, summary=counted.summary(),
-                  warnings=counted.warnings(data.get("clips_per_participant"), data.get("options")))
+                  warnings=counted.warnings(data.get("clips_per_participant"), data.get("options")),
+                  norms_html=str(norms_table(data["pool"])) if counted.total is not None else "")
     if reuse_section:
         answer["warnings"].insert(0, REUSED)
     return answer

@@ -83,7 +83,7 @@ BAD = [  # (section_type, pool, options, clips, field, words the message must co
     ("gesture_emotion", {"modality": "gait"}, {}, 6, "pool", ["'modality'", "gesture"]),
     ("naturalness", {"source": {"origin": "copied"}}, {}, 6, "pool", ["sub-pool 'source'", "'copied'"]),
     ("naturalness", {"generated": "demo"}, {}, 6, "pool", ["sub-pool 'generated'", "JSON object"]),
-    ("theme_rating", {}, {"colour": "red"}, 6, "options", ["'colour'", "no options"]),
+    ("affect_likert", {}, {"colour": "red"}, 6, "options", ["'colour'", "no options"]),
     ("emotion_choice", {}, "four", 6, "options", ["JSON object"]),
     ("naturalness", {}, {"n_options": 4}, 6, "options", ["'n_options'", "n_generated"]),
     ("naturalness", {}, {"anchors": {"6": "great"}}, 6, "options", ["'anchors'", "'6'"]),

@@ -135,16 +135,18 @@ def stage_clips(stage: str, split: str, path: str | Path | None = None) -> list:
     return clips
 
 
-def clip_sequences(clips: list, data: GaitDataConfig, augment: RealAugment, labelled: bool = True
-                   ) -> GaitSequences:
+def clip_sequences(clips: list, data: GaitDataConfig, augment: RealAugment, labelled: bool = True,
+                   emotion_of=None) -> GaitSequences:
     """Network sequences of windows of ``clips`` (each clip's split kept per row). Rows of one window (its mirror,
     time warps and subsampling offsets) share a ``base_index``, so a training epoch visits each window once in
-    one random variant. Clips shorter than a window are skipped. ``.clip_names`` lists the clip of each base."""
+    one random variant. Clips shorter than a window are skipped. ``.clip_names`` lists the clip of each base.
+    ``emotion_of(clip)``: the (4,) emotion input of a clip instead of its label's (soft labels,
+    :mod:`generation.gait.soft_labels`)."""
     need = data.frame_step * (data.seq_len - 1) + 1 + max(augment.offsets)
     rot, root, emo, split, skels, base = [], [], [], [], [], []
     names: dict[tuple[str, int], int] = {}   # (clip, window of the captured time line) -> base index
     for clip in clips:
-        em = emotion_vector(clip.label, labelled)
+        em = emotion_of(clip) if emotion_of is not None else emotion_vector(clip.label, labelled)
         variants = [clip.motion] + ([mirror_motion(clip.motion)] if augment.mirror else [])
         for v in variants:
             for f in augment.speed_factors:

@@ -519,6 +519,14 @@ def build_parser() -> argparse.ArgumentParser:
                         "locomotion of both Bandai Namco datasets, labelled where the style is a gait emotion; "
                         "finetune = dataset 1's happy/sad/angry/normal walks; --corpus then names the real corpus "
                         "file (default var/mocap/bandai-namco.npz)")
+    p.add_argument("--soft-labels", default=None, metavar="CLIP_NORMS.csv",
+                   help="train on the rated walks of a clip_norms.csv (docs/study.md) with each one's perceived "
+                        "share vector as its emotion target (with --real finetune: beside the real takes)")
+    p.add_argument("--motions", default=None, metavar="DIR",
+                   help="where the rated clips' motions are (<clip_id>.bvh; default $MEDIA_ROOT/motions)")
+    p.add_argument("--norms-study", default=None,
+                   help="the study the norms come from, recorded in the weights (default: the CSV's folder name)")
+    p.add_argument("--min-ratings", type=int, default=1, help="soft labels only from walks with this many ratings")
     p.add_argument("--refit-normalizer", action="store_true",
                    help="with --init: standardise with this run's training walks, not the initial file's")
     p.add_argument("--out", default=str(DEFAULT_WEIGHTS), help="weights file to write")
@@ -596,7 +604,9 @@ def run(args, log=print) -> dict:
         raise SystemExit(f"--device: {exc}") from None
     amp = amp_for(device, getattr(args, "amp", False), log)
     config = config_from_args(args)
-    if getattr(args, "real", None):
+    if getattr(args, "soft_labels", None):
+        data = _soft_label_data(args, config, log)
+    elif getattr(args, "real", None):
         data = load_real_sequences(args.real, config.data, path=args.corpus)
     else:
         data = load_corpus_sequences(args.corpus, num_sequences=args.num_sequences, seed=0,
@@ -610,6 +620,43 @@ def run(args, log=print) -> dict:
                    refit_normalizer=getattr(args, "refit_normalizer", False))
     log(f"wrote {args.out}")
     return result
+
+
+SOFT_LABEL_WEIGHTS = Path("var/weights/gait_net_soft_labels.pt")
+"""Where a soft-label run writes unless --out says otherwise (never over the shipped weights)."""
+
+
+def _soft_label_data(args, config: GaitNetConfig, log) -> GaitSequences:
+    """The rated walks of ``--soft-labels`` (and, with ``--real``, that stage's real takes beside them); points
+    ``--out`` away from the shipped weights."""
+    import os
+
+    from .real_data import concat_sequences
+    from .soft_labels import SoftLabelError, load_soft_label_sequences
+
+    motions = args.motions or (Path(os.environ["MEDIA_ROOT"]) / "motions" if os.environ.get("MEDIA_ROOT") else None)
+    if motions is None:
+        raise SystemExit("--soft-labels: say where the clips' motions are (--motions DIR or MEDIA_ROOT)")
+    try:
+        soft = load_soft_label_sequences(args.soft_labels, motions, config.data, study=args.norms_study,
+                                         min_ratings=args.min_ratings)
+    except (SoftLabelError, ValueError) as exc:
+        raise SystemExit(f"--soft-labels: {exc}") from None
+    if Path(args.out).resolve() == Path(DEFAULT_WEIGHTS).resolve():
+        args.out = str(SOFT_LABEL_WEIGHTS)
+        Path(args.out).parent.mkdir(parents=True, exist_ok=True)
+        log(f"--soft-labels: writing {args.out} (the shipped weights are never replaced; --out to choose)")
+    info = soft.source["soft_labels"]
+    log(f"soft labels: {info['n_clips']} rated walks, {info['n_ratings']} ratings, study {info['study']}")
+    if not getattr(args, "real", None):
+        return soft
+    real = load_real_sequences(args.real, config.data, path=args.corpus)
+    soft.base_index = soft.base_index + int(real.base_index.max()) + 1
+    both = concat_sequences([real, soft])
+    both.clip_names = [*real.clip_names, *soft.clip_names]
+    both.source = {**real.source, **soft.source}
+    both.trained_on = f"{real.trained_on}; {soft.trained_on}"
+    return both
 
 
 def main(argv=None) -> int:

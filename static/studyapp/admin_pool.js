@@ -78,6 +78,10 @@
       e.messages.forEach(function (m) { item(list, e.label + ": " + m, "pool-error"); });
     });
     (body.warnings || []).forEach(function (w) { item(list, w, "pool-warning"); });
+    var norms = row.querySelector(".norms-slot");
+    if (norms && status === 200) {
+      norms.innerHTML = body.norms_html || "";     // escaped by the server (studyapp.admin_norms)
+    }
     if (json && body.pool) {
       json.textContent = "pool " + (body.used && body.used.pool === "fields" ? "(from the fields)" : "(raw JSON)")
         + ": " + JSON.stringify(body.pool);

@@ -1,0 +1,164 @@
+"""The pool rule ``norms``: admit only clips whose per-clip norms pass (study_pools.NORMS_RULE).
+
+``{"norms": {"from": "<study slug>" | "<path to clip_norms.csv>", "min_ratings": 10, "min_intended_share": 0.5,
+"max_entropy_bits": 1.5}}``. The norms come from a study of this site (computed from its exports with its
+exclusion rules, as the report does: analysis.norms) or from a clip_norms.csv file (a path, relative to
+``settings.DATA_DIR`` unless absolute), read and checked whole by analysis.norms.read_clip_norms before anything is
+used, so a bad file changes nothing.
+
+A clip's norm is its row with an intended label and the most ratings (a clip rated in several sections: the
+norming section's emotion question). A clip passes when it has a norm with at least ``min_ratings`` ratings, an
+intended share of at least ``min_intended_share`` and an entropy of at most ``max_entropy_bits``; each failed
+condition is a reason shown by the pool editor. Where a clip has a norm, the automatic observers' verdict (the
+``observer`` quality check) is advisory: a clip flagged only by the observer (and advisory checks) stays in a pool
+with a norms rule -- people's ratings outrank an observer's.
+"""
+from __future__ import annotations
+
+import io
+import os
+import threading
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from django.conf import settings
+
+from study_pools import NORMS_RULE
+
+from .models import Clip, Response, Study
+
+
+class NormsSourceError(ValueError):
+    """The ``from`` of a norms rule cannot give norms; the message names the field, and the file, line and column
+    of each problem of a clip_norms.csv."""
+
+
+@dataclass
+class ClipVerdict:
+    """A clip's norm (a dict of clip_norms.csv cells, None when it has none) and the reasons it is out (none: in)."""
+    norm: dict | None
+    reasons: list[str] = field(default_factory=list)
+
+    @property
+    def passes(self) -> bool:
+        return not self.reasons
+
+
+_cache: dict[tuple, dict[str, dict]] = {}
+_lock = threading.Lock()
+
+
+def _is_path(source: str) -> bool:
+    return source.endswith(".csv") or "/" in source or os.sep in source
+
+
+def _from_file(source: str) -> tuple[tuple, callable]:
+    path = Path(source)
+    if not path.is_absolute():
+        path = Path(getattr(settings, "DATA_DIR", ".")) / path
+    try:
+        stat = path.stat()
+    except OSError as exc:
+        raise NormsSourceError(f"pool.norms.from: cannot read {source!r} ({exc.strerror or exc})") from None
+
+    def load():
+        from analysis.io import ValidationError
+        from analysis.norms import read_clip_norms
+        try:
+            return read_clip_norms(path, known_clips=Clip.objects.values_list("clip_id", flat=True))
+        except ValidationError as exc:
+            more = f"; and {exc.total - len(exc.problems)} more" if exc.total > len(exc.problems) else ""
+            raise NormsSourceError("pool.norms.from: " + "; ".join(map(str, exc.problems)) + more) from None
+    return ("file", str(path), stat.st_mtime_ns, stat.st_size), load
+
+
+def _from_study(slug: str) -> tuple[tuple, callable]:
+    study = Study.objects.filter(slug=slug).first()
+    if study is None:
+        raise NormsSourceError(f"pool.norms.from: no study {slug!r} on this site (give a study's slug or a "
+                               "clip_norms.csv path)")
+    answers = Response.objects.filter(section__study=study)
+    last = answers.order_by("-id").values_list("id", flat=True).first()
+
+    def load():
+        from analysis import exclusion
+        from analysis.io import StudyData, load_study
+        from analysis.norms import clip_norms
+
+        from .export import stream_csv
+        texts = {k: io.StringIO("".join(stream_csv(study, k)))
+                 for k in ("responses", "clips", "participants", "viewing")}
+        data = load_study(texts["responses"], texts["clips"], texts["participants"], texts["viewing"])
+        rules = exclusion.resolve_rules(study.exclusion_rules)
+        excl = exclusion.exclusions(data.responses, data.clips, participants=data.participants, rules=rules,
+                                    viewing=data.viewing)
+        kept = StudyData(exclusion.apply_exclusions(data.responses, excl), data.clips, data.participants)
+        norms = clip_norms(kept.responses, kept.clips)
+        if norms.empty:
+            raise NormsSourceError(f"pool.norms.from: study {slug!r} has no norms yet (no answers to an emotion "
+                                   "question of its clips)")
+        return norms
+    return ("study", study.pk, last, answers.count()), load
+
+
+def load_norms(source: str) -> dict[str, dict]:
+    """clip_id -> its norm (the chosen clip_norms row as a dict) from a norms rule's ``from``; cached per source
+    version (file mtime and size, or the study's answers). Raises NormsSourceError."""
+    source = (source or "").strip()
+    key, load = _from_file(source) if _is_path(source) else _from_study(source)
+    with _lock:
+        if key in _cache:
+            return _cache[key]
+    table = load()
+    with_intended = table.assign(_has=table["intended"].notna() & (table["intended"].astype(str) != ""))
+    best = (with_intended.sort_values(["clip_id", "_has", "n_ratings"], ascending=[True, False, False])
+            .drop_duplicates("clip_id").drop(columns="_has"))
+    norms = {row["clip_id"]: row for row in best.to_dict("records")}
+    with _lock:
+        _cache[key] = norms
+        while len(_cache) > 16:
+            _cache.pop(next(iter(_cache)))
+    return norms
+
+
+def judge(rule: dict, norm: dict | None) -> ClipVerdict:
+    """Whether one clip's norm passes the rule, with the reasons it does not."""
+    if norm is None:
+        return ClipVerdict(None, ["no norms for this clip"])
+    reasons = []
+    n = norm.get("n_ratings")
+    if "min_ratings" in rule and not (n == n and n >= rule["min_ratings"]):
+        reasons.append(f"{int(n) if n == n else 0} ratings < {rule['min_ratings']}")
+    if "min_intended_share" in rule:
+        share = norm.get("intended_share")
+        if share is None or share != share:
+            reasons.append("no intended label to compare")
+        elif share < rule["min_intended_share"]:
+            reasons.append(f"intended share {share:.2f} < {rule['min_intended_share']:g}")
+    if "max_entropy_bits" in rule:
+        h = norm.get("entropy_bits")
+        if h is None or h != h or h > rule["max_entropy_bits"]:
+            reasons.append(f"entropy {h:.2f} bits > {rule['max_entropy_bits']:g}" if h == h and h is not None
+                           else "no entropy")
+    return ClipVerdict(norm, reasons)
+
+
+def verdicts(pool: dict | None, clip_ids) -> dict[str, ClipVerdict]:
+    """clip_id -> verdict of the pool's norms rule for each of ``clip_ids`` ({} when the pool has no rule)."""
+    rule = (pool or {}).get(NORMS_RULE)
+    if not isinstance(rule, dict):
+        return {}
+    norms = load_norms(rule.get("from", ""))
+    return {cid: judge(rule, norms.get(cid)) for cid in clip_ids}
+
+
+def passing_ids(pool: dict) -> tuple[set[str], set[str]]:
+    """(clip ids that pass the pool's norms rule, clip ids that have a norm at all)."""
+    rule = pool[NORMS_RULE]
+    norms = load_norms(rule.get("from", ""))
+    return {cid for cid, norm in norms.items() if judge(rule, norm).passes}, set(norms)
+
+
+def clear() -> None:
+    with _lock:
+        _cache.clear()
