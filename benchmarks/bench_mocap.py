@@ -8,29 +8,27 @@ the scaled source positions of mapped joints), the distance to the ground-truth 
 per 1000 frames (read + map + IK, best of 3, one thread).
 
 Writes a markdown section to ``docs/benchmarks/mocap.md`` (use --md to change) and prints it.
-Usage: OMP_NUM_THREADS=1 python benchmarks/bench_mocap.py [--frames 1000]
+Usage: OMP_NUM_THREADS=1 python -m benchmarks.bench_mocap [--frames 1000]
 """
 from __future__ import annotations
 
 import argparse
 import datetime
 import os
-import sys
 import tempfile
 import time
 from pathlib import Path
 
 os.environ.setdefault("OMP_NUM_THREADS", "1")
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-import numpy as np  # noqa: E402
-import torch  # noqa: E402
+import numpy as np
+import torch
 
-from generation.core.skeleton import gait_skeleton  # noqa: E402
-from generation.mocap.conventions import CONVENTIONS, export_as  # noqa: E402
-from generation.mocap.importer import ImportOptions, import_file  # noqa: E402
-from generation.procedural.gesture import GestureParams, seated_gesture  # noqa: E402
-from generation.procedural.walk import WalkParams, walk  # noqa: E402
+from generation.core.skeleton import gait_skeleton
+from generation.mocap.conventions import CONVENTIONS, export_as
+from generation.mocap.importer import ImportOptions, import_file
+from generation.procedural.gesture import GestureParams, seated_gesture
+from generation.procedural.walk import WalkParams, walk
 
 EG16 = ("root", "spine", "neck", "head", "left_shoulder", "left_elbow", "left_hand", "right_shoulder",
         "right_elbow", "right_hand", "left_hip", "left_knee", "left_heel", "right_hip", "right_knee", "right_heel")

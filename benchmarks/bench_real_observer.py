@@ -1,7 +1,7 @@
 """The real-capture gait observer on held-out real takes, the demo and seed000 plans' gait clips read by it and by the
 synthetic observer, and the realism measures of real walks beside the generated ones.
 
-    python benchmarks/bench_real_observer.py [--corpus var/mocap/bandai-namco.npz] [--plans demo seed000]
+    python -m benchmarks.bench_real_observer [--corpus var/mocap/bandai-namco.npz] [--plans demo seed000]
         [--json docs/benchmarks/real_observer.json] [--md docs/benchmarks/mocap.md]
 
 1. Held-out takes: the observer (generation/quality/real_observer.py) is fitted on the corpus's training split and
@@ -30,21 +30,15 @@ import time
 from collections import defaultdict
 from pathlib import Path
 
-os.environ.setdefault("OMP_NUM_THREADS", "1")
-ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT))
+import numpy as np
 
-import numpy as np  # noqa: E402
-
-from generation.mocap.real_corpus import load_real_corpus, real_corpus_path  # noqa: E402
-from generation.quality import real_observer as ro  # noqa: E402
-from generation.quality.realism import MEASURES  # noqa: E402
-from generation.quality.realism_ranges import load_ranges, measure_corpus  # noqa: E402
-from study_protocol import CAPTURE_GAIT_EMOTIONS, GAIT_EMOTIONS  # noqa: E402
-
-sys.path.insert(0, str(ROOT / "benchmarks"))
-import doc_tables  # noqa: E402
-from bench_record import commit_label, machine_label  # noqa: E402
+from benchmarks import doc_tables
+from benchmarks.bench_record import commit_label, machine_label, one_thread
+from generation.mocap.real_corpus import load_real_corpus, real_corpus_path
+from generation.quality import real_observer as ro
+from generation.quality.realism import MEASURES
+from generation.quality.realism_ranges import load_ranges, measure_corpus
+from study_protocol import CAPTURE_GAIT_EMOTIONS, GAIT_EMOTIONS
 
 
 def held_out(obs: ro.RealGaitObserver, test) -> dict:
@@ -216,6 +210,7 @@ def _count(items) -> dict:
 
 
 def main(argv=None) -> int:
+    one_thread()
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--corpus", default=None)
     ap.add_argument("--plans", nargs="*", default=["demo", "seed000"])
@@ -238,7 +233,7 @@ def main(argv=None) -> int:
     plans_synth = {p: plan_rows(p, "synthetic") for p in args.plans}
     ranges = load_ranges()
     res = {"date": datetime.date.today().isoformat(), "commit": commit_label(),
-           "command": shlex.join(["python", "benchmarks/bench_real_observer.py",
+           "command": shlex.join(["python", "-m", "benchmarks.bench_real_observer",
                                   *(sys.argv[1:] if argv is None else argv)]),
            "machine": machine_label(),
            "corpus": path.name, "observer_source": obs.source, "train_takes": dict(obs.train_takes),

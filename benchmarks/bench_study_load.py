@@ -1,6 +1,6 @@
 """Load test: simulated participants take the demo study over HTTP against gunicorn + PostgreSQL.
 
-    python benchmarks/bench_study_load.py --participants 200 --arrival 30 --workers 2 --threads 8 \
+    python -m benchmarks.bench_study_load --participants 200 --arrival 30 --workers 2 --threads 8 \
         [--driver locust|threads] [--viewers 4] [--db-url postgres://postgres@127.0.0.1:5432/postgres]
 
 Loopback only, bounded in participant count (<= 400) and time (--time-limit). It creates its own uniquely named
@@ -29,7 +29,7 @@ ratio of the study's requests/s to it, lost / duplicated answers found in the da
 responses.csv (all must be 0), and the CPU seconds of the study phase by gunicorn, PostgreSQL (the whole local
 server), the generator and the machine (Linux /proc), also per answered clip.
 
-    python benchmarks/bench_study_load.py --in-process-only --in-process 10 [--profile FILE]
+    python -m benchmarks.bench_study_load --in-process-only --in-process 10 [--profile FILE]
 
 measures only the server time, CPU time and queries of each request kind in-process (Django test client, same
 scratch database set-up, no gunicorn or Locust), optionally with a cProfile of the measured participants.
@@ -53,7 +53,6 @@ from pathlib import Path
 from urllib.parse import urlencode, urljoin, urlsplit, urlunsplit
 
 ROOT = Path(__file__).resolve().parent.parent
-sys.path.insert(0, str(ROOT))
 LOCUSTFILE = Path(__file__).resolve().parent / "locustfile.py"
 
 FORM_RE = re.compile(r"<form\b([^>]*)>(.*?)</form>", re.S | re.I)
@@ -307,8 +306,7 @@ def start_gunicorn(args, env: dict, log: Path) -> subprocess.Popen:
 def start_local_nginx(args, out: Path) -> tuple[str, subprocess.Popen]:
     """deploy/nginx/study.conf templated to this run (TLS with a self-signed certificate, /protected-media/ ->
     out/media) in front of gunicorn; returns its https base URL and process."""
-    sys.path.insert(0, str(ROOT / "deploy" / "nginx"))
-    from local_site import free_port, start_nginx, write_local_site
+    from deploy.nginx.local_site import free_port, start_nginx, write_local_site
 
     (out / "static").mkdir(exist_ok=True)
     https_port = free_port()

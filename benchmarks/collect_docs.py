@@ -2,7 +2,7 @@
 
 Each benchmark script writes (or its author pastes) its figures into docs/benchmarks/<area>.md; this
 script puts them into the one page researchers read, in a fixed order, with a table of contents.
-Usage: python benchmarks/collect_docs.py
+Usage: python -m benchmarks.collect_docs
 """
 from __future__ import annotations
 
@@ -38,7 +38,7 @@ def main() -> None:
         "Speed and quality figures, measured with the scripts in `benchmarks/` on the project's 2-core CI VM",
         "(no GPU, 24 GiB) on 2026-11-27. During most runs other jobs shared the two cores, so absolute times are",
         "pessimistic; ratios were measured within one run. Each section is kept in `docs/benchmarks/<area>.md` and",
-        "collected here by `python benchmarks/collect_docs.py`.",
+        "collected here by `python -m benchmarks.collect_docs`.",
         "",
     ]
     lines += [f"- [{TITLES.get(p.stem, p.stem)}](#{p.stem.replace('_', '-')})" for p in parts]

@@ -9,29 +9,27 @@ to the original in that frame.
 
 Writes docs/img/mocap_import_sheet.png (one row per motion, one column per frame) and prints the errors.
 
-Usage: python benchmarks/mocap_import_sheet.py [--out docs/img/mocap_import_sheet.png]
+Usage: python -m benchmarks.mocap_import_sheet [--out docs/img/mocap_import_sheet.png]
 """
 from __future__ import annotations
 
 import argparse
 import os
-import sys
 import tempfile
 from pathlib import Path
 
-os.environ.setdefault("OMP_NUM_THREADS", "1")
+import numpy as np
+
+from benchmarks.bench_record import one_thread
+from generation.mocap import ImportOptions, import_file
+from generation.mocap.captured import WALK_FILES, captured_walks, chain_clip_repeats
+from generation.mocap.conventions import export_as
+from generation.render.clip import render_frames_at
+from generation.render.contact_sheet import contact_sheet
+from generation.render.settings import RenderSettings
+
 os.environ.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow")
 ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT))
-
-import numpy as np  # noqa: E402
-
-from generation.mocap import ImportOptions, import_file  # noqa: E402
-from generation.mocap.captured import WALK_FILES, captured_walks, chain_clip_repeats  # noqa: E402
-from generation.mocap.conventions import export_as  # noqa: E402
-from generation.render.clip import render_frames_at  # noqa: E402
-from generation.render.contact_sheet import contact_sheet  # noqa: E402
-from generation.render.settings import RenderSettings  # noqa: E402
 
 CONVENTIONS = (("mixamo", "Mixamo"), ("cmu", "CMU"))
 FRAMES = (0, 12, 24, 36, 48, 60)
@@ -59,6 +57,7 @@ def imported_motions(motion, folder: Path) -> list[tuple[str, object]]:
 
 
 def main() -> None:
+    one_thread()
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--out", type=Path, default=ROOT / "docs" / "img" / "mocap_import_sheet.png")
     a = ap.parse_args()

@@ -11,7 +11,7 @@ are written as CMU BVH files, then the documented commands run and are timed (wa
 The default (20 takes of 2,400 frames, windows every 24 frames) gives 1,820 windows of 240 frames, about the
 1,835 gaits seed 000 trained on (section 5.1). Figures: docs/benchmarks/mocap.md.
 
-Usage: python benchmarks/mocap_training_time.py [--takes 20] [--frames 2400] [--stride 24] [--epochs 2] [--dir DIR]
+Usage: python -m benchmarks.mocap_training_time [--takes 20] [--frames 2400] [--stride 24] [--epochs 2] [--dir DIR]
 """
 from __future__ import annotations
 
@@ -25,7 +25,6 @@ import time
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT))
 
 
 def write_takes(folder: Path, n_takes: int, n_frames: int) -> None:
