@@ -43,9 +43,9 @@ import torch
 from benchmarks import doc_tables
 from benchmarks.bench_gait import nearest_neighbour_errors, network_errors, pose_rotation_errors, zero_velocity_errors
 from benchmarks.bench_record import commit_label, machine_label
+from generation.core.digest import file_sha256
 from generation.core.paths import path_from_spec as make_path
 from generation.core.quaternion import qmul
-from generation.gait.data import file_sha256
 from generation.gait.generate import generate_gaits, load_model
 from generation.gait.real_data import RealAugment, clip_sequences, stage_clips
 from generation.gait.weights import weights_path

@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from generation.core.digest import file_sha256
 from generation.mocap.real_corpus import save_real_corpus
 from generation.pipeline.plan_qa import observer_for, unread_line
 from generation.quality import evaluate, resolve_thresholds
@@ -40,7 +41,7 @@ def test_observer_trained_on_a_tiny_corpus_reads_its_takes_and_is_cached(shipped
     assert obs.theme_proba(by_style["feminine"].motion, "feminine_vs_masculine") < 0.5
     assert obs.theme_proba(by_style["tired"].motion, "energetic_vs_tired") > 0.5
     pickles = list((fresh / "cache").glob("real_gait_observer_v*_*.pkl"))
-    assert len(pickles) == 1 and ro.corpus_digest(corpus)[:12] in pickles[0].name
+    assert len(pickles) == 1 and file_sha256(corpus)[:12] in pickles[0].name
     # a new process (empty memory) loads the pickle instead of training again
     monkeypatch.setattr(ro, "_DEFAULT", {})
     monkeypatch.setattr(ro, "train_real_observer", lambda path: pytest.fail("trained again"))

@@ -19,13 +19,13 @@ section 5.1). Per step we compute, on the ground plane (x, z; y-up):
 """
 from __future__ import annotations
 
-import hashlib
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 import torch
 
+from generation.core.digest import file_sha256
 from generation.core.features import gait_affective_features, movement_features
 from generation.core.kinematics import forward_kinematics, np_forward_kinematics
 from generation.core.quaternion import np_qfix, np_qmul, np_qrot, qmul
@@ -380,15 +380,6 @@ def load_corpus_sequences(path: str | Path | None = None, num_sequences: int = 1
                              corpus.build, fps=fps, frame_step=frame_step, seq_len=seq_len, offsets=offsets)
     data.source = {"path": str(path), "sha256": file_sha256(path)}
     return data
-
-
-def file_sha256(path: str | Path) -> str:
-    """Hex SHA-256 of a file (identifies the corpus version a model was trained on)."""
-    h = hashlib.sha256()
-    with open(path, "rb") as f:
-        for chunk in iter(lambda: f.read(1 << 20), b""):
-            h.update(chunk)
-    return h.hexdigest()
 
 
 def quat_torch_yaw(yaw: torch.Tensor) -> torch.Tensor:

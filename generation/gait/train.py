@@ -41,6 +41,7 @@ from generation.core.device import (
     resolve_device,
     to_cpu,
 )
+from generation.core.digest import file_sha256
 
 from .config import GaitNetConfig
 from .data import (
@@ -48,7 +49,6 @@ from .data import (
     GaitSequences,
     Normalizer,
     affective_features,
-    file_sha256,
     heading_frame_positions,
     kappa_torch,
     load_corpus_sequences,

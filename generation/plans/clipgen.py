@@ -18,6 +18,7 @@ import importlib
 import importlib.util
 from pathlib import Path
 
+from generation.core.digest import cached_file_sha256
 from generation.core.motion import Motion
 from generation.formats.bvh import write_bvh
 
@@ -45,15 +46,6 @@ def availability(generator: str, inputs: PlanInputs | None = None) -> str | None
     if weights is not None and not weights.is_file():
         return f"weights file {weights} is missing"
     return None
-
-
-@functools.cache
-def _file_digest(path: str, size: int, mtime_ns: int) -> str:
-    h = hashlib.sha256()
-    with open(path, "rb") as f:
-        for block in iter(lambda: f.read(1 << 20), b""):
-            h.update(block)
-    return h.hexdigest()[:12]
 
 
 PACKAGE_DIR = Path(__file__).resolve().parent.parent
@@ -133,8 +125,7 @@ def generator_version(generator: str, inputs: PlanInputs | None = None) -> str:
     version = f"{get_generator(generator).version}+src{source_digest(generator)}"
     weights = _weights_file(generator, inputs)
     if weights is not None and weights.is_file():
-        st = weights.stat()
-        version += "+w" + _file_digest(str(weights), st.st_size, st.st_mtime_ns)
+        version += "+w" + cached_file_sha256(weights)[:12]
     return version
 
 
