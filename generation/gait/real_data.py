@@ -26,11 +26,13 @@ from pathlib import Path
 
 import numpy as np
 
+from generation.core.digest import file_sha256
 from generation.core.motion import Motion
+from generation.mocap.real_corpus import load_real_corpus, real_corpus_path
 from study_protocol import CAPTURE_GAIT_EMOTIONS, GAIT_EMOTIONS
 
 from .config import GaitDataConfig
-from .data import GaitSequences, file_sha256, prepare_sequences
+from .data import GaitSequences, prepare_sequences
 
 STAGES = ("pretrain", "finetune")
 LOCOMOTION = {"bandai-namco-1": ("walk",), "bandai-namco-2": ("walk", "walk-turn-left", "walk-turn-right")}
@@ -124,7 +126,6 @@ def window_starts(num_frames: int, need: int, stride: int) -> list[int]:
 
 def stage_clips(stage: str, split: str, path: str | Path | None = None) -> list:
     """Corpus clips (``CorpusClip``) of a training stage and split (see the module docstring)."""
-    from generation.mocap.real_corpus import load_real_corpus
     if stage not in STAGES:
         raise ValueError(f"unknown stage {stage!r}: use one of {', '.join(STAGES)}")
     contents = sorted({c for cs in LOCOMOTION.values() for c in cs})
@@ -173,7 +174,6 @@ def load_real_sequences(stage: str, data: GaitDataConfig, augment: RealAugment |
                         path: str | Path | None = None) -> GaitSequences:
     """Training ("train" takes, augmented) and validation ("val" takes, as captured) sequences of a stage, with
     ``.source`` (corpus path and SHA-256) and ``.trained_on`` for the weights file's record."""
-    from generation.mocap.real_corpus import real_corpus_path
     augment = augment or STAGE_AUGMENT[stage]
     train = clip_sequences(stage_clips(stage, "train", path), data, augment)
     parts = [train]

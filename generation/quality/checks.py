@@ -47,6 +47,7 @@ from study_protocol import GAIT_EMOTIONS, GESTURE_VAD, QA_CHECKS, QA_COLUMNS, QA
 
 from .metrics import motion_metrics
 from .realism import MEASURES, realism_measures
+from .realism_ranges import out_of_range, realism_thresholds
 
 DOMINANT_SHARE = 0.5
 OBSERVER_KEY = "observer"
@@ -92,7 +93,6 @@ def resolve_thresholds(plan_qa: dict | None = None) -> dict:
     """QA_THRESHOLDS plus the realism bounds (realism_ranges.json) and the gait observer kind (``observer``:
     real or synthetic), overridden by a plan's ``qa:`` block; unknown keys and bad values raise
     QAThresholdError."""
-    from .realism_ranges import realism_thresholds  # here, so that `python -m ...realism_ranges` runs cleanly
 
     out = {**QA_THRESHOLDS, **realism_thresholds(), OBSERVER_KEY: default_observer_kind()}
     if plan_qa is None:
@@ -184,7 +184,6 @@ def failed_checks(values: dict, thresholds: dict | None = None, intended=None) -
         limit = th.get("observer_mismatch_p_real") if values.get("observer") == "real" else th["observer_mismatch_p"]
         failed["observer"] = (limit is not None and dominant is not None and observed is not None
                               and p is not None and observed != dominant and p >= limit)
-    from .realism_ranges import out_of_range
 
     failed["realism"] = bool(out_of_range(values, th))
     return [c for c in QA_CHECKS if failed[c]]

@@ -25,6 +25,8 @@ from generation.core.features import np_gesture_affective_features
 from generation.core.kinematics import np_forward_kinematics
 from generation.core.motion import Motion
 from generation.core.skeleton import GESTURE_JOINTS, gesture_skeleton
+from generation.gesture import config
+from generation.gesture.config import MIN_SECONDS
 from generation.gesture.metrics import wrist_speed_of_positions
 from study_protocol import GESTURE_EMOTIONS, GESTURE_VAD
 
@@ -121,7 +123,6 @@ class GestureObserver:
         emotion each gesture performs (``data.emotion``; the counterfactual variants included). ``min_seconds``:
         the shortest of them (2.7 s in the shipped corpus) or the shortest gesture the network makes
         (:data:`generation.gesture.config.MIN_SECONDS`, 2.5 s), whichever is shorter."""
-        from generation.gesture.config import MIN_SECONDS
 
         idx = data.indices("train") if idx is None else np.asarray(idx)
         return cls(corpus_descriptors(data, idx), data.emotion[idx], data.fps, C,
@@ -189,8 +190,7 @@ FEATURE_SOURCES = (REPO_ROOT / "generation" / "core" / "features.py",
 def corpus_version() -> str:
     """Key of the corpus and observer version: a hash of the sentence CSV, the procedural generator and corpus
     code (:func:`generation.gesture.data._generator_fingerprint`), the feature code and this module's source."""
-    from generation.gesture import config
-    from generation.gesture.data import _generator_fingerprint
+    from generation.gesture.data import _generator_fingerprint  # heavy: torch
 
     h = hashlib.sha256()
     h.update(Path(config.SENTENCES_CSV).read_bytes())
@@ -202,7 +202,7 @@ def corpus_version() -> str:
 
 def train_gesture_observer(data=None) -> GestureObserver:
     """A GestureObserver fitted on the training split of the synthetic gesture corpus (built when missing)."""
-    from generation.gesture.data import build_dataset
+    from generation.gesture.data import build_dataset  # heavy: torch
 
     data = build_dataset() if data is None else data
     return GestureObserver.from_corpus(data)

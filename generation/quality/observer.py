@@ -11,6 +11,7 @@ from pathlib import Path
 
 import numpy as np
 
+from generation.core.digest import file_sha256
 from generation.core.features import np_gait_affective_features
 from generation.core.motion import Motion
 from generation.core.skeleton import GAIT_JOINTS
@@ -79,7 +80,7 @@ class GaitObserver:
 
 
 def _corpus_path(path: str | Path | None) -> Path:
-    from generation.gait.data import DEFAULT_CORPUS
+    from generation.gait.data import DEFAULT_CORPUS  # heavy: torch (generation.gait loads it)
 
     p = Path(path) if path is not None else DEFAULT_CORPUS
     return p if p.is_absolute() else REPO_ROOT / p
@@ -87,7 +88,7 @@ def _corpus_path(path: str | Path | None) -> Path:
 
 def train_observer(corpus_path: str | Path | None = None) -> GaitObserver:
     """A GaitObserver fitted on the training split (offset 0) of the gait corpus (built when missing)."""
-    from generation.gait.data import load_corpus_sequences
+    from generation.gait.data import load_corpus_sequences  # heavy: torch
 
     data = load_corpus_sequences(_corpus_path(corpus_path))
     train = data.subset((data.split == "train") & (data.offset == 0))
@@ -99,7 +100,6 @@ def train_observer(corpus_path: str | Path | None = None) -> GaitObserver:
 def default_observer(corpus_path: str | Path | None = None) -> GaitObserver | None:
     """The observer of the current corpus: from memory, from the cache file, or trained (and cached); None when
     the gait corpus file does not exist (build it with the gait training; clips then get no observer reading)."""
-    from generation.gait.data import file_sha256
 
     path = _corpus_path(corpus_path)
     if not path.is_file():

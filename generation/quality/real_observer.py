@@ -26,15 +26,18 @@ the repository (generation/data/mocap/bandai-namco/: one take per emotion, nothi
 """
 from __future__ import annotations
 
-import hashlib
 from collections import Counter
 from pathlib import Path
 
 import numpy as np
 
+from generation.core.digest import file_sha256
 from generation.core.features import np_gait_affective_features
 from generation.core.motion import Motion
 from generation.core.skeleton import GAIT_JOINTS
+from generation.mocap.bandai_namco import shipped_takes
+from generation.mocap.dataset_import import import_take
+from generation.mocap.real_corpus import load_real_corpus, real_corpus_path
 from study_protocol import CAPTURE_GAIT_EMOTIONS, GAIT_EMOTIONS
 
 from .pickle_cache import load_or_build
@@ -168,15 +171,8 @@ class RealGaitObserver:
         return {"observed": label, "observed_p": round(p, 4), "observer": self.kind}
 
 
-def corpus_digest(path: Path) -> str:
-    """Hex SHA-256 of the corpus file."""
-    with open(path, "rb") as f:
-        return hashlib.file_digest(f, "sha256").hexdigest()
-
-
 def train_real_observer(corpus_path: str | Path | None = None) -> RealGaitObserver:
     """A RealGaitObserver fitted on the gait takes of the corpus's training split."""
-    from generation.mocap.real_corpus import load_real_corpus, real_corpus_path
 
     path = Path(corpus_path) if corpus_path is not None else real_corpus_path()
     clips = load_real_corpus(path, skeleton="gait", split="train")
@@ -186,8 +182,6 @@ def train_real_observer(corpus_path: str | Path | None = None) -> RealGaitObserv
 def shipped_clips() -> list:
     """The gait takes shipped in the repository (generation/data/mocap/bandai-namco/), imported onto the gait
     skeleton (CorpusClips; a take that fails to import raises)."""
-    from generation.mocap.bandai_namco import shipped_takes
-    from generation.mocap.dataset_import import import_take
 
     out = []
     for take in shipped_takes():
@@ -204,14 +198,13 @@ def default_real_observer(corpus_path: str | Path | None = None) -> RealGaitObse
     """The real-capture observer: from memory, from the cache file, or trained (and cached) on the corpus file
     (default :func:`generation.mocap.real_corpus.real_corpus_path`); without that file, on the shipped real takes
     (``source`` says so); None when neither is there."""
-    from generation.mocap.real_corpus import real_corpus_path
 
     path = Path(corpus_path) if corpus_path is not None else real_corpus_path()
     if path.is_file():
         st = path.stat()
         key = f"{path}:{st.st_mtime_ns}:{st.st_size}"
         if key not in _DEFAULT:
-            sha = corpus_digest(path)
+            sha = file_sha256(path)
             _DEFAULT[key] = load_or_build(CACHE_DIR / f"real_gait_observer_v{DESCRIPTOR_VERSION}_{sha[:12]}.pkl",
                                           RealGaitObserver, lambda: train_real_observer(path))
         return _DEFAULT[key]

@@ -8,6 +8,7 @@ from pathlib import Path
 
 from generation.core.motion import Motion
 from generation.gesture.config import gesture_seconds
+from generation.gesture.generate import generate_gesture
 from study_protocol import GENDERS, GESTURE_TASKS, HANDEDNESS
 
 from .fields import FieldError, choice, gesture_label, number, text
@@ -57,7 +58,6 @@ def to_procedural_gesture(inputs: GestureNetInputs, fallback: str) -> PlanInputs
 
 
 def make_gesture_net(entry, context: MakeContext) -> Motion:
-    from generation.gesture.generate import generate_gesture  # heavy: torch
 
     inp: GestureNetInputs = entry.inputs
     return generate_gesture(inp.sentence, inp.task, inp.emotion_label, inp.gender, inp.handedness, fps=context.fps,
