@@ -8,7 +8,6 @@ from pathlib import Path
 
 from generation.core.motion import Motion
 from generation.gesture.config import gesture_seconds
-from generation.gesture.generate import generate_gesture
 from study_protocol import GENDERS, GESTURE_TASKS, HANDEDNESS
 
 from .fields import FieldError, choice, gesture_label, number, text
@@ -58,6 +57,7 @@ def to_procedural_gesture(inputs: GestureNetInputs, fallback: str) -> PlanInputs
 
 
 def make_gesture_net(entry, context: MakeContext) -> Motion:
+    from generation.gesture.generate import generate_gesture  # torch; optional (clipgen.availability)
 
     inp: GestureNetInputs = entry.inputs
     return generate_gesture(inp.sentence, inp.task, inp.emotion_label, inp.gender, inp.handedness, fps=context.fps,

@@ -8,7 +8,6 @@ from dataclasses import dataclass
 from generation.core.motion import Motion
 from generation.rbf.neutral_base import neutral_cycle
 from generation.rbf.real_neutral import load_cycle
-from generation.rbf.stylise import cycle_stride, plant_walk_feet, warp_and_repeat_cycle
 from study_protocol import NEUTRAL_THEME
 
 from .fields import choice, integer, number
@@ -45,6 +44,11 @@ class NeutralWalkInputs(PlanInputs):
 
 
 def make_neutral_walk(entry, context: MakeContext) -> Motion:
+    from generation.rbf.stylise import (  # torch; optional (clipgen.availability)
+        cycle_stride,
+        plant_walk_feet,
+        warp_and_repeat_cycle,
+    )
 
     inp: NeutralWalkInputs = entry.inputs
     base = base_cycle(inp.base)

@@ -5,7 +5,6 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from generation.core.motion import Motion
-from generation.rbf.stylise import stylise
 from study_protocol import THEMES
 
 from .fields import FieldError, choice, integer, number
@@ -48,6 +47,7 @@ class RbfInputs(PlanInputs):
 
 
 def make_rbf(entry, context: MakeContext) -> Motion:
+    from generation.rbf.stylise import stylise  # torch; optional (clipgen.availability)
 
     inp: RbfInputs = entry.inputs
     motion = stylise(base_cycle(inp.base), inp.theme, inp.weight, inp.n_features, speed=inp.speed,
