@@ -114,7 +114,7 @@ def save_gesture_corpus(arrays: dict, path: str | Path) -> Path:
 def load_gesture_corpus(path: str | Path, seed: int = 0, cache_dir: str | Path | None = None):
     """A ``generation.gesture.data.GestureDataset`` from a corpus file (sentence tokens cached next to the synthetic
     corpus's, in ``cache_dir`` or the gesture package's var folder). ValueError names a bad file."""
-    from generation.gesture.data import SentenceRow, _assemble, split_sentences  # heavy: torch
+    from generation.gesture.data import SentenceRow, assemble_dataset, split_sentences  # heavy: torch
 
     path = Path(path)
     try:
@@ -134,4 +134,4 @@ def load_gesture_corpus(path: str | Path, seed: int = 0, cache_dir: str | Path |
     pairs = {"sentence_index": np.arange(len(rows)), "emotion": a["emotion"].astype(str),
              "gender": a["gender"].astype(str), "handedness": a["handedness"].astype(str),
              "lengths": a["lengths"], "rotations": a["rotations"]}
-    return _assemble(pairs, rows, encodings, split_sentences(rows, seed), float(a["fps"]))
+    return assemble_dataset(pairs, rows, encodings, split_sentences(rows, seed), float(a["fps"]))

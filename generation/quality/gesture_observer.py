@@ -189,12 +189,10 @@ FEATURE_SOURCES = (REPO_ROOT / "generation" / "core" / "features.py",
 
 def corpus_version() -> str:
     """Key of the corpus and observer version: a hash of the sentence CSV, the procedural generator and corpus
-    code (:func:`generation.gesture.data._generator_fingerprint`), the feature code and this module's source."""
-    from generation.gesture.data import _generator_fingerprint  # heavy: torch
-
+    code (:func:`generation.gesture.config.generator_fingerprint`), the feature code and this module's source."""
     h = hashlib.sha256()
     h.update(Path(config.SENTENCES_CSV).read_bytes())
-    h.update(_generator_fingerprint().encode())
+    h.update(config.generator_fingerprint().encode())
     for path in (*FEATURE_SOURCES, Path(__file__)):
         h.update(path.read_bytes())
     return h.hexdigest()[:12]
