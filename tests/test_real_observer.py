@@ -89,13 +89,15 @@ def test_a_stored_gait_record_from_another_observer_is_measured_again(shipped, t
     (job,), _ = plan_jobs(validate_plan(plan))
     obs = ro.RealGaitObserver(shipped, source="test")
     monkeypatch.setattr(runner, "observer_for", lambda modality, kind=None: obs)
-    # a record written before the realism measures, read by the synthetic observer, with the render's camera
-    done = {"clip_id": job.clip_id, "qa": {"foot_skate_cm_s": 1.0, "observed": "sad", "observed_p": 0.99, "flag": ""},
+    # a record of version 2 (before the realism measures), read by the synthetic observer, with the render's camera
+    done = {"clip_id": job.clip_id, "record_version": 2,
+            "qa": {"foot_skate_cm_s": 1.0, "observed": "sad", "observed_p": 0.99, "flag": ""},
             "metadata": {"camera": {"rule": "fixed", "min_figure_fraction": 0.7, "seated": False}}}
     assert runner._stale_qa(done, job)
     batch = runner._Batch(tmp_path, tmp_path, lambda kind, info: None, runner.BatchResult())
     runner._remeasure_qa(done, job, batch)
     assert done["qa"]["observer"] == "real" and done["qa"]["skate_cm_s"] is not None
+    assert done["record_version"] == runner.RECORD_VERSION
     assert done["qa"]["figure_height_frac"] == 0.7                      # the render's camera is kept
     assert json.loads((tmp_path / f"{job.clip_id}.json").read_text())["qa"] == done["qa"]
     assert not runner._stale_qa(done, job)

@@ -34,7 +34,12 @@ from .plan_qa import clip_qa, intended_emotion, observer_for
 
 __all__ = ["BatchResult", "Job", "base_record", "plan_jobs", "render_job", "render_job_on_worker", "run_plan"]
 
-RECORD_VERSION = 2  # 2: records carry the quality record ``qa`` and ``qa_flag``
+#: Version of the stored clip records: 2, they carry the quality record ``qa`` and ``qa_flag``; 3, a gait clip's
+#: ``qa`` carries the realism measures. A record of an older version than REMEASURED_FROM is rendered again.
+RECORD_VERSION = 3
+#: The oldest record version whose clip files are kept: its gait clips have their quality record measured again
+#: (:func:`_stale_qa`), its other clips are complete.
+REMEASURED_FROM = 2
 
 
 @dataclass
@@ -87,7 +92,7 @@ def load_done_record(clip_id: str, clips_dir: Path, records_dir: Path, webm: boo
         rec = json.loads(rec_path.read_text(encoding="utf-8"))
     except (OSError, ValueError):
         return None
-    if rec.get("record_version") != RECORD_VERSION or rec.get("clip_id") != clip_id:
+    if not REMEASURED_FROM <= rec.get("record_version", 0) <= RECORD_VERSION or rec.get("clip_id") != clip_id:
         return None
     return rec
 
@@ -164,12 +169,13 @@ def _add_qa(record: dict, job: Job, motion, camera: dict) -> None:
 
 
 def _stale_qa(done: dict, job: Job) -> bool:
-    """Whether a stored gait clip's quality record predates the realism measures or was read by another gait
-    observer than the plan's (``qa: {observer: ...}``; real by default): then it is measured again."""
+    """Whether a stored gait clip's quality record is measured again: its record is of a version before 3 (no
+    realism measures) or it was read by another gait observer than the plan's (``qa: {observer: ...}``; real by
+    default)."""
     if job.run_entry.modality != "gait":
         return False
-    qa = done.get("qa") or {}
-    return "skate_cm_s" not in qa or qa.get("observer") != (job.qa_thresholds or {}).get("observer")
+    old = done.get("record_version", 0) < 3
+    return old or (done.get("qa") or {}).get("observer") != (job.qa_thresholds or {}).get("observer")
 
 
 def _remeasure_qa(done: dict, job: Job, batch: _Batch) -> None:
@@ -179,6 +185,7 @@ def _remeasure_qa(done: dict, job: Job, batch: _Batch) -> None:
         motion = make_motion(job.run_entry, requested=job.entry.generator, fallback_reason=job.fallback_reason,
                              device=job.device)
         _add_qa(done, job, motion, (done.get("metadata") or {}).get("camera"))
+        done["record_version"] = RECORD_VERSION
     except Exception as exc:  # noqa: BLE001 - the clip's files are fine; only its quality record stays old
         batch.emit("warn", {"clip_id": job.clip_id, "entry": job.entry.id,
                             "message": f"quality record not re-measured ({type(exc).__name__}: {exc})"})

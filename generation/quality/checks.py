@@ -17,7 +17,7 @@ Checks (names in :data:`study_protocol.QA_CHECKS`), each against :data:`study_pr
   the intended ``emotion_label``'s (NRC-VAD arousal, 0..1; the observed arousal is the arousal of the 11 emotions
   weighted by the observer's probabilities). The gesture rule reads arousal, not the top label: the 11 categories
   overlap in VAD (afraid and disgusted differ by at most 0.04 in each dimension) and the observer confuses such
-  neighbours on generated gestures (69 % top-label accuracy, 97 % on the arousal half;
+  neighbours on generated gestures far more often than it misreads their arousal (figures in
   docs/benchmarks/motion_quality.md, "Gesture observer").
 
 - ``realism``: a gait clip whose realism measures (:mod:`generation.quality.realism`: foot speed near the floor,
