@@ -50,7 +50,7 @@ from generation.gait.generate import generate_gaits, load_model
 from generation.gait.real_data import RealAugment, clip_sequences, stage_clips
 from generation.gait.weights import weights_path
 from generation.mocap.real_corpus import load_real_corpus, real_corpus_path
-from generation.quality.real_observer import default_real_observer
+from generation.quality.observers import OBSERVERS
 from generation.quality.realism import MEASURES, realism_measures
 from generation.quality.realism_ranges import load_ranges
 from study_protocol import CAPTURE_GAIT_EMOTIONS, GAIT_EMOTIONS
@@ -380,7 +380,7 @@ def run(a, argv) -> dict:
         res["prediction"][subset] = {"n": len(test), "takes": len(clips),
                                      "methods": prediction_table(nets, train, test, prefix)}
         print(f"prediction {subset}: {time.time() - t0:.0f} s", flush=True)
-    observer = default_real_observer()
+    observer = OBSERVERS.gait("real")
     res["observer"] = observer.source
     res["real_realism"] = real_realism()
     takes = heldout_emotion_takes()

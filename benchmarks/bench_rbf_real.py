@@ -33,7 +33,8 @@ import numpy as np
 
 from benchmarks import doc_tables
 from generation.mocap.real_corpus import load_real_corpus, real_corpus_path
-from generation.quality.real_observer import THEME_PAIRS, default_real_observer
+from generation.quality.observers import OBSERVERS
+from generation.quality.real_observer import THEME_PAIRS
 from generation.quality.realism import realism_measures
 from generation.rbf.compare import compare_theme
 from generation.rbf.data_features import PART_OF
@@ -215,7 +216,7 @@ def main(argv=None) -> int:
     corpus = a.corpus or real_corpus_path()
     if not Path(corpus).is_file():
         raise SystemExit(f"no real-capture corpus at {corpus}; build it with python -m generation.mocap dataset ...")
-    observer = default_real_observer(corpus)
+    observer = OBSERVERS.gait("real", corpus)
     base = load_cycle()
     threads = f"OMP_NUM_THREADS={os.environ['OMP_NUM_THREADS']} " if "OMP_NUM_THREADS" in os.environ else ""
     result = {"machine": f"{platform.machine()} {platform.system()}, {os.cpu_count()} CPUs (shared), no GPU",

@@ -9,7 +9,8 @@ synthetic observer, and the realism measures of real walks beside the generated 
    neutral), confusion matrix per take and per window; the theme pairs on both datasets.
 2. Plans: every gait entry of each plan made as ``generate_clips`` makes it (no video, no figure-height projection)
    and checked by the quality gate (:func:`generation.pipeline.plan_qa.run`) once with the real-capture observer
-   and once with the synthetic one (``QA_GAIT_OBSERVER=synthetic``), grouped by the intended dominant emotion.
+   and once with the synthetic one (``plan_qa.run(gait_observer="synthetic")``), grouped by the intended dominant
+   emotion.
 3. Realism: the measures of :mod:`generation.quality.realism` per real style (all gait takes) beside the plans'
    generated clips (and the plans' real source walks, cut as rendered).
 
@@ -22,7 +23,6 @@ from __future__ import annotations
 import argparse
 import datetime
 import json
-import os
 import re
 import shlex
 import sys
@@ -36,6 +36,7 @@ from benchmarks import doc_tables
 from benchmarks.bench_record import commit_label, machine_label, one_thread
 from generation.mocap.real_corpus import load_real_corpus, real_corpus_path
 from generation.quality import real_observer as ro
+from generation.quality.observers import OBSERVERS
 from generation.quality.realism import MEASURES
 from generation.quality.realism_ranges import load_ranges, measure_corpus
 from study_protocol import CAPTURE_GAIT_EMOTIONS, GAIT_EMOTIONS
@@ -138,11 +139,7 @@ def plan_rows(plan: str, kind: str) -> list[dict]:
     from generation.pipeline import plan_qa
     from generation.plans.schema import load_plan
 
-    os.environ["QA_GAIT_OBSERVER"] = kind
-    try:
-        rows = plan_qa.run(plan, modality="gait", figure_height=False, log=lambda *a: None)
-    finally:
-        os.environ.pop("QA_GAIT_OBSERVER", None)
+    rows = plan_qa.run(plan, modality="gait", figure_height=False, log=lambda *a: None, gait_observer=kind)
     entries = {e.id: e for e in load_plan(plan).entries}
     for r in rows:
         e = entries[r["entry"]]
@@ -220,15 +217,13 @@ def main(argv=None) -> int:
     args = ap.parse_args(argv)
     t0 = time.perf_counter()
     path = Path(args.corpus) if args.corpus else real_corpus_path()
-    obs = ro.default_real_observer(path)
+    obs = OBSERVERS.gait("real", path)
     if obs is None or not path.is_file():
         raise SystemExit(f"{path}: no real-capture corpus; build it with `python -m generation.mocap dataset "
                          "bandai-namco DIR --out PATH`")
     test = load_real_corpus(path, skeleton="gait", split="test")
     real = measure_corpus(load_real_corpus(path, skeleton="gait"))
-    from generation.quality.observer import default_observer
-
-    synth = default_observer()
+    synth = OBSERVERS.gait("synthetic")
     plans_real = {p: plan_rows(p, "real") for p in args.plans}
     plans_synth = {p: plan_rows(p, "synthetic") for p in args.plans}
     ranges = load_ranges()

@@ -10,6 +10,7 @@ from generation.mocap.real_corpus import save_real_corpus
 from generation.pipeline.plan_qa import observer_for, unread_line
 from generation.quality import evaluate, resolve_thresholds
 from generation.quality import real_observer as ro
+from generation.quality.observers import OBSERVERS, Observers
 from study_protocol import CAPTURE_GAIT_EMOTIONS
 
 
@@ -22,14 +23,15 @@ def shipped():
 @pytest.fixture()
 def fresh(monkeypatch, tmp_path):
     """An empty in-memory observer cache and a temporary pickle folder."""
-    monkeypatch.setattr(ro, "_DEFAULT", {})
     monkeypatch.setattr(ro, "CACHE_DIR", tmp_path / "cache")
-    return tmp_path
+    OBSERVERS.clear()
+    yield tmp_path
+    OBSERVERS.clear()
 
 
 def test_observer_trained_on_a_tiny_corpus_reads_its_takes_and_is_cached(shipped, fresh, monkeypatch):
     corpus = save_real_corpus(fresh / "tiny.npz", shipped, {"split_rule": "test corpus"})
-    obs = ro.default_real_observer(corpus)
+    obs = OBSERVERS.gait("real", corpus)
     assert "tiny.npz" in obs.source and sum(obs.train_takes.values()) == 4
     for clip in shipped:
         if clip.style in CAPTURE_GAIT_EMOTIONS:
@@ -43,9 +45,9 @@ def test_observer_trained_on_a_tiny_corpus_reads_its_takes_and_is_cached(shipped
     pickles = list((fresh / "cache").glob("real_gait_observer_v*_*.pkl"))
     assert len(pickles) == 1 and file_sha256(corpus)[:12] in pickles[0].name
     # a new process (empty memory) loads the pickle instead of training again
-    monkeypatch.setattr(ro, "_DEFAULT", {})
+    assert OBSERVERS.gait("real", corpus) is obs                                   # from memory
     monkeypatch.setattr(ro, "train_real_observer", lambda path: pytest.fail("trained again"))
-    again = ro.default_real_observer(corpus)
+    again = Observers().gait("real", corpus)
     np.testing.assert_allclose(again.proba(shipped[0].motion), obs.proba(shipped[0].motion))
 
 
@@ -62,17 +64,17 @@ def test_the_gate_flags_a_real_walk_read_as_another_emotion(shipped, fresh):
 def test_without_a_corpus_it_falls_back_to_the_shipped_takes_or_says_there_is_none(shipped, fresh, monkeypatch):
     missing = fresh / "absent.npz"
     monkeypatch.setattr(ro, "shipped_clips", lambda: shipped)
-    obs = ro.default_real_observer(missing)
+    obs = OBSERVERS.gait("real", missing)
     assert "shipped real takes only" in obs.source and str(missing) in obs.source
     assert obs.observe(next(c for c in shipped if c.style == "angry").motion)[0] == "angry"
 
     def no_files():
         raise FileNotFoundError("generation/data/mocap/bandai-namco: gone")
 
-    monkeypatch.setattr(ro, "_DEFAULT", {})
+    OBSERVERS.clear()
     monkeypatch.setattr(ro, "shipped_clips", no_files)
     monkeypatch.setenv("REAL_CORPUS", str(missing))
-    assert ro.default_real_observer() is None and observer_for("gait", "real") is None
+    assert ro.load_real_observer() is None and observer_for("gait", "real") is None
     line = unread_line([{"modality": "gait", "qa": {"observed": None}}], "real")
     assert "no real-capture observer" in line
 

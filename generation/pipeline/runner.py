@@ -161,7 +161,7 @@ def render_job(job: Job, record: dict, clips_dir: str, records_dir: str) -> dict
 
 def _add_qa(record: dict, job: Job, motion, camera: dict) -> None:
     """Measure the clip's quality (:mod:`generation.quality`) into ``record["qa"]`` and ``record["qa_flag"]``."""
-    observer = observer_for(job.run_entry.modality, (job.qa_thresholds or {}).get("observer"))
+    observer = observer_for(job.run_entry.modality, job.gait_observer)
     result, _ = clip_qa(motion, job.run_entry.render, job.qa_thresholds, intended_emotion(job.run_entry.inputs),
                         observer, camera_info=camera)
     record["qa"] = _json_safe(result.as_dict())
@@ -175,7 +175,7 @@ def _stale_qa(done: dict, job: Job) -> bool:
     if job.run_entry.modality != "gait":
         return False
     old = done.get("record_version", 0) < 3
-    return old or (done.get("qa") or {}).get("observer") != (job.qa_thresholds or {}).get("observer")
+    return old or (done.get("qa") or {}).get("observer") != job.gait_observer
 
 
 def _remeasure_qa(done: dict, job: Job, batch: _Batch) -> None:
@@ -346,7 +346,7 @@ def _render_dask(batch: _Batch, todo: list[Job], scheduler, threads_per_worker: 
 def run_plan(plan: Plan, clips_dir: str | Path, records_dir: str | Path, media_prefix: str = "clips/",
              workers: int = 1, webm: bool = False, limit: int | None = None,
              on_event: Callable[[str, dict], None] | None = None, threads_per_worker: int = 1,
-             scheduler=None, device: str = "cpu") -> BatchResult:
+             scheduler=None, device: str = "cpu", gait_observer: str = "real") -> BatchResult:
     """Render every entry of ``plan`` that is not already complete.
 
     Args:
@@ -362,6 +362,7 @@ def run_plan(plan: Plan, clips_dir: str | Path, records_dir: str | Path, media_p
         scheduler: a Dask distributed scheduler address (``tcp://host:port``) or Client: render there instead of
             in local processes (``workers`` is then ignored; the workers need the shared media folder).
         device: torch device of the network generators (gait_net, gesture_net), carried to every worker.
+        gait_observer: the gait observer (real or synthetic) that reads the clips of a plan that names none.
     Returns a BatchResult with the records of every clip of the plan that exists now.
     """
     t0 = time.perf_counter()
@@ -369,7 +370,7 @@ def run_plan(plan: Plan, clips_dir: str | Path, records_dir: str | Path, media_p
     clips_dir.mkdir(parents=True, exist_ok=True)
     records_dir.mkdir(parents=True, exist_ok=True)
     emit = on_event or (lambda kind, info: None)
-    jobs, failures = plan_jobs(plan, limit, device)
+    jobs, failures = plan_jobs(plan, limit, device, gait_observer)
     batch = _Batch(clips_dir, records_dir, emit, BatchResult(failed=list(failures)))
     for where, msg in failures:
         emit("fail", {"entry": where, "error": msg})
@@ -379,7 +380,7 @@ def run_plan(plan: Plan, clips_dir: str | Path, records_dir: str | Path, media_p
     if workers > 1 or scheduler is not None:
         for modality in sorted({j.run_entry.modality for j in todo}):
             # train/cache the quality observers once, not in every worker
-            observer_for(modality, (todo[0].qa_thresholds or {}).get("observer"))
+            observer_for(modality, todo[0].gait_observer)
     if scheduler is not None:
         _render_dask(batch, todo, scheduler, threads_per_worker)
     elif workers <= 1 or len(todo) <= 1:

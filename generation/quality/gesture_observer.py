@@ -10,8 +10,9 @@ The descriptors (:func:`motion_descriptors`; also the inputs of the binary arous
 benchmarks/bench_gesture.py) are the mean and standard deviation over frames of the 15 gesture affective features
 plus the peak and mean wrist speed, measured at the corpus frame rate (10 fps; clips are resampled to it first).
 
-``default_gesture_observer()`` trains it once per corpus and generator version and keeps the fitted model in
-``var/quality/gesture_observer_<key>.pkl`` (and in memory per process).
+:func:`load_gesture_observer` trains it once per corpus and generator version and keeps the fitted model in
+``var/quality/gesture_observer_<key>.pkl``; :class:`generation.quality.observers.Observers` keeps it in memory per
+process (keyed by :func:`observer_version`).
 """
 from __future__ import annotations
 
@@ -40,7 +41,6 @@ AROUSAL_SPLIT = 0.5  # NRC-VAD arousal above it: the high-arousal half (8 of the
 #: (11,) NRC-VAD arousal of GESTURE_EMOTIONS, in that order.
 AROUSAL = np.array([GESTURE_VAD[e][1] for e in GESTURE_EMOTIONS])
 N_DESCRIPTORS = 32  # 15 feature means + 15 feature SDs + peak and mean wrist speed
-_DEFAULT: dict[str, GestureObserver] = {}
 
 
 # ---- descriptors (shared with benchmarks/bench_gesture.py) ----------------------------------------------------
@@ -98,6 +98,8 @@ class GestureObserver:
     """
 
     labels = GESTURE_EMOTIONS
+    kind = "synthetic-gesture"
+    source = "synthetic procedural gesture corpus (training split)"
 
     def __init__(self, X: np.ndarray, y, fps: float, C: float = REGULARISATION_C, min_seconds: float = 0.0):
         from sklearn.linear_model import LogisticRegression
@@ -160,12 +162,12 @@ class GestureObserver:
         """(N, 11) probabilities in GESTURE_EMOTIONS order."""
         return self.proba_features(self.features(motions))
 
-    def qa_values(self, motion: Motion) -> dict:
+    def read(self, motion: Motion) -> dict:
         """The quality record's reading: ``observed`` (top label), ``observed_p`` (its probability) and
         ``observed_arousal`` (what the gesture ``observer`` check compares), and ``observer``: synthetic-gesture."""
         label, p, arousal = self.reading(motion)
         return {"observed": label, "observed_p": round(p, 4), "observed_arousal": round(arousal, 4),
-                "observer": "synthetic-gesture"}
+                "observer": self.kind}
 
     def observe(self, motion: Motion) -> tuple[str, float]:
         """(top label, its probability) for one gesture motion."""
@@ -206,20 +208,23 @@ def train_gesture_observer(data=None) -> GestureObserver:
     return GestureObserver.from_corpus(data)
 
 
-def default_gesture_observer() -> GestureObserver | None:
-    """The observer of the current corpus: from memory, from the cache file, or trained (and cached); None (with
-    a warning) when the corpus cannot be built here (clips then get no gesture observer reading)."""
+def observer_version() -> str | None:
+    """:func:`corpus_version`, or None (with a warning) when the corpus files cannot be read here."""
     try:
-        key = corpus_version()
+        return corpus_version()
     except OSError as exc:
         warnings.warn(f"gesture observer unavailable: {exc}", stacklevel=2)
         return None
-    if key in _DEFAULT:
-        return _DEFAULT[key]
+
+
+def load_gesture_observer() -> GestureObserver | None:
+    """The observer of the current corpus: from the cache file, or trained (and cached); None (with a warning)
+    when the corpus cannot be built here (clips then get no gesture observer reading)."""
+    key = observer_version()
+    if key is None:
+        return None
     try:
-        obs = load_or_build(CACHE_DIR / f"gesture_observer_{key}.pkl", GestureObserver, train_gesture_observer)
+        return load_or_build(CACHE_DIR / f"gesture_observer_{key}.pkl", GestureObserver, train_gesture_observer)
     except Exception as exc:  # noqa: BLE001 - any failure to build the corpus leaves clips without a reading
         warnings.warn(f"gesture observer could not be trained ({type(exc).__name__}: {exc})", stacklevel=2)
         return None
-    _DEFAULT[key] = obs
-    return obs

@@ -19,10 +19,11 @@ masculine, happy vs sad) get one binary classifier each on the same descriptors,
 of those styles (:data:`THEME_PAIRS`); the quality gate does not use them, the benchmark reports where they
 separate.
 
-:func:`default_real_observer` trains it once per corpus version (file SHA-256) and keeps it in
-``var/quality/real_gait_observer_<sha[:12]>.pkl``. Without the corpus file it trains on the real walks shipped in
-the repository (generation/data/mocap/bandai-namco/: one take per emotion, nothing held out; the observer says so in
-``source``), and with neither it is None and the gate says that no real observer is available.
+:func:`load_real_observer` trains it once per corpus version (file SHA-256) and keeps it in
+``var/quality/real_gait_observer_<sha[:12]>.pkl`` (in memory: :class:`generation.quality.observers.Observers`).
+Without the corpus file it trains on the real walks shipped in the repository (generation/data/mocap/bandai-namco/:
+one take per emotion, nothing held out; the observer says so in ``source``), and with neither it is None and the
+gate says that no real observer is available.
 """
 from __future__ import annotations
 
@@ -55,7 +56,6 @@ THEME_PAIRS = {
     "happy_vs_sad": (("happy",), ("sad",)),
 }
 EMOTION_DATASET = "bandai-namco-1"
-_DEFAULT: dict[str, RealGaitObserver | None] = {}
 
 
 def window_slices(num_frames: int, fps: float) -> list[slice]:
@@ -165,7 +165,7 @@ class RealGaitObserver:
         """Whether the quality gate asks this observer about ``motion``: the 21-joint gait skeleton, >= 2 frames."""
         return motion.skeleton.joints == GAIT_JOINTS and motion.num_frames >= 2
 
-    def qa_values(self, motion: Motion) -> dict:
+    def read(self, motion: Motion) -> dict:
         """The quality record's reading: ``observed``, ``observed_p`` and ``observer``: real."""
         label, p = self.observe(motion)
         return {"observed": label, "observed_p": round(p, 4), "observer": self.kind}
@@ -194,28 +194,27 @@ def shipped_clips() -> list:
     return out
 
 
-def default_real_observer(corpus_path: str | Path | None = None) -> RealGaitObserver | None:
-    """The real-capture observer: from memory, from the cache file, or trained (and cached) on the corpus file
-    (default :func:`generation.mocap.real_corpus.real_corpus_path`); without that file, on the shipped real takes
-    (``source`` says so); None when neither is there."""
+def observer_version(corpus_path: str | Path | None = None) -> str:
+    """Key of the corpus file's version (path, modification time, size), or ``shipped`` without the file."""
+    path = Path(corpus_path) if corpus_path is not None else real_corpus_path()
+    if not path.is_file():
+        return "shipped"
+    st = path.stat()
+    return f"{path}:{st.st_mtime_ns}:{st.st_size}"
 
+
+def load_real_observer(corpus_path: str | Path | None = None) -> RealGaitObserver | None:
+    """The real-capture observer: from the cache file, or trained (and cached) on the corpus file (default
+    :func:`generation.mocap.real_corpus.real_corpus_path`); without that file, on the shipped real takes
+    (``source`` says so); None when neither is there."""
     path = Path(corpus_path) if corpus_path is not None else real_corpus_path()
     if path.is_file():
-        st = path.stat()
-        key = f"{path}:{st.st_mtime_ns}:{st.st_size}"
-        if key not in _DEFAULT:
-            sha = file_sha256(path)
-            _DEFAULT[key] = load_or_build(CACHE_DIR / f"real_gait_observer_v{DESCRIPTOR_VERSION}_{sha[:12]}.pkl",
-                                          RealGaitObserver, lambda: train_real_observer(path))
-        return _DEFAULT[key]
-    key = "shipped"
-    if key not in _DEFAULT:
-        try:
-            clips = shipped_clips()
-        except (FileNotFoundError, ValueError):
-            _DEFAULT[key] = None
-        else:
-            _DEFAULT[key] = RealGaitObserver(
-                clips, source=f"shipped real takes only ({len(clips)} walks, one take per style; no corpus at "
-                              f"{path}; not validated on held-out takes)")
-    return _DEFAULT[key]
+        sha = file_sha256(path)
+        return load_or_build(CACHE_DIR / f"real_gait_observer_v{DESCRIPTOR_VERSION}_{sha[:12]}.pkl",
+                             RealGaitObserver, lambda: train_real_observer(path))
+    try:
+        clips = shipped_clips()
+    except (FileNotFoundError, ValueError):
+        return None
+    return RealGaitObserver(clips, source=f"shipped real takes only ({len(clips)} walks, one take per style; no "
+                                          f"corpus at {path}; not validated on held-out takes)")
