@@ -1,6 +1,6 @@
 """Benchmark of the motion-capture importer (generation.mocap): each naming convention's import.
 
-For every convention of ``generation.mocap.conventions`` (gait and gesture skeletons) a 1000-frame procedural
+For every convention of ``tests.mocap_conventions`` (gait and gesture skeletons) a 1000-frame procedural
 motion (walk / seated gesture) is written as that rig would write it (its names, its extra joints, a T-pose rest,
 centimetres) and imported back; plus a BVH from a body of other proportions and Emotion-Gait-style joint
 positions (16 joints, z-up, millimetres, NPY). Reported: joints mapped, the importer's retarget error (our FK vs
@@ -25,10 +25,10 @@ import numpy as np
 import torch
 
 from generation.core.skeleton import gait_skeleton
-from generation.mocap.conventions import CONVENTIONS, export_as
 from generation.mocap.importer import ImportOptions, import_file
 from generation.procedural.gesture import GestureParams, seated_gesture
 from generation.procedural.walk import WalkParams, walk
+from tests.mocap_conventions import CONVENTIONS, export_as
 
 EG16 = ("root", "spine", "neck", "head", "left_shoulder", "left_elbow", "left_hand", "right_shoulder",
         "right_elbow", "right_hand", "left_hip", "left_knee", "left_heel", "right_hip", "right_knee", "right_heel")
@@ -87,7 +87,7 @@ def main() -> None:
     lines = ["## Motion-capture import (`python -m generation.mocap import`)", "",
              f"Machine: 2-core VM shared with other jobs, no GPU; date {date}; one thread (`OMP_NUM_THREADS=1`). "
              f"Each source: {T} frames at 30 fps of a procedural motion (walk for gait, three seated gestures for "
-             "gesture) written as the rig would write it (`generation/mocap/conventions.py`: its joint names, its "
+             "gesture) written as the rig would write it (`tests/mocap_conventions.py`: its joint names, its "
              "extra joints such as clavicles and `LHipJoint`, arms out in a T-pose rest, centimetres), then "
              "imported back. Produced by `benchmarks/bench_mocap.py`.", "",
              "| source | skeleton | mapped joints | unmapped | retarget max error (mm) "

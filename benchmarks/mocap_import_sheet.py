@@ -1,7 +1,7 @@
 """Contact sheet: a motion re-exported under other rigs' conventions, imported back, beside the original.
 
 The original is a captured walk on our gait skeleton (DeepMimic's CMU/SFU-derived ``0walk_forward``, two cycles).
-It is written as a Mixamo BVH and as a CMU BVH (:func:`generation.mocap.conventions.export_as`: their joint
+It is written as a Mixamo BVH and as a CMU BVH (:func:`tests.mocap_conventions.export_as`: their joint
 names and extra joints, a T-pose rest pose, centimetres, their rotation orders), each file is imported back with
 ``generation.mocap.import_file`` (rig auto-mapping, units and up axis guessed), and the three motions are
 rendered with the study's mannequin at the same frames. Each caption gives the largest joint-position difference
@@ -23,10 +23,10 @@ import numpy as np
 from benchmarks.bench_record import one_thread
 from generation.mocap import ImportOptions, import_file
 from generation.mocap.captured import WALK_FILES, captured_walks, chain_clip_repeats
-from generation.mocap.conventions import export_as
 from generation.render.clip import render_frames_at
 from generation.render.contact_sheet import contact_sheet
 from generation.render.settings import RenderSettings
+from tests.mocap_conventions import export_as
 
 os.environ.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow")
 ROOT = Path(__file__).resolve().parents[1]

@@ -30,10 +30,10 @@ ROOT = Path(__file__).resolve().parents[1]
 def write_takes(folder: Path, n_takes: int, n_frames: int) -> None:
     import numpy as np
 
-    from generation.mocap.conventions import export_as
     from generation.procedural.emotion import gait_params_for_emotion
     from generation.procedural.walk import walk
     from study_protocol import GAIT_EMOTIONS
+    from tests.mocap_conventions import export_as
 
     folder.mkdir(parents=True, exist_ok=True)
     rng = np.random.default_rng(0)

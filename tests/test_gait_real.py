@@ -12,6 +12,7 @@ import torch
 
 from generation.core.paths import curved, straight
 from generation.core.skeleton import gait_skeleton
+from generation.core.windows import windows
 from generation.gait.config import GaitDataConfig, GaitNetConfig
 from generation.gait.real_data import (
     RealAugment,
@@ -21,7 +22,6 @@ from generation.gait.real_data import (
     mirror_motion,
     stage_clips,
     time_warp,
-    window_starts,
 )
 from generation.gait.weights import NAMED_WEIGHTS, weights_path
 from generation.mocap.real_corpus import CorpusClip, save_real_corpus
@@ -78,10 +78,10 @@ def test_time_warp_keeps_the_path_and_changes_the_duration():
         time_warp(m, 0.0)
 
 
-def test_window_starts_cover_the_take():
-    assert window_starts(100, 40, 25) == [0, 25, 50, 60]
-    assert window_starts(40, 40, 25) == [0]
-    assert window_starts(39, 40, 25) == []
+def test_training_windows_cover_the_take():
+    assert [w.start for w in windows(100, 40, 25)] == [0, 25, 50, 60]
+    assert [w.start for w in windows(40, 40, 25)] == [0]
+    assert windows(39, 40, 25) == []
 
 
 def test_labels_one_hot_or_uniform():

@@ -5,10 +5,10 @@ import numpy as np
 import pytest
 
 from generation.mocap.cli import main
-from generation.mocap.conventions import export_as
 from generation.procedural.corpus import GaitCorpus
 from generation.procedural.walk import WalkParams, walk
 from study_protocol import GAIT_EMOTIONS
+from tests.mocap_conventions import export_as
 
 
 @pytest.fixture(scope="module")

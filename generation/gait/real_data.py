@@ -28,6 +28,7 @@ import numpy as np
 
 from generation.core.digest import file_sha256
 from generation.core.motion import Motion
+from generation.core.windows import windows
 from generation.mocap.real_corpus import load_real_corpus, real_corpus_path
 from study_protocol import CAPTURE_GAIT_EMOTIONS, GAIT_EMOTIONS
 
@@ -113,17 +114,6 @@ def time_warp(motion: Motion, factor: float) -> Motion:
     return fast.resample(motion.fps)
 
 
-def window_starts(num_frames: int, need: int, stride: int) -> list[int]:
-    """First frames of windows of ``need`` frames every ``stride`` frames, plus one ending at the last frame
-    ([] when the take is shorter than a window)."""
-    if num_frames < need:
-        return []
-    starts = list(range(0, num_frames - need + 1, max(1, stride)))
-    if starts[-1] != num_frames - need:
-        starts.append(num_frames - need)
-    return starts
-
-
 def stage_clips(stage: str, split: str, path: str | Path | None = None) -> list:
     """Corpus clips (``CorpusClip``) of a training stage and split (see the module docstring)."""
     if stage not in STAGES:
@@ -151,7 +141,7 @@ def clip_sequences(clips: list, data: GaitDataConfig, augment: RealAugment, labe
             for f in augment.speed_factors:
                 m = time_warp(v, f)
                 stride = augment.stride_for(m.num_frames, need)
-                for s0 in window_starts(m.num_frames, need, stride):
+                for s0 in (w.start for w in windows(m.num_frames, need, stride)):
                     key = (clip.name, int(round(s0 * f / stride)))
                     base.append(names.setdefault(key, len(names)))
                     rot.append(m.rotations[s0:s0 + need])

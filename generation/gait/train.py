@@ -42,6 +42,7 @@ from generation.core.device import (
     to_cpu,
 )
 from generation.core.digest import file_sha256
+from generation.core.splits import SPLITS
 
 from .config import GaitNetConfig
 from .data import (
@@ -602,7 +603,7 @@ def run(args, log=print) -> dict:
         data = load_corpus_sequences(args.corpus, num_sequences=args.num_sequences, seed=0,
                                      frame_step=config.data.frame_step, seq_len=config.data.seq_len,
                                      offsets=tuple(range(args.offsets)))
-    counts = ", ".join(f"{s}: {int(((data.split == s) & (data.offset == 0)).sum())}" for s in ("train", "val", "test"))
+    counts = ", ".join(f"{s}: {int(((data.split == s) & (data.offset == 0)).sum())}" for s in SPLITS)
     log(f"{len(data)} sequences ({counts}), network {GaitNet(config.model).num_parameters()} parameters")
     result = train(config, data, args.out, args.checkpoint, args.resume, args.max_minutes, progress=not args.quiet,
                    log=log, device=device, amp=amp, init=getattr(args, "init", None),

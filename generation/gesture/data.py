@@ -35,6 +35,7 @@ import torch
 from generation.core.motion import Motion
 from generation.core.quaternion import np_qfix, np_qnormalize
 from generation.core.skeleton import gesture_skeleton
+from generation.core.splits import SPLITS
 from generation.procedural.emotion import gesture_params_for_vad
 from generation.procedural.gesture import seated_gesture, seated_rest_pose
 from study_protocol import GESTURE_VAD
@@ -43,7 +44,6 @@ from . import config
 from .text import EMBED_DIM, cached_encodings, count_words, pad_tokens
 
 SYNTHETIC_LABEL = "synthetic procedural gestures"
-SPLITS = ("train", "val", "test")
 
 
 class CorpusFormatError(ValueError):

@@ -36,6 +36,7 @@ from generation.core.digest import file_sha256
 from generation.core.features import np_gait_affective_features
 from generation.core.motion import Motion
 from generation.core.skeleton import GAIT_JOINTS
+from generation.core.windows import windows
 from generation.mocap.bandai_namco import shipped_takes
 from generation.mocap.dataset_import import import_take
 from generation.mocap.real_corpus import load_real_corpus, real_corpus_path
@@ -60,13 +61,7 @@ EMOTION_DATASET = "bandai-namco-1"
 
 def window_slices(num_frames: int, fps: float) -> list[slice]:
     """2 s windows with 0.5 s hop (the last window ends at the clip's end); one window for a shorter clip."""
-    w, h = int(round(WINDOW_S * fps)), max(1, int(round(HOP_S * fps)))
-    if num_frames <= w:
-        return [slice(0, num_frames)]
-    starts = list(range(0, num_frames - w + 1, h))
-    if starts[-1] != num_frames - w:
-        starts.append(num_frames - w)
-    return [slice(a, a + w) for a in starts]
+    return windows(num_frames, int(round(WINDOW_S * fps)), int(round(HOP_S * fps)), whole_if_short=True)
 
 
 def window_descriptors(motion: Motion) -> np.ndarray:
