@@ -498,12 +498,12 @@ def main(argv=None) -> int:
     nets, results = _load(args)
     corpus = GaitCorpus.load(args.corpus)
     data = load_corpus_sequences(args.corpus)
-    results["corpus"] = data.source
+    results["corpus"] = data.training_data.corpus
     for name, net in nets.items():
         trained = (net.info.get("corpus") or {}).get("sha256")
-        if trained != data.source["sha256"]:
+        if trained != data.training_data.corpus["sha256"]:
             print(f"WARNING: model {name!r} was trained on corpus {str(trained)[:12]}, evaluated on "
-                  f"{data.source['sha256'][:12]}")
+                  f"{data.training_data.corpus['sha256'][:12]}")
     train = data.subset((data.split == "train") & (data.offset == 0))
     test = data.subset((data.split == "test") & (data.offset == 0))
     if args.quick:

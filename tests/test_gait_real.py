@@ -112,7 +112,8 @@ def test_sequences_labels_augmentation_and_split(corpus):
     assert seqs.q.shape[1:] == (DATA.seq_len, 21, 4)
     val = seqs.subset("val")
     assert len(val) == len(np.unique(val.base_index)) and set(val.offset) == {0}   # validation as captured
-    assert seqs.trained_on.startswith("real capture") and seqs.source["stage"] == "pretrain"
+    assert seqs.training_data.kind == "real" and seqs.training_data.corpus["stage"] == "pretrain"
+    assert seqs.training_data.datasets == ("bandai-namco-1", "bandai-namco-2")
     assert "dataset-2_walk_normal_002" not in seqs.clip_names
 
 
@@ -134,6 +135,7 @@ def test_training_on_real_windows_records_the_data(corpus, tmp_path):
     run(args, log=lambda *_: None)
     payload = torch.load(out, weights_only=False)
     assert payload["trained_on"].startswith("real capture") and payload["corpus"]["stage"] == "finetune"
+    assert payload["training_data"]["kind"] == "real" and payload["training_data"]["datasets"] == ["bandai-namco-1"]
     assert GaitNetConfig.from_dict(payload["config"]).data.seq_len == 12
 
 

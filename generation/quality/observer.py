@@ -95,7 +95,7 @@ def train_observer(corpus_path: str | Path | None = None) -> GaitObserver:
     data = load_corpus_sequences(_corpus_path(corpus_path))
     train = data.subset((data.split == "train") & (data.offset == 0))
     obs = GaitObserver(train)
-    obs.corpus_sha256 = data.source["sha256"]
+    obs.corpus_sha256 = data.training_data.corpus["sha256"]
     return obs
 
 
