@@ -1,8 +1,9 @@
 """Turn a validated plan entry into a Motion with its registered generator (generation.plans.generators).
 
-The network generators (gait_net, gesture_net, rbf: they load torch) import it inside ``make``, so planning,
-hashing and procedural clips never load torch, and a missing or broken network fails only the entries that use
-it, with a message naming the entry (:class:`ClipGenerationError`).
+The optional network generators (gesture_net, rbf, neutral_walk) import their networks inside ``make``, so a
+missing or broken network fails only the entries that use it, with a message naming the entry
+(:class:`ClipGenerationError`; :func:`availability` says why beforehand). gait_net names its weights through
+``generation.gait.weights``, whose package loads torch, so planning loads torch.
 
 A network generator whose weights are not there yet may be replaced by the entry's ``fallback``
 (procedural_walk for gait_net, procedural_gesture for gesture_net). The clip is then recorded with the
