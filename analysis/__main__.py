@@ -13,6 +13,7 @@ import sys
 
 from .exclusion import rule_errors
 from .io import ValidationError
+from .report import write_report
 
 
 def main(argv=None) -> int:
@@ -55,8 +56,6 @@ def main(argv=None) -> int:
         if errors:
             print("error: --exclusion-rules: " + "; ".join(errors), file=sys.stderr)
             return 2
-    from .report import write_report  # imported late: matplotlib/pingouin are slow to import
-
     try:
         report = write_report(a.responses, a.clips, a.participants, a.out, a.alpha, a.permutations,
                               figures=not a.no_figures, exclude=not a.no_exclusions,

@@ -158,9 +158,10 @@ def power_table(preset: str, participants, effects: dict | None = None, sims: in
     return pd.DataFrame(rows)
 
 
-def fig_power(table: pd.DataFrame, alpha: float = 0.05):
-    """Power against participants, one line per test, the conventional 0.8 dashed."""
-    from .figures import plt  # heavy: matplotlib, only when a figure is drawn
+def save_power_figure(table: pd.DataFrame, out: str, alpha: float = 0.05) -> dict:
+    """power.png and power.svg in ``out`` (paths by format): power against participants, one line per test, the
+    conventional 0.8 dashed."""
+    from .figures import plt, save_figure  # heavy: matplotlib, only when a figure is drawn
 
     fig, ax = plt.subplots(figsize=(5.5, 3.4))
     for test, g in table.groupby("test", sort=False):
@@ -174,7 +175,7 @@ def fig_power(table: pd.DataFrame, alpha: float = 0.05):
     ax.set_ylabel(f"power (alpha = {alpha})")
     ax.legend(fontsize=7, frameon=False, loc="lower right")
     fig.subplots_adjust(left=0.12, right=0.98, bottom=0.15, top=0.95)
-    return fig
+    return save_figure(fig, out, "power")
 
 
 def _parse_effect(text: str) -> tuple[str, float]:
@@ -211,9 +212,7 @@ def main(argv=None) -> int:
         print(f"| {r['test']} | {r['effects']} | {r['participants']} | {r['power']:.3f} | {r['mc_se']:.3f} |")
     os.makedirs(a.out, exist_ok=True)
     table.to_csv(os.path.join(a.out, "power.csv"), index=False)
-    from .figures import save_figure  # heavy: matplotlib, only when a figure is drawn
-
-    paths = save_figure(fig_power(table, a.alpha), a.out, "power")
+    paths = save_power_figure(table, a.out, a.alpha)
     print(f"wrote {os.path.join(a.out, 'power.csv')}, {paths['png']}, {paths['svg']}")
     return 0
 

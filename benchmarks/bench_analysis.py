@@ -1,6 +1,6 @@
 """Benchmark: time to produce the whole report for N simulated (SYNTHETIC) participants.
 
-    python benchmarks/bench_analysis.py --participants 10000
+    python -m benchmarks.bench_analysis --participants 10000
 
 Writes the synthetic study to a temporary folder (not timed), then times, in this process after imports:
 load + validate the three CSVs, every analysis, figures (PNG + SVG), and the whole ``write_report`` call
@@ -17,7 +17,6 @@ import time
 
 os.environ.setdefault("OMP_NUM_THREADS", "1")
 os.environ.setdefault("MKL_NUM_THREADS", "1")
-sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
 
 
 def main(argv=None) -> int:

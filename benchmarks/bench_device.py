@@ -10,7 +10,7 @@ Measures on this machine's CPU (and on CUDA when torch sees a GPU):
    in ms per agent per output frame, next to the paper's 4 ms per agent per frame (two GTX 1080 Ti, including
    rendering). The paper-size network is timed with untrained weights (speed does not depend on the values).
 
-Usage: python benchmarks/bench_device.py [--batches 2] [--threads 1] [--no-doc]
+Usage: python -m benchmarks.bench_device [--batches 2] [--threads 1] [--no-doc]
 Writes var/benchmarks/bench_device.json and rewrites the gait part of docs/benchmarks/device.md (the Gesture
 subsection below the marker is kept).
 """
@@ -20,21 +20,18 @@ import argparse
 import json
 import os
 import platform
-import sys
 import time
 from pathlib import Path
 
 import numpy as np
 import torch
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
-
-from generation.core.device import autocast_context, describe, resolve_device  # noqa: E402
-from generation.core.paths import straight  # noqa: E402
-from generation.gait.config import GaitNetConfig  # noqa: E402
-from generation.gait.generate import LoadedGaitNet, generate_gaits, load_default_model  # noqa: E402
-from generation.gait.model import GaitNet  # noqa: E402
-from generation.gait.train import _Step, evaluate, fit_normalizer, splice_histories  # noqa: E402
+from generation.core.device import autocast_context, describe, resolve_device
+from generation.core.paths import straight
+from generation.gait.config import GaitNetConfig
+from generation.gait.generate import LoadedGaitNet, generate_gaits, load_default_model
+from generation.gait.model import GaitNet
+from generation.gait.train import _Step, evaluate, fit_normalizer, splice_histories
 
 DOC = Path("docs/benchmarks/device.md")
 GESTURE_MARKER = "### Gesture"

@@ -13,7 +13,7 @@ Measures, on the held-out test split of the synthetic gait corpus:
 5. speed in ms per agent per step / per 30 fps frame for 1 and 10 agents;
 6. the contact sheet docs/img/gait_contact_sheet.png and docs/img/gait_trajectories.png.
 
-Usage: python benchmarks/bench_gait.py [--full W.pt] [--no-affect W.pt] [--no-root W.pt] [--quick]
+Usage: python -m benchmarks.bench_gait [--full W.pt] [--no-affect W.pt] [--no-root W.pt] [--quick]
 Results go to docs/benchmarks/gait.json (``--out``); the tables are printed and rendered into the marked blocks of
 docs/benchmarks/gait.md (benchmarks/doc_tables.py; the narrative there is written by hand).
 """
@@ -21,36 +21,32 @@ from __future__ import annotations
 
 import argparse
 import math
-import sys
 import time
 from pathlib import Path
 
 import numpy as np
 import torch
 
-sys.path[:0] = [str(Path(__file__).resolve().parents[1]), str(Path(__file__).resolve().parent)]
-
-import doc_tables  # noqa: E402
-
-from generation.core.kinematics import forward_kinematics  # noqa: E402
-from generation.core.motion import Motion  # noqa: E402
-from generation.core.paths import random_path, straight  # noqa: E402
-from generation.core.quaternion import qangle  # noqa: E402
-from generation.core.skeleton import GAIT_PARENTS  # noqa: E402
-from generation.gait.data import load_corpus_sequences, world_rotations  # noqa: E402
-from generation.gait.generate import distance_to_path, emotion_transition, load_model  # noqa: E402
-from generation.gait.generate import generate_gaits as _generate_gaits  # noqa: E402
-from generation.gait.train import DEFAULT_WEIGHTS, rollout  # noqa: E402
-from generation.procedural.corpus import GaitCorpus  # noqa: E402
-from generation.quality.gait_guidance import (  # noqa: E402
+from benchmarks import doc_tables
+from generation.core.kinematics import forward_kinematics
+from generation.core.motion import Motion
+from generation.core.paths import random_path, straight
+from generation.core.quaternion import qangle
+from generation.core.skeleton import GAIT_PARENTS
+from generation.gait.data import load_corpus_sequences, world_rotations
+from generation.gait.generate import distance_to_path, emotion_transition, load_model
+from generation.gait.generate import generate_gaits as _generate_gaits
+from generation.gait.train import DEFAULT_WEIGHTS, rollout
+from generation.procedural.corpus import GaitCorpus
+from generation.quality.gait_guidance import (
     HELDOUT_SEED,
     heldout_corpus,
     seed_walks,
     single_dominant,
     unseen_mixtures,
 )
-from generation.quality.observer import GaitObserver  # noqa: E402
-from study_protocol import GAIT_EMOTIONS  # noqa: E402
+from generation.quality.observer import GaitObserver
+from study_protocol import GAIT_EMOTIONS
 
 PREFIX, HORIZON = 18, 42
 
@@ -502,12 +498,12 @@ def main(argv=None) -> int:
     nets, results = _load(args)
     corpus = GaitCorpus.load(args.corpus)
     data = load_corpus_sequences(args.corpus)
-    results["corpus"] = data.source
+    results["corpus"] = data.training_data.corpus
     for name, net in nets.items():
         trained = (net.info.get("corpus") or {}).get("sha256")
-        if trained != data.source["sha256"]:
+        if trained != data.training_data.corpus["sha256"]:
             print(f"WARNING: model {name!r} was trained on corpus {str(trained)[:12]}, evaluated on "
-                  f"{data.source['sha256'][:12]}")
+                  f"{data.training_data.corpus['sha256'][:12]}")
     train = data.subset((data.split == "train") & (data.offset == 0))
     test = data.subset((data.split == "test") & (data.offset == 0))
     if args.quick:

@@ -18,7 +18,7 @@ the real-capture corpus (``generation.mocap.real_corpus``); only its held-out ``
 3. Realism (``generation.quality.realism``) per asked emotion of those generated walks, beside the real takes of
    that emotion (dataset 1 walks, both takes; dataset 2 normal walks for neutral) and the corpus's pooled range.
 
-Usage: python benchmarks/bench_gait_real.py [--real W.pt] [--before W.pt] [--procedural W.pt] [--steps 100]
+Usage: python -m benchmarks.bench_gait_real [--real W.pt] [--before W.pt] [--procedural W.pt] [--steps 100]
        [--skip-plan]
 ``--before`` measures a previous real-trained weights file in the same run (rows "real-trained (before)").
 Results: docs/benchmarks/gait_real.json (``--out``) with the run's machine, date, commit, command, duration, weights
@@ -40,25 +40,22 @@ from pathlib import Path
 import numpy as np
 import torch
 
+from benchmarks import doc_tables
+from benchmarks.bench_gait import nearest_neighbour_errors, network_errors, pose_rotation_errors, zero_velocity_errors
+from benchmarks.bench_record import commit_label, machine_label
+from generation.core.digest import file_sha256
+from generation.core.paths import path_from_spec as make_path
+from generation.core.quaternion import qmul
+from generation.gait.generate import generate_gaits, load_model
+from generation.gait.real_data import RealAugment, clip_sequences, stage_clips
+from generation.gait.weights import weights_path
+from generation.mocap.real_corpus import load_real_corpus, real_corpus_path
+from generation.quality.observers import OBSERVERS
+from generation.quality.realism import MEASURES, realism_measures
+from generation.quality.realism_ranges import load_ranges
+from study_protocol import CAPTURE_GAIT_EMOTIONS, GAIT_EMOTIONS
+
 ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT))
-sys.path.insert(0, str(ROOT / "benchmarks"))
-
-import doc_tables  # noqa: E402
-from bench_gait import nearest_neighbour_errors, network_errors, pose_rotation_errors, zero_velocity_errors  # noqa: E402
-from bench_record import commit_label, machine_label  # noqa: E402
-
-from generation.core.paths import path_from_spec as make_path  # noqa: E402
-from generation.core.quaternion import qmul  # noqa: E402
-from generation.gait.data import file_sha256  # noqa: E402
-from generation.gait.generate import generate_gaits, load_model  # noqa: E402
-from generation.gait.real_data import RealAugment, clip_sequences, stage_clips  # noqa: E402
-from generation.gait.weights import weights_path  # noqa: E402
-from generation.mocap.real_corpus import load_real_corpus, real_corpus_path  # noqa: E402
-from generation.quality.real_observer import default_real_observer  # noqa: E402
-from generation.quality.realism import MEASURES, realism_measures  # noqa: E402
-from generation.quality.realism_ranges import load_ranges  # noqa: E402
-from study_protocol import CAPTURE_GAIT_EMOTIONS, GAIT_EMOTIONS  # noqa: E402
 
 
 # ---- 1. prediction error -------------------------------------------------------------------------
@@ -364,7 +361,7 @@ def run(a, argv) -> dict:
     nets = load_nets(a)
     corpus = real_corpus_path()
     res = {"date": datetime.date.today().isoformat(), "commit": commit_label(),
-           "command": shlex.join(["python", "benchmarks/bench_gait_real.py", *argv]),
+           "command": shlex.join(["python", "-m", "benchmarks.bench_gait_real", *argv]),
            "machine": machine_label(f"{a.threads} torch thread(s)"),
            "corpus": _file_record(corpus) if corpus.is_file() else {"path": str(corpus), "sha256": None},
            "weights": {name: _file_record(net.path) for name, net in nets.items()}}
@@ -383,7 +380,7 @@ def run(a, argv) -> dict:
         res["prediction"][subset] = {"n": len(test), "takes": len(clips),
                                      "methods": prediction_table(nets, train, test, prefix)}
         print(f"prediction {subset}: {time.time() - t0:.0f} s", flush=True)
-    observer = default_real_observer()
+    observer = OBSERVERS.gait("real")
     res["observer"] = observer.source
     res["real_realism"] = real_realism()
     takes = heldout_emotion_takes()

@@ -3,9 +3,9 @@
 Pose error in the paper's Table 1 layout (with ablations and baselines), liveliness (wrist speed, generated vs
 corpus), emotional expressiveness, generation and training speed, and two contact sheets.
 
-    python benchmarks/bench_gesture.py                      # the shipped weights
-    python benchmarks/bench_gesture.py --original-weights A.pt --previous-weights B.pt   # with two comparisons
-    python benchmarks/bench_gesture.py --ablations --ablation-minutes 4 --skip-train    # + loss ablations (slow)
+    python -m benchmarks.bench_gesture                      # the shipped weights
+    python -m benchmarks.bench_gesture --original-weights A.pt --previous-weights B.pt   # with two comparisons
+    python -m benchmarks.bench_gesture --ablations --ablation-minutes 4 --skip-train    # + loss ablations (slow)
 
 Everything is measured on held-out sentences of the SYNTHETIC corpus (procedural gestures), not captured motion.
 Results go to docs/benchmarks/gesture.json (``--out``); the tables are printed and rendered into the marked blocks
@@ -25,32 +25,30 @@ import time
 from datetime import UTC, datetime
 from pathlib import Path
 
-os.environ.setdefault("OMP_NUM_THREADS", "1")
-os.environ.setdefault("MKL_NUM_THREADS", "1")
-ROOT = Path(__file__).resolve().parents[1]
-sys.path[:0] = [str(ROOT), str(ROOT / "benchmarks")]
+import numpy as np
+import torch
+from scipy import stats
 
-import doc_tables  # noqa: E402
-import numpy as np  # noqa: E402
-import torch  # noqa: E402
-from scipy import stats  # noqa: E402
-
-from generation.core.quaternion import np_qnormalize  # noqa: E402
-from generation.core.skeleton import gesture_skeleton  # noqa: E402
-from generation.gesture import config  # noqa: E402
-from generation.gesture.data import GestureDataset, build_dataset, nrc_vad, with_emotions  # noqa: E402
-from generation.gesture.generate import decode_examples, generate_gesture, load_model  # noqa: E402
-from generation.gesture.losses import LossWeights  # noqa: E402
-from generation.gesture.metrics import (  # noqa: E402
+from benchmarks import doc_tables
+from benchmarks.bench_record import one_thread
+from generation.core.quaternion import np_qnormalize
+from generation.core.skeleton import gesture_skeleton
+from generation.gesture import config
+from generation.gesture.data import GestureDataset, build_dataset, nrc_vad, with_emotions
+from generation.gesture.generate import decode_examples, generate_gesture, load_model
+from generation.gesture.losses import LossWeights
+from generation.gesture.metrics import (
     dataset_pose_error,
     upper_body_acceleration,
     wrist_speed,
     wrist_speed_of_positions,
 )
-from generation.gesture.model import GestureNetConfig  # noqa: E402
-from generation.gesture.train import TrainConfig, train  # noqa: E402
-from generation.quality.gesture_observer import corpus_descriptors, motion_descriptors, positions_of  # noqa: E402
-from study_protocol import GESTURE_EMOTIONS  # noqa: E402
+from generation.gesture.model import GestureNetConfig
+from generation.gesture.train import TrainConfig, train
+from generation.quality.gesture_observer import corpus_descriptors, motion_descriptors, positions_of
+from study_protocol import GESTURE_EMOTIONS
+
+ROOT = Path(__file__).resolve().parents[1]
 
 SHEET_SENTENCE = "I can't believe we finally made it to the top of the mountain!"
 ABLATIONS = {
@@ -494,7 +492,7 @@ def _git_commit() -> dict:
 
 def _meta(args, argv: list[str], seconds: float) -> dict:
     return {"machine": args.machine, "date": datetime.now(UTC).date().isoformat(), **_git_commit(),
-            "seconds": seconds, "command": " ".join(["python benchmarks/bench_gesture.py", *map(shlex.quote, argv)]),
+            "seconds": seconds, "command": " ".join(["python -m benchmarks.bench_gesture", *map(shlex.quote, argv)]),
             "weights": _rel(args.weights),
             "comparison_weights": {label: _rel(path) for label, path in _comparisons(args).items()}}
 
@@ -541,6 +539,7 @@ def _json_default(o):
 
 
 def main(argv=None) -> int:
+    one_thread()
     argv = sys.argv[1:] if argv is None else list(argv)
     args = _args(argv)
     torch.set_num_threads(1)

@@ -1,6 +1,6 @@
 """How well the synthetic gesture observer (generation/quality/gesture_observer.py) reads gesture emotion.
 
-    python benchmarks/bench_gesture_observer.py [--json var/gobs/bench.json] [--skip-generated] [--skip-plan]
+    python -m benchmarks.bench_gesture_observer [--json var/gobs/bench.json] [--skip-generated] [--skip-plan]
 
 1. Held-out procedural gestures: the observer is fitted on the training split of the SYNTHETIC gesture corpus and
    tested on its validation and test sentences (11-class accuracy, per-class recall, confusion, accuracy of the
@@ -24,21 +24,20 @@ import time
 from collections import Counter
 from pathlib import Path
 
-os.environ.setdefault("OMP_NUM_THREADS", "1")
-ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT))
+import numpy as np
 
-import numpy as np  # noqa: E402
-
-from generation.gesture.data import GestureDataset, attribute_vector, build_dataset, nrc_vad  # noqa: E402
-from generation.quality.gesture_observer import (  # noqa: E402
+from benchmarks.bench_record import one_thread
+from generation.gesture.data import GestureDataset, attribute_vector, build_dataset, nrc_vad
+from generation.quality.gesture_observer import (
     GestureObserver,
     arousal_half,
     corpus_descriptors,
     motion_descriptors,
     positions_of,
 )
-from study_protocol import GESTURE_EMOTIONS, GESTURE_VAD  # noqa: E402
+from study_protocol import GESTURE_EMOTIONS, GESTURE_VAD
+
+ROOT = Path(__file__).resolve().parents[1]
 
 
 def scores(observer: GestureObserver, X: np.ndarray, truth) -> dict:
@@ -168,6 +167,7 @@ def relabelled_caught(rows: list[dict]) -> dict:
 
 
 def main(argv=None) -> int:
+    one_thread()
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--json", default=str(ROOT / "var" / "quality" / "gesture_observer_bench.json"))
     ap.add_argument("--weights", default=str(ROOT / "generation" / "data" / "weights" / "gesture_net_default.pt"))

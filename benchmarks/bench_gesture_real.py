@@ -1,7 +1,7 @@
 """Generated gestures measured against REAL captured ones (seated), before and after the real-range training, and the
 real-capture gesture observer's held-out accuracy.
 
-    python benchmarks/bench_gesture_real.py --before var/gesture/realrange/before.pt \
+    python -m benchmarks.bench_gesture_real --before var/gesture/realrange/before.pt \
         --after generation/data/weights/gesture_net_default.pt [--sheet docs/img/gesture_real_contact_sheet.png]
 
 Real: the real corpus's dataset-1 gesture takes (bow, bye, byebye, guide) in the styles that name a gesture emotion
@@ -15,24 +15,18 @@ from __future__ import annotations
 
 import argparse
 import json
-import os
-import sys
 from pathlib import Path
 
-os.environ.setdefault("OMP_NUM_THREADS", "1")
-ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT))
-sys.path.insert(0, str(ROOT / "benchmarks"))
+import numpy as np
+import torch
 
-import numpy as np  # noqa: E402
-import torch  # noqa: E402
-from bench_gesture import liveliness, onion_skin, speed_benchmark  # noqa: E402
-
-from generation.gesture.data import build_dataset, with_emotions  # noqa: E402
-from generation.gesture.generate import decode_examples, generate_gesture, load_model  # noqa: E402
-from generation.gesture.metrics import dataset_pose_error, positions  # noqa: E402
-from generation.gesture.real_stats import STAT_NAMES, gesture_stats, in_range_shares, real_ranges  # noqa: E402
-from generation.quality.real_gesture_observer import (  # noqa: E402
+from benchmarks.bench_gesture import liveliness, onion_skin, speed_benchmark
+from benchmarks.bench_record import one_thread
+from generation.gesture.data import build_dataset, with_emotions
+from generation.gesture.generate import decode_examples, generate_gesture, load_model
+from generation.gesture.metrics import dataset_pose_error, positions
+from generation.gesture.real_stats import STAT_NAMES, gesture_stats, in_range_shares, real_ranges
+from generation.quality.real_gesture_observer import (
     STYLES_15,
     RealGestureObserver,
     features_of_positions,
@@ -40,8 +34,10 @@ from generation.quality.real_gesture_observer import (  # noqa: E402
     held_out_accuracy,
     real_gesture_dataset,
 )
-from generation.quality.real_gestures import real_gesture_clips, real_stats_table  # noqa: E402
-from study_protocol import CAPTURE_GESTURE_EMOTIONS  # noqa: E402
+from generation.quality.real_gestures import real_gesture_clips, real_stats_table
+from study_protocol import CAPTURE_GESTURE_EMOTIONS
+
+ROOT = Path(__file__).resolve().parents[1]
 
 EMOTIONS = ("joyous", "sad", "angry", "proud", "neutral")
 SHEET_EMOTIONS = ("afraid", "sad", "angry", "joyous", "proud", "neutral")
@@ -150,6 +146,7 @@ def contact_sheet(nets: dict, real: dict, path: Path) -> list[str]:
 
 
 def main(argv=None) -> dict:
+    one_thread()
     p = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     p.add_argument("--before", required=True)
     p.add_argument("--after", required=True)

@@ -7,7 +7,7 @@ one address, half one after another and half from 8 threads at once, and meanwhi
 Prints how many attempts had their password checked (the login form again, 200) and how many were refused
 (429), and the participant pages' p50 / p99 / max latency during the flood. Example:
 
-    .venv/bin/python benchmarks/bench_login_flood.py --limit 1000000 --limit 5
+    .venv/bin/python -m benchmarks.bench_login_flood --limit 1000000 --limit 5
 """
 from __future__ import annotations
 
@@ -21,7 +21,7 @@ import threading
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
-from bench_slow_clients import ROOT, free_port, measure, prepare, print_table, scratch_env, start_server
+from benchmarks.bench_slow_clients import ROOT, free_port, measure, prepare, print_table, scratch_env, start_server
 
 ADMIN = """
 from django.contrib.auth.models import User

@@ -1,6 +1,6 @@
 """Benchmark of the motion-capture importer (generation.mocap): each naming convention's import.
 
-For every convention of ``generation.mocap.conventions`` (gait and gesture skeletons) a 1000-frame procedural
+For every convention of ``tests.mocap_conventions`` (gait and gesture skeletons) a 1000-frame procedural
 motion (walk / seated gesture) is written as that rig would write it (its names, its extra joints, a T-pose rest,
 centimetres) and imported back; plus a BVH from a body of other proportions and Emotion-Gait-style joint
 positions (16 joints, z-up, millimetres, NPY). Reported: joints mapped, the importer's retarget error (our FK vs
@@ -8,29 +8,27 @@ the scaled source positions of mapped joints), the distance to the ground-truth 
 per 1000 frames (read + map + IK, best of 3, one thread).
 
 Writes a markdown section to ``docs/benchmarks/mocap.md`` (use --md to change) and prints it.
-Usage: OMP_NUM_THREADS=1 python benchmarks/bench_mocap.py [--frames 1000]
+Usage: OMP_NUM_THREADS=1 python -m benchmarks.bench_mocap [--frames 1000]
 """
 from __future__ import annotations
 
 import argparse
 import datetime
 import os
-import sys
 import tempfile
 import time
 from pathlib import Path
 
 os.environ.setdefault("OMP_NUM_THREADS", "1")
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-import numpy as np  # noqa: E402
-import torch  # noqa: E402
+import numpy as np
+import torch
 
-from generation.core.skeleton import gait_skeleton  # noqa: E402
-from generation.mocap.conventions import CONVENTIONS, export_as  # noqa: E402
-from generation.mocap.importer import ImportOptions, import_file  # noqa: E402
-from generation.procedural.gesture import GestureParams, seated_gesture  # noqa: E402
-from generation.procedural.walk import WalkParams, walk  # noqa: E402
+from generation.core.skeleton import gait_skeleton
+from generation.mocap.importer import ImportOptions, import_file
+from generation.procedural.gesture import GestureParams, seated_gesture
+from generation.procedural.walk import WalkParams, walk
+from tests.mocap_conventions import CONVENTIONS, export_as
 
 EG16 = ("root", "spine", "neck", "head", "left_shoulder", "left_elbow", "left_hand", "right_shoulder",
         "right_elbow", "right_hand", "left_hip", "left_knee", "left_heel", "right_hip", "right_knee", "right_heel")
@@ -89,7 +87,7 @@ def main() -> None:
     lines = ["## Motion-capture import (`python -m generation.mocap import`)", "",
              f"Machine: 2-core VM shared with other jobs, no GPU; date {date}; one thread (`OMP_NUM_THREADS=1`). "
              f"Each source: {T} frames at 30 fps of a procedural motion (walk for gait, three seated gestures for "
-             "gesture) written as the rig would write it (`generation/mocap/conventions.py`: its joint names, its "
+             "gesture) written as the rig would write it (`tests/mocap_conventions.py`: its joint names, its "
              "extra joints such as clavicles and `LHipJoint`, arms out in a T-pose rest, centimetres), then "
              "imported back. Produced by `benchmarks/bench_mocap.py`.", "",
              "| source | skeleton | mapped joints | unmapped | retarget max error (mm) "

@@ -12,7 +12,7 @@ For every ``gait_net`` entry of the built-in ``seed000`` plan (made as the study
   generator of the training corpus): one per single-emotion entry, on its path and with its duration;
 - bone length error (max, mm) and the largest joint speed (m/s; a pop would raise it).
 
-Usage: ``python benchmarks/bench_motion_quality.py [--json var/motion_quality.json]``
+Usage: ``python -m benchmarks.bench_motion_quality [--json var/motion_quality.json]``
 
 ``--qa seed000 seed003 seed004`` instead runs the per-clip quality checks (:mod:`generation.quality`, the record
 ``generate_clips`` keeps per clip) over every entry of the plans without rendering video, and prints per plan the
@@ -24,19 +24,16 @@ import argparse
 import dataclasses
 import json
 import platform
-import sys
 import time
 from pathlib import Path
 
 import numpy as np
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
-
-from generation.core.features import detect_foot_contacts, foot_joints, foot_skate  # noqa: E402
-from generation.core.motion import Motion  # noqa: E402
-from generation.plans import clipgen  # noqa: E402
-from generation.plans.schema import load_plan  # noqa: E402
-from study_protocol import GAIT_EMOTIONS  # noqa: E402
+from generation.core.features import detect_foot_contacts, foot_joints, foot_skate
+from generation.core.motion import Motion
+from generation.plans import clipgen
+from generation.plans.schema import load_plan
+from study_protocol import GAIT_EMOTIONS
 
 
 def stance_knee_flexion(motion: Motion) -> np.ndarray:

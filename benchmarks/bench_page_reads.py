@@ -11,7 +11,7 @@ request's thread CPU time is recorded by kind. The modes alternate in one proces
 Prints and (``--json``) writes the median over rounds of each mode's per-round median CPU ms for the answer POST
 (which brings the next clip page) and the clip page GET, and the saving of each mode against ``queryset``.
 
-    python benchmarks/bench_page_reads.py [--db-url postgres://postgres@127.0.0.1:5432/postgres | --sqlite]
+    python -m benchmarks.bench_page_reads [--db-url postgres://postgres@127.0.0.1:5432/postgres | --sqlite]
         [--participants 6] [--rounds 5] [--json docs/benchmarks/page_reads.json]
 """
 from __future__ import annotations
@@ -19,16 +19,12 @@ from __future__ import annotations
 import argparse
 import os
 import statistics
-import sys
 import tempfile
 import time
 from pathlib import Path
 
-ROOT = Path(__file__).resolve().parent.parent
-sys.path[:0] = [str(ROOT), str(ROOT / "benchmarks")]
-
-import bench_study_load as load  # noqa: E402
-from bench_record import record  # noqa: E402
+from benchmarks import bench_study_load as load
+from benchmarks.bench_record import record
 
 KINDS = ("answer POST", "clip page")      # take_study's names of the answer POST and the clip page GET
 

@@ -1,7 +1,7 @@
 """Seed 004 RBF styliser: effect of each theme on the 18 gait affective features, bone lengths, speed,
 and the contact sheet docs/img/rbf_contact_sheet.png.
 
-Run:  OMP_NUM_THREADS=1 python benchmarks/bench_rbf_features.py [--out docs/benchmarks/rbf_features.json]
+Run:  OMP_NUM_THREADS=1 python -m benchmarks.bench_rbf_features [--out docs/benchmarks/rbf_features.json]
           [--doc docs/benchmarks/rbf.md] [--sheet docs/img/rbf_contact_sheet.png] [--shapes docs/img/rbf_shapes.png]
           [--base real|procedural]
 
@@ -28,19 +28,14 @@ import warnings
 from pathlib import Path
 
 import numpy as np
+import torch
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
-
-import torch  # noqa: E402
-
-from generation.core.features import GAIT_FEATURE_NAMES, foot_joints, np_gait_affective_features  # noqa: E402
-from generation.rbf.neutral_base import neutral_cycle  # noqa: E402
-from generation.rbf.real_neutral import load_cycle  # noqa: E402
-from generation.rbf.stylise import PAPER_FEATURE_COUNTS, PAPER_WEIGHTS, stylise, stylised_cycle  # noqa: E402
-from generation.rbf.themes import THEME_NAMES, THEMES  # noqa: E402
-
-sys.path.insert(0, str(Path(__file__).resolve().parent))
-import doc_tables  # noqa: E402
+from benchmarks import doc_tables
+from generation.core.features import GAIT_FEATURE_NAMES, foot_joints, np_gait_affective_features
+from generation.rbf.neutral_base import neutral_cycle
+from generation.rbf.real_neutral import load_cycle
+from generation.rbf.stylise import PAPER_FEATURE_COUNTS, PAPER_WEIGHTS, stylise, stylised_cycle
+from generation.rbf.themes import THEME_NAMES, THEMES
 
 WEIGHTS = (0.7, -0.7)
 
@@ -334,7 +329,7 @@ def main(argv=None) -> int:
     threads = f"OMP_NUM_THREADS={os.environ['OMP_NUM_THREADS']} " if "OMP_NUM_THREADS" in os.environ else ""
     result = {"machine": f"{platform.machine()} {platform.system()}, {os.cpu_count()} CPUs (shared), no GPU",
               "date": datetime.date.today().isoformat(),
-              "command": threads + shlex.join(["python", "benchmarks/bench_rbf_features.py",
+              "command": threads + shlex.join(["python", "-m", "benchmarks.bench_rbf_features",
                                                *(sys.argv[1:] if argv is None else argv)]),
               **evaluate(nc)}
     result["summary"] = summary(result)

@@ -1,7 +1,7 @@
 """Foot planting of the RBF-styled walks (generation.rbf.stylise.plant_walk_feet): quality before/after and how
 much of each theme feature survives.
 
-    python benchmarks/bench_rbf_feet.py
+    python -m benchmarks.bench_rbf_feet
 
 Per clip (paper settings, 4 cycles at 25 fps): foot skate and penetration before -> after; for every Table III
 feature the RMS displacement from the neutral walk along the feature's axis on the feature's joints (mm),
@@ -11,17 +11,14 @@ gait features (time means) from the neutral walk's, before -> after. Synthetic n
 from __future__ import annotations
 
 import sys
-from pathlib import Path
 
 import numpy as np
 
-sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
-
-from generation.core.features import affective_features  # noqa: E402
-from generation.quality.metrics import motion_metrics  # noqa: E402
-from generation.rbf.neutral_base import neutral_cycle  # noqa: E402
-from generation.rbf.stylise import neutral_walk, stylise  # noqa: E402
-from generation.rbf.themes import AXES, BODY_PARTS, theme_features  # noqa: E402
+from generation.core.features import affective_features
+from generation.quality.metrics import motion_metrics
+from generation.rbf.neutral_base import neutral_cycle
+from generation.rbf.stylise import neutral_walk, stylise
+from generation.rbf.themes import AXES, BODY_PARTS, theme_features
 
 CASES = (("tired", 1.0, 7), ("tired", 0.4, 4), ("tired", -0.7, 10), ("energetic", 1.3, 10),
          ("masculine", -0.7, 10), ("happy", 1.3, 10), ("sad", 1.0, 10), ("feminine", 1.3, 10))

@@ -1,7 +1,7 @@
 """Seed 004 on real capture: the averaged neutral walk checked against real normal walks, expert vs data-driven
 RBF features per theme, what the real-capture observers read, and a contact sheet per theme.
 
-Run:  OMP_NUM_THREADS=1 python benchmarks/bench_rbf_real.py [--corpus var/mocap/bandai-namco.npz]
+Run:  OMP_NUM_THREADS=1 python -m benchmarks.bench_rbf_real [--corpus var/mocap/bandai-namco.npz]
           [--out docs/benchmarks/rbf_real.json] [--doc docs/benchmarks/rbf.md] [--sheets docs/img]
 
 Writes its figures to the JSON (--out); with --doc it renders them into that page's ``rbf_real.*`` tables
@@ -31,22 +31,18 @@ from pathlib import Path
 
 import numpy as np
 
-ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT))
-
-from generation.mocap.real_corpus import load_real_corpus, real_corpus_path  # noqa: E402
-from generation.quality.real_observer import THEME_PAIRS, default_real_observer  # noqa: E402
-from generation.quality.realism import realism_measures  # noqa: E402
-from generation.rbf.compare import compare_theme  # noqa: E402
-from generation.rbf.data_features import PART_OF  # noqa: E402
-from generation.rbf.neutral_base import neutral_cycle  # noqa: E402
-from generation.rbf.real_neutral import load_cycle, steady_cycles  # noqa: E402
-from generation.rbf.stylise import neutral_walk, stylise  # noqa: E402
-from generation.rbf.themes import THEME_NAMES, theme_features  # noqa: E402
-from study_protocol import CAPTURE_THEMES, GAIT_EMOTIONS  # noqa: E402
-
-sys.path.insert(0, str(ROOT / "benchmarks"))
-import doc_tables  # noqa: E402
+from benchmarks import doc_tables
+from generation.mocap.real_corpus import load_real_corpus, real_corpus_path
+from generation.quality.observers import OBSERVERS
+from generation.quality.real_observer import THEME_PAIRS
+from generation.quality.realism import realism_measures
+from generation.rbf.compare import compare_theme
+from generation.rbf.data_features import PART_OF
+from generation.rbf.neutral_base import neutral_cycle
+from generation.rbf.real_neutral import load_cycle, steady_cycles
+from generation.rbf.stylise import neutral_walk, stylise
+from generation.rbf.themes import THEME_NAMES, theme_features
+from study_protocol import CAPTURE_THEMES, GAIT_EMOTIONS
 
 CHECKED = ("speed_m_s", "cadence_steps_min", "stance_knee_deg", "pelvis_bounce_cm")
 WEIGHTS = (0.7, 1.0)
@@ -220,12 +216,12 @@ def main(argv=None) -> int:
     corpus = a.corpus or real_corpus_path()
     if not Path(corpus).is_file():
         raise SystemExit(f"no real-capture corpus at {corpus}; build it with python -m generation.mocap dataset ...")
-    observer = default_real_observer(corpus)
+    observer = OBSERVERS.gait("real", corpus)
     base = load_cycle()
     threads = f"OMP_NUM_THREADS={os.environ['OMP_NUM_THREADS']} " if "OMP_NUM_THREADS" in os.environ else ""
     result = {"machine": f"{platform.machine()} {platform.system()}, {os.cpu_count()} CPUs (shared), no GPU",
               "date": datetime.date.today().isoformat(),
-              "command": threads + shlex.join(["python", "benchmarks/bench_rbf_real.py",
+              "command": threads + shlex.join(["python", "-m", "benchmarks.bench_rbf_real",
                                                *(sys.argv[1:] if argv is None else argv)]),
               "neutral": neutral_section(corpus, observer), "accuracy": pair_accuracy(observer, corpus),
               "compare": {t: compare_theme(base, t) for t in THEME_NAMES},

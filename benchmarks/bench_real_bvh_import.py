@@ -8,7 +8,7 @@ from the rest pose. "After" is :func:`generation.formats.bvh.parse_bvh` and the 
 Pelvis bounce: the quality gate's measure (:func:`generation.quality.realism.pelvis_bounce_cm`) of the pelvis
 (``Hips``): median over 1 s windows of its detrended height's peak-to-peak, cm.
 
-Usage: python benchmarks/bench_real_bvh_import.py DIR [--out docs/benchmarks/real_bvh_import.json]
+Usage: python -m benchmarks.bench_real_bvh_import DIR [--out docs/benchmarks/real_bvh_import.json]
 (DIR holds the unpacked ``dataset/Bandai-Namco-Research-Motiondataset-{1,2}`` folders). Prints a markdown table.
 """
 from __future__ import annotations
@@ -22,13 +22,11 @@ import sys
 import time
 from pathlib import Path
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+import numpy as np
 
-import numpy as np  # noqa: E402
-
-from generation.formats.bvh import parse_bvh  # noqa: E402
-from generation.mocap.importer import ImportOptions, import_file  # noqa: E402
-from generation.quality.realism import pelvis_bounce_cm  # noqa: E402
+from generation.formats.bvh import parse_bvh
+from generation.mocap.importer import ImportOptions, import_file
+from generation.quality.realism import pelvis_bounce_cm
 
 
 def measure(path: Path) -> dict:

@@ -1,7 +1,7 @@
 """The real-capture gait observer on held-out real takes, the demo and seed000 plans' gait clips read by it and by the
 synthetic observer, and the realism measures of real walks beside the generated ones.
 
-    python benchmarks/bench_real_observer.py [--corpus var/mocap/bandai-namco.npz] [--plans demo seed000]
+    python -m benchmarks.bench_real_observer [--corpus var/mocap/bandai-namco.npz] [--plans demo seed000]
         [--json docs/benchmarks/real_observer.json] [--md docs/benchmarks/mocap.md]
 
 1. Held-out takes: the observer (generation/quality/real_observer.py) is fitted on the corpus's training split and
@@ -9,7 +9,8 @@ synthetic observer, and the realism measures of real walks beside the generated 
    neutral), confusion matrix per take and per window; the theme pairs on both datasets.
 2. Plans: every gait entry of each plan made as ``generate_clips`` makes it (no video, no figure-height projection)
    and checked by the quality gate (:func:`generation.pipeline.plan_qa.run`) once with the real-capture observer
-   and once with the synthetic one (``QA_GAIT_OBSERVER=synthetic``), grouped by the intended dominant emotion.
+   and once with the synthetic one (``plan_qa.run(gait_observer="synthetic")``), grouped by the intended dominant
+   emotion.
 3. Realism: the measures of :mod:`generation.quality.realism` per real style (all gait takes) beside the plans'
    generated clips (and the plans' real source walks, cut as rendered).
 
@@ -22,7 +23,6 @@ from __future__ import annotations
 import argparse
 import datetime
 import json
-import os
 import re
 import shlex
 import sys
@@ -30,21 +30,16 @@ import time
 from collections import defaultdict
 from pathlib import Path
 
-os.environ.setdefault("OMP_NUM_THREADS", "1")
-ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT))
+import numpy as np
 
-import numpy as np  # noqa: E402
-
-from generation.mocap.real_corpus import load_real_corpus, real_corpus_path  # noqa: E402
-from generation.quality import real_observer as ro  # noqa: E402
-from generation.quality.realism import MEASURES  # noqa: E402
-from generation.quality.realism_ranges import load_ranges, measure_corpus  # noqa: E402
-from study_protocol import CAPTURE_GAIT_EMOTIONS, GAIT_EMOTIONS  # noqa: E402
-
-sys.path.insert(0, str(ROOT / "benchmarks"))
-import doc_tables  # noqa: E402
-from bench_record import commit_label, machine_label  # noqa: E402
+from benchmarks import doc_tables
+from benchmarks.bench_record import commit_label, machine_label, one_thread
+from generation.mocap.real_corpus import load_real_corpus, real_corpus_path
+from generation.quality import real_observer as ro
+from generation.quality.observers import OBSERVERS
+from generation.quality.realism import MEASURES
+from generation.quality.realism_ranges import load_ranges, measure_corpus
+from study_protocol import CAPTURE_GAIT_EMOTIONS, GAIT_EMOTIONS
 
 
 def held_out(obs: ro.RealGaitObserver, test) -> dict:
@@ -144,11 +139,7 @@ def plan_rows(plan: str, kind: str) -> list[dict]:
     from generation.pipeline import plan_qa
     from generation.plans.schema import load_plan
 
-    os.environ["QA_GAIT_OBSERVER"] = kind
-    try:
-        rows = plan_qa.run(plan, modality="gait", figure_height=False, log=lambda *a: None)
-    finally:
-        os.environ.pop("QA_GAIT_OBSERVER", None)
+    rows = plan_qa.run(plan, modality="gait", figure_height=False, log=lambda *a: None, gait_observer=kind)
     entries = {e.id: e for e in load_plan(plan).entries}
     for r in rows:
         e = entries[r["entry"]]
@@ -216,6 +207,7 @@ def _count(items) -> dict:
 
 
 def main(argv=None) -> int:
+    one_thread()
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--corpus", default=None)
     ap.add_argument("--plans", nargs="*", default=["demo", "seed000"])
@@ -225,20 +217,18 @@ def main(argv=None) -> int:
     args = ap.parse_args(argv)
     t0 = time.perf_counter()
     path = Path(args.corpus) if args.corpus else real_corpus_path()
-    obs = ro.default_real_observer(path)
+    obs = OBSERVERS.gait("real", path)
     if obs is None or not path.is_file():
         raise SystemExit(f"{path}: no real-capture corpus; build it with `python -m generation.mocap dataset "
                          "bandai-namco DIR --out PATH`")
     test = load_real_corpus(path, skeleton="gait", split="test")
     real = measure_corpus(load_real_corpus(path, skeleton="gait"))
-    from generation.quality.observer import default_observer
-
-    synth = default_observer()
+    synth = OBSERVERS.gait("synthetic")
     plans_real = {p: plan_rows(p, "real") for p in args.plans}
     plans_synth = {p: plan_rows(p, "synthetic") for p in args.plans}
     ranges = load_ranges()
     res = {"date": datetime.date.today().isoformat(), "commit": commit_label(),
-           "command": shlex.join(["python", "benchmarks/bench_real_observer.py",
+           "command": shlex.join(["python", "-m", "benchmarks.bench_real_observer",
                                   *(sys.argv[1:] if argv is None else argv)]),
            "machine": machine_label(),
            "corpus": path.name, "observer_source": obs.source, "train_takes": dict(obs.train_takes),

@@ -38,3 +38,14 @@ def commit_label() -> str:
 
     dirty = git("status", "--porcelain", "--untracked-files=no")
     return f"commit {git('rev-parse', '--short', 'HEAD')}" + (" + uncommitted changes" if dirty else "")
+
+
+def one_thread() -> None:
+    """Run the numerical libraries of this process on $OMP_NUM_THREADS threads (1 unless set): the BLAS and OpenMP
+    pools and torch's. The benchmarks that time single-threaded work call it first in ``main``."""
+    import torch  # heavy: only the benchmarks that time torch work load it
+    from threadpoolctl import threadpool_limits
+
+    n = int(os.environ.get("OMP_NUM_THREADS") or 1)
+    threadpool_limits(n)
+    torch.set_num_threads(n)

@@ -1,10 +1,10 @@
 """Render + encode speed, and wall time of the built-in plans.
 
-    python benchmarks/bench_render.py speed [--frames 300] [--aa auto none fxaa msaa ssaa2] [--procs 1 2]
+    python -m benchmarks.bench_render speed [--frames 300] [--aa auto none fxaa msaa ssaa2] [--procs 1 2]
                                             [--motion walk gesture] [--patches 1 0]
                                             [--body mannequin stick points] [--width 1280 --height 720]
-    python benchmarks/bench_render.py sheet [--out docs/img/render_contact_sheet.png]
-    python benchmarks/bench_render.py plans [--plans seed000 seed003 seed004] [--sample 6 10 12] [--workers 2]
+    python -m benchmarks.bench_render sheet [--out docs/img/render_contact_sheet.png]
+    python -m benchmarks.bench_render plans [--plans seed000 seed003 seed004] [--sample 6 10 12] [--workers 2]
 
 ``speed`` renders a 10 s procedural walk (21 joints, a loop of 3 m radius) and/or a seated procedural gesture
 (23 joints, on a chair) at 1280x720 (``--width/--height``) with each ``--body`` to H.264 and reports
@@ -36,7 +36,6 @@ import time
 from pathlib import Path
 
 os.environ.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow")
-sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
 
 def _cpu() -> float:

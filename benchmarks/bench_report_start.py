@@ -5,20 +5,16 @@ A scratch SQLite database in a temporary DATA_DIR (synthetic catalogue, the demo
 synthetic participants); each round starts a build of a new data version (one more answer each time), records the
 wall time of ``start_build`` and waits for the build to end before the next round.
 
-    python benchmarks/bench_report_start.py [--rounds 5] [--json FILE]
+    python -m benchmarks.bench_report_start [--rounds 5] [--json FILE]
 """
 from __future__ import annotations
 
 import argparse
 import os
 import statistics
-import sys
 import tempfile
 import time
 from pathlib import Path
-
-ROOT = Path(__file__).resolve().parent.parent
-sys.path[:0] = [str(ROOT), str(ROOT / "benchmarks")]
 
 
 def main(argv=None) -> dict:
@@ -29,8 +25,8 @@ def main(argv=None) -> dict:
     data = Path(tempfile.mkdtemp(prefix="report-start-bench-"))
     os.environ.update(DATA_DIR=str(data), REPORTS_DIR=str(data / "reports"))
     os.environ.pop("DATABASE_URL", None)
-    import bench_study_load as load
-    from bench_record import record
+    from benchmarks import bench_study_load as load
+    from benchmarks.bench_record import record
 
     study = load.setup_django(f"sqlite:///{data / 'db.sqlite3'}", data / "media")
     from studyapp import reports

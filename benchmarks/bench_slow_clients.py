@@ -11,7 +11,7 @@ Prints per phase: probes, p50 / p99 / max latency in ms and the number that fail
 --probe-timeout (25 s, the probe of the security review). The target for a public study: p99 < 200 ms under
 attack. Example:
 
-    .venv/bin/python benchmarks/bench_slow_clients.py --server gthread --server asgi --seconds 30
+    .venv/bin/python -m benchmarks.bench_slow_clients --server gthread --server asgi --seconds 30
 """
 from __future__ import annotations
 

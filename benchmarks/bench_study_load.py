@@ -1,6 +1,6 @@
 """Load test: simulated participants take the demo study over HTTP against gunicorn + PostgreSQL.
 
-    python benchmarks/bench_study_load.py --participants 200 --arrival 30 --workers 2 --threads 8 \
+    python -m benchmarks.bench_study_load --participants 200 --arrival 30 --workers 2 --threads 8 \
         [--driver locust|threads] [--viewers 4] [--db-url postgres://postgres@127.0.0.1:5432/postgres]
 
 Loopback only, bounded in participant count (<= 400) and time (--time-limit). It creates its own uniquely named
@@ -29,8 +29,8 @@ ratio of the study's requests/s to it, lost / duplicated answers found in the da
 responses.csv (all must be 0), and the CPU seconds of the study phase by gunicorn, PostgreSQL (the whole local
 server), the generator and the machine (Linux /proc), also per answered clip.
 
-    python benchmarks/bench_study_load.py --server asgi --participants 0 --burst 3 --burst-size 40 --in-process 0
-    python benchmarks/bench_study_load.py --driver threads --server asgi --participants 55 --kill 1 \
+    python -m benchmarks.bench_study_load --server asgi --participants 0 --burst 3 --burst-size 40 --in-process 0
+    python -m benchmarks.bench_study_load --driver threads --server asgi --participants 55 --kill 1 \
         [--database sqlite] [--db-connections 20]
 
 --server asgi serves with demo.sh's asyncio workers instead of gthread; --database sqlite uses a scratch SQLite file.
@@ -40,7 +40,7 @@ sends W waves of --burst-size page loads released together (consent page, consen
 reports each wave's successes, 5xx and p50/p99. --kill K (threads driver) kills a worker with -9 K times during the
 study; clients resend a request the kill cut off, and lost / duplicated answers and 5xx must still be 0.
 
-    python benchmarks/bench_study_load.py --in-process-only --in-process 10 [--profile FILE]
+    python -m benchmarks.bench_study_load --in-process-only --in-process 10 [--profile FILE]
 
 measures only the server time, CPU time and queries of each request kind in-process (Django test client, same
 scratch database set-up, no gunicorn or Locust), optionally with a cProfile of the measured participants.
@@ -64,7 +64,6 @@ from pathlib import Path
 from urllib.parse import urlencode, urljoin, urlsplit, urlunsplit
 
 ROOT = Path(__file__).resolve().parent.parent
-sys.path.insert(0, str(ROOT))
 LOCUSTFILE = Path(__file__).resolve().parent / "locustfile.py"
 
 FORM_RE = re.compile(r"<form\b([^>]*)>(.*?)</form>", re.S | re.I)
@@ -337,8 +336,7 @@ def start_gunicorn(args, env: dict, log: Path) -> subprocess.Popen:
 def start_local_nginx(args, out: Path) -> tuple[str, subprocess.Popen]:
     """deploy/nginx/study.conf templated to this run (TLS with a self-signed certificate, /protected-media/ ->
     out/media) in front of gunicorn; returns its https base URL and process."""
-    sys.path.insert(0, str(ROOT / "deploy" / "nginx"))
-    from local_site import free_port, start_nginx, write_local_site
+    from deploy.nginx.local_site import free_port, start_nginx, write_local_site
 
     (out / "static").mkdir(exist_ok=True)
     https_port = free_port()

@@ -15,7 +15,7 @@ cubic splines (``Motion.resample(fps, smooth=True)``), on real captured walks an
 4. A figure: the right hand's speed over 3 s of a generated angry walk, both ways, above the same for the real
    angry take subsampled and upsampled (docs/img/upsampling_hand_speed.png).
 
-Usage: OMP_NUM_THREADS=1 python benchmarks/bench_upsampling.py [--out JSON] [--figure PNG]
+Usage: OMP_NUM_THREADS=1 python -m benchmarks.bench_upsampling [--out JSON] [--figure PNG]
 Results: docs/benchmarks/upsampling.json, rendered into the marked ``upsampling.*`` tables of
 docs/benchmarks/gait.md (benchmarks/doc_tables.py); also the time of one upsampling call per method.
 """
@@ -32,21 +32,18 @@ from pathlib import Path
 import numpy as np
 import torch
 
+from benchmarks import doc_tables
+from benchmarks.bench_record import commit_label, machine_label
+from generation.core import paths
+from generation.core.foot_contact import plant_feet
+from generation.core.motion import Motion
+from generation.gait.generate import generate_gaits, load_default_model
+from generation.gait.real_seeds import STYLE_OF_EMOTION, shipped_walk
+from generation.quality.metrics import mean_jerk
+from generation.quality.realism import realism_measures
+from study_protocol import GAIT_EMOTIONS
+
 ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT))
-sys.path.insert(0, str(ROOT / "benchmarks"))
-
-import doc_tables  # noqa: E402
-from bench_record import commit_label, machine_label  # noqa: E402
-
-from generation.core import paths  # noqa: E402
-from generation.core.foot_contact import plant_feet  # noqa: E402
-from generation.core.motion import Motion  # noqa: E402
-from generation.gait.generate import generate_gaits, load_default_model  # noqa: E402
-from generation.gait.real_seeds import STYLE_OF_EMOTION, shipped_walk  # noqa: E402
-from generation.quality.metrics import mean_jerk  # noqa: E402
-from generation.quality.realism import realism_measures  # noqa: E402
-from study_protocol import GAIT_EMOTIONS  # noqa: E402
 
 METHODS = {"slerp": False, "spline": True}
 """Upsampling method -> the ``smooth`` argument of Motion.resample."""
@@ -196,7 +193,7 @@ def main(argv=None) -> int:
     torch.set_num_threads(1)
     t0 = time.time()
     res = {"date": datetime.date.today().isoformat(), "commit": commit_label(),
-           "command": shlex.join(["python", "benchmarks/bench_upsampling.py", *argv]),
+           "command": shlex.join(["python", "-m", "benchmarks.bench_upsampling", *argv]),
            "machine": machine_label("1 torch thread"),
            "real_round_trip": real_round_trip(), "generated": generated(a.steps), "gestures": gestures(),
            "call_ms": call_ms()}

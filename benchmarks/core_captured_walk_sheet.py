@@ -3,7 +3,7 @@
 Writes docs/img/core_features_captured_walks.png: for each clip, side views (z forward, y up) at 6 frames with
 the left side in blue and the right in red, plus a top view of the root path and the foot contacts.
 
-Usage: python benchmarks/core_captured_walk_sheet.py [out.png]
+Usage: python -m benchmarks.core_captured_walk_sheet [out.png]
 """
 from __future__ import annotations
 
@@ -11,16 +11,14 @@ import sys
 from pathlib import Path
 
 import matplotlib
+import matplotlib.pyplot as plt
+import numpy as np
+
+from generation.core.features import detect_foot_contacts
+from generation.mocap.captured import captured_walks
 
 matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
-
 ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT))
-
-from generation.core.features import detect_foot_contacts  # noqa: E402
-from generation.mocap.captured import captured_walks  # noqa: E402
 
 
 def main(out: Path) -> None:

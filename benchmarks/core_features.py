@@ -2,11 +2,10 @@
 
 Prints a Markdown table. Single thread (OMP_NUM_THREADS=1, torch.set_num_threads(1)).
 
-Usage: OMP_NUM_THREADS=1 python benchmarks/core_features.py
+Usage: OMP_NUM_THREADS=1 python -m benchmarks.core_features
 """
 from __future__ import annotations
 
-import sys
 import tempfile
 import time
 from pathlib import Path
@@ -14,10 +13,7 @@ from pathlib import Path
 import numpy as np
 import torch
 
-ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT))
-
-from generation.core.features import (  # noqa: E402
+from generation.core.features import (
     detect_foot_contacts,
     foot_skate,
     gait_affective_features,
@@ -25,13 +21,13 @@ from generation.core.features import (  # noqa: E402
     movement_features,
     np_gait_affective_features,
 )
-from generation.core.ik import fit_positions_to_skeleton, inverse_kinematics  # noqa: E402
-from generation.core.kinematics import np_forward_kinematics  # noqa: E402
-from generation.core.motion import Motion  # noqa: E402
-from generation.core.quaternion import np_qfrom_axis_angle, np_qnormalize  # noqa: E402
-from generation.core.skeleton import gait_skeleton, gesture_skeleton  # noqa: E402
-from generation.formats.bvh import read_bvh, write_bvh  # noqa: E402
-from generation.mocap.captured import captured_walks, chain_clip_repeats  # noqa: E402
+from generation.core.ik import fit_positions_to_skeleton, inverse_kinematics
+from generation.core.kinematics import np_forward_kinematics
+from generation.core.motion import Motion
+from generation.core.quaternion import np_qfrom_axis_angle, np_qnormalize
+from generation.core.skeleton import gait_skeleton, gesture_skeleton
+from generation.formats.bvh import read_bvh, write_bvh
+from generation.mocap.captured import captured_walks, chain_clip_repeats
 
 torch.set_num_threads(1)
 

@@ -10,35 +10,33 @@ Measures
    dominance, Pearson r).
 
 Writes a markdown section to ``docs/benchmarks/corpus.md`` (use --md to change) and prints it.
-Usage: OMP_NUM_THREADS=1 python benchmarks/corpus_build.py [--num 1000] [--seed 0]
+Usage: OMP_NUM_THREADS=1 python -m benchmarks.corpus_build [--num 1000] [--seed 0]
 """
 from __future__ import annotations
 
 import argparse
 import os
-import sys
 import tempfile
 import time
 from pathlib import Path
 
 os.environ.setdefault("OMP_NUM_THREADS", "1")
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-import numpy as np  # noqa: E402
-import torch  # noqa: E402
-from scipy.stats import pearsonr  # noqa: E402
+import numpy as np
+import torch
+from scipy.stats import pearsonr
 
 from generation.core import paths
-from generation.core.features import (  # noqa: E402
+from generation.core.features import (
     GAIT_FEATURE_NAMES,
     foot_skate,
     np_gait_affective_features,
     np_gesture_affective_features,
 )
-from generation.core.kinematics import np_forward_kinematics  # noqa: E402
-from generation.procedural.corpus import build_gait_corpus, build_gesture_corpus, default_gesture_specs  # noqa: E402
-from generation.procedural.emotion import GAIT_EMOTIONS, gait_params_for_emotion  # noqa: E402
-from generation.procedural.walk import planted_foot_slide, walk_with_contacts  # noqa: E402
+from generation.core.kinematics import np_forward_kinematics
+from generation.procedural.corpus import build_gait_corpus, build_gesture_corpus, default_gesture_specs
+from generation.procedural.emotion import GAIT_EMOTIONS, gait_params_for_emotion
+from generation.procedural.walk import planted_foot_slide, walk_with_contacts
 
 torch.set_num_threads(1)
 MACHINE = "2-core CI VM, no GPU"
@@ -176,8 +174,8 @@ def main(argv=None):
     out.append(f"| mean speed of the leading wrist (m/s) | arousal | {r_a:.2f} | {p_a:.1e} |")
     out.append(f"| wrist spread d(10,14)/d(0,6) | dominance | {r_d:.2f} | {p_d:.1e} |")
     out.append(f"| trunk-head straightness ang(0,2,6)/pi | dominance | {r_s:.2f} | {p_s:.1e} |")
-    out.append("\nReproduce: `OMP_NUM_THREADS=1 python benchmarks/corpus_build.py --num 1000 --seed 0`; "
-               "contact sheets: `python benchmarks/corpus_contact_sheet.py`.")
+    out.append("\nReproduce: `OMP_NUM_THREADS=1 python -m benchmarks.corpus_build --num 1000 --seed 0`; "
+               "contact sheets: `python -m benchmarks.corpus_contact_sheet`.")
     text = "\n".join(out) + "\n"
     print(text)
     if args.md:

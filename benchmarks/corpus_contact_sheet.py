@@ -4,30 +4,28 @@ Writes ``docs/img/corpus_gait_emotions.png`` (side and front views, a few frames
 ``docs/img/corpus_gait_paths.png`` (top view of walks on straight, curved and sharp-turn paths with
 their footprints) and ``docs/img/corpus_gesture_emotions.png`` (seated gestures per emotion).
 
-Usage: python benchmarks/corpus_contact_sheet.py [--out docs/img]
+Usage: python -m benchmarks.corpus_contact_sheet [--out docs/img]
 """
 from __future__ import annotations
 
 import argparse
 import os
-import sys
 from pathlib import Path
 
 os.environ.setdefault("OMP_NUM_THREADS", "1")
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-import matplotlib  # noqa: E402
+import matplotlib
 
 matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
-import torch  # noqa: E402
+import matplotlib.pyplot as plt
+import numpy as np
+import torch
 
 from generation.core import paths
-from generation.procedural.emotion import GAIT_EMOTIONS, gait_params_for_emotion, gesture_params_for_vad  # noqa: E402
-from generation.procedural.gesture import seated_gesture  # noqa: E402
-from generation.procedural.walk import walk, walk_with_contacts  # noqa: E402
-from study_protocol import GESTURE_VAD  # noqa: E402
+from generation.procedural.emotion import GAIT_EMOTIONS, gait_params_for_emotion, gesture_params_for_vad
+from generation.procedural.gesture import seated_gesture
+from generation.procedural.walk import walk, walk_with_contacts
+from study_protocol import GESTURE_VAD
 
 torch.set_num_threads(1)
 

@@ -11,11 +11,11 @@ Benchmarks write their figures as JSON (``docs/benchmarks/<area>.json``); the na
 and this script replaces each marked block with the table rendered from the JSON (blocks whose data the JSON lacks
 are left as they are)::
 
-    python benchmarks/doc_tables.py gait            # docs/benchmarks/gait.json -> the marked tables of gait.md
-    python benchmarks/doc_tables.py gesture         # docs/benchmarks/gesture.json -> gesture.md
-    python benchmarks/doc_tables.py rbf_real        # docs/benchmarks/rbf_real.json -> rbf.md
-    python benchmarks/doc_tables.py gait_real       # docs/benchmarks/gait_real.json -> gait.md
-    python benchmarks/doc_tables.py gait --print    # print every table of the JSON instead
+    python -m benchmarks.doc_tables gait            # docs/benchmarks/gait.json -> the marked tables of gait.md
+    python -m benchmarks.doc_tables gesture         # docs/benchmarks/gesture.json -> gesture.md
+    python -m benchmarks.doc_tables rbf_real        # docs/benchmarks/rbf_real.json -> rbf.md
+    python -m benchmarks.doc_tables gait_real       # docs/benchmarks/gait_real.json -> gait.md
+    python -m benchmarks.doc_tables gait --print    # print every table of the JSON instead
 
 The renderers live in ``doc_renderers/``, one module per area (gait, gesture, rbf_features, rbf_real,
 real_observer, gait_real, upsampling), each with its own ``TABLES``, and ``doc_renderers/common.py`` for the
@@ -29,9 +29,9 @@ import re
 import sys
 from pathlib import Path
 
-from doc_renderers import gait, gait_real, gesture, rbf_features, rbf_real, real_observer, upsampling
-from doc_renderers.common import EMOTIONS, Renderer, table
-from doc_renderers.gait_real import GAIT_REAL_SUBSETS
+from benchmarks.doc_renderers import gait, gait_real, gesture, rbf_features, rbf_real, real_observer, upsampling
+from benchmarks.doc_renderers.common import EMOTIONS, Renderer, table
+from benchmarks.doc_renderers.gait_real import GAIT_REAL_SUBSETS
 
 __all__ = ["BLOCK_RE", "DOCS", "EMOTIONS", "FILES", "GAIT_REAL_SUBSETS", "TABLES", "area_files", "fill_doc", "main",
            "render_tables", "table", "update_doc", "write_results"]

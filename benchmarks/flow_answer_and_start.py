@@ -1,6 +1,6 @@
 """Benchmark of the participant flow: SQL statements per answered clip, and concurrent starts.
 
-    DATA_DIR=$(mktemp -d) .venv/bin/python benchmarks/flow_answer_and_start.py [--starts 200] [--threads 16]
+    DATA_DIR=$(mktemp -d) .venv/bin/python -m benchmarks.flow_answer_and_start [--starts 200] [--threads 16]
         [--out docs/benchmarks/flow.md]
 
 Runs on a fresh SQLite file database under DATA_DIR (WAL, the app's default), with the SYNTHETIC test catalogue
@@ -23,15 +23,12 @@ from __future__ import annotations
 import argparse
 import os
 import statistics
-import sys
 import tempfile
 import threading
 import time
 from collections import Counter
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
-
-ROOT = Path(__file__).resolve().parents[1]
 
 
 def setup_django(data_dir: str, db_url: str = "") -> None:
@@ -42,7 +39,6 @@ def setup_django(data_dir: str, db_url: str = "") -> None:
     else:
         os.environ.pop("DATABASE_URL", None)
     os.environ.setdefault("DJANGO_SETTINGS_MODULE", "studyapp.settings")
-    sys.path.insert(0, os.getcwd())
     import django
     from django.core.management import call_command
     from django.test.utils import setup_test_environment

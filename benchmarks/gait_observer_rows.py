@@ -3,7 +3,7 @@
 synthetic observer (generation/quality/observer.py) reads it; optionally also procedural seeds of the unseen
 mixtures. Uses bench_gait's own functions, so the figures are the benchmark's.
 
-    python benchmarks/gait_observer_rows.py WEIGHTS.pt [WEIGHTS2.pt ...] [--split val|test|both]
+    python -m benchmarks.gait_observer_rows WEIGHTS.pt [WEIGHTS2.pt ...] [--split val|test|both]
         [--guidance 0,1,2] [--seed-frames 0,80,160] [--no-procedural] [--steps 200]
 
 Choose on --split val; report test only for the chosen candidate. With 19-29 walks per class one walk moves a
@@ -14,25 +14,22 @@ from __future__ import annotations
 
 import argparse
 import itertools
-import os
-import sys
 import time
 from pathlib import Path
 
-os.environ.setdefault("OMP_NUM_THREADS", "1")
+import numpy as np
+import torch
+
+from benchmarks import bench_gait as bench
+from benchmarks.bench_record import one_thread
+from generation.core.paths import straight
+from generation.gait.data import DEFAULT_CORPUS, load_corpus_sequences
+from generation.gait.generate import load_model
+from generation.procedural.corpus import GaitCorpus
+from generation.quality.gait_guidance import heldout_corpus, seed_walks, single_dominant
+from study_protocol import GAIT_EMOTIONS
+
 ROOT = Path(__file__).resolve().parents[1]
-sys.path[:0] = [str(ROOT), str(ROOT / "benchmarks")]
-
-import bench_gait as bench  # noqa: E402
-import numpy as np  # noqa: E402
-import torch  # noqa: E402
-
-from generation.core.paths import straight  # noqa: E402
-from generation.gait.data import DEFAULT_CORPUS, load_corpus_sequences  # noqa: E402
-from generation.gait.generate import load_model  # noqa: E402
-from generation.procedural.corpus import GaitCorpus  # noqa: E402
-from generation.quality.gait_guidance import heldout_corpus, seed_walks, single_dominant  # noqa: E402
-from study_protocol import GAIT_EMOTIONS  # noqa: E402
 
 
 def row(table: dict) -> str:
@@ -48,6 +45,7 @@ def p_own_row(proba: np.ndarray, intended: np.ndarray) -> str:
 
 
 def main(argv=None) -> int:
+    one_thread()
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("weights", nargs="+")
     ap.add_argument("--split", choices=("val", "test", "both", "extra-a", "extra-b"), default="val",

@@ -13,9 +13,9 @@ User classes (chosen on the locust command line):
     MediaViewer       a slow player: 64 KiB Range requests of one clip ($STUDY_BENCH_MEDIA), 4 per second
     HealthUser        GET /healthz as fast as possible: the requests/s ceiling of the stack
 
-Run by hand against a running server (the benchmark script sets the variables):
+Run by hand from the repository root against a running server (the benchmark script sets the variables):
     STUDY_BENCH_SLUG=bench STUDY_BENCH_RESULTS=/tmp/p.jsonl STUDY_BENCH_TICKETS=/tmp/t STUDY_BENCH_PARTICIPANTS=50 \
-        .venv/bin/locust -f benchmarks/locustfile.py \
+        .venv/bin/python -m locust -f benchmarks/locustfile.py \
         --headless --host http://127.0.0.1:8000 -u 50 -r 5 -t 120s StudyParticipant
 """
 from __future__ import annotations
@@ -24,16 +24,13 @@ import fcntl
 import itertools
 import json
 import os
-import sys
 import time
-from pathlib import Path
 from urllib.parse import urlencode
 
 from locust import FastHttpUser, constant, task
 from locust.exception import StopUser
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
-from bench_study_load import MEDIA_CHUNK, take_study  # noqa: E402
+from benchmarks.bench_study_load import MEDIA_CHUNK, take_study
 
 _numbers = itertools.count()
 

@@ -1,7 +1,7 @@
 """Contact sheet: a motion re-exported under other rigs' conventions, imported back, beside the original.
 
 The original is a captured walk on our gait skeleton (DeepMimic's CMU/SFU-derived ``0walk_forward``, two cycles).
-It is written as a Mixamo BVH and as a CMU BVH (:func:`generation.mocap.conventions.export_as`: their joint
+It is written as a Mixamo BVH and as a CMU BVH (:func:`tests.mocap_conventions.export_as`: their joint
 names and extra joints, a T-pose rest pose, centimetres, their rotation orders), each file is imported back with
 ``generation.mocap.import_file`` (rig auto-mapping, units and up axis guessed), and the three motions are
 rendered with the study's mannequin at the same frames. Each caption gives the largest joint-position difference
@@ -9,29 +9,27 @@ to the original in that frame.
 
 Writes docs/img/mocap_import_sheet.png (one row per motion, one column per frame) and prints the errors.
 
-Usage: python benchmarks/mocap_import_sheet.py [--out docs/img/mocap_import_sheet.png]
+Usage: python -m benchmarks.mocap_import_sheet [--out docs/img/mocap_import_sheet.png]
 """
 from __future__ import annotations
 
 import argparse
 import os
-import sys
 import tempfile
 from pathlib import Path
 
-os.environ.setdefault("OMP_NUM_THREADS", "1")
+import numpy as np
+
+from benchmarks.bench_record import one_thread
+from generation.mocap import ImportOptions, import_file
+from generation.mocap.captured import WALK_FILES, captured_walks, chain_clip_repeats
+from generation.render.clip import render_frames_at
+from generation.render.contact_sheet import contact_sheet
+from generation.render.settings import RenderSettings
+from tests.mocap_conventions import export_as
+
 os.environ.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow")
 ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT))
-
-import numpy as np  # noqa: E402
-
-from generation.mocap import ImportOptions, import_file  # noqa: E402
-from generation.mocap.captured import WALK_FILES, captured_walks, chain_clip_repeats  # noqa: E402
-from generation.mocap.conventions import export_as  # noqa: E402
-from generation.render.clip import render_frames_at  # noqa: E402
-from generation.render.contact_sheet import contact_sheet  # noqa: E402
-from generation.render.settings import RenderSettings  # noqa: E402
 
 CONVENTIONS = (("mixamo", "Mixamo"), ("cmu", "CMU"))
 FRAMES = (0, 12, 24, 36, 48, 60)
@@ -59,6 +57,7 @@ def imported_motions(motion, folder: Path) -> list[tuple[str, object]]:
 
 
 def main() -> None:
+    one_thread()
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--out", type=Path, default=ROOT / "docs" / "img" / "mocap_import_sheet.png")
     a = ap.parse_args()

@@ -11,7 +11,7 @@ are written as CMU BVH files, then the documented commands run and are timed (wa
 The default (20 takes of 2,400 frames, windows every 24 frames) gives 1,820 windows of 240 frames, about the
 1,835 gaits seed 000 trained on (section 5.1). Figures: docs/benchmarks/mocap.md.
 
-Usage: python benchmarks/mocap_training_time.py [--takes 20] [--frames 2400] [--stride 24] [--epochs 2] [--dir DIR]
+Usage: python -m benchmarks.mocap_training_time [--takes 20] [--frames 2400] [--stride 24] [--epochs 2] [--dir DIR]
 """
 from __future__ import annotations
 
@@ -25,16 +25,15 @@ import time
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT))
 
 
 def write_takes(folder: Path, n_takes: int, n_frames: int) -> None:
     import numpy as np
 
-    from generation.mocap.conventions import export_as
     from generation.procedural.emotion import gait_params_for_emotion
     from generation.procedural.walk import walk
     from study_protocol import GAIT_EMOTIONS
+    from tests.mocap_conventions import export_as
 
     folder.mkdir(parents=True, exist_ok=True)
     rng = np.random.default_rng(0)

@@ -6,25 +6,23 @@ onto our gait skeleton (``generation.mocap.import_file``). Generated: the ``gait
 plans (falling back to the SYNTHETIC procedural walk when no weights are shipped), a straight 10 m walk per emotion,
 same render settings. One row per motion, frames every ``--step`` seconds from 0.5 s.
 
-Usage: python benchmarks/real_vs_generated_sheet.py [--takes DIR] [--out docs/img/real_vs_generated_gait.png]
+Usage: python -m benchmarks.real_vs_generated_sheet [--takes DIR] [--out docs/img/real_vs_generated_gait.png]
 DIR holds ``dataset-1_walk_<style>_<take>.bvh`` files (default: the shipped real subset).
 """
 from __future__ import annotations
 
 import argparse
-import sys
 import tempfile
 from pathlib import Path
 
-ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT))
+from generation.mocap.importer import ImportOptions, import_file
+from generation.plans.clipgen import make_motion, resolve
+from generation.plans.schema import validate_plan
+from generation.render.clip import render_frames_at
+from generation.render.contact_sheet import contact_sheet
+from generation.render.settings import RenderSettings
 
-from generation.mocap.importer import ImportOptions, import_file  # noqa: E402
-from generation.plans.clipgen import make_motion, resolve  # noqa: E402
-from generation.plans.schema import validate_plan  # noqa: E402
-from generation.render.clip import render_frames_at  # noqa: E402
-from generation.render.contact_sheet import contact_sheet  # noqa: E402
-from generation.render.settings import RenderSettings  # noqa: E402
+ROOT = Path(__file__).resolve().parents[1]
 
 EMOTIONS = (("happy", "happy", [1, 0, 0, 0]), ("sad", "sad", [0, 1, 0, 0]), ("angry", "angry", [0, 0, 1, 0]),
             ("neutral", "normal", [0, 0, 0, 1]))

@@ -1,1 +1,1 @@
-"""Maintenance scripts run from the repository root (python scripts/NAME.py); importable for tests."""
+"""Maintenance scripts run from the repository root (python -m scripts.NAME); importable for tests."""

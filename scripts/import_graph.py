@@ -4,8 +4,8 @@ Packages are the subpackages of ``generation`` (``generation.core``, ``generatio
 ``studyapp`` and the top-level protocol modules. Imports inside functions count as edges too (marked ``local``):
 they hide cycles as well as top-level ones do. Exits 1 when the package graph has a cycle, naming it.
 
-    python scripts/import_graph.py            # edges, then cycles if any
-    python scripts/import_graph.py --local    # also list each function-local import with its file and line
+    python -m scripts.import_graph            # edges, then cycles if any
+    python -m scripts.import_graph --local    # also list each function-local import with its file and line
 
 Importable (``from scripts.import_graph import package_edges, find_cycles``): tests/test_layers.py checks the layer
 rules on the same edges.

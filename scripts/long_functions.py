@@ -1,6 +1,6 @@
 """List functions longer than a limit (default 80 lines) in the three libraries.
 
-    python scripts/long_functions.py [--limit N] [FOLDER ...]
+    python -m scripts.long_functions [--limit N] [FOLDER ...]
 """
 from __future__ import annotations
 

@@ -32,9 +32,6 @@ COMPACT = {models.JSONField: {"widget": Textarea(attrs={"rows": 2, "cols": 90})}
            models.TextField: {"widget": Textarea(attrs={"rows": 3, "cols": 90})}}
 
 
-SECTION_HAS_COUNTERBALANCE = "counterbalance" in {f.name for f in Section._meta.get_fields()}
-"""Section.counterbalance (added by a later migration) is shown in the inline once the field exists."""
-
 RAW_JSON_HELP = ("The pool and options as JSON (study_pools). The fields above win as soon as one of them is "
                  "edited, and this JSON then only adds the keys they cannot show (e.g. <code>plan__startswith</code>, "
                  "<code>happy__gt</code>); it wins when the fields above are left as they were.")
@@ -44,8 +41,7 @@ def section_fieldsets() -> list:
     """The section form: main settings, the clip pool's fields with the live count, the naturalness halves, the
     options of each section type (the page shows those of the chosen type) and the raw JSON (collapsed)."""
     main = [("order", "section_type", "title"), "instructions", ("clips_per_participant", "reuse_section"),
-            ("randomize_order", "require_full_play", "loop", *(("counterbalance",) if SECTION_HAS_COUNTERBALANCE
-                                                              else ()))]
+            ("randomize_order", "require_full_play", "loop", "counterbalance")]
     pool = ["matching_clips", ("pool_modality", "pool_origin"), "pool_plan", "pool_emotion_label", "pool_theme",
             ("pool_weight_sign", "pool_weight_min", "pool_weight_max"), ("pool_n_features_min", "pool_n_features_max"),
             ("pool_transition", "pool_rbf"), "pool_include_flagged"]

@@ -114,6 +114,8 @@ if MEDIA_ACCEL_REDIRECT and not (MEDIA_ACCEL_REDIRECT.startswith("/") and MEDIA_
 
     raise ImproperlyConfigured(f"MEDIA_ACCEL_REDIRECT must start and end with '/', got {MEDIA_ACCEL_REDIRECT!r}")
 REPORTS_DIR = Path(os.environ.get("REPORTS_DIR", DATA_DIR / "reports"))
+# The gait observer of the quality gate for plans that name none in their qa: block (study_protocol.QA_OBSERVERS).
+QA_GAIT_OBSERVER = os.environ.get("QA_GAIT_OBSERVER", "").strip() or "real"
 STATIC_URL = "/static/"
 # collectstatic's target; outside production WhiteNoise serves from the app folders and needs none.
 STATIC_ROOT = Path(os.environ["STATIC_ROOT"]) if os.environ.get("STATIC_ROOT") else (

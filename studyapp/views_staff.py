@@ -18,12 +18,15 @@ from django.shortcuts import redirect, render
 from django.urls import reverse
 from django.views.decorators.http import require_http_methods
 
+from generation.render import contact_sheet
 from study_protocol import ATTENTION_CHECK
 
 from .assignment import plan_study
+from .catalogue import clip_label
 from .export import EXPORT_KINDS, stream_csv
 from .forms import ConsentForm, PresetStudyForm
 from .i18n import activate_study_language
+from .media import media_path
 from .models import Assignment, Participant, Response, Study
 from .permissions import EXPORT_PERMISSION, staff_permission_required, study_of
 from .presets import create_study_from_preset
@@ -174,10 +177,7 @@ def contact_sheet_response(request, clips):
 
     To get a plan's sheet in the admin: filter the clip list by plan, select all, run the action.
     """
-    from generation.render import contact_sheet
 
-    from .catalogue import clip_label
-    from .media import media_path
 
     clips = [c for c in clips.order_by("plan", "clip_id") if c.poster]
     if not clips:

@@ -11,6 +11,7 @@ from generation.gait.data import prepare_sequences
 from generation.gait.generate import LoadedGaitNet
 from generation.gait.model import GaitNet
 from generation.gait.train import fit_normalizer
+from generation.gait.weights import TrainingData
 from generation.procedural.walk import WalkParams, walk
 
 torch.set_num_threads(1)
@@ -31,7 +32,7 @@ def tiny_data():
         emo.append(np.eye(4)[i % 4])
     split = np.array(["train", "train", "val", "val", "test", "test"])
     return prepare_sequences(np.stack(rots), np.stack(roots), np.stack(emo), split, np.full(6, 1.75),
-                             np.array(["male"] * 6))
+                             np.array(["male"] * 6), training_data=TrainingData.procedural())
 
 
 @pytest.fixture(scope="module")

@@ -2,18 +2,12 @@
 transitions by their first and last seconds, ties scored by their components."""
 from __future__ import annotations
 
-import sys
-from pathlib import Path
-
 import numpy as np
 import pytest
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "benchmarks"))
-
-import bench_gait_real as bench  # noqa: E402
-
-from generation.core.motion import Motion  # noqa: E402
-from generation.core.skeleton import gait_skeleton  # noqa: E402
+from benchmarks import bench_gait_real as bench
+from generation.core.motion import Motion
+from generation.core.skeleton import gait_skeleton
 
 
 def _walk(labels: list[int], fps: float = 10.0) -> Motion:

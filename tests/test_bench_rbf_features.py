@@ -1,12 +1,7 @@
 """benchmarks/bench_rbf_features.py: the summary figures it writes to its JSON for the doc's summary table."""
 from __future__ import annotations
 
-import sys
-from pathlib import Path
-
-sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "benchmarks"))
-
-import bench_rbf_features  # noqa: E402
+from benchmarks import bench_rbf_features
 
 
 def _row(theme, weight, checks, measures, before, after, foot, foot_direction_only):

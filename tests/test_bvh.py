@@ -9,7 +9,8 @@ from generation.core.motion import Motion, MotionFormatError
 from generation.core.quaternion import np_qangle, np_qfrom_axis_angle, np_qnormalize
 from generation.core.skeleton import Skeleton, gait_skeleton, gesture_skeleton
 from generation.formats.bvh import read_bvh, write_bvh
-from generation.mocap.retarget import default_joint_map, retarget
+from generation.mocap.retarget import leg_scale, retarget
+from generation.mocap.rigs import auto_joint_map
 
 torch.set_num_threads(1)
 
@@ -162,7 +163,11 @@ def test_retarget_scales_to_target_and_fills_unmapped(tmp_path):
     m = random_motion(src, seed=5)
     mapping = {n: n for n in src.joints if n != "lower_back"}
     out = retarget(m, tgt, mapping)
-    scale = tgt.root_height() / src.root_height()
+    def legs(sk):                                                       # thigh + shin
+        return sk.bone_lengths()[sk.index("left_knee")] + sk.bone_lengths()[sk.index("left_heel")]
+
+    scale = legs(tgt) / legs(src)                                       # our leg length / the source's
+    assert leg_scale(m.positions(), src.joints, tgt, mapping) == pytest.approx(scale)
     assert out.metadata["retarget"]["scale"] == pytest.approx(scale)
     # the root moves so that the hips' midpoint lands on the scaled source's (rigs hang the hips at different
     # depths below the root; keeping the root would leave the legs short of the feet)
@@ -193,18 +198,18 @@ def test_retarget_scales_to_target_and_fills_unmapped(tmp_path):
         retarget(m, tgt, {"root": "root", "left_knee": "LeftLeg"})
 
 
-def test_default_joint_map_for_mixamo_names():
+def test_the_default_joint_map_for_mixamo_names_is_the_rig_map():
     names = ("Hips", "LeftUpLeg", "LeftLeg", "LeftFoot", "LeftToeBase", "RightUpLeg", "RightLeg", "RightFoot",
              "RightToeBase", "Spine", "Spine1", "Spine2", "Neck", "Head", "LeftShoulder", "LeftArm",
              "LeftForeArm", "LeftHand", "RightShoulder", "RightArm", "RightForeArm", "RightHand")
     parents = (-1, 0, 1, 2, 3, 0, 5, 6, 7, 0, 9, 10, 11, 12, 11, 14, 15, 16, 11, 18, 19, 20)
     src = Skeleton("mixamo", names, parents, np.ones((len(names), 3)))
-    gait = default_joint_map(src, gait_skeleton())
+    gait = auto_joint_map(src.joints, gait_skeleton())
     assert gait["root"] == "Hips" and gait["left_knee"] == "LeftLeg" and gait["left_shoulder"] == "LeftArm"
     assert gait["spine"] == "Spine2" and gait["lower_back"] == "Spine"
-    gesture = default_joint_map(src, gesture_skeleton())
+    gesture = auto_joint_map(src.joints, gesture_skeleton())
     assert gesture["left_collar"] == "LeftShoulder" and gesture["left_wrist"] == "LeftHand"
-    assert "chest4" not in gesture
+    assert gesture["chest4"] == "Spine2" and "chest3" not in gesture        # the top spine joint carries the arms
 
 
 def test_mixamo_named_bvh_retargets_onto_gait_with_default_map(tmp_path):

@@ -74,6 +74,7 @@ def test_autocast_context_and_cpu_copies():
 @pytest.fixture(scope="module")
 def tiny_data():
     from generation.gait.data import prepare_sequences
+    from generation.gait.weights import TrainingData
     rng = np.random.default_rng(1)
     rots, roots = [], []
     for _ in range(6):
@@ -83,7 +84,7 @@ def tiny_data():
         roots.append(m.root_positions)
     split = np.array(["train", "train", "train", "train", "val", "val"])
     return prepare_sequences(np.stack(rots), np.stack(roots), np.eye(4)[[0, 1, 2, 3, 0, 1]], split,
-                             np.full(6, 1.75), np.array(["female"] * 6))
+                             np.full(6, 1.75), np.array(["female"] * 6), training_data=TrainingData.procedural())
 
 
 TINY = dict(epochs=1, batch_size=2, tf_decay=0.5)

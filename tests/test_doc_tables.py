@@ -4,15 +4,10 @@ from __future__ import annotations
 import importlib
 import json
 import pkgutil
-import sys
-from pathlib import Path
 
 import pytest
 
-sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "benchmarks"))
-
-import doc_renderers  # noqa: E402
-import doc_tables  # noqa: E402
+from benchmarks import doc_renderers, doc_tables
 
 RESULTS = {
     "prediction": {"full": {"pose_error_body_diag": 0.0231, "pose_error_cm": 3.94, "pose_error_first10_cm": 1.26,
@@ -67,7 +62,7 @@ def test_each_renderer_module_is_one_area_of_the_tables():
     areas = sorted(m.name for m in pkgutil.iter_modules(doc_renderers.__path__) if m.name != "common")
     assert areas == sorted(doc_tables.TABLES)
     for area in areas:
-        module = importlib.import_module(f"doc_renderers.{area}")
+        module = importlib.import_module(f"benchmarks.doc_renderers.{area}")
         assert doc_tables.TABLES[area] is module.TABLES
         assert module.TABLES and all(name.startswith(area + ".") for name in module.TABLES)
     assert all(hasattr(doc_tables, name) for name in doc_tables.__all__)

@@ -6,6 +6,7 @@ import torch
 
 from generation.gait.generate import load_model
 from generation.gait.train import save_checkpoint
+from generation.gait.weights import TrainingData
 
 torch.set_num_threads(1)
 pytest_plugins = ("gait_fixtures",)   # the tiny_data and tiny_net fixtures
@@ -20,7 +21,7 @@ def test_guidance_scale_choice_and_storage(tiny_net, tmp_path):
     assert lowest_class(results[1.0]) == 0.85
     assert choose_scale(results) == 1.0   # the best lowest class; the smaller scale on a tie
     path = tmp_path / "w.pt"
-    save_checkpoint(path, tiny_net.model, tiny_net.normalizer, tiny_net.config)
+    save_checkpoint(path, tiny_net.model, tiny_net.normalizer, tiny_net.config, training_data=TrainingData.procedural())
     assert load_model(path).emotion_guidance == 0.0
     write_guidance(path, 1.0, results, "abc")
     loaded = load_model(path)

@@ -12,6 +12,7 @@ import torch
 
 from generation.core.paths import curved, straight
 from generation.core.skeleton import gait_skeleton
+from generation.core.windows import windows
 from generation.gait.config import GaitDataConfig, GaitNetConfig
 from generation.gait.real_data import (
     RealAugment,
@@ -21,7 +22,6 @@ from generation.gait.real_data import (
     mirror_motion,
     stage_clips,
     time_warp,
-    window_starts,
 )
 from generation.gait.weights import NAMED_WEIGHTS, weights_path
 from generation.mocap.real_corpus import CorpusClip, save_real_corpus
@@ -78,10 +78,10 @@ def test_time_warp_keeps_the_path_and_changes_the_duration():
         time_warp(m, 0.0)
 
 
-def test_window_starts_cover_the_take():
-    assert window_starts(100, 40, 25) == [0, 25, 50, 60]
-    assert window_starts(40, 40, 25) == [0]
-    assert window_starts(39, 40, 25) == []
+def test_training_windows_cover_the_take():
+    assert [w.start for w in windows(100, 40, 25)] == [0, 25, 50, 60]
+    assert [w.start for w in windows(40, 40, 25)] == [0]
+    assert windows(39, 40, 25) == []
 
 
 def test_labels_one_hot_or_uniform():
@@ -112,7 +112,8 @@ def test_sequences_labels_augmentation_and_split(corpus):
     assert seqs.q.shape[1:] == (DATA.seq_len, 21, 4)
     val = seqs.subset("val")
     assert len(val) == len(np.unique(val.base_index)) and set(val.offset) == {0}   # validation as captured
-    assert seqs.trained_on.startswith("real capture") and seqs.source["stage"] == "pretrain"
+    assert seqs.training_data.kind == "real" and seqs.training_data.corpus["stage"] == "pretrain"
+    assert seqs.training_data.datasets == ("bandai-namco-1", "bandai-namco-2")
     assert "dataset-2_walk_normal_002" not in seqs.clip_names
 
 
@@ -134,6 +135,7 @@ def test_training_on_real_windows_records_the_data(corpus, tmp_path):
     run(args, log=lambda *_: None)
     payload = torch.load(out, weights_only=False)
     assert payload["trained_on"].startswith("real capture") and payload["corpus"]["stage"] == "finetune"
+    assert payload["training_data"]["kind"] == "real" and payload["training_data"]["datasets"] == ["bandai-namco-1"]
     assert GaitNetConfig.from_dict(payload["config"]).data.seq_len == 12
 
 

@@ -2,6 +2,8 @@
 free-running rollout, fine-tuning."""
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 import pytest
 import torch
@@ -22,6 +24,7 @@ from generation.gait.train import (
     splice_histories,
     train,
 )
+from generation.gait.weights import TrainingData, is_real
 
 torch.set_num_threads(1)
 pytest_plugins = ("gait_fixtures",)   # the tiny_data and tiny_net fixtures
@@ -93,7 +96,8 @@ def test_training_writes_checkpoint_and_resumes(tiny_data, tmp_path):
     res = train(cfg2, tiny_data, out, ckpt, resume=True, progress=False, log=lambda *_: None)
     assert [h["epoch"] for h in res["history"]] == [1, 2]
     model, norm, payload = load_checkpoint(out)
-    assert payload["trained_on"] == "synthetic procedural corpus" and payload["format"] == "gait_net/2"
+    assert payload["trained_on"] == "synthetic procedural corpus" and payload["format"] == "gait_net/3"
+    assert payload["training_data"]["kind"] == "procedural"
     assert GaitNetConfig.from_dict(payload["config"]) == cfg2 and model.config == cfg2.model
     bad = tmp_path / "bad.pt"
     bad.write_bytes(b"not a checkpoint")
@@ -114,7 +118,7 @@ def test_keep_epochs_writes_the_weights_of_every_epoch(tiny_data, tmp_path):
 
 def test_save_and_load_model(tiny_net, tmp_path):
     path = tmp_path / "m.pt"
-    save_checkpoint(path, tiny_net.model, tiny_net.normalizer, tiny_net.config)
+    save_checkpoint(path, tiny_net.model, tiny_net.normalizer, tiny_net.config, training_data=TrainingData.procedural())
     loaded = load_model(path)
     for p, q in zip(loaded.model.parameters(), tiny_net.model.parameters()):
         assert torch.equal(p, q)
@@ -123,8 +127,27 @@ def test_save_and_load_model(tiny_net, tmp_path):
     payload = torch.load(path, weights_only=False)
     other = tmp_path / "other.pt"
     torch.save({**payload, "format": "gait_net/1"}, other)
-    with pytest.raises(ValueError, match="checkpoint format 'gait_net/1', expected 'gait_net/2'"):
+    with pytest.raises(ValueError, match="checkpoint format 'gait_net/1', expected one of"):
         load_model(other)
+
+
+def test_weights_files_say_what_they_were_trained_on_and_old_files_still_load(tiny_net, tiny_data, tmp_path):
+    real = TrainingData.real("finetune", {"path": "c.npz", "sha256": "0" * 64, "stage": "finetune"})
+    new = tmp_path / "new.pt"
+    save_checkpoint(new, tiny_net.model, tiny_net.normalizer, tiny_net.config, training_data=real)
+    assert load_model(new).training_data == real and is_real(load_model(new).training_data)
+    payload = torch.load(new, weights_only=False)
+    del payload["training_data"]
+    for trained_on, kind in ((real.description, "real"), ("synthetic procedural corpus", "procedural")):
+        old = tmp_path / f"old_{kind}.pt"                   # format gait_net/2: the prose field only
+        torch.save({**payload, "format": "gait_net/2", "trained_on": trained_on}, old)
+        net = load_model(old)
+        assert net.training_data.kind == kind and net.info["trained_on"] == trained_on
+    with pytest.raises(ValueError, match="training data kind"):
+        TrainingData("synthetic", "x")
+    with pytest.raises(ValueError, match="do not say what they are"):
+        train(GaitNetConfig.tiny(epochs=1), replace(tiny_data, training_data=None), tmp_path / "x.pt",
+              progress=False, log=lambda *_: None)
 
 
 def test_training_is_deterministic_for_a_seed(tiny_data, tmp_path):

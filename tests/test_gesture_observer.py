@@ -13,6 +13,7 @@ from generation.gesture.data import build_dataset
 from generation.pipeline import plan_qa
 from generation.quality import checks, evaluate, failed_checks, qa_columns, resolve_thresholds
 from generation.quality import gesture_observer as go
+from generation.quality.observers import Observers
 from study_protocol import GESTURE_EMOTIONS, GESTURE_VAD, QA_THRESHOLDS
 from tests.test_render import seated, swinging_walk
 
@@ -83,20 +84,18 @@ def test_default_observer_cache_round_trips(tmp_path, monkeypatch, small_observe
 
     monkeypatch.setattr(go, "CACHE_DIR", tmp_path)
     monkeypatch.setattr(go, "train_gesture_observer", train)
-    monkeypatch.setattr(go, "_DEFAULT", {})
-    first = go.default_gesture_observer()
+    observers = Observers()
+    first = observers.gesture()
     assert first is small_observer and len(calls) == 1
     files = list(tmp_path.glob("gesture_observer_*.pkl"))
     assert [f.name for f in files] == [f"gesture_observer_{go.corpus_version()}.pkl"]
-    assert go.default_gesture_observer() is first and len(calls) == 1          # from memory
-    monkeypatch.setattr(go, "_DEFAULT", {})
-    loaded = go.default_gesture_observer()                                      # from the file
+    assert observers.gesture() is first and len(calls) == 1                    # from memory
+    loaded = Observers().gesture()                                              # from the file
     assert len(calls) == 1 and loaded is not small_observer
     X = go.corpus_descriptors(corpus, corpus.indices("val")[:5])
     np.testing.assert_allclose(loaded.proba_features(X), small_observer.proba_features(X))
     files[0].write_bytes(b"not a pickle")                                       # a broken file: trained again
-    monkeypatch.setattr(go, "_DEFAULT", {})
-    assert go.default_gesture_observer() is small_observer and len(calls) == 2
+    assert Observers().gesture() is small_observer and len(calls) == 2
     assert isinstance(pickle.loads(files[0].read_bytes()), go.GestureObserver)
 
 
@@ -104,9 +103,8 @@ def test_default_observer_is_none_without_the_corpus(tmp_path, monkeypatch):
     from generation.gesture import config
 
     monkeypatch.setattr(config, "SENTENCES_CSV", tmp_path / "missing.csv")
-    monkeypatch.setattr(go, "_DEFAULT", {})
     with pytest.warns(UserWarning, match="gesture observer"):
-        assert go.default_gesture_observer() is None
+        assert Observers().gesture() is None
 
 
 class FixedReading(go.GestureObserver):

@@ -4,7 +4,11 @@
 - analysis never imports generation;
 - generation.core imports no other project package (it is the bottom layer);
 - the top-level vocabulary (study_protocol, study_pools, study_presets) imports none of the libraries nor Django;
-- the package graph (scripts/import_graph.py's packages) has no cycle.
+- inside generation, a package imports only the packages below it in LAYERS (core < formats < procedural < render
+  < gesture < mocap < gait < rbf < quality < plans < pipeline, the order of the design notes);
+- the package graph (scripts/import_graph.py's packages) has no cycle;
+- a function-local import of a project module says on its line why it is local (a heavy import such as torch or
+  matplotlib, or an optional library), and there are at most LOCAL_IMPORT_BUDGET of them.
 """
 from __future__ import annotations
 
@@ -12,7 +16,12 @@ from pathlib import Path
 
 import pytest
 
-from scripts.import_graph import TOP_MODULES, find_cycles, package_edges
+from scripts.import_graph import ROOT, TOP_MODULES, find_cycles, package_edges, package_of
+
+#: The packages of generation, bottom first: each may import only those before it.
+LAYERS = ("core", "formats", "procedural", "render", "gesture", "mocap", "gait", "rbf", "quality", "plans",
+          "pipeline")
+LOCAL_IMPORT_BUDGET = 10
 
 FORBIDDEN = [
     ("generation", ("studyapp", "django"), "generation never imports studyapp or Django"),
@@ -36,6 +45,31 @@ def layer_violations(edges) -> list[str]:
             if _under(source, sources) and _under(dest, targets) and dest != source:
                 found += [f"{rule}: {path}:{line} imports {dest}" + (" (inside a function)" if local else "")
                           for path, line, local in uses]
+    return found + layer_order_violations(edges)
+
+
+def _layer(package: str) -> int | None:
+    parts = package.split(".")
+    return LAYERS.index(parts[1]) if parts[0] == "generation" and len(parts) > 1 and parts[1] in LAYERS else None
+
+
+def layer_order_violations(edges) -> list[str]:
+    """'file:line: generation.a imports generation.b above it' for every import up the LAYERS order."""
+    found = []
+    for (source, dest), uses in sorted(edges.items()):
+        low, high = _layer(source), _layer(dest)
+        if low is not None and high is not None and high > low:
+            found += [f"{path}:{line}: {source} imports {dest} above it" + (" (inside a function)" if local else "")
+                      for path, line, local in uses]
+    return found
+
+
+def local_project_imports(local_imports, root: Path = ROOT) -> list[tuple[str, str]]:
+    """(file:line, the import's first line) of every function-local import of a project module."""
+    found = []
+    for path, line, target in local_imports:
+        if package_of(target) not in (None, "django"):
+            found.append((f"{path.relative_to(root)}:{line}", path.read_text().splitlines()[line - 1].strip()))
     return found
 
 
@@ -50,6 +84,12 @@ def test_no_import_crosses_the_layers_the_wrong_way(edges):
 
 def test_package_graph_has_no_cycle(edges):
     assert find_cycles(edges) == []
+
+
+def test_function_local_project_imports_are_few_and_say_why():
+    found = local_project_imports(package_edges()[1])
+    assert [where for where, text in found if "#" not in text] == []
+    assert len(found) <= LOCAL_IMPORT_BUDGET, found
 
 
 def _tree(root: Path, files: dict[str, str]) -> Path:
@@ -70,6 +110,7 @@ def test_the_checks_see_local_imports_and_cycles(tmp_path):
         "generation/core/__init__.py": "from ..render import x\n",
         "generation/render/__init__.py": "def g():\n    from generation.core import y\n",
         "generation/plans/x.py": "import django.db\n",
+        "generation/gesture/y.py": "def h():\n    from generation.quality import z\n",
         "studyapp/__init__.py": "",
     })
     edges, local = package_edges(root)
@@ -77,5 +118,9 @@ def test_the_checks_see_local_imports_and_cycles(tmp_path):
     assert any("analysis/a.py:2 imports generation.plans (inside a function)" in v for v in found)
     assert any("generation/plans/x.py:1 imports django" in v for v in found)
     assert any("generation.core imports nothing above it" in v for v in found)
+    assert any("generation/gesture/y.py:2: generation.gesture imports generation.quality above it (inside a "
+               "function)" in v for v in found)
     assert find_cycles(edges) == [["generation.core", "generation.render"]]
-    assert {(p.name, line) for p, line, _ in local} == {("a.py", 2), ("__init__.py", 2)}
+    assert {(p.name, line) for p, line, _ in local} == {("a.py", 2), ("__init__.py", 2), ("y.py", 2)}
+    assert sorted(text for _, text in local_project_imports(local, root) if "#" not in text) == [
+        "from generation.core import y", "from generation.plans import schema", "from generation.quality import z"]

@@ -12,9 +12,9 @@ import pytest
 from generation.core.motion import Motion
 from generation.formats.bvh import write_bvh
 from generation.mocap.cli import main
-from generation.mocap.conventions import convention_motion, export_as
 from generation.mocap.importer import REPORT_COLUMNS
 from generation.procedural.walk import WalkParams, walk
+from tests.mocap_conventions import convention_motion, export_as
 
 ROOT = Path(__file__).resolve().parents[1]
 

@@ -5,10 +5,10 @@ import numpy as np
 import pytest
 
 from generation.mocap.cli import main
-from generation.mocap.conventions import export_as
 from generation.procedural.corpus import GaitCorpus
 from generation.procedural.walk import WalkParams, walk
 from study_protocol import GAIT_EMOTIONS
+from tests.mocap_conventions import export_as
 
 
 @pytest.fixture(scope="module")
@@ -46,7 +46,7 @@ def test_corpus_feeds_the_gait_network_data(tmp_path, imported):
     path = tmp_path / "captured.npz"
     assert main(["corpus", str(imported), "--out", str(path), "--frames", "120"]) == 1
     data = load_corpus_sequences(path, frame_step=4, seq_len=20)
-    assert data.source["path"] == str(path)
+    assert data.training_data.corpus["path"] == str(path)
 
 
 def test_corpus_without_labels_fails(tmp_path, imported):

@@ -10,10 +10,10 @@ from django.core.management import call_command
 
 from generation.core.skeleton import gesture_skeleton
 from generation.mocap.cli import main
-from generation.mocap.conventions import export_as
 from generation.procedural.emotion import gesture_params_for_vad
 from generation.procedural.gesture import seated_gesture
 from study_protocol import GAIT_EMOTIONS, GESTURE_TASKS, GESTURE_VAD
+from tests.mocap_conventions import export_as
 
 EMOTIONS = ("proud", "sad", "afraid", "joyous")
 

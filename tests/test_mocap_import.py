@@ -1,7 +1,7 @@
 """One file -> Motion (generation.mocap.importer): every naming convention, positions, units, labels, errors.
 
 Fixtures are written here: our own procedural motions re-exported under each rig's names, with the rig's extra
-joints, a T-pose rest and centimetre units (generation.mocap.conventions), so the original positions are the
+joints, a T-pose rest and centimetre units (tests/mocap_conventions.py), so the original positions are the
 ground truth of the import.
 """
 from __future__ import annotations
@@ -15,13 +15,13 @@ from generation.core.motion import Motion
 from generation.core.quaternion import np_qmul
 from generation.core.skeleton import Skeleton, gait_skeleton
 from generation.formats.bvh import write_bvh
-from generation.mocap.conventions import CONVENTIONS, convention_motion, export_as
 from generation.mocap.importer import ImportOptions, import_file
 from generation.mocap.labels import Label, LabelError, compile_pattern, label_from_pattern, read_labels
 from generation.mocap.positions import LAYOUTS
 from generation.procedural.gesture import GestureParams, seated_gesture
 from generation.procedural.walk import WalkParams, walk
 from study_protocol import GAIT_EMOTIONS, GESTURE_VAD
+from tests.mocap_conventions import CONVENTIONS, convention_motion, export_as
 
 EG16 = ("root", "spine", "neck", "head", "left_shoulder", "left_elbow", "left_hand", "right_shoulder",
         "right_elbow", "right_hand", "left_hip", "left_knee", "left_heel", "right_hip", "right_knee", "right_heel")

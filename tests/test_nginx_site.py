@@ -17,9 +17,9 @@ from pathlib import Path
 
 import pytest
 
+from deploy.nginx.local_site import free_port, nginx_binary, start_nginx, write_local_site
+
 ROOT = Path(__file__).resolve().parent.parent
-sys.path.insert(0, str(ROOT / "deploy" / "nginx"))
-from local_site import free_port, nginx_binary, start_nginx, write_local_site  # noqa: E402
 
 PAYLOAD = bytes((i * 7) % 251 for i in range(200_000))      # synthetic clip bytes, not a video
 

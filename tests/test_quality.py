@@ -58,7 +58,7 @@ def test_figure_height_threshold_depends_on_seated():
 
 
 class _FakeObserver(GaitObserver):
-    """A gait observer with a fixed reading (the real one's reads/qa_values, no training)."""
+    """A gait observer with a fixed reading (the real one's reads/read, no training)."""
 
     def __init__(self, label, p):
         self.label, self.p = label, p

@@ -5,10 +5,12 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from generation.core.digest import file_sha256
 from generation.mocap.real_corpus import save_real_corpus
 from generation.pipeline.plan_qa import observer_for, unread_line
 from generation.quality import evaluate, resolve_thresholds
 from generation.quality import real_observer as ro
+from generation.quality.observers import OBSERVERS, Observers
 from study_protocol import CAPTURE_GAIT_EMOTIONS
 
 
@@ -21,14 +23,15 @@ def shipped():
 @pytest.fixture()
 def fresh(monkeypatch, tmp_path):
     """An empty in-memory observer cache and a temporary pickle folder."""
-    monkeypatch.setattr(ro, "_DEFAULT", {})
     monkeypatch.setattr(ro, "CACHE_DIR", tmp_path / "cache")
-    return tmp_path
+    OBSERVERS.clear()
+    yield tmp_path
+    OBSERVERS.clear()
 
 
 def test_observer_trained_on_a_tiny_corpus_reads_its_takes_and_is_cached(shipped, fresh, monkeypatch):
     corpus = save_real_corpus(fresh / "tiny.npz", shipped, {"split_rule": "test corpus"})
-    obs = ro.default_real_observer(corpus)
+    obs = OBSERVERS.gait("real", corpus)
     assert "tiny.npz" in obs.source and sum(obs.train_takes.values()) == 4
     for clip in shipped:
         if clip.style in CAPTURE_GAIT_EMOTIONS:
@@ -40,11 +43,11 @@ def test_observer_trained_on_a_tiny_corpus_reads_its_takes_and_is_cached(shipped
     assert obs.theme_proba(by_style["feminine"].motion, "feminine_vs_masculine") < 0.5
     assert obs.theme_proba(by_style["tired"].motion, "energetic_vs_tired") > 0.5
     pickles = list((fresh / "cache").glob("real_gait_observer_v*_*.pkl"))
-    assert len(pickles) == 1 and ro.corpus_digest(corpus)[:12] in pickles[0].name
+    assert len(pickles) == 1 and file_sha256(corpus)[:12] in pickles[0].name
     # a new process (empty memory) loads the pickle instead of training again
-    monkeypatch.setattr(ro, "_DEFAULT", {})
+    assert OBSERVERS.gait("real", corpus) is obs                                   # from memory
     monkeypatch.setattr(ro, "train_real_observer", lambda path: pytest.fail("trained again"))
-    again = ro.default_real_observer(corpus)
+    again = Observers().gait("real", corpus)
     np.testing.assert_allclose(again.proba(shipped[0].motion), obs.proba(shipped[0].motion))
 
 
@@ -61,17 +64,17 @@ def test_the_gate_flags_a_real_walk_read_as_another_emotion(shipped, fresh):
 def test_without_a_corpus_it_falls_back_to_the_shipped_takes_or_says_there_is_none(shipped, fresh, monkeypatch):
     missing = fresh / "absent.npz"
     monkeypatch.setattr(ro, "shipped_clips", lambda: shipped)
-    obs = ro.default_real_observer(missing)
+    obs = OBSERVERS.gait("real", missing)
     assert "shipped real takes only" in obs.source and str(missing) in obs.source
     assert obs.observe(next(c for c in shipped if c.style == "angry").motion)[0] == "angry"
 
     def no_files():
         raise FileNotFoundError("generation/data/mocap/bandai-namco: gone")
 
-    monkeypatch.setattr(ro, "_DEFAULT", {})
+    OBSERVERS.clear()
     monkeypatch.setattr(ro, "shipped_clips", no_files)
     monkeypatch.setenv("REAL_CORPUS", str(missing))
-    assert ro.default_real_observer() is None and observer_for("gait", "real") is None
+    assert ro.load_real_observer() is None and observer_for("gait", "real") is None
     line = unread_line([{"modality": "gait", "qa": {"observed": None}}], "real")
     assert "no real-capture observer" in line
 
@@ -88,13 +91,15 @@ def test_a_stored_gait_record_from_another_observer_is_measured_again(shipped, t
     (job,), _ = plan_jobs(validate_plan(plan))
     obs = ro.RealGaitObserver(shipped, source="test")
     monkeypatch.setattr(runner, "observer_for", lambda modality, kind=None: obs)
-    # a record written before the realism measures, read by the synthetic observer, with the render's camera
-    done = {"clip_id": job.clip_id, "qa": {"foot_skate_cm_s": 1.0, "observed": "sad", "observed_p": 0.99, "flag": ""},
+    # a record of version 2 (before the realism measures), read by the synthetic observer, with the render's camera
+    done = {"clip_id": job.clip_id, "record_version": 2,
+            "qa": {"foot_skate_cm_s": 1.0, "observed": "sad", "observed_p": 0.99, "flag": ""},
             "metadata": {"camera": {"rule": "fixed", "min_figure_fraction": 0.7, "seated": False}}}
     assert runner._stale_qa(done, job)
     batch = runner._Batch(tmp_path, tmp_path, lambda kind, info: None, runner.BatchResult())
     runner._remeasure_qa(done, job, batch)
     assert done["qa"]["observer"] == "real" and done["qa"]["skate_cm_s"] is not None
+    assert done["record_version"] == runner.RECORD_VERSION
     assert done["qa"]["figure_height_frac"] == 0.7                      # the render's camera is kept
     assert json.loads((tmp_path / f"{job.clip_id}.json").read_text())["qa"] == done["qa"]
     assert not runner._stale_qa(done, job)

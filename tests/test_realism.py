@@ -12,7 +12,7 @@ from generation.core.motion import Motion
 from generation.core.skeleton import gait_skeleton
 from generation.plans.catalogue import read_clips_csv, write_clips_csv
 from generation.plans.schema import PlanError, validate_plan
-from generation.quality import QAThresholdError, evaluate, failed_checks, resolve_thresholds
+from generation.quality import QAThresholdError, evaluate, failed_checks, gait_observer_kind, resolve_thresholds
 from generation.quality.realism import MEASURES, foot_floor, knee_flexion_deg, realism_measures
 from generation.quality.realism_ranges import (
     compute_ranges,
@@ -110,7 +110,7 @@ def test_speed_variability_of_constant_and_changing_walking_speed():
 def test_realism_bounds_come_from_one_file_and_plans_override_them():
     th = resolve_thresholds()
     assert set(threshold_keys()) <= set(th) and th == {**th, **realism_thresholds()}
-    assert th["observer"] in ("real", "synthetic")
+    assert "observer" not in th                                  # the observer kind is no threshold
     values = {"pelvis_bounce_cm": th["pelvis_bounce_cm_max"] + 5, "speed_cv": th["speed_cv_min"] / 2,
               "stance_knee_deg": 170.0}
     assert out_of_range(values, th) == [f"stance_knee_deg>{th['stance_knee_deg_max']:g}",
@@ -119,11 +119,14 @@ def test_realism_bounds_come_from_one_file_and_plans_override_them():
     assert "realism" in failed_checks(values, th)
     relaxed = resolve_thresholds({"pelvis_bounce_cm_max": None, "speed_cv_min": 0, "stance_knee_deg_max": None,
                                   "observer": "synthetic"})
-    assert "realism" not in failed_checks(values, relaxed) and relaxed["observer"] == "synthetic"
+    assert "realism" not in failed_checks(values, relaxed) and "observer" not in relaxed
+    assert gait_observer_kind({"observer": "synthetic"}) == "synthetic" and gait_observer_kind({}, "real") == "real"
     assert out_of_range(values, resolve_thresholds({"stance_knee_deg_max": 60})) == [
         "stance_knee_deg>60", f"pelvis_bounce_cm>{th['pelvis_bounce_cm_max']:g}", f"speed_cv<{th['speed_cv_min']:g}"]
     with pytest.raises(QAThresholdError, match="qa.observer"):
         resolve_thresholds({"observer": "human"})
+    with pytest.raises(QAThresholdError, match="default gait observer"):
+        gait_observer_kind(None, "human")
     with pytest.raises(QAThresholdError, match="qa.knee"):
         resolve_thresholds({"knee": 3})
     plan = {"name": "p", "clips": [{"id": "a", "generator": "procedural_walk", "emotion": [1, 0, 0, 0]}]}

@@ -1,7 +1,7 @@
 """Tables of the gait network on synthetic walks (benchmarks/bench_gait.py; docs/benchmarks/gait.md)."""
 from __future__ import annotations
 
-from doc_renderers.common import EMOTIONS, Renderer, table
+from benchmarks.doc_renderers.common import EMOTIONS, Renderer, table
 
 
 def gait_prediction(r: dict) -> list[str]:

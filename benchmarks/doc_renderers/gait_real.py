@@ -1,7 +1,7 @@
 """Tables of the gait network on real capture (benchmarks/bench_gait_real.py; docs/benchmarks/gait.md)."""
 from __future__ import annotations
 
-from doc_renderers.common import EMOTIONS, Renderer, _opt, _run, table
+from benchmarks.doc_renderers.common import EMOTIONS, Renderer, _opt, _run, table
 
 REALISM_LABELS = {"skate_cm_s": "foot skate cm/s", "skate_ratio": "skate ratio", "toe_skim": "toe skim",
                   "stance_knee_deg": "stance knee deg", "pelvis_bounce_cm": "pelvis bounce cm", "speed_cv": "speed CV"}

@@ -1,7 +1,7 @@
 """Tables of the gesture network (benchmarks/bench_gesture.py; docs/benchmarks/gesture.md)."""
 from __future__ import annotations
 
-from doc_renderers.common import Renderer, table
+from benchmarks.doc_renderers.common import Renderer, table
 
 
 def _by_arousal(r: dict, emotions) -> list[str]:

@@ -1,7 +1,7 @@
 """Tables of the RBF styliser's synthetic measures (benchmarks/bench_rbf_features.py; docs/benchmarks/rbf.md)."""
 from __future__ import annotations
 
-from doc_renderers.common import Renderer, _run, _yes, table
+from benchmarks.doc_renderers.common import Renderer, _run, _yes, table
 
 
 def _w(row: dict) -> str:

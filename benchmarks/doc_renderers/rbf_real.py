@@ -1,7 +1,7 @@
 """Tables of the RBF styliser on real capture (benchmarks/bench_rbf_real.py; docs/benchmarks/rbf.md)."""
 from __future__ import annotations
 
-from doc_renderers.common import EMOTIONS, Renderer, _opt, _run, _yes, table
+from benchmarks.doc_renderers.common import EMOTIONS, Renderer, _opt, _run, _yes, table
 
 RBF_REAL_CHECKED = ("speed_m_s", "cadence_steps_min", "stance_knee_deg", "pelvis_bounce_cm")
 

@@ -3,7 +3,7 @@ from __future__ import annotations
 
 import statistics
 
-from doc_renderers.common import EMOTIONS, Renderer, _run, table
+from benchmarks.doc_renderers.common import EMOTIONS, Renderer, _run, table
 
 
 def real_observer_run(r: dict) -> list[str]:

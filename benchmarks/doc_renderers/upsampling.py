@@ -1,7 +1,7 @@
 """Tables of upsampling the networks' output (benchmarks/bench_upsampling.py; docs/benchmarks/gait.md)."""
 from __future__ import annotations
 
-from doc_renderers.common import Renderer, _opt, _run, table
+from benchmarks.doc_renderers.common import Renderer, _opt, _run, table
 
 UPSAMPLING = ("slerp", "spline")
 

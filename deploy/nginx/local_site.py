@@ -2,7 +2,7 @@
 a minimal main nginx.conf around it, and a self-signed certificate. Used by tests/test_nginx_site.py and
 benchmarks/bench_study_load.py --nginx; by hand:
 
-    python deploy/nginx/local_site.py --app-port 8000 --https-port 8443 --data-dir var --out /tmp/study-nginx
+    python -m deploy.nginx.local_site --app-port 8000 --https-port 8443 --data-dir var --out /tmp/study-nginx
     nginx -c /tmp/study-nginx/nginx.conf -g 'daemon off;'     # then https://127.0.0.1:8443/ (self-signed)
 
 Run the app with MEDIA_ACCEL_REDIRECT=/protected-media/ and MEDIA_ROOT / STATIC_ROOT under --data-dir

@@ -11,9 +11,9 @@ Reading (:func:`parse_bvh`, :func:`read_bvh`):
 - ``End Site`` blocks with a non-zero offset become leaf joints named ``<parent>_end`` with identity rotation;
   zero-offset end sites are dropped;
 - units: ``scale`` multiplies file units into metres. ``scale=None`` guesses from the posed body's extent
-  (median over frames; a rest pose with bones along local x says nothing about height): 0.5..3 -> metres (1),
-  50..300 -> centimetres (0.01), anything else is normalised to a 1.7 m body; the guess is recorded in
-  ``metadata["bvh_scale"]`` and ``metadata["bvh_scale_guess"]``.
+  (median over frames; a rest pose with bones along local x says nothing about height) by the one unit rule,
+  :func:`generation.formats.units.guess_unit` (metres, centimetres, millimetres, else normalised to a 1.7 m
+  body); the guess is recorded in ``metadata["bvh_scale"]`` and ``metadata["bvh_scale_guess"]``.
 Malformed files raise :class:`~generation.core.motion.MotionFormatError` naming the file and line.
 
 Writing (:func:`write_bvh`): root with 3 position + 3 rotation channels, other joints 3 rotation channels,
@@ -33,6 +33,7 @@ import numpy as np
 from generation.core.motion import Motion, MotionFormatError
 from generation.core.quaternion import np_qfix, np_qmul, np_qto_matrix, qeuler, qfrom_euler
 from generation.core.skeleton import Skeleton
+from generation.formats.units import guess_unit
 
 _CHANNELS = ("Xposition", "Yposition", "Zposition", "Xrotation", "Yrotation", "Zrotation")
 
@@ -165,16 +166,6 @@ def _euler_channels_to_quat(values: np.ndarray, order: str) -> np.ndarray:
         return qfrom_euler(torch.as_tensor(np.radians(angles)), order).numpy()
 
 
-def _guess_scale(height: float) -> tuple[float, str]:
-    if 0.5 <= height <= 3.0:
-        return 1.0, "metres"
-    if 50.0 <= height <= 300.0:
-        return 0.01, "centimetres"
-    if height <= 0:
-        return 1.0, "flat hierarchy, kept as metres"
-    return 1.7 / height, "unknown unit, normalised to a 1.7 m body"
-
-
 @dataclass
 class BvhData:
     """A BVH file as written: the hierarchy and, per frame, every joint's local rotation and translation.
@@ -295,7 +286,7 @@ def read_bvh(path: str | Path, scale: float | None = None) -> Motion:
     extent = max(float(np.median((exact.max(1) - exact.min(1)).max(-1))), 1e-9)
     guess = "given"
     if scale is None:
-        scale, guess = _guess_scale(extent)
+        scale, guess = guess_unit(extent)
     if not scale > 0:
         raise MotionFormatError(f"{path}: scale must be positive, got {scale}")
     names, parents = list(data.names), list(data.parents)

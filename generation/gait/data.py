@@ -19,19 +19,21 @@ section 5.1). Per step we compute, on the ground plane (x, z; y-up):
 """
 from __future__ import annotations
 
-import hashlib
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 import torch
 
+from generation.core.digest import file_sha256
 from generation.core.features import gait_affective_features, movement_features
 from generation.core.kinematics import forward_kinematics, np_forward_kinematics
 from generation.core.quaternion import np_qfix, np_qmul, np_qrot, qmul
 from generation.core.rigging import yaw_quat
 from generation.core.skeleton import GAIT_PARENTS, gait_skeleton
 from generation.procedural.corpus import GaitCorpus, build_gait_corpus
+
+from .weights import TrainingData
 
 DEFAULT_CORPUS = Path("var/corpus/gait_corpus_synthetic.npz")
 SBAR_ALPHA = 0.3      # low-pass coefficient of s-bar per network step
@@ -228,6 +230,9 @@ class GaitSequences:
         fps: network rate (7.5 for a 30 fps corpus sampled every 4th frame).
         base_index: (N,) corpus sequence each row comes from; offset: (N,) first frame of the subsampling
             (rows with offsets 1..3 are the same walk sampled from a later frame: data augmentation).
+        training_data: what the sequences are (:class:`generation.gait.weights.TrainingData`; it goes into the
+            weights file trained on them); None for sequences that are not training data (seed walks).
+        clip_names: for real capture, the clip of each ``base_index``.
     """
 
     q: torch.Tensor
@@ -247,6 +252,8 @@ class GaitSequences:
     fps: float
     base_index: np.ndarray | None = None
     offset: np.ndarray | None = None
+    training_data: TrainingData | None = None
+    clip_names: tuple[str, ...] = ()
 
     def __post_init__(self):
         n = self.q.shape[0]
@@ -275,10 +282,7 @@ class GaitSequences:
         batches are gathered on the device itself); the numpy fields stay on the host."""
         kw = {k: (v.to(device) if isinstance(v, torch.Tensor) else v)
               for k, v in ((k, getattr(self, k)) for k in self.__dataclass_fields__)}
-        out = GaitSequences(**kw)
-        if hasattr(self, "source"):
-            out.source = self.source
-        return out
+        return GaitSequences(**kw)
 
     @property
     def device(self) -> torch.device:
@@ -293,8 +297,8 @@ class GaitSequences:
 
 def prepare_sequences(rotations: np.ndarray, root_positions: np.ndarray, emotion: np.ndarray, split: np.ndarray,
                       heights: np.ndarray, builds: np.ndarray, fps: float = 30.0, frame_step: int = 4,
-                      seq_len: int = 60, skeletons: list | None = None, offsets: tuple[int, ...] = (0,)
-                      ) -> GaitSequences:
+                      seq_len: int = 60, skeletons: list | None = None, offsets: tuple[int, ...] = (0,),
+                      training_data: TrainingData | None = None) -> GaitSequences:
     """Turn corpus arrays into network sequences.
 
     Args:
@@ -303,6 +307,7 @@ def prepare_sequences(rotations: np.ndarray, root_positions: np.ndarray, emotion
         emotion: (N, 4) soft labels; split: (N,) strings; heights: (N,) metres; builds: (N,) "male"/"female".
         skeletons: optional list of N gait skeletons used instead of ``gait_skeleton(height, build)``.
         offsets: first frames of the subsampling; each offset adds N rows (augmentation), in offset-major order.
+        training_data: what the arrays are (:attr:`GaitSequences.training_data`).
     """
     rotations = np.asarray(rotations, dtype=np.float64)
     root_positions = np.asarray(root_positions, dtype=np.float64)
@@ -341,7 +346,8 @@ def prepare_sequences(rotations: np.ndarray, root_positions: np.ndarray, emotion
                                                                                                   (K, 1, 1))),
         mean_height=cat["mean_height"], root_pos=cat["root_pos"], rotations_world=cat["rotations_world"],
         split=np.tile(np.asarray(split).astype(str), K), fps=fps / frame_step,
-        base_index=np.tile(np.arange(N), K), offset=np.repeat(np.asarray(offsets, dtype=int), N))
+        base_index=np.tile(np.arange(N), K), offset=np.repeat(np.asarray(offsets, dtype=int), N),
+        training_data=training_data)
 
 
 def _network_rate(rot: np.ndarray, rp: np.ndarray, theta: np.ndarray, bone_offsets: np.ndarray) -> dict:
@@ -373,22 +379,11 @@ def load_corpus_sequences(path: str | Path | None = None, num_sequences: int = 1
     else:
         corpus = build_gait_corpus(num_sequences, seed)
         path.parent.mkdir(parents=True, exist_ok=True)
-        if hasattr(corpus, "save"):
-            corpus.save(path)
-    fps = float(getattr(corpus, "fps", 30.0))
-    data = prepare_sequences(corpus.rotations, corpus.root_positions, corpus.emotion, corpus.split, corpus.height,
-                             corpus.build, fps=fps, frame_step=frame_step, seq_len=seq_len, offsets=offsets)
-    data.source = {"path": str(path), "sha256": file_sha256(path)}
-    return data
-
-
-def file_sha256(path: str | Path) -> str:
-    """Hex SHA-256 of a file (identifies the corpus version a model was trained on)."""
-    h = hashlib.sha256()
-    with open(path, "rb") as f:
-        for chunk in iter(lambda: f.read(1 << 20), b""):
-            h.update(chunk)
-    return h.hexdigest()
+        corpus.save(path)
+    training = TrainingData.procedural({"path": str(path), "sha256": file_sha256(path)})
+    return prepare_sequences(corpus.rotations, corpus.root_positions, corpus.emotion, corpus.split, corpus.height,
+                             corpus.build, fps=corpus.fps, frame_step=frame_step, seq_len=seq_len, offsets=offsets,
+                             training_data=training)
 
 
 def quat_torch_yaw(yaw: torch.Tensor) -> torch.Tensor:

@@ -46,7 +46,7 @@ from .data import (
 from .model import GaitNet
 from .real_seeds import real_seed
 from .train import load_checkpoint
-from .weights import DEFAULT_WEIGHTS_NAME, is_real, weights_path
+from .weights import DEFAULT_WEIGHTS_NAME, TrainingData, is_real, training_data_of, weights_path
 
 
 @dataclass
@@ -61,6 +61,8 @@ class LoadedGaitNet:
     path: str
     info: dict = field(default_factory=dict)
     config: GaitNetConfig | None = None
+    # what the weights were trained on (a weights file's record; a network built in code: the procedural corpus)
+    training_data: TrainingData = field(default_factory=TrainingData.procedural)
 
     def __post_init__(self):
         if self.config is None:
@@ -94,7 +96,8 @@ class LoadedGaitNet:
         copies = self.__dict__.setdefault("_copies", {})
         if str(dev) not in copies:
             model = copy.deepcopy(self.model).to(dev).eval()
-            copies[str(dev)] = LoadedGaitNet(model, self.normalizer, self.path, dict(self.info), self.config)
+            copies[str(dev)] = LoadedGaitNet(model, self.normalizer, self.path, dict(self.info), self.config,
+                                             self.training_data)
         return copies[str(dev)]
 
 
@@ -104,12 +107,14 @@ _DEFAULT: dict[str, LoadedGaitNet] = {}
 def load_model(path: str | Path, device: str | torch.device | None = "cpu") -> LoadedGaitNet:
     """Load weights written by the training command (on any device) onto ``device``."""
     model, norm, payload = load_checkpoint(path, device)
-    info = {k: payload[k] for k in ("trained_on", "num_parameters", "corpus", "initialised_from", "emotion_guidance")
+    info = {k: payload[k] for k in ("num_parameters", "corpus", "initialised_from", "emotion_guidance")
             if k in payload}
+    training = training_data_of(payload)
+    info["trained_on"] = training.description
     info["epochs"] = len(payload.get("history", []))
     info["weights_name"] = next((n for n in ("real", "procedural") if Path(path).name == weights_path(n).name),
                                 Path(path).stem)
-    return LoadedGaitNet(model, norm, str(path), info, GaitNetConfig.from_dict(payload["config"]))
+    return LoadedGaitNet(model, norm, str(path), info, GaitNetConfig.from_dict(payload["config"]), training)
 
 
 def load_default_model(device: str | torch.device | None = None, weights: str | None = None) -> LoadedGaitNet:
@@ -392,7 +397,7 @@ def _with_seed(seed: dict, placement: _Placement, i: int, rot: np.ndarray, root:
 def _metadata(net: LoadedGaitNet, emotions: np.ndarray, path: GroundPath, seed_motion: Motion) -> dict:
     """Metadata of one generated gait with per-step emotions (steps, 4)."""
     first, last = emotions[0], emotions[-1]
-    real = is_real(net.info)
+    real = is_real(net.training_data)
     credit = {"training_data_licence": "CC BY-NC 4.0",
               "training_data_citation": "Kobayashi et al. 2023, arXiv:2306.08861"} if real else {}
     seed_take = seed_motion.metadata.get("seed_take")
@@ -400,7 +405,7 @@ def _metadata(net: LoadedGaitNet, emotions: np.ndarray, path: GroundPath, seed_m
         "origin": "generated", "generator": "gait_net",
         "emotion": [round(float(v), 6) for v in first],
         "final_emotion": None if np.allclose(first, last, atol=1e-6) else [round(float(v), 6) for v in last],
-        "trained_on": net.info.get("trained_on", "synthetic procedural corpus"),
+        "trained_on": net.training_data.description,
         "synthetic": True,
         "path_kind": path.kind, "steps": len(emotions), "network_fps": net.fps,
         "seed_origin": seed_motion.metadata.get("origin", "unknown"),
@@ -455,7 +460,7 @@ def generate_gaits(seeds, paths: list[GroundPath], emotions, steps: int = 200, f
     if device is not None:
         net = net.on(device)
     seeds, emotions = _check_inputs(seeds, paths, emotions, steps)
-    real_weights = is_real(net.info)
+    real_weights = is_real(net.training_data)
     seed_motions, seed = _seed_batch(seeds, emotions, net.config.data, np.random.default_rng(rng_seed),
                                      real_weights)
     placement = _Placement.onto_paths(paths, seed)

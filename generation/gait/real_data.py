@@ -21,23 +21,25 @@ frames and the four subsampling offsets of the 30 fps capture (stepping-phase va
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
 
+from generation.core.digest import file_sha256
 from generation.core.motion import Motion
+from generation.core.windows import windows
+from generation.mocap.real_corpus import load_real_corpus, real_corpus_path
 from study_protocol import CAPTURE_GAIT_EMOTIONS, GAIT_EMOTIONS
 
 from .config import GaitDataConfig
-from .data import GaitSequences, file_sha256, prepare_sequences
+from .data import GaitSequences, prepare_sequences
+from .weights import TrainingData
 
 STAGES = ("pretrain", "finetune")
 LOCOMOTION = {"bandai-namco-1": ("walk",), "bandai-namco-2": ("walk", "walk-turn-left", "walk-turn-right")}
 """Corpus contents (per dataset) of forward locomotion used for the gait network."""
 FINETUNE_STYLES = tuple(CAPTURE_GAIT_EMOTIONS)   # dataset 1's happy, sad, angry, normal
-TRAINED_ON = {"pretrain": "real capture: Bandai Namco datasets 1 and 2 forward locomotion (CC BY-NC 4.0)",
-              "finetune": "real capture: Bandai Namco dataset 1 happy/sad/angry/normal walks (CC BY-NC 4.0)"}
 
 
 @dataclass(frozen=True)
@@ -111,20 +113,8 @@ def time_warp(motion: Motion, factor: float) -> Motion:
     return fast.resample(motion.fps)
 
 
-def window_starts(num_frames: int, need: int, stride: int) -> list[int]:
-    """First frames of windows of ``need`` frames every ``stride`` frames, plus one ending at the last frame
-    ([] when the take is shorter than a window)."""
-    if num_frames < need:
-        return []
-    starts = list(range(0, num_frames - need + 1, max(1, stride)))
-    if starts[-1] != num_frames - need:
-        starts.append(num_frames - need)
-    return starts
-
-
 def stage_clips(stage: str, split: str, path: str | Path | None = None) -> list:
     """Corpus clips (``CorpusClip``) of a training stage and split (see the module docstring)."""
-    from generation.mocap.real_corpus import load_real_corpus
     if stage not in STAGES:
         raise ValueError(f"unknown stage {stage!r}: use one of {', '.join(STAGES)}")
     contents = sorted({c for cs in LOCOMOTION.values() for c in cs})
@@ -139,7 +129,8 @@ def clip_sequences(clips: list, data: GaitDataConfig, augment: RealAugment, labe
                    emotion_of=None) -> GaitSequences:
     """Network sequences of windows of ``clips`` (each clip's split kept per row). Rows of one window (its mirror,
     time warps and subsampling offsets) share a ``base_index``, so a training epoch visits each window once in
-    one random variant. Clips shorter than a window are skipped. ``.clip_names`` lists the clip of each base.
+    one random variant. Clips shorter than a window are skipped. ``clip_names`` lists the clip of each base;
+    ``training_data`` is None until :func:`load_real_sequences` says which stage and corpus they are.
     ``emotion_of(clip)``: the (4,) emotion input of a clip instead of its label's (soft labels,
     :mod:`generation.gait.soft_labels`)."""
     need = data.frame_step * (data.seq_len - 1) + 1 + max(augment.offsets)
@@ -152,7 +143,7 @@ def clip_sequences(clips: list, data: GaitDataConfig, augment: RealAugment, labe
             for f in augment.speed_factors:
                 m = time_warp(v, f)
                 stride = augment.stride_for(m.num_frames, need)
-                for s0 in window_starts(m.num_frames, need, stride):
+                for s0 in (w.start for w in windows(m.num_frames, need, stride)):
                     key = (clip.name, int(round(s0 * f / stride)))
                     base.append(names.setdefault(key, len(names)))
                     rot.append(m.rotations[s0:s0 + need])
@@ -166,32 +157,29 @@ def clip_sequences(clips: list, data: GaitDataConfig, augment: RealAugment, labe
                              np.array([s.height for s in skels]), np.array([s.build for s in skels]),
                              frame_step=data.frame_step, seq_len=data.seq_len, skeletons=skels,
                              offsets=augment.offsets)
-    seqs.base_index = np.tile(np.asarray(base), len(augment.offsets))
-    seqs.clip_names = [name for name, _ in sorted(names, key=names.get)]
-    return seqs
+    return replace(seqs, base_index=np.tile(np.asarray(base), len(augment.offsets)),
+                               clip_names=tuple(name for name, _ in sorted(names, key=names.get)))
 
 
 def load_real_sequences(stage: str, data: GaitDataConfig, augment: RealAugment | None = None,
                         path: str | Path | None = None) -> GaitSequences:
     """Training ("train" takes, augmented) and validation ("val" takes, as captured) sequences of a stage, with
-    ``.source`` (corpus path and SHA-256) and ``.trained_on`` for the weights file's record."""
-    from generation.mocap.real_corpus import real_corpus_path
+    their ``training_data`` (real capture of the stage; the corpus path, SHA-256 and augmentation) for the weights
+    file's record."""
     augment = augment or STAGE_AUGMENT[stage]
     train = clip_sequences(stage_clips(stage, "train", path), data, augment)
     parts = [train]
     val_clips = stage_clips(stage, "val", path)
     if val_clips:
         val = clip_sequences(val_clips, data, RealAugment.none())
-        val.base_index = val.base_index + int(train.base_index.max()) + 1
-        parts.append(val)
-    out = concat_sequences(parts)
-    out.clip_names = [name for p in parts for name in p.clip_names]
+        parts.append(replace(val, base_index=val.base_index + int(train.base_index.max()) + 1))
     corpus = Path(path) if path is not None else real_corpus_path()
-    out.source = {"path": str(corpus), "sha256": file_sha256(corpus), "stage": stage,
-                  "augment": {"mirror": augment.mirror, "speed_factors": list(augment.speed_factors),
-                              "stride_frames": augment.stride_frames, "offsets": list(augment.offsets)}}
-    out.trained_on = TRAINED_ON[stage]
-    return out
+    training = TrainingData.real(stage, {
+        "path": str(corpus), "sha256": file_sha256(corpus), "stage": stage,
+        "augment": {"mirror": augment.mirror, "speed_factors": list(augment.speed_factors),
+                    "stride_frames": augment.stride_frames, "offsets": list(augment.offsets)}})
+    return replace(concat_sequences(parts), training_data=training,
+                               clip_names=tuple(name for p in parts for name in p.clip_names))
 
 
 def concat_sequences(parts: list[GaitSequences]) -> GaitSequences:

@@ -12,6 +12,8 @@ import functools
 import numpy as np
 
 from generation.core.motion import Motion
+from generation.mocap.bandai_namco import shipped_takes
+from generation.mocap.importer import ImportOptions, import_file
 from generation.mocap.real_corpus import CITATION, LICENCE
 from study_protocol import CAPTURE_GAIT_EMOTIONS, GAIT_EMOTIONS
 
@@ -22,8 +24,6 @@ STYLE_OF_EMOTION = {emotion: style for style, emotion in CAPTURE_GAIT_EMOTIONS.i
 @functools.cache
 def shipped_walk(style: str) -> Motion:
     """The shipped dataset-1 forward walk of ``style`` on the gait skeleton at 30 fps (imported once)."""
-    from generation.mocap.bandai_namco import shipped_takes
-    from generation.mocap.importer import ImportOptions, import_file
 
     takes = [t for t in shipped_takes() if t.content == "walk" and t.style == style and t.skeleton == "gait"]
     if not takes:

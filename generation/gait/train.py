@@ -41,6 +41,8 @@ from generation.core.device import (
     resolve_device,
     to_cpu,
 )
+from generation.core.digest import file_sha256
+from generation.core.splits import SPLITS
 
 from .config import GaitNetConfig
 from .data import (
@@ -48,7 +50,6 @@ from .data import (
     GaitSequences,
     Normalizer,
     affective_features,
-    file_sha256,
     heading_frame_positions,
     kappa_torch,
     load_corpus_sequences,
@@ -57,10 +58,13 @@ from .losses import total_loss
 from .model import GaitNet
 from .real_data import STAGES as REAL_STAGES
 from .real_data import load_real_sequences
+from .weights import TrainingData
 
 DEFAULT_WEIGHTS = Path(__file__).resolve().parent.parent / "data" / "weights" / "gait_net_default.pt"
 CHECKPOINT_DIR = Path("var/gait_runs")
-CHECKPOINT_FORMAT = "gait_net/2"
+CHECKPOINT_FORMAT = "gait_net/3"
+#: Formats this code reads: gait_net/2 files say what they were trained on in prose only (weights.training_data_of).
+READABLE_FORMATS = ("gait_net/2", CHECKPOINT_FORMAT)
 
 
 def fit_normalizer(data: GaitSequences) -> Normalizer:
@@ -280,16 +284,20 @@ def evaluate(model: GaitNet, norm: Normalizer, data: GaitSequences, config: Gait
     return {k: v / max(n, 1) for k, v in sums.items()}
 
 
-def save_checkpoint(path: Path, model: GaitNet, norm: Normalizer, config: GaitNetConfig, **extra) -> None:
-    """Write model weights, config and normaliser (plus any training state in ``extra``), device-independent:
-    the weights and every tensor of ``extra`` (optimizer state) are copied to the CPU first.
+def save_checkpoint(path: Path, model: GaitNet, norm: Normalizer, config: GaitNetConfig, *,
+                    training_data: TrainingData, **extra) -> None:
+    """Write model weights, config, normaliser and what they were trained on (``training_data``: its record,
+    ``trained_on`` its description, ``corpus`` its corpus file), plus any training state in ``extra``,
+    device-independent: the weights and every tensor of ``extra`` (optimizer state) are copied to the CPU first.
 
-    Format ``gait_net/2`` (:data:`CHECKPOINT_FORMAT`) stores the config split by section (``GaitNetConfig.to_dict``).
+    Format ``gait_net/3`` (:data:`CHECKPOINT_FORMAT`) stores the config split by section (``GaitNetConfig.to_dict``)
+    and, from the weights' own record, ``training_data`` (:class:`generation.gait.weights.TrainingData`).
     """
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     payload = {"format": CHECKPOINT_FORMAT, "config": config.to_dict(), "normalizer": norm.to_dict(),
-               "model": cpu_state_dict(model), **to_cpu(extra)}
+               "model": cpu_state_dict(model), "training_data": training_data.record(),
+               "trained_on": training_data.description, "corpus": training_data.corpus, **to_cpu(extra)}
     tmp = path.with_suffix(path.suffix + ".tmp")
     torch.save(payload, tmp)
     tmp.replace(path)
@@ -309,8 +317,8 @@ def load_checkpoint(path: str | Path, device: str | torch.device | None = "cpu")
     for key in ("config", "normalizer", "model"):
         if key not in payload:
             raise ValueError(f"{path}: checkpoint lacks field {key!r}")
-    if payload.get("format") != CHECKPOINT_FORMAT:
-        raise ValueError(f"{path}: checkpoint format {payload.get('format')!r}, expected {CHECKPOINT_FORMAT!r}")
+    if payload.get("format") not in READABLE_FORMATS:
+        raise ValueError(f"{path}: checkpoint format {payload.get('format')!r}, expected one of {READABLE_FORMATS}")
     model = GaitNet(GaitNetConfig.from_dict(payload["config"]).model)
     model.load_state_dict(payload["model"])
     model.to(resolve_device(device))
@@ -426,6 +434,8 @@ def train(config: GaitNetConfig, data: GaitSequences, out_path: str | Path, chec
     the validation walks afterwards). ``refit_normalizer``: with ``init``, standardise with this run's training
     walks instead of the initial file's statistics (another corpus, such as real capture after procedural walks).
     """
+    if data.training_data is None:
+        raise ValueError("the training sequences do not say what they are (GaitSequences.training_data)")
     tc = config.train
     dev = resolve_device(device)
     torch.manual_seed(tc.seed)
@@ -464,7 +474,8 @@ def train(config: GaitNetConfig, data: GaitSequences, out_path: str | Path, chec
                         "elapsed_s": elapsed, "device": str(dev), "amp": bool(amp)})
         log(f"epoch {epoch + 1}: train {sums['total']:.4f} val {val.get('total', float('nan')):.4f} "
             f"tf {tf:.3f} ({elapsed / 60:.1f} min)")
-        save_checkpoint(checkpoint_path, model, step.norm, config, optimizer=opt.state_dict(),
+        save_checkpoint(checkpoint_path, model, step.norm, config, training_data=data.training_data,
+                        optimizer=opt.state_dict(),
                         scheduler=sched.state_dict(), epoch=epoch, history=history,
                         numpy_rng=rng.bit_generator.state, torch_gen=gen.get_state(),
                         torch_rng=torch.get_rng_state(), grad_scaler=scaler.state_dict() if scaler else None)
@@ -482,10 +493,8 @@ def train(config: GaitNetConfig, data: GaitSequences, out_path: str | Path, chec
 def _save_weights(path: Path, model: GaitNet, norm: Normalizer, config: GaitNetConfig, history: list[dict],
                   data: GaitSequences, init_info: dict | None) -> None:
     """The small, device-independent weights file (model, config, normaliser, history, provenance)."""
-    save_checkpoint(path, model, norm, config, history=history,
-                    trained_on=getattr(data, "trained_on", "synthetic procedural corpus"),
-                    num_parameters=model.num_parameters(), corpus=getattr(data, "source", None),
-                    initialised_from=init_info)
+    save_checkpoint(path, model, norm, config, training_data=data.training_data, history=history,
+                    num_parameters=model.num_parameters(), initialised_from=init_info)
 
 
 CONFIG_NAMES = ("small", "paper")
@@ -612,7 +621,7 @@ def run(args, log=print) -> dict:
         data = load_corpus_sequences(args.corpus, num_sequences=args.num_sequences, seed=0,
                                      frame_step=config.data.frame_step, seq_len=config.data.seq_len,
                                      offsets=tuple(range(args.offsets)))
-    counts = ", ".join(f"{s}: {int(((data.split == s) & (data.offset == 0)).sum())}" for s in ("train", "val", "test"))
+    counts = ", ".join(f"{s}: {int(((data.split == s) & (data.offset == 0)).sum())}" for s in SPLITS)
     log(f"{len(data)} sequences ({counts}), network {GaitNet(config.model).num_parameters()} parameters")
     result = train(config, data, args.out, args.checkpoint, args.resume, args.max_minutes, progress=not args.quiet,
                    log=log, device=device, amp=amp, init=getattr(args, "init", None),

@@ -8,9 +8,14 @@
   (docs/benchmarks/gait.md).
 
 Plans choose with the gait_net entry field ``weights: real | procedural``; clip metadata records the name.
+
+A weights file says what it was trained on in a typed record, :class:`TrainingData` (``training_data``: its kind,
+procedural or real, the dataset ids, a description and the corpus file), which picks the seed walks and the foot
+clean-up of the walks it makes (:func:`is_real`).
 """
 from __future__ import annotations
 
+from dataclasses import dataclass, field
 from pathlib import Path
 
 WEIGHTS_DIR = Path(__file__).resolve().parent.parent / "data" / "weights"
@@ -27,6 +32,73 @@ def weights_path(name: str | None = None) -> Path:
     return WEIGHTS_DIR / NAMED_WEIGHTS[name]
 
 
-def is_real(info: dict) -> bool:
-    """Whether a weights file's record (``LoadedGaitNet.info``) says it was trained on real capture."""
-    return str(info.get("trained_on", "")).startswith("real capture")
+#: What a gait network can be trained on: the synthetic procedural corpus, or real capture.
+TRAINING_KINDS = ("procedural", "real")
+PROCEDURAL_DESCRIPTION = "synthetic procedural corpus"
+PROCEDURAL_DATASETS = ("procedural-gait-corpus",)
+#: Real-capture training by stage: (description, dataset ids of the real-capture corpus).
+REAL_STAGES = {
+    "pretrain": ("real capture: Bandai Namco datasets 1 and 2 forward locomotion (CC BY-NC 4.0)",
+                 ("bandai-namco-1", "bandai-namco-2")),
+    "finetune": ("real capture: Bandai Namco dataset 1 happy/sad/angry/normal walks (CC BY-NC 4.0)",
+                 ("bandai-namco-1",)),
+}
+
+
+@dataclass(frozen=True)
+class TrainingData:
+    """What a gait network is (or was) trained on.
+
+    Attributes:
+        kind: ``procedural`` (the synthetic procedural corpus) or ``real`` (real capture).
+        description: one line for people (clip metadata ``trained_on``).
+        datasets: ids of the datasets (``procedural-gait-corpus``; ``bandai-namco-1``, ``bandai-namco-2``).
+        corpus: the corpus file read: ``path``, ``sha256`` and, for real capture, ``stage`` and ``augment``.
+    """
+
+    kind: str
+    description: str
+    datasets: tuple[str, ...] = ()
+    corpus: dict | None = field(default=None, compare=False)
+
+    def __post_init__(self):
+        if self.kind not in TRAINING_KINDS:
+            raise ValueError(f"training data kind must be one of {TRAINING_KINDS}, got {self.kind!r}")
+
+    @classmethod
+    def procedural(cls, corpus: dict | None = None) -> TrainingData:
+        return cls("procedural", PROCEDURAL_DESCRIPTION, PROCEDURAL_DATASETS, corpus)
+
+    @classmethod
+    def real(cls, stage: str, corpus: dict | None = None) -> TrainingData:
+        """Real capture of a training stage (:data:`REAL_STAGES`)."""
+        description, datasets = REAL_STAGES[stage]
+        return cls("real", description, datasets, corpus)
+
+    def record(self) -> dict:
+        """The ``training_data`` field of a weights file."""
+        return {"kind": self.kind, "description": self.description, "datasets": list(self.datasets),
+                "corpus": self.corpus}
+
+    @classmethod
+    def from_record(cls, record: dict) -> TrainingData:
+        return cls(record["kind"], record["description"], tuple(record["datasets"]), record.get("corpus"))
+
+
+def training_data_of(payload: dict) -> TrainingData:
+    """The training data of a weights file's payload: its ``training_data`` record (format gait_net/3). A file of
+    format gait_net/2 has only the prose ``trained_on`` and the ``corpus`` record; it is read here, once: a
+    ``trained_on`` that begins "real capture" is real capture of the corpus's ``stage``, anything else the
+    procedural corpus."""
+    if payload.get("format") != "gait_net/2":
+        return TrainingData.from_record(payload["training_data"])
+    corpus = payload.get("corpus")
+    if str(payload.get("trained_on", "")).startswith("real capture"):
+        return TrainingData.real((corpus or {}).get("stage", "finetune"), corpus)
+    return TrainingData.procedural(corpus)
+
+
+def is_real(training: TrainingData) -> bool:
+    """Whether a network (its ``LoadedGaitNet.training_data``) was trained on real capture: that picks its seed
+    walks and its foot clean-up."""
+    return training.kind == "real"

@@ -1,6 +1,7 @@
 """Paths and defaults of the gesture network (seed 003)."""
 from __future__ import annotations
 
+import hashlib
 import os
 from pathlib import Path
 
@@ -37,3 +38,15 @@ def gesture_seconds(n_words: int) -> float:
 def gesture_frames(n_words: int, fps: float = TRAIN_FPS) -> int:
     """Number of frames at ``fps`` of the gesture for a sentence of ``n_words`` words."""
     return int(round(gesture_seconds(n_words) * fps))
+
+
+def generator_fingerprint() -> str:
+    """Hash of the procedural gesture generator's source and the corpus code, so cached pairs (and the observer
+    fitted on them) are rebuilt when it changes."""
+    base = Path(__file__).resolve().parent.parent
+    digest = hashlib.sha1()
+    for name in ("procedural/gesture.py", "procedural/emotion.py", "gesture/data.py", "gesture/config.py"):
+        f = base / name
+        if f.is_file():
+            digest.update(f.read_bytes())
+    return digest.hexdigest()

@@ -35,6 +35,7 @@ import torch
 from generation.core.motion import Motion
 from generation.core.quaternion import np_qfix, np_qnormalize
 from generation.core.skeleton import gesture_skeleton
+from generation.core.splits import SPLITS
 from generation.procedural.emotion import gesture_params_for_vad
 from generation.procedural.gesture import seated_gesture, seated_rest_pose
 from study_protocol import GESTURE_VAD
@@ -43,7 +44,6 @@ from . import config
 from .text import EMBED_DIM, cached_encodings, count_words, pad_tokens
 
 SYNTHETIC_LABEL = "synthetic procedural gestures"
-SPLITS = ("train", "val", "test")
 
 
 class CorpusFormatError(ValueError):
@@ -428,17 +428,6 @@ def progress_features(frames: torch.Tensor, lengths: torch.Tensor, fps: float) -
     return torch.stack(((t / last).clamp(0, 1), ((last - t).clamp_min(0) / fps) / 10.0), dim=-1)
 
 
-def _generator_fingerprint() -> str:
-    """Hash of the procedural generator's source, so cached pairs are rebuilt when it changes."""
-    base = Path(__file__).resolve().parent.parent
-    digest = hashlib.sha1()
-    for name in ("procedural/gesture.py", "procedural/emotion.py", "gesture/data.py", "gesture/config.py"):
-        f = base / name
-        if f.is_file():
-            digest.update(f.read_bytes())
-    return digest.hexdigest()
-
-
 def _make_pairs(rows: list[SentenceRow], variants: int, counterfactual: int, seed: int, fps: float) -> dict:
     """The procedural gestures of every sentence: ``variants`` with the sentence's own emotion, then
     ``counterfactual`` with another emotion drawn uniformly from the rest. Returns arrays sentence_index (N,),
@@ -507,14 +496,14 @@ def build_dataset(variants: int = 2, seed: int = 0, fps: float = config.TRAIN_FP
         pairs = _concat_pairs(pairs, aug_pairs, offset=len(rows))
         split = {**split, **{r.sentence_id: "train" for r in extra}}
         rows = list(rows) + extra
-    return _assemble(pairs, rows, encodings, split, fps)
+    return assemble_dataset(pairs, rows, encodings, split, fps)
 
 
 def _cached_pairs(cache_dir: Path, prefix: str, rows: list[SentenceRow], options: str, make) -> dict:
     """The :func:`_make_pairs` arrays for ``rows``: read from ``cache_dir/<prefix>_<key>.npz`` (the key hashes the
     rows, ``options`` and the generator's source) or made by ``make()`` and written there."""
     src = json.dumps([[r.sentence_id, r.emotion, r.task, r.sentence] for r in rows]) + options
-    key = hashlib.sha1((src + _generator_fingerprint()).encode()).hexdigest()[:12]
+    key = hashlib.sha1((src + config.generator_fingerprint()).encode()).hexdigest()[:12]
     path = cache_dir / f"{prefix}_{key}.npz"
     if path.is_file():
         with np.load(path, allow_pickle=False) as data:
@@ -539,7 +528,7 @@ def _concat_pairs(a: dict, b: dict, offset: int) -> dict:
     return out
 
 
-def _assemble(pairs: dict, rows: list[SentenceRow], encodings: list[np.ndarray], split: dict[str, str],
+def assemble_dataset(pairs: dict, rows: list[SentenceRow], encodings: list[np.ndarray], split: dict[str, str],
               fps: float) -> GestureDataset:
     """A :class:`GestureDataset` from the arrays of :func:`_make_pairs` and the sentences' token vectors."""
 

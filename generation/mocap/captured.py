@@ -5,11 +5,12 @@ Source: DeepMimic (Peng et al., SIGGRAPH 2018) humanoid reference motions as shi
 These are captured human motion (not synthetic) with no emotion labels: one neutral walk cycle and five walker
 clips (straight, two left turns, two right turns), each about 1.3 s at 30 fps.
 
-Retargeting: DeepMimic joints are mapped by name onto the gait skeleton (:data:`DEEPMIMIC_TO_GAIT`); the gait
-skeleton's ``lower_back`` lies on the root-chest line, the hand index tips follow the forearms. Positions are
-scaled by the ratio of hip heights (gait 0.94 m / DeepMimic 0.88 m for a 1.75 m gait body), solved with IK, the
-legs bent with two-bone IK so the heels land where the source's ankles do (keeps the captured foot contacts; foot
-skate stays at the source's 3-8 cm/s), then shifted vertically so the lowest joint over the clip touches y = 0.
+Retargeting: :func:`generation.mocap.retarget.retarget`, the importer's path. DeepMimic joints are mapped by name
+onto the gait skeleton (:func:`generation.mocap.rigs.auto_joint_map`: ankle -> heel, chest -> spine, wrist ->
+hand); the gait skeleton's ``lower_back`` lies on the root-chest line, the hand index tips follow the forearms.
+Positions are scaled by our leg length / DeepMimic's (thigh + shin: 1.011 for a 1.75 m gait body), solved with IK,
+the legs bent with two-bone IK so the heels land where the source's ankles do (keeps the captured foot contacts),
+then shifted vertically so the lowest joint over the clip touches y = 0.
 """
 from __future__ import annotations
 
@@ -37,17 +38,6 @@ WALK_FILES = (
 CREDIT = ("DeepMimic humanoid reference motions (Peng, Abbeel, Levine, van de Panne, SIGGRAPH 2018), from the "
           "CMU Graphics Lab and SFU motion capture databases, distributed with pybullet_data")
 
-#: gait joint <- DeepMimic joint
-DEEPMIMIC_TO_GAIT = {
-    "root": "root",
-    "left_hip": "left_hip", "left_knee": "left_knee", "left_heel": "left_ankle", "left_toe": "left_toe",
-    "right_hip": "right_hip", "right_knee": "right_knee", "right_heel": "right_ankle", "right_toe": "right_toe",
-    "spine": "chest", "neck": "neck", "head": "head",
-    "left_shoulder": "left_shoulder", "left_elbow": "left_elbow", "left_hand": "left_wrist",
-    "right_shoulder": "right_shoulder", "right_elbow": "right_elbow", "right_hand": "right_wrist",
-}
-
-
 def ground(motion: Motion) -> tuple[Motion, float]:
     """Shift the root vertically so the lowest joint over the whole clip is at y = 0; returns (motion, shift m)."""
     shift = -float(motion.positions()[..., 1].min())
@@ -65,7 +55,7 @@ def load_captured_walk(file_name: str, skeleton: Skeleton | None = None) -> Moti
     if source.metadata.get("loop") == "wrap" and _last_is_closure(DATA_DIR / file_name):
         source = source.slice(0, source.num_frames - 1)      # the last frame repeats the first (duration 0)
     target = skeleton or gait_skeleton(REFERENCE_HEIGHT_M, "male")
-    motion = retarget(source, target, DEEPMIMIC_TO_GAIT)
+    motion = retarget(source, target)
     motion, shift = ground(motion)
     motion.metadata = {
         "origin": "captured",

@@ -21,9 +21,21 @@ from pathlib import Path
 
 from study_protocol import GENDERS, MODALITIES
 
+from .bandai_namco import (
+    FAST_CONTENTS,
+    GESTURE_CONTENTS,
+    LOCOMOTION_CONTENTS,
+    SPLIT_RULE,
+    LayoutError,
+    importable_contents,
+)
+from .corpus import build_captured_gait_corpus, load_motions
+from .dataset_import import build_bandai_namco
+from .gesture_corpus import build_gesture_corpus, read_sentences, save_gesture_corpus
 from .importer import REPORT_COLUMNS, SUFFIXES, ImportOptions, import_file
 from .labels import LabelError, compile_pattern, label_for, label_from_pattern, read_labels
 from .positions import LAYOUTS
+from .real_corpus import real_corpus_path
 from .rigs import JOINT_MAP_HELP, RigMapError, load_joint_map
 
 
@@ -81,8 +93,6 @@ def _parser() -> argparse.ArgumentParser:
 
 
 def _add_dataset_parser(sub) -> None:
-    from .bandai_namco import FAST_CONTENTS, GESTURE_CONTENTS, LOCOMOTION_CONTENTS, SPLIT_RULE, importable_contents
-    from .real_corpus import real_corpus_path
 
     def names(table):
         return ", ".join(f"dataset {k}: {' '.join(v)}" for k, v in table.items())
@@ -107,8 +117,6 @@ def _add_dataset_parser(sub) -> None:
 
 
 def run_dataset(args) -> int:
-    from .bandai_namco import LayoutError
-    from .dataset_import import build_bandai_namco
 
     if args.limit is not None and args.limit < 1 or args.workers < 1:
         print("error: --limit and --workers must be at least 1", file=sys.stderr)
@@ -122,7 +130,6 @@ def run_dataset(args) -> int:
 
 
 def run_gesture_corpus(args, motions, problems) -> int:
-    from .gesture_corpus import build_gesture_corpus, read_sentences, save_gesture_corpus
 
     if args.sentences is None:
         print("error: a gesture corpus needs --sentences CSV (source, sentence, task)", file=sys.stderr)
@@ -141,7 +148,6 @@ def run_gesture_corpus(args, motions, problems) -> int:
 
 
 def run_corpus(args) -> int:
-    from .corpus import build_captured_gait_corpus, load_motions
     motions, problems = load_motions(args.paths)
     if args.skeleton == "gesture":
         return run_gesture_corpus(args, motions, problems)

@@ -24,6 +24,9 @@ from pathlib import Path
 
 import numpy as np
 
+from generation.core.quaternion import np_qfix, np_qnormalize
+from generation.gesture import config
+from generation.gesture.text import cached_encodings
 from study_protocol import GESTURE_TASKS, GESTURE_VAD, HANDEDNESS
 
 from .labels import LabelError, open_csv
@@ -68,8 +71,6 @@ def build_gesture_corpus(named_motions, sentences: dict) -> tuple[dict, list[str
 
     Returns (arrays, skipped: one message per Motion left out: not on the gesture skeleton, no gesture emotion
     label, no sentence). ValueError when none is left."""
-    from generation.core.quaternion import np_qfix, np_qnormalize
-    from generation.gesture import config
 
     fps, max_frames = config.TRAIN_FPS, int(round(config.MAX_SECONDS * config.TRAIN_FPS))
     keep, skipped = [], []
@@ -113,9 +114,7 @@ def save_gesture_corpus(arrays: dict, path: str | Path) -> Path:
 def load_gesture_corpus(path: str | Path, seed: int = 0, cache_dir: str | Path | None = None):
     """A ``generation.gesture.data.GestureDataset`` from a corpus file (sentence tokens cached next to the synthetic
     corpus's, in ``cache_dir`` or the gesture package's var folder). ValueError names a bad file."""
-    from generation.gesture import config
-    from generation.gesture.data import SentenceRow, _assemble, split_sentences
-    from generation.gesture.text import cached_encodings
+    from generation.gesture.data import SentenceRow, assemble_dataset, split_sentences  # heavy: torch
 
     path = Path(path)
     try:
@@ -135,4 +134,4 @@ def load_gesture_corpus(path: str | Path, seed: int = 0, cache_dir: str | Path |
     pairs = {"sentence_index": np.arange(len(rows)), "emotion": a["emotion"].astype(str),
              "gender": a["gender"].astype(str), "handedness": a["handedness"].astype(str),
              "lengths": a["lengths"], "rotations": a["rotations"]}
-    return _assemble(pairs, rows, encodings, split_sentences(rows, seed), float(a["fps"]))
+    return assemble_dataset(pairs, rows, encodings, split_sentences(rows, seed), float(a["fps"]))

@@ -1,17 +1,18 @@
 """One motion-capture file -> a Motion on our gait or gesture skeleton, and its report row.
 
-Every input becomes global joint positions first: a BVH through its own forward kinematics (``read_bvh``, any
-hierarchy and channel order), a CSV/NPY position file as it is. Units are ``--scale`` or guessed from the body
-height along the up axis (BVH: the rest pose; positions: the median over the frames): 0.5..3 -> metres,
-50..300 -> centimetres, 500..3000 -> millimetres, else normalised to a 1.7 m body. Then:
+Every input becomes global joint positions first: a BVH through its own forward kinematics
+(:func:`generation.formats.bvh.parse_bvh`, any hierarchy and channel order), a CSV/NPY position file as it is.
+Units are ``--scale`` or guessed from the posed body's height along the up axis (median over the frames) by the
+one unit rule, :func:`generation.formats.units.guess_unit`: 0.5..3 -> metres, 50..300 -> centimetres,
+500..3000 -> millimetres, else normalised to a 1.7 m body. Then:
 1. joints are mapped onto ours by name (:mod:`generation.mocap.rigs`; ``--joint-map`` entries first); a rig
    without the joints we need is an error that lists what the file has;
 2. the up axis is the world axis closest to feet -> head (``up="auto"``) and is turned onto +y by a proper
    rotation (z-up files from 3ds Max, say); facing needs no correction: the IK orients the root freely;
-3. positions are scaled by our leg length / the source's (thigh + shin, median over frames), so strides and root
-   heights fit our legs, placed on our joints, unmapped joints interpolated between mapped neighbours, and solved
-   with the analytic IK of :mod:`generation.core.ik` plus two-bone IK of the legs so the feet land where the
-   source's do (as :func:`generation.formats.bvh.retarget`);
+3. :func:`generation.mocap.retarget.solve_onto` (the one retargeting path): positions are scaled by our leg
+   length / the source's (thigh + shin, median over frames), so strides and root heights fit our legs, placed on
+   our joints, unmapped joints interpolated between mapped neighbours, and solved with the analytic IK of
+   :mod:`generation.core.ik` plus two-bone IK of the legs so the feet land where the source's do;
 4. the error reported is the largest distance between our FK and the scaled source positions of mapped joints:
    zero for a source with our proportions, otherwise how much the bone-length differences show.
 """
@@ -23,14 +24,14 @@ from pathlib import Path
 
 import numpy as np
 
-from generation.core.ik import solve_rotations
 from generation.core.motion import Motion, MotionFormatError
 from generation.core.skeleton import REFERENCE_HEIGHT_M, Skeleton, gait_skeleton, gesture_skeleton
 from generation.formats.bvh import parse_bvh
+from generation.formats.units import guess_unit
 
 from .labels import Label
 from .positions import LAYOUT_MAPS, read_positions
-from .retarget import align_root_to_hips, fill_unmapped_joints, fit_proportions, place_feet_on_source
+from .retarget import leg_length, solve_onto
 from .rigs import auto_joint_map, check_joint_map
 
 BVH_SUFFIXES = (".bvh",)
@@ -56,14 +57,14 @@ def standing_height_m(P: np.ndarray, names, joint_map: dict[str, str]) -> float:
     """Estimated standing height (head top to sole), metres, of a body given as (T, K, 3) positions, y-up.
 
     Rigs place their head joint anywhere from the neck to mid-head and few mark the head top, but hip joint
-    centres are anatomical: the standing hip height is thigh + shin (:func:`_leg_length`) + the ankle's lowest
+    centres are anatomical: the standing hip height is thigh + shin (:func:`leg_length`) + the ankle's lowest
     height (5th percentile) above the floor (the lowest point of the clip), divided by
     :data:`HIP_HEIGHT_FRACTION`. 0 when the legs are not mapped.
     """
     idx = {n: k for k, n in enumerate(names)}
     end = "heel" if "left_heel" in joint_map or "right_heel" in joint_map else "ankle"
     index = {ours: idx[theirs] for ours, theirs in joint_map.items()}
-    leg = _leg_length(P, index, end)
+    leg = leg_length(P, index, end)
     ankles = [index[f"{s}_{end}"] for s in ("left", "right")
               if all(f"{s}_{j}" in index for j in ("hip", "knee", end))]
     if not ankles or leg <= 0:
@@ -132,21 +133,9 @@ class ImportResult:
     seconds: float = 0.0
 
 
-def _guess_unit(height: float) -> tuple[float, str]:
-    if 0.5 <= height <= 3.0:
-        return 1.0, "metres"
-    if 50.0 <= height <= 300.0:
-        return 0.01, "centimetres"
-    if 500.0 <= height <= 3000.0:
-        return 0.001, "millimetres"
-    if height <= 0:
-        raise MotionFormatError("the body has no vertical extent; cannot guess units (give --scale)")
-    return 1.7 / height, "unknown unit, normalised to a 1.7 m body"
-
-
 def load_source(path: Path, options: ImportOptions) -> tuple[np.ndarray, tuple[str, ...], float, dict]:
-    """Global positions (T, K, 3) in file units (up axis not yet corrected), joint names, fps, info (format; for
-    BVH the rest-pose positions (K, 3), whose height along the up axis gives the units)."""
+    """Global positions (T, K, 3) in file units (up axis not yet corrected), joint names, fps and info
+    (``{"format": "bvh" | "csv" | "npy"}``)."""
     if path.suffix.lower() in BVH_SUFFIXES:
         data = parse_bvh(path)
         return data.global_positions(), data.names, data.fps, {"format": "bvh"}
@@ -163,79 +152,6 @@ def _up_axis(P: np.ndarray, names, jm: dict[str, str]) -> str:
     d = (P[:, idx[top]] - P[:, [idx[f] for f in feet]].mean(1)).mean(0)
     k = int(np.argmax(np.abs(d)))
     return ("+" if d[k] >= 0 else "-") + "xyz"[k]
-
-
-def _leg_length(P: np.ndarray, index: dict[str, int], end: str) -> float:
-    """Median over frames of thigh + shin length, mean of the sides present (P (T, J, 3) or (J, 3))."""
-    P = P.reshape(-1, P.shape[-2], 3)
-    sides = []
-    for s in ("left", "right"):
-        hip, knee, foot = (index.get(f"{s}_hip"), index.get(f"{s}_knee"), index.get(f"{s}_{end}"))
-        if None in (hip, knee, foot):
-            continue
-        sides.append(np.median(np.linalg.norm(P[:, hip] - P[:, knee], axis=-1)
-                               + np.linalg.norm(P[:, knee] - P[:, foot], axis=-1)))
-    return float(np.mean(sides)) if sides else 0.0
-
-
-def _place_source(P_src: np.ndarray, names, target: Skeleton, joint_map: dict[str, str], scale: float):
-    """Source positions (T, K, 3) times ``scale`` on the target's joints: (T, J, 3), known (J,), mapped indices."""
-    idx = {n: k for k, n in enumerate(names)}
-    T, J = len(P_src), target.num_joints
-    P = np.zeros((T, J, 3))
-    known = np.zeros(J, bool)
-    for ours, theirs in joint_map.items():
-        P[:, target.index(ours)] = P_src[:, idx[theirs]] * scale
-        known[target.index(ours)] = True
-    return P, known, np.flatnonzero(known)
-
-
-def _solve(P: np.ndarray, known: np.ndarray, mapped: np.ndarray, target: Skeleton, joint_map: dict[str, str],
-           fit: bool = False) -> tuple[Motion, float]:
-    """IK of placed positions onto ``target`` (feet put on the source's): (Motion at fps 1, max mapped error m).
-    With ``fit`` the target first takes the source's rest geometry (:func:`fit_proportions`)."""
-    P = P.copy()
-    known = known.copy()
-    fill_unmapped_joints(P, known, target)
-    if fit:
-        target = fit_proportions(P, known, target)
-    rotations = solve_rotations(P, target, known)
-    P[:, 0] = align_root_to_hips(rotations, P, known, target)
-    rotations = place_feet_on_source(rotations, P, known, target, joint_map)
-    motion = Motion(target, rotations, P[:, 0].copy(), 1.0, {})
-    err = np.linalg.norm(motion.positions()[:, mapped] - P[:, mapped], axis=-1)
-    return motion, float(err.max())
-
-
-def solve_onto(P_src: np.ndarray, names, target: Skeleton, joint_map: dict[str, str],
-               proportions: str = "ours") -> tuple[Motion, float, float, float]:
-    """Mapped source positions (T, K, 3), metres, y-up -> a Motion on our joints.
-
-    The import check always solves onto our joints with the source's bone lengths
-    (:func:`~generation.mocap.retarget.fit_proportions`): its largest error over mapped joints says whether the
-    file was read and solved right (millimetres for a right reading; bone-length changes within a take and rest
-    directions that differ from ours add a few). ``proportions="source"`` returns that motion (the actor's body);
-    ``"ours"`` moves it onto ``target``'s own lengths: positions scaled by our leg length / the source's, feet put
-    where the scaled source's are.
-
-    Returns:
-        (Motion at fps 1, scale applied to the source positions, import error m, retarget error m): the import
-        error of the source-proportioned solve, and the largest mapped-joint distance of the returned motion.
-    """
-    idx = {n: k for k, n in enumerate(names)}
-    P, known, mapped = _place_source(P_src, names, target, joint_map, 1.0)
-    motion, import_err = _solve(P, known, mapped, target, joint_map, fit=True)
-    if proportions == "source":
-        return motion, 1.0, import_err, import_err
-    if proportions != "ours":
-        raise ValueError(f"proportions must be 'source' or 'ours', got {proportions!r}")
-    end = "heel" if "left_heel" in target.joints else "ankle"
-    src_leg = _leg_length(P_src, {ours: idx[theirs] for ours, theirs in joint_map.items()}, end)
-    tgt_leg = _leg_length(target.rest_positions(), {n: j for j, n in enumerate(target.joints)}, end)
-    scale = tgt_leg / src_leg if src_leg > 1e-6 else 1.0
-    P, known, mapped = _place_source(P_src, names, target, joint_map, scale)
-    motion, err = _solve(P, known, mapped, target, joint_map)
-    return motion, scale, import_err, err
 
 
 def import_file(path: str | Path, options: ImportOptions, label: Label | None = None,
@@ -270,7 +186,7 @@ def _import(path: Path, options: ImportOptions, label: Label | None) -> tuple[Mo
         raise ValueError(f"up must be 'auto' or one of {', '.join(_UP_TO_Y)}, got {up!r}")
     P = P @ _UP_TO_Y[up].T
     extent = float(np.median(P[..., 1].max(1) - P[..., 1].min(1)))   # the posed body's height over the frames
-    unit, guess = (options.scale, "given") if options.scale is not None else _guess_unit(extent)
+    unit, guess = (options.scale, "given") if options.scale is not None else guess_unit(extent)
     if not unit > 0:
         raise ValueError(f"--scale must be positive, got {unit}")
     P = P * unit
@@ -294,8 +210,6 @@ def _import(path: Path, options: ImportOptions, label: Label | None) -> tuple[Mo
             "up_axis": up, "source_height_m": info["height_m"],
             "proportions": options.proportions,
             "retarget": {"scale": scale, "joint_map": joint_map, "max_error_m": err, "import_error_m": import_err}}
-    if "ignored_channels" in info:
-        meta["ignored_channels"] = info["ignored_channels"]
     if label is not None:
         meta.update(label.metadata(target.name))
     if options.fps is not None:

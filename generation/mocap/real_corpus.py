@@ -26,6 +26,7 @@ import numpy as np
 
 from generation.core.motion import Motion, MotionFormatError
 from generation.core.skeleton import Skeleton
+from generation.core.splits import SPLITS
 from study_protocol import MODALITIES
 
 REPO_ROOT = Path(__file__).resolve().parents[2]
@@ -33,7 +34,6 @@ DEFAULT_PATH = REPO_ROOT / "var" / "mocap" / "bandai-namco.npz"
 ENV_VAR = "REAL_CORPUS"
 
 DATASETS = ("bandai-namco-1", "bandai-namco-2")
-SPLITS = ("train", "val", "test")
 SKELETON_KINDS = MODALITIES
 LICENCE = "CC BY-NC 4.0"
 CITATION = ("M. Kobayashi, C.-C. Liao, K. Inoue, S. Yojima, M. Takahashi. Motion Capture Dataset for Practical Use "

@@ -1,8 +1,11 @@
-"""Retargeting by joint names: a source motion's positions onto the gait or gesture skeleton with IK.
+"""Retargeting by joint names, the one path: source joint positions onto the gait or gesture skeleton with IK.
 
-Source FK positions, scaled by the ratio of hip heights, are mapped by joint name onto the target and solved with
-:func:`generation.core.ik.solve_rotations`; two-bone IK of the legs then puts the feet where the source's are.
-The importer (:mod:`generation.mocap.importer`) uses the same steps on any file's global joint positions.
+Source positions are mapped by joint name onto ours (:func:`generation.mocap.rigs.auto_joint_map` unless a map is
+given), scaled by our leg length / the source's (thigh + shin, median over frames) so strides and root heights fit
+our legs, unmapped joints interpolated between mapped neighbours, and solved with
+:func:`generation.core.ik.solve_rotations`; the root is moved so our hips land on the source's, and two-bone IK of
+the legs puts the feet where the source's are. :func:`solve_onto` does it on global positions (the importer,
+:mod:`generation.mocap.importer`, for any file); :func:`retarget` on a Motion (the captured DeepMimic walks).
 """
 from __future__ import annotations
 
@@ -14,142 +17,118 @@ from generation.core.motion import Motion
 from generation.core.quaternion import np_qto_matrix
 from generation.core.skeleton import Skeleton
 
-#: Candidate source names per gait-skeleton joint (first present wins): Mixamo/Unity-style, CMU-style
-#: (cgspeed conversion), our own skeletons and the DeepMimic humanoid.
-GAIT_NAME_CANDIDATES: dict[str, tuple[str, ...]] = {
-    "root": ("Hips", "hips", "Hip", "pelvis", "root"),
-    "left_hip": ("LeftUpLeg", "LeftHip", "LeftThigh", "LHip", "left_hip"),
-    "left_knee": ("LeftLeg", "LeftKnee", "LeftShin", "LKnee", "left_knee"),
-    "left_heel": ("LeftFoot", "LeftAnkle", "LAnkle", "left_heel", "left_ankle"),
-    "left_toe": ("LeftToeBase", "LeftToe", "LeftToe_End", "LeftFoot_end", "left_toe", "left_heel_end"),
-    "right_hip": ("RightUpLeg", "RightHip", "RightThigh", "RHip", "right_hip"),
-    "right_knee": ("RightLeg", "RightKnee", "RightShin", "RKnee", "right_knee"),
-    "right_heel": ("RightFoot", "RightAnkle", "RAnkle", "right_heel", "right_ankle"),
-    "right_toe": ("RightToeBase", "RightToe", "RightToe_End", "RightFoot_end", "right_toe", "right_heel_end"),
-    "lower_back": ("LowerBack", "Spine", "spine", "lower_back", "chest"),
-    "spine": ("Spine2", "Spine1", "Chest", "chest3", "chest4", "spine"),
-    "neck": ("Neck", "neck"),
-    "head": ("Head", "head", "Neck1", "Neck_end", "neck_end"),
-    "left_shoulder": ("LeftArm", "LeftShoulder", "LeftUpperArm", "left_shoulder"),
-    "left_elbow": ("LeftForeArm", "LeftElbow", "LeftLowerArm", "left_elbow"),
-    "left_hand": ("LeftHand", "LeftWrist", "left_hand", "left_wrist"),
-    "left_hand_index": ("LeftHandIndex1", "LeftHandMiddle1", "LeftFingerBase", "LeftHand_end", "left_hand_index",
-                        "left_wrist_end"),
-    "right_shoulder": ("RightArm", "RightShoulder", "RightUpperArm", "right_shoulder"),
-    "right_elbow": ("RightForeArm", "RightElbow", "RightLowerArm", "right_elbow"),
-    "right_hand": ("RightHand", "RightWrist", "right_hand", "right_wrist"),
-    "right_hand_index": ("RightHandIndex1", "RightHandMiddle1", "RightFingerBase", "RightHand_end",
-                         "right_hand_index", "right_wrist_end"),
-}
-#: Candidate source names per gesture-skeleton joint.
-GESTURE_NAME_CANDIDATES: dict[str, tuple[str, ...]] = {
-    "root": ("Hips", "hips", "Hip", "pelvis", "root"),
-    "chest": ("Spine", "LowerBack", "chest"),
-    "chest2": ("Spine1", "chest2"),
-    "chest3": ("Spine2", "Chest", "chest3"),
-    "chest4": ("Spine3", "UpperChest", "Chest2", "chest4"),
-    "neck": ("Neck", "neck"),
-    "head": ("Head", "head", "Neck1"),
-    "left_collar": ("LeftShoulder", "LeftCollar", "LeftClavicle", "left_collar"),
-    "left_shoulder": ("LeftArm", "LeftUpperArm", "left_shoulder"),
-    "left_elbow": ("LeftForeArm", "LeftElbow", "LeftLowerArm", "left_elbow"),
-    "left_wrist": ("LeftHand", "LeftWrist", "left_wrist", "left_hand"),
-    "right_collar": ("RightShoulder", "RightCollar", "RightClavicle", "right_collar"),
-    "right_shoulder": ("RightArm", "RightUpperArm", "right_shoulder"),
-    "right_elbow": ("RightForeArm", "RightElbow", "RightLowerArm", "right_elbow"),
-    "right_wrist": ("RightHand", "RightWrist", "right_wrist", "right_hand"),
-    "left_hip": ("LeftUpLeg", "LeftHip", "LeftThigh", "left_hip"),
-    "left_knee": ("LeftLeg", "LeftKnee", "LeftShin", "left_knee"),
-    "left_ankle": ("LeftFoot", "LeftAnkle", "left_ankle", "left_heel"),
-    "left_toe": ("LeftToeBase", "LeftToe", "LeftToe_End", "LeftFoot_end", "left_toe"),
-    "right_hip": ("RightUpLeg", "RightHip", "RightThigh", "right_hip"),
-    "right_knee": ("RightLeg", "RightKnee", "RightShin", "right_knee"),
-    "right_ankle": ("RightFoot", "RightAnkle", "right_ankle", "right_heel"),
-    "right_toe": ("RightToeBase", "RightToe", "RightToe_End", "RightFoot_end", "right_toe"),
-}
+from .rigs import auto_joint_map
 
 
-def default_joint_map(source: Skeleton, target: Skeleton) -> dict[str, str]:
-    """Map target joint names to source joint names from the candidate tables (first present name wins).
+def leg_length(P: np.ndarray, index: dict[str, int], end: str) -> float:
+    """Median over frames of thigh + shin length, mean of the sides present (P (T, J, 3) or (J, 3))."""
+    P = P.reshape(-1, P.shape[-2], 3)
+    sides = []
+    for s in ("left", "right"):
+        hip, knee, foot = (index.get(f"{s}_hip"), index.get(f"{s}_knee"), index.get(f"{s}_{end}"))
+        if None in (hip, knee, foot):
+            continue
+        sides.append(np.median(np.linalg.norm(P[:, hip] - P[:, knee], axis=-1)
+                               + np.linalg.norm(P[:, knee] - P[:, foot], axis=-1)))
+    return float(np.mean(sides)) if sides else 0.0
 
-    The target must be the gait or gesture skeleton (by joint names); joints with no candidate present are left
-    out (retarget interpolates or keeps them straight).
+
+def _place_source(P_src: np.ndarray, names, target: Skeleton, joint_map: dict[str, str], scale: float):
+    """Source positions (T, K, 3) times ``scale`` on the target's joints: (T, J, 3), known (J,), mapped indices."""
+    idx = {n: k for k, n in enumerate(names)}
+    T, J = len(P_src), target.num_joints
+    P = np.zeros((T, J, 3))
+    known = np.zeros(J, bool)
+    for ours, theirs in joint_map.items():
+        P[:, target.index(ours)] = P_src[:, idx[theirs]] * scale
+        known[target.index(ours)] = True
+    return P, known, np.flatnonzero(known)
+
+
+def _solve(P: np.ndarray, known: np.ndarray, mapped: np.ndarray, target: Skeleton, joint_map: dict[str, str],
+           fit: bool = False, foot_ik: bool = True) -> tuple[Motion, float]:
+    """IK of placed positions onto ``target`` (with ``foot_ik``, feet put on the source's): (Motion at fps 1, max
+    mapped error m). With ``fit`` the target first takes the source's rest geometry (:func:`fit_proportions`)."""
+    P = P.copy()
+    known = known.copy()
+    fill_unmapped_joints(P, known, target)
+    if fit:
+        target = fit_proportions(P, known, target)
+    rotations = solve_rotations(P, target, known)
+    P[:, 0] = align_root_to_hips(rotations, P, known, target)
+    if foot_ik:
+        rotations = place_feet_on_source(rotations, P, known, target, joint_map)
+    motion = Motion(target, rotations, P[:, 0].copy(), 1.0, {})
+    err = np.linalg.norm(motion.positions()[:, mapped] - P[:, mapped], axis=-1)
+    return motion, float(err.max())
+
+
+def leg_scale(P_src: np.ndarray, names, target: Skeleton, joint_map: dict[str, str]) -> float:
+    """Our leg length / the source's (thigh + shin, median over frames; 1 when the source's legs are not mapped)."""
+    idx = {n: k for k, n in enumerate(names)}
+    end = "heel" if "left_heel" in target.joints else "ankle"
+    src_leg = leg_length(P_src, {ours: idx[theirs] for ours, theirs in joint_map.items()}, end)
+    tgt_leg = leg_length(target.rest_positions(), {n: j for j, n in enumerate(target.joints)}, end)
+    return tgt_leg / src_leg if src_leg > 1e-6 else 1.0
+
+
+def solve_onto(P_src: np.ndarray, names, target: Skeleton, joint_map: dict[str, str],
+               proportions: str = "ours", foot_ik: bool = True) -> tuple[Motion, float, float, float]:
+    """Mapped source positions (T, K, 3), metres, y-up -> a Motion on our joints.
+
+    The import check always solves onto our joints with the source's bone lengths
+    (:func:`fit_proportions`): its largest error over mapped joints says whether the file was read and solved
+    right (millimetres for a right reading; bone-length changes within a take and rest directions that differ
+    from ours add a few). ``proportions="source"`` returns that motion (the actor's body); ``"ours"`` moves it
+    onto ``target``'s own lengths: positions scaled by :func:`leg_scale`, feet put where the scaled source's are
+    (``foot_ik=False``: directions only).
+
+    Returns:
+        (Motion at fps 1, scale applied to the source positions, import error m, retarget error m): the import
+        error of the source-proportioned solve, and the largest mapped-joint distance of the returned motion.
     """
-    table = GAIT_NAME_CANDIDATES if "left_hand_index" in target.joints else GESTURE_NAME_CANDIDATES
-    present = set(source.joints)
-    out = {}
-    for name in target.joints:
-        for cand in table.get(name, ()):
-            if cand in present:
-                out[name] = cand
-                break
-    return out
-
-
-def _leg_height(skeleton: Skeleton) -> float:
-    """Root height above the lowest rest joint, or the rest vertical extent when the root is at the bottom."""
-    rest = skeleton.rest_positions()
-    extent = float(rest[:, 1].max() - rest[:, 1].min())
-    h = skeleton.root_height()
-    return h if h > 0.2 * extent else extent
+    P, known, mapped = _place_source(P_src, names, target, joint_map, 1.0)
+    motion, import_err = _solve(P, known, mapped, target, joint_map, fit=True)
+    if proportions == "source":
+        return motion, 1.0, import_err, import_err
+    if proportions != "ours":
+        raise ValueError(f"proportions must be 'source' or 'ours', got {proportions!r}")
+    scale = leg_scale(P_src, names, target, joint_map)
+    P, known, mapped = _place_source(P_src, names, target, joint_map, scale)
+    motion, err = _solve(P, known, mapped, target, joint_map, foot_ik=foot_ik)
+    return motion, scale, import_err, err
 
 
 def retarget(motion: Motion, target_skeleton: Skeleton, joint_map: dict[str, str] | None = None,
              metadata: dict | None = None, foot_ik: bool = True) -> Motion:
-    """Move a motion onto another skeleton by matching joints by name.
-
-    The source's FK positions are scaled by target hip height / source hip height (so strides and root heights
-    fit the target's legs), mapped target joint <- source joint, and solved with IK on the target (bone lengths
-    of the target are kept; directions come from the source). Target joints without a mapping are placed on the
-    line between their nearest mapped ancestor and descendant in proportion to rest bone lengths, or, for
-    leaves, keep the identity local rotation.
-
-    With ``foot_ik`` (default) each mapped leg chain (``<side>_hip`` - ``<side>_knee`` - ``<side>_heel`` or
-    ``_ankle``) is then bent with two-bone IK so the heel/ankle lands exactly on the scaled source position, and
-    the foot's children point where the source's do. Matching directions alone would move the feet with every
-    difference in leg proportions and make planted feet slide; this keeps the source's foot contacts.
+    """A Motion moved onto another skeleton by joint names: :func:`solve_onto` of its FK positions onto our
+    proportions, at the source's fps.
 
     Args:
         motion: source Motion.
         target_skeleton: e.g. ``gait_skeleton()``.
-        joint_map: {target joint name: source joint name}; default :func:`default_joint_map`. The root must be
-            mapped.
+        joint_map: {target joint name: source joint name}; default :func:`generation.mocap.rigs.auto_joint_map`.
+            The root must be mapped.
         metadata: merged over a copy of the source metadata.
+        foot_ik: put the feet where the scaled source's are (default), else match directions only.
 
     Returns:
-        Motion on ``target_skeleton`` at the source fps; metadata gains ``retarget`` (scale, map, IK error of the
-        mapped joints in metres).
+        Motion on ``target_skeleton`` at the source fps; metadata gains ``retarget`` (source skeleton, scale, map,
+        largest error of the mapped joints and the import check's, in metres).
     """
-    src = motion.skeleton
-    tgt = target_skeleton
-    joint_map = dict(default_joint_map(src, tgt) if joint_map is None else joint_map)
+    src, tgt = motion.skeleton, target_skeleton
+    joint_map = dict(auto_joint_map(src.joints, tgt) if joint_map is None else joint_map)
     for t_name, s_name in joint_map.items():
         tgt.index(t_name)
         src.index(s_name)
-    root_name = tgt.joints[0]
-    if root_name not in joint_map:
-        raise ValueError(f"retarget: the target root {root_name!r} must be mapped (joint_map has {sorted(joint_map)})")
-    scale = _leg_height(tgt) / _leg_height(src)
-    src_pos = motion.positions() * scale
-    T, J = motion.num_frames, tgt.num_joints
-    P = np.zeros((T, J, 3))
-    known = np.zeros(J, bool)
-    for t_name, s_name in joint_map.items():
-        P[:, tgt.index(t_name)] = src_pos[:, src.index(s_name)]
-        known[tgt.index(t_name)] = True
-    fill_unmapped_joints(P, known, tgt)
-    rotations = solve_rotations(P, tgt, known)
-    P[:, 0] = align_root_to_hips(rotations, P, known, tgt)
-    if foot_ik:
-        rotations = place_feet_on_source(rotations, P, known, tgt, joint_map)
-    meta = dict(motion.metadata)
-    meta.update(metadata or {})
-    out = Motion(tgt, rotations, P[:, 0].copy(), motion.fps, meta)
-    mapped = [tgt.index(n) for n in joint_map]
-    err = np.linalg.norm(out.positions()[:, mapped] - P[:, mapped], axis=-1)
-    meta["retarget"] = {"source_skeleton": src.name, "scale": scale, "joint_map": joint_map,
-                        "max_error_m": float(err.max()), "mean_error_m": float(err.mean())}
-    return out
+    if tgt.joints[0] not in joint_map:
+        raise ValueError(f"retarget: the target root {tgt.joints[0]!r} must be mapped (joint_map has "
+                         f"{sorted(joint_map)})")
+    solved, scale, import_err, err = solve_onto(motion.positions(), src.joints, tgt, joint_map, foot_ik=foot_ik)
+    meta = {**motion.metadata, **(metadata or {})}
+    meta["retarget"] = {"source_skeleton": src.name, "scale": scale, "joint_map": joint_map, "max_error_m": err,
+                        "import_error_m": import_err}
+    return Motion(tgt, solved.rotations, solved.root_positions, motion.fps, meta)
 
 
 def align_root_to_hips(rotations: np.ndarray, P: np.ndarray, known: np.ndarray, tgt: Skeleton) -> np.ndarray:

@@ -29,6 +29,7 @@ from generation.core.motion import Motion
 from generation.core.quaternion import np_qconj, np_qfix, np_qmul, np_qrot, np_qslerp
 from generation.core.rigging import smoothstep, yaw_quat
 from generation.core.skeleton import GESTURE_JOINTS, GESTURE_PARENTS, Skeleton, gesture_skeleton
+from generation.procedural.gesture import seated_rest_pose
 
 J = {name: i for i, name in enumerate(GESTURE_JOINTS)}
 #: Joints whose captured local rotations are kept as they are (spine above the lower chest, neck, head).
@@ -140,7 +141,6 @@ def seat_gesture(motion: Motion, build: str | None = None) -> Motion:
         copied plus ``seated: True`` and ``seating`` (method, arm_capture_share per arm: mean weight of the
         captured arm, min_clearance_m: the smallest wrist clearance reached, heading_deg removed).
     """
-    from generation.procedural.gesture import seated_rest_pose
 
     if tuple(motion.skeleton.joints) != GESTURE_JOINTS or motion.num_frames < 2:
         raise SeatingError(f"seat_gesture needs a motion on the 23-joint gesture skeleton with >= 2 frames, got "

@@ -1,12 +1,13 @@
 """Jobs of a plan: each entry resolved to the generator that will run (or its fallback), hashed to its clip id,
-with the plan's quality thresholds and the torch device of the network generators."""
+with the plan's quality thresholds, the gait observer that reads it and the torch device of the network
+generators."""
 from __future__ import annotations
 
 from dataclasses import dataclass
 
 from generation.plans.clipgen import ClipGenerationError, generator_version, resolve
 from generation.plans.schema import ClipEntry, Plan, clip_hash
-from generation.quality.checks import resolve_thresholds
+from generation.quality.checks import gait_observer_kind, resolve_thresholds
 
 
 @dataclass
@@ -22,12 +23,16 @@ class Job:
     # torch device of the network generators, fixed where the jobs are planned and carried to every worker
     # (local processes and Dask workers on other machines alike)
     device: str = "cpu"
+    # the gait observer that reads the clip (real or synthetic): the plan's ``qa: {observer: ...}`` or the caller's
+    gait_observer: str = "real"
 
 
-def plan_jobs(plan: Plan, limit: int | None = None, device: str = "cpu") -> tuple[list[Job], list[tuple[str, str]]]:
-    """Jobs for the plan's entries (first ``limit``) with the network generators on ``device``, and (entry,
-    message) for entries that cannot run."""
+def plan_jobs(plan: Plan, limit: int | None = None, device: str = "cpu",
+              gait_observer: str = "real") -> tuple[list[Job], list[tuple[str, str]]]:
+    """Jobs for the plan's entries (first ``limit``) with the network generators on ``device`` and the plan's gait
+    observer (``gait_observer`` when the plan names none), and (entry, message) for entries that cannot run."""
     thresholds = resolve_thresholds(plan.qa)
+    observer = gait_observer_kind(plan.qa, gait_observer)
     jobs, failures = [], []
     for entry in plan.entries[:limit] if limit else plan.entries:
         try:
@@ -37,5 +42,5 @@ def plan_jobs(plan: Plan, limit: int | None = None, device: str = "cpu") -> tupl
             continue
         version = generator_version(run_entry.generator, run_entry.inputs)
         jobs.append(Job(entry, run_entry, clip_hash(run_entry, run_entry.generator, version), version, reason,
-                        thresholds, device))
+                        thresholds, device, observer))
     return jobs, failures

@@ -1,10 +1,11 @@
 """Quality records of a plan's clips without rendering video (the motion part, the realism measures of gait clips,
 the projected figure height and an observer's reading: for gait clips the real-capture observer, or the synthetic
-one when the plan's ``qa: {observer: synthetic}`` or ``QA_GAIT_OBSERVER=synthetic`` asks; for gesture clips the
-synthetic gesture observer), and the per-flag summary that ``generate_clips`` prints.
+one when the plan's ``qa: {observer: synthetic}`` asks or, for a plan that names none, ``gait_observer`` (the
+command line's ``--observer``, default ``$QA_GAIT_OBSERVER`` or real); for gesture clips the synthetic gesture
+observer), and the per-flag summary that ``generate_clips`` prints.
 
     python -m generation.pipeline.plan_qa --plan seed000 [--limit K] [--modality gesture] [--no-figure-height]
-        [--json out.json]
+        [--observer real|synthetic] [--json out.json]
 
 The video render computes the same record for every clip it makes (:func:`generation.pipeline.runner.render_job`).
 """
@@ -12,6 +13,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import os
 import sys
 import time
 from collections import Counter
@@ -20,13 +22,11 @@ from collections.abc import Iterable
 from generation.core.motion import Motion
 from generation.plans.clipgen import make_motion
 from generation.plans.schema import load_plan
-from generation.quality.checks import QAResult, default_observer_kind, evaluate, resolve_thresholds
-from generation.quality.gesture_observer import default_gesture_observer
-from generation.quality.observer import default_observer
-from generation.quality.real_observer import default_real_observer
+from generation.quality.checks import QAResult, evaluate, gait_observer_kind, resolve_thresholds
+from generation.quality.observers import OBSERVERS
 from generation.quality.realism_ranges import out_of_range
 from generation.render.clip import plan_cameras, prepare
-from study_protocol import QA_CHECKS
+from study_protocol import QA_CHECKS, QA_OBSERVERS
 
 from .jobs import plan_jobs
 
@@ -55,18 +55,11 @@ def clip_qa(motion: Motion, settings, thresholds: dict, intended=None, observer=
     return result, camera_info
 
 
-def observer_for(modality: str, kind: str | None = None):
-    """The observer that reads clips of ``modality``: "gait" with ``kind`` "real" (the default, see
-    :func:`generation.quality.checks.default_observer_kind`; :func:`real_observer.default_real_observer`) or
-    "synthetic" (:func:`observer.default_observer`); "gesture": :func:`gesture_observer.default_gesture_observer`.
-    None for other modalities or when it cannot be built (:func:`unread_line` then says why)."""
-    if modality == "gait":
-        if (kind or default_observer_kind()) == "real":
-            return default_real_observer()
-        return default_observer()
-    if modality == "gesture":
-        return default_gesture_observer()
-    return None
+def observer_for(modality: str, kind: str = "real"):
+    """The observer that reads clips of ``modality`` (:data:`generation.quality.observers.OBSERVERS`): "gait" with
+    ``kind`` real or synthetic; "gesture": the synthetic gesture observer. None for other modalities or when it
+    cannot be built (:func:`unread_line` then says why)."""
+    return OBSERVERS.for_modality(modality, kind)
 
 
 def summary_counts(flags: Iterable[str]) -> Counter:
@@ -122,19 +115,21 @@ def unread_line(records: Iterable[dict], gait_kind: str = "real") -> str:
 
 
 def run(plan_name: str, limit: int | None = None, log=print, modality: str | None = None,
-        figure_height: bool = True) -> list[dict]:
+        figure_height: bool = True, gait_observer: str = "real") -> list[dict]:
     """Make every entry's motion and compute its quality record (no video). Returns one row per entry.
 
     ``modality``: only the entries of that modality ("gait" or "gesture"; None: all). ``figure_height=False``
-    skips the camera projection (no ``figure_height`` check, faster)."""
+    skips the camera projection (no ``figure_height`` check, faster). ``gait_observer``: the gait observer when
+    the plan names none (real or synthetic)."""
     plan = load_plan(plan_name)
     thresholds = resolve_thresholds(plan.qa)
-    jobs, failures = plan_jobs(plan, limit)
+    kind = gait_observer_kind(plan.qa, gait_observer)
+    jobs, failures = plan_jobs(plan, limit, gait_observer=kind)
     if modality is not None:
         jobs = [j for j in jobs if j.run_entry.modality == modality]
-    observers = {m: observer_for(m, thresholds["observer"]) for m in sorted({j.run_entry.modality for j in jobs})}
+    observers = {m: observer_for(m, kind) for m in sorted({j.run_entry.modality for j in jobs})}
     if "gait" in observers:
-        log(observer_line(thresholds["observer"], observers["gait"]))
+        log(observer_line(kind, observers["gait"]))
     rows = []
     for job in jobs:
         t0 = time.perf_counter()
@@ -160,9 +155,12 @@ def main(argv=None) -> int:
     ap.add_argument("--limit", type=int, default=None)
     ap.add_argument("--modality", choices=("gait", "gesture"), default=None, help="only the entries of this modality")
     ap.add_argument("--no-figure-height", action="store_true", help="skip the camera projection (figure_height)")
+    ap.add_argument("--observer", choices=QA_OBSERVERS, default=os.environ.get("QA_GAIT_OBSERVER") or "real",
+                    help="the gait observer for a plan that names none (default $QA_GAIT_OBSERVER, else real)")
     ap.add_argument("--json", default=None)
     args = ap.parse_args(argv)
-    rows = run(args.plan, args.limit, modality=args.modality, figure_height=not args.no_figure_height)
+    rows = run(args.plan, args.limit, modality=args.modality, figure_height=not args.no_figure_height,
+               gait_observer=args.observer)
     print(f"plan {args.plan}: {len(rows)} clips; " + summary_line(r["flag"] for r in rows))
     if args.json:
         with open(args.json, "w", encoding="utf-8") as f:

@@ -34,7 +34,12 @@ from .plan_qa import clip_qa, intended_emotion, observer_for
 
 __all__ = ["BatchResult", "Job", "base_record", "plan_jobs", "render_job", "render_job_on_worker", "run_plan"]
 
-RECORD_VERSION = 2  # 2: records carry the quality record ``qa`` and ``qa_flag``
+#: Version of the stored clip records: 2, they carry the quality record ``qa`` and ``qa_flag``; 3, a gait clip's
+#: ``qa`` carries the realism measures. A record of an older version than REMEASURED_FROM is rendered again.
+RECORD_VERSION = 3
+#: The oldest record version whose clip files are kept: its gait clips have their quality record measured again
+#: (:func:`_stale_qa`), its other clips are complete.
+REMEASURED_FROM = 2
 
 
 @dataclass
@@ -87,7 +92,7 @@ def load_done_record(clip_id: str, clips_dir: Path, records_dir: Path, webm: boo
         rec = json.loads(rec_path.read_text(encoding="utf-8"))
     except (OSError, ValueError):
         return None
-    if rec.get("record_version") != RECORD_VERSION or rec.get("clip_id") != clip_id:
+    if not REMEASURED_FROM <= rec.get("record_version", 0) <= RECORD_VERSION or rec.get("clip_id") != clip_id:
         return None
     return rec
 
@@ -156,7 +161,7 @@ def render_job(job: Job, record: dict, clips_dir: str, records_dir: str) -> dict
 
 def _add_qa(record: dict, job: Job, motion, camera: dict) -> None:
     """Measure the clip's quality (:mod:`generation.quality`) into ``record["qa"]`` and ``record["qa_flag"]``."""
-    observer = observer_for(job.run_entry.modality, (job.qa_thresholds or {}).get("observer"))
+    observer = observer_for(job.run_entry.modality, job.gait_observer)
     result, _ = clip_qa(motion, job.run_entry.render, job.qa_thresholds, intended_emotion(job.run_entry.inputs),
                         observer, camera_info=camera)
     record["qa"] = _json_safe(result.as_dict())
@@ -164,12 +169,13 @@ def _add_qa(record: dict, job: Job, motion, camera: dict) -> None:
 
 
 def _stale_qa(done: dict, job: Job) -> bool:
-    """Whether a stored gait clip's quality record predates the realism measures or was read by another gait
-    observer than the plan's (``qa: {observer: ...}``; real by default): then it is measured again."""
+    """Whether a stored gait clip's quality record is measured again: its record is of a version before 3 (no
+    realism measures) or it was read by another gait observer than the plan's (``qa: {observer: ...}``; real by
+    default)."""
     if job.run_entry.modality != "gait":
         return False
-    qa = done.get("qa") or {}
-    return "skate_cm_s" not in qa or qa.get("observer") != (job.qa_thresholds or {}).get("observer")
+    old = done.get("record_version", 0) < 3
+    return old or (done.get("qa") or {}).get("observer") != job.gait_observer
 
 
 def _remeasure_qa(done: dict, job: Job, batch: _Batch) -> None:
@@ -179,6 +185,7 @@ def _remeasure_qa(done: dict, job: Job, batch: _Batch) -> None:
         motion = make_motion(job.run_entry, requested=job.entry.generator, fallback_reason=job.fallback_reason,
                              device=job.device)
         _add_qa(done, job, motion, (done.get("metadata") or {}).get("camera"))
+        done["record_version"] = RECORD_VERSION
     except Exception as exc:  # noqa: BLE001 - the clip's files are fine; only its quality record stays old
         batch.emit("warn", {"clip_id": job.clip_id, "entry": job.entry.id,
                             "message": f"quality record not re-measured ({type(exc).__name__}: {exc})"})
@@ -339,7 +346,7 @@ def _render_dask(batch: _Batch, todo: list[Job], scheduler, threads_per_worker: 
 def run_plan(plan: Plan, clips_dir: str | Path, records_dir: str | Path, media_prefix: str = "clips/",
              workers: int = 1, webm: bool = False, limit: int | None = None,
              on_event: Callable[[str, dict], None] | None = None, threads_per_worker: int = 1,
-             scheduler=None, device: str = "cpu") -> BatchResult:
+             scheduler=None, device: str = "cpu", gait_observer: str = "real") -> BatchResult:
     """Render every entry of ``plan`` that is not already complete.
 
     Args:
@@ -355,6 +362,7 @@ def run_plan(plan: Plan, clips_dir: str | Path, records_dir: str | Path, media_p
         scheduler: a Dask distributed scheduler address (``tcp://host:port``) or Client: render there instead of
             in local processes (``workers`` is then ignored; the workers need the shared media folder).
         device: torch device of the network generators (gait_net, gesture_net), carried to every worker.
+        gait_observer: the gait observer (real or synthetic) that reads the clips of a plan that names none.
     Returns a BatchResult with the records of every clip of the plan that exists now.
     """
     t0 = time.perf_counter()
@@ -362,7 +370,7 @@ def run_plan(plan: Plan, clips_dir: str | Path, records_dir: str | Path, media_p
     clips_dir.mkdir(parents=True, exist_ok=True)
     records_dir.mkdir(parents=True, exist_ok=True)
     emit = on_event or (lambda kind, info: None)
-    jobs, failures = plan_jobs(plan, limit, device)
+    jobs, failures = plan_jobs(plan, limit, device, gait_observer)
     batch = _Batch(clips_dir, records_dir, emit, BatchResult(failed=list(failures)))
     for where, msg in failures:
         emit("fail", {"entry": where, "error": msg})
@@ -372,7 +380,7 @@ def run_plan(plan: Plan, clips_dir: str | Path, records_dir: str | Path, media_p
     if workers > 1 or scheduler is not None:
         for modality in sorted({j.run_entry.modality for j in todo}):
             # train/cache the quality observers once, not in every worker
-            observer_for(modality, (todo[0].qa_thresholds or {}).get("observer"))
+            observer_for(modality, todo[0].gait_observer)
     if scheduler is not None:
         _render_dask(batch, todo, scheduler, threads_per_worker)
     elif workers <= 1 or len(todo) <= 1:

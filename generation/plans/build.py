@@ -30,7 +30,9 @@ from pathlib import Path
 import yaml
 
 from generation.gesture.config import gesture_seconds
+from generation.gesture.data import load_sentences, split_sentences
 from generation.gesture.text import count_words
+from generation.gesture.train import TrainConfig
 from study_protocol import CAPTURE_GESTURE_EMOTIONS, GAIT_EMOTIONS, GESTURE_EMOTIONS, GESTURE_TASKS, THEMES
 
 from .generators.captured import CAPTURED_CLIPS
@@ -101,8 +103,6 @@ def seed000() -> dict:
 def _sentence_splits() -> dict[str, str]:
     """sentence_id -> "train" | "val" | "test" as the gesture network's training split them
     (``generation.gesture.data.split_sentences`` with the training seed)."""
-    from generation.gesture.data import load_sentences, split_sentences  # heavy: torch
-    from generation.gesture.train import TrainConfig  # heavy: torch
 
     return split_sentences(load_sentences(SENTENCES), TrainConfig().seed)
 

@@ -1,8 +1,9 @@
 """Turn a validated plan entry into a Motion with its registered generator (generation.plans.generators).
 
-The network generators (gait_net, gesture_net, rbf: they load torch) import it inside ``make``, so planning,
-hashing and procedural clips never load torch, and a missing or broken network fails only the entries that use
-it, with a message naming the entry (:class:`ClipGenerationError`).
+The optional network generators (gesture_net, rbf, neutral_walk) import their networks inside ``make``, so a
+missing or broken network fails only the entries that use it, with a message naming the entry
+(:class:`ClipGenerationError`; :func:`availability` says why beforehand). gait_net names its weights through
+``generation.gait.weights``, whose package loads torch, so planning loads torch.
 
 A network generator whose weights are not there yet may be replaced by the entry's ``fallback``
 (procedural_walk for gait_net, procedural_gesture for gesture_net). The clip is then recorded with the
@@ -18,6 +19,7 @@ import importlib
 import importlib.util
 from pathlib import Path
 
+from generation.core.digest import cached_file_sha256
 from generation.core.motion import Motion
 from generation.formats.bvh import write_bvh
 
@@ -45,15 +47,6 @@ def availability(generator: str, inputs: PlanInputs | None = None) -> str | None
     if weights is not None and not weights.is_file():
         return f"weights file {weights} is missing"
     return None
-
-
-@functools.cache
-def _file_digest(path: str, size: int, mtime_ns: int) -> str:
-    h = hashlib.sha256()
-    with open(path, "rb") as f:
-        for block in iter(lambda: f.read(1 << 20), b""):
-            h.update(block)
-    return h.hexdigest()[:12]
 
 
 PACKAGE_DIR = Path(__file__).resolve().parent.parent
@@ -133,8 +126,7 @@ def generator_version(generator: str, inputs: PlanInputs | None = None) -> str:
     version = f"{get_generator(generator).version}+src{source_digest(generator)}"
     weights = _weights_file(generator, inputs)
     if weights is not None and weights.is_file():
-        st = weights.stat()
-        version += "+w" + _file_digest(str(weights), st.st_size, st.st_mtime_ns)
+        version += "+w" + cached_file_sha256(weights)[:12]
     return version
 
 

@@ -28,6 +28,7 @@ import numpy as np
 from generation.core.motion import Motion
 from generation.core.paths import PATH_KINDS, random_path
 from generation.core.skeleton import gait_skeleton, gesture_skeleton
+from generation.core.splits import SPLITS
 from study_protocol import GAIT_EMOTIONS, GENDERS, GESTURE_EMOTIONS, GESTURE_TASKS, HANDEDNESS
 
 from .emotion import gait_params_for_emotion, gesture_params_for_vad, simulate_annotators, vad_for
@@ -37,7 +38,6 @@ from .walk import walk
 DEFAULT_DIR = Path("var/corpus")
 GAIT_CORPUS_FILE = "gait_corpus_synthetic.npz"
 GESTURE_CORPUS_FILE = "gesture_corpus_synthetic.npz"
-SPLITS = ("train", "val", "test")
 FORMAT_VERSION = 1
 
 

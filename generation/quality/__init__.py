@@ -5,6 +5,9 @@ Public interface:
     motion_metrics(motion) -> dict          the motion measures (units in the keys)
     evaluate(motion, ...) -> QAResult       measures + failed checks against thresholds
     resolve_thresholds(plan_qa) -> dict     QA_THRESHOLDS (study_protocol) overridden by a plan's ``qa:`` block
+    gait_observer_kind(plan_qa, default)    the gait observer a plan names (``qa: {observer: ...}``), else default
+    observers.Observer, OBSERVERS           the observer protocol (``reads``, ``read(motion) -> reading``) and the
+                                            process's observers, each loaded once per corpus version
     realism.realism_measures(motion)        foot skate / skating ratio / toe skim with height-only contact, stance
                                             knee flexion, pelvis bounce, speed variability (realism.py)
     realism_ranges.realism_thresholds()     the real corpus's ranges of those measures (realism_ranges.json)
@@ -16,8 +19,16 @@ Public interface:
 
 Pure numpy/scikit-learn; no Django, no VTK.
 """
-from .checks import QAResult, QAThresholdError, evaluate, failed_checks, qa_columns, resolve_thresholds
+from .checks import (
+    QAResult,
+    QAThresholdError,
+    evaluate,
+    failed_checks,
+    gait_observer_kind,
+    qa_columns,
+    resolve_thresholds,
+)
 from .metrics import motion_metrics
 
-__all__ = ["QAResult", "QAThresholdError", "evaluate", "failed_checks", "motion_metrics", "qa_columns",
-           "resolve_thresholds"]
+__all__ = ["QAResult", "QAThresholdError", "evaluate", "failed_checks", "gait_observer_kind", "motion_metrics",
+           "qa_columns", "resolve_thresholds"]

@@ -17,7 +17,7 @@ Checks (names in :data:`study_protocol.QA_CHECKS`), each against :data:`study_pr
   the intended ``emotion_label``'s (NRC-VAD arousal, 0..1; the observed arousal is the arousal of the 11 emotions
   weighted by the observer's probabilities). The gesture rule reads arousal, not the top label: the 11 categories
   overlap in VAD (afraid and disgusted differ by at most 0.04 in each dimension) and the observer confuses such
-  neighbours on generated gestures (69 % top-label accuracy, 97 % on the arousal half;
+  neighbours on generated gestures far more often than it misreads their arousal (figures in
   docs/benchmarks/motion_quality.md, "Gesture observer").
 
 - ``realism``: a gait clip whose realism measures (:mod:`generation.quality.realism`: foot speed near the floor,
@@ -26,7 +26,9 @@ Checks (names in :data:`study_protocol.QA_CHECKS`), each against :data:`study_pr
 
 The gait observer is by default the real-capture observer (:mod:`generation.quality.real_observer`, trained on
 real captured walks); the synthetic one (trained on the procedural corpus) is chosen with the plan's
-``qa: {observer: synthetic}`` or the env var ``QA_GAIT_OBSERVER=synthetic``. The gesture observer is synthetic.
+``qa: {observer: synthetic}`` (:func:`gait_observer_kind`) or, for plans that name none, by the caller (the
+``QA_GAIT_OBSERVER`` setting of the web app, ``--observer`` of the command line). The gesture observer is
+synthetic. The observers and their cache: :mod:`generation.quality.observers`.
 Observers are stand-ins for participants; a clip's record keeps the top label (``observed``), its probability
 (``observed_p``), which observer read it (``observer``: real, synthetic or synthetic-gesture) and, for gestures,
 the observed arousal (``observed_arousal``; in the record and Clip.qa, not a clips.csv column). Gesture clips
@@ -36,7 +38,6 @@ descriptors are outside what it was fitted on.
 from __future__ import annotations
 
 import math
-import os
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -47,10 +48,11 @@ from study_protocol import GAIT_EMOTIONS, GESTURE_VAD, QA_CHECKS, QA_COLUMNS, QA
 
 from .metrics import motion_metrics
 from .realism import MEASURES, realism_measures
+from .realism_ranges import out_of_range, realism_thresholds
 
 DOMINANT_SHARE = 0.5
+#: The key of a plan's ``qa:`` block that names the gait observer (the other keys are thresholds).
 OBSERVER_KEY = "observer"
-OBSERVER_ENV = "QA_GAIT_OBSERVER"
 
 
 class QAThresholdError(ValueError):
@@ -80,30 +82,35 @@ class QAResult:
         return cls(values, [f for f in flag.split(";") if f])
 
 
-def default_observer_kind() -> str:
-    """The gait observer when a plan names none: ``$QA_GAIT_OBSERVER`` (real or synthetic), else ``real``."""
-    kind = os.environ.get(OBSERVER_ENV, "").strip() or "real"
+def check_gait_observer(kind, where: str = "gait observer") -> str:
+    """``kind`` when it names a gait observer (:data:`study_protocol.QA_OBSERVERS`: real or synthetic), else
+    QAThresholdError naming ``where`` (the plan field, setting or option it came from)."""
     if kind not in QA_OBSERVERS:
-        raise QAThresholdError(f"{OBSERVER_ENV}={kind!r}: expected one of {', '.join(QA_OBSERVERS)}")
+        raise QAThresholdError(f"{where}: expected one of {', '.join(QA_OBSERVERS)}, got {kind!r}")
     return kind
 
 
-def resolve_thresholds(plan_qa: dict | None = None) -> dict:
-    """QA_THRESHOLDS plus the realism bounds (realism_ranges.json) and the gait observer kind (``observer``:
-    real or synthetic), overridden by a plan's ``qa:`` block; unknown keys and bad values raise
-    QAThresholdError."""
-    from .realism_ranges import realism_thresholds  # here, so that `python -m ...realism_ranges` runs cleanly
+def gait_observer_kind(plan_qa: dict | None, default: str = "real") -> str:
+    """The gait observer that reads a plan's clips: its ``qa: {observer: ...}``, else ``default`` (the caller's
+    setting)."""
+    kind = (plan_qa or {}).get(OBSERVER_KEY)
+    return check_gait_observer(default if kind is None else kind,
+                               "the default gait observer" if kind is None else f"field 'qa.{OBSERVER_KEY}'")
 
-    out = {**QA_THRESHOLDS, **realism_thresholds(), OBSERVER_KEY: default_observer_kind()}
+
+def resolve_thresholds(plan_qa: dict | None = None) -> dict:
+    """The numeric thresholds: QA_THRESHOLDS plus the realism bounds (realism_ranges.json), overridden by a plan's
+    ``qa:`` block (its ``observer`` key names the gait observer, not a threshold: :func:`gait_observer_kind`);
+    unknown keys and bad values raise QAThresholdError."""
+
+    out = {**QA_THRESHOLDS, **realism_thresholds()}
     if plan_qa is None:
         return out
     if not isinstance(plan_qa, dict):
         raise QAThresholdError(f"field 'qa': expected a mapping of thresholds, got {plan_qa!r}")
     for key, value in plan_qa.items():
         if key == OBSERVER_KEY:
-            if value not in QA_OBSERVERS:
-                raise QAThresholdError(f"field 'qa.{key}': expected one of {', '.join(QA_OBSERVERS)}, got {value!r}")
-            out[key] = value
+            check_gait_observer(value, f"field 'qa.{key}'")
             continue
         if key not in out:
             raise QAThresholdError(f"field 'qa.{key}': unknown threshold; expected one of {sorted(out)}")
@@ -145,8 +152,9 @@ def evaluate(motion: Motion, thresholds: dict | None = None, figure_height_frac:
             :class:`generation.quality.real_observer.RealGaitObserver` or the synthetic
             :class:`generation.quality.observer.GaitObserver`) or a
             :class:`generation.quality.gesture_observer.GestureObserver` for gesture motions (23 joints, at least
-            as long as its ``min_seconds``, 2.5 s); each says which motions it ``reads`` and gives their
-            ``qa_values``. None or an observer of the other skeleton: no reading.
+            as long as its ``min_seconds``, 2.5 s): an :class:`generation.quality.observers.Observer`, which says
+            which motions it ``reads`` and ``read`` gives their reading. None or an observer of the other
+            skeleton: no reading.
 
     Gait-skeleton motions also get the realism measures (:data:`generation.quality.realism.MEASURES`; None for
     other skeletons).
@@ -155,7 +163,7 @@ def evaluate(motion: Motion, thresholds: dict | None = None, figure_height_frac:
     values["figure_height_frac"] = None if figure_height_frac is None else round(float(figure_height_frac), 4)
     values["observed"], values["observed_p"], values["observer"] = None, None, None
     if observer is not None and observer.reads(motion):
-        values.update(observer.qa_values(motion))
+        values.update(observer.read(motion))
     gait = motion.skeleton.joints == GAIT_JOINTS and motion.num_frames >= 2
     realism = realism_measures(motion) if gait else dict.fromkeys(MEASURES)
     values.update({k: None if v is None else round(v, 4) for k, v in realism.items()})
@@ -184,7 +192,6 @@ def failed_checks(values: dict, thresholds: dict | None = None, intended=None) -
         limit = th.get("observer_mismatch_p_real") if values.get("observer") == "real" else th["observer_mismatch_p"]
         failed["observer"] = (limit is not None and dominant is not None and observed is not None
                               and p is not None and observed != dominant and p >= limit)
-    from .realism_ranges import out_of_range
 
     failed["realism"] = bool(out_of_range(values, th))
     return [c for c in QA_CHECKS if failed[c]]

@@ -24,8 +24,9 @@ from pathlib import Path
 import numpy as np
 import torch
 
+from generation.core.digest import file_sha256
 from generation.core.paths import straight
-from generation.gait.data import DEFAULT_CORPUS, file_sha256, load_corpus_sequences
+from generation.gait.data import DEFAULT_CORPUS, load_corpus_sequences
 from generation.gait.generate import generate_gaits, load_model
 from generation.procedural.corpus import GaitCorpus, build_and_save
 from study_protocol import GAIT_EMOTIONS

@@ -10,8 +10,9 @@ The descriptors (:func:`motion_descriptors`; also the inputs of the binary arous
 benchmarks/bench_gesture.py) are the mean and standard deviation over frames of the 15 gesture affective features
 plus the peak and mean wrist speed, measured at the corpus frame rate (10 fps; clips are resampled to it first).
 
-``default_gesture_observer()`` trains it once per corpus and generator version and keeps the fitted model in
-``var/quality/gesture_observer_<key>.pkl`` (and in memory per process).
+:func:`load_gesture_observer` trains it once per corpus and generator version and keeps the fitted model in
+``var/quality/gesture_observer_<key>.pkl``; :class:`generation.quality.observers.Observers` keeps it in memory per
+process (keyed by :func:`observer_version`).
 """
 from __future__ import annotations
 
@@ -25,6 +26,8 @@ from generation.core.features import np_gesture_affective_features
 from generation.core.kinematics import np_forward_kinematics
 from generation.core.motion import Motion
 from generation.core.skeleton import GESTURE_JOINTS, gesture_skeleton
+from generation.gesture import config
+from generation.gesture.config import MIN_SECONDS
 from generation.gesture.metrics import wrist_speed_of_positions
 from study_protocol import GESTURE_EMOTIONS, GESTURE_VAD
 
@@ -38,7 +41,6 @@ AROUSAL_SPLIT = 0.5  # NRC-VAD arousal above it: the high-arousal half (8 of the
 #: (11,) NRC-VAD arousal of GESTURE_EMOTIONS, in that order.
 AROUSAL = np.array([GESTURE_VAD[e][1] for e in GESTURE_EMOTIONS])
 N_DESCRIPTORS = 32  # 15 feature means + 15 feature SDs + peak and mean wrist speed
-_DEFAULT: dict[str, GestureObserver] = {}
 
 
 # ---- descriptors (shared with benchmarks/bench_gesture.py) ----------------------------------------------------
@@ -96,6 +98,8 @@ class GestureObserver:
     """
 
     labels = GESTURE_EMOTIONS
+    kind = "synthetic-gesture"
+    source = "synthetic procedural gesture corpus (training split)"
 
     def __init__(self, X: np.ndarray, y, fps: float, C: float = REGULARISATION_C, min_seconds: float = 0.0):
         from sklearn.linear_model import LogisticRegression
@@ -121,7 +125,6 @@ class GestureObserver:
         emotion each gesture performs (``data.emotion``; the counterfactual variants included). ``min_seconds``:
         the shortest of them (2.7 s in the shipped corpus) or the shortest gesture the network makes
         (:data:`generation.gesture.config.MIN_SECONDS`, 2.5 s), whichever is shorter."""
-        from generation.gesture.config import MIN_SECONDS
 
         idx = data.indices("train") if idx is None else np.asarray(idx)
         return cls(corpus_descriptors(data, idx), data.emotion[idx], data.fps, C,
@@ -159,12 +162,12 @@ class GestureObserver:
         """(N, 11) probabilities in GESTURE_EMOTIONS order."""
         return self.proba_features(self.features(motions))
 
-    def qa_values(self, motion: Motion) -> dict:
+    def read(self, motion: Motion) -> dict:
         """The quality record's reading: ``observed`` (top label), ``observed_p`` (its probability) and
         ``observed_arousal`` (what the gesture ``observer`` check compares), and ``observer``: synthetic-gesture."""
         label, p, arousal = self.reading(motion)
         return {"observed": label, "observed_p": round(p, 4), "observed_arousal": round(arousal, 4),
-                "observer": "synthetic-gesture"}
+                "observer": self.kind}
 
     def observe(self, motion: Motion) -> tuple[str, float]:
         """(top label, its probability) for one gesture motion."""
@@ -188,13 +191,10 @@ FEATURE_SOURCES = (REPO_ROOT / "generation" / "core" / "features.py",
 
 def corpus_version() -> str:
     """Key of the corpus and observer version: a hash of the sentence CSV, the procedural generator and corpus
-    code (:func:`generation.gesture.data._generator_fingerprint`), the feature code and this module's source."""
-    from generation.gesture import config
-    from generation.gesture.data import _generator_fingerprint
-
+    code (:func:`generation.gesture.config.generator_fingerprint`), the feature code and this module's source."""
     h = hashlib.sha256()
     h.update(Path(config.SENTENCES_CSV).read_bytes())
-    h.update(_generator_fingerprint().encode())
+    h.update(config.generator_fingerprint().encode())
     for path in (*FEATURE_SOURCES, Path(__file__)):
         h.update(path.read_bytes())
     return h.hexdigest()[:12]
@@ -202,26 +202,29 @@ def corpus_version() -> str:
 
 def train_gesture_observer(data=None) -> GestureObserver:
     """A GestureObserver fitted on the training split of the synthetic gesture corpus (built when missing)."""
-    from generation.gesture.data import build_dataset
+    from generation.gesture.data import build_dataset  # heavy: torch
 
     data = build_dataset() if data is None else data
     return GestureObserver.from_corpus(data)
 
 
-def default_gesture_observer() -> GestureObserver | None:
-    """The observer of the current corpus: from memory, from the cache file, or trained (and cached); None (with
-    a warning) when the corpus cannot be built here (clips then get no gesture observer reading)."""
+def observer_version() -> str | None:
+    """:func:`corpus_version`, or None (with a warning) when the corpus files cannot be read here."""
     try:
-        key = corpus_version()
+        return corpus_version()
     except OSError as exc:
         warnings.warn(f"gesture observer unavailable: {exc}", stacklevel=2)
         return None
-    if key in _DEFAULT:
-        return _DEFAULT[key]
+
+
+def load_gesture_observer() -> GestureObserver | None:
+    """The observer of the current corpus: from the cache file, or trained (and cached); None (with a warning)
+    when the corpus cannot be built here (clips then get no gesture observer reading)."""
+    key = observer_version()
+    if key is None:
+        return None
     try:
-        obs = load_or_build(CACHE_DIR / f"gesture_observer_{key}.pkl", GestureObserver, train_gesture_observer)
+        return load_or_build(CACHE_DIR / f"gesture_observer_{key}.pkl", GestureObserver, train_gesture_observer)
     except Exception as exc:  # noqa: BLE001 - any failure to build the corpus leaves clips without a reading
         warnings.warn(f"gesture observer could not be trained ({type(exc).__name__}: {exc})", stacklevel=2)
         return None
-    _DEFAULT[key] = obs
-    return obs

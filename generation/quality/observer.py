@@ -2,8 +2,9 @@
 time, trained on the synthetic gait corpus's training split (moved here from benchmarks/bench_gait.py, which
 imports it). It stands in for a participant when checking clips; it is not a human judgement.
 
-``default_observer()`` trains it once per corpus version and keeps the fitted model in
-``var/quality/gait_observer_<corpus sha256[:12]>.pkl`` (and in memory per process).
+:func:`load_observer` trains it once per corpus version and keeps the fitted model in
+``var/quality/gait_observer_<corpus sha256[:12]>.pkl``; :class:`generation.quality.observers.Observers` keeps it in
+memory per process (keyed by :func:`observer_version`).
 """
 from __future__ import annotations
 
@@ -11,6 +12,7 @@ from pathlib import Path
 
 import numpy as np
 
+from generation.core.digest import file_sha256
 from generation.core.features import np_gait_affective_features
 from generation.core.motion import Motion
 from generation.core.skeleton import GAIT_JOINTS
@@ -21,7 +23,6 @@ from .pickle_cache import load_or_build
 REPO_ROOT = Path(__file__).resolve().parents[2]
 CACHE_DIR = REPO_ROOT / "var" / "quality"
 FEATURE_CLIP = 10.0
-_DEFAULT: dict[str, GaitObserver] = {}
 
 
 class GaitObserver:
@@ -33,6 +34,8 @@ class GaitObserver:
     """
 
     labels = GAIT_EMOTIONS
+    kind = "synthetic"
+    source = "synthetic procedural gait corpus (training split)"
 
     def __init__(self, train):
         from sklearn.linear_model import LogisticRegression
@@ -65,11 +68,11 @@ class GaitObserver:
         """Whether the quality gate asks this observer about ``motion``: the 21-joint gait skeleton, >= 2 frames."""
         return motion.skeleton.num_joints == len(GAIT_JOINTS) and motion.num_frames >= 2
 
-    def qa_values(self, motion: Motion) -> dict:
+    def read(self, motion: Motion) -> dict:
         """The quality record's reading: ``observed`` (top label), ``observed_p`` (its probability) and
         ``observer``: synthetic."""
         label, p = self.observe(motion)
-        return {"observed": label, "observed_p": round(p, 4), "observer": "synthetic"}
+        return {"observed": label, "observed_p": round(p, 4), "observer": self.kind}
 
     def observe(self, motion: Motion) -> tuple[str, float]:
         """(top label, its probability) for one gait motion."""
@@ -79,7 +82,7 @@ class GaitObserver:
 
 
 def _corpus_path(path: str | Path | None) -> Path:
-    from generation.gait.data import DEFAULT_CORPUS
+    from generation.gait.data import DEFAULT_CORPUS  # heavy: torch (generation.gait loads it)
 
     p = Path(path) if path is not None else DEFAULT_CORPUS
     return p if p.is_absolute() else REPO_ROOT / p
@@ -87,28 +90,29 @@ def _corpus_path(path: str | Path | None) -> Path:
 
 def train_observer(corpus_path: str | Path | None = None) -> GaitObserver:
     """A GaitObserver fitted on the training split (offset 0) of the gait corpus (built when missing)."""
-    from generation.gait.data import load_corpus_sequences
+    from generation.gait.data import load_corpus_sequences  # heavy: torch
 
     data = load_corpus_sequences(_corpus_path(corpus_path))
     train = data.subset((data.split == "train") & (data.offset == 0))
     obs = GaitObserver(train)
-    obs.corpus_sha256 = data.source["sha256"]
+    obs.corpus_sha256 = data.training_data.corpus["sha256"]
     return obs
 
 
-def default_observer(corpus_path: str | Path | None = None) -> GaitObserver | None:
-    """The observer of the current corpus: from memory, from the cache file, or trained (and cached); None when
-    the gait corpus file does not exist (build it with the gait training; clips then get no observer reading)."""
-    from generation.gait.data import file_sha256
-
+def observer_version(corpus_path: str | Path | None = None) -> str | None:
+    """Key of the corpus file's version (path, modification time, size), or None when it does not exist."""
     path = _corpus_path(corpus_path)
     if not path.is_file():
         return None
     st = path.stat()
-    key = f"{path}:{st.st_mtime_ns}:{st.st_size}"   # hash the corpus once per process and version
-    if key in _DEFAULT:
-        return _DEFAULT[key]
+    return f"{path}:{st.st_mtime_ns}:{st.st_size}"
+
+
+def load_observer(corpus_path: str | Path | None = None) -> GaitObserver | None:
+    """The observer of the current corpus: from the cache file, or trained (and cached); None when the gait corpus
+    file does not exist (build it with the gait training; clips then get no observer reading)."""
+    path = _corpus_path(corpus_path)
+    if not path.is_file():
+        return None
     sha = file_sha256(path)
-    obs = load_or_build(CACHE_DIR / f"gait_observer_{sha[:12]}.pkl", GaitObserver, lambda: train_observer(path))
-    _DEFAULT[key] = obs
-    return obs
+    return load_or_build(CACHE_DIR / f"gait_observer_{sha[:12]}.pkl", GaitObserver, lambda: train_observer(path))

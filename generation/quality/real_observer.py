@@ -19,22 +19,27 @@ masculine, happy vs sad) get one binary classifier each on the same descriptors,
 of those styles (:data:`THEME_PAIRS`); the quality gate does not use them, the benchmark reports where they
 separate.
 
-:func:`default_real_observer` trains it once per corpus version (file SHA-256) and keeps it in
-``var/quality/real_gait_observer_<sha[:12]>.pkl``. Without the corpus file it trains on the real walks shipped in
-the repository (generation/data/mocap/bandai-namco/: one take per emotion, nothing held out; the observer says so in
-``source``), and with neither it is None and the gate says that no real observer is available.
+:func:`load_real_observer` trains it once per corpus version (file SHA-256) and keeps it in
+``var/quality/real_gait_observer_<sha[:12]>.pkl`` (in memory: :class:`generation.quality.observers.Observers`).
+Without the corpus file it trains on the real walks shipped in the repository (generation/data/mocap/bandai-namco/:
+one take per emotion, nothing held out; the observer says so in ``source``), and with neither it is None and the
+gate says that no real observer is available.
 """
 from __future__ import annotations
 
-import hashlib
 from collections import Counter
 from pathlib import Path
 
 import numpy as np
 
+from generation.core.digest import file_sha256
 from generation.core.features import np_gait_affective_features
 from generation.core.motion import Motion
 from generation.core.skeleton import GAIT_JOINTS
+from generation.core.windows import windows
+from generation.mocap.bandai_namco import shipped_takes
+from generation.mocap.dataset_import import import_take
+from generation.mocap.real_corpus import load_real_corpus, real_corpus_path
 from study_protocol import CAPTURE_GAIT_EMOTIONS, GAIT_EMOTIONS
 
 from .pickle_cache import load_or_build
@@ -52,18 +57,11 @@ THEME_PAIRS = {
     "happy_vs_sad": (("happy",), ("sad",)),
 }
 EMOTION_DATASET = "bandai-namco-1"
-_DEFAULT: dict[str, RealGaitObserver | None] = {}
 
 
 def window_slices(num_frames: int, fps: float) -> list[slice]:
     """2 s windows with 0.5 s hop (the last window ends at the clip's end); one window for a shorter clip."""
-    w, h = int(round(WINDOW_S * fps)), max(1, int(round(HOP_S * fps)))
-    if num_frames <= w:
-        return [slice(0, num_frames)]
-    starts = list(range(0, num_frames - w + 1, h))
-    if starts[-1] != num_frames - w:
-        starts.append(num_frames - w)
-    return [slice(a, a + w) for a in starts]
+    return windows(num_frames, int(round(WINDOW_S * fps)), int(round(HOP_S * fps)), whole_if_short=True)
 
 
 def window_descriptors(motion: Motion) -> np.ndarray:
@@ -162,21 +160,14 @@ class RealGaitObserver:
         """Whether the quality gate asks this observer about ``motion``: the 21-joint gait skeleton, >= 2 frames."""
         return motion.skeleton.joints == GAIT_JOINTS and motion.num_frames >= 2
 
-    def qa_values(self, motion: Motion) -> dict:
+    def read(self, motion: Motion) -> dict:
         """The quality record's reading: ``observed``, ``observed_p`` and ``observer``: real."""
         label, p = self.observe(motion)
         return {"observed": label, "observed_p": round(p, 4), "observer": self.kind}
 
 
-def corpus_digest(path: Path) -> str:
-    """Hex SHA-256 of the corpus file."""
-    with open(path, "rb") as f:
-        return hashlib.file_digest(f, "sha256").hexdigest()
-
-
 def train_real_observer(corpus_path: str | Path | None = None) -> RealGaitObserver:
     """A RealGaitObserver fitted on the gait takes of the corpus's training split."""
-    from generation.mocap.real_corpus import load_real_corpus, real_corpus_path
 
     path = Path(corpus_path) if corpus_path is not None else real_corpus_path()
     clips = load_real_corpus(path, skeleton="gait", split="train")
@@ -186,8 +177,6 @@ def train_real_observer(corpus_path: str | Path | None = None) -> RealGaitObserv
 def shipped_clips() -> list:
     """The gait takes shipped in the repository (generation/data/mocap/bandai-namco/), imported onto the gait
     skeleton (CorpusClips; a take that fails to import raises)."""
-    from generation.mocap.bandai_namco import shipped_takes
-    from generation.mocap.dataset_import import import_take
 
     out = []
     for take in shipped_takes():
@@ -200,29 +189,27 @@ def shipped_clips() -> list:
     return out
 
 
-def default_real_observer(corpus_path: str | Path | None = None) -> RealGaitObserver | None:
-    """The real-capture observer: from memory, from the cache file, or trained (and cached) on the corpus file
-    (default :func:`generation.mocap.real_corpus.real_corpus_path`); without that file, on the shipped real takes
-    (``source`` says so); None when neither is there."""
-    from generation.mocap.real_corpus import real_corpus_path
+def observer_version(corpus_path: str | Path | None = None) -> str:
+    """Key of the corpus file's version (path, modification time, size), or ``shipped`` without the file."""
+    path = Path(corpus_path) if corpus_path is not None else real_corpus_path()
+    if not path.is_file():
+        return "shipped"
+    st = path.stat()
+    return f"{path}:{st.st_mtime_ns}:{st.st_size}"
 
+
+def load_real_observer(corpus_path: str | Path | None = None) -> RealGaitObserver | None:
+    """The real-capture observer: from the cache file, or trained (and cached) on the corpus file (default
+    :func:`generation.mocap.real_corpus.real_corpus_path`); without that file, on the shipped real takes
+    (``source`` says so); None when neither is there."""
     path = Path(corpus_path) if corpus_path is not None else real_corpus_path()
     if path.is_file():
-        st = path.stat()
-        key = f"{path}:{st.st_mtime_ns}:{st.st_size}"
-        if key not in _DEFAULT:
-            sha = corpus_digest(path)
-            _DEFAULT[key] = load_or_build(CACHE_DIR / f"real_gait_observer_v{DESCRIPTOR_VERSION}_{sha[:12]}.pkl",
-                                          RealGaitObserver, lambda: train_real_observer(path))
-        return _DEFAULT[key]
-    key = "shipped"
-    if key not in _DEFAULT:
-        try:
-            clips = shipped_clips()
-        except (FileNotFoundError, ValueError):
-            _DEFAULT[key] = None
-        else:
-            _DEFAULT[key] = RealGaitObserver(
-                clips, source=f"shipped real takes only ({len(clips)} walks, one take per style; no corpus at "
-                              f"{path}; not validated on held-out takes)")
-    return _DEFAULT[key]
+        sha = file_sha256(path)
+        return load_or_build(CACHE_DIR / f"real_gait_observer_v{DESCRIPTOR_VERSION}_{sha[:12]}.pkl",
+                             RealGaitObserver, lambda: train_real_observer(path))
+    try:
+        clips = shipped_clips()
+    except (FileNotFoundError, ValueError):
+        return None
+    return RealGaitObserver(clips, source=f"shipped real takes only ({len(clips)} walks, one take per style; no "
+                                          f"corpus at {path}; not validated on held-out takes)")

@@ -50,6 +50,7 @@ from scipy.ndimage import gaussian_filter1d, uniform_filter1d
 from generation.core.foot_contact import legs
 from generation.core.motion import Motion
 from generation.core.skeleton import REFERENCE_HEIGHT_M, Skeleton
+from generation.core.windows import windows
 
 #: Near-floor height (GMD: 5 cm) for a 1.75 m body; scaled with skeleton.height / 1.75.
 CONTACT_HEIGHT_M = 0.05
@@ -127,8 +128,7 @@ def knee_flexion_deg(positions: np.ndarray, skeleton: Skeleton) -> np.ndarray:
 
 def _windows(T: int, fps: float) -> list[slice]:
     """1 s windows with 0.5 s hop over T frames (none when the clip is shorter than a window)."""
-    w, h = max(2, int(round(WINDOW_S * fps))), max(1, int(round(HOP_S * fps)))
-    return [slice(a, a + w) for a in range(0, T - w + 1, h)]
+    return windows(T, max(2, int(round(WINDOW_S * fps))), int(round(HOP_S * fps)), to_end=False)
 
 
 def pelvis_bounce_cm(positions: np.ndarray, fps: float) -> float | None:

@@ -30,6 +30,8 @@ from pathlib import Path
 
 import numpy as np
 
+from generation.mocap.real_corpus import load_real_corpus, read_meta, real_corpus_path
+
 from .realism import MEASURES, UNITS, realism_measures
 
 RANGES_PATH = Path(__file__).with_name("realism_ranges.json")
@@ -140,7 +142,6 @@ def measure_corpus(clips) -> list[dict]:
 
 
 def main(argv=None) -> int:
-    from generation.mocap.real_corpus import load_real_corpus, read_meta, real_corpus_path
 
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--corpus", default=None, help="real-capture corpus (default: $REAL_CORPUS or var/mocap/)")

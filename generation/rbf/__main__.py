@@ -11,6 +11,13 @@ from __future__ import annotations
 import argparse
 import sys
 
+from generation.core.skeleton import GAIT_JOINTS
+from generation.mocap.real_corpus import load_real_corpus, real_corpus_path
+
+from .data_features import SHIPPED_PATH as FEATURES_PATH
+from .data_features import fit_data_features, save_data_features
+from .real_neutral import SHIPPED_PATH, build_real_neutral
+
 
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog="python -m generation.rbf", description=__doc__.splitlines()[0])
@@ -22,7 +29,6 @@ def main(argv: list[str] | None = None) -> int:
         p.add_argument("--out", default=None, help="output file (default: the shipped file in generation/data/rbf)")
     args = parser.parse_args(argv)
     if args.command == "neutral":
-        from .real_neutral import SHIPPED_PATH, build_real_neutral
 
         cycle = build_real_neutral(args.corpus, args.out or SHIPPED_PATH)
         md = cycle.metadata
@@ -30,11 +36,7 @@ def main(argv: list[str] | None = None) -> int:
               f"stride {md['stride_m'][2]:.3f} m, DTW spread {md['dtw_spread']['before']:.5f} -> "
               f"{md['dtw_spread']['after']:.5f} heights -> {args.out or SHIPPED_PATH}")
         return 0
-    from generation.core.skeleton import GAIT_JOINTS
-    from generation.mocap.real_corpus import load_real_corpus, real_corpus_path
 
-    from .data_features import SHIPPED_PATH as FEATURES_PATH
-    from .data_features import fit_data_features, save_data_features
 
     clips = load_real_corpus(args.corpus or real_corpus_path(), skeleton="gait", split="train", contents=["walk"])
     features = fit_data_features(clips, GAIT_JOINTS)

@@ -30,8 +30,11 @@ from dataclasses import dataclass
 import numpy as np
 
 from generation.core.features import detect_foot_contacts, foot_joints
+from generation.core.ik import inverse_kinematics
 from generation.core.motion import Motion
 from generation.core.skeleton import GAIT_JOINTS, Skeleton, gait_skeleton
+from generation.mocap.captured import captured_walks, chain_clip_repeats
+from generation.procedural.walk import WalkParams, walk
 
 TIME_WARPING = "contact-based piecewise-linear (left heel strike -> 0, right -> m/2, next left -> m)"
 DEFAULT_BODIES = ((1.58, "female"), (1.66, "female"), (1.74, "female"), (1.70, "male"), (1.78, "male"),
@@ -213,7 +216,6 @@ def cycle_motion(mean: np.ndarray, stride: float, duration: float, skeleton: Ske
     Returns:
         Motion of m frames at fps = m / duration whose root advances ``metadata["stride_m"]`` per cycle along +z.
     """
-    from generation.core.ik import inverse_kinematics
 
     m = mean.shape[0]
     H = skeleton.height
@@ -237,7 +239,6 @@ def default_sources(n_frames_s: float = 3.3, fps: float = 100.0, include_capture
     a different footprint-jitter seed. Captured walks are included only when ``generation.mocap.captured`` exists and
     yields gait-skeleton motions.
     """
-    from generation.procedural.walk import WalkParams, walk
 
     sources = []
     for i, (height, build) in enumerate(DEFAULT_BODIES):
@@ -262,17 +263,13 @@ def _is_straight(motion: Motion, max_turn_deg: float = 20.0) -> bool:
 
 
 def captured_sources() -> list[Motion]:
-    """Real captured straight walks on the gait skeleton from :mod:`generation.mocap.captured`, or [] if unavailable.
+    """Real captured straight walks on the gait skeleton from :mod:`generation.mocap.captured`.
 
     Turning clips (described as turning, or turning by more than 20 degrees) are left out: the paper averaged
     straight walks. A loopable clip (``loop == "wrap"``) is
     repeated three times so a full left-right-left cycle can be cut from it; ``max_cycles`` = 1 in the metadata
     tells :func:`neutral_cycle_from_motions` to keep only its first cycle, so the repeat does not count twice.
     """
-    try:
-        from generation.mocap.captured import captured_walks, chain_clip_repeats
-    except ImportError:
-        return []
     out = []
     for mo in captured_walks():
         turning = "turn" in str(mo.metadata.get("description", "")).lower()

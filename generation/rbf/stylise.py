@@ -25,6 +25,7 @@ from __future__ import annotations
 import numpy as np
 import torch
 
+from generation.core.features import foot_joints
 from generation.core.foot_contact import plant_feet
 from generation.core.kinematics import forward_kinematics, np_forward_kinematics
 from generation.core.motion import Motion
@@ -32,6 +33,7 @@ from generation.core.quaternion import np_qbetween, np_qconj, np_qfix, np_qmul, 
 from generation.core.skeleton import Skeleton
 
 from .basis import CYCLE_FRAMES, rbf_sum, shape_params, swing_params
+from .data_features import data_rbfs, load_data_features
 from .themes import AXES, BODY_PARTS, THEME_NAMES, theme_features
 
 _MODELLED = frozenset(name for joints in BODY_PARTS.values() for name in joints)
@@ -402,7 +404,6 @@ def stylised_cycle(neutral_cycle: Motion, theme: str, weight: float, n_features:
     if features == "expert":
         S = theme_displacement(P, skel, theme, n_features, exclude=exclude)
     else:
-        from .data_features import data_rbfs
 
         S = rbf_displacement(P, skel, data_rbfs(theme, n_features, skel.height, P.shape[0]), propagate=False)
     Y = P + float(weight) * S
@@ -424,7 +425,6 @@ def keep_feet_above_ground(Y: np.ndarray, P: np.ndarray, skeleton: Skeleton) -> 
     push the planted foot through the floor. Each heel/toe joint's height is clamped to its minimum over the
     neutral cycle. Returns the clamped copy (m, J, 3) and the largest lift applied (metres).
     """
-    from generation.core.features import foot_joints
 
     left, right = foot_joints(skeleton)
     out = Y.copy()
@@ -493,7 +493,6 @@ def stylise(neutral_cycle: Motion, theme: str, weight: float, n_features: int, s
         metadata["excluded_ranks"] = sorted(exclude)
     metadata.update(base_provenance(base_meta))
     if features == "data" and "licence" not in metadata:
-        from .data_features import load_data_features
 
         data = load_data_features()
         metadata.update({"licence": data["licence"], "citation": data["citation"]})

@@ -10,6 +10,8 @@ import dataclasses
 import sys
 from pathlib import Path
 
+from generation.plans.schema import COMMON_FIELDS
+
 from . import registered
 from .registry import GeneratorSpec
 
@@ -28,7 +30,6 @@ def _field_line(spec: GeneratorSpec) -> str:
 
 def render_page() -> str:
     """The Markdown page: one section per registered generator."""
-    from generation.plans.schema import COMMON_FIELDS  # the schema reads this package: imported once it is loaded
 
     common = ", ".join(f"`{name}`" for name in sorted(COMMON_FIELDS))
     lines = ["# Generators", "",

@@ -33,13 +33,13 @@ the retarget error) and the importer's own metadata (source file name, units, up
 from __future__ import annotations
 
 import functools
-import hashlib
 import json
 import math
 import re
 from dataclasses import dataclass
 from pathlib import Path
 
+from generation.core.digest import cached_file_sha256
 from generation.core.motion import Motion, MotionFormatError
 from generation.mocap import ImportOptions, import_file
 from generation.mocap.seated_gesture import seat_gesture
@@ -62,19 +62,9 @@ class CapturedFileError(ValueError):
         self.message = message
 
 
-@functools.lru_cache(maxsize=64)
-def _digest(path: str, size: int, mtime_ns: int) -> str:
-    h = hashlib.sha256()
-    with open(path, "rb") as f:
-        for block in iter(lambda: f.read(1 << 20), b""):
-            h.update(block)
-    return h.hexdigest()[:16]
-
-
 def file_digest(path: Path) -> str:
-    """16 hex digits of the file's SHA-256 (cached by path, size and modification time)."""
-    st = path.stat()
-    return _digest(str(path.resolve()), st.st_size, st.st_mtime_ns)
+    """16 hex digits of the file's SHA-256 (:func:`generation.core.digest.cached_file_sha256`)."""
+    return cached_file_sha256(path)[:16]
 
 
 @functools.lru_cache(maxsize=16)

@@ -10,6 +10,7 @@ import numpy as np
 
 from generation.core.motion import Motion
 from generation.core.paths import path_from_spec
+from generation.gait.generate import emotion_transition, generate_gaits, load_default_model
 from generation.gait.weights import NAMED_WEIGHTS, weights_path
 
 from .fields import choice
@@ -45,7 +46,6 @@ def weights_file(inputs: GaitNetInputs | None) -> Path:
 
 
 def make_gait_net(entry, context: MakeContext) -> Motion:
-    from generation.gait.generate import emotion_transition, generate_gaits, load_default_model  # heavy: torch
 
     inp: GaitNetInputs = entry.inputs
     net = load_default_model(context.device, weights=inp.weights)

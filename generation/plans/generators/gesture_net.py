@@ -7,6 +7,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from generation.core.motion import Motion
+from generation.core.splits import SPLITS
 from generation.gesture.config import gesture_seconds
 from study_protocol import GENDERS, GESTURE_TASKS, HANDEDNESS
 
@@ -17,7 +18,6 @@ from .registry import GeneratorSpec, InputContext, MakeContext, PlanInputs, regi
 WEIGHTS_FILE = Path(__file__).resolve().parents[2] / "data" / "weights" / "gesture_net_default.pt"
 #: Splits of the network's sentence corpus (generation.gesture.data.split_sentences): an entry may record which
 #: one its sentence comes from (held-out inputs are "test").
-SENTENCE_SPLITS = ("train", "val", "test")
 
 
 @dataclass(frozen=True)
@@ -45,7 +45,7 @@ class GestureNetInputs(PlanInputs):
                    choice("gender", raw.get("gender", "female"), GENDERS),
                    choice("handedness", raw.get("handedness", "right"), HANDEDNESS),
                    number("noise", raw.get("noise", 0.0), 0.0, 1.0),
-                   choice("sentence_split", raw["sentence_split"], SENTENCE_SPLITS) if "sentence_split" in raw
+                   choice("sentence_split", raw["sentence_split"], SPLITS) if "sentence_split" in raw
                    else None)
 
 
@@ -57,7 +57,7 @@ def to_procedural_gesture(inputs: GestureNetInputs, fallback: str) -> PlanInputs
 
 
 def make_gesture_net(entry, context: MakeContext) -> Motion:
-    from generation.gesture.generate import generate_gesture  # heavy: torch
+    from generation.gesture.generate import generate_gesture  # torch; optional (clipgen.availability)
 
     inp: GestureNetInputs = entry.inputs
     return generate_gesture(inp.sentence, inp.task, inp.emotion_label, inp.gender, inp.handedness, fps=context.fps,

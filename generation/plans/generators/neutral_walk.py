@@ -44,7 +44,11 @@ class NeutralWalkInputs(PlanInputs):
 
 
 def make_neutral_walk(entry, context: MakeContext) -> Motion:
-    from generation.rbf.stylise import cycle_stride, plant_walk_feet, warp_and_repeat_cycle  # heavy: torch
+    from generation.rbf.stylise import (  # torch; optional (clipgen.availability)
+        cycle_stride,
+        plant_walk_feet,
+        warp_and_repeat_cycle,
+    )
 
     inp: NeutralWalkInputs = entry.inputs
     base = base_cycle(inp.base)

@@ -47,7 +47,7 @@ class RbfInputs(PlanInputs):
 
 
 def make_rbf(entry, context: MakeContext) -> Motion:
-    from generation.rbf.stylise import stylise  # heavy: torch
+    from generation.rbf.stylise import stylise  # torch; optional (clipgen.availability)
 
     inp: RbfInputs = entry.inputs
     motion = stylise(base_cycle(inp.base), inp.theme, inp.weight, inp.n_features, speed=inp.speed,

@@ -24,7 +24,7 @@ from generation.pipeline.plan_qa import summary_line, unread_line
 from generation.pipeline.runner import run_plan
 from generation.plans.catalogue import write_clips_csv
 from generation.plans.schema import PlanError, load_plan
-from generation.quality.checks import resolve_thresholds
+from generation.quality.checks import QAThresholdError, gait_observer_kind
 from generation.render import contact_sheet
 from studyapp.catalogue import clip_label, retire_superseded, upsert_clips
 
@@ -80,6 +80,10 @@ class Command(BaseCommand):
             device = str(resolve_device(opts["device"]))
         except ValueError as exc:
             raise CommandError(f"--device: {exc}") from None
+        try:
+            gait_observer = gait_observer_kind(plan.qa, settings.QA_GAIT_OBSERVER)
+        except QAThresholdError as exc:
+            raise CommandError(f"QA_GAIT_OBSERVER: {exc}") from None
         media_root = Path(settings.MEDIA_ROOT)
         clips_dir = media_root / "clips"
         records_dir = Path(opts["records_dir"]) if opts["records_dir"] else media_root / "clip_records"
@@ -87,7 +91,7 @@ class Command(BaseCommand):
         try:
             result = run_plan(plan, clips_dir, records_dir, media_prefix="clips/", workers=opts["workers"],
                               webm=opts["webm"], limit=opts["limit"], on_event=bars.event,
-                              scheduler=opts["scheduler"], device=device)
+                              scheduler=opts["scheduler"], device=device, gait_observer=gait_observer)
         except OSError as exc:  # e.g. no Dask scheduler at that address
             raise CommandError(f"cannot render: {exc}") from None
         finally:
@@ -110,7 +114,7 @@ class Command(BaseCommand):
                           f"{len(result.failed)} failed, {result.seconds:.1f} s; catalogue {csv_path}")
         if records:
             self.stdout.write(f"plan {plan.name}: " + summary_line(r.get("qa_flag", "") for r in records))
-            if unread := unread_line(records, resolve_thresholds(plan.qa)["observer"]):
+            if unread := unread_line(records, gait_observer):
                 self.stdout.write(f"plan {plan.name}: {unread}")
         if opts["contact_sheet"] is not None and records:
             out = Path(opts["contact_sheet"]) if opts["contact_sheet"] else (

@@ -8,6 +8,7 @@ from __future__ import annotations
 from django.core.management.base import BaseCommand, CommandError
 
 from generation.gesture.train import build_parser, config_from_args, train
+from generation.mocap.gesture_corpus import load_gesture_corpus
 from studyapp.management.cli import mirror_arguments, mirrored_namespace
 
 
@@ -29,7 +30,6 @@ class Command(BaseCommand):
             raise CommandError(str(exc)) from exc
         data = None
         if options.get("corpus"):
-            from generation.mocap.gesture_corpus import load_gesture_corpus  # heavy: torch, only with --corpus
 
             try:
                 data = load_gesture_corpus(options["corpus"], seed=cfg.seed)

@@ -1,0 +1,81 @@
+"""The observers of the quality gate: one protocol and one cache.
+
+An observer stands in for a participant: it reads a clip's motion and says which emotion it shows. Three are
+declared: the real-capture gait observer (:class:`generation.quality.real_observer.RealGaitObserver`, kind
+``real``), the synthetic gait observer (:class:`generation.quality.observer.GaitObserver`, ``synthetic``) and the
+synthetic gesture observer (:class:`generation.quality.gesture_observer.GestureObserver`,
+``synthetic-gesture``). Each module gives its observer's version key (``observer_version``: which corpus it is
+trained on) and a loader (from its pickle file, or trained); :class:`Observers` keeps one of each per version in
+memory, and :data:`OBSERVERS` is the process's.
+"""
+from __future__ import annotations
+
+from collections.abc import Callable
+from pathlib import Path
+from typing import Protocol, runtime_checkable
+
+from generation.core.motion import Motion
+
+from . import gesture_observer, observer, real_observer
+from .checks import check_gait_observer
+
+
+@runtime_checkable
+class Observer(Protocol):
+    """What the quality gate asks of an observer."""
+
+    kind: str      # the record's ``observer`` value: real, synthetic or synthetic-gesture
+    source: str    # what it was trained on, for the logs and the benchmarks
+
+    def reads(self, motion: Motion) -> bool:
+        """Whether the gate asks it about ``motion`` (its skeleton, long enough)."""
+
+    def read(self, motion: Motion) -> dict:
+        """The reading that goes into the quality record: ``observed``, ``observed_p``, ``observer`` (gestures
+        also ``observed_arousal``)."""
+
+
+class Observers:
+    """The observers of one process, each loaded once per version of what it is trained on."""
+
+    def __init__(self) -> None:
+        self._loaded: dict[tuple, Observer | None] = {}
+
+    def _get(self, name: str, version: str | None, load: Callable[[], Observer | None]) -> Observer | None:
+        if version is None:
+            return None
+        key = (name, version)
+        if key not in self._loaded:
+            self._loaded[key] = load()
+        return self._loaded[key]
+
+    def gait(self, kind: str = "real", corpus_path: str | Path | None = None) -> Observer | None:
+        """The ``kind`` gait observer (real or synthetic) of the corpus at ``corpus_path`` (default: its module's
+        default corpus); None when it cannot be built here."""
+        if check_gait_observer(kind) == "real":
+            return self._get("real", real_observer.observer_version(corpus_path),
+                             lambda: real_observer.load_real_observer(corpus_path))
+        return self._get("synthetic", observer.observer_version(corpus_path),
+                         lambda: observer.load_observer(corpus_path))
+
+    def gesture(self) -> Observer | None:
+        """The synthetic gesture observer of the current gesture corpus; None when it cannot be built here."""
+        return self._get("synthetic-gesture", gesture_observer.observer_version(),
+                         gesture_observer.load_gesture_observer)
+
+    def for_modality(self, modality: str, gait_kind: str = "real") -> Observer | None:
+        """The observer that reads clips of ``modality`` ("gait": the ``gait_kind`` one; "gesture"); None for
+        other modalities."""
+        if modality == "gait":
+            return self.gait(gait_kind)
+        if modality == "gesture":
+            return self.gesture()
+        return None
+
+    def clear(self) -> None:
+        """Forget every loaded observer (their pickle files stay)."""
+        self._loaded.clear()
+
+
+#: The observers of this process.
+OBSERVERS = Observers()
