@@ -196,7 +196,7 @@ def pool_queryset(pool: dict | None, include_flagged: bool | None = None) -> Que
         include_flagged = bool((pool or {}).get(INCLUDE_FLAGGED, False))
     normed: set[str] | None = None
     if isinstance((pool or {}).get(NORMS_RULE), dict):
-        from .norms_rule import NormsSourceError, passing_ids
+        from .norms_rule import NormsSourceError, passing_ids  # cycle: norms_rule -> export -> this module
         try:
             passing, normed = passing_ids(pool)
         except NormsSourceError as exc:

@@ -7,6 +7,7 @@ from django import forms
 from django.utils.translation import gettext
 from django.utils.translation import gettext_lazy as _
 
+from analysis.exclusion import rule_errors
 from study_pools import SUB_POOLS
 
 from . import pool_editor
@@ -166,12 +167,6 @@ class StudyAdminForm(forms.ModelForm):
     def clean_exclusion_rules(self):
         rules = self.cleaned_data.get("exclusion_rules")
         rules = {} if rules is None else rules
-        try:
-            from analysis.exclusion import rule_errors  # optional: the analysis library may be absent
-        except ImportError as exc:
-            raise forms.ValidationError(
-                "analysis library not installed: the exclusion rules cannot be checked (analysis.exclusion."
-                "rule_errors is missing)") from exc
         errors = rule_errors(rules)
         if errors:
             raise forms.ValidationError(errors)

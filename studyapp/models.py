@@ -219,8 +219,7 @@ class Section(models.Model):
             errors.setdefault("options", []).append(f"'practice_clip': no clip {practice_clip!r} in the catalogue")
         pool = self.pool if isinstance(self.pool, dict) else {}
         if isinstance(pool.get(NORMS_RULE), dict) and "pool" not in errors:
-            # norms_rule reads these models: imported when used
-            from .norms_rule import NormsSourceError, load_norms
+            from .norms_rule import NormsSourceError, load_norms  # cycle: norms_rule reads these models
             try:
                 load_norms(pool[NORMS_RULE].get("from", ""))
             except NormsSourceError as exc:

@@ -23,8 +23,12 @@ from pathlib import Path
 
 from django.conf import settings
 
+from analysis import exclusion
+from analysis.io import StudyData, ValidationError, load_study
+from analysis.norms import clip_norms, read_clip_norms
 from study_pools import NORMS_RULE
 
+from .export import stream_csv
 from .models import Clip, Response, Study
 
 
@@ -62,8 +66,6 @@ def _from_file(source: str) -> tuple[tuple, callable]:
         raise NormsSourceError(f"pool.norms.from: cannot read {source!r} ({exc.strerror or exc})") from None
 
     def load():
-        from analysis.io import ValidationError
-        from analysis.norms import read_clip_norms
         try:
             return read_clip_norms(path, known_clips=Clip.objects.values_list("clip_id", flat=True))
         except ValidationError as exc:
@@ -81,11 +83,6 @@ def _from_study(slug: str) -> tuple[tuple, callable]:
     last = answers.order_by("-id").values_list("id", flat=True).first()
 
     def load():
-        from analysis import exclusion
-        from analysis.io import StudyData, load_study
-        from analysis.norms import clip_norms
-
-        from .export import stream_csv
         texts = {k: io.StringIO("".join(stream_csv(study, k)))
                  for k in ("responses", "clips", "participants", "viewing")}
         data = load_study(texts["responses"], texts["clips"], texts["participants"], texts["viewing"])

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 from functools import wraps
 
+from django.apps import apps
 from django.contrib.admin.views.decorators import staff_member_required
 from django.core.exceptions import PermissionDenied
 from django.db.models import Q
@@ -56,7 +57,7 @@ def staff_permission_required(perm: str):
 def studies_for(user):
     """The studies ``user`` may see (a Study queryset): every study for an active superuser, else those the user
     owns or collaborates on; none for anyone else."""
-    from .models import Study
+    Study = apps.get_model("studyapp", "Study")  # noqa: N806 - studyapp.models imports this module
 
     if not (user.is_authenticated and user.is_active):
         return Study.objects.none()

@@ -44,7 +44,8 @@ def test_sequences_carry_the_shares(rated):
     seqs = load_soft_label_sequences(path, motions, GaitDataConfig())
     targets = {tuple(np.round(v.astype(float), 3).tolist()) for v in seqs.emotion.cpu().numpy()}
     assert targets == {tuple(v) for v in SHARES.values()}
-    info = seqs.source["soft_labels"]
+    assert seqs.training_data.kind == "rated"
+    info = seqs.training_data.corpus["soft_labels"]
     assert info["study"] == "pilot-study" and info["n_ratings"] == 41 and info["clips"] == {"sim-walk-a": 20,
                                                                                           "sim-walk-b": 21}
     assert info["sha256"] == hashlib.sha256(path.read_bytes()).hexdigest()

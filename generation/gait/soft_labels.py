@@ -25,10 +25,13 @@ import numpy as np
 
 from generation.core.motion import Motion, MotionFormatError
 from generation.core.skeleton import GAIT_JOINTS, gait_skeleton
+from generation.formats.bvh import read_bvh
 from study_protocol import CLIP_NORMS_COLUMNS, GAIT_EMOTIONS, NORMS_SHARE_PREFIX
 
 from .config import GaitDataConfig
 from .data import GaitSequences, file_sha256
+from .real_data import STAGE_AUGMENT, clip_sequences
+from .weights import TrainingData
 
 SHARE_COLUMNS = tuple(f"{NORMS_SHARE_PREFIX}{e}" for e in GAIT_EMOTIONS)
 REQUIRED = ("clip_id", "modality", "section_type", "question", "n_ratings", *SHARE_COLUMNS)
@@ -102,8 +105,6 @@ def rated_clips(labels: list[SoftLabel], motions_dir: str | Path, source: str = 
     """Each label's motion from ``motions_dir/<clip_id>.bvh`` on the 21-joint gait skeleton at 30 fps, as a
     training clip. Raises SoftLabelError naming the clip (and its line of ``source``) when the file is missing
     or not a gait motion."""
-    from generation.formats.bvh import read_bvh
-
     out = []
     for lab in labels:
         path = Path(motions_dir) / f"{lab.clip_id}.bvh"
@@ -128,20 +129,17 @@ def rated_clips(labels: list[SoftLabel], motions_dir: str | Path, source: str = 
 
 def load_soft_label_sequences(norms_path: str | Path, motions_dir: str | Path, data: GaitDataConfig,
                               study: str | None = None, min_ratings: int = 1, augment=None) -> GaitSequences:
-    """Training sequences of every rated walk with its perceived shares as the emotion input, with ``.source``
-    (``{"soft_labels": {path, sha256, study, n_clips, n_ratings, clips: {clip_id: n_ratings}}}``) and
-    ``.trained_on`` for the weights file. ``study`` defaults to the name of the folder holding the file."""
-    from .real_data import STAGE_AUGMENT, clip_sequences
-
+    """Training sequences of every rated walk with its perceived shares as the emotion input; their
+    ``training_data`` is of kind ``rated`` with corpus ``{"soft_labels": {path, sha256, study, n_clips,
+    n_ratings, clips: {clip_id: n_ratings}}}`` (it goes into the weights file). ``study`` defaults to the name of the folder holding the file."""
     norms_path = Path(norms_path)
     labels = read_soft_labels(norms_path, min_ratings)
     clips = rated_clips(labels, motions_dir, norms_path.name)
     seqs = clip_sequences(clips, data, augment or STAGE_AUGMENT["finetune"], emotion_of=lambda c: c.shares)
     n_ratings = sum(lab.n_ratings for lab in labels)
     study = study or norms_path.resolve().parent.name
-    seqs.source = {"soft_labels": {"path": str(norms_path), "sha256": file_sha256(norms_path), "study": study,
-                                   "n_clips": len(labels), "n_ratings": n_ratings,
-                                   "clips": {lab.clip_id: lab.n_ratings for lab in labels}}}
-    seqs.trained_on = (f"soft labels: the perceived emotion shares of {len(labels)} rated walks ({n_ratings} "
-                       f"ratings, study {study})")
-    return seqs
+    norms = {"path": str(norms_path), "sha256": file_sha256(norms_path), "study": study, "n_clips": len(labels),
+             "n_ratings": n_ratings, "clips": {lab.clip_id: lab.n_ratings for lab in labels}}
+    description = (f"soft labels: the perceived emotion shares of {len(labels)} rated walks ({n_ratings} ratings, "
+                   f"study {study})")
+    return dataclasses.replace(seqs, training_data=TrainingData.rated(description, norms))

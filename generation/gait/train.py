@@ -25,6 +25,7 @@ import argparse
 import dataclasses
 import json
 import math
+import os
 import time
 from pathlib import Path
 
@@ -57,7 +58,8 @@ from .data import (
 from .losses import total_loss
 from .model import GaitNet
 from .real_data import STAGES as REAL_STAGES
-from .real_data import load_real_sequences
+from .real_data import concat_sequences, load_real_sequences
+from .soft_labels import SoftLabelError, load_soft_label_sequences
 from .weights import TrainingData
 
 DEFAULT_WEIGHTS = Path(__file__).resolve().parent.parent / "data" / "weights" / "gait_net_default.pt"
@@ -638,11 +640,6 @@ SOFT_LABEL_WEIGHTS = Path("var/weights/gait_net_soft_labels.pt")
 def _soft_label_data(args, config: GaitNetConfig, log) -> GaitSequences:
     """The rated walks of ``--soft-labels`` (and, with ``--real``, that stage's real takes beside them); points
     ``--out`` away from the shipped weights."""
-    import os
-
-    from .real_data import concat_sequences
-    from .soft_labels import SoftLabelError, load_soft_label_sequences
-
     motions = args.motions or (Path(os.environ["MEDIA_ROOT"]) / "motions" if os.environ.get("MEDIA_ROOT") else None)
     if motions is None:
         raise SystemExit("--soft-labels: say where the clips' motions are (--motions DIR or MEDIA_ROOT)")
@@ -655,17 +652,15 @@ def _soft_label_data(args, config: GaitNetConfig, log) -> GaitSequences:
         args.out = str(SOFT_LABEL_WEIGHTS)
         Path(args.out).parent.mkdir(parents=True, exist_ok=True)
         log(f"--soft-labels: writing {args.out} (the shipped weights are never replaced; --out to choose)")
-    info = soft.source["soft_labels"]
+    info = soft.training_data.corpus["soft_labels"]
     log(f"soft labels: {info['n_clips']} rated walks, {info['n_ratings']} ratings, study {info['study']}")
     if not getattr(args, "real", None):
         return soft
     real = load_real_sequences(args.real, config.data, path=args.corpus)
     soft.base_index = soft.base_index + int(real.base_index.max()) + 1
     both = concat_sequences([real, soft])
-    both.clip_names = [*real.clip_names, *soft.clip_names]
-    both.source = {**real.source, **soft.source}
-    both.trained_on = f"{real.trained_on}; {soft.trained_on}"
-    return both
+    return dataclasses.replace(both, clip_names=(*real.clip_names, *soft.clip_names),
+                               training_data=real.training_data.with_soft_labels(soft.training_data))
 
 
 def main(argv=None) -> int:

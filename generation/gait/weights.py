@@ -32,8 +32,10 @@ def weights_path(name: str | None = None) -> Path:
     return WEIGHTS_DIR / NAMED_WEIGHTS[name]
 
 
-#: What a gait network can be trained on: the synthetic procedural corpus, or real capture.
-TRAINING_KINDS = ("procedural", "real")
+#: What a gait network can be trained on: the synthetic procedural corpus, real capture, or rated clips (the stored
+#: motions of a study's clips, generated or captured, with their perceived-emotion shares as labels).
+TRAINING_KINDS = ("procedural", "real", "rated")
+RATED_DATASETS = ("clip-norms",)
 PROCEDURAL_DESCRIPTION = "synthetic procedural corpus"
 PROCEDURAL_DATASETS = ("procedural-gait-corpus",)
 #: Real-capture training by stage: (description, dataset ids of the real-capture corpus).
@@ -68,6 +70,16 @@ class TrainingData:
     @classmethod
     def procedural(cls, corpus: dict | None = None) -> TrainingData:
         return cls("procedural", PROCEDURAL_DESCRIPTION, PROCEDURAL_DATASETS, corpus)
+
+    @classmethod
+    def rated(cls, description: str, norms: dict) -> TrainingData:
+        """Rated clips; ``norms`` is the record of the clip_norms.csv they were labelled from."""
+        return cls("rated", description, RATED_DATASETS, {"soft_labels": norms})
+
+    def with_soft_labels(self, other: TrainingData) -> TrainingData:
+        """This training data plus the rated clips of ``other`` (a real-capture stage beside soft labels)."""
+        return TrainingData(self.kind, f"{self.description}; {other.description}", (*self.datasets, *other.datasets),
+                            {**(self.corpus or {}), **(other.corpus or {})})
 
     @classmethod
     def real(cls, stage: str, corpus: dict | None = None) -> TrainingData:

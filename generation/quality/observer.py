@@ -81,18 +81,21 @@ class GaitObserver:
         return self.labels[int(self.clf.classes_[k])], float(p[k])
 
 
-def _corpus_path(path: str | Path | None) -> Path:
-    from generation.gait.data import DEFAULT_CORPUS  # heavy: torch (generation.gait loads it)
+def _gait_data():
+    """generation.gait.data, imported when a corpus is read."""
+    from generation.gait import data  # heavy: torch (generation.gait loads it)
 
-    p = Path(path) if path is not None else DEFAULT_CORPUS
+    return data
+
+
+def _corpus_path(path: str | Path | None) -> Path:
+    p = Path(path) if path is not None else _gait_data().DEFAULT_CORPUS
     return p if p.is_absolute() else REPO_ROOT / p
 
 
 def train_observer(corpus_path: str | Path | None = None) -> GaitObserver:
     """A GaitObserver fitted on the training split (offset 0) of the gait corpus (built when missing)."""
-    from generation.gait.data import load_corpus_sequences  # heavy: torch
-
-    data = load_corpus_sequences(_corpus_path(corpus_path))
+    data = _gait_data().load_corpus_sequences(_corpus_path(corpus_path))
     train = data.subset((data.split == "train") & (data.offset == 0))
     obs = GaitObserver(train)
     obs.corpus_sha256 = data.training_data.corpus["sha256"]
