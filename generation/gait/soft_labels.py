@@ -131,7 +131,8 @@ def load_soft_label_sequences(norms_path: str | Path, motions_dir: str | Path, d
                               study: str | None = None, min_ratings: int = 1, augment=None) -> GaitSequences:
     """Training sequences of every rated walk with its perceived shares as the emotion input; their
     ``training_data`` is of kind ``rated`` with corpus ``{"soft_labels": {path, sha256, study, n_clips,
-    n_ratings, clips: {clip_id: n_ratings}}}`` (it goes into the weights file). ``study`` defaults to the name of the folder holding the file."""
+    n_ratings, clips: {clip_id: n_ratings}}}`` (it goes into the weights file). ``study`` defaults to the name of
+    the folder holding the file."""
     norms_path = Path(norms_path)
     labels = read_soft_labels(norms_path, min_ratings)
     clips = rated_clips(labels, motions_dir, norms_path.name)
