@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import os
 import sys
 import time
 from collections import Counter
@@ -20,6 +21,7 @@ from collections.abc import Iterable
 from generation.core.motion import Motion
 from generation.plans.clipgen import make_motion
 from generation.plans.schema import load_plan
+from generation.quality.calibrated_observer import default_calibrated_observer
 from generation.quality.checks import QAResult, default_observer_kind, evaluate, resolve_thresholds
 from generation.quality.gesture_observer import default_gesture_observer
 from generation.quality.observer import default_observer
@@ -62,7 +64,9 @@ def observer_for(modality: str, kind: str | None = None):
     None for other modalities or when it cannot be built (:func:`unread_line` then says why)."""
     if modality == "gait":
         if (kind or default_observer_kind()) == "real":
-            return default_real_observer()
+            # calibrated on both real corpora when both are built (labels: $QA_REAL_OBSERVER_LABELS, default acted)
+            calibrated = default_calibrated_observer(os.environ.get("QA_REAL_OBSERVER_LABELS", "acted"))
+            return calibrated if calibrated is not None else default_real_observer()
         return default_observer()
     if modality == "gesture":
         return default_gesture_observer()
