@@ -100,6 +100,17 @@ SPLIT_RULE = (f"Held out by performer (never by clip): the 30 BML actors are ran
               "train. A pure function of the performer's name, so adding clips never moves an actor.")
 
 
+DEFAULT_CORPUS = Path(__file__).resolve().parents[2] / "var" / "mocap" / "emotion-gait-bml.npz"
+CORPUS_ENV_VAR = "BML_CORPUS"
+
+
+def bml_corpus_path() -> Path:
+    """The BML corpus file: ``$BML_CORPUS`` if set, else ``<repo>/var/mocap/emotion-gait-bml.npz``."""
+    import os
+    env = os.environ.get(CORPUS_ENV_VAR)
+    return Path(env) if env else DEFAULT_CORPUS
+
+
 class BmlFormatError(ValueError):
     """The data file is missing or not laid out as the README says; the message names the file and field."""
 

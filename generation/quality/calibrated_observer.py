@@ -34,6 +34,7 @@ import numpy as np
 
 from generation.core.motion import Motion
 from generation.core.skeleton import GAIT_JOINTS
+from generation.mocap.emotion_gait_bml import bml_corpus_path
 from study_protocol import CAPTURE_GAIT_EMOTIONS, GAIT_EMOTIONS
 
 from . import real_observer as ro
@@ -41,16 +42,6 @@ from . import real_observer as ro
 ADVISORY_RECALL = 0.6
 LABEL_VARIANTS = ("acted", "perceived")
 BML_DATASET = "emotion-gait-bml"
-REPO_ROOT = Path(__file__).resolve().parents[2]
-DEFAULT_BML_CORPUS = REPO_ROOT / "var" / "mocap" / "emotion-gait-bml.npz"
-BML_ENV_VAR = "BML_CORPUS"
-
-
-def bml_corpus_path() -> Path:
-    """``$BML_CORPUS`` if set, else ``<repo>/var/mocap/emotion-gait-bml.npz``."""
-    import os
-    env = os.environ.get(BML_ENV_VAR)
-    return Path(env) if env else DEFAULT_BML_CORPUS
 
 
 def clip_label(clip, labels: str) -> str | None:
