@@ -103,10 +103,11 @@ def bml_clips(split, path: str | Path | None = None, n_frames: int = EXTENDED_FR
 
 
 def load_both_sequences(data: GaitDataConfig, labels: str = "acted", bandai_path: str | Path | None = None,
-                        bml_path: str | Path | None = None) -> GaitSequences:
+                        bml_path: str | Path | None = None, bandai_windows: int | None = None) -> GaitSequences:
     """Training rows (Bandai dataset-1 emotion walks + BML training performers, augmented) and validation rows
     (BML validation performers, as captured) with ``.source`` (typed provenance: datasets, licences, citations,
-    performer split, corpus hashes) and ``.trained_on``."""
+    performer split, corpus hashes) and ``.trained_on``. ``bandai_windows``: windows per Bandai take (default
+    :data:`BANDAI_AUGMENT`'s 12; more weighs the four Bandai takes more against the 84 BML walks)."""
     from generation.mocap.emotion_gait_bml import bml_corpus_path
     from generation.mocap.real_corpus import CITATION, LICENCE, SOURCE_URL, read_meta, real_corpus_path
 
@@ -115,7 +116,8 @@ def load_both_sequences(data: GaitDataConfig, labels: str = "acted", bandai_path
     bandai_train = stage_clips("finetune", "train", bandai)
     bml_train = bml_clips("train", bml)
     bml_val = bml_clips("val", bml)
-    parts = _with_vector(bandai_train, data, BANDAI_AUGMENT, labels)
+    bandai_augment = RealAugment(windows_per_clip=bandai_windows) if bandai_windows else BANDAI_AUGMENT
+    parts = _with_vector(bandai_train, data, bandai_augment, labels)
     parts += _with_vector(bml_train, data, BML_AUGMENT, labels)
     parts += _with_vector(bml_val, data, RealAugment.none(), labels)
     base = 0
@@ -137,7 +139,7 @@ def load_both_sequences(data: GaitDataConfig, labels: str = "acted", bandai_path
              "performer_split": meta.get("performer_split", {}), "clips_train": len(bml_train),
              "clips_val": len(bml_val), "extended_frames": EXTENDED_FRAMES},
         ],
-        "augment": {"bandai_windows_per_clip": BANDAI_AUGMENT.windows_per_clip,
+        "augment": {"bandai_windows_per_clip": bandai_augment.windows_per_clip,
                     "bml_windows_per_clip": BML_AUGMENT.windows_per_clip, "mirror": True,
                     "speed_factors": list(BML_AUGMENT.speed_factors), "offsets": list(BML_AUGMENT.offsets)},
     }

@@ -35,13 +35,15 @@ def main(argv=None) -> int:
     ap.add_argument("--max-minutes", type=float, default=None)
     ap.add_argument("--out", type=Path, required=True)
     ap.add_argument("--threads", type=int, default=1)
+    ap.add_argument("--bandai-windows", type=int, default=None,
+                    help="windows per Bandai take (default 12; more weighs the Bandai emotion takes more)")
     ap.add_argument("--quiet", action="store_true")
     a = ap.parse_args(argv)
     torch.set_num_threads(a.threads)
     payload = torch.load(a.init, map_location="cpu", weights_only=False)
     config = GaitNetConfig.from_dict(payload["config"])
     config.train.epochs = a.epochs
-    data = load_both_sequences(config.data, a.labels)
+    data = load_both_sequences(config.data, a.labels, bandai_windows=a.bandai_windows)
     n = {s: int(((data.split == s) & (data.offset == 0)).sum()) for s in ("train", "val")}
     print(f"{len(data)} rows ({n}); init {a.init}", flush=True)
     result = train(config, data, a.out, init=a.init, keep_epochs=True, max_minutes=a.max_minutes,
@@ -52,7 +54,8 @@ def main(argv=None) -> int:
     chosen = a.out.with_name(f"{a.out.stem}_e{best:02d}{a.out.suffix}")
     shutil.copyfile(chosen, a.out)
     a.out.with_name(f"{a.out.stem}_choice.json").write_text(json.dumps(
-        {"labels": a.labels, "init": str(a.init), "epochs_run": len(history), "val_total": dict(val),
+        {"labels": a.labels, "init": str(a.init), "bandai_windows": a.bandai_windows, "epochs_run": len(history),
+         "val_total": dict(val),
          "chosen_epoch": best, "rule": "lowest free-running validation loss on the BML validation actors",
          "minutes": history[-1]["elapsed_s"] / 60 if history else 0}, indent=1) + "\n")
     print(f"chose epoch {best} (val {dict(val)[best]:.4f}) -> {a.out}")
