@@ -168,6 +168,12 @@ def main(argv=None) -> int:
     args = ap.parse_args(argv)
     rows = run(args.plan, args.limit, modality=args.modality, figure_height=not args.no_figure_height)
     print(f"plan {args.plan}: {len(rows)} clips; " + summary_line(r["flag"] for r in rows))
+    from .section_coverage import coverage_lines, presets_of_plan
+
+    for preset in presets_of_plan(args.plan):      # which section of the preset is short after the gate, and why
+        scope = f" ({args.modality} entries checked only)" if args.modality else ""
+        for line in coverage_lines(preset, {r["entry"]: r["flag"] for r in rows}):
+            print(f"plan {args.plan}, preset {preset}{scope}: {line}")
     if args.json:
         with open(args.json, "w", encoding="utf-8") as f:
             json.dump(rows, f, indent=1)
