@@ -156,3 +156,27 @@ def test_unreadable_data_file_exits_2(tmp_path):
     assert eg.build_emotion_gait_bml(tmp_path, tmp_path / "x.npz", quiet=True) == 2
     np.savez(tmp_path / eg.FILE_NAME, positions=np.zeros((1, 75, 16, 3)))
     assert main(["dataset", "emotion-gait-bml", str(tmp_path), "--out", str(tmp_path / "x.npz"), "--quiet"]) == 2
+
+
+
+
+def _shared_bml():
+    from pathlib import Path
+    here = Path(__file__).resolve().parents[1]
+    for root in (here.parent / "shared", here.parents[1] / "shared", Path("/work/shared")):
+        f = root / "mocap" / "emotion-gait-bml" / eg.FILE_NAME
+        if f.is_file():
+            return f
+    return None
+
+
+@pytest.mark.skipif(_shared_bml() is None, reason="the BML walks are not in ../shared/mocap/emotion-gait-bml")
+def test_the_real_bml_walks_all_fit_within_the_bound():
+    clips = eg.load_clips(_shared_bml())
+    assert len(clips) == 120 and len({c.performer for c in clips}) == 30
+    sample = [c for c in clips if c.performer in ("BML_ale", "BML_alx")]
+    fitted, rows = eg.import_clips(sample)
+    assert [r["status"] for r in rows] == ["ok"] * 8
+    assert all(float(r["ik_error_p95_cm"]) < 100 * eg.MAX_IK_ERROR_M for r in rows)
+    assert all(c.motion.metadata["loop_period_frames"] for c in fitted)
+    assert {r["split"] for r in rows if r["performer"] == "BML_alx"} == {"test"}
