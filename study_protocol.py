@@ -235,10 +235,12 @@ observer behind ``qa_observed``: ``real`` (trained on real capture), ``synthetic
 QA_FLOAT_COLUMNS = ("qa_foot_skate_cm_s", "qa_penetration_cm", "qa_jerk", "qa_bone_error_mm", "qa_figure_height_frac",
                     "qa_observed_p", *QA_REALISM_COLUMNS)
 
-QA_OBSERVERS = ("real", "synthetic")
+QA_OBSERVERS = ("real", "real-perceived", "synthetic")
 """Which gait observer fills ``qa_observed`` (plan ``qa: {observer: ...}``, env ``QA_GAIT_OBSERVER``): ``real``, a
-classifier trained on real captured walks (generation/quality/real_observer.py, the default), or ``synthetic``,
-trained on the procedural corpus (generation/quality/observer.py)."""
+classifier trained on real captured walks with the actors' acted labels (the default: calibrated on both real
+corpora when both are built, generation/quality/calibrated_observer.py, else generation/quality/real_observer.py),
+``real-perceived``, the calibrated one with the BML annotators' perceived labels, or ``synthetic``, trained on the
+procedural corpus (generation/quality/observer.py)."""
 
 QA_THRESHOLDS = {
     "foot_skate_cm_s": 10.0,         # max mean foot slide in contact (corpus walks 2.2-2.6, raw network 15-30)

@@ -11,7 +11,7 @@ weights (``--init``), train the same epochs on the same windows and differ only 
 one-hot of the acted label; soft: the simulated shares), through ``--soft-labels`` (hard labels as a clip_norms.csv
 of one-hot shares). Then each network (and the shipped one) walks with the four pure emotion vectors and with
 happy/neutral mixtures (a, 0, 0, 1 - a), and the real-capture observer (trained on the same shipped takes here,
-as no corpus file is built: ``default_real_observer``) reads the walks: its mean probabilities per input, and the
+as no corpus file is built: ``OBSERVERS.gait("real")``) reads the walks: its mean probabilities per input, and the
 mixture response (observed P(happy) against the input share a). Nothing here is data from people.
 """
 from __future__ import annotations
@@ -92,13 +92,13 @@ def readings(weights: Path, observer, steps: int = 200, seeds: int = 2) -> dict:
 def main(argv=None) -> dict:
     from generation.gait.train import DEFAULT_WEIGHTS
     from generation.gait.train import main as train_main
-    from generation.quality.real_observer import default_real_observer
+    from generation.quality.observers import OBSERVERS
 
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--epochs", type=int, default=6)
     ap.add_argument("--json", default=None)
     args = ap.parse_args(argv)
-    observer = default_real_observer()
+    observer = OBSERVERS.gait("real")
     result = {"benchmark": "bench_soft_labels (SIMULATED perceived shares of real takes)", "epochs": args.epochs,
               "simulated_shares": SIMULATED_SHARES, "observer": observer.source}
     with tempfile.TemporaryDirectory() as tmp:

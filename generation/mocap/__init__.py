@@ -11,8 +11,10 @@ unmapped_joints, retarget_max_error_m, height_m``). Modules:
 - :mod:`.importer`: one file -> Motion + report row (units, up axis, scaling, IK);
 - :mod:`.bandai_namco`: the Bandai Namco Research Motion Dataset's layout, labels and held-out split by take;
 - :mod:`.dataset_import`: a labelled dataset -> the real-capture corpus (process pool, report per file);
+- :mod:`.emotion_gait_bml`: the Emotion-Gait BML walks (positions only) -> the corpus: checks, IK, split by
+  performer; :mod:`.root_travel`: root travel of a walk captured in place, from the stance foot;
 - :mod:`.real_corpus`: the real-capture corpus file (:class:`~.real_corpus.CorpusClip`, save/load, filters);
-- :mod:`.cli`: the command (``import``, ``corpus``, ``dataset bandai-namco DIR --out CORPUS``).
+- :mod:`.cli`: the command (``import``, ``corpus``, ``dataset bandai-namco|emotion-gait-bml DIR --out CORPUS``).
 See docs/mocap.md.
 """
 from .importer import REPORT_COLUMNS, ImportOptions, ImportResult, import_file

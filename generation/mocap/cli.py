@@ -31,6 +31,7 @@ from .bandai_namco import (
 )
 from .corpus import build_captured_gait_corpus, load_motions
 from .dataset_import import build_bandai_namco
+from .emotion_gait_bml import build_emotion_gait_bml
 from .gesture_corpus import build_gesture_corpus, read_sentences, save_gesture_corpus
 from .importer import REPORT_COLUMNS, SUFFIXES, ImportOptions, import_file
 from .labels import LabelError, compile_pattern, label_for, label_from_pattern, read_labels
@@ -102,7 +103,8 @@ def _add_dataset_parser(sub) -> None:
                                     "onto the gesture skeleton, keeping dataset, content, style, label, take and "
                                     "the held-out split; write the corpus and import_report.csv beside it. "
                                     f"Split: {SPLIT_RULE}")
-    ds.add_argument("source", choices=("bandai-namco",), help="the dataset's layout")
+    ds.add_argument("source", choices=("bandai-namco", "emotion-gait-bml"),
+                    help="the dataset's layout (emotion-gait-bml: DIR holds bml_walks.npz, positions only)")
     ds.add_argument("root", type=Path, metavar="DIR", help="folder holding the dataset (searched recursively)")
     ds.add_argument("--out", type=Path, default=real_corpus_path(),
                     help=f"corpus .npz to write (default {real_corpus_path()}, or $REAL_CORPUS)")
@@ -121,6 +123,9 @@ def run_dataset(args) -> int:
     if args.limit is not None and args.limit < 1 or args.workers < 1:
         print("error: --limit and --workers must be at least 1", file=sys.stderr)
         return 2
+    if args.source == "emotion-gait-bml":
+        out = args.out if args.out != real_corpus_path() else real_corpus_path().with_name("emotion-gait-bml.npz")
+        return build_emotion_gait_bml(args.root, out, args.height, args.build, args.quiet)
     try:
         return build_bandai_namco(args.root, args.out, args.contents, args.limit, args.workers, args.height,
                                   args.build, args.quiet)

@@ -1,12 +1,14 @@
 """The observers of the quality gate: one protocol and one cache.
 
-An observer stands in for a participant: it reads a clip's motion and says which emotion it shows. Three are
-declared: the real-capture gait observer (:class:`generation.quality.real_observer.RealGaitObserver`, kind
-``real``), the synthetic gait observer (:class:`generation.quality.observer.GaitObserver`, ``synthetic``) and the
-synthetic gesture observer (:class:`generation.quality.gesture_observer.GestureObserver`,
-``synthetic-gesture``). Each module gives its observer's version key (``observer_version``: which corpus it is
-trained on) and a loader (from its pickle file, or trained); :class:`Observers` keeps one of each per version in
-memory, and :data:`OBSERVERS` is the process's.
+An observer stands in for a participant: it reads a clip's motion and says which emotion it shows. Four are
+declared: the gait observer calibrated on both real corpora
+(:class:`generation.quality.calibrated_observer.CalibratedGaitObserver`, kinds ``real`` with acted labels and
+``real-perceived``; used whenever both corpora are built), the Bandai-only real-capture gait observer
+(:class:`generation.quality.real_observer.RealGaitObserver`, kind ``real`` otherwise), the synthetic gait observer
+(:class:`generation.quality.observer.GaitObserver`, ``synthetic``) and the synthetic gesture observer
+(:class:`generation.quality.gesture_observer.GestureObserver`, ``synthetic-gesture``). Each module gives its
+observer's version key (``observer_version``: which corpus it is trained on) and a loader (from its pickle file,
+or trained); :class:`Observers` keeps one of each per version in memory, and :data:`OBSERVERS` is the process's.
 """
 from __future__ import annotations
 
@@ -16,7 +18,7 @@ from typing import Protocol, runtime_checkable
 
 from generation.core.motion import Motion
 
-from . import gesture_observer, observer, real_observer
+from . import calibrated_observer, gesture_observer, observer, real_observer
 from .checks import check_gait_observer
 
 
@@ -50,13 +52,25 @@ class Observers:
         return self._loaded[key]
 
     def gait(self, kind: str = "real", corpus_path: str | Path | None = None) -> Observer | None:
-        """The ``kind`` gait observer (real or synthetic) of the corpus at ``corpus_path`` (default: its module's
-        default corpus); None when it cannot be built here."""
-        if check_gait_observer(kind) == "real":
-            return self._get("real", real_observer.observer_version(corpus_path),
-                             lambda: real_observer.load_real_observer(corpus_path))
-        return self._get("synthetic", observer.observer_version(corpus_path),
-                         lambda: observer.load_observer(corpus_path))
+        """The ``kind`` gait observer of the corpus at ``corpus_path`` (default: its module's default corpus);
+        None when it cannot be built here. ``real``: the observer calibrated on both real corpora (acted labels)
+        when both are built, else the Bandai-only one; ``real-perceived``: the calibrated one with perceived
+        labels (None without both corpora); ``synthetic``: the procedural-corpus one."""
+        kind = check_gait_observer(kind)
+        if kind == "synthetic":
+            return self._get("synthetic", observer.observer_version(corpus_path),
+                             lambda: observer.load_observer(corpus_path))
+        if corpus_path is None:
+            labels = "acted" if kind == "real" else "perceived"
+            calibrated = self._get(f"calibrated-{labels}", calibrated_observer.observer_version(labels),
+                                   lambda: calibrated_observer.load_calibrated_observer(labels))
+            if calibrated is not None or kind == "real-perceived":
+                return calibrated
+        return self._real(corpus_path)
+
+    def _real(self, corpus_path: str | Path | None) -> Observer | None:
+        return self._get("real", real_observer.observer_version(corpus_path),
+                         lambda: real_observer.load_real_observer(corpus_path))
 
     def gesture(self) -> Observer | None:
         """The synthetic gesture observer of the current gesture corpus; None when it cannot be built here."""

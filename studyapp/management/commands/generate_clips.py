@@ -22,6 +22,7 @@ from tqdm import tqdm
 from generation.core.device import resolve_device
 from generation.pipeline.plan_qa import summary_line, unread_line
 from generation.pipeline.runner import run_plan
+from generation.pipeline.section_coverage import coverage_lines, presets_of_plan
 from generation.plans.catalogue import write_clips_csv
 from generation.plans.schema import PlanError, load_plan
 from generation.quality.checks import QAThresholdError, gait_observer_kind
@@ -116,6 +117,10 @@ class Command(BaseCommand):
             self.stdout.write(f"plan {plan.name}: " + summary_line(r.get("qa_flag", "") for r in records))
             if unread := unread_line(records, gait_observer):
                 self.stdout.write(f"plan {plan.name}: {unread}")
+            flags = {str(r.get("metadata", {}).get("entry_id")): r.get("qa_flag", "") for r in records}
+            for preset in presets_of_plan(plan.name):
+                for line in coverage_lines(preset, flags, plan):
+                    self.stdout.write(f"plan {plan.name}, preset {preset}: {line}")
         if opts["contact_sheet"] is not None and records:
             out = Path(opts["contact_sheet"]) if opts["contact_sheet"] else (
                 Path(settings.DATA_DIR) / "contact_sheets" / f"{plan.name}.png")
