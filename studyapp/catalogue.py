@@ -25,6 +25,7 @@ from study_protocol import (
     ORIGINS,
     QA_ADVISORY_CHECKS,
     QA_CHECKS,
+    SECTION_MODALITY,
 )
 
 from .models import Clip
@@ -175,6 +176,15 @@ def retire_replaced(plan: str, entry_id: str, clip_id: str) -> list[str]:
     ids = sorted(stale.values_list("clip_id", flat=True))
     Clip.objects.filter(clip_id__in=ids).update(retired=True)
     return ids
+
+
+def section_queryset(section_type: str | None, pool: dict | None, include_flagged: bool | None = None) -> QuerySet:
+    """The clips a section of ``section_type`` draws from its pool: :func:`pool_queryset` limited to the modality
+    the section type shows (``study_protocol.SECTION_MODALITY``: a gait section never shows a gesture or an
+    imported ``other`` video, whatever its filters say; naturalness sections take any modality)."""
+    qs = pool_queryset(pool, include_flagged)
+    wanted = SECTION_MODALITY.get(section_type or "")
+    return qs.filter(modality=wanted) if wanted else qs
 
 
 def pool_queryset(pool: dict | None, include_flagged: bool | None = None) -> QuerySet:

@@ -19,7 +19,7 @@ from django.db.models import Count, Max, Q
 from study_pools import SUB_POOLS
 from study_protocol import SECTION_MODALITY
 
-from .catalogue import pool_queryset
+from .catalogue import pool_queryset, section_queryset
 from .models import Clip, Section
 
 CLIP_FIELDS = ("id", "clip_id", "modality", "origin", "source_clip_id", "emotion_label", "theme", "duration_s",
@@ -57,7 +57,7 @@ def load_section_pool(section: Section) -> SectionPool:
     """Query one section's pool (no cache). A reusing section has no pool of its own."""
     if section.reuse_section_id:
         return SectionPool()
-    clips = list(light(pool_queryset(section.pool)).order_by("clip_id"))
+    clips = list(light(section_queryset(section.section_type, section.pool)).order_by("clip_id"))
     # a sub-pool only narrows the section's pool, which already decided about flagged clips
     subs = {key: set(pool_queryset(section.pool[key], include_flagged=True).filter(pk__in=[c.pk for c in clips])
                      .values_list("pk", flat=True))

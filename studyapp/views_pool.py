@@ -27,7 +27,7 @@ from study_pools import SUB_POOLS, pool_errors
 from study_protocol import ORIGINS
 
 from .admin_norms import norms_table
-from .catalogue import CatalogueError, pool_queryset
+from .catalogue import CatalogueError, pool_queryset, section_queryset
 from .forms import SectionPreviewForm
 from .permissions import has_staff_permission
 from .pool_editor import SUB_POOL_SECTION_TYPE
@@ -77,7 +77,7 @@ def count_pool(section_type: str | None, pool) -> PoolCount:
     if errors:
         return PoolCount(None, errors=errors)
     try:
-        base = pool_queryset(pool or {})
+        base = section_queryset(section_type, pool or {})
         total = base.count()
         by_origin = {}
         if section_type == SUB_POOL_SECTION_TYPE:

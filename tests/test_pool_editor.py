@@ -171,8 +171,8 @@ def test_count_endpoint_counts_the_catalogue(catalogue, staff):
     assert answer["count"] == pool_queryset(pool).count() > 0
     negative = count(staff, section_type="theme_inversion", pool_weight_sign="negative", touched_pool="on")
     assert negative["count"] == Clip.objects.filter(weight__lt=0).count() == 6
-    every = count(staff, section_type="theme_rating", pool="")                 # empty pool: every clip
-    assert every["count"] == Clip.objects.count() and every["pool"] == {}
+    every = count(staff, section_type="theme_rating", pool="")          # empty pool: every clip it can show
+    assert every["count"] == Clip.objects.filter(modality="gait").count() and every["pool"] == {}
     Clip.objects.filter(clip_id="rbf_sad_inv").update(retired=True)
     assert count(staff, section_type="theme_inversion", pool=json.dumps({"weight__lt": 0}))["count"] == 5
 
@@ -444,3 +444,17 @@ def screenshot(driver, path: str) -> None:
     driver.execute_script("document.querySelectorAll('#sections-0 details').forEach(function (d) { d.open = true; "
                           "});")
     full_shot(driver, Path(path), width=1280)
+
+
+def test_a_section_draws_only_the_modality_it_shows(catalogue):
+    """A gait section whose pool names no modality never draws gestures (nor imported `other` videos); its count
+    says the same; naturalness sections take either modality."""
+    from studyapp.catalogue import section_queryset
+    from studyapp.views_pool import count_pool
+
+    assert Clip.objects.filter(modality="gesture").exists() and Clip.objects.filter(modality="gait").exists()
+    gait = section_queryset("emotion_choice", {})
+    assert set(gait.values_list("modality", flat=True)) == {"gait"}
+    assert count_pool("emotion_choice", {}).total == gait.count() < pool_queryset({}).count()
+    assert set(section_queryset("gesture_emotion", {}).values_list("modality", flat=True)) == {"gesture"}
+    assert section_queryset("naturalness", {}).count() == pool_queryset({}).count()

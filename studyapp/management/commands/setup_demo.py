@@ -4,7 +4,7 @@ superuser and so sees every study anyway)."""
 from django.contrib.auth import get_user_model
 from django.core.management.base import BaseCommand, CommandError
 
-from studyapp.catalogue import pool_queryset
+from studyapp.catalogue import section_queryset
 from studyapp.models import Clip, Study
 from studyapp.presets import create_study_from_preset
 
@@ -43,7 +43,7 @@ class Command(BaseCommand):
         for section in study.sections.order_by("order"):
             if section.reuse_section_id:
                 continue
-            n = pool_queryset(section.pool).count()
+            n = section_queryset(section.section_type, section.pool).count()
             if n == 0:
                 self.stdout.write(self.style.WARNING(
                     f"  section {section.order} ({section.section_type}): no clip matches its pool {section.pool}; "
