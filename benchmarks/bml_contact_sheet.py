@@ -15,9 +15,8 @@ import argparse
 import tempfile
 from pathlib import Path
 
-from benchmarks.real_vs_generated_sheet import EMOTIONS, generated_walks
+from benchmarks.real_vs_generated_sheet import EMOTIONS, add_frames, generated_walks
 from generation.gait.bml_data import bml_clips
-from generation.render.clip import render_frames_at
 from generation.render.contact_sheet import contact_sheet
 from generation.render.settings import RenderSettings
 
@@ -31,7 +30,6 @@ def main() -> None:
     ap.add_argument("--step", type=float, default=0.4)
     ap.add_argument("--columns", type=int, default=6)
     a = ap.parse_args()
-    from PIL import Image
 
     times = [0.5 + a.step * k for k in range(a.columns)]
     settings = RenderSettings(width=320, height=400, fps=30, duration_s=times[-1] + 0.2, camera="tracking")
@@ -50,13 +48,7 @@ def main() -> None:
             gen = generated[emotion]
             rows.append((f"{gen.metadata.get('generator', '?')} ({gen.metadata.get('weights_name', '?')}) {emotion}",
                          gen))
-            for label, motion in rows:
-                frames = [round(t * settings.fps) for t in times]
-                for t, (_, img) in zip(times, render_frames_at(motion, settings, frames)):
-                    p = Path(tmp) / f"{len(posters):03d}.png"
-                    Image.fromarray(img).save(p)
-                    posters.append(p)
-                    labels.append(f"{label}, {t:.1f} s")
+            add_frames(rows, settings, times, Path(tmp), posters, labels)
         contact_sheet(posters, labels, a.out, columns=a.columns, thumb_width=200)
     print(f"wrote {a.out}")
 

@@ -44,6 +44,20 @@ def generated_walks(seconds: float, weights: str | None = None) -> dict[str, obj
     return out
 
 
+def add_frames(rows, settings: RenderSettings, times: list[float], folder: Path, posters: list, labels: list) -> None:
+    """Render each (label, Motion) of ``rows`` at ``times`` (s) into PNGs in ``folder``, appending their paths to
+    ``posters`` and their captions to ``labels`` (one contact-sheet row per motion)."""
+    from PIL import Image
+
+    for label, motion in rows:
+        frames = [round(t * settings.fps) for t in times]
+        for t, (_, img) in zip(times, render_frames_at(motion, settings, frames)):
+            p = folder / f"{len(posters):03d}.png"
+            Image.fromarray(img).save(p)
+            posters.append(p)
+            labels.append(f"{label}, {t:.1f} s")
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--takes", type=Path, default=ROOT / "generation" / "data" / "mocap" / "bandai-namco"
@@ -55,7 +69,6 @@ def main() -> None:
     ap.add_argument("--weights", choices=("real", "procedural"), default=None,
                     help="gait network weights of the generated walks (default: the plans' default, real)")
     a = ap.parse_args()
-    from PIL import Image
 
     times = [0.5 + a.step * k for k in range(a.columns)]
     settings = RenderSettings(width=320, height=400, fps=30, duration_s=times[-1] + 0.2, camera="tracking")
@@ -70,13 +83,7 @@ def main() -> None:
             gen = generated[emotion]
             name = f"{gen.metadata.get('generator', '?')} ({gen.metadata.get('weights_name', '?')})"
             rows = ((f"REAL {style} t{a.take[-1]}", real.motion), (f"{name} {emotion}", gen))
-            for label, motion in rows:
-                frames = [round(t * settings.fps) for t in times]
-                for t, (_, img) in zip(times, render_frames_at(motion, settings, frames)):
-                    p = Path(tmp) / f"{len(posters):03d}.png"
-                    Image.fromarray(img).save(p)
-                    posters.append(p)
-                    labels.append(f"{label}, {t:.1f} s")
+            add_frames(rows, settings, times, Path(tmp), posters, labels)
         contact_sheet(posters, labels, a.out, columns=a.columns, thumb_width=200)
     print(f"wrote {a.out}")
 

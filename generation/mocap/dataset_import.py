@@ -112,11 +112,11 @@ def import_takes(takes: list[bn.Take], workers: int = 1, height: float = REFEREN
     return [c for c, _ in results if c is not None], [r for _, r in results]
 
 
-def write_report(path: Path, rows: list[dict]) -> Path:
-    """``import_report.csv`` (:func:`report_columns`) at ``path``."""
+def write_report(path: Path, rows: list[dict], columns: tuple[str, ...] | None = None) -> Path:
+    """An import report at ``path``: ``columns`` (default :func:`report_columns`), one row per take."""
     path.parent.mkdir(parents=True, exist_ok=True)
     with open(path, "w", newline="", encoding="utf-8") as fh:
-        writer = csv.DictWriter(fh, fieldnames=report_columns(), extrasaction="ignore")
+        writer = csv.DictWriter(fh, fieldnames=columns or report_columns(), extrasaction="ignore")
         writer.writeheader()
         writer.writerows(rows)
     return path

@@ -34,7 +34,6 @@ Split (:func:`split_for`, :data:`SPLIT_RULE`): whole performers are held out, ne
 """
 from __future__ import annotations
 
-import csv
 import sys
 import zlib
 from dataclasses import dataclass
@@ -46,7 +45,7 @@ from generation.core.motion import Motion
 from generation.core.skeleton import REFERENCE_HEIGHT_M, gait_skeleton
 from study_protocol import GAIT_EMOTIONS
 
-from .dataset_import import TAKE_COLUMNS
+from .dataset_import import TAKE_COLUMNS, write_report
 from .importer import REPORT_COLUMNS, solve_onto, standing_height_m
 from .real_corpus import CorpusClip, save_real_corpus
 from .root_travel import loop_period, reconstruct_root_travel, seam_frames
@@ -357,15 +356,6 @@ def report_path(out: Path) -> Path:
     return out.with_name(out.stem + ".import_report.csv")
 
 
-def write_report(path: Path, rows: list[dict]) -> Path:
-    path.parent.mkdir(parents=True, exist_ok=True)
-    with open(path, "w", newline="", encoding="utf-8") as fh:
-        writer = csv.DictWriter(fh, fieldnames=report_columns(), extrasaction="ignore")
-        writer.writeheader()
-        writer.writerows(rows)
-    return path
-
-
 def import_clips(clips: list[BmlClip], height: float = REFERENCE_HEIGHT_M, build: str = "male",
                  max_ik_error_m: float = MAX_IK_ERROR_M) -> tuple[list[CorpusClip], list[dict]]:
     """Fit every clip: (the ones that fitted, one report row per clip), in file order."""
@@ -394,7 +384,7 @@ def build_emotion_gait_bml(root: Path, out: Path, height: float = REFERENCE_HEIG
         print(f"error: {exc}", file=sys.stderr)
         return 2
     clips, rows = import_clips(source, height, build, max_ik_error_m)
-    report = write_report(report_path(out), rows)
+    report = write_report(report_path(out), rows, report_columns())
     failed = [r for r in rows if r["status"] != "ok"]
     if clips:
         meta = {"dataset": "Emotion-Gait BML walks (Biological Motion Library, Emotion-Gait perceived labels)",

@@ -34,7 +34,6 @@ import numpy as np
 
 from generation.core.digest import file_sha256
 from generation.core.motion import Motion
-from generation.core.skeleton import GAIT_JOINTS
 from generation.mocap.emotion_gait_bml import bml_corpus_path
 from generation.mocap.real_corpus import load_real_corpus, real_corpus_path
 from study_protocol import CAPTURE_GAIT_EMOTIONS, GAIT_EMOTIONS
@@ -59,7 +58,7 @@ def clip_label(clip, labels: str) -> str | None:
     return None
 
 
-class CalibratedGaitObserver:
+class CalibratedGaitObserver(ro.WindowedGaitObserver):
     """Emotion classifier on real walks of both corpora, with its recall on held-out real actors.
 
     Args:
@@ -70,7 +69,6 @@ class CalibratedGaitObserver:
         C: inverse regularisation strength.
     """
 
-    labels = GAIT_EMOTIONS
 
     def __init__(self, train, heldout, labels: str = "acted", source: str = "", C: float = 0.1):
         if labels not in LABEL_VARIANTS:
@@ -115,14 +113,6 @@ class CalibratedGaitObserver:
         out = np.zeros(len(GAIT_EMOTIONS))
         out[self.clf.classes_.astype(int)] = p
         return out
-
-    def observe(self, motion: Motion) -> tuple[str, float]:
-        p = self.proba(motion)
-        k = int(np.argmax(p))
-        return self.labels[k], float(p[k])
-
-    def reads(self, motion: Motion) -> bool:
-        return motion.skeleton.joints == GAIT_JOINTS and motion.num_frames >= 2
 
     def read(self, motion: Motion) -> dict:
         """The quality record's reading: ``observed``, ``observed_p``, ``observer`` (real), and beside it the

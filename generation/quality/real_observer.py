@@ -104,7 +104,27 @@ def _fit(X: np.ndarray, y: np.ndarray, w: np.ndarray, C: float):
     return clf.fit(X, y, logisticregression__sample_weight=w)
 
 
-class RealGaitObserver:
+class WindowedGaitObserver:
+    """What the real-capture gait observers share: a (4,) probability per motion (``proba``, the mean over its 2 s
+    windows, by the subclass) read as the top label, on the 21-joint gait skeleton."""
+
+    labels = GAIT_EMOTIONS
+
+    def proba(self, motion: Motion) -> np.ndarray:
+        raise NotImplementedError
+
+    def observe(self, motion: Motion) -> tuple[str, float]:
+        """(top label, its probability) for one gait motion."""
+        p = self.proba(motion)
+        k = int(np.argmax(p))
+        return self.labels[k], float(p[k])
+
+    def reads(self, motion: Motion) -> bool:
+        """Whether the quality gate asks this observer about ``motion``: the 21-joint gait skeleton, >= 2 frames."""
+        return motion.skeleton.joints == GAIT_JOINTS and motion.num_frames >= 2
+
+
+class RealGaitObserver(WindowedGaitObserver):
     """Emotion (and theme-pair) classifiers trained on real captured walks.
 
     Args:
@@ -114,7 +134,6 @@ class RealGaitObserver:
         C: inverse regularisation strength of the logistic regressions.
     """
 
-    labels = GAIT_EMOTIONS
     kind = "real"
 
     def __init__(self, clips, source: str = "", C: float = 0.1):
@@ -149,16 +168,6 @@ class RealGaitObserver:
         if pair not in self.themes:
             raise KeyError(f"real observer: no classifier for theme pair {pair!r} (have {sorted(self.themes)})")
         return float(self.themes[pair].predict_proba(window_descriptors(motion))[:, 1].mean())
-
-    def observe(self, motion: Motion) -> tuple[str, float]:
-        """(top label, its probability) for one gait motion."""
-        p = self.proba(motion)
-        k = int(np.argmax(p))
-        return self.labels[k], float(p[k])
-
-    def reads(self, motion: Motion) -> bool:
-        """Whether the quality gate asks this observer about ``motion``: the 21-joint gait skeleton, >= 2 frames."""
-        return motion.skeleton.joints == GAIT_JOINTS and motion.num_frames >= 2
 
     def read(self, motion: Motion) -> dict:
         """The quality record's reading: ``observed``, ``observed_p`` and ``observer``: real."""
