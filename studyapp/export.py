@@ -45,8 +45,8 @@ from study_protocol import (
 from .catalogue import pool_queryset
 from .models import Assignment, Clip, Response, Study
 
-__all__ = ["ASSIGNMENT_COLUMNS", "CLIP_COLUMNS", "EXPORT_KINDS", "PARTICIPANT_COLUMNS", "RESPONSE_COLUMNS",
-           "VIEWING_COLUMNS", "run_report", "stream_csv", "write_study_csvs"]
+__all__ = ["ASSIGNMENT_COLUMNS", "CLIP_COLUMNS", "EXPORT_CLIP_COLUMNS", "EXPORT_KINDS", "PARTICIPANT_COLUMNS",
+           "RESPONSE_COLUMNS", "VIEWING_COLUMNS", "run_report", "stream_csv", "write_study_csvs"]
 
 EXPORT_KINDS = ("responses", "clips", "participants", "assignments", "viewing")
 """The CSV exports, each written as ``<kind>.csv``."""
@@ -115,9 +115,14 @@ def study_clips(study: Study):
     return Clip.objects.filter(q).distinct().order_by("clip_id")
 
 
+#: The study's clips.csv: the public columns, then the licence and citation of what each clip was made from (blank
+#: where the catalogue has none), which travel with the clips into every report and reuse.
+EXPORT_CLIP_COLUMNS = (*CLIP_COLUMNS, "licence", "citation")
+
+
 def clip_rows(study: Study) -> Iterator[list]:
     for clip in study_clips(study).iterator(chunk_size=CHUNK):
-        yield [getattr(clip, c) for c in CLIP_COLUMNS]
+        yield [getattr(clip, c) for c in EXPORT_CLIP_COLUMNS]
 
 
 def feedback_keys(study: Study) -> list[str]:
@@ -176,7 +181,7 @@ def stream_csv(study: Study, kind: str) -> Iterator[str]:
     if kind == "responses":
         return _csv_lines(RESPONSE_COLUMNS, response_rows(study))
     if kind == "clips":
-        return _csv_lines(CLIP_COLUMNS, clip_rows(study))
+        return _csv_lines(EXPORT_CLIP_COLUMNS, clip_rows(study))
     if kind == "participants":
         return _csv_lines([*PARTICIPANT_COLUMNS, *feedback_keys(study)], participant_rows(study))
     if kind == "assignments":
