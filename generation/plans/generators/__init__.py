@@ -1,21 +1,18 @@
 """The generators a plan entry can name, one module each, registered in :mod:`.registry` on import.
 
-=====================  ========  ==================================================================
-generator              modality  module
-=====================  ========  ==================================================================
-gait_net               gait      :mod:`.gait_net` (seed 000 network; falls back to procedural_walk)
-procedural_walk        gait      :mod:`.procedural_walk` (SYNTHETIC)
-captured               gait      :mod:`.captured` (shipped real walks)
-neutral_walk           gait      :mod:`.neutral_walk` (seed 004's unstyled base)
-rbf                    gait      :mod:`.rbf` (seed 004 styles)
-gesture_net            gesture   :mod:`.gesture_net` (seed 003 network; falls back to procedural_gesture)
-procedural_gesture     gesture   :mod:`.procedural_gesture` (SYNTHETIC)
-captured_file          any       :mod:`.captured_file` (an imported motion file)
-=====================  ========  ==================================================================
-
-``docs/generators.md`` is written from the registry (``python -m generation.plans.generators``).
+``docs/generators.md`` lists them with their fields and defaults; it is written from the registry
+(``python -m generation.plans.generators``), so the registry is the one place a generator is described.
 """
-from . import captured, captured_file, gait_net, gesture_net, neutral_walk, procedural_gesture, procedural_walk, rbf
+from . import (  # noqa: F401 - importing a generator's module registers it
+    captured,
+    captured_file,
+    gait_net,
+    gesture_net,
+    neutral_walk,
+    procedural_gesture,
+    procedural_walk,
+    rbf,
+)
 from .registry import (
     ClipGenerationError,
     GeneratorSpec,
@@ -29,8 +26,5 @@ from .registry import (
     unregister,
 )
 
-BUILTIN_MODULES = (gait_net, procedural_walk, captured, neutral_walk, rbf, gesture_net, procedural_gesture,
-                   captured_file)
-
-__all__ = ["BUILTIN_MODULES", "ClipGenerationError", "GeneratorSpec", "InputContext", "MakeContext", "PlanInputs",
+__all__ = ["ClipGenerationError", "GeneratorSpec", "InputContext", "MakeContext", "PlanInputs",
            "generator_names", "get_generator", "register", "registered", "unregister"]
