@@ -208,20 +208,25 @@ def run_with_kills(server: str, tmp_path: Path, database_url: str, connections=N
         for t in clients:
             t.start()
         kills = 0
+        expected_pages = sum(len(p["pages"]) for p in participants)
+        # a kill at each of KILLS evenly spaced answer counts, so fast clients cannot finish before the last kill
+        milestones = [expected_pages * (k + 1) // (KILLS + 1) for k in range(KILLS)]
 
         def sample():
             if connections is not None:
                 stats["peak_connections"] = max(stats["peak_connections"], connections())
 
         while kills < KILLS and any(t.is_alive() for t in clients):
-            for _ in range(6):
-                time.sleep(0.1)
-                sample()
+            time.sleep(0.02)
+            sample()
             with lock:
-                in_progress = stats["posts"] > 0
-            pids = _workers(master.pid)
-            if in_progress and pids:
-                os.kill(pids[kills % len(pids)], signal.SIGKILL)
+                due = stats["posts"] >= milestones[kills]
+            pids = _workers(master.pid) if due else []
+            if pids:
+                try:
+                    os.kill(pids[kills % len(pids)], signal.SIGKILL)
+                except ProcessLookupError:  # a worker that exited between pgrep and the kill
+                    continue
                 kills += 1
         end = time.monotonic() + 180
         while any(t.is_alive() for t in clients) and time.monotonic() < end:
@@ -236,7 +241,6 @@ def run_with_kills(server: str, tmp_path: Path, database_url: str, connections=N
             master.kill()
             master.wait()
     result = _manage_json(env, CHECK)
-    expected_pages = sum(len(p["pages"]) for p in participants)
     print(server, "kills", kills, stats, result)
     assert kills == KILLS
     assert stats["retries"] > 0, "no request was in flight at any kill: nothing was tested"
