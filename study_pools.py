@@ -4,8 +4,9 @@ whether a pool or an option is well formed.
 
 A pool is a JSON object of catalogue filters: ``field`` or ``field__lookup`` -> value (a list without a lookup
 means ``in``), plus two boolean shorthands, ``transition`` (the clip has a final emotion) and ``rbf`` (the clip
-has a theme), and the switch ``include_flagged`` (true: clips whose quality record failed a check, ``qa_flag``, are
-in the pool too; they are left out otherwise). A naturalness section may add ``generated`` and ``source``
+has a theme), and the switches ``include_flagged`` (true: clips whose quality record failed a check, ``qa_flag``, are
+in the pool too; they are left out otherwise) and ``observer_advisory`` (true: only the automatic observer's flag is
+disregarded). A naturalness section may add ``generated`` and ``source``
 sub-pools (filters of the same kind) for its two halves. Options are type-specific (``SECTION_OPTIONS``).
 """
 from __future__ import annotations
@@ -42,6 +43,10 @@ NUMBER_LOOKUPS = ("", "in", "lt", "lte", "gt", "gte", "isnull")
 FLAGS = ("transition", "rbf")
 INCLUDE_FLAGGED = "include_flagged"
 """Pool switch: also draw clips that failed a quality check (``Clip.qa_flag`` not empty)."""
+OBSERVER_ADVISORY = "observer_advisory"
+"""Pool switch: the automatic observer's flag does not keep a clip out (people judge the clip: a norming section's
+candidates are rated precisely because an observer's reading is a weak judge); other failed checks still do."""
+SWITCHES = (INCLUDE_FLAGGED, OBSERVER_ADVISORY)
 NORMS_RULE = "norms"
 """Pool rule admitting only clips whose per-clip norms pass: ``{"from": <study slug or clip_norms.csv path>,
 "min_ratings": 10, "min_intended_share": 0.5, "max_entropy_bits": 1.5}`` (studyapp.norms_rule applies it)."""
@@ -165,7 +170,7 @@ def pool_problems(pool, section_type: str | None = None, sub_pools: bool = True)
     for key, value in pool.items():
         if key == NORMS_RULE:
             found += _norms_rule_problems(value)
-        elif key in FLAGS or key == INCLUDE_FLAGGED:
+        elif key in FLAGS or key in SWITCHES:
             if not isinstance(value, bool):
                 found.append(((key,), f"{key!r} takes true or false, got {value!r}"))
         elif key in SUB_POOLS and sub_pools:
@@ -225,7 +230,7 @@ def pool_lookups(pool: dict | None) -> list[tuple[str, dict]]:
         raise PoolError({"pool": errors})
     calls = []
     for key, value in (pool or {}).items():
-        if key in SUB_POOLS or key == INCLUDE_FLAGGED or key == NORMS_RULE:   # NORMS_RULE: studyapp.norms_rule
+        if key in SUB_POOLS or key in SWITCHES or key == NORMS_RULE:   # NORMS_RULE: studyapp.norms_rule
             continue
         if key == "transition":
             calls.append(("filter", {f"{FINAL_EMOTION_COLUMNS[0]}__isnull": not value}))

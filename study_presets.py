@@ -148,6 +148,8 @@ PRESETS["demo"]["sections"][4]["title"] = "Perceived emotion: gestures"
 # admin shows K, M and the N needed, and refuses to open a study whose N cannot give K.
 NORMING_RATINGS_PER_CLIP = 20
 _NORMING = {"norming": {"ratings_per_clip": NORMING_RATINGS_PER_CLIP}, "practice": True}
+# people are the judge of the candidates: the automatic observer's flag keeps none out (other failed checks do)
+_CANDIDATES = {"observer_advisory": True}
 PRESETS["norming"] = {
     "title": "Norming the stimuli: how each clip is perceived",
     "introduction": "Each clip shows a virtual character walking or gesturing. For every clip, tell us which emotion "
@@ -158,17 +160,17 @@ PRESETS["norming"] = {
         {"section_type": "emotion_choice", "title": "Walks",
          "instructions": "Watch each walk. Report the emotion(s) you perceive (more than one is allowed), how "
                          "intense it looks and how natural the motion looks.",
-         "pool": {"modality": "gait", "transition": False, "rbf": False}, "clips_per_participant": 8,
+         "pool": {"modality": "gait", "transition": False, "rbf": False, **_CANDIDATES}, "clips_per_participant": 8,
          "options": {**_NORMING, "attention_checks": {"count": 1, "answer": "sad", "positions": "random"}}},
         {"section_type": "gesture_emotion", "title": "Gestures",
          "instructions": "Watch each clip. Choose the emotion you perceive from the gestures, how intense it looks "
                          "and how natural the gestures look.",
-         "pool": {"modality": "gesture"}, "clips_per_participant": 8,
+         "pool": {"modality": "gesture", **_CANDIDATES}, "clips_per_participant": 8,
          "options": {**_NORMING, "n_options": 4}},
         {"section_type": "theme_rating", "title": "Walking styles",
          "instructions": "Rate the amount of the named style in each walk, how intense the style looks and how "
                          "natural the motion looks.",
-         "pool": {"rbf": True, "weight__gt": 0}, "clips_per_participant": 8, "loop": True,
+         "pool": {"rbf": True, "weight__gt": 0, **_CANDIDATES}, "clips_per_participant": 8, "loop": True,
          "options": dict(_NORMING)},
     ],
 }

@@ -6,7 +6,7 @@ from __future__ import annotations
 from django.utils.html import format_html, format_html_join
 from django.utils.safestring import SafeString
 
-from study_pools import INCLUDE_FLAGGED, NORMS_RULE
+from study_pools import INCLUDE_FLAGGED, NORMS_RULE, OBSERVER_ADVISORY
 from study_protocol import QA_ADVISORY_CHECKS
 
 from .catalogue import CatalogueError, pool_queryset
@@ -37,11 +37,13 @@ def _norm_text(norm: dict | None) -> str:
     return f"n {int(norm['n_ratings'])}; {what}; entropy {norm.get('entropy_bits', float('nan')):.2f} bits"
 
 
-def _flag_reason(clip, has_norm: bool, include_flagged: bool) -> tuple[str, str]:
+def _flag_reason(clip, has_norm: bool, pool: dict) -> tuple[str, str]:
     """(reason the quality gate keeps the clip out or '', note on an observer flag made advisory or '')."""
     failed = [c for c in (clip.qa_flag or "").split(";") if c and c not in QA_ADVISORY_CHECKS]
-    if include_flagged or not failed:
+    if pool.get(INCLUDE_FLAGGED) or not failed:
         return "", ""
+    if failed == ["observer"] and pool.get(OBSERVER_ADVISORY):
+        return "", "observer flag advisory in this pool"
     if has_norm and failed == ["observer"]:
         return "", "observer flag advisory: people rated this clip"
     return f"failed quality check(s): {', '.join(failed)}", ""
@@ -58,11 +60,10 @@ def norms_table(pool: dict | None) -> SafeString:
         judged = verdicts(pool, [c.clip_id for c in clips])
     except (CatalogueError, NormsSourceError) as exc:
         return format_html('<p class="norms-error errornote">{}</p>', str(exc))
-    include_flagged = bool(pool.get(INCLUDE_FLAGGED))
     rows = []
     for c in clips:
         v = judged[c.clip_id]
-        gate, note = _flag_reason(c, v.norm is not None, include_flagged)
+        gate, note = _flag_reason(c, v.norm is not None, pool)
         reasons = v.reasons + ([gate] if gate else [])
         status = "in" if not reasons else "out: " + "; ".join(reasons)
         rows.append((("norms-in" if not reasons else "norms-out"), c.clip_id, c.modality, c.origin, _quality(c),

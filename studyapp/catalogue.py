@@ -16,7 +16,7 @@ from itertools import combinations
 from django.db import transaction
 from django.db.models import Q, QuerySet
 
-from study_pools import INCLUDE_FLAGGED, NORMS_RULE, PoolError, pool_lookups
+from study_pools import INCLUDE_FLAGGED, NORMS_RULE, OBSERVER_ADVISORY, PoolError, pool_lookups
 from study_protocol import (
     CLIP_FLOAT_COLUMNS,
     CLIP_MODALITIES,
@@ -35,8 +35,8 @@ ADVISORY_FLAGS = ("", *(";".join(c for c in QA_CHECKS if c in subset)
                         for n in range(1, len(QA_ADVISORY_CHECKS) + 1)
                         for subset in combinations(QA_ADVISORY_CHECKS, n)))
 
-#: ``qa_flag`` values that keep a clip with norms in a pool with a norms rule: failed only the observer check and
-#: advisory ones (studyapp.norms_rule).
+#: ``qa_flag`` values that failed only the observer check and advisory ones: they keep a clip in a pool that says
+#: ``observer_advisory`` (a norming section's candidates), and a clip with norms in a pool with a norms rule.
 OBSERVER_ADVISORY_FLAGS = tuple(";".join(c for c in QA_CHECKS if c in subset)
                                 for n in range(1, len(QA_ADVISORY_CHECKS) + 2)
                                 for subset in combinations(("observer", *QA_ADVISORY_CHECKS), n)
@@ -194,8 +194,9 @@ def pool_queryset(pool: dict | None, include_flagged: bool | None = None) -> Que
     ``"include_flagged": true`` or ``include_flagged`` is given (True for a sub-pool, which only narrows its
     section's pool); failing only advisory checks (``study_protocol.QA_ADVISORY_CHECKS``) does not count.
     A ``norms`` rule (studyapp.norms_rule) keeps only clips whose norms pass, and makes the ``observer`` check
-    advisory for clips that have norms. Raises CatalogueError naming the filter (or the norms source's file, line
-    and column) when the pool is not valid; sub-pools are left to the assignment.
+    advisory for clips that have norms; ``"observer_advisory": true`` makes it advisory for every clip. Raises
+    CatalogueError naming the filter (or the norms source's file, line and column) when the pool is not valid;
+    sub-pools are left to the assignment.
     """
     try:
         calls = pool_lookups(pool)
@@ -214,7 +215,9 @@ def pool_queryset(pool: dict | None, include_flagged: bool | None = None) -> Que
         qs = qs.filter(clip_id__in=passing)
     if not include_flagged:
         flags = Q(qa_flag__in=ADVISORY_FLAGS)
-        if normed:      # a norm outranks an observer: its verdict is advisory for clips people rated
+        if (pool or {}).get(OBSERVER_ADVISORY):
+            flags |= Q(qa_flag__in=OBSERVER_ADVISORY_FLAGS)
+        elif normed:      # a norm outranks an observer: its verdict is advisory for clips people rated
             flags |= Q(qa_flag__in=OBSERVER_ADVISORY_FLAGS, clip_id__in=normed)
         qs = qs.filter(flags)
     for method, kwargs in calls:

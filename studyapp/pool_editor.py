@@ -31,6 +31,7 @@ from study_pools import (
     DEFAULT_PLAYER_CONTROLS,
     INCLUDE_FLAGGED,
     MAX_REPLAYS_LIMIT,
+    OBSERVER_ADVISORY,
     PLAYER_CONTROLS,
     SECTION_OPTIONS,
     SUB_POOLS,
@@ -499,6 +500,9 @@ def _main_pool_specs() -> list[ChoiceSpec]:
         TristateSpec(p + "rbf", "rbf", (), "Styled", "yes: clips with a theme (RBF styled, or the neutral input walk)"),
         FlagSpec(p + "include_flagged", INCLUDE_FLAGGED, (), "Include clips that failed a quality check",
                  "off: clips with a quality flag (Clip.qa_flag) are left out"),
+        FlagSpec(p + "observer_advisory", OBSERVER_ADVISORY, (), "Observer flag is advisory",
+                 "on: a clip the automatic emotion observer flagged stays in (people judge it, as in a norming "
+                 "study); other failed checks still keep a clip out"),
     ]
 
 

@@ -45,9 +45,20 @@ def test_advisory_realism_flag_keeps_a_clip_in_pools():
     assert set(flagged.values_list("clip_id", flat=True)) == {"real_like", "off_emotion", "good"}
 
 
-def test_include_flagged_is_a_boolean_pool_switch():
-    assert pool_errors({"include_flagged": True, "modality": "gait"}) == []
+@pytest.mark.django_db
+def test_observer_advisory_pool_keeps_observer_flags_but_not_other_failures():
+    upsert_clips([rec("off_emotion", "observer"), rec("off_and_real", "observer;realism"),
+                  rec("sunk_off", "penetration;observer"), rec("good")])
+    plain = pool_queryset({"modality": "gait"})
+    assert set(plain.values_list("clip_id", flat=True)) == {"good"}
+    candidates = pool_queryset({"modality": "gait", "observer_advisory": True})
+    assert set(candidates.values_list("clip_id", flat=True)) == {"off_emotion", "off_and_real", "good"}
+
+
+def test_include_flagged_and_observer_advisory_are_boolean_pool_switches():
+    assert pool_errors({"include_flagged": True, "observer_advisory": False, "modality": "gait"}) == []
     assert any("include_flagged" in e for e in pool_errors({"include_flagged": "yes"}))
+    assert any("observer_advisory" in e for e in pool_errors({"observer_advisory": 1}))
 
 
 @pytest.mark.django_db

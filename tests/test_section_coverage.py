@@ -12,6 +12,8 @@ def test_pool_filters_on_planned_rows():
     assert matches(row, {"sections__contains": "naturalness", "happy__gte": 0.5})
     assert not matches(row, {"origin": ["source"]})
     assert blocking("observer;realism") == ["observer"] and blocking("realism") == [] and blocking("") == []
+    assert blocking("observer;realism", observer_advisory=True) == []
+    assert blocking("penetration;observer", observer_advisory=True) == ["penetration"]
 
 
 def test_demo_sections_full_when_nothing_is_flagged_and_short_when_the_gate_takes_clips():
@@ -29,3 +31,21 @@ def test_demo_sections_full_when_nothing_is_flagged_and_short_when_the_gate_take
     assert lines[0].startswith("section 1 (emotion_choice)") and "SHORT" in lines[0] and "sad_loop: penetration" \
         in lines[0]
     assert "shows the clips of section 1 again" in lines[2]
+
+
+def test_norming_candidates_keep_observer_flags_and_a_pool_smaller_than_m_is_not_short():
+    """People judge a norming study's candidates: an observer flag keeps none out, and when fewer than M
+    candidates are usable each participant rates them all."""
+    flags = {"happy_neutral_mix": "observer", "sad_loop": "penetration"}
+    walks = section_coverage("norming", flags)[0]
+    assert walks["asks"] == 8 and walks["in_pool"] == 8
+    assert walks["left_out"] == [("sad_loop", ["penetration"])]
+    assert walks["usable"] == 7 and not walks["short"]
+    assert "norming: each participant rates 7 of the 7 candidates" in walks["why"]
+    gestures = section_coverage("norming", {})[1]
+    assert gestures["asks"] == 8 and gestures["in_pool"] < 8 and not gestures["short"]
+    broken = section_coverage("norming", {"happy_loop": "jerk", "sad_loop": "jerk", "angry_hairpin": "jerk",
+                                          "happy_neutral_mix": "jerk", "source_walk_happy": "jerk",
+                                          "source_walk_sad": "jerk", "source_walk_angry": "jerk",
+                                          "source_walk_normal": "jerk"})[0]
+    assert broken["usable"] == 0 and broken["short"]

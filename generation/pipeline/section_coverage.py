@@ -3,21 +3,22 @@
 A study made from a preset (``study_presets.PRESETS``) draws each section's clips from its pool (catalogue filters,
 ``study_pools``; :func:`create_study_from_preset` adds the preset's plan, ``study_presets.PRESET_PLANS``) and leaves
 out clips that failed a non-advisory quality check (``qa_flag`` other than ``study_protocol.QA_ADVISORY_CHECKS``)
-unless the pool says ``include_flagged``. :func:`section_coverage` applies the same filters to the plan's planned
+unless the pool says ``include_flagged`` (or failed only the observer's check in a pool that says
+``observer_advisory``). :func:`section_coverage` applies the same filters to the plan's planned
 clip rows (:func:`generation.plans.planned.planned_clip_rows`, the rows the catalogue will hold) with each entry's
 quality flag from the gate (:func:`generation.pipeline.plan_qa.run`), and compares what is left with the section's
 ``clips_per_participant`` (0: every clip of the pool; naturalness sections also their ``n_generated`` /
-``n_source`` halves). Plain Python: the pool filters are evaluated on dict rows, no Django.
+``n_source`` halves; a norming section, which shows each participant min(M, C) of its C candidates, is full with
+one usable candidate). Plain Python: the pool filters are evaluated on dict rows, no Django.
 """
 from __future__ import annotations
 
 from generation.plans.planned import planned_clip_rows
 from generation.plans.schema import load_plan
-from study_pools import SUB_POOLS, pool_lookups
+from study_norming import ratings_per_clip
+from study_pools import INCLUDE_FLAGGED, OBSERVER_ADVISORY, SUB_POOLS, pool_lookups
 from study_presets import PRESET_PLANS, PRESETS
 from study_protocol import QA_ADVISORY_CHECKS
-
-INCLUDE_FLAGGED = "include_flagged"
 
 
 def _value(row: dict, field: str):
@@ -53,9 +54,11 @@ def matches(row: dict, pool: dict | None) -> bool:
     return True
 
 
-def blocking(flag: str | None) -> list[str]:
-    """The failed checks of a ``qa_flag`` that keep a clip out of pools (all but the advisory ones)."""
-    return [c for c in (flag or "").split(";") if c and c not in QA_ADVISORY_CHECKS]
+def blocking(flag: str | None, observer_advisory: bool = False) -> list[str]:
+    """The failed checks of a ``qa_flag`` that keep a clip out of pools (all but the advisory ones, and but the
+    observer's in a pool that says ``observer_advisory``)."""
+    advisory = (*QA_ADVISORY_CHECKS, "observer") if observer_advisory else QA_ADVISORY_CHECKS
+    return [c for c in (flag or "").split(";") if c and c not in advisory]
 
 
 def section_coverage(preset: str, flags: dict[str, str], plan=None) -> list[dict]:
@@ -82,12 +85,16 @@ def section_coverage(preset: str, flags: dict[str, str], plan=None) -> list[dict
         pool = {**(sec.get("pool") or {}), "plan": plan.name}
         keep_flagged = bool(pool.get(INCLUDE_FLAGGED, False))
         in_pool = [r for r in rows if matches(r, pool)]
-        left = [(r["entry_id"], blocking(flags.get(r["entry_id"]))) for r in in_pool]
+        left = [(r["entry_id"], blocking(flags.get(r["entry_id"]), bool(pool.get(OBSERVER_ADVISORY))))
+                for r in in_pool]
         left = [(e, b) for e, b in left if b and not keep_flagged]
         gone = {e for e, _ in left}
         usable = [r for r in in_pool if r["entry_id"] not in gone]
         asks = int(sec.get("clips_per_participant") or 0)
         need = asks if asks else len(in_pool)
+        if ratings_per_clip(sec.get("options")) is not None:
+            # a norming design shows each participant min(M, C) of its C candidates: any candidate is enough
+            need = min(need, max(len(usable), 1))
         item = {**base, "asks": asks, "in_pool": len(in_pool), "usable": len(usable), "left_out": left}
         halves = {}
         options = sec.get("options") or {}
@@ -101,6 +108,7 @@ def section_coverage(preset: str, flags: dict[str, str], plan=None) -> list[dict
             item["halves"] = halves
         short_halves = [h for h, v in halves.items() if v["usable"] < v["asks"]]
         item["short"] = len(usable) < need or bool(short_halves)
+        norming = ratings_per_clip(options) is not None
         if item["short"]:
             reasons = "; ".join(f"{e}: {', '.join(b)}" for e, b in left) or "the pool itself is too small"
             half_txt = "".join(f"; its {h} half asks {halves[h]['asks']}, {halves[h]['usable']} usable"
@@ -109,7 +117,9 @@ def section_coverage(preset: str, flags: dict[str, str], plan=None) -> list[dict
                            f"the quality gate: {reasons}")
         else:
             item["why"] = (f"asks {need}, {len(usable)} usable of {len(in_pool)} in its pool"
-                           + (f" ({len(left)} left out by the gate)" if left else ""))
+                           + (f" ({len(left)} left out by the gate)" if left else "")
+                           + (f"; norming: each participant rates {min(asks or len(usable), len(usable))} of the "
+                              f"{len(usable)} candidates" if norming else ""))
         out.append(item)
     return out
 
