@@ -14,7 +14,8 @@ from __future__ import annotations
 import sys
 
 from django.db import OperationalError
-from django.http import HttpResponse
+from django.http import HttpResponse, HttpResponsePermanentRedirect
+from django.templatetags.static import static
 from django.views import defaults
 from django.views.decorators.cache import never_cache
 from django.views.decorators.http import require_safe
@@ -56,3 +57,10 @@ def server_error(request, template_name: str = defaults.ERROR_500_TEMPLATE_NAME)
     if database_unavailable(sys.exc_info()[1]):
         return unavailable_response()
     return defaults.server_error(request, template_name)
+
+
+@require_safe
+def favicon(request):
+    """/favicon.ico, which browsers ask for on pages that name no icon (the admin's): the static icon, resolved per
+    request so that a missing static manifest never breaks the URL map."""
+    return HttpResponsePermanentRedirect(static("studyapp/favicon.svg"))

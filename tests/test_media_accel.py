@@ -94,3 +94,9 @@ def test_healthz_answers_without_touching_the_database(client, django_assert_num
     with django_assert_num_queries(0):
         r = client.get("/healthz")
     assert r.status_code == 200 and r.content == b"ok" and r["Content-Type"].startswith("text/plain")
+
+
+def test_favicon_is_the_static_icon(client):
+    r = client.get("/favicon.ico")
+    assert r.status_code == 301 and r["Location"].endswith("studyapp/favicon.svg")
+    assert client.get(r["Location"]).status_code == 200
