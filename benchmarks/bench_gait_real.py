@@ -134,16 +134,18 @@ def _named_weights(name: str, net):
             generate._DEFAULT[name] = saved
 
 
-def plan_walks(weights: str, net=None) -> list[dict]:
+def plan_walks(weights: str, net=None, keep=None, seed_offset: int = 0) -> list[dict]:
     """The seed000 plan's gait_net clips made with the named weights (not rendered), as ``plan_qa`` makes them;
-    with ``net``, that network in place of the named one."""
+    with ``net``, that network in place of the named one; with ``keep``, only the plan entries (raw dicts) it
+    accepts; with ``seed_offset``, each entry's seed moved by it (other walks of the same entries)."""
     import yaml
 
     from generation.plans.clipgen import make_motion
     from generation.plans.schema import plan_path, validate_plan
 
     plan = yaml.safe_load(plan_path("seed000").read_text())
-    raw = [{**e, "weights": weights} for e in plan["clips"] if e.get("generator") == "gait_net"]
+    raw = [{**e, "weights": weights, "seed": e.get("seed", 0) + seed_offset} for e in plan["clips"]
+           if e.get("generator") == "gait_net" and (keep is None or keep(e))]
     sub = validate_plan({"name": "seed000-gait", "render": plan.get("render", {}), "clips": raw})
     rows = []
     with _named_weights(weights, net) if net is not None else nullcontext():

@@ -15,11 +15,13 @@ are left as they are)::
     python -m benchmarks.doc_tables gesture         # docs/benchmarks/gesture.json -> gesture.md
     python -m benchmarks.doc_tables rbf_real        # docs/benchmarks/rbf_real.json -> rbf.md
     python -m benchmarks.doc_tables gait_real       # docs/benchmarks/gait_real.json -> gait.md
+    python -m benchmarks.doc_tables realism_by_emotion  # realism_by_emotion.json -> gait.md
     python -m benchmarks.doc_tables gait --print    # print every table of the JSON instead
 
 The renderers live in ``doc_renderers/``, one module per area (gait, gesture, rbf_features, rbf_real,
-real_observer, gait_real, upsampling), each with its own ``TABLES``, and ``doc_renderers/common.py`` for the
-formatting they share; this module combines them into ``TABLES`` and keeps the doc handling and the CLI.
+real_observer, gait_real, upsampling, realism_by_emotion), each with its own ``TABLES``, and
+``doc_renderers/common.py`` for the formatting they share; this module combines them into ``TABLES`` and keeps the
+doc handling and the CLI.
 """
 from __future__ import annotations
 
@@ -29,7 +31,16 @@ import re
 import sys
 from pathlib import Path
 
-from benchmarks.doc_renderers import gait, gait_real, gesture, rbf_features, rbf_real, real_observer, upsampling
+from benchmarks.doc_renderers import (
+    gait,
+    gait_real,
+    gesture,
+    rbf_features,
+    rbf_real,
+    real_observer,
+    realism_by_emotion,
+    upsampling,
+)
 from benchmarks.doc_renderers.common import EMOTIONS, Renderer, table
 from benchmarks.doc_renderers.gait_real import GAIT_REAL_SUBSETS
 
@@ -41,7 +52,8 @@ BLOCK_RE = re.compile(r"(<!-- table: (?P<name>[\w.]+) -->\n)(?P<body>.*?)(<!-- /
 
 TABLES: dict[str, dict[str, tuple[str, Renderer]]] = {
     "gait": gait.TABLES, "gesture": gesture.TABLES, "rbf_features": rbf_features.TABLES, "rbf_real": rbf_real.TABLES,
-    "real_observer": real_observer.TABLES, "gait_real": gait_real.TABLES, "upsampling": upsampling.TABLES}
+    "real_observer": real_observer.TABLES, "gait_real": gait_real.TABLES, "upsampling": upsampling.TABLES,
+    "realism_by_emotion": realism_by_emotion.TABLES}
 """area -> table name -> (the JSON key it needs, renderer)."""
 
 
@@ -49,7 +61,8 @@ FILES: dict[str, tuple[str, str]] = {"rbf_features": ("rbf_features.json", "rbf.
                                      "rbf_real": ("rbf_real.json", "rbf.md"),
                                      "real_observer": ("real_observer.json", "mocap.md"),
                                      "gait_real": ("gait_real.json", "gait.md"),
-                                     "upsampling": ("upsampling.json", "gait.md")}
+                                     "upsampling": ("upsampling.json", "gait.md"),
+                                     "realism_by_emotion": ("realism_by_emotion.json", "gait.md")}
 """area -> (its JSON, its doc) in docs/benchmarks/, where they are not <area>.json and <area>.md."""
 
 
