@@ -46,6 +46,7 @@ from generation.gesture.metrics import (
 from generation.gesture.model import GestureNetConfig
 from generation.gesture.train import TrainConfig, train
 from generation.quality.gesture_observer import corpus_descriptors, motion_descriptors, positions_of
+from generation.render.offscreen import prepare_render_process
 from study_protocol import GESTURE_EMOTIONS
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -540,6 +541,7 @@ def _json_default(o):
 
 def main(argv=None) -> int:
     one_thread()
+    prepare_render_process()
     argv = sys.argv[1:] if argv is None else list(argv)
     args = _args(argv)
     torch.set_num_threads(1)

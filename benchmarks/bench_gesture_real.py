@@ -35,6 +35,7 @@ from generation.quality.real_gesture_observer import (
     real_gesture_dataset,
 )
 from generation.quality.real_gestures import real_gesture_clips, real_stats_table
+from generation.render.offscreen import prepare_render_process
 from study_protocol import CAPTURE_GESTURE_EMOTIONS
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -147,6 +148,7 @@ def contact_sheet(nets: dict, real: dict, path: Path) -> list[str]:
 
 def main(argv=None) -> dict:
     one_thread()
+    prepare_render_process()
     p = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     p.add_argument("--before", required=True)
     p.add_argument("--after", required=True)

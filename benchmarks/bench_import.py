@@ -16,7 +16,6 @@ from __future__ import annotations
 import argparse
 import csv
 import json
-import os
 import subprocess
 import tempfile
 import time
@@ -27,6 +26,7 @@ import imageio_ffmpeg
 from benchmarks.bench_record import commit_label, machine_label, record
 from generation.imports import ImportSettings, import_manifest
 from generation.imports.manifest import MANIFEST_COLUMNS
+from generation.render.offscreen import prepare_render_process
 
 ROOT = Path(__file__).resolve().parents[1]
 BVH = (ROOT / "generation/data/mocap/bandai-namco/Bandai-Namco-Research-Motiondataset-1/data"
@@ -99,7 +99,7 @@ def main(argv=None) -> int:
     if args.from_json:
         write_markdown(json.loads(Path(args.from_json).read_text()), args.md)
         return 0
-    os.environ.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow")
+    prepare_render_process()
     settings = ImportSettings()
     rows = []
     with tempfile.TemporaryDirectory(prefix="bench-import-") as tmp:

@@ -42,6 +42,7 @@ from generation.rbf.neutral_base import neutral_cycle
 from generation.rbf.real_neutral import load_cycle, steady_cycles
 from generation.rbf.stylise import neutral_walk, stylise
 from generation.rbf.themes import THEME_NAMES, theme_features
+from generation.render.offscreen import prepare_render_process
 from study_protocol import CAPTURE_THEMES, GAIT_EMOTIONS
 
 CHECKED = ("speed_m_s", "cadence_steps_min", "stance_knee_deg", "pelvis_bounce_cm")
@@ -206,6 +207,7 @@ def main(argv=None) -> int:
     import platform
     import shlex
 
+    prepare_render_process()
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--corpus", type=Path, default=None)
     ap.add_argument("--out", type=Path, default=doc_tables.area_files("rbf_real")[0])

@@ -35,7 +35,9 @@ import tempfile
 import time
 from pathlib import Path
 
-os.environ.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow")
+from generation.render.offscreen import prepare_render_process
+
+prepare_render_process()  # here, not in main(): the spawned render processes import this module too
 
 
 def _cpu() -> float:

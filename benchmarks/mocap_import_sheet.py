@@ -14,7 +14,6 @@ Usage: python -m benchmarks.mocap_import_sheet [--out docs/img/mocap_import_shee
 from __future__ import annotations
 
 import argparse
-import os
 import tempfile
 from pathlib import Path
 
@@ -25,10 +24,10 @@ from generation.mocap import ImportOptions, import_file
 from generation.mocap.captured import WALK_FILES, captured_walks, chain_clip_repeats
 from generation.render.clip import render_frames_at
 from generation.render.contact_sheet import contact_sheet
+from generation.render.offscreen import prepare_render_process
 from generation.render.settings import RenderSettings
 from tests.mocap_conventions import export_as
 
-os.environ.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow")
 ROOT = Path(__file__).resolve().parents[1]
 
 CONVENTIONS = (("mixamo", "Mixamo"), ("cmu", "CMU"))
@@ -58,6 +57,7 @@ def imported_motions(motion, folder: Path) -> list[tuple[str, object]]:
 
 def main() -> None:
     one_thread()
+    prepare_render_process()
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--out", type=Path, default=ROOT / "docs" / "img" / "mocap_import_sheet.png")
     a = ap.parse_args()

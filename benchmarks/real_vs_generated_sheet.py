@@ -20,6 +20,7 @@ from generation.plans.clipgen import make_motion, resolve
 from generation.plans.schema import validate_plan
 from generation.render.clip import render_frames_at
 from generation.render.contact_sheet import contact_sheet
+from generation.render.offscreen import prepare_render_process
 from generation.render.settings import RenderSettings
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -59,6 +60,7 @@ def add_frames(rows, settings: RenderSettings, times: list[float], folder: Path,
 
 
 def main() -> None:
+    prepare_render_process()
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--takes", type=Path, default=ROOT / "generation" / "data" / "mocap" / "bandai-namco"
                     / "Bandai-Namco-Research-Motiondataset-1" / "data")

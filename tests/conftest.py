@@ -1,13 +1,14 @@
 """Shared pytest fixtures: a headless Chromium driven by Selenium, and single-threaded torch."""
 from __future__ import annotations
 
-import os
 import shutil
 import tempfile
 
 import pytest
 
-os.environ.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow")
+from generation.render.offscreen import prepare_render_process
+
+prepare_render_process()
 
 CHROMIUM_FLAGS = (
     "--headless",

@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import csv
+import os
 import sys
 
 import numpy as np
@@ -479,3 +480,13 @@ def test_liveliness_options_are_opt_in():
     err = {"pose_error": 0.01, "speed_log_ratio": 0.2, "emotion_speed_gap": 0.4}
     assert selection_score(err) == pytest.approx(0.012)
     assert selection_score(err, emotion_gap=True) == pytest.approx(0.016)
+
+
+def test_text_encoder_loads_without_writing_the_environment(monkeypatch):
+    from generation.gesture.text import TextEncoder
+
+    offline = ("HF_HUB_OFFLINE", "TRANSFORMERS_OFFLINE")
+    for name in offline:
+        monkeypatch.delenv(name, raising=False)
+    vectors = TextEncoder().encode("Hello there.")   # local_files_only: the package's files, no download
+    assert [name for name in offline if name in os.environ] == [] and vectors.shape[1] == 384

@@ -5,7 +5,8 @@
 - generation.core imports no other project package (it is the bottom layer);
 - the top-level vocabulary (study_protocol, study_pools, study_presets) imports none of the libraries nor Django;
 - inside generation, a package imports only the packages below it in LAYERS (core < formats < procedural < render
-  < gesture < mocap < gait < rbf < quality < plans < pipeline, the order of the design notes);
+  < gesture < mocap < gait < rbf < quality < plans < pipeline < imports, the order of the design notes), and
+  every package of generation has its place in that order;
 - the package graph (scripts/import_graph.py's packages) has no cycle;
 - a function-local import of a project module says on its line why it is local (a heavy import such as torch or
   matplotlib, or an optional library), and there are at most LOCAL_IMPORT_BUDGET of them.
@@ -20,7 +21,7 @@ from scripts.import_graph import ROOT, TOP_MODULES, find_cycles, package_edges, 
 
 #: The packages of generation, bottom first: each may import only those before it.
 LAYERS = ("core", "formats", "procedural", "render", "gesture", "mocap", "gait", "rbf", "quality", "plans",
-          "pipeline")
+          "pipeline", "imports")
 LOCAL_IMPORT_BUDGET = 10
 
 FORBIDDEN = [
@@ -82,6 +83,15 @@ def test_no_import_crosses_the_layers_the_wrong_way(edges):
     assert layer_violations(edges) == []
 
 
+def unplaced_packages(root: Path = ROOT) -> list[str]:
+    """Packages of generation (folders with an ``__init__.py``) that LAYERS does not place, so nothing checks them."""
+    return sorted(p.parent.name for p in (root / "generation").glob("*/__init__.py") if p.parent.name not in LAYERS)
+
+
+def test_every_generation_package_has_a_layer():
+    assert unplaced_packages() == []
+
+
 def test_package_graph_has_no_cycle(edges):
     assert find_cycles(edges) == []
 
@@ -111,6 +121,8 @@ def test_the_checks_see_local_imports_and_cycles(tmp_path):
         "generation/render/__init__.py": "def g():\n    from generation.core import y\n",
         "generation/plans/x.py": "import django.db\n",
         "generation/gesture/y.py": "def h():\n    from generation.quality import z\n",
+        "generation/pipeline/w.py": "from generation.imports import run\n",
+        "generation/extra/__init__.py": "",
         "studyapp/__init__.py": "",
     })
     edges, local = package_edges(root)
@@ -120,6 +132,9 @@ def test_the_checks_see_local_imports_and_cycles(tmp_path):
     assert any("generation.core imports nothing above it" in v for v in found)
     assert any("generation/gesture/y.py:2: generation.gesture imports generation.quality above it (inside a "
                "function)" in v for v in found)
+    assert any("generation/pipeline/w.py:1: generation.pipeline imports generation.imports above it" in v
+               for v in found)
+    assert unplaced_packages(root) == ["extra"]
     assert find_cycles(edges) == [["generation.core", "generation.render"]]
     assert {(p.name, line) for p, line, _ in local} == {("a.py", 2), ("__init__.py", 2), ("y.py", 2)}
     assert sorted(text for _, text in local_project_imports(local, root) if "#" not in text) == [

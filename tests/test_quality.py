@@ -166,3 +166,6 @@ def test_unread_line_says_which_clips_got_no_observer_reading():
     assert "2 gait clip(s)" in line and "build_corpus" in line and "1 gesture clip(s)" in line
     real = unread_line(unread)                       # the real-capture observer is the default
     assert "2 gait clip(s) (no real-capture observer" in real and "generation/data/mocap/bandai-namco" in real
+    perceived = unread_line(unread, "real-perceived")
+    assert "2 gait clip(s) (the perceived-label observer needs both real corpora" in perceived
+    assert "build_corpus" not in perceived

@@ -19,29 +19,30 @@ Emotion vectors (:func:`emotion_for`): ``acted`` one-hot of the acted label; ``s
 """
 from __future__ import annotations
 
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
 
+from generation.core.digest import file_sha256
 from generation.core.motion import Motion
+from generation.mocap.emotion_gait_bml import CITATION as BML_CITATION
+from generation.mocap.emotion_gait_bml import DATASET as BML_DATASET
+from generation.mocap.emotion_gait_bml import LICENCE as BML_LICENCE
 from generation.mocap.emotion_gait_bml import bml_corpus_path
 from generation.mocap.real_corpus import CITATION, LICENCE, SOURCE_URL, load_real_corpus, read_meta, real_corpus_path
 from study_protocol import CAPTURE_GAIT_EMOTIONS, GAIT_EMOTIONS
 
 from .config import GaitDataConfig
-from .data import GaitSequences, file_sha256
+from .data import GaitSequences
 from .real_data import RealAugment, clip_sequences, concat_sequences, stage_clips
+from .weights import TrainingData
 
 LABEL_MODES = ("acted", "soft")
-BML_DATASET = "emotion-gait-bml"
+BOTH_STAGE = "finetune-both"
 EXTENDED_FRAMES = 150
 BML_AUGMENT = RealAugment(windows_per_clip=3)
 BANDAI_AUGMENT = RealAugment(windows_per_clip=12)
-BML_LICENCE = "research use only, with citation (Biological Motion Library; Emotion-Gait labels)"
-BML_CITATION = ("Y. Ma, H. M. Paterson, F. E. Pollick. A motion capture library for the study of identity, gender, "
-                "and emotion perception from biological motion. Behavior Research Methods 38(1):134-141, 2006. "
-                "U. Bhattacharya et al. STEP: Spatial Temporal Graph Convolutional Networks for Emotion Perception "
-                "from Gaits. AAAI 2020.")
 
 
 def extend_loop(motion: Motion, n_frames: int) -> Motion:
@@ -104,10 +105,10 @@ def bml_clips(split, path: str | Path | None = None, n_frames: int = EXTENDED_FR
 def load_both_sequences(data: GaitDataConfig, labels: str = "acted", bandai_path: str | Path | None = None,
                         bml_path: str | Path | None = None, bandai_windows: int | None = None) -> GaitSequences:
     """Training rows (Bandai dataset-1 emotion walks + BML training performers, augmented) and validation rows
-    (BML validation performers, as captured) with ``.source`` (typed provenance: datasets, licences, citations,
-    performer split, corpus hashes) and ``.trained_on``. ``bandai_windows``: windows per Bandai take (default
-    :data:`BANDAI_AUGMENT`'s 12; more weighs the four Bandai takes more against the 84 BML walks)."""
-
+    (BML validation performers, as captured) with their ``training_data`` (real capture of stage
+    ``finetune-both``: both corpora with licences, citations, splits and SHA-256, the labels and the augmentation)
+    for the weights file's record. ``bandai_windows``: windows per Bandai take (default :data:`BANDAI_AUGMENT`'s 12;
+    more weighs the four Bandai takes more against the 84 BML walks)."""
     bandai = Path(bandai_path) if bandai_path is not None else real_corpus_path()
     bml = Path(bml_path) if bml_path is not None else bml_corpus_path()
     bandai_train = stage_clips("finetune", "train", bandai)
@@ -121,25 +122,29 @@ def load_both_sequences(data: GaitDataConfig, labels: str = "acted", bandai_path
     for p in parts:
         p.base_index = p.base_index + base
         base = int(p.base_index.max()) + 1
-    out = concat_sequences(parts)
-    out.clip_names = [n for p in parts for n in p.clip_names]
-    meta = read_meta(bml)
-    out.source = {
-        "stage": f"finetune-both-{labels}",
+    corpus = {
+        "stage": BOTH_STAGE,
         "labels": labels,
-        "datasets": [
-            {"name": "bandai-namco-1", "corpus": str(bandai), "sha256": file_sha256(bandai), "licence": LICENCE,
-             "citation": CITATION, "url": SOURCE_URL, "split": "by take (take 1 train, take 2 test)",
-             "clips": sorted(c.name for c in bandai_train)},
-            {"name": BML_DATASET, "corpus": str(bml), "sha256": file_sha256(bml), "licence": BML_LICENCE,
-             "citation": BML_CITATION, "url": meta.get("source_url", ""), "split": meta.get("split_rule", ""),
-             "performer_split": meta.get("performer_split", {}), "clips_train": len(bml_train),
-             "clips_val": len(bml_val), "extended_frames": EXTENDED_FRAMES},
-        ],
+        "datasets": [_bandai_record(bandai, bandai_train), _bml_record(bml, len(bml_train), len(bml_val))],
         "augment": {"bandai_windows_per_clip": bandai_augment.windows_per_clip,
                     "bml_windows_per_clip": BML_AUGMENT.windows_per_clip, "mirror": True,
                     "speed_factors": list(BML_AUGMENT.speed_factors), "offsets": list(BML_AUGMENT.offsets)},
     }
-    out.trained_on = ("real capture: Bandai Namco dataset 1 happy/sad/angry/normal walks (CC BY-NC 4.0) + BML walks "
-                      f"of 21 training actors (research use, citation), {labels} emotion labels")
-    return out
+    return replace(concat_sequences(parts), training_data=TrainingData.real(BOTH_STAGE, corpus, labels=labels),
+                   clip_names=tuple(name for p in parts for name in p.clip_names))
+
+
+def _bandai_record(path: Path, train_clips: list) -> dict:
+    """The Bandai corpus file in a ``finetune-both`` training record."""
+    return {"name": "bandai-namco-1", "corpus": str(path), "sha256": file_sha256(path), "licence": LICENCE,
+            "citation": CITATION, "url": SOURCE_URL, "split": "by take (take 1 train, take 2 test)",
+            "clips": sorted(c.name for c in train_clips)}
+
+
+def _bml_record(path: Path, n_train: int, n_val: int) -> dict:
+    """The BML corpus file in a ``finetune-both`` training record (split rule and performers from its meta)."""
+    meta = read_meta(path)
+    return {"name": BML_DATASET, "corpus": str(path), "sha256": file_sha256(path), "licence": BML_LICENCE,
+            "citation": BML_CITATION, "url": meta.get("source_url", ""), "split": meta.get("split_rule", ""),
+            "performer_split": meta.get("performer_split", {}), "clips_train": n_train, "clips_val": n_val,
+            "extended_frames": EXTENDED_FRAMES}

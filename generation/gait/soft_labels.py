@@ -23,13 +23,14 @@ from pathlib import Path
 
 import numpy as np
 
+from generation.core.digest import file_sha256
 from generation.core.motion import Motion, MotionFormatError
 from generation.core.skeleton import GAIT_JOINTS, gait_skeleton
 from generation.formats.bvh import read_bvh
 from study_protocol import CLIP_NORMS_COLUMNS, GAIT_EMOTIONS, NORMS_SHARE_PREFIX
 
 from .config import GaitDataConfig
-from .data import GaitSequences, file_sha256
+from .data import GaitSequences
 from .real_data import STAGE_AUGMENT, clip_sequences
 from .weights import TrainingData
 

@@ -9,8 +9,9 @@ fine-tuned on dataset 1's four emotion walks) with its configuration (30-step wi
 trains on :func:`generation.gait.bml_data.load_both_sequences` and writes every epoch's weights
 (``<out stem>_eNN.pt``), then copies the epoch of the lowest validation loss (free-running, BML validation actors)
 to ``--out`` and writes ``<out stem>_choice.json`` (the per-epoch validation losses and the choice). The weights
-record their provenance in typed fields (``corpus``: datasets with licence, citation, performer split, corpus
-hashes; ``trained_on``). Test actors are never read here.
+record their provenance in the typed ``training_data`` record (real capture of stage ``finetune-both``: both
+datasets with licence, citation, performer split and corpus hashes, and the labels). Test actors are never read
+here.
 """
 from __future__ import annotations
 

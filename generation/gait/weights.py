@@ -44,6 +44,8 @@ REAL_STAGES = {
                  ("bandai-namco-1", "bandai-namco-2")),
     "finetune": ("real capture: Bandai Namco dataset 1 happy/sad/angry/normal walks (CC BY-NC 4.0)",
                  ("bandai-namco-1",)),
+    "finetune-both": ("real capture: Bandai Namco dataset 1 happy/sad/angry/normal walks (CC BY-NC 4.0) + BML walks "
+                      "of the training actors (research use, citation)", ("bandai-namco-1", "emotion-gait-bml")),
 }
 
 
@@ -54,8 +56,11 @@ class TrainingData:
     Attributes:
         kind: ``procedural`` (the synthetic procedural corpus) or ``real`` (real capture).
         description: one line for people (clip metadata ``trained_on``).
-        datasets: ids of the datasets (``procedural-gait-corpus``; ``bandai-namco-1``, ``bandai-namco-2``).
-        corpus: the corpus file read: ``path``, ``sha256`` and, for real capture, ``stage`` and ``augment``.
+        datasets: ids of the datasets (``procedural-gait-corpus``; ``bandai-namco-1``, ``bandai-namco-2``,
+            ``emotion-gait-bml``; ``clip-norms``).
+        corpus: the corpus file read: ``path``, ``sha256`` and, for real capture, ``stage`` and ``augment``; for
+            the two corpora of ``finetune-both``, ``stage``, ``labels``, ``augment`` and one entry per corpus file
+            under ``datasets`` (its path, SHA-256, licence, citation and split).
     """
 
     kind: str
@@ -82,9 +87,12 @@ class TrainingData:
                             {**(self.corpus or {}), **(other.corpus or {})})
 
     @classmethod
-    def real(cls, stage: str, corpus: dict | None = None) -> TrainingData:
-        """Real capture of a training stage (:data:`REAL_STAGES`)."""
+    def real(cls, stage: str, corpus: dict | None = None, labels: str | None = None) -> TrainingData:
+        """Real capture of a training stage (:data:`REAL_STAGES`); ``labels`` names the emotion labels where the
+        stage offers a choice (``acted`` or ``soft`` for ``finetune-both``) and ends the description."""
         description, datasets = REAL_STAGES[stage]
+        if labels is not None:
+            description = f"{description}, {labels} emotion labels"
         return cls("real", description, datasets, corpus)
 
     def record(self) -> dict:

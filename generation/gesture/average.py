@@ -14,10 +14,11 @@ measured on the validation split (rollout pose error, r(peak wrist speed, arousa
 from __future__ import annotations
 
 import argparse
-import hashlib
 from pathlib import Path
 
 import torch
+
+from generation.core.digest import file_sha256
 
 from .data import build_dataset
 from .generate import decode_examples, load_model
@@ -77,7 +78,7 @@ def main(argv: list[str] | None = None) -> dict:
     figures = {"val_rollout": dataset_pose_error(decode_examples(net, data, val), data, val),
                "val_real_range": real_range_rollout(net, data, val)}
     run["averaged"] = {"epochs": [e for e, _ in window], "init": str(init) if args.init_share else None,
-                       "init_sha256": hashlib.sha256(Path(init).read_bytes()).hexdigest() if args.init_share else None,
+                       "init_sha256": file_sha256(init) if args.init_share else None,
                        "init_share": args.init_share, "run": str(args.run), **figures}
     run["best_epoch"], run["selected_by"] = None, "weight average (see 'averaged')"
     Path(args.out).parent.mkdir(parents=True, exist_ok=True)

@@ -13,12 +13,13 @@ statistic outside its [min, max] (0 inside the range), with a floor added to bot
 """
 from __future__ import annotations
 
-import hashlib
 import json
 from pathlib import Path
 
 import numpy as np
 import torch
+
+from generation.core.digest import file_sha256
 
 from .real_stats import ELBOWS, HEAD, HOLD_SPEED, NECK, RANGES_FILE, ROOT, WRISTS
 
@@ -46,7 +47,7 @@ def provenance(path: str | Path = RANGES_FILE) -> dict:
     "licence", "citation"} (the ranges are statistics of real capture and keep its licence)."""
     path = Path(path)
     data = load_ranges(path)
-    return {"file": path.name, "sha256": hashlib.sha256(path.read_bytes()).hexdigest(),
+    return {"file": path.name, "sha256": file_sha256(path),
             **{k: data.get(k) for k in ("source", "licence", "citation")}}
 
 

@@ -3,8 +3,8 @@
 Seed 003 section 3.1 embeds each word with pretrained GloVe vectors (300-d) and marks the sentence start and end
 with SoS/EoS vectors. No GloVe vectors are available offline here, so the 384-d contextual token vectors of
 all-MiniLM-L6-v2 play that part; its ``[CLS]`` and ``[SEP]`` token vectors are the SoS and EoS vectors.
-The model is loaded from the package folder with ``local_files_only=True`` and ``HF_HUB_OFFLINE=1``: nothing is
-downloaded at run time.
+The model is loaded from the package folder with ``local_files_only=True``: nothing is downloaded at run time, and
+the process environment (``HF_HUB_OFFLINE`` and the like) is left as it is.
 """
 from __future__ import annotations
 
@@ -48,8 +48,6 @@ class TextEncoder:
     """Sentence -> (n_tokens, 384) contextual token vectors, float32, SoS ([CLS]) first and EoS ([SEP]) last."""
 
     def __init__(self):
-        os.environ.setdefault("HF_HUB_OFFLINE", "1")
-        os.environ.setdefault("TRANSFORMERS_OFFLINE", "1")
         path = model_dir()
         try:
             from transformers import AutoModel, AutoTokenizer  # heavy: loaded when a sentence is first encoded

@@ -29,6 +29,7 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path, PurePosixPath
 
+from generation.core.digest import file_sha256
 from generation.plans.catalogue import write_clips_csv
 from generation.render.settings import RenderSettings
 from study_protocol import CLIP_COLUMNS, IMPORTED
@@ -84,15 +85,6 @@ class RowOutcome:
     def report_row(self) -> dict:
         return {"row": self.row, "path": self.path, "status": self.status, "clip_id": self.clip_id,
                 "message": self.message}
-
-
-def file_sha256(path: Path) -> str:
-    """Hex SHA-256 of a file's bytes."""
-    h = hashlib.sha256()
-    with path.open("rb") as f:
-        for block in iter(lambda: f.read(1 << 20), b""):
-            h.update(block)
-    return h.hexdigest()
 
 
 def _keep_audio(row: ManifestRow, settings: ImportSettings) -> bool:

@@ -23,7 +23,8 @@ class Job:
     # torch device of the network generators, fixed where the jobs are planned and carried to every worker
     # (local processes and Dask workers on other machines alike)
     device: str = "cpu"
-    # the gait observer that reads the clip (real or synthetic): the plan's ``qa: {observer: ...}`` or the caller's
+    # the gait observer that reads the clip (real, real-perceived or synthetic): the plan's ``qa: {observer: ...}``,
+    # else the caller's choice
     gait_observer: str = "real"
 
 

@@ -58,8 +58,8 @@ def clip_qa(motion: Motion, settings, thresholds: dict, intended=None, observer=
 
 def observer_for(modality: str, kind: str = "real"):
     """The observer that reads clips of ``modality`` (:data:`generation.quality.observers.OBSERVERS`): "gait" with
-    ``kind`` real or synthetic; "gesture": the synthetic gesture observer. None for other modalities or when it
-    cannot be built (:func:`unread_line` then says why)."""
+    ``kind`` real, real-perceived or synthetic; "gesture": the synthetic gesture observer. None for other modalities
+    or when it cannot be built (:func:`unread_line` then says why)."""
     return OBSERVERS.for_modality(modality, kind)
 
 
@@ -96,7 +96,7 @@ def observer_line(kind: str, observer) -> str:
 def unread_line(records: Iterable[dict], gait_kind: str = "real") -> str:
     """'' when every gait and gesture clip got an observer's reading, else a line saying how many did not and why
     that usually happens, so that a switched-off observer check is never silent. ``records``: render records
-    (``modality``, ``qa``); ``gait_kind``: the gait observer asked (real or synthetic)."""
+    (``modality``, ``qa``); ``gait_kind``: the gait observer asked (real, real-perceived or synthetic)."""
     missing = Counter(r.get("modality") for r in records
                       if r.get("modality") in ("gait", "gesture") and not (r.get("qa") or {}).get("observed"))
     if not missing:
@@ -106,6 +106,10 @@ def unread_line(records: Iterable[dict], gait_kind: str = "real") -> str:
         parts.append(f"{missing['gait']} gait clip(s) (no real-capture observer: no corpus at var/mocap/ "
                      "(`python -m generation.mocap dataset bandai-namco DIR`), and the shipped real takes in "
                      "generation/data/mocap/bandai-namco/ are missing or do not import)")
+    elif missing["gait"] and gait_kind == "real-perceived":
+        parts.append(f"{missing['gait']} gait clip(s) (the perceived-label observer needs both real corpora: "
+                     "var/mocap/bandai-namco.npz and var/mocap/emotion-gait-bml.npz, "
+                     "`python -m generation.mocap dataset bandai-namco|emotion-gait-bml DIR`)")
     elif missing["gait"]:
         parts.append(f"{missing['gait']} gait clip(s) (no synthetic gait corpus at var/corpus/: "
                      "`manage.py build_corpus` builds it in about a minute, then render again)")
@@ -121,7 +125,7 @@ def run(plan_name: str, limit: int | None = None, log=print, modality: str | Non
 
     ``modality``: only the entries of that modality ("gait" or "gesture"; None: all). ``figure_height=False``
     skips the camera projection (no ``figure_height`` check, faster). ``gait_observer``: the gait observer when
-    the plan names none (real or synthetic)."""
+    the plan names none (real, real-perceived or synthetic)."""
     plan = load_plan(plan_name)
     thresholds = resolve_thresholds(plan.qa)
     kind = gait_observer_kind(plan.qa, gait_observer)

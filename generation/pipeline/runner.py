@@ -28,6 +28,7 @@ from generation.plans.clipgen import make_motion, write_motion_bvh
 from generation.plans.schema import ClipEntry, Plan, intent_fields
 from generation.quality.checks import QAResult, failed_checks
 from generation.render.clip import clip_files_complete, render_clip
+from generation.render.offscreen import prepare_render_process
 
 from .jobs import Job, plan_jobs
 from .plan_qa import clip_qa, intended_emotion, observer_for
@@ -110,16 +111,14 @@ def _exit_with_parent(parent_pid: int) -> None:
 
 
 def _init_worker(progress_queue, threads: int, parent_pid: int | None = None) -> None:
+    """Set up a render worker (a spawned process, or a Dask worker once): its progress queue, its exit with the
+    parent, the environment its C libraries read when they load (:func:`prepare_render_process`: headless GL,
+    ``threads`` per worker) and torch's threads."""
     global _PROGRESS_QUEUE
     _PROGRESS_QUEUE = progress_queue
     if parent_pid is not None:
         threading.Thread(target=_exit_with_parent, args=(parent_pid,), daemon=True).start()
-    os.environ.setdefault("OMP_NUM_THREADS", str(threads))
-    os.environ.setdefault("MKL_NUM_THREADS", str(threads))
-    # Mesa's software rasteriser (llvmpipe) starts a thread per core by default; with one worker per core
-    # that oversubscribes the machine.
-    os.environ.setdefault("LP_NUM_THREADS", str(threads))
-    os.environ.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow")
+    prepare_render_process(threads)
     try:
         import torch  # heavy: loaded in render workers only, to cap their threads
 
@@ -362,7 +361,8 @@ def run_plan(plan: Plan, clips_dir: str | Path, records_dir: str | Path, media_p
         scheduler: a Dask distributed scheduler address (``tcp://host:port``) or Client: render there instead of
             in local processes (``workers`` is then ignored; the workers need the shared media folder).
         device: torch device of the network generators (gait_net, gesture_net), carried to every worker.
-        gait_observer: the gait observer (real or synthetic) that reads the clips of a plan that names none.
+        gait_observer: the gait observer (:data:`study_protocol.QA_OBSERVERS`: real, real-perceived or synthetic)
+            that reads the clips of a plan that names none.
     Returns a BatchResult with the records of every clip of the plan that exists now.
     """
     t0 = time.perf_counter()

@@ -84,7 +84,8 @@ class QAResult:
 
 
 def check_gait_observer(kind, where: str = "gait observer") -> str:
-    """``kind`` when it names a gait observer (:data:`study_protocol.QA_OBSERVERS`: real or synthetic), else
+    """``kind`` when it names a gait observer (:data:`study_protocol.QA_OBSERVERS`: real, real-perceived or
+    synthetic), else
     QAThresholdError naming ``where`` (the plan field, setting or option it came from)."""
     if kind not in QA_OBSERVERS:
         raise QAThresholdError(f"{where}: expected one of {', '.join(QA_OBSERVERS)}, got {kind!r}")

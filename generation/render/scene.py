@@ -6,16 +6,12 @@ then ``render()`` + ``screenshot(return_img=True)`` per frame.
 """
 from __future__ import annotations
 
-import os
-
 import numpy as np
 
 from generation.core.skeleton import Skeleton
 
 from .body import MANNEQUIN_COLOUR, PartPoser, mannequin_parts, part_mesh
 from .camera import CameraPose, project
-
-os.environ.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow")
 
 LEFT_COLOUR = (0.16, 0.42, 0.85)    # blue
 RIGHT_COLOUR = (0.90, 0.35, 0.12)   # orange

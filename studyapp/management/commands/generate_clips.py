@@ -10,7 +10,6 @@ the clips render on a Dask distributed cluster whose workers share this media fo
 """
 from __future__ import annotations
 
-import os
 from pathlib import Path
 
 from django.conf import settings
@@ -26,7 +25,7 @@ from generation.pipeline.section_coverage import coverage_lines, presets_of_plan
 from generation.plans.catalogue import write_clips_csv
 from generation.plans.schema import PlanError, load_plan
 from generation.quality.checks import QAThresholdError, gait_observer_kind
-from generation.render import contact_sheet
+from generation.render import contact_sheet, prepare_render_process
 from studyapp.catalogue import clip_label, retire_superseded, upsert_clips
 
 
@@ -75,7 +74,7 @@ class Command(BaseCommand):
             raise CommandError(str(exc)) from None
         if not opts["no_db"]:
             _require_migrated_database()
-        os.environ.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow")
+        prepare_render_process()
 
         try:
             device = str(resolve_device(opts["device"]))

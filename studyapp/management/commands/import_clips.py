@@ -12,7 +12,6 @@ format is in docs/study.md ("Bring your own stimuli").
 from __future__ import annotations
 
 import contextlib
-import os
 from pathlib import Path
 
 from django.conf import settings
@@ -22,6 +21,7 @@ from django.db import transaction
 from generation.imports import ImportSettings, ManifestError, import_manifest, write_report
 from generation.imports.run import REPORT_NAME
 from generation.imports.video import VideoLimits
+from generation.render.offscreen import prepare_render_process
 from generation.render.settings import RenderSettings, RenderSettingsError
 from studyapp.catalogue import retire_replaced, upsert_clips
 
@@ -93,7 +93,7 @@ class Command(BaseCommand):
             raise CommandError(f"--render-size: {exc}") from None
         if not opts["dry_run"]:
             _require_migrated_database()
-        os.environ.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow")
+        prepare_render_process()
         config = ImportSettings(limits=VideoLimits(opts["max_duration"], int(opts["max_size_mb"] * 2**20)),
                                 keep_audio=opts["keep_audio"], webm=opts["webm"], render=render,
                                 observer=not opts["no_observer"], threads=opts["threads"],
