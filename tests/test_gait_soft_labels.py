@@ -71,8 +71,29 @@ def test_bad_norms_name_file_line_and_column(rated, tmp_path):
     with pytest.raises(SoftLabelError, match="a.csv header, column 'share_sad': required column is missing"):
         read_soft_labels(tmp_path / "a.csv")
     df.assign(share_happy=[0.9, 0.05]).to_csv(tmp_path / "b.csv", index=False)
-    with pytest.raises(SoftLabelError, match="b.csv line 2, column 'share_\\*': the gait shares sum to 1.3, not 1"):
+    with pytest.raises(SoftLabelError) as bad_sum:
         read_soft_labels(tmp_path / "b.csv")
+    assert str(bad_sum.value) == ("b.csv line 2, columns 'share_happy' 0.9, 'share_sad' 0.1, 'share_angry' 0.1, "
+                                  "'share_neutral' 0.2: the gait shares sum to 1.3, not 1")
     df.assign(clip_id=["sim-walk-a", "sim-walk-x"]).to_csv(tmp_path / "c.csv", index=False)
     with pytest.raises(SoftLabelError, match="c.csv line 3, column 'clip_id': clip 'sim-walk-x': no motion file"):
         load_soft_label_sequences(tmp_path / "c.csv", motions, GaitDataConfig())
+
+
+def test_a_clip_the_catalogue_does_not_know_is_named_so(rated, tmp_path):
+    """With a catalogue beside the motions folder (MEDIA_ROOT/clips.csv), a clip id it lacks is an unknown clip, not
+    a missing motion file; a catalogued clip whose file is gone is still a missing motion file."""
+    path, motions = rated
+    catalogue = motions.parent / "clips.csv"
+    pd.DataFrame({"clip_id": ["sim-walk-a", "sim-walk-b", "sim-walk-gone"], "modality": "gait"}).to_csv(
+        catalogue, index=False)
+    df = pd.read_csv(path)
+    df.assign(clip_id=["sim-walk-a", "sim-walk-x"]).to_csv(tmp_path / "c.csv", index=False)
+    with pytest.raises(SoftLabelError) as unknown:
+        load_soft_label_sequences(tmp_path / "c.csv", motions, GaitDataConfig())
+    assert str(unknown.value) == (f"c.csv line 3, column 'clip_id': clip 'sim-walk-x': unknown clip (not in the "
+                                  f"catalogue {catalogue})")
+    df.assign(clip_id=["sim-walk-gone", "sim-walk-a"]).to_csv(tmp_path / "d.csv", index=False)
+    with pytest.raises(SoftLabelError, match="d.csv line 2, column 'clip_id': clip 'sim-walk-gone': no motion file"):
+        load_soft_label_sequences(tmp_path / "d.csv", motions, GaitDataConfig())
+    assert set(load_soft_label_sequences(path, motions, GaitDataConfig()).clip_names) == set(SHARES)
