@@ -14,9 +14,10 @@ Reading clip_norms.csv, the catalogue and the motion files is shared with the ge
 (:mod:`generation.formats.rated_clips`); problems raise :class:`SoftLabelError` naming file, line and column.
 
 Only the stored motion is read, never the source take a real source clip was cut from: clips.csv names no source
-file, and the take is not what people rated (the ``captured_file`` generator cuts it at ``start_s`` to the render
-length, puts it on the 21-joint gait skeleton and resamples it; redoing that means running the generator, which lives
-in generation.plans, above this package). The renderer writes ``motions/<clip_id>.bvh`` for every clip it renders,
+file (only the clip record does, as the generator input ``file``), and the take is not what people rated (the
+``captured_file`` generator retargets it onto the 21-joint gait skeleton, starts it at ``start_s`` and resamples it,
+and the clip lasts the render duration; redoing that means running the generator, which lives in generation.plans,
+above this package). The renderer writes ``motions/<clip_id>.bvh`` for every clip it renders,
 real source takes included, so a rated clip without one is an imported video (no motion at all) or a deleted file.
 """
 from __future__ import annotations
