@@ -3,6 +3,7 @@ the weights recording the norms they learned from, and bad input named by file, 
 SIMULATED norms rows on two procedural walks, a tiny network, one epoch."""
 from __future__ import annotations
 
+import dataclasses
 import hashlib
 
 import numpy as np
@@ -97,3 +98,49 @@ def test_a_clip_the_catalogue_does_not_know_is_named_so(rated, tmp_path):
     with pytest.raises(SoftLabelError, match="d.csv line 2, column 'clip_id': clip 'sim-walk-gone': no motion file"):
         load_soft_label_sequences(tmp_path / "d.csv", motions, GaitDataConfig())
     assert set(load_soft_label_sequences(path, motions, GaitDataConfig()).clip_names) == set(SHARES)
+
+
+def test_real_finetune_with_soft_labels_trains_on_both(rated, tmp_path, monkeypatch):
+    """The documented command ``--real finetune --soft-labels clip_norms.csv``: the real fine-tuning stage's takes
+    (here two procedural walks with hard labels standing in for them; the real corpus is not built in tests) and the
+    rated walks reach train() as one set, rated rows after the real ones with their shares, and the weights' record
+    says both. The heavy training step is replaced by a recorder."""
+    import generation.gait.train as gait_train
+    from generation.gait.real_data import STAGE_AUGMENT, clip_sequences
+    from generation.gait.soft_labels import RatedClip
+    from generation.gait.weights import TrainingData
+
+    path, motions = rated
+    stand_ins = [RatedClip(f"sim-real-{label}", walk(WalkParams(cadence_spm=cadence), straight(12.0), 260, 30.0),
+                           "train", None, label) for label, cadence in (("happy", 120), ("sad", 90))]
+    asked, made = [], {}
+
+    def fake_real(stage, data, path=None):
+        asked.append((stage, path))
+        seqs = clip_sequences(stand_ins, data, STAGE_AUGMENT[stage])
+        made.update(rows=len(seqs), names=len(seqs.clip_names))
+        return dataclasses.replace(seqs, training_data=TrainingData.real(stage, {"path": "sim-real.npz"}))
+
+    seen = {}
+
+    def fake_train(config, data, out, *args, **kwargs):
+        seen.update(data=data, out=out)
+        return {}
+
+    monkeypatch.setattr(gait_train, "load_real_sequences", fake_real)
+    monkeypatch.setattr(gait_train, "train", fake_train)
+    out = tmp_path / "both.pt"
+    main(["--real", "finetune", "--soft-labels", str(path), "--motions", str(motions), "--out", str(out),
+          "--corpus", "sim-real.npz", "--quiet"])
+    assert asked == [("finetune", "sim-real.npz")] and seen["out"] == str(out)
+    data, n = seen["data"], made["rows"]
+    assert len(data) > n
+    assert set(data.clip_names[:made["names"]]) == {"sim-real-happy", "sim-real-sad"}
+    assert set(data.clip_names[made["names"]:]) == set(SHARES)
+    rounded = lambda rows: {tuple(np.round(v, 3)) for v in rows.cpu().numpy().astype(float)}  # noqa: E731
+    assert rounded(data.emotion[:n]) == {(1.0, 0.0, 0.0, 0.0), (0.0, 1.0, 0.0, 0.0)}
+    assert rounded(data.emotion[n:]) == {tuple(v) for v in SHARES.values()}
+    assert data.base_index[n:].min() > data.base_index[:n].max()   # rated windows never share a real one's base
+    record = data.training_data
+    assert record.kind == "real" and "soft labels" in record.description
+    assert record.corpus["path"] == "sim-real.npz" and record.corpus["soft_labels"]["n_clips"] == 2
