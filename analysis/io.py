@@ -54,7 +54,8 @@ MAX_LISTED = 20
 
 @dataclass(frozen=True)
 class Problem:
-    """One invalid cell: file name, line number (header = 1; 0 = whole file), column, message."""
+    """One invalid cell: file name, line number (header = 1; 0 = whole file), column, message. A problem of several
+    cells of one line (shares that do not sum to one) names its columns joined by ", "."""
 
     file: str
     line: int
@@ -63,7 +64,9 @@ class Problem:
 
     def __str__(self) -> str:
         where = f"line {self.line}" if self.line else "header"
-        return f"{self.file} {where}, column '{self.column}': {self.message}"
+        columns = self.column.split(", ")
+        named = f"column '{self.column}'" if len(columns) == 1 else "columns " + ", ".join(f"'{c}'" for c in columns)
+        return f"{self.file} {where}, {named}: {self.message}"
 
 
 class ValidationError(ValueError):

@@ -256,7 +256,10 @@ def read_clip_norms(src, known_clips=None) -> pd.DataFrame:
             sums = dict(zip(np.flatnonzero(rows), total))
             lines = df["_line"].to_numpy()
             for i in np.flatnonzero(bad)[:20]:
-                col.add(int(lines[i]), "share_*", f"shares of {section_type}/{question} sum to {sums[i]:.4g}, not 1")
+                cells = shares.loc[df.index[i], present].dropna()
+                col.add(int(lines[i]), ", ".join(cells.index) or ", ".join(present),
+                        f"shares of {section_type}/{question} sum to {sums[i]:.4g}, not 1 "
+                        f"({' + '.join(f'{v:.4g}' for v in cells)})")
             col.total += max(0, int(bad.sum()) - min(20, int(bad.sum())))
     if col.total:
         raise ValidationError(sorted(col.problems, key=lambda p: (p.line, p.column)), col.total)

@@ -3,6 +3,7 @@ the weights recording the norms they learned from, and bad input named by file, 
 SIMULATED norms rows on two procedural walks, a tiny network, one epoch."""
 from __future__ import annotations
 
+import dataclasses
 import hashlib
 
 import numpy as np
@@ -71,8 +72,75 @@ def test_bad_norms_name_file_line_and_column(rated, tmp_path):
     with pytest.raises(SoftLabelError, match="a.csv header, column 'share_sad': required column is missing"):
         read_soft_labels(tmp_path / "a.csv")
     df.assign(share_happy=[0.9, 0.05]).to_csv(tmp_path / "b.csv", index=False)
-    with pytest.raises(SoftLabelError, match="b.csv line 2, column 'share_\\*': the gait shares sum to 1.3, not 1"):
+    with pytest.raises(SoftLabelError) as bad_sum:
         read_soft_labels(tmp_path / "b.csv")
+    assert str(bad_sum.value) == ("b.csv line 2, columns 'share_happy' 0.9, 'share_sad' 0.1, 'share_angry' 0.1, "
+                                  "'share_neutral' 0.2: the gait shares sum to 1.3, not 1")
     df.assign(clip_id=["sim-walk-a", "sim-walk-x"]).to_csv(tmp_path / "c.csv", index=False)
     with pytest.raises(SoftLabelError, match="c.csv line 3, column 'clip_id': clip 'sim-walk-x': no motion file"):
         load_soft_label_sequences(tmp_path / "c.csv", motions, GaitDataConfig())
+
+
+def test_a_clip_the_catalogue_does_not_know_is_named_so(rated, tmp_path):
+    """With a catalogue beside the motions folder (MEDIA_ROOT/clips.csv), a clip id it lacks is an unknown clip, not
+    a missing motion file; a catalogued clip whose file is gone is still a missing motion file."""
+    path, motions = rated
+    catalogue = motions.parent / "clips.csv"
+    pd.DataFrame({"clip_id": ["sim-walk-a", "sim-walk-b", "sim-walk-gone"], "modality": "gait"}).to_csv(
+        catalogue, index=False)
+    df = pd.read_csv(path)
+    df.assign(clip_id=["sim-walk-a", "sim-walk-x"]).to_csv(tmp_path / "c.csv", index=False)
+    with pytest.raises(SoftLabelError) as unknown:
+        load_soft_label_sequences(tmp_path / "c.csv", motions, GaitDataConfig())
+    assert str(unknown.value) == (f"c.csv line 3, column 'clip_id': clip 'sim-walk-x': unknown clip (not in the "
+                                  f"catalogue {catalogue})")
+    df.assign(clip_id=["sim-walk-gone", "sim-walk-a"]).to_csv(tmp_path / "d.csv", index=False)
+    with pytest.raises(SoftLabelError, match="d.csv line 2, column 'clip_id': clip 'sim-walk-gone': no motion file"):
+        load_soft_label_sequences(tmp_path / "d.csv", motions, GaitDataConfig())
+    assert set(load_soft_label_sequences(path, motions, GaitDataConfig()).clip_names) == set(SHARES)
+
+
+def test_real_finetune_with_soft_labels_trains_on_both(rated, tmp_path, monkeypatch):
+    """The documented command ``--real finetune --soft-labels clip_norms.csv``: the real fine-tuning stage's takes
+    (here two procedural walks with hard labels standing in for them; the real corpus is not built in tests) and the
+    rated walks reach train() as one set, rated rows after the real ones with their shares, and the weights' record
+    says both. The heavy training step is replaced by a recorder."""
+    import generation.gait.train as gait_train
+    from generation.gait.real_data import STAGE_AUGMENT, clip_sequences
+    from generation.gait.soft_labels import RatedClip
+    from generation.gait.weights import TrainingData
+
+    path, motions = rated
+    stand_ins = [RatedClip(f"sim-real-{label}", walk(WalkParams(cadence_spm=cadence), straight(12.0), 260, 30.0),
+                           "train", None, label) for label, cadence in (("happy", 120), ("sad", 90))]
+    asked, made = [], {}
+
+    def fake_real(stage, data, path=None):
+        asked.append((stage, path))
+        seqs = clip_sequences(stand_ins, data, STAGE_AUGMENT[stage])
+        made.update(rows=len(seqs), names=len(seqs.clip_names))
+        return dataclasses.replace(seqs, training_data=TrainingData.real(stage, {"path": "sim-real.npz"}))
+
+    seen = {}
+
+    def fake_train(config, data, out, *args, **kwargs):
+        seen.update(data=data, out=out)
+        return {}
+
+    monkeypatch.setattr(gait_train, "load_real_sequences", fake_real)
+    monkeypatch.setattr(gait_train, "train", fake_train)
+    out = tmp_path / "both.pt"
+    main(["--real", "finetune", "--soft-labels", str(path), "--motions", str(motions), "--out", str(out),
+          "--corpus", "sim-real.npz", "--quiet"])
+    assert asked == [("finetune", "sim-real.npz")] and seen["out"] == str(out)
+    data, n = seen["data"], made["rows"]
+    assert len(data) > n
+    assert set(data.clip_names[:made["names"]]) == {"sim-real-happy", "sim-real-sad"}
+    assert set(data.clip_names[made["names"]:]) == set(SHARES)
+    rounded = lambda rows: {tuple(np.round(v, 3)) for v in rows.cpu().numpy().astype(float)}  # noqa: E731
+    assert rounded(data.emotion[:n]) == {(1.0, 0.0, 0.0, 0.0), (0.0, 1.0, 0.0, 0.0)}
+    assert rounded(data.emotion[n:]) == {tuple(v) for v in SHARES.values()}
+    assert data.base_index[n:].min() > data.base_index[:n].max()   # rated windows never share a real one's base
+    record = data.training_data
+    assert record.kind == "real" and "soft labels" in record.description
+    assert record.corpus["path"] == "sim-real.npz" and record.corpus["soft_labels"]["n_clips"] == 2

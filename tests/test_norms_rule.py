@@ -92,8 +92,9 @@ def test_clips_admitted_by_their_norms_and_observer_flags_advisory(tmp_path):
                                                  "missing"),
     (lambda df: df.assign(clip_id=["gait_gen_00", "no_such_clip"]),
      "bad.csv line 3, column 'clip_id': unknown clip 'no_such_clip' (not in the catalogue)"),
-    (lambda df: df.assign(share_sad=[0.5, 0.2]), "bad.csv line 2, column 'share_*': shares of "
-                                                 "emotion_choice/perceived sum to 1.433, not 1"),
+    (lambda df: df.assign(share_sad=[0.5, 0.2]), "bad.csv line 2, columns 'share_happy', 'share_sad', "
+     "'share_angry', 'share_neutral': shares of emotion_choice/perceived sum to 1.433, not 1 (0.8 + 0.5 + 0.06667 + "
+     "0.06667)"),
 ])
 def test_bad_norms_file_is_refused_whole(tmp_path, edit, message):
     good = write_norms(tmp_path, [norm_row("gait_gen_00", "happy", 0.8, 20), norm_row("gait_gen_01", "sad", 0.7, 20)])

@@ -535,6 +535,9 @@ def build_parser() -> argparse.ArgumentParser:
                         "share vector as its emotion target (with --real finetune: beside the real takes)")
     p.add_argument("--motions", default=None, metavar="DIR",
                    help="where the rated clips' motions are (<clip_id>.bvh; default $MEDIA_ROOT/motions)")
+    p.add_argument("--clips", default=None, metavar="CLIPS.csv",
+                   help="the clip catalogue, to tell a clip it does not know from a missing motion file (default: "
+                        "clips.csv beside the motions folder, i.e. $MEDIA_ROOT/clips.csv, when there)")
     p.add_argument("--norms-study", default=None,
                    help="the study the norms come from, recorded in the weights (default: the CSV's folder name)")
     p.add_argument("--min-ratings", type=int, default=1, help="soft labels only from walks with this many ratings")
@@ -645,7 +648,7 @@ def _soft_label_data(args, config: GaitNetConfig, log) -> GaitSequences:
         raise SystemExit("--soft-labels: say where the clips' motions are (--motions DIR or MEDIA_ROOT)")
     try:
         soft = load_soft_label_sequences(args.soft_labels, motions, config.data, study=args.norms_study,
-                                         min_ratings=args.min_ratings)
+                                         min_ratings=args.min_ratings, catalogue=getattr(args, "clips", None))
     except (SoftLabelError, ValueError) as exc:
         raise SystemExit(f"--soft-labels: {exc}") from None
     if Path(args.out).resolve() == Path(DEFAULT_WEIGHTS).resolve():

@@ -21,6 +21,12 @@ draw (batch order, input noise, self-fed picks) comes from one CPU generator, so
 device up to float rounding. ``--amp`` runs the forward passes under CUDA autocast (ignored on the CPU).
 Files are device-independent: CPU tensors, read with ``map_location="cpu"``.
 
+Soft labels: ``--soft-labels clip_norms.csv`` trains on the gestures people rated in a norming study instead of the
+synthetic corpus, each with its perceived shares turned into a share-weighted NRC-VAD emotion attribute
+(:mod:`generation.gesture.soft_labels`); ``--init-from`` the shipped weights makes it a fine-tune. The weights file's
+``corpus.soft_labels`` records the norms (path, sha256, study, clips and ratings); without ``--out`` it writes
+``var/weights/gesture_net_soft_labels.pt``, never the shipped weights.
+
 Presets: ``--config small`` (the shipped weights: d_model 64, 269,772 parameters, a 20-minute CPU budget) and
 ``--config paper`` (the published size, 26.2 M parameters, 600 epochs, no time budget; :func:`paper_config`).
 """
@@ -29,6 +35,7 @@ from __future__ import annotations
 import argparse
 import dataclasses
 import json
+import os
 import time
 import warnings
 from dataclasses import dataclass, field
@@ -57,6 +64,7 @@ from .model import MODEL_PRESETS, GestureNet, GestureNetConfig
 from .real_range import load_ranges, range_arrays
 from .real_range import provenance as real_range_provenance
 from .selection import history_score, real_range_rollout
+from .soft_labels import SoftLabelError, load_soft_label_dataset
 
 PRESETS = tuple(MODEL_PRESETS)
 SELECTIONS = ("pose", "real-range")
@@ -106,6 +114,7 @@ class TrainConfig:
     device: str = "auto"
     amp: bool = False
     preset: str = "small"
+    soft_labels: str | None = None  # the clip_norms.csv the rated training gestures come from (soft_labels.py)
 
 
 def preset_config(name: str = "small", **overrides) -> TrainConfig:
@@ -246,8 +255,9 @@ def _save_checkpoint(path: Path, epoch: int, net, optimizer, scheduler, generato
 
 def _data_options(cfg: TrainConfig) -> dict:
     """The options that decide the training corpus (build_dataset), so --resume refuses another corpus."""
-    return {"variants": cfg.variants, "counterfactual": cfg.counterfactual, "seed": cfg.seed,
-            "augment": cfg.augment}
+    options = {"variants": cfg.variants, "counterfactual": cfg.counterfactual, "seed": cfg.seed,
+               "augment": cfg.augment}
+    return {**options, "soft_labels": cfg.soft_labels} if cfg.soft_labels else options
 
 
 def _build(cfg: TrainConfig, device: torch.device):
@@ -267,8 +277,10 @@ def _build(cfg: TrainConfig, device: torch.device):
     return net, optimizer, scheduler, torch.Generator().manual_seed(cfg.seed)
 
 
-def train(cfg: TrainConfig, data: GestureDataset | None = None, progress: bool = True) -> dict:
-    """Train and save; returns {"history": [...], "best_val", "epochs_run", "seconds", "device", "out"}."""
+def train(cfg: TrainConfig, data: GestureDataset | None = None, progress: bool = True,
+          provenance: dict | None = None) -> dict:
+    """Train and save; returns {"history": [...], "best_val", "epochs_run", "seconds", "device", "out"}.
+    ``provenance``: entries for the weights file saying what ``data`` is (``trained_on``, ``corpus``)."""
 
     selected_by = _selected_by(cfg)  # an unusable selection rule fails before any data is built
     torch.set_num_threads(cfg.threads)
@@ -326,7 +338,7 @@ def train(cfg: TrainConfig, data: GestureDataset | None = None, progress: bool =
                          run.seconds_before + time.time() - t0)
         if last_epoch:
             break
-    return _finish(net, cfg, run, epoch, selected_by, run.seconds_before + time.time() - t0, device)
+    return _finish(net, cfg, run, epoch, selected_by, run.seconds_before + time.time() - t0, device, provenance)
 
 
 def _selected_by(cfg: TrainConfig) -> str:
@@ -359,7 +371,7 @@ def _score(net, data, val_idx, cfg: TrainConfig, epoch: int, last_epoch: bool, v
 
 
 def _finish(net, cfg: TrainConfig, run: _Run, epoch: int, selected_by: str, seconds: float,
-            device: torch.device) -> dict:
+            device: torch.device, provenance: dict | None = None) -> dict:
     """Load the best state, save the weights file and return the run summary."""
     if run.best_state is not None:
         net.load_state_dict(run.best_state)
@@ -373,7 +385,7 @@ def _finish(net, cfg: TrainConfig, run: _Run, epoch: int, selected_by: str, seco
         # choice of epoch, so their source, licence and citation go with the weights
         used = [u for u, on in (("loss", cfg.loss.real_range), ("epoch selection", cfg.select == "real-range")) if on]
         extra["real_statistics"] = {"used_for": used, **real_range_provenance()}
-    save_weights(net, cfg.out, extra)
+    save_weights(net, cfg.out, {**extra, **(provenance or {})})
     summary["history"] = run.history
     return summary
 
@@ -439,6 +451,22 @@ def build_parser() -> argparse.ArgumentParser:
                    help="also write the weights of every rollout epoch into this folder (epochNNN.pt)")
     p.add_argument("--d-model", type=int, default=None, help="default: the preset's (64 small, 992 paper)")
     p.add_argument("--init-from", default=None, help="start from these weights (fine-tuning; same model config)")
+    p.add_argument("--soft-labels", default=None, metavar="CLIP_NORMS.csv",
+                   help="train on the gestures rated in a clip_norms.csv (docs/study.md) instead of the synthetic "
+                   "corpus, each with its perceived shares as a share-weighted NRC-VAD emotion (with --init-from: a "
+                   "fine-tune); default --out var/weights/gesture_net_soft_labels.pt")
+    p.add_argument("--motions", default=None, metavar="DIR",
+                   help="where the rated clips' motions are (<clip_id>.bvh; default $MEDIA_ROOT/motions)")
+    p.add_argument("--clips", default=None, metavar="CLIPS.csv",
+                   help="the clip catalogue (default clips.csv beside the motions folder): tells an unknown clip from "
+                   "a missing motion, and extra columns sentence, task, gender, handedness give a clip's speech")
+    p.add_argument("--records", default=None, metavar="DIR",
+                   help="the clip records, which name each generated gesture's sentence (default clip_records "
+                   "beside the motions folder)")
+    p.add_argument("--norms-study", default=None,
+                   help="the study the norms come from, recorded in the weights (default: the CSV's folder name)")
+    p.add_argument("--min-ratings", type=int, default=1,
+                   help="soft labels only from gestures with this many ratings")
     p.add_argument("--out", default=d.out, help="where the best weights go")
     p.add_argument("--checkpoint", default=d.checkpoint)
     p.add_argument("--resume", action="store_true", help="continue from --checkpoint")
@@ -474,7 +502,7 @@ def config_from_args(args: argparse.Namespace) -> TrainConfig:
                      init_from=args.init_from, device=args.device, amp=bool(args.amp),
                      rollout_every=args.rollout_every, select_emotion_gap=bool(args.select_emotion_gap),
                      select=args.select, max_pose_error=args.max_pose_error, min_arousal_r=args.min_arousal_r,
-                     keep_rollouts=args.keep_rollouts)
+                     keep_rollouts=args.keep_rollouts, soft_labels=getattr(args, "soft_labels", None))
     if args.epochs is not None:
         overrides["epochs"] = args.epochs
     if args.max_minutes is not None:
@@ -485,14 +513,47 @@ def config_from_args(args: argparse.Namespace) -> TrainConfig:
     return cfg
 
 
+SOFT_LABEL_WEIGHTS = Path("var/weights/gesture_net_soft_labels.pt")
+"""Where a soft-label run writes unless --out says otherwise (never over the shipped weights)."""
+
+
+def soft_label_data(cfg: TrainConfig, args: argparse.Namespace, log=print) -> tuple[GestureDataset, dict]:
+    """The rated gestures of ``--soft-labels`` and the weights file's record of them (``trained_on``,
+    ``corpus.soft_labels``); points ``cfg.out`` and ``cfg.checkpoint`` away from the shipped weights and the
+    synthetic run's checkpoint when they are the defaults. ValueError (with file, line and column) on bad input."""
+    motions = args.motions or (Path(os.environ["MEDIA_ROOT"]) / "motions" if os.environ.get("MEDIA_ROOT") else None)
+    if motions is None:
+        raise ValueError("--soft-labels: say where the clips' motions are (--motions DIR or MEDIA_ROOT)")
+    try:
+        data, norms = load_soft_label_dataset(args.soft_labels, motions, study=args.norms_study,
+                                              min_ratings=args.min_ratings, catalogue=args.clips,
+                                              records_dir=args.records, max_frames=cfg.model.max_frames, log=log)
+    except SoftLabelError as exc:
+        raise ValueError(f"--soft-labels: {exc}") from None
+    defaults = TrainConfig()
+    if Path(cfg.out).resolve() == Path(defaults.out).resolve():
+        cfg.out = str(SOFT_LABEL_WEIGHTS)
+        log(f"--soft-labels: writing {cfg.out} (the shipped weights are never replaced; --out to choose)")
+    if cfg.checkpoint == defaults.checkpoint:
+        cfg.checkpoint = str(Path(defaults.checkpoint).with_name("gesture_net_soft_labels.pt"))
+    log(f"soft labels: {norms['n_clips']} rated gestures, {norms['n_ratings']} ratings, study {norms['study']}"
+        + (f"; {len(norms['skipped'])} left out without a sentence" if norms["skipped"] else ""))
+    description = (f"soft labels: {norms['n_clips']} rated gestures ({norms['n_ratings']} ratings, study "
+                   f"{norms['study']}), emotion = {norms['target']}")
+    return data, {"trained_on": description, "corpus": {"soft_labels": norms}}
+
+
 def main(argv: list[str] | None = None) -> dict:
     parser = build_parser()
     args = parser.parse_args(argv)
+    data, provenance = None, None
     try:
         cfg = config_from_args(args)
-    except ValueError as exc:  # unknown preset, unknown or unavailable device: a usage error, not a traceback
+        if args.soft_labels:
+            data, provenance = soft_label_data(cfg, args)
+    except ValueError as exc:  # unknown preset, unavailable device, bad norms: a usage error, not a traceback
         parser.error(str(exc))
-    summary = train(cfg, progress=not args.quiet)
+    summary = train(cfg, data=data, progress=not args.quiet, provenance=provenance)
     last = summary["history"][-1] if summary["history"] else {}
     print(f"trained {summary['epochs_run']} epochs in {summary['seconds']:.0f} s on {summary['device']}; best "
           f"selection score {summary['best_val']:.5f}; last {json.dumps(last.get('val', {}))}; "

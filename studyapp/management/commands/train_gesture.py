@@ -7,7 +7,7 @@ from __future__ import annotations
 
 from django.core.management.base import BaseCommand, CommandError
 
-from generation.gesture.train import build_parser, config_from_args, train
+from generation.gesture.train import build_parser, config_from_args, soft_label_data, train
 from generation.mocap.gesture_corpus import load_gesture_corpus
 from studyapp.management.cli import mirror_arguments, mirrored_namespace
 
@@ -28,14 +28,21 @@ class Command(BaseCommand):
             cfg = config_from_args(ns)
         except ValueError as exc:  # unknown preset, unavailable device
             raise CommandError(str(exc)) from exc
-        data = None
-        if options.get("corpus"):
+        data = provenance = None
+        if ns.soft_labels:
+            if options.get("corpus"):
+                raise CommandError("--soft-labels and --corpus: choose one training set")
+            try:
+                data, provenance = soft_label_data(cfg, ns, log=self.stdout.write)
+            except ValueError as exc:
+                raise CommandError(str(exc)) from exc
+        elif options.get("corpus"):
 
             try:
                 data = load_gesture_corpus(options["corpus"], seed=cfg.seed)
             except ValueError as exc:
                 raise CommandError(str(exc)) from exc
-        summary = train(cfg, data=data, progress=not ns.quiet)
+        summary = train(cfg, data=data, progress=not ns.quiet, provenance=provenance)
         self.stdout.write(f"trained {summary['epochs_run']} epochs in {summary['seconds']:.0f} s on "
                           f"{summary['device']}; best selection score {summary['best_val']:.5f}; "
                           f"weights -> {summary['out']}")
