@@ -27,13 +27,17 @@ from datetime import UTC, datetime
 from pathlib import Path, PurePosixPath
 
 from django.conf import settings
+from django.utils.text import slugify
 
 from generation.imports.run import REPORT_NAME
+
+from .models import Clip
 
 LOG_NAME = "import.log"
 PID_NAME = "import.pid"
 MAX_ZIP_BYTES = 4 * 1024**3
 """Largest total unpacked size of an uploaded zip."""
+COLLECTION_MAX_LENGTH = 40
 
 
 class UploadError(ValueError):
@@ -128,6 +132,24 @@ def save_upload(manifest=None, files=(), archive=None) -> tuple[str, Path]:
     return job, found
 
 
+UPLOAD_PREFIX = "upload"
+
+
+def collection_name(username: str, collection: str) -> str:
+    """The ``import_clips --name`` of an admin upload: ``upload/<user>/<collection>``, so one user's collection is
+    never another's (a changed file retires only the older clip of the same collection and path); UploadError
+    when the catalogue plan ``import:<name>`` would not fit its field."""
+    name = f"{UPLOAD_PREFIX}/{username}/{collection}"
+    if len(f"import:{name}") > Clip._meta.get_field("plan").max_length:
+        raise UploadError(f"the collection import:{name} is too long: give a shorter collection name")
+    return name
+
+
+def default_collection(upload_name: str) -> str:
+    """A collection slug from an uploaded file's name (``Spring Walks.zip`` -> ``spring-walks``)."""
+    return slugify(Path(upload_name).stem)[:COLLECTION_MAX_LENGTH] or "upload"
+
+
 def import_command(manifest: Path, job: str, name: str, keep_audio: bool, dry_run: bool) -> list[str]:
     """The ``manage.py import_clips`` command line of a job."""
     cmd = [sys.executable, str(Path(settings.BASE_DIR) / "manage.py"), "import_clips", str(manifest),
@@ -147,10 +169,9 @@ def launch(cmd: list[str], job: str) -> None:
     threading.Thread(target=proc.wait, name=f"clip-import-{proc.pid}", daemon=True).start()   # no zombie
 
 
-def start_import(manifest: Path, job: str, name: str = "", keep_audio: bool = False, dry_run: bool = False) -> None:
-    """Start ``import_clips`` on a saved upload (catalogue plan ``import:<name>``, by default the manifest's
-    name)."""
-    launch(import_command(manifest, job, name or f"upload/{manifest.stem}", keep_audio, dry_run), job)
+def start_import(manifest: Path, job: str, name: str, keep_audio: bool = False, dry_run: bool = False) -> None:
+    """Start ``import_clips`` on a saved upload into the collection ``import:<name>`` (:func:`collection_name`)."""
+    launch(import_command(manifest, job, name, keep_audio, dry_run), job)
 
 
 @dataclass(frozen=True)

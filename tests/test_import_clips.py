@@ -340,13 +340,13 @@ def test_admin_upload_of_a_manifest_and_its_files(media, lab, staff, inline_jobs
     manifest = write_manifest(lab, rows, "lab_stimuli.csv")
     resp = staff.post(reverse("admin:studyapp_clip_import"), {
         "manifest": _upload(manifest), "files": [_upload(lab / "videos/walk.mp4"), _upload(lab / "videos/face.webm")],
-        "name": "spring"})
+        "collection": "spring"})
     assert resp.status_code == 302, resp.content.decode()[:2000]
     page = staff.get(resp["Location"]).content.decode()
     assert "Status: <strong>done</strong>" in page and "2 of 3 row(s) imported" in page
     assert "no such file &#x27;missing.mp4&#x27;" in page
     clips = Clip.objects.filter(origin="imported")
-    assert clips.count() == 2 and {c.plan for c in clips} == {"import:upload/spring"}
+    assert clips.count() == 2 and {c.plan for c in clips} == {"import:upload/importer/spring"}
     assert {c.licence for c in clips} == {"CC0", "CC BY 4.0"}
 
 
@@ -376,6 +376,77 @@ def test_admin_upload_of_a_zip(media, lab, staff, inline_jobs, tmp_path):
     resp = staff.post(reverse("admin:studyapp_clip_import"), {"archive": _upload(evil)})
     assert resp.status_code == 200 and "must stay inside the upload" in resp.content.decode()
     assert not (media.parent / "data" / "escape.mp4").exists()
+
+
+def _zip_of(manifest: Path, files: dict[str, Path], archive: Path) -> Path:
+    import zipfile
+
+    archive.parent.mkdir(parents=True, exist_ok=True)
+    with zipfile.ZipFile(archive, "w") as zf:
+        zf.write(manifest, "manifest.csv")
+        for arcname, path in files.items():
+            zf.write(path, arcname)
+    return archive
+
+
+def _client_of(username: str):
+    from django.contrib.auth.models import User
+    from django.test import Client
+
+    client = Client()
+    client.force_login(User.objects.create_superuser(username, f"{username}@example.org", "pw"))
+    return client
+
+
+@pytest.mark.django_db
+def test_uploads_of_two_users_never_retire_each_others_clips(media, lab, tmp_path, inline_jobs):
+    """Two labs upload a stimuli.zip with a manifest.csv naming walk.mp4, each its own video: each upload is its
+    own collection (the user's, named after the zip), so neither retires the other's clip; within one collection
+    a changed file still retires the older clip."""
+    from django.urls import reverse
+
+    from studyapp.models import Clip
+
+    manifest = write_manifest(lab, GOOD[:1])
+    videos = {"lab-a": lab / "videos/walk.mp4", "lab-b": make_video(tmp_path / "other/walk.mp4", pattern="testsrc")}
+    clients = {user: _client_of(user) for user in videos}
+    url = reverse("admin:studyapp_clip_import")
+
+    def upload(user: str):
+        archive = _zip_of(manifest, {"videos/walk.mp4": videos[user]}, tmp_path / user / "stimuli.zip")
+        resp = clients[user].post(url, {"archive": _upload(archive)})
+        assert resp.status_code == 302, resp.content.decode()[:2000]
+        return Clip.objects.get(plan=f"import:upload/{user}/stimuli", retired=False)
+
+    clip_of = {user: upload(user) for user in videos}
+    assert clip_of["lab-a"].clip_id != clip_of["lab-b"].clip_id
+    assert not Clip.objects.filter(retired=True).exists()
+
+    make_video(videos["lab-a"], pattern="smptebars")                               # lab A re-exports its video
+    assert upload("lab-a").clip_id != clip_of["lab-a"].clip_id
+    retired = set(Clip.objects.filter(retired=True).values_list("clip_id", flat=True))
+    assert retired == {clip_of["lab-a"].clip_id}                                   # lab B's clip stays
+
+
+@pytest.mark.django_db
+def test_a_file_of_another_collection_is_refused_not_taken_over(media, lab, staff, inline_jobs, tmp_path):
+    """The same file uploaded after the command imported it stays the command's clip, labels and collection."""
+    from django.urls import reverse
+
+    from studyapp.models import Clip
+
+    run(write_manifest(lab, GOOD[:1]))
+    clip = Clip.objects.get()
+    catalogue = (media / "clips.csv").read_bytes()
+    archive = _zip_of(write_manifest(tmp_path, [{**GOOD[0], "citation": "another lab"}]),
+                      {"videos/walk.mp4": lab / "videos/walk.mp4"}, tmp_path / "mine.zip")
+    resp = staff.post(reverse("admin:studyapp_clip_import"), {"archive": _upload(archive)})
+    page = staff.get(resp["Location"]).content.decode()
+    assert "0 of 1 row(s) imported" in page
+    assert f"already clip {clip.clip_id} of the collection &#x27;import:lab/manifest&#x27;" in page
+    clip.refresh_from_db()
+    assert clip.plan == "import:lab/manifest" and clip.citation == "Our lab 2026" and not clip.retired
+    assert (media / "clips.csv").read_bytes() == catalogue
 
 
 @pytest.mark.django_db

@@ -49,6 +49,10 @@ STAGING_DIR = ".import-staging"
 CatalogueStep = Callable[[dict, list], contextlib.AbstractContextManager]
 
 
+class RowRefused(Exception):
+    """A catalogue step's refusal of a row (e.g. its clip belongs to another collection); the message says why."""
+
+
 @dataclass(frozen=True)
 class ImportSettings:
     """How rows are imported.
@@ -56,8 +60,8 @@ class ImportSettings:
     limits: the longest (s) and largest (bytes) file accepted; keep_audio: the default of the manifest's
     ``keep_audio`` column; webm: also deliver VP9 WebM; render: the renderer's settings for motion files (the body
     comes from the manifest's ``body``); observer: read motion clips with the modality's observer; threads: ffmpeg
-    threads per encode (0: ffmpeg decides); plan: the catalogue ``plan`` name of this manifest's clips (a changed
-    file retires the older clip of the same plan and path)."""
+    threads per encode (0: ffmpeg decides); plan: the catalogue ``plan`` of this manifest's clips, their collection
+    (a changed file retires the older clip of the same plan and path, never one of another plan)."""
 
     limits: VideoLimits = field(default_factory=VideoLimits)
     keep_audio: bool = False
@@ -250,7 +254,7 @@ def _summary(rec: dict) -> str:
     return text + (f", quality flag {rec['qa_flag']}" if rec.get("qa_flag") else "")
 
 
-ROW_ERRORS = (ManifestError, VideoImportError, MotionImportError, OSError)
+ROW_ERRORS = (ManifestError, VideoImportError, MotionImportError, RowRefused, OSError)
 
 
 def import_row(row: ManifestRow, media_root: Path, settings: ImportSettings, catalogue: CatalogueStep | None,

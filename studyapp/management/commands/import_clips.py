@@ -20,10 +20,11 @@ from django.core.management.base import BaseCommand, CommandError
 from django.db import transaction
 
 from generation.imports import ImportSettings, ManifestError, import_manifest, write_report
-from generation.imports.run import REPORT_NAME
+from generation.imports.run import REPORT_NAME, RowRefused
 from generation.imports.video import VideoLimits
 from generation.render.settings import RenderSettings, RenderSettingsError
 from studyapp.catalogue import retire_replaced, upsert_clips
+from studyapp.models import Clip
 
 from .generate_clips import _require_migrated_database
 
@@ -31,16 +32,31 @@ PLAN_PREFIX = "import:"
 
 
 def plan_name(manifest: Path, name: str | None = None) -> str:
-    """The catalogue ``plan`` of a manifest's clips: ``import:<name>``, by default ``import:<folder>/<stem>``."""
+    """The collection of a manifest's clips, their catalogue ``plan``: ``import:<name>``, by default
+    ``import:<folder>/<stem>`` (the admin passes ``upload/<user>/<collection>``)."""
     name = name or f"{manifest.resolve().parent.name}/{manifest.stem}"
-    return (PLAN_PREFIX + name)[:100]
+    plan = PLAN_PREFIX + name
+    if len(plan) > Clip._meta.get_field("plan").max_length:      # cut short, two collections could merge
+        raise CommandError(f"the collection {plan!r} is too long; give a shorter --name")
+    return plan
+
+
+def refuse_other_collections(record: dict) -> None:
+    """RowRefused when the row's clip (the same file with the same settings) belongs to another collection: a
+    clip has one collection, whose manifest alone relabels or retires it."""
+    owner = Clip.objects.filter(clip_id=record["clip_id"]).values_list("plan", flat=True).first()
+    if owner is not None and owner != record["plan"]:
+        raise RowRefused(f"the same file is already clip {record['clip_id']} of the collection {owner!r}; a clip "
+                         "belongs to one collection (select that clip in a pool by its id, or import the file "
+                         "from that collection)")
 
 
 @contextlib.contextmanager
 def catalogue_step(record: dict, notes: list):
     """The Clip row of one imported clip, in one transaction with its files (generation.imports.run.commit_row);
-    the older clip of the same manifest path is retired when the file changed."""
+    the older clip of the same collection and manifest path is retired when the file changed."""
     with transaction.atomic():
+        refuse_other_collections(record)
         upsert_clips([record])
         retired = retire_replaced(record["plan"], record["metadata"]["entry_id"], record["clip_id"])
         if retired:
@@ -74,7 +90,9 @@ class Command(BaseCommand):
         parser.add_argument("--max-size-mb", type=float, default=VideoLimits.max_bytes / 2**20, metavar="MB",
                             help=f"largest file accepted, MiB (default {VideoLimits.max_bytes / 2**20:g})")
         parser.add_argument("--name", default=None,
-                            help="catalogue plan name of these clips (default: import:<folder>/<manifest stem>)")
+                            help="the collection of these clips, their catalogue plan import:<name> (default: "
+                                 "import:<folder>/<manifest stem>); a changed file retires only the older clip of "
+                                 "the same collection and path")
         parser.add_argument("--render-size", default=None, metavar="WxH",
                             help="frame size of rendered motion files (default 1280x720, as generated clips)")
         parser.add_argument("--no-observer", action="store_true",
