@@ -5,6 +5,7 @@ request), and the job's state read back for the status page.
     IMPORTS_DIR/<job>/files/...            the uploaded manifest and files (a zip unpacked here)
                       import_report.csv    the command's report (appears when it is done)
                       import.log           its output
+                      job.json             the collection and whether it is a dry run
                       import.pid           the process id while it is started
 
 ``IMPORTS_DIR`` is ``DATA_DIR/imports`` (never served). Zip members and file names that could leave the job
@@ -14,6 +15,7 @@ again by the import (generation.imports.manifest).
 from __future__ import annotations
 
 import csv
+import json
 import os
 import secrets
 import shutil
@@ -34,6 +36,7 @@ from generation.imports.run import REPORT_NAME
 from .models import Clip
 
 LOG_NAME = "import.log"
+JOB_NAME = "job.json"
 PID_NAME = "import.pid"
 MAX_ZIP_BYTES = 4 * 1024**3
 """Largest total unpacked size of an uploaded zip."""
@@ -170,18 +173,23 @@ def launch(cmd: list[str], job: str) -> None:
 
 
 def start_import(manifest: Path, job: str, name: str, keep_audio: bool = False, dry_run: bool = False) -> None:
-    """Start ``import_clips`` on a saved upload into the collection ``import:<name>`` (:func:`collection_name`)."""
+    """Start ``import_clips`` on a saved upload into the collection ``import:<name>`` (:func:`collection_name`);
+    what was asked is kept in the job's JOB_NAME for the status page."""
+    (job_dir(job) / JOB_NAME).write_text(json.dumps({"collection": f"import:{name}", "dry_run": dry_run}))
     launch(import_command(manifest, job, name, keep_audio, dry_run), job)
 
 
 @dataclass(frozen=True)
 class ImportState:
-    """Where an import job stands: ``status`` running | done | failed, its report rows and its log's tail."""
+    """Where an import job stands: ``status`` running | done | failed, its report rows and its log's tail; the
+    collection it imports into and whether it is a dry run (only checks, imports nothing)."""
 
     job: str
     status: str
     rows: list[dict]
     log: str
+    collection: str = ""
+    dry_run: bool = False
 
 
 def _running(folder: Path) -> bool:
@@ -196,6 +204,14 @@ def _running(folder: Path) -> bool:
         return True
 
 
+def _job_info(folder: Path) -> dict:
+    try:
+        info = json.loads((folder / JOB_NAME).read_text())
+    except (OSError, ValueError):
+        return {}
+    return info if isinstance(info, dict) else {}
+
+
 def import_state(job: str) -> ImportState:
     folder = job_dir(job)
     if not folder.is_dir():
@@ -206,6 +222,6 @@ def import_state(job: str) -> ImportState:
     if report.is_file():
         with report.open(newline="", encoding="utf-8") as f:
             rows = list(csv.DictReader(f))
-    if _running(folder):
-        return ImportState(job, "running", rows, log)
-    return ImportState(job, "done" if report.is_file() else "failed", rows, log)
+    info = _job_info(folder)
+    status = "running" if _running(folder) else "done" if report.is_file() else "failed"
+    return ImportState(job, status, rows, log, str(info.get("collection", "")), bool(info.get("dry_run")))

@@ -248,8 +248,32 @@ def test_dry_run_writes_nothing(media, lab):
     from studyapp.models import Clip
 
     out = run(write_manifest(lab, GOOD), "--dry-run", *TINY)
-    assert "3 of 3 row(s) imported (dry run: nothing written)" in out and "would transcode vp9" in out
+    assert "dry run: 3 of 3 row(s) checked and would import, nothing written" in out and "would transcode vp9" in out
+    assert "row(s) imported" not in out and "no report written" in out
     assert Clip.objects.count() == 0 and _files(media) == set() and not (lab / "import_report.csv").exists()
+
+
+@pytest.mark.django_db
+def test_a_failing_dry_run_says_nothing_was_imported_and_where_the_report_is(media, lab, tmp_path):
+    manifest = write_manifest(lab, [GOOD[0], {"path": "missing.mp4", "modality": "gait"}])
+    with pytest.raises(CommandError) as failed:
+        run(manifest, "--dry-run")
+    assert str(failed.value) == "1 row(s) failed the check (see the rows above); dry run: nothing was imported"
+    report = tmp_path / "checked.csv"
+    with pytest.raises(CommandError) as failed:
+        run(manifest, "--dry-run", "--report", str(report))
+    assert f"(see the report {report}); dry run: nothing was imported" in str(failed.value)
+    assert [r["status"] for r in read_report(report)] == ["ok", "error"] and _files(media) == set()
+
+
+def test_a_dry_run_says_a_long_take_will_be_cut(lab):
+    from generation.imports import ImportSettings, import_manifest
+    from generation.render.settings import RenderSettings
+
+    settings = ImportSettings(render=RenderSettings(duration_s=2.0))
+    (out,) = import_manifest(write_manifest(lab, GOOD[2:]), lab / "media", settings, dry_run=True)
+    assert out.status == "ok" and not (lab / "media").exists()
+    assert "would render the first 2.00 s of 7.10 s of motion (cut to the render length, 2 s)" in out.message
 
 
 @pytest.mark.django_db
@@ -348,6 +372,21 @@ def test_admin_upload_of_a_manifest_and_its_files(media, lab, staff, inline_jobs
     clips = Clip.objects.filter(origin="imported")
     assert clips.count() == 2 and {c.plan for c in clips} == {"import:upload/importer/spring"}
     assert {c.licence for c in clips} == {"CC0", "CC BY 4.0"}
+
+
+@pytest.mark.django_db
+def test_admin_dry_run_says_what_would_be_imported(media, lab, staff, inline_jobs):
+    from django.urls import reverse
+
+    from studyapp.models import Clip
+
+    manifest = write_manifest(lab, [{**GOOD[0], "path": "walk.mp4"}], "spring.csv")
+    resp = staff.post(reverse("admin:studyapp_clip_import"), {
+        "manifest": _upload(manifest), "files": [_upload(lab / "videos/walk.mp4")], "dry_run": "on"})
+    page = staff.get(resp["Location"]).content.decode()
+    assert "(dry run: every row is checked, nothing is imported)" in page
+    assert "1 of 1 row(s) checked and would import" in page and "row(s) imported" not in page
+    assert "Collection: <code>import:upload/importer/spring</code>" in page and not Clip.objects.exists()
 
 
 @pytest.mark.django_db

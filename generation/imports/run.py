@@ -254,6 +254,13 @@ def _summary(rec: dict) -> str:
     return text + (f", quality flag {rec['qa_flag']}" if rec.get("qa_flag") else "")
 
 
+def _render_span(source_s: float, render_s: float) -> str:
+    """What of a take of ``source_s`` seconds a render of at most ``render_s`` seconds shows."""
+    if source_s > render_s + 0.05:
+        return f"the first {render_s:.2f} s of {source_s:.2f} s of motion (cut to the render length, {render_s:g} s)"
+    return f"{source_s:.2f} s of motion"
+
+
 ROW_ERRORS = (ManifestError, VideoImportError, MotionImportError, RowRefused, OSError)
 
 
@@ -276,7 +283,8 @@ def import_row(row: ManifestRow, media_root: Path, settings: ImportSettings, cat
                              f"{probe.width}x{probe.height}, {probe.duration_s:.2f} s (dry run: nothing written)")
             else:
                 motion, _ = load_motion(row.file, row.modality, settings.limits.max_duration_s)
-                notes.append(f"would render {motion.duration:.2f} s of motion (dry run: nothing written)")
+                notes.append(f"would render {_render_span(motion.duration, settings.render.duration_s)} "
+                             "(dry run: nothing written)")
         elif stored is not None:
             _with_media(rec, stored)
             commit_row(rec, {}, media_root, catalogue, notes)

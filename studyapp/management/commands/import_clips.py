@@ -127,11 +127,28 @@ class Command(BaseCommand):
         except ManifestError as exc:
             raise CommandError(str(exc)) from None
         report = Path(opts["report"]) if opts["report"] else manifest.parent / REPORT_NAME
-        if not opts["dry_run"] or opts["report"]:
+        written = not opts["dry_run"] or bool(opts["report"])
+        if written:
             write_report(outcomes, report)
         ok = sum(o.status == "ok" for o in outcomes)
-        self.stdout.write(f"{ok} of {len(outcomes)} row(s) imported{' (dry run: nothing written)' * opts['dry_run']}"
-                          f"; plan {config.plan}" + ("" if opts["dry_run"] and not opts["report"]
-                                                     else f"; report {report}"))
+        self.stdout.write(summary_line(ok, len(outcomes), config.plan, report if written else None,
+                                       opts["dry_run"]))
         if ok < len(outcomes):
-            raise CommandError(f"{len(outcomes) - ok} row(s) failed (see the report); the others are imported")
+            raise CommandError(failure_line(len(outcomes) - ok, ok, report if written else None, opts["dry_run"]))
+
+
+def summary_line(ok: int, rows: int, plan: str, report: Path | None, dry_run: bool) -> str:
+    """The command's last line: how many rows were imported (a dry run: checked and would import), the
+    collection, and where the report is (a dry run without --report writes none)."""
+    where = f"report {report}" if report else "no report written (the rows are above; --report PATH writes one)"
+    if dry_run:
+        return f"dry run: {ok} of {rows} row(s) checked and would import, nothing written; collection {plan}; {where}"
+    return f"{ok} of {rows} row(s) imported; collection {plan}; {where}"
+
+
+def failure_line(failed: int, ok: int, report: Path | None, dry_run: bool) -> str:
+    """The command's error when rows failed: how many, where their causes are, what happened to the others."""
+    where = f"see the report {report}" if report else "see the rows above"
+    if dry_run:
+        return f"{failed} row(s) failed the check ({where}); dry run: nothing was imported"
+    return f"{failed} row(s) failed ({where}); " + (f"the other {ok} are imported" if ok else "nothing was imported")
