@@ -303,6 +303,34 @@ def test_manifest_refuses_unknown_columns(tmp_path):
         read_manifest(tmp_path / "m.csv")
 
 
+@pytest.mark.parametrize("delimiter", [";", "\t"])
+def test_a_semicolon_or_tab_separated_manifest_is_read(tmp_path, delimiter):
+    """As a spreadsheet in a decimal-comma locale saves CSV: semicolons (or tabs) between cells, decimal commas in
+    the labels, commas inside text cells."""
+    (tmp_path / "walk.mp4").write_bytes(b"not probed here")
+    header = ["path", "modality", "happy", "sad", "angry", "neutral", "valence", "citation"]
+    cells = ["walk.mp4", "gait", "0,75", "0", "0", "0,25", "0,6", "Doe, J. and Roe, R. (2026)"]
+    (tmp_path / "m.csv").write_text(f"{delimiter.join(header)}\n{delimiter.join(cells)}\n", encoding="utf-8")
+    (row,) = read_manifest(tmp_path / "m.csv")
+    assert row.labels == {"happy": 0.75, "sad": 0.0, "angry": 0.0, "neutral": 0.25, "valence": 0.6}
+    assert row.text["citation"] == "Doe, J. and Roe, R. (2026)" and row.modality == "gait"
+
+
+def test_column_names_that_differ_in_case_name_the_expected_column(tmp_path):
+    from generation.imports import ManifestError
+
+    (tmp_path / "m.csv").write_text("path,modality,Title\na.mp4,gait,walk\n")
+    with pytest.raises(ManifestError, match="'Title': not a manifest column .*; column names are lower case: "
+                                            "write 'title'"):
+        read_manifest(tmp_path / "m.csv")
+    (tmp_path / "m.csv").write_text("Path;Modality\na.mp4;gait\n")
+    with pytest.raises(ManifestError, match="'path': missing column .*write 'path' for 'Path'"):
+        read_manifest(tmp_path / "m.csv")
+    (tmp_path / "m.csv").write_text("path,modality,hapy\na.mp4,gait,1\n")
+    with pytest.raises(ManifestError, match="did you mean 'happy'"):
+        read_manifest(tmp_path / "m.csv")
+
+
 @pytest.mark.django_db
 def test_imported_clips_in_the_naturalness_analysis(media, lab):
     from analysis.io import read_clips
