@@ -16,7 +16,14 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 import pandas as pd  # noqa: E402
 
-from study_protocol import GAIT_EMOTIONS, LIKERT_FEATURES, THEMES, VAD_DIMENSIONS  # noqa: E402
+from study_protocol import (  # noqa: E402
+    GAIT_EMOTIONS,
+    IMPORTED,
+    LIKERT_FEATURES,
+    ORIGINS,
+    THEMES,
+    VAD_DIMENSIONS,
+)
 
 plt.rcParams.update({"svg.hashsalt": "analysis", "svg.fonttype": "none", "font.size": 9, "axes.titlesize": 9,
                      "figure.dpi": 100})
@@ -164,28 +171,36 @@ def fig_vad(pairs: pd.DataFrame, pearson: pd.DataFrame):
     return fig
 
 
+ORIGIN_COLORS = {"generated": PERCEIVED_COLOR, "source": INTENDED_COLOR, IMPORTED: "#55A868"}
+"""Bar colour of each clip origin in the naturalness figure (an origin not named here is grey)."""
+
+
 def fig_naturalness(nat: pd.DataFrame):
-    """Share of each naturalness rating 1..5, generated vs source, one panel per modality."""
+    """Share of each naturalness rating 1..5 per clip origin (generated, source, imported: those in the table), one
+    panel per modality; each origin's bars are labelled with its share of ratings >= 3 and its n."""
     if nat.empty:
         return None
     modalities = sorted(nat["modality"].unique())
+    present = set(nat["origin"])
+    origins = [o for o in ORIGINS if o in present] + sorted(present - set(ORIGINS))
+    width = 0.8 / len(origins)
     fig, axes = plt.subplots(1, len(modalities), figsize=(4.2 * len(modalities), 3), squeeze=False, sharey=True)
     x = np.arange(1, 6)
     for ax, mod in zip(axes[0], modalities):
-        for k, (origin, color) in enumerate((("generated", PERCEIVED_COLOR), ("source", INTENDED_COLOR))):
+        for k, origin in enumerate(origins):
             r = nat[(nat["modality"] == mod) & (nat["origin"] == origin)]
             if r.empty:
                 continue
             r = r.iloc[0]
             shares = [r[f"share_{v}"] for v in x]
-            ax.bar(x + (k - 0.5) * 0.4, shares, 0.4, color=color,
+            ax.bar(x + (k - (len(origins) - 1) / 2) * width, shares, width, color=ORIGIN_COLORS.get(origin, "grey"),
                    label=f"{origin} ({r['share_at_least_3']:.0%} >= 3, n = {int(r['n'])})")
         ax.set_xticks(x)
         ax.set_xlabel("naturalness rating (1 not natural .. 5 very natural)")
         ax.set_title(mod)
         ax.legend(fontsize=7, frameon=False, loc="upper left")
     axes[0, 0].set_ylabel("share of answers")
-    fig.suptitle("Naturalness of generated and source motion")
+    fig.suptitle(f"Naturalness by clip origin ({', '.join(origins)})")
     fig.tight_layout()
     return fig
 

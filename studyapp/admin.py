@@ -287,12 +287,12 @@ class ClipAdmin(admin.ModelAdmin):
         if request.method == "POST" and form.is_valid():
             data = form.cleaned_data
             try:
+                name = clip_import.collection_name(request.user.get_username(), data["collection"])
                 job, manifest = clip_import.save_upload(data["manifest"], data["files"], data["archive"])
             except clip_import.UploadError as exc:
                 form.add_error(None, str(exc))
             else:
-                clip_import.start_import(manifest, job, f"upload/{data['name']}" if data["name"] else "",
-                                         data["keep_audio"], data["dry_run"])
+                clip_import.start_import(manifest, job, name, data["keep_audio"], data["dry_run"])
                 return HttpResponseRedirect(reverse("admin:studyapp_clip_import_status", args=[job]))
         context = {**self.admin_site.each_context(request), "opts": self.model._meta, "form": form,
                    "title": "Import clips"}

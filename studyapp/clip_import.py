@@ -5,6 +5,7 @@ request), and the job's state read back for the status page.
     IMPORTS_DIR/<job>/files/...            the uploaded manifest and files (a zip unpacked here)
                       import_report.csv    the command's report (appears when it is done)
                       import.log           its output
+                      job.json             the collection and whether it is a dry run
                       import.pid           the process id while it is started
 
 ``IMPORTS_DIR`` is ``DATA_DIR/imports`` (never served). Zip members and file names that could leave the job
@@ -14,6 +15,7 @@ again by the import (generation.imports.manifest).
 from __future__ import annotations
 
 import csv
+import json
 import os
 import secrets
 import shutil
@@ -27,13 +29,18 @@ from datetime import UTC, datetime
 from pathlib import Path, PurePosixPath
 
 from django.conf import settings
+from django.utils.text import slugify
 
 from generation.imports.run import REPORT_NAME
 
+from .models import Clip
+
 LOG_NAME = "import.log"
+JOB_NAME = "job.json"
 PID_NAME = "import.pid"
 MAX_ZIP_BYTES = 4 * 1024**3
 """Largest total unpacked size of an uploaded zip."""
+COLLECTION_MAX_LENGTH = 40
 
 
 class UploadError(ValueError):
@@ -128,6 +135,24 @@ def save_upload(manifest=None, files=(), archive=None) -> tuple[str, Path]:
     return job, found
 
 
+UPLOAD_PREFIX = "upload"
+
+
+def collection_name(username: str, collection: str) -> str:
+    """The ``import_clips --name`` of an admin upload: ``upload/<user>/<collection>``, so one user's collection is
+    never another's (a changed file retires only the older clip of the same collection and path); UploadError
+    when the catalogue plan ``import:<name>`` would not fit its field."""
+    name = f"{UPLOAD_PREFIX}/{username}/{collection}"
+    if len(f"import:{name}") > Clip._meta.get_field("plan").max_length:
+        raise UploadError(f"the collection import:{name} is too long: give a shorter collection name")
+    return name
+
+
+def default_collection(upload_name: str) -> str:
+    """A collection slug from an uploaded file's name (``Spring Walks.zip`` -> ``spring-walks``)."""
+    return slugify(Path(upload_name).stem)[:COLLECTION_MAX_LENGTH] or "upload"
+
+
 def import_command(manifest: Path, job: str, name: str, keep_audio: bool, dry_run: bool) -> list[str]:
     """The ``manage.py import_clips`` command line of a job."""
     cmd = [sys.executable, str(Path(settings.BASE_DIR) / "manage.py"), "import_clips", str(manifest),
@@ -147,20 +172,24 @@ def launch(cmd: list[str], job: str) -> None:
     threading.Thread(target=proc.wait, name=f"clip-import-{proc.pid}", daemon=True).start()   # no zombie
 
 
-def start_import(manifest: Path, job: str, name: str = "", keep_audio: bool = False, dry_run: bool = False) -> None:
-    """Start ``import_clips`` on a saved upload (catalogue plan ``import:<name>``, by default the manifest's
-    name)."""
-    launch(import_command(manifest, job, name or f"upload/{manifest.stem}", keep_audio, dry_run), job)
+def start_import(manifest: Path, job: str, name: str, keep_audio: bool = False, dry_run: bool = False) -> None:
+    """Start ``import_clips`` on a saved upload into the collection ``import:<name>`` (:func:`collection_name`);
+    what was asked is kept in the job's JOB_NAME for the status page."""
+    (job_dir(job) / JOB_NAME).write_text(json.dumps({"collection": f"import:{name}", "dry_run": dry_run}))
+    launch(import_command(manifest, job, name, keep_audio, dry_run), job)
 
 
 @dataclass(frozen=True)
 class ImportState:
-    """Where an import job stands: ``status`` running | done | failed, its report rows and its log's tail."""
+    """Where an import job stands: ``status`` running | done | failed, its report rows and its log's tail; the
+    collection it imports into and whether it is a dry run (only checks, imports nothing)."""
 
     job: str
     status: str
     rows: list[dict]
     log: str
+    collection: str = ""
+    dry_run: bool = False
 
 
 def _running(folder: Path) -> bool:
@@ -175,6 +204,14 @@ def _running(folder: Path) -> bool:
         return True
 
 
+def _job_info(folder: Path) -> dict:
+    try:
+        info = json.loads((folder / JOB_NAME).read_text())
+    except (OSError, ValueError):
+        return {}
+    return info if isinstance(info, dict) else {}
+
+
 def import_state(job: str) -> ImportState:
     folder = job_dir(job)
     if not folder.is_dir():
@@ -185,6 +222,6 @@ def import_state(job: str) -> ImportState:
     if report.is_file():
         with report.open(newline="", encoding="utf-8") as f:
             rows = list(csv.DictReader(f))
-    if _running(folder):
-        return ImportState(job, "running", rows, log)
-    return ImportState(job, "done" if report.is_file() else "failed", rows, log)
+    info = _job_info(folder)
+    status = "running" if _running(folder) else "done" if report.is_file() else "failed"
+    return ImportState(job, status, rows, log, str(info.get("collection", "")), bool(info.get("dry_run")))

@@ -10,7 +10,7 @@ from django.utils.translation import gettext_lazy as _
 from analysis.exclusion import rule_errors
 from study_pools import SUB_POOLS
 
-from . import pool_editor
+from . import clip_import, pool_editor
 from .i18n import display
 from .inputs import refuse_control_characters, refuse_control_characters_in_text
 from .models import Clip, Section, Study
@@ -199,9 +199,12 @@ class ClipImportForm(forms.Form):
     archive = forms.FileField(required=False, label="or a zip",
                               help_text="A zip of the manifest (manifest.csv, or the only .csv) and its files; the "
                                         "manifest's paths are relative to the zip's top.")
-    name = forms.CharField(required=False, max_length=80,
-                           help_text="Catalogue plan of these clips: import:upload/<name> (default: the manifest's "
-                                     "name). A changed file retires the older clip of the same plan and path.")
+    collection = forms.SlugField(
+        required=False, max_length=clip_import.COLLECTION_MAX_LENGTH,
+        help_text="The collection these clips belong to, yours alone (catalogue plan import:upload/<your user "
+                  "name>/<collection>); blank: from the uploaded file's name. Upload a changed version of the "
+                  "same stimuli into the same collection: a changed file retires the older clip of that "
+                  "collection and path, never another collection's.")
     keep_audio = forms.BooleanField(required=False, help_text="Keep the videos' sound (default: stripped).")
     dry_run = forms.BooleanField(required=False, help_text="Only check every row; import nothing.")
 
@@ -211,6 +214,7 @@ class ClipImportForm(forms.Form):
             raise forms.ValidationError("Upload a manifest with its files, or a zip of them.")
         if data.get("manifest") and not data["manifest"].name.lower().endswith(".csv"):
             self.add_error("manifest", "The manifest must be a .csv file.")
-        if data.get("name") and not all(c.isalnum() or c in "-_." for c in data["name"]):
-            self.add_error("name", "Letters, digits, '-', '_' and '.' only.")
+        if not data.get("collection") and "collection" not in self.errors:
+            upload = data.get("archive") or data.get("manifest")
+            data["collection"] = clip_import.default_collection(upload.name)
         return data

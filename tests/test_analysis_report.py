@@ -61,6 +61,32 @@ def test_report_files(report_dir):
     assert "src=\"http" not in html and "href=\"http" not in html  # self-contained
 
 
+def test_the_naturalness_figure_draws_imported_clips():
+    """A report whose naturalness clips include imported ones draws them beside generated and source: one labelled
+    set of bars per origin and modality, with the table's shares."""
+    from analysis.figures import fig_naturalness
+    from analysis.io import load_study
+    from analysis.report import build_report
+
+    responses, clips, participants = simulate_study(8, seed=1)
+    rated = responses.loc[responses["section_type"] == "naturalness", "clip_id"].unique()
+    gesture_sources = clips["clip_id"].isin(rated) & (clips["origin"] == "source") & (clips["modality"] == "gesture")
+    clips.loc[gesture_sources, "origin"] = "imported"
+    data = load_study(*(io.StringIO(df.to_csv(index=False)) for df in (responses, clips, participants)))
+    nat = build_report(data)[1]["naturalness"]
+    assert "imported" in set(nat["origin"])
+    fig = fig_naturalness(nat)
+    drawn = {}
+    for ax in fig.axes:
+        for bars in ax.containers:
+            origin = bars.get_label().split(" (")[0]
+            drawn[(origin, ax.get_title())] = [bar.get_height() for bar in bars]
+    expected = {(r.origin, r.modality): [getattr(r, f"share_{k}") for k in range(1, 6)] for r in nat.itertuples()}
+    assert drawn.keys() == expected.keys() and ("imported", "gesture") in drawn
+    assert all(drawn[key] == pytest.approx(expected[key]) for key in expected)
+    assert "imported" in fig._suptitle.get_text()
+
+
 def test_write_report_accepts_file_objects(tmp_path):
     r, c, p = simulate_study(8, seed=1)
     bufs = [io.StringIO(df.to_csv(index=False)) for df in (r, c, p)]

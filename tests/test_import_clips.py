@@ -248,8 +248,32 @@ def test_dry_run_writes_nothing(media, lab):
     from studyapp.models import Clip
 
     out = run(write_manifest(lab, GOOD), "--dry-run", *TINY)
-    assert "3 of 3 row(s) imported (dry run: nothing written)" in out and "would transcode vp9" in out
+    assert "dry run: 3 of 3 row(s) checked and would import, nothing written" in out and "would transcode vp9" in out
+    assert "row(s) imported" not in out and "no report written" in out
     assert Clip.objects.count() == 0 and _files(media) == set() and not (lab / "import_report.csv").exists()
+
+
+@pytest.mark.django_db
+def test_a_failing_dry_run_says_nothing_was_imported_and_where_the_report_is(media, lab, tmp_path):
+    manifest = write_manifest(lab, [GOOD[0], {"path": "missing.mp4", "modality": "gait"}])
+    with pytest.raises(CommandError) as failed:
+        run(manifest, "--dry-run")
+    assert str(failed.value) == "1 row(s) failed the check (see the rows above); dry run: nothing was imported"
+    report = tmp_path / "checked.csv"
+    with pytest.raises(CommandError) as failed:
+        run(manifest, "--dry-run", "--report", str(report))
+    assert f"(see the report {report}); dry run: nothing was imported" in str(failed.value)
+    assert [r["status"] for r in read_report(report)] == ["ok", "error"] and _files(media) == set()
+
+
+def test_a_dry_run_says_a_long_take_will_be_cut(lab):
+    from generation.imports import ImportSettings, import_manifest
+    from generation.render.settings import RenderSettings
+
+    settings = ImportSettings(render=RenderSettings(duration_s=2.0))
+    (out,) = import_manifest(write_manifest(lab, GOOD[2:]), lab / "media", settings, dry_run=True)
+    assert out.status == "ok" and not (lab / "media").exists()
+    assert "would render the first 2.00 s of 7.10 s of motion (cut to the render length, 2 s)" in out.message
 
 
 @pytest.mark.django_db
@@ -276,6 +300,34 @@ def test_manifest_refuses_unknown_columns(tmp_path):
 
     (tmp_path / "m.csv").write_text("path,modality,hapy\na.mp4,gait,1\n")
     with pytest.raises(ManifestError, match="'hapy': not a manifest column"):
+        read_manifest(tmp_path / "m.csv")
+
+
+@pytest.mark.parametrize("delimiter", [";", "\t"])
+def test_a_semicolon_or_tab_separated_manifest_is_read(tmp_path, delimiter):
+    """As a spreadsheet in a decimal-comma locale saves CSV: semicolons (or tabs) between cells, decimal commas in
+    the labels, commas inside text cells."""
+    (tmp_path / "walk.mp4").write_bytes(b"not probed here")
+    header = ["path", "modality", "happy", "sad", "angry", "neutral", "valence", "citation"]
+    cells = ["walk.mp4", "gait", "0,75", "0", "0", "0,25", "0,6", "Doe, J. and Roe, R. (2026)"]
+    (tmp_path / "m.csv").write_text(f"{delimiter.join(header)}\n{delimiter.join(cells)}\n", encoding="utf-8")
+    (row,) = read_manifest(tmp_path / "m.csv")
+    assert row.labels == {"happy": 0.75, "sad": 0.0, "angry": 0.0, "neutral": 0.25, "valence": 0.6}
+    assert row.text["citation"] == "Doe, J. and Roe, R. (2026)" and row.modality == "gait"
+
+
+def test_column_names_that_differ_in_case_name_the_expected_column(tmp_path):
+    from generation.imports import ManifestError
+
+    (tmp_path / "m.csv").write_text("path,modality,Title\na.mp4,gait,walk\n")
+    with pytest.raises(ManifestError, match="'Title': not a manifest column .*; column names are lower case: "
+                                            "write 'title'"):
+        read_manifest(tmp_path / "m.csv")
+    (tmp_path / "m.csv").write_text("Path;Modality\na.mp4;gait\n")
+    with pytest.raises(ManifestError, match="'path': missing column .*write 'path' for 'Path'"):
+        read_manifest(tmp_path / "m.csv")
+    (tmp_path / "m.csv").write_text("path,modality,hapy\na.mp4,gait,1\n")
+    with pytest.raises(ManifestError, match="did you mean 'happy'"):
         read_manifest(tmp_path / "m.csv")
 
 
@@ -340,14 +392,29 @@ def test_admin_upload_of_a_manifest_and_its_files(media, lab, staff, inline_jobs
     manifest = write_manifest(lab, rows, "lab_stimuli.csv")
     resp = staff.post(reverse("admin:studyapp_clip_import"), {
         "manifest": _upload(manifest), "files": [_upload(lab / "videos/walk.mp4"), _upload(lab / "videos/face.webm")],
-        "name": "spring"})
+        "collection": "spring"})
     assert resp.status_code == 302, resp.content.decode()[:2000]
     page = staff.get(resp["Location"]).content.decode()
     assert "Status: <strong>done</strong>" in page and "2 of 3 row(s) imported" in page
     assert "no such file &#x27;missing.mp4&#x27;" in page
     clips = Clip.objects.filter(origin="imported")
-    assert clips.count() == 2 and {c.plan for c in clips} == {"import:upload/spring"}
+    assert clips.count() == 2 and {c.plan for c in clips} == {"import:upload/importer/spring"}
     assert {c.licence for c in clips} == {"CC0", "CC BY 4.0"}
+
+
+@pytest.mark.django_db
+def test_admin_dry_run_says_what_would_be_imported(media, lab, staff, inline_jobs):
+    from django.urls import reverse
+
+    from studyapp.models import Clip
+
+    manifest = write_manifest(lab, [{**GOOD[0], "path": "walk.mp4"}], "spring.csv")
+    resp = staff.post(reverse("admin:studyapp_clip_import"), {
+        "manifest": _upload(manifest), "files": [_upload(lab / "videos/walk.mp4")], "dry_run": "on"})
+    page = staff.get(resp["Location"]).content.decode()
+    assert "(dry run: every row is checked, nothing is imported)" in page
+    assert "1 of 1 row(s) checked and would import" in page and "row(s) imported" not in page
+    assert "Collection: <code>import:upload/importer/spring</code>" in page and not Clip.objects.exists()
 
 
 @pytest.mark.django_db
@@ -376,6 +443,77 @@ def test_admin_upload_of_a_zip(media, lab, staff, inline_jobs, tmp_path):
     resp = staff.post(reverse("admin:studyapp_clip_import"), {"archive": _upload(evil)})
     assert resp.status_code == 200 and "must stay inside the upload" in resp.content.decode()
     assert not (media.parent / "data" / "escape.mp4").exists()
+
+
+def _zip_of(manifest: Path, files: dict[str, Path], archive: Path) -> Path:
+    import zipfile
+
+    archive.parent.mkdir(parents=True, exist_ok=True)
+    with zipfile.ZipFile(archive, "w") as zf:
+        zf.write(manifest, "manifest.csv")
+        for arcname, path in files.items():
+            zf.write(path, arcname)
+    return archive
+
+
+def _client_of(username: str):
+    from django.contrib.auth.models import User
+    from django.test import Client
+
+    client = Client()
+    client.force_login(User.objects.create_superuser(username, f"{username}@example.org", "pw"))
+    return client
+
+
+@pytest.mark.django_db
+def test_uploads_of_two_users_never_retire_each_others_clips(media, lab, tmp_path, inline_jobs):
+    """Two labs upload a stimuli.zip with a manifest.csv naming walk.mp4, each its own video: each upload is its
+    own collection (the user's, named after the zip), so neither retires the other's clip; within one collection
+    a changed file still retires the older clip."""
+    from django.urls import reverse
+
+    from studyapp.models import Clip
+
+    manifest = write_manifest(lab, GOOD[:1])
+    videos = {"lab-a": lab / "videos/walk.mp4", "lab-b": make_video(tmp_path / "other/walk.mp4", pattern="testsrc")}
+    clients = {user: _client_of(user) for user in videos}
+    url = reverse("admin:studyapp_clip_import")
+
+    def upload(user: str):
+        archive = _zip_of(manifest, {"videos/walk.mp4": videos[user]}, tmp_path / user / "stimuli.zip")
+        resp = clients[user].post(url, {"archive": _upload(archive)})
+        assert resp.status_code == 302, resp.content.decode()[:2000]
+        return Clip.objects.get(plan=f"import:upload/{user}/stimuli", retired=False)
+
+    clip_of = {user: upload(user) for user in videos}
+    assert clip_of["lab-a"].clip_id != clip_of["lab-b"].clip_id
+    assert not Clip.objects.filter(retired=True).exists()
+
+    make_video(videos["lab-a"], pattern="smptebars")                               # lab A re-exports its video
+    assert upload("lab-a").clip_id != clip_of["lab-a"].clip_id
+    retired = set(Clip.objects.filter(retired=True).values_list("clip_id", flat=True))
+    assert retired == {clip_of["lab-a"].clip_id}                                   # lab B's clip stays
+
+
+@pytest.mark.django_db
+def test_a_file_of_another_collection_is_refused_not_taken_over(media, lab, staff, inline_jobs, tmp_path):
+    """The same file uploaded after the command imported it stays the command's clip, labels and collection."""
+    from django.urls import reverse
+
+    from studyapp.models import Clip
+
+    run(write_manifest(lab, GOOD[:1]))
+    clip = Clip.objects.get()
+    catalogue = (media / "clips.csv").read_bytes()
+    archive = _zip_of(write_manifest(tmp_path, [{**GOOD[0], "citation": "another lab"}]),
+                      {"videos/walk.mp4": lab / "videos/walk.mp4"}, tmp_path / "mine.zip")
+    resp = staff.post(reverse("admin:studyapp_clip_import"), {"archive": _upload(archive)})
+    page = staff.get(resp["Location"]).content.decode()
+    assert "0 of 1 row(s) imported" in page
+    assert f"already clip {clip.clip_id} of the collection &#x27;import:lab/manifest&#x27;" in page
+    clip.refresh_from_db()
+    assert clip.plan == "import:lab/manifest" and clip.citation == "Our lab 2026" and not clip.retired
+    assert (media / "clips.csv").read_bytes() == catalogue
 
 
 @pytest.mark.django_db

@@ -166,6 +166,38 @@ def test_body_size_limit(stack):
     assert r.status_code == 413
 
 
+def _location_body_sizes() -> dict[str, str]:
+    """{location (with its '= ' when exact): client_max_body_size in it} of the site file's locations."""
+    import re
+
+    text = (ROOT / "deploy/nginx/study.conf").read_text()
+    return {m["where"]: size["value"]
+            for m in re.finditer(r"location\s+(?P<where>(?:=\s+)?\S+)\s*\{(?P<body>[^}]*)\}", text)
+            if (size := re.search(r"client_max_body_size\s+(?P<value>\S+);", m["body"]))}
+
+
+def test_the_clip_import_url_alone_takes_uploads_of_the_import_limit():
+    """The admin's clip import URL (exactly, not its status pages) allows the import's file limit."""
+    from django.urls import reverse
+
+    from generation.imports.video import VideoLimits
+
+    sizes = _location_body_sizes()
+    assert sizes == {f"= {reverse('admin:studyapp_clip_import')}": f"{VideoLimits.max_bytes // 2**20}m"}
+
+
+def test_an_upload_passes_on_the_import_url_only(stack):
+    import requests
+    from django.urls import reverse
+
+    body = b"x" * (3 * 1024 * 1024)
+    upload = requests.post(f"{stack['https']}{reverse('admin:studyapp_clip_import')}", data=body, verify=False,
+                           allow_redirects=False, timeout=20)
+    assert upload.status_code != 413 and upload.headers["Server"] == "nginx"      # the app's answer (CSRF)
+    status_page = reverse("admin:studyapp_clip_import_status", args=["20260101-000000-abcd1234"])
+    assert requests.post(f"{stack['https']}{status_page}", data=body, verify=False, timeout=20).status_code == 413
+
+
 def test_login_requests_are_rate_limited(stack):
     """The admin login allows a burst of 5 beyond the 10/minute rate per address; nginx answers 429 after that,
     while the participant pages stay open."""

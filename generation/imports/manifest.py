@@ -15,14 +15,17 @@ misspelt label is not silently dropped):
     keep_audio  yes | no (blank: the command's --keep-audio); videos only
     body        mannequin | stick | points (blank: mannequin); BVH only: how the figure is drawn
 
-A path that could leave the manifest's folder (absolute, ``..``, a symlink pointing out of it) is refused. Every
-problem of a row is a :class:`ManifestError` naming the manifest, the row (1 = the first line after the header)
-and the field.
+The columns are separated by commas, or by semicolons or tabs (as spreadsheets in decimal-comma locales write
+CSV; labels may then use decimal commas). Column names are lower case. A path that could leave the manifest's
+folder (absolute, ``..``, a symlink pointing out of it) is refused. Every problem of a row is a
+:class:`ManifestError` naming the manifest, the row (1 = the first line after the header) and the field.
 """
 from __future__ import annotations
 
 import csv
+import difflib
 import math
+import re
 from dataclasses import dataclass, field
 from pathlib import Path, PurePosixPath
 
@@ -208,31 +211,77 @@ def check_row(raw: dict, row: int, folder: Path, manifest: str | Path) -> Manife
                        body=body or "mannequin")
 
 
+DELIMITERS = (",", ";", "\t")
+"""Column separators a manifest may use: a comma, or a semicolon or tab as spreadsheets write CSV in locales whose
+decimal mark is a comma."""
+DECIMAL_COMMA = re.compile(r"^[+-]?\d*,\d+$")
+
+
+def sniff_delimiter(header_line: str) -> str:
+    """The separator of a manifest: the one of :data:`DELIMITERS` that splits its header line into the most
+    manifest column names (in any case; the comma when none does better). A header names the columns it has, so
+    this never depends on the cells, which may hold commas (citations) or decimal commas."""
+    known = {c.lower() for c in MANIFEST_COLUMNS}
+
+    def names(delimiter: str) -> int:
+        return sum(h.strip().strip('"').lower() in known for h in header_line.split(delimiter))
+
+    return max(DELIMITERS, key=names)           # the first of equals: the comma
+
+
+def expected_column(name: str) -> str:
+    """A hint for a header name that is not a manifest column: the column it differs from only in case, else a
+    close spelling; "" when none is near."""
+    same = [c for c in MANIFEST_COLUMNS if c.lower() == name.lower()]
+    if same:
+        return f"; column names are lower case: write {same[0]!r}"
+    close = difflib.get_close_matches(name.lower(), MANIFEST_COLUMNS, n=1, cutoff=0.8)
+    return f"; did you mean {close[0]!r}?" if close else ""
+
+
+def _cells(raw: dict, delimiter: str) -> dict:
+    """One line's cells, stripped; with a semicolon or tab separator a label's decimal comma (0,8) reads as 0.8."""
+    cells = {k: (v or "").strip() for k, v in raw.items() if k is not None and isinstance(v, str)}
+    if delimiter != ",":
+        cells.update({k: v.replace(",", ".") for k, v in cells.items()
+                      if k in LABEL_COLUMNS and DECIMAL_COMMA.match(v)})
+    return cells
+
+
 def read_manifest(path: str | Path) -> list[ManifestRow | BadRow]:
     """Every row of the manifest at ``path``, checked: a ManifestRow or a BadRow with its error.
 
-    Raises ManifestError (row None) for a manifest that cannot be read at all: missing, not UTF-8, no header,
-    without the ``path`` or ``modality`` column, or with a column that is not a manifest column."""
+    The separator is a comma, a semicolon or a tab (:func:`sniff_delimiter`). Raises ManifestError (row None) for a
+    manifest that cannot be read at all: missing, not UTF-8, no header, without the ``path`` or ``modality``
+    column, or with a column that is not a manifest column (names are lower case; the error names the column
+    meant when it differs only in case or spelling)."""
     path = Path(path)
     try:
         text = path.read_text(encoding="utf-8-sig")
-    except (OSError, UnicodeDecodeError) as exc:
+    except UnicodeDecodeError as exc:
+        raise ManifestError(path, None, None, f"cannot read ({exc}): save it as UTF-8 text (a spreadsheet's "
+                                              "\"CSV UTF-8\")") from None
+    except OSError as exc:
         raise ManifestError(path, None, None, f"cannot read ({exc})") from None
-    reader = csv.DictReader(text.splitlines())
+    lines = text.splitlines()
+    delimiter = sniff_delimiter(lines[0]) if lines else ","
+    reader = csv.DictReader(lines, delimiter=delimiter)
     header = [h.strip() for h in (reader.fieldnames or [])]
     if not header:
         raise ManifestError(path, None, None, "empty: expected a header line with at least path and modality")
     for needed in ("path", "modality"):
         if needed not in header:
-            raise ManifestError(path, None, needed, f"missing column (the header has {', '.join(header)})")
+            differs = [h for h in header if h.lower() == needed]
+            hint = f"; column names are lower case: write {needed!r} for {differs[0]!r}" if differs else ""
+            raise ManifestError(path, None, needed, f"missing column (the header has {', '.join(header)}){hint}")
     unknown = [h for h in header if h not in MANIFEST_COLUMNS]
     if unknown:
         raise ManifestError(path, None, unknown[0], f"not a manifest column (expected some of "
-                                                    f"{', '.join(MANIFEST_COLUMNS)})")
+                                                    f"{', '.join(MANIFEST_COLUMNS)}){expected_column(unknown[0])}")
     reader.fieldnames = header
     out: list[ManifestRow | BadRow] = []
     for row, raw in enumerate(reader, start=1):
-        cells = {k: (v or "").strip() for k, v in raw.items() if k is not None and isinstance(v, str)}
+        cells = _cells(raw, delimiter)
         if not any(cells.values()):
             continue
         try:

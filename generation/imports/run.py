@@ -50,6 +50,10 @@ STAGING_DIR = ".import-staging"
 CatalogueStep = Callable[[dict, list], contextlib.AbstractContextManager]
 
 
+class RowRefused(Exception):
+    """A catalogue step's refusal of a row (e.g. its clip belongs to another collection); the message says why."""
+
+
 @dataclass(frozen=True)
 class ImportSettings:
     """How rows are imported.
@@ -57,8 +61,8 @@ class ImportSettings:
     limits: the longest (s) and largest (bytes) file accepted; keep_audio: the default of the manifest's
     ``keep_audio`` column; webm: also deliver VP9 WebM; render: the renderer's settings for motion files (the body
     comes from the manifest's ``body``); observer: read motion clips with the modality's observer; threads: ffmpeg
-    threads per encode (0: ffmpeg decides); plan: the catalogue ``plan`` name of this manifest's clips (a changed
-    file retires the older clip of the same plan and path)."""
+    threads per encode (0: ffmpeg decides); plan: the catalogue ``plan`` of this manifest's clips, their collection
+    (a changed file retires the older clip of the same plan and path, never one of another plan)."""
 
     limits: VideoLimits = field(default_factory=VideoLimits)
     keep_audio: bool = False
@@ -242,7 +246,14 @@ def _summary(rec: dict) -> str:
     return text + (f", quality flag {rec['qa_flag']}" if rec.get("qa_flag") else "")
 
 
-ROW_ERRORS = (ManifestError, VideoImportError, MotionImportError, OSError)
+def _render_span(source_s: float, render_s: float) -> str:
+    """What of a take of ``source_s`` seconds a render of at most ``render_s`` seconds shows."""
+    if source_s > render_s + 0.05:
+        return f"the first {render_s:.2f} s of {source_s:.2f} s of motion (cut to the render length, {render_s:g} s)"
+    return f"{source_s:.2f} s of motion"
+
+
+ROW_ERRORS = (ManifestError, VideoImportError, MotionImportError, RowRefused, OSError)
 
 
 def import_row(row: ManifestRow, media_root: Path, settings: ImportSettings, catalogue: CatalogueStep | None,
@@ -264,7 +275,8 @@ def import_row(row: ManifestRow, media_root: Path, settings: ImportSettings, cat
                              f"{probe.width}x{probe.height}, {probe.duration_s:.2f} s (dry run: nothing written)")
             else:
                 motion, _ = load_motion(row.file, row.modality, settings.limits.max_duration_s)
-                notes.append(f"would render {motion.duration:.2f} s of motion (dry run: nothing written)")
+                notes.append(f"would render {_render_span(motion.duration, settings.render.duration_s)} "
+                             "(dry run: nothing written)")
         elif stored is not None:
             _with_media(rec, stored)
             commit_row(rec, {}, media_root, catalogue, notes)

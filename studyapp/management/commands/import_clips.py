@@ -19,11 +19,12 @@ from django.core.management.base import BaseCommand, CommandError
 from django.db import transaction
 
 from generation.imports import ImportSettings, ManifestError, import_manifest, write_report
-from generation.imports.run import REPORT_NAME
+from generation.imports.run import REPORT_NAME, RowRefused
 from generation.imports.video import VideoLimits
 from generation.render.offscreen import prepare_render_process
 from generation.render.settings import RenderSettings, RenderSettingsError
 from studyapp.catalogue import retire_replaced, upsert_clips
+from studyapp.models import Clip
 
 from .generate_clips import _require_migrated_database
 
@@ -31,16 +32,31 @@ PLAN_PREFIX = "import:"
 
 
 def plan_name(manifest: Path, name: str | None = None) -> str:
-    """The catalogue ``plan`` of a manifest's clips: ``import:<name>``, by default ``import:<folder>/<stem>``."""
+    """The collection of a manifest's clips, their catalogue ``plan``: ``import:<name>``, by default
+    ``import:<folder>/<stem>`` (the admin passes ``upload/<user>/<collection>``)."""
     name = name or f"{manifest.resolve().parent.name}/{manifest.stem}"
-    return (PLAN_PREFIX + name)[:100]
+    plan = PLAN_PREFIX + name
+    if len(plan) > Clip._meta.get_field("plan").max_length:      # cut short, two collections could merge
+        raise CommandError(f"the collection {plan!r} is too long; give a shorter --name")
+    return plan
+
+
+def refuse_other_collections(record: dict) -> None:
+    """RowRefused when the row's clip (the same file with the same settings) belongs to another collection: a
+    clip has one collection, whose manifest alone relabels or retires it."""
+    owner = Clip.objects.filter(clip_id=record["clip_id"]).values_list("plan", flat=True).first()
+    if owner is not None and owner != record["plan"]:
+        raise RowRefused(f"the same file is already clip {record['clip_id']} of the collection {owner!r}; a clip "
+                         "belongs to one collection (select that clip in a pool by its id, or import the file "
+                         "from that collection)")
 
 
 @contextlib.contextmanager
 def catalogue_step(record: dict, notes: list):
     """The Clip row of one imported clip, in one transaction with its files (generation.imports.run.commit_row);
-    the older clip of the same manifest path is retired when the file changed."""
+    the older clip of the same collection and manifest path is retired when the file changed."""
     with transaction.atomic():
+        refuse_other_collections(record)
         upsert_clips([record])
         retired = retire_replaced(record["plan"], record["metadata"]["entry_id"], record["clip_id"])
         if retired:
@@ -74,7 +90,9 @@ class Command(BaseCommand):
         parser.add_argument("--max-size-mb", type=float, default=VideoLimits.max_bytes / 2**20, metavar="MB",
                             help=f"largest file accepted, MiB (default {VideoLimits.max_bytes / 2**20:g})")
         parser.add_argument("--name", default=None,
-                            help="catalogue plan name of these clips (default: import:<folder>/<manifest stem>)")
+                            help="the collection of these clips, their catalogue plan import:<name> (default: "
+                                 "import:<folder>/<manifest stem>); a changed file retires only the older clip of "
+                                 "the same collection and path")
         parser.add_argument("--render-size", default=None, metavar="WxH",
                             help="frame size of rendered motion files (default 1280x720, as generated clips)")
         parser.add_argument("--no-observer", action="store_true",
@@ -109,11 +127,28 @@ class Command(BaseCommand):
         except ManifestError as exc:
             raise CommandError(str(exc)) from None
         report = Path(opts["report"]) if opts["report"] else manifest.parent / REPORT_NAME
-        if not opts["dry_run"] or opts["report"]:
+        written = not opts["dry_run"] or bool(opts["report"])
+        if written:
             write_report(outcomes, report)
         ok = sum(o.status == "ok" for o in outcomes)
-        self.stdout.write(f"{ok} of {len(outcomes)} row(s) imported{' (dry run: nothing written)' * opts['dry_run']}"
-                          f"; plan {config.plan}" + ("" if opts["dry_run"] and not opts["report"]
-                                                     else f"; report {report}"))
+        self.stdout.write(summary_line(ok, len(outcomes), config.plan, report if written else None,
+                                       opts["dry_run"]))
         if ok < len(outcomes):
-            raise CommandError(f"{len(outcomes) - ok} row(s) failed (see the report); the others are imported")
+            raise CommandError(failure_line(len(outcomes) - ok, ok, report if written else None, opts["dry_run"]))
+
+
+def summary_line(ok: int, rows: int, plan: str, report: Path | None, dry_run: bool) -> str:
+    """The command's last line: how many rows were imported (a dry run: checked and would import), the
+    collection, and where the report is (a dry run without --report writes none)."""
+    where = f"report {report}" if report else "no report written (the rows are above; --report PATH writes one)"
+    if dry_run:
+        return f"dry run: {ok} of {rows} row(s) checked and would import, nothing written; collection {plan}; {where}"
+    return f"{ok} of {rows} row(s) imported; collection {plan}; {where}"
+
+
+def failure_line(failed: int, ok: int, report: Path | None, dry_run: bool) -> str:
+    """The command's error when rows failed: how many, where their causes are, what happened to the others."""
+    where = f"see the report {report}" if report else "see the rows above"
+    if dry_run:
+        return f"{failed} row(s) failed the check ({where}); dry run: nothing was imported"
+    return f"{failed} row(s) failed ({where}); " + (f"the other {ok} are imported" if ok else "nothing was imported")
