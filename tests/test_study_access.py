@@ -65,6 +65,7 @@ def staff_pages(study: Study) -> list[tuple[str, str]]:
     pages = [("get", reverse("studyapp:preview_start", args=[sid])),
              ("get", reverse("studyapp:preview_item", args=[sid, 1])),
              ("get", reverse("studyapp:progress", args=[sid])),
+             ("get", reverse("studyapp:norming_monitor", args=[sid])),
              ("get", reverse("studyapp:report_zip", args=[sid])),
              ("post", reverse("studyapp:report_zip", args=[sid]))]
     return pages + [("get", reverse("studyapp:export_csv", args=[sid, kind])) for kind in EXPORT_KINDS]
