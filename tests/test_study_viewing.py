@@ -331,6 +331,23 @@ def test_media_needs_the_participants_session_and_stops_once_answered(client, st
 
 
 @pytest.mark.django_db
+def test_media_admits_the_current_clip_and_the_preloaded_next_one_only(client, study):
+    p = started(client, study)
+    client.get(reverse("studyapp:item", args=[p.token, 1]))
+    order = list(p.assignments.order_by("seq"))
+    near = {a.clip_id for a in order[:2]}                              # the current page's clip and the next
+    later = next(a for a in order[2:] if a.clip_id not in near)       # a page further on
+
+    def status(assignment) -> int:
+        return client.get(reverse("studyapp:media", args=[assignment.clip.media_key, "mp4"])).status_code
+
+    assert (status(order[0]), status(order[1]), status(later)) == (200, 200, 403)
+    for n in range(1, later.seq - 1):                                 # on to the page before it
+        answer(client, p, n, posted(GOOD_RECORD))
+    assert status(later) == 200                                        # now the next one: preloaded
+
+
+@pytest.mark.django_db
 def test_a_participant_link_opened_in_a_new_browser_can_play_its_clip(client, study):
     p = started(client, study)
     step = cur(p)
