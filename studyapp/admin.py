@@ -194,6 +194,13 @@ class StudyAdmin(StudyScopedAdmin):
                   path("pool-count/", views_pool.pool_count, name="studyapp_pool_count")]
         return custom + super().get_urls()
 
+    def get_formset_kwargs(self, request, obj, inline, prefix):
+        """The section forms know who saves (SectionForm's reader: a norms rule may name only their studies)."""
+        kwargs = super().get_formset_kwargs(request, obj, inline, prefix)
+        if isinstance(inline, SectionInline):
+            kwargs["form_kwargs"] = {"reader": request.user}
+        return kwargs
+
     def save_formset(self, request, form, formset, change):
         """Save, then say how many clips each saved section's pool matches (a warning where it is too small)."""
         super().save_formset(request, form, formset, change)

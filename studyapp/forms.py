@@ -15,6 +15,7 @@ from .i18n import display
 from .inputs import refuse_control_characters, refuse_control_characters_in_text
 from .models import Clip, Section, Study
 from .norming import open_errors
+from .norms_rule import NormsSourceError, check_reader, norms_source
 from .pool_editor import PoolEditorFields
 from .presets import preset_choices
 from .questions import section_type_choices
@@ -98,14 +99,20 @@ class SectionForm(forms.ModelForm, PoolEditorFields):
     they cannot show. Every bad pool filter, option or count is an error on the field it comes from
     (study_pools), so a study can never reach a participant with a pool or options the assignment cannot use.
     (A field with an error leaves cleaned_data, so Section.clean, which repeats the check, does not report it
-    twice.)"""
+    twice.)
+
+    ``reader``: the user saving (the admin passes it). A norms rule whose source this save changes may name only a
+    study of theirs (studyapp.norms_rule.check_reader); a source already saved stays as it is, so a collaborator
+    can still save a section a superuser pointed at another study's norms."""
 
     class Meta:
         model = Section
         fields = "__all__"
 
-    def __init__(self, *args, **kwargs):
+    def __init__(self, *args, reader=None, **kwargs):
         super().__init__(*args, **kwargs)
+        self.reader = reader
+        self.saved_norms_source = norms_source(self.instance.pool)
         for name, value in pool_editor.initial_values(self.instance.pool, self.instance.options).items():
             self.initial.setdefault(name, value)
         plans = catalogue_plans()
@@ -116,7 +123,18 @@ class SectionForm(forms.ModelForm, PoolEditorFields):
     def clean(self):
         data = super().clean()
         pool_editor.resolve_section_json(self, data, pool_editor.touched_groups(self.changed_data))
+        self._check_norms_reader(data)
         return data
+
+    def _check_norms_reader(self, data: dict) -> None:
+        """An error on the pool (which then keeps its saved value) when the reader may not read its new source."""
+        source = norms_source(data.get("pool"))
+        if self.reader is None or source is None or source == self.saved_norms_source:
+            return
+        try:
+            check_reader(data["pool"], self.reader)
+        except NormsSourceError as exc:
+            self.add_error("pool", str(exc))
 
 
 def catalogue_plans() -> list[str]:

@@ -6,6 +6,11 @@ exclusion rules, as the report does: analysis.norms) or from a clip_norms.csv fi
 ``settings.DATA_DIR`` unless absolute), read and checked whole by analysis.norms.read_clip_norms before anything is
 used, so a bad file changes nothing.
 
+Who may read what: a file must be a .csv inside DATA_DIR once symbolic links and ``..`` are resolved (``norms_file``,
+whoever reads it), so no other file of the server is opened. Where a user acts (the pool editor's live count, a
+section saved in the admin) a study source must be one of the user's studies (``check_reader``; superusers: any);
+the assignment of a participant, where no user acts, reads the rule as saved.
+
 A clip's norm is its row with an intended label and the most ratings (a clip rated in several sections: the
 norming section's emotion question). A clip passes when it has a norm with at least ``min_ratings`` ratings, an
 intended share of at least ``min_intended_share`` and an entropy of at most ``max_entropy_bits``; each failed
@@ -30,6 +35,7 @@ from study_pools import NORMS_RULE
 
 from .export import stream_csv
 from .models import Clip, Response, Study
+from .permissions import studies_for
 
 
 class NormsSourceError(ValueError):
@@ -56,10 +62,22 @@ def _is_path(source: str) -> bool:
     return source.endswith(".csv") or "/" in source or os.sep in source
 
 
+def norms_file(source: str) -> Path:
+    """The file a ``from`` path names: relative to settings.DATA_DIR unless absolute, and, with symbolic links and
+    ``..`` resolved, a .csv inside DATA_DIR; NormsSourceError before the file is opened otherwise."""
+    root = Path(getattr(settings, "DATA_DIR", ".")).resolve()
+    path = (root / source).resolve()           # an absolute source replaces root
+    if path.suffix.lower() != ".csv":
+        raise NormsSourceError(f"pool.norms.from: {source!r} is not a .csv file (give a study's slug or the path of "
+                               "a clip_norms.csv under the data folder, DATA_DIR)")
+    if not path.is_relative_to(root):
+        raise NormsSourceError(f"pool.norms.from: {source!r} is outside the data folder: a clip_norms.csv must lie "
+                               "under DATA_DIR (give it relative to that folder, e.g. norms/clip_norms.csv)")
+    return path
+
+
 def _from_file(source: str) -> tuple[tuple, callable]:
-    path = Path(source)
-    if not path.is_absolute():
-        path = Path(getattr(settings, "DATA_DIR", ".")) / path
+    path = norms_file(source)
     try:
         stat = path.stat()
     except OSError as exc:
@@ -96,6 +114,24 @@ def _from_study(slug: str) -> tuple[tuple, callable]:
                                    "question of its clips)")
         return norms
     return ("study", study.pk, last, answers.count()), load
+
+
+def norms_source(pool) -> str | None:
+    """The ``from`` of a pool's norms rule (stripped), None when the pool has no norms rule."""
+    rule = pool.get(NORMS_RULE) if isinstance(pool, dict) else None
+    return str(rule.get("from") or "").strip() if isinstance(rule, dict) else None
+
+
+def check_reader(pool, reader) -> None:
+    """Raise NormsSourceError unless ``reader`` (the user acting) may read the study the pool's norms rule names:
+    one of studies_for(reader). The message is the same for another lab's study and for none, so a slug is not
+    confirmed. A file source is left to norms_file, which holds for everyone."""
+    source = norms_source(pool)
+    if not source or _is_path(source):
+        return
+    if not studies_for(reader).filter(slug=source).exists():
+        raise NormsSourceError(f"pool.norms.from: no study {source!r} among the studies you may see (give the slug "
+                               "of a study you own or collaborate on, or a clip_norms.csv path)")
 
 
 def load_norms(source: str) -> dict[str, dict]:

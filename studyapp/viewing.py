@@ -9,8 +9,9 @@ knows a record is due with every answer; nothing here rejects an answer, but the
 
 - ``missing``: the POST has none of the page's record fields (it did not come from the page);
 - ``no_script``: the fields came back blank without ``view_script`` (the browser ran no JavaScript);
-- ``implausible``: a field is not an integer within its bound, an end comes before the first play, or there are
-  more plays than the time the page was shown fits (``max_plays``): kept as sent, but not to be trusted;
+- ``implausible``: a field is not an integer within its bound, an end comes before the first play, a start-up time
+  (first play request to first frame) is longer than the time to the first frame or comes without one, or there
+  are more plays than the time the page was shown fits (``max_plays``): kept as sent, but not to be trusted;
 - ``ok`` otherwise.
 
 While the page is open the script also reports each play start and the clip's first end (``record_playback`` via
@@ -120,9 +121,11 @@ def parse_viewing(post, page_ms: int, duration_s: float | None = None, playback:
             implausible = True
             value = _integer(raw, 2**31 - 1)       # kept for the researcher to see, when it is a number at all
         record[name] = value
-    first, ended = record["first_play_ms"], record["ended_ms"]
+    first, ended, startup = record["first_play_ms"], record["ended_ms"], record["startup_ms"]
     if first is not None and ended is not None and ended < first:
         implausible = True                        # a clip ends after it starts
+    if startup is not None and (first is None or startup > first):
+        implausible = True                        # start-up ends with the first frame, timed from the page's display
     for name, value in (playback.get("carried") or {}).items():
         if name in CARRIED_FIELDS and isinstance(value, int) and value > 0:
             record[name] = (record[name] or 0) + value

@@ -521,15 +521,23 @@ def done(request, token: str):
                                                   "completion_url": study.completion_url()})
 
 
+MEDIA_PAGES = 2
+"""How many of a participant's unanswered clip pages may fetch their clip: the current page and the next one,
+whose clip the player preloads once the current one can play (static/studyapp/study.js, preloadNext)."""
+
+
 def media_allowed(request, clip: Clip) -> bool:
-    """Whether this request may fetch ``clip``: a participant of this browser session (views.SESSION_KEY) has an
-    unanswered page showing it (the current clip or the next one being preloaded), or a staff member who may see
-    the catalogue (admin and preview). The URL alone is never enough, and a clip's URL stops working for a
-    participant once it is answered."""
+    """Whether this request may fetch ``clip``: a participant of this browser session (views.SESSION_KEY) is on
+    the page showing it or on the page before, whose player preloads it (MEDIA_PAGES: the first two unanswered
+    pages by seq), or a staff member who may see the catalogue (admin and preview). The URL alone is never
+    enough; a clip further on in the study is not served until its page comes near, and a clip's URL stops
+    working for a participant once it is answered. One query per participant of the session."""
     tokens = [t for t in request.session.get(SESSION_KEY, {}).values() if isinstance(t, str)]
-    if tokens and Assignment.objects.filter(participant__token__in=tokens, clip=clip,
-                                            answered_at__isnull=True).exists():
-        return True
+    for token in tokens:
+        near = (Assignment.objects.filter(participant__token=token, answered_at__isnull=True)
+                .order_by("seq").values_list("clip_id", flat=True)[:MEDIA_PAGES])
+        if clip.pk in list(near):
+            return True
     return has_staff_permission(request.user, "studyapp.view_clip")
 
 

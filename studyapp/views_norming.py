@@ -1,17 +1,17 @@
 """The staff monitor of a norming study: per norming section, its design (C, M, K, N) and the ratings each clip has
-so far, the clips still below K first (studyapp.norming)."""
+so far, the clips still below K first (studyapp.norming). Scoped per study like every staff page: another lab's
+study is a 404 (studyapp.permissions.study_of)."""
 from __future__ import annotations
 
-from django.shortcuts import get_object_or_404, render
+from django.shortcuts import render
 
-from .models import Study
 from .norming import design_rows, ratings_so_far
-from .permissions import staff_permission_required
+from .permissions import staff_permission_required, study_of
 
 
 @staff_permission_required("studyapp.view_study")
 def norming_monitor(request, study_id: int):
-    study = get_object_or_404(Study, pk=study_id)
+    study = study_of(request, study_id)
     sections = []
     for row in design_rows(study):
         clips = ratings_so_far(row.section)

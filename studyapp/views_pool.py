@@ -10,7 +10,8 @@ the fields of one section form (names without the formset prefix) and answers JS
      "norms_html": "<details class=\"norms-table\">..."}
 
 ``norms_html`` is the norms table of a pool with a ``norms`` rule (studyapp.admin_norms; escaped HTML, "" without
-a rule).
+a rule). A norms rule may read only a study the user may see (studyapp.norms_rule.check_reader): another lab's
+study, like one that does not exist, is an error on the pool with no count and no table.
 
 Staff with the permission studyapp.view_clip only (403 JSON otherwise); bad input is an error in the answer
 (status 200), never a 500.
@@ -29,6 +30,7 @@ from study_protocol import ORIGINS
 from .admin_norms import norms_table
 from .catalogue import CatalogueError, pool_queryset, section_queryset
 from .forms import SectionPreviewForm
+from .norms_rule import NormsSourceError, check_reader
 from .permissions import has_staff_permission
 from .pool_editor import SUB_POOL_SECTION_TYPE
 
@@ -71,11 +73,17 @@ class PoolCount:
         return out
 
 
-def count_pool(section_type: str | None, pool) -> PoolCount:
-    """Count the clips of a pool (studyapp.catalogue.pool_queryset); problems come back as errors, never raised."""
+def count_pool(section_type: str | None, pool, reader=None) -> PoolCount:
+    """Count the clips of a pool (studyapp.catalogue.pool_queryset); problems come back as errors, never raised.
+    ``reader``: the user asking, whose studies alone a norms rule may read (None: the site, for a saved pool)."""
     errors = pool_errors(pool, section_type)
     if errors:
         return PoolCount(None, errors=errors)
+    if reader is not None:
+        try:
+            check_reader(pool, reader)
+        except NormsSourceError as exc:
+            return PoolCount(None, errors=[str(exc)])
     try:
         base = section_queryset(section_type, pool or {})
         total = base.count()
@@ -100,8 +108,9 @@ def _field_errors(form) -> list[dict]:
     return out
 
 
-def preview(form: SectionPreviewForm, reuse_section: str = "") -> dict:
-    """The answer for one bound preview form: count, summary, warnings, errors, and the JSON a save would store."""
+def preview(form: SectionPreviewForm, reuse_section: str = "", reader=None) -> dict:
+    """The answer for one bound preview form: count, summary, warnings, errors, and the JSON a save would store.
+    ``reader``: the user asking (count_pool)."""
     form.is_valid()
     data = form.cleaned_data
     answer = {"count": None, "by_origin": {}, "summary": "", "warnings": [], "errors": _field_errors(form),
@@ -112,7 +121,7 @@ def preview(form: SectionPreviewForm, reuse_section: str = "") -> dict:
     if "pool" not in data or "section_type" not in data:
         answer["summary"] = "fix the errors to see how many clips match"
         return answer
-    counted = count_pool(data["section_type"], data["pool"])
+    counted = count_pool(data["section_type"], data["pool"], reader)
     if counted.total is None:
         answer["errors"].append({"field": "pool", "label": "pool", "messages": counted.errors})
     answer.update(count=counted.total, by_origin=counted.by_origin, summary=counted.summary(),
@@ -133,7 +142,7 @@ def pool_count(request):
         return JsonResponse({"error": "this count needs the permission studyapp.view_clip"}, status=403)
     if request.method != "GET":
         return JsonResponse({"error": "use GET"}, status=405)
-    answer = preview(SectionPreviewForm(request.GET), request.GET.get("reuse_section", ""))
+    answer = preview(SectionPreviewForm(request.GET), request.GET.get("reuse_section", ""), reader=user)
     try:
         return JsonResponse(answer, json_dumps_params={"allow_nan": False})
     except ValueError:                 # a NaN/Infinity in the echoed JSON: answer without the echo

@@ -61,8 +61,31 @@ def _pool_timeout() -> Exception:
         return wrapped
 
 
-@pytest.mark.parametrize("error", [_pool_timeout, lambda: OperationalError("FATAL: sorry, too many clients already"),
-                                   lambda: OperationalError("database is locked")])
+NO_CONNECTION = [_pool_timeout, lambda: OperationalError("FATAL: sorry, too many clients already"),
+                 lambda: OperationalError("database is locked"),
+                 lambda: OperationalError('connection failed: connection to server at "127.0.0.1", port 5432 '
+                                          "failed: Connection refused"),
+                 lambda: OperationalError('connection is bad: connection to server on socket "/run/postgresql/'
+                                          '.s.PGSQL.5432" failed: No such file or directory\n\tIs the server '
+                                          "running locally and accepting connections on that socket?"),
+                 lambda: OperationalError("connection failed: FATAL:  the database system is starting up"),
+                 lambda: OperationalError("could not connect to server: No such file or directory"),
+                 lambda: OperationalError("FATAL: remaining connection slots are reserved for roles with the "
+                                          "SUPERUSER attribute")]
+"""Errors that mean no database connection could be had: the pool's wait ran out, PostgreSQL refused or was not
+there, SQLite stayed locked."""
+OTHER_DATABASE_FAULTS = [lambda: OperationalError("no such table: studyapp_participant"),
+                         lambda: OperationalError("no such column: studyapp_participant.seed"),
+                         lambda: OperationalError('connection failed: connection to server at "127.0.0.1", port '
+                                                  '5432 failed: FATAL:  password authentication failed for user '
+                                                  '"studies"'),
+                         lambda: OperationalError('connection failed: connection to server at "127.0.0.1", port '
+                                                  '5432 failed: FATAL:  database "studies" does not exist'),
+                         lambda: OperationalError("disk I/O error")]
+"""OperationalErrors that are faults of the deployment or a bug, not a busy server: a plain 500."""
+
+
+@pytest.mark.parametrize("error", NO_CONNECTION)
 def test_no_connection_is_a_503_with_retry_after(monkeypatch, settings, error):
     from studyapp import views
 
@@ -86,7 +109,7 @@ def test_a_failure_in_middleware_is_a_503_too(monkeypatch, settings):
     settings.DEBUG = False
 
     def refuse(self, *args, **kwargs):
-        raise OperationalError("connection pool timeout")
+        raise _pool_timeout()
 
     monkeypatch.setattr(SessionStore, "load", refuse)
     client = Client(raise_request_exception=False)
@@ -95,16 +118,30 @@ def test_a_failure_in_middleware_is_a_503_too(monkeypatch, settings):
     assert r.status_code == 503 and r["Retry-After"] == str(RETRY_AFTER_S)
 
 
-def test_other_errors_stay_a_plain_500(monkeypatch, settings):
+@pytest.mark.parametrize("error", [lambda: ZeroDivisionError("division by zero"), *OTHER_DATABASE_FAULTS])
+def test_other_errors_stay_a_plain_500(monkeypatch, settings, error):
     from studyapp import views
 
     settings.DEBUG = False
-    monkeypatch.setattr(views, "participant_by_token", lambda token: 1 / 0)
+
+    def fail(*args, **kwargs):
+        raise error()
+
+    monkeypatch.setattr(views, "participant_by_token", fail)
     r = Client(raise_request_exception=False).get(reverse("studyapp:resume", args=["x" * 20]))
     assert r.status_code == 500 and "Retry-After" not in r and b"Traceback" not in r.content
 
 
 def test_the_cause_chain_is_read():
     assert database_unavailable(_pool_timeout())
+    from psycopg_pool import PoolTimeout
+
+    try:
+        try:
+            raise PoolTimeout("pool exhausted")                # the pool's own type, whatever its words
+        except PoolTimeout as exc:
+            raise OperationalError("wrapped") from exc
+    except OperationalError as wrapped:
+        assert database_unavailable(wrapped)
     assert not database_unavailable(ValueError("x"))
     assert not database_unavailable(None)

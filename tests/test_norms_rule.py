@@ -117,6 +117,27 @@ def test_bad_norms_file_is_refused_whole(tmp_path, edit, message):
     assert set(pool_queryset(section.pool).values_list("clip_id", flat=True)) == {"gait_gen_00", "gait_gen_01"}
 
 
+def test_a_norms_file_must_lie_in_the_data_folder(settings, tmp_path):
+    data = tmp_path / "data"
+    (data / "norms").mkdir(parents=True)
+    settings.DATA_DIR = data
+    rows = [norm_row("gait_gen_00", "happy", 0.8, 20)]
+    outside = write_norms(tmp_path, rows, "outside.csv")
+    write_norms(data / "norms", rows, "clip_norms.csv")
+    write_norms(data / "norms", rows, "clip_norms.txt")
+    (data / "link.csv").symlink_to(outside)
+    ok = {**WALKS, "norms": {"from": "norms/clip_norms.csv", "min_ratings": 10}}
+    assert set(pool_queryset(ok).values_list("clip_id", flat=True)) == {"gait_gen_00"}
+    assert norms_rule.load_norms(str(data / "norms" / "clip_norms.csv"))       # absolute, but inside: fine
+    for source, words in ((outside, "outside the data folder"), ("../outside.csv", "outside the data folder"),
+                          ("link.csv", "outside the data folder"), ("/etc/passwd", "not a .csv file"),
+                          ("norms/clip_norms.txt", "not a .csv file")):
+        with pytest.raises(norms_rule.NormsSourceError) as err:
+            norms_rule.load_norms(source)
+        assert str(err.value).startswith(f"pool.norms.from: {source!r}") and words in str(err.value), source
+        assert str(tmp_path) not in str(err.value).replace(source, "")           # the server's folders stay unnamed
+
+
 def test_norms_from_a_study_of_the_site():
     pilot = create_study_from_preset("norming", "pilot", plan="test")
     section = Section(study=pilot, section_type="emotion_choice", pool={**WALKS,

@@ -3,13 +3,15 @@ analyses only the studies they own or collaborate on; another lab's study is a 4
 or refused in the admin; superusers see every study."""
 from __future__ import annotations
 
+import json
+
 import pytest
 from django.contrib.auth.models import Group, User
 from django.test import Client
 from django.urls import reverse
 
 from studyapp.export import EXPORT_KINDS
-from studyapp.models import Clip, Participant, Response, Study
+from studyapp.models import Clip, Participant, Response, Section, Study
 from studyapp.permissions import RESEARCHER_GROUP, can_access_study, studies_for
 from studyapp.presets import create_study_from_preset
 from studyapp.testing import admin_form_data, make_catalogue
@@ -65,6 +67,7 @@ def staff_pages(study: Study) -> list[tuple[str, str]]:
     pages = [("get", reverse("studyapp:preview_start", args=[sid])),
              ("get", reverse("studyapp:preview_item", args=[sid, 1])),
              ("get", reverse("studyapp:progress", args=[sid])),
+             ("get", reverse("studyapp:norming_monitor", args=[sid])),
              ("get", reverse("studyapp:report_zip", args=[sid])),
              ("post", reverse("studyapp:report_zip", args=[sid]))]
     return pages + [("get", reverse("studyapp:export_csv", args=[sid, kind])) for kind in EXPORT_KINDS]
@@ -168,3 +171,46 @@ def test_section_reuse_choices_name_no_other_labs_section(labs):
     formset = page.context["inline_admin_formsets"][0].formset
     offered = set(formset.forms[0].fields["reuse_section"].queryset.values_list("study__slug", flat=True))
     assert offered == {"ours"}
+
+
+def live_norms(c: Client, source: str) -> dict:
+    """The pool editor's live count of a pool whose norms rule reads ``source``."""
+    pool = {"modality": "gait", "norms": {"from": source, "min_ratings": 1}}
+    return c.get(reverse("admin:studyapp_pool_count"), {"section_type": "emotion_choice", "pool": json.dumps(pool),
+                                                         "clips_per_participant": "4"}).json()
+
+
+def pool_messages(answer: dict) -> str:
+    return " ".join(m for e in answer["errors"] for m in e["messages"])
+
+
+def test_pool_editor_reads_the_norms_of_ones_own_studies_only(labs):
+    mallory = client_of(labs["mallory"])
+    refused = {}
+    for source in ("ours", "no-such-study"):
+        answer = live_norms(mallory, source)
+        assert answer["count"] is None and not answer.get("norms_html"), answer    # no other lab's ratings
+        refused[source] = pool_messages(answer).replace(source, "<slug>")
+    assert refused["ours"] == refused["no-such-study"]                              # a slug is not confirmed
+    assert "pool.norms.from" in refused["ours"]
+    for who, source in (("alice", "ours"), ("bob", "ours"), ("root", "theirs")):
+        assert pool_messages(live_norms(client_of(labs[who]), source)).replace(source, "<slug>") != refused["ours"]
+
+
+def test_a_section_may_name_only_a_readable_study_as_its_norms(labs):
+    theirs = labs["theirs"]
+    section = theirs.sections.get(order=1)
+    before = section.pool
+    url = reverse("admin:studyapp_study_change", args=[theirs.pk])
+    mallory = client_of(labs["mallory"])
+    data = admin_form_data(mallory.get(url))
+    data["sections-0-pool"] = json.dumps({**before, "norms": {"from": "ours", "min_ratings": 1}})
+    page = mallory.post(url, data)
+    assert page.status_code == 200, "another lab's study accepted as a norms source"
+    errors = page.context["inline_admin_formsets"][0].formset.errors[0]
+    assert "pool.norms.from" in " ".join(errors["pool"]), errors
+    section.refresh_from_db()
+    assert section.pool == before
+    # a source a superuser saved stays: the lab can still save its study without naming it anew
+    Section.objects.filter(pk=section.pk).update(pool={**before, "norms": {"from": "ours", "min_ratings": 1}})
+    assert mallory.post(url, admin_form_data(mallory.get(url))).status_code == 302

@@ -92,6 +92,15 @@ def test_a_post_without_record_is_missing_and_a_page_without_script_says_so():
     assert parse_viewing({SCRIPT_FIELD: "1"}, page_ms=10_000)["record"] == "ok"
 
 
+def test_start_up_must_end_by_the_first_frame():
+    """startup_ms runs from the first play request to the first frame, both in ms from the page's display: it
+    cannot be longer than first_play_ms, nor come without it."""
+    assert parse_viewing(posted({**GOOD_RECORD, "startup_ms": 120}), page_ms=10_000)["record"] == "ok"
+    assert parse_viewing(posted({**GOOD_RECORD, "startup_ms": 121}), page_ms=10_000)["record"] == "implausible"
+    no_frame = {**GOOD_RECORD, "first_play_ms": "", "ended_ms": "", "startup_ms": 50}
+    assert parse_viewing(posted(no_frame), page_ms=10_000)["record"] == "implausible"
+
+
 @pytest.mark.parametrize("name,raw", [
     ("first_play_ms", "-1"), ("first_play_ms", "nan"), ("first_play_ms", "inf"), ("first_play_ms", "1e400"),
     ("first_play_ms", "abc"), ("first_play_ms", "12.5"), ("ended_ms", "15001"), ("stall_ms", "99999999"),
@@ -190,6 +199,22 @@ def test_times_beyond_the_page_time_are_not_stored(client, study):
     a = answer(client, p, 1, posted({**GOOD_RECORD, "ended_ms": 3_000_000, "stall_ms": 2_000_000}))
     a.refresh_from_db()
     assert a.viewing["record"] == "implausible" and a.viewing["plays"] == 2
+
+
+@pytest.mark.django_db
+def test_start_up_buffering_is_stored_as_start_up_time_not_as_stalls(client, study):
+    """The player's record of a clip that buffered 800 ms before its first frame and never after: viewing.csv has
+    startup_ms 800 and no stall, and a stall after the first frame is counted as one."""
+    p = started(client, study)
+    client.get(reverse("studyapp:item", args=[p.token, 1]))
+    answer(client, p, 1, posted({**GOOD_RECORD, "first_play_ms": 900, "ended_ms": 3900, "startup_ms": 800,
+                                 "stalls": 0, "stall_ms": 0}))
+    client.get(reverse("studyapp:item", args=[p.token, 2]))
+    answer(client, p, 2, posted({**GOOD_RECORD, "first_play_ms": 300, "ended_ms": 3500, "startup_ms": 250,
+                                 "stalls": 1, "stall_ms": 400}))
+    rows = list(csv.DictReader(io.StringIO("".join(stream_csv(study, "viewing")))))
+    got = [(r["startup_ms"], r["stalls"], r["stall_ms"], r["record"]) for r in rows]
+    assert got == [("800", "0", "0", "ok"), ("250", "1", "400", "ok")], got
 
 
 @pytest.mark.django_db
@@ -328,6 +353,23 @@ def test_media_needs_the_participants_session_and_stops_once_answered(client, st
     p.assignments.exclude(pk=step.assignment.pk).filter(clip=step.assignment.clip).delete()   # shown once only
     answer(client, p, 1, posted(GOOD_RECORD))
     assert client.get(clip_url).status_code == 403                    # answered: no more viewing
+
+
+@pytest.mark.django_db
+def test_media_admits_the_current_clip_and_the_preloaded_next_one_only(client, study):
+    p = started(client, study)
+    client.get(reverse("studyapp:item", args=[p.token, 1]))
+    order = list(p.assignments.order_by("seq"))
+    near = {a.clip_id for a in order[:2]}                              # the current page's clip and the next
+    later = next(a for a in order[2:] if a.clip_id not in near)       # a page further on
+
+    def status(assignment) -> int:
+        return client.get(reverse("studyapp:media", args=[assignment.clip.media_key, "mp4"])).status_code
+
+    assert (status(order[0]), status(order[1]), status(later)) == (200, 200, 403)
+    for n in range(1, later.seq - 1):                                 # on to the page before it
+        answer(client, p, n, posted(GOOD_RECORD))
+    assert status(later) == 200                                        # now the next one: preloaded
 
 
 @pytest.mark.django_db
