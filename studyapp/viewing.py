@@ -10,8 +10,9 @@ knows a record is due with every answer; nothing here rejects an answer, but the
 - ``missing``: the POST has none of the page's record fields (it did not come from the page);
 - ``no_script``: the fields came back blank without ``view_script`` (the browser ran no JavaScript);
 - ``implausible``: a field is not an integer within its bound, an end comes before the first play, a start-up time
-  (first play request to first frame) is longer than the time to the first frame or comes without one, or there
-  are more plays than the time the page was shown fits (``max_plays``): kept as sent, but not to be trusted;
+  (first play request to first frame) is longer than the time to the first frame or comes without one, there
+  are more plays than the time the page was shown fits (``max_plays``), or more than the section's player allows
+  (1 + ``max_replays``; the player refuses them, so they did not come from it): kept as sent, but not to be trusted;
 - ``ok`` otherwise.
 
 While the page is open the script also reports each play start and the clip's first end (``record_playback`` via
@@ -93,7 +94,7 @@ def _integer(raw, high: int) -> int | None:
 
 
 def parse_viewing(post, page_ms: int, duration_s: float | None = None, playback: dict | None = None,
-                  time_slack_ms: int = 5_000) -> dict:
+                  time_slack_ms: int = 5_000, max_replays: int | None = None) -> dict:
     """The viewing record of an answer POST: every field of VIEWING_FIELDS (int or None) plus ``record`` (one of
     VIEWING_RECORDS), ``page_ms`` and ``shows``.
 
@@ -102,7 +103,7 @@ def parse_viewing(post, page_ms: int, duration_s: float | None = None, playback:
     what the player reported while the page was open (``{"plays": int, "ended_ms": int | None, "shows": int,
     "carried": {field: int}}``, from the assignment): the plays count is at least its plays, an end reached before a
     reload of the page is kept as ``ended_ms`` 0 ("before this display"), and the counts of displays left without
-    an answer are added to this display's."""
+    an answer are added to this display's. max_replays: the section player's limit (None: unlimited)."""
     playback = playback or {}
     record: dict = {name: None for name in VIEWING_FIELDS}
     record.update(page_ms=page_ms, shows=max(1, int(playback.get("shows") or 0)))
@@ -141,4 +142,6 @@ def parse_viewing(post, page_ms: int, duration_s: float | None = None, playback:
     bound = max_plays(page_ms + time_slack_ms, duration_s)
     if bound is not None and (record["plays"] or 0) > bound:
         implausible = True
+    if max_replays is not None and (record["plays"] or 0) > 1 + max_replays:
+        implausible = True                        # more plays than the player lets a participant start
     return {**record, "record": "implausible" if implausible else "ok"}

@@ -388,7 +388,7 @@ def item(request, token: str, n: int):
     viewing = parse_viewing(request.POST, min(MAX_RESPONSE_MS, server_ms), clip.duration_s,
                             {"plays": assignment.plays, "ended_ms": assignment.play_ended_ms,
                              "shows": assignment.shows, "carried": assignment.carried},
-                            time_slack_ms=RT_SLACK_MS)
+                            time_slack_ms=RT_SLACK_MS, max_replays=player_options(section.options)["max_replays"])
     save_answers(assignment, answers, response_ms, viewing)
     if request.POST.get(INLINE_NEXT_FIELD) == "1" and n < participant.n_items:
         nxt = current_step(participant, lookahead=True)

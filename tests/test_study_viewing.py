@@ -132,6 +132,11 @@ def test_plays_are_bounded_by_the_page_time_over_the_clip_duration():
     assert fair["record"] == "ok"
     assert parse_viewing(posted({**GOOD_RECORD, "plays": 7}), 5_000, 1.0, time_slack_ms=0)["record"] == "implausible"
 
+    assert parse_viewing(posted({**GOOD_RECORD, "plays": 2}), 5_000, 1.0, max_replays=1)["record"] == "ok"
+    beyond = parse_viewing(posted({**GOOD_RECORD, "plays": 3}), 5_000, 1.0, max_replays=1)
+    assert beyond["record"] == "implausible" and beyond["plays"] == 3
+    assert parse_viewing(posted({**GOOD_RECORD, "plays": 2}), 5_000, 1.0, max_replays=0)["record"] == "implausible"
+
 
 def test_the_servers_playback_counts_survive_a_reload():
     """After a reload the page's own record starts from zero; the plays and the end the player reported before
@@ -305,6 +310,20 @@ def test_a_reload_keeps_the_plays_and_max_replays_holds(client, study):
     assert report(client, p, 1, "play").status_code == 404
     a.refresh_from_db()
     assert a.plays == 2
+
+
+@pytest.mark.django_db
+def test_plays_beyond_max_replays_that_bypass_the_player_make_the_record_implausible(client, study):
+    for section in study.sections.all():
+        section.options = {**section.options, "max_replays": 0}
+        section.save()
+    p = started(client, study)
+    client.get(reverse("studyapp:item", args=[p.token, 1]))
+    assert report(client, p, 1, "play").status_code == 204
+    assert report(client, p, 1, "play").status_code == 204       # a replay the player would not have started
+    a = answer(client, p, 1, posted({"plays": 0, "pauses": 0}))
+    a.refresh_from_db()
+    assert a.viewing["plays"] == 2 and a.viewing["record"] == "implausible"
 
 
 @pytest.mark.django_db
