@@ -196,6 +196,38 @@ def test_every_bad_row_is_an_error_and_leaves_nothing(media, tmp_path):
     assert _files(media) == set()                          # no media, no record, no poster, no clips.csv
 
 
+def _zero_frame_videos(folder: Path) -> None:
+    """Containers with sound but no picture: an MP4 of an audio stream only, and a Matroska file whose H.264 video
+    stream holds zero frames beside one second of audio (ffmpeg's ``select=0`` drops every frame)."""
+    folder.mkdir(parents=True, exist_ok=True)
+    ffmpeg = [imageio_ffmpeg.get_ffmpeg_exe(), "-hide_banner", "-v", "error", "-y"]
+    sine = ["-f", "lavfi", "-i", "sine=frequency=440:duration=1"]
+    subprocess.run([*ffmpeg, *sine, "-c:a", "aac", str(folder / "sound_only.mp4")], check=True)
+    subprocess.run([*ffmpeg, "-f", "lavfi", "-i", "testsrc2=size=64x48:rate=15:duration=1", *sine, "-map", "0:v",
+                    "-map", "1:a", "-vf", "select=0", "-c:v", "libx264", "-pix_fmt", "yuv420p", "-c:a", "aac",
+                    str(folder / "zero_frames.mkv")], check=True)
+
+
+@pytest.mark.django_db
+@pytest.mark.parametrize("dry_run", [False, True])
+def test_a_video_of_zero_frames_is_an_error_and_leaves_nothing(media, tmp_path, dry_run):
+    from studyapp.models import Clip
+
+    folder = tmp_path / "lab"
+    _zero_frame_videos(folder)
+    rows = [{"path": "sound_only.mp4", "modality": "other"}, {"path": "zero_frames.mkv", "modality": "gait"}]
+    report = tmp_path / "report.csv"
+    with pytest.raises(CommandError, match="2 row\\(s\\) failed"):
+        run(write_manifest(folder, rows), "--report", str(report), *(["--dry-run"] if dry_run else []))
+    sound_only, zero_frames = read_report(report)
+    assert (sound_only["status"], zero_frames["status"]) == ("error", "error")
+    assert not sound_only["clip_id"] and not zero_frames["clip_id"]
+    assert sound_only["message"] == ("sound_only.mp4: no video stream (the file holds mov,mp4,m4a,3gp,3g2,mj2 "
+                                     "without pictures)")
+    assert zero_frames["message"] == "zero_frames.mkv: the video stream holds no frames (an empty video)"
+    assert Clip.objects.count() == 0 and _files(media) == set()          # no media, no poster, no record, no row
+
+
 @pytest.mark.django_db
 def test_a_too_long_or_too_large_video_is_an_error(media, tmp_path):
     folder = tmp_path / "lab"

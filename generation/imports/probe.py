@@ -95,6 +95,24 @@ def probe_video(path: str | Path, timeout_s: float = 60.0) -> VideoProbe:
                       duration_s=duration, audio_codec=audio.group("codec") if audio else "", size_bytes=size)
 
 
+def count_video_packets(path: str | Path, timeout_s: float = 600.0) -> int:
+    """Frames (packets) in the first video stream of ``path``, counted by reading the file without decoding it.
+
+    A container can declare a video stream and hold no frame of it (a sound track beside an empty picture track):
+    the header alone cannot tell, so :func:`probe_video` does not; this is the cheap check that can."""
+    path = Path(path)
+    cmd = [ffmpeg_exe(), "-hide_banner", "-nostdin", "-v", "error", "-stats", "-i", str(path), "-map", "0:v:0",
+           "-c", "copy", "-f", "null", "-"]
+    try:
+        proc = subprocess.run(cmd, capture_output=True, text=True, errors="replace", timeout=timeout_s)
+    except subprocess.TimeoutExpired:
+        raise VideoProbeError(f"{path.name}: reading the video stream took longer than {timeout_s:g} s") from None
+    if proc.returncode != 0:
+        raise VideoProbeError(f"{path.name}: cannot be decoded ({_reason(proc.stderr)})")
+    frames = re.findall(r"frame=\s*(\d+)", proc.stderr)
+    return int(frames[-1]) if frames else 0
+
+
 def decode_check(path: str | Path, timeout_s: float = 1800.0) -> tuple[int, float]:
     """Decode every video frame of ``path``: (frames, seconds of video). VideoProbeError names the first decoding
     error, or a file without a single frame."""

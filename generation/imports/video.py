@@ -16,7 +16,7 @@ from pathlib import Path
 
 from generation.render.encode import codec_params
 
-from .probe import VideoProbe, VideoProbeError, decode_check, ffmpeg_exe, probe_video
+from .probe import VideoProbe, VideoProbeError, count_video_packets, decode_check, ffmpeg_exe, probe_video
 
 PLAYABLE_CODECS = ("h264",)
 PLAYABLE_PIX_FMTS = ("yuv420p", "yuvj420p")
@@ -54,7 +54,8 @@ class StagedVideo:
 
 
 def check_video(path: Path, limits: VideoLimits) -> VideoProbe:
-    """Probe ``path`` and check it against ``limits`` without writing; VideoImportError says what is wrong."""
+    """Probe ``path``, check it against ``limits`` and that its video stream holds frames, without writing;
+    VideoImportError says what is wrong."""
     size = path.stat().st_size
     if size == 0:
         raise VideoImportError("empty file (0 bytes)")
@@ -70,6 +71,12 @@ def check_video(path: Path, limits: VideoLimits) -> VideoProbe:
                                f"{limits.max_duration_s:g} s")
     if probe.width and probe.height and (probe.width < 16 or probe.height < 16):
         raise VideoImportError(f"frame size {probe.width}x{probe.height} is too small (at least 16x16)")
+    try:
+        frames = count_video_packets(path)
+    except VideoProbeError as exc:
+        raise VideoImportError(str(exc).removeprefix(f"{path.name}: ")) from None
+    if frames == 0:
+        raise VideoImportError("the video stream holds no frames (an empty video)")
     return probe
 
 
