@@ -23,13 +23,14 @@ from __future__ import annotations
 import argparse
 import datetime
 import json
+import os
 import time
 from pathlib import Path
 
 import numpy as np
 
 from benchmarks.bench_record import one_thread
-from generation.mocap.real_corpus import load_real_corpus, real_corpus_path
+from generation.mocap.real_corpus import RealCorpora, load_real_corpus
 from generation.quality import calibrated_observer as co
 from generation.quality import real_observer as ro
 from study_protocol import CAPTURE_GAIT_EMOTIONS, GAIT_EMOTIONS
@@ -117,7 +118,8 @@ def main(argv=None) -> int:
     ap.add_argument("--skip-mixture", action="store_true")
     a = ap.parse_args(argv)
     t0 = time.time()
-    bandai, bml = real_corpus_path(), co.bml_corpus_path()
+    corpora = RealCorpora.from_environ(os.environ)   # $REAL_CORPUS and $BML_CORPUS, else var/mocap/
+    bandai, bml = corpora.bandai, corpora.bml
     bandai_train = [c for c in load_real_corpus(bandai, skeleton="gait", split="train", contents="walk")
                     if c.dataset == ro.EMOTION_DATASET and c.style in CAPTURE_GAIT_EMOTIONS]
     bandai_test = [c for c in load_real_corpus(bandai, skeleton="gait", split="test", contents="walk")

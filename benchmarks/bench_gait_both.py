@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import os
 import time
 from pathlib import Path
 
@@ -30,6 +31,7 @@ from benchmarks.bench_record import one_thread
 from generation.gait.bml_data import bml_clips
 from generation.gait.generate import load_model
 from generation.gait.real_data import RealAugment, clip_sequences, stage_clips
+from generation.mocap.real_corpus import RealCorpora
 from generation.quality import calibrated_observer as co
 from generation.quality.realism import realism_measures
 from study_protocol import CAPTURE_GAIT_EMOTIONS, GAIT_EMOTIONS
@@ -52,9 +54,11 @@ def main(argv=None) -> int:
     data_cfg = next(iter(nets.values())).config.data
     prefix = data_cfg.prefix_len
     lib = RealAugment(mirror=False, speed_factors=(1.0,), stride_frames=16, offsets=(0,))
-    train = clip_sequences(stage_clips("pretrain", "train") + bml_clips("train"), data_cfg, lib)
-    bml_test = bml_clips("test")
-    bandai_test = stage_clips("pretrain", "test")
+    corpora = RealCorpora.from_environ(os.environ)   # $REAL_CORPUS and $BML_CORPUS, else var/mocap/
+    train = clip_sequences(stage_clips("pretrain", "train", corpora.bandai) + bml_clips("train", corpora.bml),
+                           data_cfg, lib)
+    bml_test = bml_clips("test", corpora.bml)
+    bandai_test = stage_clips("pretrain", "test", corpora.bandai)
     sets = {"BML held-out actors (6 actors, 24 walks)": bml_test,
             "Bandai held-out emotion takes (dataset 1 walk take 2)": [c for c in bandai_test if c.content == "walk"
                                                                       and c.dataset == "bandai-namco-1"

@@ -30,6 +30,7 @@ from __future__ import annotations
 import argparse
 import datetime
 import math
+import os
 import shlex
 import sys
 import time
@@ -49,7 +50,7 @@ from generation.core.quaternion import qmul
 from generation.gait.generate import generate_gaits, load_model
 from generation.gait.real_data import RealAugment, clip_sequences, stage_clips
 from generation.gait.weights import weights_path
-from generation.mocap.real_corpus import load_real_corpus, real_corpus_path
+from generation.mocap.real_corpus import RealCorpora, load_real_corpus
 from generation.quality.observers import OBSERVERS
 from generation.quality.realism import MEASURES, realism_measures
 from generation.quality.realism_ranges import load_ranges
@@ -87,10 +88,10 @@ def prediction_table(nets: dict, train, test, prefix: int) -> dict:
 
 
 # ---- 2. emotion carried ------------------------------------------------------------------------
-def heldout_emotion_takes(max_neutral: int = 3) -> list:
+def heldout_emotion_takes(corpus: Path, max_neutral: int = 3) -> list:
     """Held-out takes of the four emotions: dataset 1 walk take 2 (happy, sad, angry, normal where long enough) and
     the first ``max_neutral`` dataset-2 normal walk test takes."""
-    clips = load_real_corpus(skeleton="gait", split="test", contents="walk",
+    clips = load_real_corpus(corpus, skeleton="gait", split="test", contents="walk",
                              styles=tuple(CAPTURE_GAIT_EMOTIONS))
     d1 = [c for c in clips if c.dataset == "bandai-namco-1"]
     d2 = [c for c in clips if c.dataset == "bandai-namco-2"][:max_neutral]
@@ -260,11 +261,11 @@ def mixture_response(net, observer, steps: int = 76, shares=MIX_SHARES) -> dict:
             for e, per in out.items()}
 
 
-def real_take_recognition(observer) -> dict:
+def real_take_recognition(observer, corpus: Path) -> dict:
     """Per split (test, train): :func:`recognition` of dataset 1's real happy / sad / angry / normal forward walks
     read whole: what the observer makes of the actors themselves (the reference for the generated walks; the
     observer is trained on the ``train`` split)."""
-    clips = load_real_corpus(skeleton="gait", split=("test", "train"), contents="walk",
+    clips = load_real_corpus(corpus, skeleton="gait", split=("test", "train"), contents="walk",
                              styles=tuple(CAPTURE_GAIT_EMOTIONS))
     out = {}
     for split in ("test", "train"):
@@ -278,10 +279,10 @@ def real_take_recognition(observer) -> dict:
 
 
 # ---- 3. realism --------------------------------------------------------------------------------
-def real_realism() -> dict:
+def real_realism(corpus: Path) -> dict:
     """Per emotion, the realism measures of the real forward walks of that style (all splits) as min / median /
     max."""
-    clips = load_real_corpus(skeleton="gait", contents="walk", styles=tuple(CAPTURE_GAIT_EMOTIONS))
+    clips = load_real_corpus(corpus, skeleton="gait", contents="walk", styles=tuple(CAPTURE_GAIT_EMOTIONS))
     out = {}
     for style, emotion in CAPTURE_GAIT_EMOTIONS.items():
         vals = [realism_measures(c.motion) for c in clips if c.style == style]
@@ -361,7 +362,8 @@ def run(a, argv) -> dict:
     """Every measurement into one results dict (the run's record first)."""
     t0 = time.time()
     nets = load_nets(a)
-    corpus = real_corpus_path()
+    corpora = RealCorpora.from_environ(os.environ)   # $REAL_CORPUS and $BML_CORPUS, else var/mocap/
+    corpus = corpora.bandai
     res = {"date": datetime.date.today().isoformat(), "commit": commit_label(),
            "command": shlex.join(["python", "-m", "benchmarks.bench_gait_real", *argv]),
            "machine": machine_label(f"{a.threads} torch thread(s)"),
@@ -370,9 +372,9 @@ def run(a, argv) -> dict:
     data_cfg = nets["real-trained"].config.data
     prefix = data_cfg.prefix_len
     # nearest-neighbour library: every training take's windows as captured, a window every 16 frames
-    train = clip_sequences(stage_clips("pretrain", "train"), data_cfg,
+    train = clip_sequences(stage_clips("pretrain", "train", corpus), data_cfg,
                            RealAugment(mirror=False, speed_factors=(1.0,), stride_frames=16, offsets=(0,)))
-    test_clips = stage_clips("pretrain", "test")
+    test_clips = stage_clips("pretrain", "test", corpus)
     emotion_clips = [c for c in test_clips if c.style in CAPTURE_GAIT_EMOTIONS and c.content == "walk"]
     res |= {"prefix": prefix, "horizon": data_cfg.seq_len - prefix, "prediction": {}, "recognition": {},
             "realism": {}}
@@ -382,12 +384,12 @@ def run(a, argv) -> dict:
         res["prediction"][subset] = {"n": len(test), "takes": len(clips),
                                      "methods": prediction_table(nets, train, test, prefix)}
         print(f"prediction {subset}: {time.time() - t0:.0f} s", flush=True)
-    observer = OBSERVERS.gait("real")
+    observer = OBSERVERS.gait("real", corpora=corpora)
     res["observer"] = observer.source
-    res["real_realism"] = real_realism()
-    takes = heldout_emotion_takes()
+    res["real_realism"] = real_realism(corpus)
+    takes = heldout_emotion_takes(corpus)
     res["seed_takes"] = [t.name for t in takes]
-    res["real_take_reading"] = real_take_recognition(observer)
+    res["real_take_reading"] = real_take_recognition(observer, corpus)
     res["mixture_response"] = mixture_response(nets["real-trained"], observer)
     for name, net in nets.items():
         rows = generated_from_seeds(net, takes, a.steps)

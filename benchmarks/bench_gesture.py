@@ -440,7 +440,7 @@ def _comparisons(args) -> dict[str, str]:
 
 def _ablation_rows(data: GestureDataset, test: np.ndarray, blob: dict, args) -> dict:
     """Pose-error rows of the loss ablations (trained here unless ``--skip-train`` finds them in var/)."""
-    abl_dir = config.VAR_DIR / "ablations"
+    abl_dir = args.var_dir / "ablations"
     rows = {}
     for name, weights in ABLATIONS.items():
         out = abl_dir / f"{name.replace(' ', '_')}.pt"
@@ -507,7 +507,7 @@ def _print_tables(results: dict, *names: str) -> None:
 
 def _measure(net, args, results: dict) -> None:
     """Every measurement of the shipped weights (and the comparisons) into ``results``."""
-    data = build_dataset()
+    data = build_dataset(cache_dir=args.var_dir)
     test = data.indices("test")
     blob = torch.load(args.weights, weights_only=False)
     results["split"] = {k: int(len(data.indices(k))) for k in ("train", "val", "test")}
@@ -515,7 +515,7 @@ def _measure(net, args, results: dict) -> None:
     results["emotion_vad"] = {e: dict(zip(("valence", "arousal", "dominance"), nrc_vad(e))) for e in GESTURE_EMOTIONS}
     results["pose_error_table"] = _pose_table(net, data, test, blob, args)
     if args.ablations:
-        results["equal_epoch_validation"] = equal_epoch_validation(blob, config.VAR_DIR / "ablations",
+        results["equal_epoch_validation"] = equal_epoch_validation(blob, args.var_dir / "ablations",
                                                                    args.ablation_epochs)
     results["gt_acceleration"] = float(np.mean([
         upper_body_acceleration(data.rotations[i, : data.lengths[i]], str(data.gender[i]), data.root[i], data.fps)
@@ -544,6 +544,7 @@ def main(argv=None) -> int:
     prepare_render_process()
     argv = sys.argv[1:] if argv is None else list(argv)
     args = _args(argv)
+    args.var_dir = config.var_dir(os.environ)   # caches and ablation weights: $GESTURE_VAR_DIR, else var/gesture
     torch.set_num_threads(1)
     torch.manual_seed(0)
     t_start = time.time()

@@ -215,7 +215,7 @@ def main(argv=None) -> int:
     ap.add_argument("--sheets", type=Path, default=None, help="write rbf_real_<theme>.png into this folder")
     a = ap.parse_args(argv)
     warnings.filterwarnings("ignore", message="The given NumPy array is not writable")
-    corpus = a.corpus or real_corpus_path()
+    corpus = a.corpus or real_corpus_path(os.environ)
     if not Path(corpus).is_file():
         raise SystemExit(f"no real-capture corpus at {corpus}; build it with python -m generation.mocap dataset ...")
     observer = OBSERVERS.gait("real", corpus)

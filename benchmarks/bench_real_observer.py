@@ -23,6 +23,7 @@ from __future__ import annotations
 import argparse
 import datetime
 import json
+import os
 import re
 import shlex
 import sys
@@ -216,7 +217,7 @@ def main(argv=None) -> int:
                     help="render the real_observer tables marked in this page")
     args = ap.parse_args(argv)
     t0 = time.perf_counter()
-    path = Path(args.corpus) if args.corpus else real_corpus_path()
+    path = Path(args.corpus) if args.corpus else real_corpus_path(os.environ)
     obs = OBSERVERS.gait("real", path)
     if obs is None or not path.is_file():
         raise SystemExit(f"{path}: no real-capture corpus; build it with `python -m generation.mocap dataset "

@@ -31,6 +31,7 @@ from __future__ import annotations
 
 import argparse
 import datetime
+import os
 import shlex
 import sys
 import time
@@ -219,7 +220,7 @@ def _args(argv):
 
 def run(a, argv) -> dict:
     t0 = time.time()
-    corpus = a.corpus or real_corpus_path()
+    corpus = a.corpus or real_corpus_path(os.environ)
     real_items = real_walks(corpus)
     gen_items = generated_walks(a.extra_seeds)
     res = {"date": datetime.date.today().isoformat(), "commit": commit_label(),

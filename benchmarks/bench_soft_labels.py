@@ -17,6 +17,7 @@ mixture response (observed P(happy) against the input share a). Nothing here is 
 from __future__ import annotations
 
 import argparse
+import os
 import tempfile
 import time
 from pathlib import Path
@@ -25,6 +26,7 @@ import numpy as np
 import pandas as pd
 
 from benchmarks.bench_record import record
+from generation.mocap.real_corpus import RealCorpora
 from study_protocol import CAPTURE_GAIT_EMOTIONS, CLIP_NORMS_COLUMNS, GAIT_EMOTIONS
 
 SIMULATED_SHARES = {          # (happy, sad, angry, neutral) perceived, per acted emotion: SIMULATED
@@ -98,7 +100,7 @@ def main(argv=None) -> dict:
     ap.add_argument("--epochs", type=int, default=6)
     ap.add_argument("--json", default=None)
     args = ap.parse_args(argv)
-    observer = OBSERVERS.gait("real")
+    observer = OBSERVERS.gait("real", corpora=RealCorpora.from_environ(os.environ))
     result = {"benchmark": "bench_soft_labels (SIMULATED perceived shares of real takes)", "epochs": args.epochs,
               "simulated_shares": SIMULATED_SHARES, "observer": observer.source}
     with tempfile.TemporaryDirectory() as tmp:

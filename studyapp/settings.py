@@ -23,6 +23,12 @@ Variables (all optional for the demo):
     LOGIN_LOCKOUT_MINUTES how long such a lockout lasts (default 15)
     TRUSTED_PROXY_COUNT   reverse proxies in front of the app whose X-Forwarded-For is trusted for the client
                       address of the login throttle (default: 1 with PRODUCTION=1, the nginx recipe; else 0)
+    QA_GAIT_OBSERVER  the quality gate's gait observer for plans that name none: real (default), real-perceived
+                      or synthetic
+    REAL_CORPUS       the Bandai Namco real-capture corpus the real gait observers are trained on (default:
+                      var/mocap/bandai-namco.npz); generate_clips passes it down
+    BML_CORPUS        the BML walks of Emotion-Gait, the second corpus of the calibrated gait observer (default:
+                      var/mocap/emotion-gait-bml.npz)
 """
 import os
 from datetime import timedelta
@@ -116,6 +122,10 @@ if MEDIA_ACCEL_REDIRECT and not (MEDIA_ACCEL_REDIRECT.startswith("/") and MEDIA_
 REPORTS_DIR = Path(os.environ.get("REPORTS_DIR", DATA_DIR / "reports"))
 # The gait observer of the quality gate for plans that name none in their qa: block (study_protocol.QA_OBSERVERS).
 QA_GAIT_OBSERVER = os.environ.get("QA_GAIT_OBSERVER", "").strip() or "real"
+# The real-capture corpora of the real gait observers (generation.mocap.real_corpus.RealCorpora.of); "" = the built
+# ones under var/mocap/.
+REAL_CORPUS = os.environ.get("REAL_CORPUS", "").strip()
+BML_CORPUS = os.environ.get("BML_CORPUS", "").strip()
 STATIC_URL = "/static/"
 # collectstatic's target; outside production WhiteNoise serves from the app folders and needs none.
 STATIC_ROOT = Path(os.environ["STATIC_ROOT"]) if os.environ.get("STATIC_ROOT") else (

@@ -180,3 +180,25 @@ def test_the_real_bml_walks_all_fit_within_the_bound():
     assert all(float(r["ik_error_p95_cm"]) < 100 * eg.MAX_IK_ERROR_M for r in rows)
     assert all(c.motion.metadata["loop_period_frames"] for c in fitted)
     assert {r["split"] for r in rows if r["performer"] == "BML_alx"} == {"test"}
+
+
+def test_dataset_command_writes_where_the_variables_say(tmp_path, monkeypatch):
+    """Without --out, `dataset` writes each corpus where its readers look: $REAL_CORPUS / $BML_CORPUS (read by the
+    command line, passed down), else var/mocap/."""
+    from generation.mocap import cli
+    from generation.mocap.real_corpus import DEFAULT_BML_PATH, DEFAULT_PATH
+
+    written = []
+    monkeypatch.setattr(cli, "build_emotion_gait_bml", lambda root, out, *a: written.append(out) or 0)
+    monkeypatch.setattr(cli, "build_bandai_namco", lambda root, out, *a: written.append(out) or 0)
+    monkeypatch.delenv("REAL_CORPUS", raising=False)
+    monkeypatch.delenv("BML_CORPUS", raising=False)
+    assert main(["dataset", "emotion-gait-bml", str(tmp_path)]) == 0
+    assert main(["dataset", "bandai-namco", str(tmp_path)]) == 0
+    monkeypatch.setenv("REAL_CORPUS", str(tmp_path / "bandai.npz"))
+    monkeypatch.setenv("BML_CORPUS", str(tmp_path / "bml.npz"))
+    assert main(["dataset", "emotion-gait-bml", str(tmp_path)]) == 0
+    assert main(["dataset", "bandai-namco", str(tmp_path)]) == 0
+    assert main(["dataset", "bandai-namco", str(tmp_path), "--out", str(tmp_path / "given.npz")]) == 0
+    assert written == [DEFAULT_BML_PATH, DEFAULT_PATH, tmp_path / "bml.npz", tmp_path / "bandai.npz",
+                       tmp_path / "given.npz"]

@@ -173,7 +173,7 @@ def test_plan_qa_run_reads_gesture_clips(tmp_path, monkeypatch, small_observer):
                                     "clips": [{"id": "sad_sit", "generator": "procedural_gesture", "origin": "source",
                                                "emotion_label": "sad", "duration_s": 3.0, "seed": 1}]}))
     monkeypatch.setattr(plan_qa, "observer_for",
-                        lambda modality, kind=None: small_observer if modality == "gesture" else None)
+                        lambda modality, *_: small_observer if modality == "gesture" else None)
     rows = plan_qa.run(str(plan), log=lambda line: None, modality="gesture", figure_height=False)
     assert len(rows) == 1 and rows[0]["intended"] == "sad" and rows[0]["modality"] == "gesture"
     assert rows[0]["observed"] in GESTURE_EMOTIONS and rows[0]["figure_height_frac"] is None

@@ -44,7 +44,8 @@ def _record(folder, clip_id, inputs, source_clip_id=""):
 
 @pytest.fixture
 def rated(tmp_path, monkeypatch):
-    monkeypatch.setattr(config, "VAR_DIR", tmp_path / "var")      # the token cache of these sentences stays here
+    # the token cache of these sentences stays here: library calls get cache_dir, the command lines read the variable
+    monkeypatch.setenv("GESTURE_VAR_DIR", str(tmp_path / "var"))
     media = tmp_path / "media"
     records = media / "clip_records"
     records.mkdir(parents=True)
@@ -75,10 +76,10 @@ def test_soft_target_is_the_share_weighted_nrc_vad():
     np.testing.assert_allclose(soft_vad(mix), (np.array(GESTURE_VAD["sad"]) + GESTURE_VAD["joyous"]) / 2)
 
 
-def test_dataset_takes_shares_sentences_and_motions(rated):
+def test_dataset_takes_shares_sentences_and_motions(rated, tmp_path):
     path, motions = rated
     logged = []
-    data, norms = load_soft_label_dataset(path, motions, log=logged.append)
+    data, norms = load_soft_label_dataset(path, motions, cache_dir=tmp_path / "var", log=logged.append)
     assert [r.sentence_id for r in data.rows] == ["sim-gen-1", "sim-src-1", "sim-cat-1"]
     assert [(r.sentence, r.task) for r in data.rows] == [(SENTENCE, "narration"), (SENTENCE, "narration"),
                                                          (CATALOGUED, "conversation")]
@@ -100,6 +101,7 @@ def test_one_epoch_through_the_command_records_the_norms(rated, tmp_path):
                     "--checkpoint", str(tmp_path / "ck.pt"), "--epochs", "1", "--d-model", "16", "--batch-size", "2",
                     "--rollout-every", "0", "--max-minutes", "0", "--quiet"])
     assert summary["epochs_run"] == 1
+    assert (tmp_path / "var" / "sentence_tokens.npz").is_file()          # $GESTURE_VAR_DIR, read by the command line
     saved = torch.load(out, weights_only=False)
     info = saved["corpus"]["soft_labels"]
     assert info["n_clips"] == 3 and info["n_ratings"] == 63 and info["study"] == "pilot-gestures"
@@ -114,7 +116,7 @@ def test_unknown_clip_and_missing_motion_name_file_line_and_column(rated, tmp_pa
     df = pd.read_csv(path)
     df.assign(clip_id=["sim-gen-1", "sim-nowhere", "sim-cat-1", "sim-bye"]).to_csv(tmp_path / "u.csv", index=False)
     with pytest.raises(SoftLabelError) as unknown:
-        load_soft_label_dataset(tmp_path / "u.csv", motions)
+        load_soft_label_dataset(tmp_path / "u.csv", motions, cache_dir=tmp_path / "var")
     assert str(unknown.value) == (f"u.csv line 3, column 'clip_id': clip 'sim-nowhere': unknown clip (not in the "
                                   f"catalogue {motions.parent / 'clips.csv'})")
     (motions / "sim-cat-1.bvh").unlink()
@@ -126,7 +128,7 @@ def test_unknown_clip_and_missing_motion_name_file_line_and_column(rated, tmp_pa
     df.assign(share_sad=[0.0, 0.7, 0.2, 0.0]).to_csv(tmp_path / "s.csv", index=False)
     with pytest.raises(SoftLabelError, match="s.csv line 4, columns 'share_afraid' 0.0, .*'share_angry' 1.0, .*"
                                              "'share_sad' 0.2, .*: the gesture shares sum to 1.2, not 1"):
-        load_soft_label_dataset(tmp_path / "s.csv", motions)
+        load_soft_label_dataset(tmp_path / "s.csv", motions, cache_dir=tmp_path / "var")
 
 
 def test_manage_py_train_gesture_takes_the_same_soft_labels(rated, tmp_path):

@@ -3,6 +3,7 @@ from __future__ import annotations
 
 import json
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -82,11 +83,16 @@ def test_nan_measures_and_default_path(tmp_path, monkeypatch):
     clips = _clips()[:1]
     clips[0].import_error_cm = math.nan
     path = rc.save_real_corpus(tmp_path / "c.npz", clips, {})
+    assert math.isnan(rc.load_real_corpus(path)[0].import_error_cm)
+    default = rc.REPO_ROOT / "var" / "mocap" / "bandai-namco.npz"
+    # the variable counts only where an edge passes its environment; the library never reads it
     monkeypatch.setenv("REAL_CORPUS", str(path))
-    assert rc.real_corpus_path() == path
-    assert math.isnan(rc.load_real_corpus()[0].import_error_cm)
-    monkeypatch.delenv("REAL_CORPUS")
-    assert rc.real_corpus_path() == rc.REPO_ROOT / "var" / "mocap" / "bandai-namco.npz"
+    assert rc.real_corpus_path() == default == rc.DEFAULT_PATH
+    assert rc.real_corpus_path({"REAL_CORPUS": str(path)}) == path
+    assert rc.real_corpus_path({"REAL_CORPUS": ""}) == default
+    assert rc.RealCorpora.from_environ({"REAL_CORPUS": str(path)}) == rc.RealCorpora(path, rc.DEFAULT_BML_PATH)
+    assert rc.RealCorpora.from_environ({"BML_CORPUS": "b.npz"}) == rc.RealCorpora(default, Path("b.npz"))
+    assert rc.RealCorpora.of(None, "") == rc.RealCorpora() == rc.DEFAULT_CORPORA
 
 
 def test_bad_input(tmp_path):

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from generation.core.digest import file_sha256
-from generation.mocap.real_corpus import save_real_corpus
+from generation.mocap.real_corpus import RealCorpora, save_real_corpus
 from generation.pipeline.plan_qa import observer_for, unread_line
 from generation.quality import evaluate, resolve_thresholds
 from generation.quality import real_observer as ro
@@ -73,8 +73,8 @@ def test_without_a_corpus_it_falls_back_to_the_shipped_takes_or_says_there_is_no
 
     OBSERVERS.clear()
     monkeypatch.setattr(ro, "shipped_clips", no_files)
-    monkeypatch.setenv("REAL_CORPUS", str(missing))
-    assert ro.load_real_observer() is None and observer_for("gait", "real") is None
+    nowhere = RealCorpora.of(missing, fresh / "absent-bml.npz")
+    assert ro.load_real_observer(missing) is None and observer_for("gait", "real", nowhere) is None
     line = unread_line([{"modality": "gait", "qa": {"observed": None}}], "real")
     assert "no real-capture observer" in line
 
@@ -90,7 +90,7 @@ def test_a_stored_gait_record_from_another_observer_is_measured_again(shipped, t
             "clips": [{"id": "w", "generator": "procedural_walk", "emotion": [0, 1, 0, 0], "seed": 1}]}
     (job,), _ = plan_jobs(validate_plan(plan))
     obs = ro.RealGaitObserver(shipped, source="test")
-    monkeypatch.setattr(runner, "observer_for", lambda modality, kind=None: obs)
+    monkeypatch.setattr(runner, "observer_for", lambda modality, kind=None, corpora=None: obs)
     # a record of version 2 (before the realism measures), read by the synthetic observer, with the render's camera
     done = {"clip_id": job.clip_id, "record_version": 2,
             "qa": {"foot_skate_cm_s": 1.0, "observed": "sad", "observed_p": 0.99, "flag": ""},
@@ -105,3 +105,24 @@ def test_a_stored_gait_record_from_another_observer_is_measured_again(shipped, t
     assert not runner._stale_qa(done, job)
     (synthetic,), _ = plan_jobs(validate_plan({**plan, "qa": {"observer": "synthetic"}}))
     assert runner._stale_qa(done, synthetic)
+
+
+def test_the_real_corpora_travel_with_the_job_to_the_observer(shipped, fresh, monkeypatch):
+    """The corpora a command line or the settings name reach the observer of every clip inside its job (a render
+    worker never looks them up itself); without both corpus files the Bandai one of ``corpora`` is read."""
+    from generation.pipeline import runner
+    from generation.pipeline.jobs import plan_jobs
+    from generation.plans.schema import validate_plan
+
+    corpus = save_real_corpus(fresh / "named.npz", shipped, {"split_rule": "test corpus"})
+    corpora = RealCorpora.of(corpus, fresh / "no-bml.npz")
+    plan = {"name": "p", "render": {"width": 160, "height": 120, "fps": 25, "duration_s": 3.0},
+            "clips": [{"id": "w", "generator": "procedural_walk", "emotion": [0, 1, 0, 0], "seed": 1}]}
+    (job,), _ = plan_jobs(validate_plan(plan), corpora=corpora)
+    assert job.corpora == corpora and plan_jobs(validate_plan(plan))[0][0].corpora == RealCorpora()
+    asked = []
+    monkeypatch.setattr(runner, "observer_for", lambda modality, kind, corpora: asked.append(corpora))
+    runner._add_qa({}, job, shipped[0].motion, None)
+    assert asked == [corpora]
+    assert "named.npz" in OBSERVERS.gait("real", corpora=corpora).source
+    assert OBSERVERS.gait("real-perceived", corpora=corpora) is None           # needs both corpus files

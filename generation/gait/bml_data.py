@@ -29,8 +29,15 @@ from generation.core.motion import Motion
 from generation.mocap.emotion_gait_bml import CITATION as BML_CITATION
 from generation.mocap.emotion_gait_bml import DATASET as BML_DATASET
 from generation.mocap.emotion_gait_bml import LICENCE as BML_LICENCE
-from generation.mocap.emotion_gait_bml import bml_corpus_path
-from generation.mocap.real_corpus import CITATION, LICENCE, SOURCE_URL, load_real_corpus, read_meta, real_corpus_path
+from generation.mocap.real_corpus import (
+    CITATION,
+    DEFAULT_BML_PATH,
+    DEFAULT_PATH,
+    LICENCE,
+    SOURCE_URL,
+    load_real_corpus,
+    read_meta,
+)
 from study_protocol import CAPTURE_GAIT_EMOTIONS, GAIT_EMOTIONS
 
 from .config import GaitDataConfig
@@ -95,7 +102,7 @@ def _with_vector(clips: list, data: GaitDataConfig, augment: RealAugment, labels
 def bml_clips(split, path: str | Path | None = None, n_frames: int = EXTENDED_FRAMES) -> list:
     """BML corpus clips of ``split`` (performer split), their loops extended to ``n_frames``."""
 
-    path = Path(path) if path is not None else bml_corpus_path()
+    path = Path(path) if path is not None else DEFAULT_BML_PATH
     clips = load_real_corpus(path, skeleton="gait", split=split)
     for c in clips:
         c.motion = extend_loop(c.motion, n_frames)
@@ -109,8 +116,8 @@ def load_both_sequences(data: GaitDataConfig, labels: str = "acted", bandai_path
     ``finetune-both``: both corpora with licences, citations, splits and SHA-256, the labels and the augmentation)
     for the weights file's record. ``bandai_windows``: windows per Bandai take (default :data:`BANDAI_AUGMENT`'s 12;
     more weighs the four Bandai takes more against the 84 BML walks)."""
-    bandai = Path(bandai_path) if bandai_path is not None else real_corpus_path()
-    bml = Path(bml_path) if bml_path is not None else bml_corpus_path()
+    bandai = Path(bandai_path) if bandai_path is not None else DEFAULT_PATH
+    bml = Path(bml_path) if bml_path is not None else DEFAULT_BML_PATH
     bandai_train = stage_clips("finetune", "train", bandai)
     bml_train = bml_clips("train", bml)
     bml_val = bml_clips("val", bml)

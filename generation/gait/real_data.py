@@ -29,7 +29,7 @@ import numpy as np
 from generation.core.digest import file_sha256
 from generation.core.motion import Motion
 from generation.core.windows import windows
-from generation.mocap.real_corpus import load_real_corpus, real_corpus_path
+from generation.mocap.real_corpus import DEFAULT_PATH, load_real_corpus
 from study_protocol import CAPTURE_GAIT_EMOTIONS, GAIT_EMOTIONS
 
 from .config import GaitDataConfig
@@ -173,7 +173,7 @@ def load_real_sequences(stage: str, data: GaitDataConfig, augment: RealAugment |
     if val_clips:
         val = clip_sequences(val_clips, data, RealAugment.none())
         parts.append(replace(val, base_index=val.base_index + int(train.base_index.max()) + 1))
-    corpus = Path(path) if path is not None else real_corpus_path()
+    corpus = Path(path) if path is not None else DEFAULT_PATH
     training = TrainingData.real(stage, {
         "path": str(corpus), "sha256": file_sha256(corpus), "stage": stage,
         "augment": {"mirror": augment.mirror, "speed_factors": list(augment.speed_factors),

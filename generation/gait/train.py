@@ -44,6 +44,7 @@ from generation.core.device import (
 )
 from generation.core.digest import file_sha256
 from generation.core.splits import SPLITS
+from generation.mocap.real_corpus import real_corpus_path
 
 from .config import GaitNetConfig
 from .data import (
@@ -529,7 +530,7 @@ def build_parser() -> argparse.ArgumentParser:
                    help="train on the real-capture corpus instead (generation.gait.real_data): pretrain = forward "
                         "locomotion of both Bandai Namco datasets, labelled where the style is a gait emotion; "
                         "finetune = dataset 1's happy/sad/angry/normal walks; --corpus then names the real corpus "
-                        "file (default var/mocap/bandai-namco.npz)")
+                        "file (default $REAL_CORPUS, else var/mocap/bandai-namco.npz)")
     p.add_argument("--soft-labels", default=None, metavar="CLIP_NORMS.csv",
                    help="train on the rated walks of a clip_norms.csv (docs/study.md) with each one's perceived "
                         "share vector as its emotion target (with --real finetune: beside the real takes)")
@@ -643,11 +644,10 @@ SOFT_LABEL_WEIGHTS = Path("var/weights/gait_net_soft_labels.pt")
 def _soft_label_data(args, config: GaitNetConfig, log) -> GaitSequences:
     """The rated walks of ``--soft-labels`` (and, with ``--real``, that stage's real takes beside them); points
     ``--out`` away from the shipped weights."""
-    motions = args.motions or (Path(os.environ["MEDIA_ROOT"]) / "motions" if os.environ.get("MEDIA_ROOT") else None)
-    if motions is None:
+    if args.motions is None:
         raise SystemExit("--soft-labels: say where the clips' motions are (--motions DIR or MEDIA_ROOT)")
     try:
-        soft = load_soft_label_sequences(args.soft_labels, motions, config.data, study=args.norms_study,
+        soft = load_soft_label_sequences(args.soft_labels, args.motions, config.data, study=args.norms_study,
                                          min_ratings=args.min_ratings, catalogue=getattr(args, "clips", None))
     except (SoftLabelError, ValueError) as exc:
         raise SystemExit(f"--soft-labels: {exc}") from None
@@ -666,8 +666,21 @@ def _soft_label_data(args, config: GaitNetConfig, log) -> GaitSequences:
                                training_data=real.training_data.with_soft_labels(soft.training_data))
 
 
+def with_edge_paths(args: argparse.Namespace, real_corpus: str | Path,
+                    media_root: str | Path | None) -> argparse.Namespace:
+    """``args`` with the paths its edge (the command line, the Django command) fills in where they are left out:
+    with ``--real``, ``--corpus`` = ``real_corpus``; ``--motions`` = ``media_root/motions`` (when given)."""
+    if getattr(args, "real", None) and args.corpus is None:
+        args.corpus = str(real_corpus)
+    if getattr(args, "motions", None) is None and media_root:
+        args.motions = Path(media_root) / "motions"
+    return args
+
+
 def main(argv=None) -> int:
-    run(build_parser().parse_args(argv))
+    args = build_parser().parse_args(argv)
+    # $REAL_CORPUS: the real corpus of --real; $MEDIA_ROOT: the study app's media folder (rated clips' motions)
+    run(with_edge_paths(args, real_corpus_path(os.environ), os.environ.get("MEDIA_ROOT")))
     return 0
 
 

@@ -17,10 +17,13 @@ from __future__ import annotations
 
 import argparse
 import json
+import os
 import shutil
 from pathlib import Path
 
 import torch
+
+from generation.mocap.real_corpus import RealCorpora
 
 from .bml_data import LABEL_MODES, load_both_sequences
 from .config import GaitNetConfig
@@ -44,7 +47,8 @@ def main(argv=None) -> int:
     payload = torch.load(a.init, map_location="cpu", weights_only=False)
     config = GaitNetConfig.from_dict(payload["config"])
     config.train.epochs = a.epochs
-    data = load_both_sequences(config.data, a.labels, bandai_windows=a.bandai_windows)
+    corpora = RealCorpora.from_environ(os.environ)   # $REAL_CORPUS and $BML_CORPUS, else var/mocap/
+    data = load_both_sequences(config.data, a.labels, corpora.bandai, corpora.bml, bandai_windows=a.bandai_windows)
     n = {s: int(((data.split == s) & (data.offset == 0)).sum()) for s in ("train", "val")}
     print(f"{len(data)} rows ({n}); init {a.init}", flush=True)
     result = train(config, data, a.out, init=a.init, keep_epochs=True, max_minutes=a.max_minutes,

@@ -14,12 +14,14 @@ measured on the validation split (rollout pose error, r(peak wrist speed, arousa
 from __future__ import annotations
 
 import argparse
+import os
 from pathlib import Path
 
 import torch
 
 from generation.core.digest import file_sha256
 
+from . import config
 from .data import build_dataset
 from .generate import decode_examples, load_model
 from .metrics import dataset_pose_error
@@ -73,7 +75,8 @@ def main(argv: list[str] | None = None) -> dict:
     run["state_dict"] = average_states(states, shares)
     net = load_model(args.run)
     net.load_state_dict(run["state_dict"])
-    data = build_dataset(augment=0)  # the validation split does not depend on --augment
+    # the validation split does not depend on --augment; cached in $GESTURE_VAR_DIR, else var/gesture
+    data = build_dataset(augment=0, cache_dir=config.var_dir(os.environ))
     val = data.indices("val")
     figures = {"val_rollout": dataset_pose_error(decode_examples(net, data, val), data, val),
                "val_real_range": real_range_rollout(net, data, val)}

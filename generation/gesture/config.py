@@ -2,7 +2,7 @@
 from __future__ import annotations
 
 import hashlib
-import os
+from collections.abc import Mapping
 from pathlib import Path
 
 from study_protocol import GENDERS, HANDEDNESS  # noqa: F401 - the attribute one-hot orders
@@ -14,8 +14,18 @@ PROJECT_DIR = GENERATION_DIR.parent
 
 SENTENCES_CSV = GENERATION_DIR / "data" / "sentences_synthetic.csv"
 DEFAULT_WEIGHTS = GENERATION_DIR / "data" / "weights" / "gesture_net_default.pt"
-# Caches and checkpoints live under var/ (git-ignored); override with GESTURE_VAR_DIR.
-VAR_DIR = Path(os.environ.get("GESTURE_VAR_DIR", PROJECT_DIR / "var" / "gesture"))
+# Caches and checkpoints live under var/ (git-ignored); a command line takes another folder from --var-dir or
+# GESTURE_VAR_DIR (var_dir) and passes it down as ``cache_dir``.
+DEFAULT_VAR_DIR = PROJECT_DIR / "var" / "gesture"
+VAR_DIR_ENV_VAR = "GESTURE_VAR_DIR"
+
+
+def var_dir(environ: Mapping[str, str] | None = None) -> Path:
+    """The folder of the gesture caches and checkpoints: ``environ["GESTURE_VAR_DIR"]`` when ``environ`` is given
+    and sets it, else :data:`DEFAULT_VAR_DIR` (``<repo>/var/gesture``). Only command lines pass an environment;
+    library functions take the folder as an argument (``cache_dir``)."""
+    value = (environ or {}).get(VAR_DIR_ENV_VAR)
+    return Path(value) if value else DEFAULT_VAR_DIR
 
 
 # The network runs at a low frame rate (the 2-core CPU budget) and output is resampled (slerp).

@@ -481,7 +481,7 @@ def build_dataset(variants: int = 2, seed: int = 0, fps: float = config.TRAIN_FP
     """
     if isinstance(augment, bool) or not isinstance(augment, (int, np.integer)) or augment < 0:
         raise ValueError(f"augment must be a whole number >= 0 of extra training sentences, got {augment!r}")
-    cache_dir = Path(cache_dir) if cache_dir is not None else config.VAR_DIR
+    cache_dir = Path(cache_dir) if cache_dir is not None else config.DEFAULT_VAR_DIR
     rows = rows if rows is not None else load_sentences(sentences_csv)
     split = split_sentences(rows, seed)
     encodings = cached_encodings([r.sentence for r in rows], cache_dir / "sentence_tokens.npz")

@@ -150,9 +150,10 @@ def load_soft_label_dataset(norms_path: str | Path, motions_dir: str | Path, stu
     weights file: ``{path, sha256, study, n_clips, n_ratings, clips, target, skipped: {clip_id: why}}``.
 
     ``catalogue`` defaults to ``clips.csv`` beside the motions folder and ``records_dir`` to ``clip_records``
-    beside it (``MEDIA_ROOT``'s own layout); token vectors are cached in ``cache_dir`` (default the gesture
-    VAR_DIR). Raises SoftLabelError naming file, line and column for an unknown clip, a missing or foreign motion,
-    a gesture longer than ``max_frames`` at the network's rate, or no usable gesture at all."""
+    beside it (``MEDIA_ROOT``'s own layout); token vectors are cached in ``cache_dir`` (default
+    :data:`generation.gesture.config.DEFAULT_VAR_DIR`). Raises SoftLabelError naming file, line and column for an
+    unknown clip, a missing or foreign motion, a gesture longer than ``max_frames`` at the network's rate, or no
+    usable gesture at all."""
     norms_path, motions_dir = Path(norms_path), Path(motions_dir)
     source = norms_path.name
     rows = read_soft_labels(norms_path, min_ratings)
@@ -181,7 +182,7 @@ def load_soft_label_dataset(norms_path: str | Path, motions_dir: str | Path, stu
     if not used:
         raise SoftLabelError(f"{source}: none of its {len(rows)} rated gesture(s) has a sentence to train on "
                              f"({'; '.join(f'{k}: {v}' for k, v in skipped.items())})")
-    data = _dataset(used, speeches, motions, Path(cache_dir) if cache_dir is not None else config.VAR_DIR)
+    data = _dataset(used, speeches, motions, Path(cache_dir) if cache_dir is not None else config.DEFAULT_VAR_DIR)
     norms = norms_record(norms_path, used, study, target=TARGET, skipped=skipped)
     return data, norms
 

@@ -95,7 +95,7 @@ class TrainConfig:
     loss: LossWeights = field(default_factory=LossWeights)
     model: GestureNetConfig = field(default_factory=GestureNetConfig)
     out: str = str(config.DEFAULT_WEIGHTS)
-    checkpoint: str = str(config.VAR_DIR / "checkpoints" / "gesture_net.pt")
+    checkpoint: str = str(config.DEFAULT_VAR_DIR / "checkpoints" / "gesture_net.pt")
     resume: bool = False
     threads: int = 1
     # Every this many epochs, generate the validation gestures autoregressively and measure their pose error;
@@ -278,9 +278,11 @@ def _build(cfg: TrainConfig, device: torch.device):
 
 
 def train(cfg: TrainConfig, data: GestureDataset | None = None, progress: bool = True,
-          provenance: dict | None = None) -> dict:
+          provenance: dict | None = None, cache_dir: str | Path | None = None) -> dict:
     """Train and save; returns {"history": [...], "best_val", "epochs_run", "seconds", "device", "out"}.
-    ``provenance``: entries for the weights file saying what ``data`` is (``trained_on``, ``corpus``)."""
+    ``provenance``: entries for the weights file saying what ``data`` is (``trained_on``, ``corpus``);
+    ``cache_dir``: where the synthetic corpus is cached when ``data`` is None (default
+    :data:`generation.gesture.config.DEFAULT_VAR_DIR`)."""
 
     selected_by = _selected_by(cfg)  # an unusable selection rule fails before any data is built
     torch.set_num_threads(cfg.threads)
@@ -291,7 +293,7 @@ def train(cfg: TrainConfig, data: GestureDataset | None = None, progress: bool =
     scaler = torch.amp.GradScaler("cuda") if needs_grad_scaler(device, amp) else None
     if data is not None and cfg.augment:
         warnings.warn(f"augment={cfg.augment} is ignored: training on the given dataset as it is", stacklevel=2)
-    data = data if data is not None else build_dataset(variants=cfg.variants, seed=cfg.seed,
+    data = data if data is not None else build_dataset(variants=cfg.variants, seed=cfg.seed, cache_dir=cache_dir,
                                                        counterfactual=cfg.counterfactual, augment=cfg.augment)
     train_idx, val_idx = data.indices("train"), data.indices("val")
     if len(train_idx) == 0:
@@ -468,7 +470,10 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--min-ratings", type=int, default=1,
                    help="soft labels only from gestures with this many ratings")
     p.add_argument("--out", default=d.out, help="where the best weights go")
-    p.add_argument("--checkpoint", default=d.checkpoint)
+    p.add_argument("--var-dir", type=Path, default=config.var_dir(os.environ),
+                   help="caches (token vectors, procedural gesture pairs) and the default checkpoint folder "
+                        f"(default $GESTURE_VAR_DIR, else {config.DEFAULT_VAR_DIR})")
+    p.add_argument("--checkpoint", default=None, help="default VAR_DIR/checkpoints/gesture_net.pt")
     p.add_argument("--resume", action="store_true", help="continue from --checkpoint")
     p.add_argument("--threads", type=int, default=d.threads)
     p.add_argument("--quiet", action="store_true")
@@ -498,7 +503,8 @@ def config_from_args(args: argparse.Namespace) -> TrainConfig:
                      sampling=args.sampling,
                      sampling_ramp=args.sampling_ramp,
                      sampling_passes=args.sampling_passes, input_noise=args.input_noise, model=model, out=args.out,
-                     checkpoint=args.checkpoint, resume=args.resume, threads=args.threads,
+                     checkpoint=args.checkpoint or str(Path(args.var_dir) / "checkpoints" / "gesture_net.pt"),
+                     resume=args.resume, threads=args.threads,
                      init_from=args.init_from, device=args.device, amp=bool(args.amp),
                      rollout_every=args.rollout_every, select_emotion_gap=bool(args.select_emotion_gap),
                      select=args.select, max_pose_error=args.max_pose_error, min_arousal_r=args.min_arousal_r,
@@ -521,21 +527,21 @@ def soft_label_data(cfg: TrainConfig, args: argparse.Namespace, log=print) -> tu
     """The rated gestures of ``--soft-labels`` and the weights file's record of them (``trained_on``,
     ``corpus.soft_labels``); points ``cfg.out`` and ``cfg.checkpoint`` away from the shipped weights and the
     synthetic run's checkpoint when they are the defaults. ValueError (with file, line and column) on bad input."""
-    motions = args.motions or (Path(os.environ["MEDIA_ROOT"]) / "motions" if os.environ.get("MEDIA_ROOT") else None)
-    if motions is None:
+    if args.motions is None:
         raise ValueError("--soft-labels: say where the clips' motions are (--motions DIR or MEDIA_ROOT)")
     try:
-        data, norms = load_soft_label_dataset(args.soft_labels, motions, study=args.norms_study,
+        data, norms = load_soft_label_dataset(args.soft_labels, args.motions, study=args.norms_study,
                                               min_ratings=args.min_ratings, catalogue=args.clips,
-                                              records_dir=args.records, max_frames=cfg.model.max_frames, log=log)
+                                              records_dir=args.records, cache_dir=args.var_dir,
+                                              max_frames=cfg.model.max_frames, log=log)
     except SoftLabelError as exc:
         raise ValueError(f"--soft-labels: {exc}") from None
     defaults = TrainConfig()
     if Path(cfg.out).resolve() == Path(defaults.out).resolve():
         cfg.out = str(SOFT_LABEL_WEIGHTS)
         log(f"--soft-labels: writing {cfg.out} (the shipped weights are never replaced; --out to choose)")
-    if cfg.checkpoint == defaults.checkpoint:
-        cfg.checkpoint = str(Path(defaults.checkpoint).with_name("gesture_net_soft_labels.pt"))
+    if args.checkpoint is None:
+        cfg.checkpoint = str(Path(cfg.checkpoint).with_name("gesture_net_soft_labels.pt"))
     log(f"soft labels: {norms['n_clips']} rated gestures, {norms['n_ratings']} ratings, study {norms['study']}"
         + (f"; {len(norms['skipped'])} left out without a sentence" if norms["skipped"] else ""))
     description = (f"soft labels: {norms['n_clips']} rated gestures ({norms['n_ratings']} ratings, study "
@@ -546,6 +552,8 @@ def soft_label_data(cfg: TrainConfig, args: argparse.Namespace, log=print) -> tu
 def main(argv: list[str] | None = None) -> dict:
     parser = build_parser()
     args = parser.parse_args(argv)
+    if args.motions is None and os.environ.get("MEDIA_ROOT"):   # the study app's media folder
+        args.motions = Path(os.environ["MEDIA_ROOT"]) / "motions"
     data, provenance = None, None
     try:
         cfg = config_from_args(args)
@@ -553,7 +561,7 @@ def main(argv: list[str] | None = None) -> dict:
             data, provenance = soft_label_data(cfg, args)
     except ValueError as exc:  # unknown preset, unavailable device, bad norms: a usage error, not a traceback
         parser.error(str(exc))
-    summary = train(cfg, data=data, progress=not args.quiet, provenance=provenance)
+    summary = train(cfg, data=data, progress=not args.quiet, provenance=provenance, cache_dir=args.var_dir)
     last = summary["history"][-1] if summary["history"] else {}
     print(f"trained {summary['epochs_run']} epochs in {summary['seconds']:.0f} s on {summary['device']}; best "
           f"selection score {summary['best_val']:.5f}; last {json.dumps(last.get('val', {}))}; "

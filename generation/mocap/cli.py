@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import argparse
 import csv
+import os
 import sys
 from pathlib import Path
 
@@ -36,7 +37,7 @@ from .gesture_corpus import build_gesture_corpus, read_sentences, save_gesture_c
 from .importer import REPORT_COLUMNS, SUFFIXES, ImportOptions, import_file
 from .labels import LabelError, compile_pattern, label_for, label_from_pattern, read_labels
 from .positions import LAYOUTS
-from .real_corpus import real_corpus_path
+from .real_corpus import DEFAULT_BML_PATH, DEFAULT_PATH, RealCorpora
 from .rigs import JOINT_MAP_HELP, RigMapError, load_joint_map
 
 
@@ -106,8 +107,11 @@ def _add_dataset_parser(sub) -> None:
     ds.add_argument("source", choices=("bandai-namco", "emotion-gait-bml"),
                     help="the dataset's layout (emotion-gait-bml: DIR holds bml_walks.npz, positions only)")
     ds.add_argument("root", type=Path, metavar="DIR", help="folder holding the dataset (searched recursively)")
-    ds.add_argument("--out", type=Path, default=real_corpus_path(),
-                    help=f"corpus .npz to write (default {real_corpus_path()}, or $REAL_CORPUS)")
+    ds.add_argument("--out", type=Path, default=None,
+                    help=f"corpus .npz to write (default: bandai-namco $REAL_CORPUS, else {DEFAULT_PATH}; "
+                         f"emotion-gait-bml $BML_CORPUS, else {DEFAULT_BML_PATH})")
+    # where the readers of the corpora look when the same variables are set
+    ds.set_defaults(corpora=RealCorpora.from_environ(os.environ))
     ds.add_argument("--contents", nargs="+", choices=sorted(importable_contents()), metavar="CONTENT",
                     help=f"import only these contents (default: locomotion {names(LOCOMOTION_CONTENTS)}; "
                          f"gestures {names(GESTURE_CONTENTS)}; {names(FAST_CONTENTS)} only when named)")
@@ -124,11 +128,11 @@ def run_dataset(args) -> int:
         print("error: --limit and --workers must be at least 1", file=sys.stderr)
         return 2
     if args.source == "emotion-gait-bml":
-        out = args.out if args.out != real_corpus_path() else real_corpus_path().with_name("emotion-gait-bml.npz")
+        out = args.out or args.corpora.bml
         return build_emotion_gait_bml(args.root, out, args.height, args.build, args.quiet)
     try:
-        return build_bandai_namco(args.root, args.out, args.contents, args.limit, args.workers, args.height,
-                                  args.build, args.quiet)
+        return build_bandai_namco(args.root, args.out or args.corpora.bandai, args.contents, args.limit,
+                                  args.workers, args.height, args.build, args.quiet)
     except LayoutError as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 2

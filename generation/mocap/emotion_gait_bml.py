@@ -36,6 +36,7 @@ from __future__ import annotations
 
 import sys
 import zlib
+from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -47,7 +48,7 @@ from study_protocol import GAIT_EMOTIONS
 
 from .dataset_import import TAKE_COLUMNS, write_report
 from .importer import REPORT_COLUMNS, solve_onto, standing_height_m
-from .real_corpus import CorpusClip, save_real_corpus
+from .real_corpus import BML_ENV_VAR, DEFAULT_BML_PATH, CorpusClip, save_real_corpus
 from .root_travel import loop_period, reconstruct_root_travel, seam_frames
 
 DATASET = "emotion-gait-bml"
@@ -100,15 +101,16 @@ SPLIT_RULE = (f"Held out by performer (never by clip): the 30 BML actors are ran
               "train. A pure function of the performer's name, so adding clips never moves an actor.")
 
 
-DEFAULT_CORPUS = Path(__file__).resolve().parents[2] / "var" / "mocap" / "emotion-gait-bml.npz"
-CORPUS_ENV_VAR = "BML_CORPUS"
+DEFAULT_CORPUS = DEFAULT_BML_PATH
+CORPUS_ENV_VAR = BML_ENV_VAR
 
 
-def bml_corpus_path() -> Path:
-    """The BML corpus file: ``$BML_CORPUS`` if set, else ``<repo>/var/mocap/emotion-gait-bml.npz``."""
-    import os
-    env = os.environ.get(CORPUS_ENV_VAR)
-    return Path(env) if env else DEFAULT_CORPUS
+def bml_corpus_path(environ: Mapping[str, str] | None = None) -> Path:
+    """The BML corpus file: ``environ["BML_CORPUS"]`` when ``environ`` is given and sets it, else
+    :data:`DEFAULT_CORPUS` (``<repo>/var/mocap/emotion-gait-bml.npz``). Only the edges pass an environment (a
+    command line's ``main``, the Django settings); library functions take the path as an argument."""
+    value = (environ or {}).get(CORPUS_ENV_VAR)
+    return Path(value) if value else DEFAULT_CORPUS
 
 
 class BmlFormatError(ValueError):

@@ -129,7 +129,7 @@ def load_gesture_corpus(path: str | Path, seed: int = 0, cache_dir: str | Path |
                          f"(missing {', '.join(missing)})")
     rows = [SentenceRow(str(i), str(e), str(t), str(s))
             for i, e, t, s in zip(a["sentence_id"], a["emotion"], a["task"], a["sentence"])]
-    cache = Path(cache_dir) if cache_dir is not None else config.VAR_DIR
+    cache = Path(cache_dir) if cache_dir is not None else config.DEFAULT_VAR_DIR
     encodings = cached_encodings([r.sentence for r in rows], cache / "captured_sentence_tokens.npz")
     pairs = {"sentence_index": np.arange(len(rows)), "emotion": a["emotion"].astype(str),
              "gender": a["gender"].astype(str), "handedness": a["handedness"].astype(str),

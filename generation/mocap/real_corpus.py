@@ -1,7 +1,8 @@
 """The real-capture corpus: labelled captured clips on our gait and gesture skeletons in one ``.npz``, with filters.
 
-File layout (default ``var/mocap/bandai-namco.npz``, :func:`real_corpus_path`; the env var ``REAL_CORPUS``
-overrides it). Per skeleton kind K in {gait, gesture} that has clips:
+File layout (default ``var/mocap/bandai-namco.npz``, :data:`DEFAULT_PATH`; command lines take another from
+``--corpus`` or the env var ``REAL_CORPUS``, :func:`real_corpus_path`). Per skeleton kind K in {gait, gesture}
+that has clips:
 
 - ``K_rotations`` (sum of frames, J, 4) float32 local unit quaternions (w, x, y, z);
 - ``K_root_positions`` (sum of frames, 3) float32 metres, y-up;
@@ -18,7 +19,7 @@ from __future__ import annotations
 import json
 import math
 import os
-from collections.abc import Iterable
+from collections.abc import Iterable, Mapping
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -32,6 +33,9 @@ from study_protocol import MODALITIES
 REPO_ROOT = Path(__file__).resolve().parents[2]
 DEFAULT_PATH = REPO_ROOT / "var" / "mocap" / "bandai-namco.npz"
 ENV_VAR = "REAL_CORPUS"
+DEFAULT_BML_PATH = REPO_ROOT / "var" / "mocap" / "emotion-gait-bml.npz"
+"""The BML walks of Emotion-Gait in this file format (:mod:`generation.mocap.emotion_gait_bml`)."""
+BML_ENV_VAR = "BML_CORPUS"
 
 DATASETS = ("bandai-namco-1", "bandai-namco-2")
 SKELETON_KINDS = MODALITIES
@@ -80,10 +84,37 @@ class CorpusClip:
     source: str = ""
 
 
-def real_corpus_path() -> Path:
-    """The corpus file: ``$REAL_CORPUS`` if set, else ``<repo>/var/mocap/bandai-namco.npz``."""
-    env = os.environ.get(ENV_VAR)
-    return Path(env) if env else DEFAULT_PATH
+def real_corpus_path(environ: Mapping[str, str] | None = None) -> Path:
+    """The corpus file: ``environ["REAL_CORPUS"]`` when ``environ`` is given and sets it, else :data:`DEFAULT_PATH`
+    (``<repo>/var/mocap/bandai-namco.npz``). Only the edges pass an environment (a command line's ``main``, the
+    Django settings); library functions take the path as an argument and default to :data:`DEFAULT_PATH`."""
+    value = (environ or {}).get(ENV_VAR)
+    return Path(value) if value else DEFAULT_PATH
+
+
+@dataclass(frozen=True)
+class RealCorpora:
+    """Where the two real-capture corpus files are: ``bandai`` (Bandai Namco, this module's) and ``bml`` (the BML
+    walks of Emotion-Gait). The default is the built ones under ``var/mocap/``; an edge (a command line, the Django
+    settings) builds another with :meth:`of` or :meth:`from_environ` and passes it down (a render worker gets it
+    inside its job)."""
+
+    bandai: Path = DEFAULT_PATH
+    bml: Path = DEFAULT_BML_PATH
+
+    @classmethod
+    def of(cls, bandai: str | Path | None = None, bml: str | Path | None = None) -> RealCorpora:
+        """The corpora at ``bandai`` and ``bml``, each the default where None or empty."""
+        return cls(Path(bandai) if bandai else DEFAULT_PATH, Path(bml) if bml else DEFAULT_BML_PATH)
+
+    @classmethod
+    def from_environ(cls, environ: Mapping[str, str]) -> RealCorpora:
+        """The corpora that ``$REAL_CORPUS`` and ``$BML_CORPUS`` name in ``environ`` (defaults where unset)."""
+        return cls.of(environ.get(ENV_VAR), environ.get(BML_ENV_VAR))
+
+
+DEFAULT_CORPORA = RealCorpora()
+"""The built corpora under ``var/mocap/`` (the default of every function that takes ``corpora``)."""
 
 
 def _float_or_none(x: float) -> float | None:
@@ -162,10 +193,10 @@ def read_meta(path: str | Path | None = None) -> dict:
 
 
 def _open(path: str | Path | None):
-    path = Path(path) if path is not None else real_corpus_path()
+    path = Path(path) if path is not None else DEFAULT_PATH
     if not path.is_file():
         raise FileNotFoundError(f"{path}: no real-capture corpus there (build it with `python -m generation.mocap "
-                                f"dataset bandai-namco DIR --out {path}`, or set {ENV_VAR})")
+                                f"dataset bandai-namco DIR --out {path}`, or name another: --corpus, {ENV_VAR})")
     try:
         data = np.load(path, allow_pickle=False)
     except (OSError, ValueError) as exc:
@@ -178,7 +209,7 @@ def _open(path: str | Path | None):
 
 def load_real_corpus(path: str | Path | None = None, skeleton: str | None = None, split=None, contents=None,
                      styles=None) -> list[CorpusClip]:
-    """Clips of the corpus at ``path`` (default :func:`real_corpus_path`), in file order, keeping those whose
+    """Clips of the corpus at ``path`` (default :data:`DEFAULT_PATH`), in file order, keeping those whose
     skeleton is ``skeleton`` ("gait"/"gesture"), split is in ``split``, content in ``contents`` and style in
     ``styles`` (each a name or a collection of names; None keeps all). Only the kept clips are decoded.
 

@@ -2,10 +2,11 @@
 the projected figure height and an observer's reading: for gait clips the real-capture observer, or the synthetic
 one when the plan's ``qa: {observer: synthetic}`` asks or, for a plan that names none, ``gait_observer`` (the
 command line's ``--observer``, default ``$QA_GAIT_OBSERVER`` or real); for gesture clips the synthetic gesture
-observer), and the per-flag summary that ``generate_clips`` prints.
+observer), and the per-flag summary that ``generate_clips`` prints. The real gait observers are trained on the
+real-capture corpora that ``$REAL_CORPUS`` and ``$BML_CORPUS`` name (default: the built ones under var/mocap/).
 
     python -m generation.pipeline.plan_qa --plan seed000 [--limit K] [--modality gesture] [--no-figure-height]
-        [--observer real|synthetic] [--json out.json]
+        [--observer real|real-perceived|synthetic] [--json out.json]
 
 The video render computes the same record for every clip it makes (:func:`generation.pipeline.runner.render_job`).
 """
@@ -20,6 +21,7 @@ from collections import Counter
 from collections.abc import Iterable
 
 from generation.core.motion import Motion
+from generation.mocap.real_corpus import DEFAULT_CORPORA, RealCorpora
 from generation.plans.clipgen import make_motion
 from generation.plans.schema import load_plan
 from generation.quality.checks import QAResult, evaluate, gait_observer_kind, resolve_thresholds
@@ -56,11 +58,11 @@ def clip_qa(motion: Motion, settings, thresholds: dict, intended=None, observer=
     return result, camera_info
 
 
-def observer_for(modality: str, kind: str = "real"):
+def observer_for(modality: str, kind: str = "real", corpora: RealCorpora = DEFAULT_CORPORA):
     """The observer that reads clips of ``modality`` (:data:`generation.quality.observers.OBSERVERS`): "gait" with
-    ``kind`` real, real-perceived or synthetic; "gesture": the synthetic gesture observer. None for other modalities
-    or when it cannot be built (:func:`unread_line` then says why)."""
-    return OBSERVERS.for_modality(modality, kind)
+    ``kind`` real, real-perceived (trained on the real corpora ``corpora``) or synthetic; "gesture": the synthetic
+    gesture observer. None for other modalities or when it cannot be built (:func:`unread_line` then says why)."""
+    return OBSERVERS.for_modality(modality, kind, corpora)
 
 
 def summary_counts(flags: Iterable[str]) -> Counter:
@@ -120,19 +122,19 @@ def unread_line(records: Iterable[dict], gait_kind: str = "real") -> str:
 
 
 def run(plan_name: str, limit: int | None = None, log=print, modality: str | None = None,
-        figure_height: bool = True, gait_observer: str = "real") -> list[dict]:
+        figure_height: bool = True, gait_observer: str = "real", corpora: RealCorpora = DEFAULT_CORPORA) -> list[dict]:
     """Make every entry's motion and compute its quality record (no video). Returns one row per entry.
 
     ``modality``: only the entries of that modality ("gait" or "gesture"; None: all). ``figure_height=False``
     skips the camera projection (no ``figure_height`` check, faster). ``gait_observer``: the gait observer when
-    the plan names none (real, real-perceived or synthetic)."""
+    the plan names none (real, real-perceived or synthetic); ``corpora``: the real corpora of the real ones."""
     plan = load_plan(plan_name)
     thresholds = resolve_thresholds(plan.qa)
     kind = gait_observer_kind(plan.qa, gait_observer)
-    jobs, failures = plan_jobs(plan, limit, gait_observer=kind)
+    jobs, failures = plan_jobs(plan, limit, gait_observer=kind, corpora=corpora)
     if modality is not None:
         jobs = [j for j in jobs if j.run_entry.modality == modality]
-    observers = {m: observer_for(m, kind) for m in sorted({j.run_entry.modality for j in jobs})}
+    observers = {m: observer_for(m, kind, corpora) for m in sorted({j.run_entry.modality for j in jobs})}
     if "gait" in observers:
         log(observer_line(kind, observers["gait"]))
     rows = []
@@ -165,7 +167,7 @@ def main(argv=None) -> int:
     ap.add_argument("--json", default=None)
     args = ap.parse_args(argv)
     rows = run(args.plan, args.limit, modality=args.modality, figure_height=not args.no_figure_height,
-               gait_observer=args.observer)
+               gait_observer=args.observer, corpora=RealCorpora.from_environ(os.environ))
     print(f"plan {args.plan}: {len(rows)} clips; " + summary_line(r["flag"] for r in rows))
 
     for preset in presets_of_plan(args.plan):      # which section of the preset is short after the gate, and why

@@ -24,6 +24,7 @@ from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from generation.mocap.real_corpus import DEFAULT_CORPORA, RealCorpora
 from generation.plans.clipgen import make_motion, write_motion_bvh
 from generation.plans.schema import ClipEntry, Plan, intent_fields
 from generation.quality.checks import QAResult, failed_checks
@@ -160,7 +161,7 @@ def render_job(job: Job, record: dict, clips_dir: str, records_dir: str) -> dict
 
 def _add_qa(record: dict, job: Job, motion, camera: dict) -> None:
     """Measure the clip's quality (:mod:`generation.quality`) into ``record["qa"]`` and ``record["qa_flag"]``."""
-    observer = observer_for(job.run_entry.modality, job.gait_observer)
+    observer = observer_for(job.run_entry.modality, job.gait_observer, job.corpora)
     result, _ = clip_qa(motion, job.run_entry.render, job.qa_thresholds, intended_emotion(job.run_entry.inputs),
                         observer, camera_info=camera)
     record["qa"] = _json_safe(result.as_dict())
@@ -345,7 +346,8 @@ def _render_dask(batch: _Batch, todo: list[Job], scheduler, threads_per_worker: 
 def run_plan(plan: Plan, clips_dir: str | Path, records_dir: str | Path, media_prefix: str = "clips/",
              workers: int = 1, webm: bool = False, limit: int | None = None,
              on_event: Callable[[str, dict], None] | None = None, threads_per_worker: int = 1,
-             scheduler=None, device: str = "cpu", gait_observer: str = "real") -> BatchResult:
+             scheduler=None, device: str = "cpu", gait_observer: str = "real",
+             corpora: RealCorpora = DEFAULT_CORPORA) -> BatchResult:
     """Render every entry of ``plan`` that is not already complete.
 
     Args:
@@ -363,6 +365,8 @@ def run_plan(plan: Plan, clips_dir: str | Path, records_dir: str | Path, media_p
         device: torch device of the network generators (gait_net, gesture_net), carried to every worker.
         gait_observer: the gait observer (:data:`study_protocol.QA_OBSERVERS`: real, real-perceived or synthetic)
             that reads the clips of a plan that names none.
+        corpora: where the real-capture corpora of the real gait observers are (default: the built ones under
+            ``var/mocap/``), carried to every worker.
     Returns a BatchResult with the records of every clip of the plan that exists now.
     """
     t0 = time.perf_counter()
@@ -370,7 +374,7 @@ def run_plan(plan: Plan, clips_dir: str | Path, records_dir: str | Path, media_p
     clips_dir.mkdir(parents=True, exist_ok=True)
     records_dir.mkdir(parents=True, exist_ok=True)
     emit = on_event or (lambda kind, info: None)
-    jobs, failures = plan_jobs(plan, limit, device, gait_observer)
+    jobs, failures = plan_jobs(plan, limit, device, gait_observer, corpora)
     batch = _Batch(clips_dir, records_dir, emit, BatchResult(failed=list(failures)))
     for where, msg in failures:
         emit("fail", {"entry": where, "error": msg})
@@ -380,7 +384,7 @@ def run_plan(plan: Plan, clips_dir: str | Path, records_dir: str | Path, media_p
     if workers > 1 or scheduler is not None:
         for modality in sorted({j.run_entry.modality for j in todo}):
             # train/cache the quality observers once, not in every worker
-            observer_for(modality, todo[0].gait_observer)
+            observer_for(modality, todo[0].gait_observer, todo[0].corpora)
     if scheduler is not None:
         _render_dask(batch, todo, scheduler, threads_per_worker)
     elif workers <= 1 or len(todo) <= 1:

@@ -34,8 +34,7 @@ import numpy as np
 
 from generation.core.digest import file_sha256
 from generation.core.motion import Motion
-from generation.mocap.emotion_gait_bml import bml_corpus_path
-from generation.mocap.real_corpus import load_real_corpus, real_corpus_path
+from generation.mocap.real_corpus import DEFAULT_BML_PATH, DEFAULT_PATH, load_real_corpus
 from study_protocol import CAPTURE_GAIT_EMOTIONS, GAIT_EMOTIONS
 
 from . import real_observer as ro
@@ -156,8 +155,8 @@ def judge_against_reference(read_as_intended: dict[str, float], heldout_recall: 
 def split_clips(bandai_path: str | Path | None = None, bml_path: str | Path | None = None):
     """(train, heldout) CorpusClips: Bandai dataset-1 emotion walks of the training split and BML train + val
     performers; held out: the BML test performers."""
-    bandai = Path(bandai_path) if bandai_path is not None else real_corpus_path()
-    bml = Path(bml_path) if bml_path is not None else bml_corpus_path()
+    bandai = Path(bandai_path) if bandai_path is not None else DEFAULT_PATH
+    bml = Path(bml_path) if bml_path is not None else DEFAULT_BML_PATH
     train = [c for c in load_real_corpus(bandai, skeleton="gait", split="train", contents="walk")
              if c.dataset == ro.EMOTION_DATASET and c.style in CAPTURE_GAIT_EMOTIONS]
     train += load_real_corpus(bml, skeleton="gait", split=("train", "val"))
@@ -180,8 +179,8 @@ def observer_version(labels: str = "acted", bandai_path: str | Path | None = Non
                      bml_path: str | Path | None = None) -> str | None:
     """Key of the two corpus files' versions (path, modification time) and the label variant; None when either
     corpus file is missing (then there is no calibrated observer)."""
-    bandai = Path(bandai_path) if bandai_path is not None else real_corpus_path()
-    bml = Path(bml_path) if bml_path is not None else bml_corpus_path()
+    bandai = Path(bandai_path) if bandai_path is not None else DEFAULT_PATH
+    bml = Path(bml_path) if bml_path is not None else DEFAULT_BML_PATH
     if not (bandai.is_file() and bml.is_file()):
         return None
     return f"{labels}:{bandai}:{bandai.stat().st_mtime_ns}:{bml}:{bml.stat().st_mtime_ns}"
@@ -191,8 +190,8 @@ def load_calibrated_observer(labels: str = "acted", bandai_path: str | Path | No
                              bml_path: str | Path | None = None) -> CalibratedGaitObserver | None:
     """The calibrated observer of the corpora (default: the built ones), from its cache file in var/quality/ (named
     by the corpora's digests) or trained; None when either corpus file is missing."""
-    bandai = Path(bandai_path) if bandai_path is not None else real_corpus_path()
-    bml = Path(bml_path) if bml_path is not None else bml_corpus_path()
+    bandai = Path(bandai_path) if bandai_path is not None else DEFAULT_PATH
+    bml = Path(bml_path) if bml_path is not None else DEFAULT_BML_PATH
     if not (bandai.is_file() and bml.is_file()):
         return None
     sha = file_sha256(bandai)[:8] + file_sha256(bml)[:8]

@@ -17,6 +17,7 @@ from pathlib import Path
 from typing import Protocol, runtime_checkable
 
 from generation.core.motion import Motion
+from generation.mocap.real_corpus import DEFAULT_CORPORA, RealCorpora
 
 from . import calibrated_observer, gesture_observer, observer, real_observer
 from .checks import check_gait_observer
@@ -51,22 +52,28 @@ class Observers:
             self._loaded[key] = load()
         return self._loaded[key]
 
-    def gait(self, kind: str = "real", corpus_path: str | Path | None = None) -> Observer | None:
-        """The ``kind`` gait observer of the corpus at ``corpus_path`` (default: its module's default corpus);
-        None when it cannot be built here. ``real``: the observer calibrated on both real corpora (acted labels)
-        when both are built, else the Bandai-only one; ``real-perceived``: the calibrated one with perceived
-        labels (None without both corpora); ``synthetic``: the procedural-corpus one."""
+    def gait(self, kind: str = "real", corpus_path: str | Path | None = None,
+             corpora: RealCorpora = DEFAULT_CORPORA) -> Observer | None:
+        """The ``kind`` gait observer; None when it cannot be built here. ``real``: the observer calibrated on both
+        real corpora of ``corpora`` (acted labels) when both are built, else the Bandai-only one of
+        ``corpora.bandai``; ``real-perceived``: the calibrated one with perceived labels (None without both
+        corpora); ``synthetic``: the procedural-corpus one. ``corpus_path`` names the one corpus file instead:
+        real kinds then give the Bandai-only observer of that file, ``synthetic`` the one of that procedural
+        corpus."""
         kind = check_gait_observer(kind)
         if kind == "synthetic":
             return self._get("synthetic", observer.observer_version(corpus_path),
                              lambda: observer.load_observer(corpus_path))
-        if corpus_path is None:
-            labels = "acted" if kind == "real" else "perceived"
-            calibrated = self._get(f"calibrated-{labels}", calibrated_observer.observer_version(labels),
-                                   lambda: calibrated_observer.load_calibrated_observer(labels))
-            if calibrated is not None or kind == "real-perceived":
-                return calibrated
-        return self._real(corpus_path)
+        if corpus_path is not None:
+            return self._real(corpus_path)
+        labels = "acted" if kind == "real" else "perceived"
+        calibrated = self._get(f"calibrated-{labels}",
+                               calibrated_observer.observer_version(labels, corpora.bandai, corpora.bml),
+                               lambda: calibrated_observer.load_calibrated_observer(labels, corpora.bandai,
+                                                                                    corpora.bml))
+        if calibrated is not None or kind == "real-perceived":
+            return calibrated
+        return self._real(corpora.bandai)
 
     def _real(self, corpus_path: str | Path | None) -> Observer | None:
         return self._get("real", real_observer.observer_version(corpus_path),
@@ -77,11 +84,12 @@ class Observers:
         return self._get("synthetic-gesture", gesture_observer.observer_version(),
                          gesture_observer.load_gesture_observer)
 
-    def for_modality(self, modality: str, gait_kind: str = "real") -> Observer | None:
-        """The observer that reads clips of ``modality`` ("gait": the ``gait_kind`` one; "gesture"); None for
-        other modalities."""
+    def for_modality(self, modality: str, gait_kind: str = "real",
+                     corpora: RealCorpora = DEFAULT_CORPORA) -> Observer | None:
+        """The observer that reads clips of ``modality`` ("gait": the ``gait_kind`` one of the real corpora
+        ``corpora``; "gesture"); None for other modalities."""
         if modality == "gait":
-            return self.gait(gait_kind)
+            return self.gait(gait_kind, corpora=corpora)
         if modality == "gesture":
             return self.gesture()
         return None

@@ -6,7 +6,7 @@ corpus seated on the chair, their statistics, and their per-emotion ranges for t
 
 Real clips: the Bandai Namco Research Motion Dataset 1's bow, bye, byebye and guide takes (one take per content and
 style; Kobayashi et al. 2023, arXiv:2306.08861, CC BY-NC 4.0), from the real corpus
-(:func:`generation.mocap.real_corpus.real_corpus_path`), seated with
+(``--corpus``, else ``$REAL_CORPUS``, else ``var/mocap/bandai-namco.npz``), seated with
 :func:`generation.mocap.seated_gesture.seat_gesture`, measured with :func:`generation.gesture.real_stats.motion_stats`
 and labelled with the gesture emotion their style names (``study_protocol.CAPTURE_GESTURE_EMOTIONS``).
 """
@@ -14,11 +14,12 @@ from __future__ import annotations
 
 import argparse
 import json
+import os
 from pathlib import Path
 
 from generation.core.motion import Motion
 from generation.gesture.real_stats import RANGES_FILE, STAT_NAMES, STATS_FPS, motion_stats, real_ranges
-from generation.mocap.real_corpus import CITATION, LICENCE, load_real_corpus
+from generation.mocap.real_corpus import CITATION, LICENCE, load_real_corpus, real_corpus_path
 from generation.mocap.seated_gesture import seat_gesture
 from study_protocol import CAPTURE_GESTURE_EMOTIONS
 
@@ -28,7 +29,7 @@ REAL_CONTENTS = ("bow", "bye", "byebye", "guide")
 def real_gesture_clips(path=None, contents=REAL_CONTENTS, styles=None, split=None) -> list[tuple[str, str, Motion]]:
     """(name, style, seated Motion) of the real corpus's dataset-1 gesture takes of ``contents`` in ``styles``
     (default: the styles that name a gesture emotion), seated on the chair. Needs the real corpus at ``path``
-    (default :func:`generation.mocap.real_corpus.real_corpus_path`)."""
+    (default ``var/mocap/bandai-namco.npz``, :data:`generation.mocap.real_corpus.DEFAULT_PATH`)."""
     styles = tuple(CAPTURE_GESTURE_EMOTIONS) if styles is None else tuple(styles)
     clips = load_real_corpus(path, skeleton="gesture", contents=contents, styles=styles, split=split)
     return [(c.name, c.style, seat_gesture(c.motion)) for c in clips if c.dataset == "bandai-namco-1"]
@@ -57,7 +58,8 @@ def write_ranges(path: str | Path, rows: list[dict]) -> dict:
 def main(argv=None) -> None:
     p = argparse.ArgumentParser(description="Statistics of the real captured gestures, seated (per take); "
                                             "--write-ranges stores the per-emotion ranges for training.")
-    p.add_argument("--corpus", default=None, help="real-capture corpus (default: generation.mocap.real_corpus_path)")
+    p.add_argument("--corpus", type=Path, default=real_corpus_path(os.environ),
+                   help="real-capture corpus (default: $REAL_CORPUS, else var/mocap/bandai-namco.npz)")
     p.add_argument("--write-ranges", action="store_true", help=f"write {RANGES_FILE}")
     args = p.parse_args(argv)
     rows = real_stats_table(real_gesture_clips(args.corpus))

@@ -39,7 +39,7 @@ from generation.core.skeleton import GAIT_JOINTS
 from generation.core.windows import windows
 from generation.mocap.bandai_namco import shipped_takes
 from generation.mocap.dataset_import import import_take
-from generation.mocap.real_corpus import load_real_corpus, real_corpus_path
+from generation.mocap.real_corpus import DEFAULT_PATH, load_real_corpus
 from study_protocol import CAPTURE_GAIT_EMOTIONS, GAIT_EMOTIONS
 
 from .pickle_cache import load_or_build
@@ -178,7 +178,7 @@ class RealGaitObserver(WindowedGaitObserver):
 def train_real_observer(corpus_path: str | Path | None = None) -> RealGaitObserver:
     """A RealGaitObserver fitted on the gait takes of the corpus's training split."""
 
-    path = Path(corpus_path) if corpus_path is not None else real_corpus_path()
+    path = Path(corpus_path) if corpus_path is not None else DEFAULT_PATH
     clips = load_real_corpus(path, skeleton="gait", split="train")
     return RealGaitObserver(clips, source=f"real-capture corpus {path.name} (training split, {len(clips)} gait takes)")
 
@@ -200,7 +200,7 @@ def shipped_clips() -> list:
 
 def observer_version(corpus_path: str | Path | None = None) -> str:
     """Key of the corpus file's version (path, modification time, size), or ``shipped`` without the file."""
-    path = Path(corpus_path) if corpus_path is not None else real_corpus_path()
+    path = Path(corpus_path) if corpus_path is not None else DEFAULT_PATH
     if not path.is_file():
         return "shipped"
     st = path.stat()
@@ -209,9 +209,9 @@ def observer_version(corpus_path: str | Path | None = None) -> str:
 
 def load_real_observer(corpus_path: str | Path | None = None) -> RealGaitObserver | None:
     """The real-capture observer: from the cache file, or trained (and cached) on the corpus file (default
-    :func:`generation.mocap.real_corpus.real_corpus_path`); without that file, on the shipped real takes
+    :data:`generation.mocap.real_corpus.DEFAULT_PATH`); without that file, on the shipped real takes
     (``source`` says so); None when neither is there."""
-    path = Path(corpus_path) if corpus_path is not None else real_corpus_path()
+    path = Path(corpus_path) if corpus_path is not None else DEFAULT_PATH
     if path.is_file():
         sha = file_sha256(path)
         return load_or_build(CACHE_DIR / f"real_gait_observer_v{DESCRIPTOR_VERSION}_{sha[:12]}.pkl",

@@ -24,6 +24,7 @@ from __future__ import annotations
 import argparse
 import json
 import math
+import os
 import sys
 from collections import defaultdict
 from pathlib import Path
@@ -144,10 +145,11 @@ def measure_corpus(clips) -> list[dict]:
 def main(argv=None) -> int:
 
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--corpus", default=None, help="real-capture corpus (default: $REAL_CORPUS or var/mocap/)")
+    ap.add_argument("--corpus", type=Path, default=real_corpus_path(os.environ),
+                    help="real-capture corpus (default: $REAL_CORPUS, else var/mocap/bandai-namco.npz)")
     ap.add_argument("--out", default=str(RANGES_PATH))
     args = ap.parse_args(argv)
-    path = Path(args.corpus) if args.corpus else real_corpus_path()
+    path = args.corpus
     rows = measure_corpus(load_real_corpus(path, skeleton="gait"))
     data = compute_ranges(rows)
     meta = read_meta(path)

@@ -4,12 +4,14 @@
     python -m generation.rbf features [--corpus CORPUS] [--out generation/data/rbf/data_features.json]
 
 CORPUS is the real-capture corpus (``python -m generation.mocap dataset bandai-namco DIR --out CORPUS``; default
-``var/mocap/bandai-namco.npz`` or $REAL_CORPUS). Both read the train split only.
+$REAL_CORPUS, else ``var/mocap/bandai-namco.npz``). Both read the train split only.
 """
 from __future__ import annotations
 
 import argparse
+import os
 import sys
+from pathlib import Path
 
 from generation.core.skeleton import GAIT_JOINTS
 from generation.mocap.real_corpus import load_real_corpus, real_corpus_path
@@ -25,7 +27,8 @@ def main(argv: list[str] | None = None) -> int:
     for name, help_ in (("neutral", "average real normal-walk cycles into the neutral base cycle"),
                         ("features", "fit data-driven RBF features per theme to real themed walks")):
         p = sub.add_parser(name, help=help_)
-        p.add_argument("--corpus", default=None, help="real-capture corpus .npz (default: REAL_CORPUS or var/mocap)")
+        p.add_argument("--corpus", type=Path, default=real_corpus_path(os.environ),
+                       help="real-capture corpus .npz (default: $REAL_CORPUS, else var/mocap/bandai-namco.npz)")
         p.add_argument("--out", default=None, help="output file (default: the shipped file in generation/data/rbf)")
     args = parser.parse_args(argv)
     if args.command == "neutral":
@@ -38,7 +41,7 @@ def main(argv: list[str] | None = None) -> int:
         return 0
 
 
-    clips = load_real_corpus(args.corpus or real_corpus_path(), skeleton="gait", split="train", contents=["walk"])
+    clips = load_real_corpus(args.corpus, skeleton="gait", split="train", contents=["walk"])
     features = fit_data_features(clips, GAIT_JOINTS)
     save_data_features(features, args.out or FEATURES_PATH)
     for theme, entry in features["themes"].items():

@@ -30,7 +30,7 @@ import numpy as np
 
 from generation.core.motion import Motion
 from generation.core.skeleton import Skeleton, gait_skeleton
-from generation.mocap.real_corpus import load_real_corpus, real_corpus_path
+from generation.mocap.real_corpus import DEFAULT_PATH, load_real_corpus
 
 from .neutral_base import NormalisedCycle, average_cycles, cycle_motion, motion_cycles
 
@@ -153,7 +153,7 @@ def real_neutral_from_clips(clips: list, skeleton: Skeleton | None = None, m: in
 def corpus_normal_walks(corpus_path: str | Path | None = None, split: str = "train") -> list:
     """Straight normal walks (content ``walk``, style ``normal``) of the real corpus, both datasets."""
 
-    return load_real_corpus(corpus_path or real_corpus_path(), skeleton="gait", split=split, contents=["walk"],
+    return load_real_corpus(corpus_path or DEFAULT_PATH, skeleton="gait", split=split, contents=["walk"],
                             styles=["normal"])
 
 

@@ -5,7 +5,8 @@
 
 Thin wrapper over :mod:`generation.pipeline.runner`: the plan is validated before anything renders, clips whose
 files are complete are skipped (resumable), files are written under temporary names and renamed. Every clip gets
-a quality record (generation.quality); the command ends with a summary of clips per flag. With ``--scheduler``
+a quality record (generation.quality; the real gait observers are trained on the corpora of the settings
+REAL_CORPUS and BML_CORPUS); the command ends with a summary of clips per flag. With ``--scheduler``
 the clips render on a Dask distributed cluster whose workers share this media folder.
 """
 from __future__ import annotations
@@ -19,6 +20,7 @@ from django.db.migrations.executor import MigrationExecutor
 from tqdm import tqdm
 
 from generation.core.device import resolve_device
+from generation.mocap.real_corpus import RealCorpora
 from generation.pipeline.plan_qa import summary_line, unread_line
 from generation.pipeline.runner import run_plan
 from generation.pipeline.section_coverage import coverage_lines, presets_of_plan
@@ -91,7 +93,8 @@ class Command(BaseCommand):
         try:
             result = run_plan(plan, clips_dir, records_dir, media_prefix="clips/", workers=opts["workers"],
                               webm=opts["webm"], limit=opts["limit"], on_event=bars.event,
-                              scheduler=opts["scheduler"], device=device, gait_observer=gait_observer)
+                              scheduler=opts["scheduler"], device=device, gait_observer=gait_observer,
+                              corpora=RealCorpora.of(settings.REAL_CORPUS, settings.BML_CORPUS))
         except OSError as exc:  # e.g. no Dask scheduler at that address
             raise CommandError(f"cannot render: {exc}") from None
         finally:

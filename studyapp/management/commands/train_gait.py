@@ -4,9 +4,11 @@
 """
 from __future__ import annotations
 
+from django.conf import settings
 from django.core.management.base import BaseCommand, CommandError
 
-from generation.gait.train import build_parser, run
+from generation.gait.train import build_parser, run, with_edge_paths
+from generation.mocap.real_corpus import RealCorpora
 from studyapp.management.cli import mirror_arguments, mirrored_namespace
 
 
@@ -21,6 +23,7 @@ class Command(BaseCommand):
         ns = mirrored_namespace(build_parser(), options)
         if ns.set is None:
             ns.set = []
+        with_edge_paths(ns, RealCorpora.of(settings.REAL_CORPUS).bandai, settings.MEDIA_ROOT)
         try:
             run(ns, log=lambda msg: self.stdout.write(msg))
         except SystemExit as exc:   # the library reports bad options (--device, --config, --set) this way

@@ -1,10 +1,14 @@
 """``manage.py train_gesture``: train the Text2Gestures network (thin wrapper over generation.gesture.train).
 
 Same options as ``python -m generation.gesture.train``, including ``--config small|paper``,
-``--device auto|cpu|cuda[:N]`` and ``--amp``.
+``--device auto|cpu|cuda[:N]``, ``--amp`` and ``--var-dir`` (default ``$GESTURE_VAR_DIR``, else var/gesture);
+``--soft-labels`` reads the rated clips' motions from ``--motions``, else this app's ``MEDIA_ROOT/motions``.
 """
 from __future__ import annotations
 
+from pathlib import Path
+
+from django.conf import settings
 from django.core.management.base import BaseCommand, CommandError
 
 from generation.gesture.train import build_parser, config_from_args, soft_label_data, train
@@ -24,6 +28,8 @@ class Command(BaseCommand):
 
     def handle(self, *args, **options):
         ns = mirrored_namespace(build_parser(), options)
+        if ns.motions is None:
+            ns.motions = Path(settings.MEDIA_ROOT) / "motions"
         try:
             cfg = config_from_args(ns)
         except ValueError as exc:  # unknown preset, unavailable device
@@ -39,10 +45,10 @@ class Command(BaseCommand):
         elif options.get("corpus"):
 
             try:
-                data = load_gesture_corpus(options["corpus"], seed=cfg.seed)
+                data = load_gesture_corpus(options["corpus"], seed=cfg.seed, cache_dir=ns.var_dir)
             except ValueError as exc:
                 raise CommandError(str(exc)) from exc
-        summary = train(cfg, data=data, progress=not ns.quiet, provenance=provenance)
+        summary = train(cfg, data=data, progress=not ns.quiet, provenance=provenance, cache_dir=ns.var_dir)
         self.stdout.write(f"trained {summary['epochs_run']} epochs in {summary['seconds']:.0f} s on "
                           f"{summary['device']}; best selection score {summary['best_val']:.5f}; "
                           f"weights -> {summary['out']}")
