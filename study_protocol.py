@@ -238,7 +238,8 @@ QA_FLOAT_COLUMNS = ("qa_foot_skate_cm_s", "qa_penetration_cm", "qa_jerk", "qa_bo
 QA_OBSERVERS = ("real", "real-perceived", "synthetic")
 """Which gait observer fills ``qa_observed`` (plan ``qa: {observer: ...}``, env ``QA_GAIT_OBSERVER``): ``real``, a
 classifier trained on real captured walks with the actors' acted labels (the default: calibrated on both real
-corpora when both are built, generation/quality/calibrated_observer.py, else generation/quality/real_observer.py),
+corpora, generation/quality/calibrated_observer.py, trained when both are built, else its fitted parameters shipped in
+generation/data/observers/; without those, generation/quality/real_observer.py),
 ``real-perceived``, the calibrated one with the BML annotators' perceived labels, or ``synthetic``, trained on the
 procedural corpus (generation/quality/observer.py)."""
 

@@ -6,7 +6,8 @@
   builders (:func:`_is_edge_function`), plus the one documented exception (the render process set-up). A new read
   anywhere else fails, and so does an entry of the list that no longer reads anything (the list stays exact);
 - the edges still honour the variables they read: REAL_CORPUS, BML_CORPUS, GESTURE_VAR_DIR and MEDIA_ROOT on the
-  command lines, and the settings REAL_CORPUS / BML_CORPUS / MEDIA_ROOT in the Django commands.
+  command lines (the observer export among them), and the settings REAL_CORPUS / BML_CORPUS / MEDIA_ROOT in the
+  Django commands.
 """
 from __future__ import annotations
 
@@ -40,6 +41,7 @@ EDGE_READS = {
     ("generation/mocap/cli.py", "_add_dataset_parser"): "REAL_CORPUS, BML_CORPUS (where `dataset` writes "
                                                         "without --out)",
     ("generation/pipeline/plan_qa.py", "main"): "QA_GAIT_OBSERVER (--observer default), REAL_CORPUS, BML_CORPUS",
+    ("generation/quality/calibrated_observer.py", "main"): "REAL_CORPUS, BML_CORPUS (--bandai / --bml defaults)",
     ("generation/quality/real_gestures.py", "main"): "REAL_CORPUS (--corpus default)",
     ("generation/quality/realism_ranges.py", "main"): "REAL_CORPUS (--corpus default)",
     ("generation/rbf/__main__.py", "main"): "REAL_CORPUS (--corpus default)",
@@ -190,6 +192,23 @@ def test_gesture_training_command_line_takes_its_folders_from_the_environment(tm
         "history": [], "epochs_run": 0, "seconds": 0.0, "device": "cpu", "best_val": 0.0, "out": cfg.out})
     gesture_train.main(["--soft-labels", "norms.csv", "--quiet"])
     assert seen == {"motions": tmp_path / "media" / "motions", "cache_dir": tmp_path / "gvar"}
+
+
+def test_observer_export_takes_the_corpora_from_the_environment(tmp_path, monkeypatch):
+    from generation.quality import calibrated_observer
+
+    seen = []
+    monkeypatch.setattr(calibrated_observer, "export_observers",
+                        lambda out, bandai, bml, labels: seen.append((out, bandai, bml)) or [])
+    for name in ("bandai.npz", "bml.npz", "given.npz"):
+        (tmp_path / name).touch()
+    monkeypatch.setenv("REAL_CORPUS", str(tmp_path / "bandai.npz"))
+    monkeypatch.setenv("BML_CORPUS", str(tmp_path / "bml.npz"))
+    out = ["export", "--out", str(tmp_path / "out")]
+    assert calibrated_observer.main(out) == 0
+    assert calibrated_observer.main([*out, "--bml", str(tmp_path / "given.npz")]) == 0
+    assert seen == [(tmp_path / "out", tmp_path / "bandai.npz", tmp_path / "bml.npz"),
+                    (tmp_path / "out", tmp_path / "bandai.npz", tmp_path / "given.npz")]
 
 
 def test_manage_py_training_commands_take_the_settings_paths(tmp_path, monkeypatch, settings):

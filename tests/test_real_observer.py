@@ -22,8 +22,10 @@ def shipped():
 
 @pytest.fixture()
 def fresh(monkeypatch, tmp_path):
-    """An empty in-memory observer cache and a temporary pickle folder."""
+    """An empty in-memory observer cache, a temporary pickle folder and no shipped calibrated observers (so that
+    without both corpora the Bandai-only observer is read, as on a machine without those files)."""
     monkeypatch.setattr(ro, "CACHE_DIR", tmp_path / "cache")
+    monkeypatch.setattr(OBSERVERS, "shipped_dir", tmp_path / "no-shipped-observers")
     OBSERVERS.clear()
     yield tmp_path
     OBSERVERS.clear()
@@ -109,7 +111,8 @@ def test_a_stored_gait_record_from_another_observer_is_measured_again(shipped, t
 
 def test_the_real_corpora_travel_with_the_job_to_the_observer(shipped, fresh, monkeypatch):
     """The corpora a command line or the settings name reach the observer of every clip inside its job (a render
-    worker never looks them up itself); without both corpus files the Bandai one of ``corpora`` is read."""
+    worker never looks them up itself); without both corpus files (and without the shipped calibrated observers)
+    the Bandai one of ``corpora`` is read."""
     from generation.pipeline import runner
     from generation.pipeline.jobs import plan_jobs
     from generation.plans.schema import validate_plan
@@ -125,4 +128,4 @@ def test_the_real_corpora_travel_with_the_job_to_the_observer(shipped, fresh, mo
     runner._add_qa({}, job, shipped[0].motion, None)
     assert asked == [corpora]
     assert "named.npz" in OBSERVERS.gait("real", corpora=corpora).source
-    assert OBSERVERS.gait("real-perceived", corpora=corpora) is None           # needs both corpus files
+    assert OBSERVERS.gait("real-perceived", corpora=corpora) is None   # needs both corpus files or the shipped one

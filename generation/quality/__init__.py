@@ -12,10 +12,12 @@ Public interface:
                                             knee flexion, pelvis bounce, speed variability (realism.py)
     realism_ranges.realism_thresholds()     the real corpus's ranges of those measures (realism_ranges.json)
     RealGaitObserver                        logistic regression over the 4 gait emotions trained on real captured
-                                            walks (real_observer.py; the gate's gait observer without the BML corpus)
+                                            walks (real_observer.py; the gate's gait observer only when neither
+                                            both corpora nor the shipped calibrated parameters are there)
     CalibratedGaitObserver                  the same trained on both real corpora, with its recall on held-out real
                                             actors per class and advisory flags below 0.6 (calibrated_observer.py;
-                                            the gate's gait observer when both corpora are built)
+                                            the gate's gait observer: trained when both corpora are built, else
+                                            read from its parameters in generation/data/observers/)
     GaitObserver                            logistic regression on the 18 gait affective features (synthetic)
     GestureObserver                         multinomial logistic regression over the 11 gesture emotions on gesture
                                             motion descriptors (synthetic; gesture_observer.py)

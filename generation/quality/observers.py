@@ -3,12 +3,14 @@
 An observer stands in for a participant: it reads a clip's motion and says which emotion it shows. Four are
 declared: the gait observer calibrated on both real corpora
 (:class:`generation.quality.calibrated_observer.CalibratedGaitObserver`, kinds ``real`` with acted labels and
-``real-perceived``; used whenever both corpora are built), the Bandai-only real-capture gait observer
-(:class:`generation.quality.real_observer.RealGaitObserver`, kind ``real`` otherwise), the synthetic gait observer
-(:class:`generation.quality.observer.GaitObserver`, ``synthetic``) and the synthetic gesture observer
+``real-perceived``; trained on the corpora when both are built, else read from its fitted parameters shipped in
+generation/data/observers/), the Bandai-only real-capture gait observer
+(:class:`generation.quality.real_observer.RealGaitObserver`, kind ``real`` when neither is there), the synthetic
+gait observer (:class:`generation.quality.observer.GaitObserver`, ``synthetic``) and the synthetic gesture observer
 (:class:`generation.quality.gesture_observer.GestureObserver`, ``synthetic-gesture``). Each module gives its
-observer's version key (``observer_version``: which corpus it is trained on) and a loader (from its pickle file,
-or trained); :class:`Observers` keeps one of each per version in memory, and :data:`OBSERVERS` is the process's.
+observer's version key (``observer_version``: which corpus it is trained on, or which shipped parameter file it
+reads) and a loader (from its pickle or parameter file, or trained); :class:`Observers` keeps one of each per
+version in memory, and :data:`OBSERVERS` is the process's.
 """
 from __future__ import annotations
 
@@ -39,10 +41,16 @@ class Observer(Protocol):
 
 
 class Observers:
-    """The observers of one process, each loaded once per version of what it is trained on."""
+    """The observers of one process, each loaded once per version of what it is trained on.
 
-    def __init__(self) -> None:
+    Args:
+        shipped_dir: where the calibrated observers' shipped parameter files are (default
+            generation/data/observers/; a test names another).
+    """
+
+    def __init__(self, shipped_dir: str | Path = calibrated_observer.SHIPPED_DIR) -> None:
         self._loaded: dict[tuple, Observer | None] = {}
+        self.shipped_dir = Path(shipped_dir)
 
     def _get(self, name: str, version: str | None, load: Callable[[], Observer | None]) -> Observer | None:
         if version is None:
@@ -55,11 +63,11 @@ class Observers:
     def gait(self, kind: str = "real", corpus_path: str | Path | None = None,
              corpora: RealCorpora = DEFAULT_CORPORA) -> Observer | None:
         """The ``kind`` gait observer; None when it cannot be built here. ``real``: the observer calibrated on both
-        real corpora of ``corpora`` (acted labels) when both are built, else the Bandai-only one of
-        ``corpora.bandai``; ``real-perceived``: the calibrated one with perceived labels (None without both
-        corpora); ``synthetic``: the procedural-corpus one. ``corpus_path`` names the one corpus file instead:
-        real kinds then give the Bandai-only observer of that file, ``synthetic`` the one of that procedural
-        corpus."""
+        real corpora of ``corpora`` (acted labels) when both are built, else the same read from its shipped
+        parameter file (``shipped_dir``), else the Bandai-only one of ``corpora.bandai``; ``real-perceived``: the
+        calibrated one with perceived labels (from the corpora, else shipped, else None); ``synthetic``: the
+        procedural-corpus one. ``corpus_path`` names the one corpus file instead: real kinds then give the
+        Bandai-only observer of that file, ``synthetic`` the one of that procedural corpus."""
         kind = check_gait_observer(kind)
         if kind == "synthetic":
             return self._get("synthetic", observer.observer_version(corpus_path),
@@ -68,9 +76,10 @@ class Observers:
             return self._real(corpus_path)
         labels = "acted" if kind == "real" else "perceived"
         calibrated = self._get(f"calibrated-{labels}",
-                               calibrated_observer.observer_version(labels, corpora.bandai, corpora.bml),
+                               calibrated_observer.observer_version(labels, corpora.bandai, corpora.bml,
+                                                                    self.shipped_dir),
                                lambda: calibrated_observer.load_calibrated_observer(labels, corpora.bandai,
-                                                                                    corpora.bml))
+                                                                                    corpora.bml, self.shipped_dir))
         if calibrated is not None or kind == "real-perceived":
             return calibrated
         return self._real(corpora.bandai)
