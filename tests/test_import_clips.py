@@ -549,6 +549,17 @@ def test_a_file_of_another_collection_is_refused_not_taken_over(media, lab, staf
 
 
 @pytest.mark.django_db
+def test_a_dry_run_already_says_a_file_belongs_to_another_collection(media, lab):
+    from studyapp.models import Clip
+
+    run(write_manifest(lab, GOOD[:1]))
+    clip_id = Clip.objects.get().clip_id
+    out = run(write_manifest(lab, GOOD[:1]), "--dry-run", "--name", "other", fail=True)
+    assert f"already clip {clip_id} of the collection 'import:lab/manifest'" in out
+    assert Clip.objects.get().plan == "import:lab/manifest"
+
+
+@pytest.mark.django_db
 def test_admin_import_needs_the_add_clip_permission(db):
     from django.contrib.auth.models import User
     from django.test import Client

@@ -48,6 +48,9 @@ STAGING_DIR = ".import-staging"
 #: A catalogue step: called with the clip record, a context manager around moving its files into place; it may
 #: append notes for the report (e.g. "retired <old clip id>"). Raising inside undoes the row.
 CatalogueStep = Callable[[dict, list], contextlib.AbstractContextManager]
+#: A check of a row's record against the catalogue before anything is made (a dry run runs it too): raises
+#: RowRefused when the catalogue cannot take the row (e.g. its clip belongs to another collection).
+RowCheck = Callable[[dict], None]
 
 
 class RowRefused(Exception):
@@ -257,15 +260,18 @@ ROW_ERRORS = (ManifestError, VideoImportError, MotionImportError, RowRefused, OS
 
 
 def import_row(row: ManifestRow, media_root: Path, settings: ImportSettings, catalogue: CatalogueStep | None,
-               dry_run: bool = False, sha: str | None = None) -> RowOutcome:
-    """Import one checked manifest row (see the module docstring; ``sha``: the file's SHA-256 if known); never
-    raises for a bad file: an error outcome names the cause, a failing catalogue step's exception too."""
+               dry_run: bool = False, sha: str | None = None, check: RowCheck | None = None) -> RowOutcome:
+    """Import one checked manifest row (see the module docstring; ``sha``: the file's SHA-256 if known; ``check``
+    runs on its record first, in a dry run too); never raises for a bad file: an error outcome names the cause, a
+    failing catalogue step's exception too."""
     t0 = time.perf_counter()
     out = RowOutcome(row.row, row.path, "error")
     try:
         sha = sha or file_sha256(row.file)
         out.clip_id = clip_id_for(row, sha, settings)
         rec = base_record(row, out.clip_id, sha, settings)
+        if check is not None:
+            check(rec)
         notes: list[str] = []
         stored = None if dry_run else _done(media_root, out.clip_id, settings.webm, row.kind)
         if dry_run:
@@ -331,12 +337,14 @@ def remove_stale_staging(media_root: Path) -> list[Path]:
 
 def import_manifest(manifest: str | Path, media_root: str | Path, settings: ImportSettings | None = None,
                     catalogue: CatalogueStep | None = None, dry_run: bool = False,
-                    on_row: Callable[[RowOutcome], None] | None = None) -> list[RowOutcome]:
+                    on_row: Callable[[RowOutcome], None] | None = None,
+                    check: RowCheck | None = None) -> list[RowOutcome]:
     """Import every row of ``manifest`` into ``media_root``; one outcome per row, in manifest order.
 
     ``dry_run`` checks every row (paths, labels, probe and limits of videos, the importer's checks of motion
-    files) and writes nothing. Two rows that give the same clip (the same file with the same settings) are one
-    clip: the second is an error naming the first. ManifestError for a manifest that cannot be read at all."""
+    files, ``check`` against the catalogue) and writes nothing. Two rows that give the same clip (the same file
+    with the same settings) are one clip: the second is an error naming the first. ManifestError for a manifest
+    that cannot be read at all."""
     settings = settings or ImportSettings()
     media_root = Path(media_root)
     if not dry_run:
@@ -356,7 +364,7 @@ def import_manifest(manifest: str | Path, media_root: str | Path, settings: Impo
                 out = RowOutcome(item.row, item.path, "error", "", f"{item.path}: the same clip as row "
                                  f"{seen[clip_id]} (same file and settings); give each file once")
             elif sha:
-                out = import_row(item, media_root, settings, catalogue, dry_run, sha)
+                out = import_row(item, media_root, settings, catalogue, dry_run, sha, check)
                 if out.status == "ok":
                     seen[clip_id] = item.row
         outcomes.append(out)

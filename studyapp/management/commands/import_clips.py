@@ -16,7 +16,7 @@ from pathlib import Path
 
 from django.conf import settings
 from django.core.management.base import BaseCommand, CommandError
-from django.db import transaction
+from django.db import DatabaseError, transaction
 
 from generation.imports import ImportSettings, ManifestError, import_manifest, write_report
 from generation.imports.run import REPORT_NAME, RowRefused
@@ -62,6 +62,15 @@ def catalogue_step(record: dict, notes: list):
         if retired:
             notes.append(f"the file changed: retired {', '.join(retired)} (kept for earlier answers)")
         yield
+
+
+def _collection_check():
+    """refuse_other_collections when the catalogue can be read (a dry run may run before ``migrate``), else None."""
+    try:
+        Clip.objects.exists()
+    except DatabaseError:
+        return None
+    return refuse_other_collections
 
 
 def _render_size(text: str | None) -> dict:
@@ -123,7 +132,7 @@ class Command(BaseCommand):
 
         try:
             outcomes = import_manifest(manifest, Path(settings.MEDIA_ROOT), config, catalogue_step,
-                                       dry_run=opts["dry_run"], on_row=show)
+                                       dry_run=opts["dry_run"], on_row=show, check=_collection_check())
         except ManifestError as exc:
             raise CommandError(str(exc)) from None
         report = Path(opts["report"]) if opts["report"] else manifest.parent / REPORT_NAME
