@@ -212,16 +212,28 @@ def _job_info(folder: Path) -> dict:
     return info if isinstance(info, dict) else {}
 
 
+def without_server_paths(text: str, folder: Path) -> str:
+    """``text`` with the server's folders (the job's upload folder, MEDIA_ROOT, DATA_DIR, the code) replaced by
+    names a researcher can read: the admin shows import messages and logs, not the server's layout."""
+    places = [(folder / "files", "<upload>"), (folder, "<import job>"), (Path(settings.MEDIA_ROOT), "<media>"),
+              (Path(settings.DATA_DIR), "<data>"), (Path(settings.BASE_DIR), "<app>")]
+    for path, name in places:
+        for spelling in {str(path), str(path.resolve())}:
+            text = text.replace(spelling, name)
+    return text
+
+
 def import_state(job: str) -> ImportState:
     folder = job_dir(job)
     if not folder.is_dir():
         raise UploadError(f"no such import {job!r}")
     log = (folder / LOG_NAME).read_text(errors="replace")[-3000:] if (folder / LOG_NAME).is_file() else ""
+    log = without_server_paths(log, folder)
     report = folder / REPORT_NAME
     rows = []
     if report.is_file():
         with report.open(newline="", encoding="utf-8") as f:
-            rows = list(csv.DictReader(f))
+            rows = [{k: without_server_paths(v or "", folder) for k, v in row.items()} for row in csv.DictReader(f)]
     info = _job_info(folder)
     status = "running" if _running(folder) else "done" if report.is_file() else "failed"
     return ImportState(job, status, rows, log, str(info.get("collection", "")), bool(info.get("dry_run")))

@@ -429,6 +429,8 @@ def test_admin_upload_of_a_manifest_and_its_files(media, lab, staff, inline_jobs
     page = staff.get(resp["Location"]).content.decode()
     assert "Status: <strong>done</strong>" in page and "2 of 3 row(s) imported" in page
     assert "no such file &#x27;missing.mp4&#x27;" in page
+    from django.conf import settings
+    assert str(settings.DATA_DIR) not in page and str(media) not in page       # no server layout shown
     clips = Clip.objects.filter(origin="imported")
     assert clips.count() == 2 and {c.plan for c in clips} == {"import:upload/importer/spring"}
     assert {c.licence for c in clips} == {"CC0", "CC BY 4.0"}
