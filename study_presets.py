@@ -166,12 +166,13 @@ PRESETS["norming"] = {
          "instructions": "Watch each clip. Choose the emotion you perceive from the gestures, how intense it looks "
                          "and how natural the gestures look.",
          "pool": {"modality": "gesture", **_CANDIDATES}, "clips_per_participant": 8,
-         "options": {**_NORMING, "n_options": 4}},
+         "options": {**_NORMING, "n_options": 4,
+                     "attention_checks": {"count": 1, "answer": "sad", "positions": "random"}}},
         {"section_type": "theme_rating", "title": "Walking styles",
          "instructions": "Rate the amount of the named style in each walk, how intense the style looks and how "
                          "natural the motion looks.",
          "pool": {"rbf": True, "weight__gt": 0, **_CANDIDATES}, "clips_per_participant": 8, "loop": True,
-         "options": dict(_NORMING)},
+         "options": {**_NORMING, "attention_checks": {"count": 1, "answer": "1", "positions": "random"}}},
     ],
 }
 

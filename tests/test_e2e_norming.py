@@ -47,8 +47,10 @@ def answer_page(driver, folder: str | None = None, name: str = "") -> None:
     for fieldset in driver.find_elements(By.CSS_SELECTOR, "fieldset.question"):
         inputs = fieldset.find_elements(By.CSS_SELECTOR, "input")
         target = inputs[0]
-        if instructed:
-            target = next(i for i in inputs if i.get_attribute("value") == "sad")
+        if instructed:      # the choice the instruction quotes, by its label or its value
+            quoted = instructed[0].text.split("\u201c", 1)[1].split("\u201d", 1)[0].strip()
+            target = next(i for i in inputs if quoted in (i.get_attribute("value"),
+                                                          i.find_element(By.XPATH, "..").text.strip()))
         target.find_element(By.XPATH, "..").click()
     if name:
         shot(driver, folder, name)
@@ -104,14 +106,15 @@ def test_norming_session_and_staff_pages_in_chromium(chromium, live_server, sett
     while "/clip/" in driver.current_url:
         answer_page(driver, shots, "norming_item.png" if pages == 1 else "")
         pages += 1
-    # practice + 2 walks + 1 attention check, 1 gesture (every gesture is in the pool: no practice clip left),
-    # practice + 1 theme clip
+    # practice + 2 walks + 1 attention check, 1 gesture + 1 attention check (every gesture is in the pool: no
+    # practice clip left), practice + 1 theme clip + 1 attention check
     p = Participant.objects.get(external_id="sim-browser")
-    assert pages == p.assignments.count() == 7
+    assert pages == p.assignments.count() == 9
     trials = Response.objects.filter(participant=p, kind="")
     assert trials.count() == 4 * 3
     assert set(trials.values_list("question", flat=True)) == {"perceived", "rating", "intensity", "naturalness"}
-    assert Response.objects.filter(participant=p, kind=ATTENTION_CHECK).get().answer == "sad"
+    checks = Response.objects.filter(participant=p, kind=ATTENTION_CHECK)
+    assert sorted(checks.values_list("answer", flat=True)) == ["1", "sad", "sad"]
 
     # eight more SIMULATED participants through the pages (test client), so the monitor shows a study under way
     study.sections.update(require_full_play=False)

@@ -226,7 +226,9 @@ def test_simulated_norming_study_through_the_pages_recovers_the_truth(norming):
             assert r.status_code == 302, r.content[:400]
         client.post(reverse("studyapp:feedback", args=[p.token]), {"comments": "simulated"})
     assert norming.participants.filter(status="completed").count() == n
-    assert Response.objects.filter(kind=ATTENTION_CHECK).count() == n
+    with_checks = [s for s in norming.sections.all() if s.options.get("attention_checks")]
+    assert len(with_checks) == 2                       # walks and gestures (the theme section was deleted)
+    assert Response.objects.filter(kind=ATTENTION_CHECK).count() == n * len(with_checks)
     exports = {kind: io.StringIO("".join(stream_csv(norming, kind))) for kind in ("responses", "clips", "participants")}
     data = load_study(exports["responses"], exports["clips"], exports["participants"])
     norms = clip_norms(data.responses, data.clips)
