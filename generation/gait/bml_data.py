@@ -19,7 +19,7 @@ Emotion vectors (:func:`emotion_for`): ``acted`` one-hot of the acted label; ``s
 """
 from __future__ import annotations
 
-from dataclasses import replace
+from dataclasses import astuple, replace
 from pathlib import Path
 
 import numpy as np
@@ -32,9 +32,9 @@ from generation.mocap.emotion_gait_bml import LICENCE as BML_LICENCE
 from generation.mocap.real_corpus import (
     CITATION,
     DEFAULT_BML_PATH,
-    DEFAULT_PATH,
     LICENCE,
     SOURCE_URL,
+    RealCorpora,
     load_real_corpus,
     read_meta,
 )
@@ -116,8 +116,7 @@ def load_both_sequences(data: GaitDataConfig, labels: str = "acted", bandai_path
     ``finetune-both``: both corpora with licences, citations, splits and SHA-256, the labels and the augmentation)
     for the weights file's record. ``bandai_windows``: windows per Bandai take (default :data:`BANDAI_AUGMENT`'s 12;
     more weighs the four Bandai takes more against the 84 BML walks)."""
-    bandai = Path(bandai_path) if bandai_path is not None else DEFAULT_PATH
-    bml = Path(bml_path) if bml_path is not None else DEFAULT_BML_PATH
+    bandai, bml = astuple(RealCorpora.of(bandai_path, bml_path))
     bandai_train = stage_clips("finetune", "train", bandai)
     bml_train = bml_clips("train", bml)
     bml_val = bml_clips("val", bml)

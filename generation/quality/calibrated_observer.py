@@ -38,13 +38,15 @@ import json
 import os
 import re
 from collections import Counter
+from dataclasses import astuple
 from pathlib import Path
 
 import numpy as np
 
 from generation.core.digest import cached_file_sha256, file_sha256
 from generation.core.motion import Motion
-from generation.mocap.real_corpus import DEFAULT_BML_PATH, DEFAULT_PATH, RealCorpora, load_real_corpus, read_meta
+from generation.mocap.emotion_gait_bml import DATASET as BML_DATASET
+from generation.mocap.real_corpus import RealCorpora, load_real_corpus, read_meta
 from study_protocol import CAPTURE_GAIT_EMOTIONS, GAIT_EMOTIONS
 
 from . import real_observer as ro
@@ -52,7 +54,6 @@ from .pickle_cache import load_or_build
 
 ADVISORY_RECALL = 0.6
 LABEL_VARIANTS = ("acted", "perceived")
-BML_DATASET = "emotion-gait-bml"
 SHIPPED_DIR = ro.REPO_ROOT / "generation" / "data" / "observers"
 """Where the fitted observers' parameter files ship (:func:`shipped_path`)."""
 PARAMETERS_FORMAT = "calibrated-gait-observer parameters 1"
@@ -248,7 +249,7 @@ def judge_against_reference(read_as_intended: dict[str, float], heldout_recall: 
 def split_clips(bandai_path: str | Path | None = None, bml_path: str | Path | None = None):
     """(train, heldout) CorpusClips: Bandai dataset-1 emotion walks of the training split and BML train + val
     performers; held out: the BML test performers."""
-    bandai, bml = _corpus_paths(bandai_path, bml_path)
+    bandai, bml = astuple(RealCorpora.of(bandai_path, bml_path))
     train = [c for c in load_real_corpus(bandai, skeleton="gait", split="train", contents="walk")
              if c.dataset == ro.EMOTION_DATASET and c.style in CAPTURE_GAIT_EMOTIONS]
     train += load_real_corpus(bml, skeleton="gait", split=("train", "val"))
@@ -267,17 +268,12 @@ def train_calibrated_observer(labels: str = "acted", bandai_path: str | Path | N
     return CalibratedGaitObserver(train, heldout, labels, source)
 
 
-def _corpus_paths(bandai_path, bml_path) -> tuple[Path, Path]:
-    return (Path(bandai_path) if bandai_path is not None else DEFAULT_PATH,
-            Path(bml_path) if bml_path is not None else DEFAULT_BML_PATH)
-
-
 def observer_version(labels: str = "acted", bandai_path: str | Path | None = None,
                      bml_path: str | Path | None = None, shipped_dir: str | Path = SHIPPED_DIR) -> str | None:
     """Key of what the observer comes from, with the label variant: both corpus files' versions (path,
     modification time) when both are there, else the shipped parameter file's SHA-256 (``shipped:...``); None
     when there is neither (then there is no calibrated observer)."""
-    bandai, bml = _corpus_paths(bandai_path, bml_path)
+    bandai, bml = astuple(RealCorpora.of(bandai_path, bml_path))
     if bandai.is_file() and bml.is_file():
         return f"{labels}:{bandai}:{bandai.stat().st_mtime_ns}:{bml}:{bml.stat().st_mtime_ns}"
     shipped = shipped_path(labels, shipped_dir)
@@ -292,7 +288,7 @@ def load_calibrated_observer(labels: str = "acted", bandai_path: str | Path | No
     """The calibrated observer of the corpora (default: the built ones), from its cache file in var/quality/ (named
     by the corpora's digests) or trained; without both corpus files, the fitted one shipped in ``shipped_dir``
     (:func:`load_shipped_observer`); None when neither is there."""
-    bandai, bml = _corpus_paths(bandai_path, bml_path)
+    bandai, bml = astuple(RealCorpora.of(bandai_path, bml_path))
     if not (bandai.is_file() and bml.is_file()):
         return load_shipped_observer(labels, shipped_dir)
     sha = file_sha256(bandai)[:8] + file_sha256(bml)[:8]
@@ -412,7 +408,7 @@ def export_observers(out_dir: str | Path = SHIPPED_DIR, bandai_path: str | Path 
                      ) -> list[tuple[Path, CalibratedGaitObserver]]:
     """Fit each ``labels`` variant on the corpora (fresh, not from the cache) and write its parameter file into
     ``out_dir``. Returns (path, observer) per variant."""
-    bandai, bml = _corpus_paths(bandai_path, bml_path)
+    bandai, bml = astuple(RealCorpora.of(bandai_path, bml_path))
     corpora = {"bandai": corpus_provenance(bandai), "bml": corpus_provenance(bml)}
     out = []
     for lab in labels:
