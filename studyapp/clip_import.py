@@ -136,15 +136,25 @@ def save_upload(manifest=None, files=(), archive=None) -> tuple[str, Path]:
 
 
 UPLOAD_PREFIX = "upload"
+PLAN_PREFIX = "import:"
+"""The catalogue ``plan`` of an import's clips is its collection: ``import:<name>``."""
+
+
+def collection_plan(name: str) -> str:
+    """The catalogue plan of the collection ``name``: ``import:<name>``; UploadError when it would not fit the
+    plan field (cut short, two collections could merge)."""
+    plan = PLAN_PREFIX + name
+    if len(plan) > Clip._meta.get_field("plan").max_length:
+        raise UploadError(f"the collection {plan} is too long: give a shorter collection name")
+    return plan
 
 
 def collection_name(username: str, collection: str) -> str:
     """The ``import_clips --name`` of an admin upload: ``upload/<user>/<collection>``, so one user's collection is
     never another's (a changed file retires only the older clip of the same collection and path); UploadError
-    when the catalogue plan ``import:<name>`` would not fit its field."""
+    when its catalogue plan would not fit (:func:`collection_plan`)."""
     name = f"{UPLOAD_PREFIX}/{username}/{collection}"
-    if len(f"import:{name}") > Clip._meta.get_field("plan").max_length:
-        raise UploadError(f"the collection import:{name} is too long: give a shorter collection name")
+    collection_plan(name)
     return name
 
 
@@ -175,7 +185,7 @@ def launch(cmd: list[str], job: str) -> None:
 def start_import(manifest: Path, job: str, name: str, keep_audio: bool = False, dry_run: bool = False) -> None:
     """Start ``import_clips`` on a saved upload into the collection ``import:<name>`` (:func:`collection_name`);
     what was asked is kept in the job's JOB_NAME for the status page."""
-    (job_dir(job) / JOB_NAME).write_text(json.dumps({"collection": f"import:{name}", "dry_run": dry_run}))
+    (job_dir(job) / JOB_NAME).write_text(json.dumps({"collection": collection_plan(name), "dry_run": dry_run}))
     launch(import_command(manifest, job, name, keep_audio, dry_run), job)
 
 

@@ -623,3 +623,14 @@ def test_staging_left_by_a_killed_import_is_removed(tmp_path):
     mine = tmp_path / STAGING_DIR / f"{os.getpid()}-abcd1234"
     mine.mkdir()
     assert remove_stale_staging(tmp_path) == [stale] and mine.is_dir()
+
+
+@pytest.mark.django_db
+def test_a_collection_too_long_for_the_plan_field_is_refused_not_cut(media, lab):
+    from studyapp.clip_import import UploadError, collection_name
+
+    with pytest.raises(CommandError, match="too long"):
+        call_command("import_clips", str(write_manifest(lab, GOOD[:1])), "--name", "x" * 200, stdout=io.StringIO())
+    with pytest.raises(UploadError, match="too long"):
+        collection_name("u" * 150, "spring")
+    assert collection_name("ann", "spring") == "upload/ann/spring"

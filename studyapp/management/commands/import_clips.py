@@ -24,21 +24,19 @@ from generation.imports.video import VideoLimits
 from generation.render.offscreen import prepare_render_process
 from generation.render.settings import RenderSettings, RenderSettingsError
 from studyapp.catalogue import retire_replaced, upsert_clips
+from studyapp.clip_import import UploadError, collection_plan
 from studyapp.models import Clip
 
 from .generate_clips import _require_migrated_database
-
-PLAN_PREFIX = "import:"
 
 
 def plan_name(manifest: Path, name: str | None = None) -> str:
     """The collection of a manifest's clips, their catalogue ``plan``: ``import:<name>``, by default
     ``import:<folder>/<stem>`` (the admin passes ``upload/<user>/<collection>``)."""
-    name = name or f"{manifest.resolve().parent.name}/{manifest.stem}"
-    plan = PLAN_PREFIX + name
-    if len(plan) > Clip._meta.get_field("plan").max_length:      # cut short, two collections could merge
-        raise CommandError(f"the collection {plan!r} is too long; give a shorter --name")
-    return plan
+    try:
+        return collection_plan(name or f"{manifest.resolve().parent.name}/{manifest.stem}")
+    except UploadError as exc:
+        raise CommandError(f"{exc} (--name)") from None
 
 
 def refuse_other_collections(record: dict) -> None:
