@@ -95,41 +95,47 @@ def probe_video(path: str | Path, timeout_s: float = 60.0) -> VideoProbe:
                       duration_s=duration, audio_codec=audio.group("codec") if audio else "", size_bytes=size)
 
 
+def _video_to_null(path: Path, timeout_s: float, doing: str, input_options=(), output_options=()
+                   ) -> subprocess.CompletedProcess:
+    """Run ffmpeg on the first video stream of ``path`` into the null muxer with progress statistics on stderr;
+    VideoProbeError when ``doing`` (e.g. "decoding") takes longer than ``timeout_s``."""
+    cmd = [ffmpeg_exe(), "-hide_banner", "-nostdin", "-v", "error", "-stats", *input_options, "-i", str(path),
+           "-map", "0:v:0", *output_options, "-f", "null", "-"]
+    try:
+        return subprocess.run(cmd, capture_output=True, text=True, errors="replace", timeout=timeout_s)
+    except subprocess.TimeoutExpired:
+        raise VideoProbeError(f"{path.name}: {doing} took longer than {timeout_s:g} s") from None
+
+
+def _last_frame_count(stderr: str) -> int:
+    """The last ``frame=`` count of ffmpeg's progress statistics (0 when there is none)."""
+    frames = re.findall(r"frame=\s*(\d+)", stderr)
+    return int(frames[-1]) if frames else 0
+
+
 def count_video_packets(path: str | Path, timeout_s: float = 600.0) -> int:
     """Frames (packets) in the first video stream of ``path``, counted by reading the file without decoding it.
 
     A container can declare a video stream and hold no frame of it (a sound track beside an empty picture track):
     the header alone cannot tell, so :func:`probe_video` does not; this is the cheap check that can."""
     path = Path(path)
-    cmd = [ffmpeg_exe(), "-hide_banner", "-nostdin", "-v", "error", "-stats", "-i", str(path), "-map", "0:v:0",
-           "-c", "copy", "-f", "null", "-"]
-    try:
-        proc = subprocess.run(cmd, capture_output=True, text=True, errors="replace", timeout=timeout_s)
-    except subprocess.TimeoutExpired:
-        raise VideoProbeError(f"{path.name}: reading the video stream took longer than {timeout_s:g} s") from None
+    proc = _video_to_null(path, timeout_s, "reading the video stream", output_options=("-c", "copy"))
     if proc.returncode != 0:
         raise VideoProbeError(f"{path.name}: cannot be decoded ({_reason(proc.stderr)})")
-    frames = re.findall(r"frame=\s*(\d+)", proc.stderr)
-    return int(frames[-1]) if frames else 0
+    return _last_frame_count(proc.stderr)
 
 
 def decode_check(path: str | Path, timeout_s: float = 1800.0) -> tuple[int, float]:
     """Decode every video frame of ``path``: (frames, seconds of video). VideoProbeError names the first decoding
     error, or a file without a single frame."""
     path = Path(path)
-    cmd = [ffmpeg_exe(), "-hide_banner", "-nostdin", "-v", "error", "-stats", "-xerror", "-i", str(path),
-           "-map", "0:v:0", "-f", "null", "-"]
-    try:
-        proc = subprocess.run(cmd, capture_output=True, text=True, errors="replace", timeout=timeout_s)
-    except subprocess.TimeoutExpired:
-        raise VideoProbeError(f"{path.name}: decoding took longer than {timeout_s:g} s") from None
+    proc = _video_to_null(path, timeout_s, "decoding", input_options=("-xerror",))
     errors = [ln for ln in proc.stderr.splitlines() if ln.strip() and not ln.lstrip().startswith("frame=")
               and "frame=" not in ln]
     if proc.returncode != 0 or errors:
         raise VideoProbeError(f"{path.name}: cannot be decoded ({_reason(chr(10).join(errors) or proc.stderr)})")
-    frames = [int(m) for m in re.findall(r"frame=\s*(\d+)", proc.stderr)]
     times = re.findall(r"time=(\d+):(\d\d):(\d\d(?:\.\d+)?)", proc.stderr)
-    n = frames[-1] if frames else 0
+    n = _last_frame_count(proc.stderr)
     secs = (int(times[-1][0]) * 3600 + int(times[-1][1]) * 60 + float(times[-1][2])) if times else 0.0
     if n == 0:
         raise VideoProbeError(f"{path.name}: no video frames could be decoded")
