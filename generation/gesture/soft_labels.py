@@ -39,6 +39,7 @@ from generation.core.skeleton import gesture_skeleton
 from generation.formats.rated_clips import (
     NormRow,
     SoftLabelError,
+    clip_motion_path,
     default_catalogue,
     norms_record,
     read_catalogue,
@@ -164,7 +165,7 @@ def load_soft_label_dataset(norms_path: str | Path, motions_dir: str | Path, stu
     used, speeches, motions, skipped = [], [], [], {}
     for row in rows:
         if clips is not None and row.clip_id not in clips:   # unknown: said so before anything else
-            read_clip_motion(row, motions_dir, gesture_skeleton(), clips, source, str(catalogue_path))
+            clip_motion_path(row, motions_dir, clips, source, str(catalogue_path))
         speech, found = clip_speech(row.clip_id, (clips or {}).get(row.clip_id), records, paired)
         if speech is None:
             skipped[row.clip_id] = found
