@@ -90,14 +90,15 @@ def section_coverage(preset: str, flags: dict[str, str], plan=None) -> list[dict
         left = [(e, b) for e, b in left if b and not keep_flagged]
         gone = {e for e, _ in left}
         usable = [r for r in in_pool if r["entry_id"] not in gone]
+        options = sec.get("options") or {}
+        norming = ratings_per_clip(options) is not None
         asks = int(sec.get("clips_per_participant") or 0)
         need = asks if asks else len(in_pool)
-        if ratings_per_clip(sec.get("options")) is not None:
+        if norming:
             # a norming design shows each participant min(M, C) of its C candidates: any candidate is enough
             need = min(need, max(len(usable), 1))
         item = {**base, "asks": asks, "in_pool": len(in_pool), "usable": len(usable), "left_out": left}
         halves = {}
-        options = sec.get("options") or {}
         for half in SUB_POOLS:
             n = options.get(f"n_{half}")
             if n is None:
@@ -108,7 +109,6 @@ def section_coverage(preset: str, flags: dict[str, str], plan=None) -> list[dict
             item["halves"] = halves
         short_halves = [h for h, v in halves.items() if v["usable"] < v["asks"]]
         item["short"] = len(usable) < need or bool(short_halves)
-        norming = ratings_per_clip(options) is not None
         if item["short"]:
             reasons = "; ".join(f"{e}: {', '.join(b)}" for e, b in left) or "the pool itself is too small"
             half_txt = "".join(f"; its {h} half asks {halves[h]['asks']}, {halves[h]['usable']} usable"
@@ -118,8 +118,8 @@ def section_coverage(preset: str, flags: dict[str, str], plan=None) -> list[dict
         else:
             item["why"] = (f"asks {need}, {len(usable)} usable of {len(in_pool)} in its pool"
                            + (f" ({len(left)} left out by the gate)" if left else "")
-                           + (f"; norming: each participant rates {min(asks or len(usable), len(usable))} of the "
-                              f"{len(usable)} candidates" if norming else ""))
+                           + (f"; norming: each participant rates {need} of the {len(usable)} candidates"
+                              if norming else ""))
         out.append(item)
     return out
 
