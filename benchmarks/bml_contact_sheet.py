@@ -18,7 +18,7 @@ from pathlib import Path
 
 from benchmarks.real_vs_generated_sheet import EMOTIONS, add_frames, generated_walks
 from generation.gait.bml_data import bml_clips
-from generation.mocap.emotion_gait_bml import bml_corpus_path
+from generation.mocap.real_corpus import RealCorpora
 from generation.render.contact_sheet import contact_sheet
 from generation.render.settings import RenderSettings
 
@@ -36,7 +36,7 @@ def main() -> None:
     times = [0.5 + a.step * k for k in range(a.columns)]
     settings = RenderSettings(width=320, height=400, fps=30, duration_s=times[-1] + 0.2, camera="tracking")
     generated = generated_walks(settings.duration_s)
-    bml = bml_corpus_path(os.environ)   # $BML_CORPUS, else var/mocap/emotion-gait-bml.npz
+    bml = RealCorpora.from_environ(os.environ).bml   # $BML_CORPUS, else var/mocap/emotion-gait-bml.npz
     real = {(c.motion.metadata["performer"], c.style): c for c in bml_clips("test", bml, n_frames=150)}
     posters, labels = [], []
     with tempfile.TemporaryDirectory() as tmp:

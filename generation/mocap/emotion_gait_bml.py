@@ -36,7 +36,6 @@ from __future__ import annotations
 
 import sys
 import zlib
-from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -48,7 +47,7 @@ from study_protocol import GAIT_EMOTIONS
 
 from .dataset_import import TAKE_COLUMNS, write_report
 from .importer import REPORT_COLUMNS, solve_onto, standing_height_m
-from .real_corpus import BML_ENV_VAR, DEFAULT_BML_PATH, CorpusClip, save_real_corpus
+from .real_corpus import CorpusClip, save_real_corpus
 from .root_travel import loop_period, reconstruct_root_travel, seam_frames
 
 DATASET = "emotion-gait-bml"
@@ -99,18 +98,6 @@ VAL_PERFORMERS = 3
 SPLIT_RULE = (f"Held out by performer (never by clip): the 30 BML actors are ranked by crc32 of their name "
               f"(BML_<actor>); the first {TEST_PERFORMERS} are test, the next {VAL_PERFORMERS} val, the rest "
               "train. A pure function of the performer's name, so adding clips never moves an actor.")
-
-
-DEFAULT_CORPUS = DEFAULT_BML_PATH
-CORPUS_ENV_VAR = BML_ENV_VAR
-
-
-def bml_corpus_path(environ: Mapping[str, str] | None = None) -> Path:
-    """The BML corpus file: ``environ["BML_CORPUS"]`` when ``environ`` is given and sets it, else
-    :data:`DEFAULT_CORPUS` (``<repo>/var/mocap/emotion-gait-bml.npz``). Only the edges pass an environment (a
-    command line's ``main``, the Django settings); library functions take the path as an argument."""
-    value = (environ or {}).get(CORPUS_ENV_VAR)
-    return Path(value) if value else DEFAULT_CORPUS
 
 
 class BmlFormatError(ValueError):

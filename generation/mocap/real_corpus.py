@@ -88,8 +88,7 @@ def real_corpus_path(environ: Mapping[str, str] | None = None) -> Path:
     """The corpus file: ``environ["REAL_CORPUS"]`` when ``environ`` is given and sets it, else :data:`DEFAULT_PATH`
     (``<repo>/var/mocap/bandai-namco.npz``). Only the edges pass an environment (a command line's ``main``, the
     Django settings); library functions take the path as an argument and default to :data:`DEFAULT_PATH`."""
-    value = (environ or {}).get(ENV_VAR)
-    return Path(value) if value else DEFAULT_PATH
+    return RealCorpora.from_environ(environ or {}).bandai
 
 
 @dataclass(frozen=True)
