@@ -198,7 +198,7 @@ class StudyAdmin(StudyScopedAdmin):
         """The section forms know who saves (SectionForm's reader: a norms rule may name only their studies)."""
         kwargs = super().get_formset_kwargs(request, obj, inline, prefix)
         if isinstance(inline, SectionInline):
-            kwargs["form_kwargs"] = {"reader": request.user}
+            kwargs["form_kwargs"] = {**kwargs.get("form_kwargs", {}), "reader": request.user}
         return kwargs
 
     def save_formset(self, request, form, formset, change):
