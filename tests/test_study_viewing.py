@@ -254,6 +254,13 @@ def test_viewing_csv_download_for_staff(client, study, django_user_model):
 
 # ---- the player's markup ---------------------------------------------------------------------------------------
 
+def with_player_options(study, **options) -> None:
+    """Give every section of ``study`` these player options (controls, max_replays) on top of its own."""
+    for section in study.sections.all():
+        section.options = {**section.options, **options}
+        section.save()
+
+
 @pytest.mark.django_db
 @pytest.mark.parametrize("options,native,attrs", [
     ({}, False, ['data-controls="replay-only"', 'data-max-replays=""', 'id="play-pause"', 'id="replay"']),
@@ -261,9 +268,7 @@ def test_viewing_csv_download_for_staff(client, study, django_user_model):
     ({"controls": "none", "max_replays": 0}, False, ['data-controls="none"', 'data-max-replays="0"']),
 ])
 def test_player_markup_follows_the_options(client, study, options, native, attrs):
-    for section in study.sections.all():
-        section.options = {**section.options, **options}
-        section.save()
+    with_player_options(study, **options)
     p = started(client, study)
     html = client.get(reverse("studyapp:item", args=[p.token, 1])).content.decode()
     video = html[html.index("<video"):html.index(">", html.index("<video"))]
@@ -285,9 +290,7 @@ def report(client, p, n, event):
 
 @pytest.mark.django_db
 def test_a_reload_keeps_the_plays_and_max_replays_holds(client, study):
-    for section in study.sections.all():
-        section.options = {**section.options, "max_replays": 1}
-        section.save()
+    with_player_options(study, max_replays=1)
     p = started(client, study)
     url = reverse("studyapp:item", args=[p.token, 1])
     html = client.get(url).content.decode()
@@ -314,9 +317,7 @@ def test_a_reload_keeps_the_plays_and_max_replays_holds(client, study):
 
 @pytest.mark.django_db
 def test_plays_beyond_max_replays_that_bypass_the_player_make_the_record_implausible(client, study):
-    for section in study.sections.all():
-        section.options = {**section.options, "max_replays": 0}
-        section.save()
+    with_player_options(study, max_replays=0)
     p = started(client, study)
     client.get(reverse("studyapp:item", args=[p.token, 1]))
     assert report(client, p, 1, "play").status_code == 204
