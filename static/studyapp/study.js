@@ -318,19 +318,25 @@
     return el.tagName === "INPUT" && !/^(radio|checkbox)$/.test(el.type);
   }
 
-  // Digit key -> option: on a numbered scale whose values are all single digits (0-4 Likert, 1-5 naturalness) the
-  // option showing that number; otherwise the n-th option (1 = first).
-  function optionForDigit(inputs, n) {
-    var numbered = Array.prototype.every.call(inputs, function (i) { return /^[0-9]$/.test(i.value); });
-    if (numbered) {
-      return Array.prototype.find.call(inputs, function (i) { return i.value === String(n); });
-    }
-    return n >= 1 ? inputs[n - 1] : undefined;
+  // Digit key -> option. On a numbered scale (every option's value an integer: 0-4 Likert, 1-5 naturalness, 1-7
+  // themes, -7..+7 inversion) the option showing that number, or none when no option shows it; a negative number is
+  // the minus key and then the digit. On any other question the n-th option (1 = first).
+  function numberedScale(inputs) {
+    return inputs.length > 0 && Array.prototype.every.call(inputs, function (i) { return /^-?[0-9]+$/.test(i.value); });
   }
 
-  function choose(fs, n, active) {
+  function optionForDigit(inputs, n, negative) {
+    if (numberedScale(inputs)) {
+      var want = String(negative ? -n : n);
+      if (negative && n === 0) { want = "0"; }
+      return Array.prototype.find.call(inputs, function (i) { return String(Number(i.value)) === want; });
+    }
+    return !negative && n >= 1 ? inputs[n - 1] : undefined;
+  }
+
+  function choose(fs, n, active, negative) {
     var inputs = fs.querySelectorAll("input[type=radio], input[type=checkbox]");
-    var input = optionForDigit(inputs, n);
+    var input = optionForDigit(inputs, n, negative);
     if (!input || input.disabled || fs.disabled) { return false; }
     input.checked = input.type === "checkbox" ? !input.checked : true;
     input.dispatchEvent(new Event("change", { bubbles: true }));
@@ -341,16 +347,31 @@
     return true;
   }
 
+  var MINUS_WINDOW_MS = 3000;   // a minus key counts for the next digit pressed within this time
+  var minusAt = 0;
+
   function setUpKeys() {
     document.addEventListener("keydown", function (e) {
       if (e.altKey || e.ctrlKey || e.metaKey || e.defaultPrevented) { return; }
       var active = document.activeElement;
       if (isTyping(active)) { return; }
-      if (/^[0-9]$/.test(e.key)) {
-        var fs = targetQuestion(active);
-        if (fs && choose(fs, Number(e.key), active)) { e.preventDefault(); }
+      if (e.key === "-") {
+        var signed = targetQuestion(active);
+        if (signed && signed.querySelector("input[value^='-']")) {
+          minusAt = Date.now();
+          live.textContent = "\u2212";
+          e.preventDefault();
+        }
         return;
       }
+      if (/^[0-9]$/.test(e.key)) {
+        var negative = Date.now() - minusAt < MINUS_WINDOW_MS;
+        minusAt = 0;
+        var fs = targetQuestion(active);
+        if (fs && choose(fs, Number(e.key), active, negative)) { e.preventDefault(); }
+        return;
+      }
+      minusAt = 0;
       if (e.key !== "Enter" || !active) { return; }
       if (/^(BUTTON|A|VIDEO|SUMMARY)$/.test(active.tagName)) { return; }   // their own meaning of Enter
       e.preventDefault();
