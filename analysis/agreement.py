@@ -19,7 +19,7 @@ import pandas as pd
 from scipy.stats import f as f_dist
 from statsmodels.stats.inter_rater import fleiss_kappa as sm_fleiss_kappa
 
-from study_protocol import LABEL_CHOICES, LIKERT_FEATURES, SECTION_QUESTIONS
+from protocol.vocabulary import LABEL_CHOICES, LIKERT_FEATURES, SECTION_QUESTIONS
 
 from .recognition import selection_weights
 
@@ -145,7 +145,7 @@ def rating_icc(responses: pd.DataFrame, clips: pd.DataFrame) -> pd.DataFrame:
 
 def choice_fleiss_kappa(responses: pd.DataFrame, seed: int = 0) -> pd.DataFrame:
     """Fleiss' kappa (:func:`fleiss_kappa`) of each categorical question (answer kinds of
-    study_protocol.LABEL_CHOICES): items = clips, categories = the question's labels, counts = answers
+    protocol.vocabulary.LABEL_CHOICES): items = clips, categories = the question's labels, counts = answers
     (multi-select answers add 1/k to each of their k labels). 95% interval: percentile bootstrap over clips
     (2000 resamples, seeded), NaN for fewer than 3 clips. Returns the ``agreement`` columns."""
     rng = np.random.default_rng(seed)

@@ -1,17 +1,18 @@
 """The design of a simulated study, read from study presets and the planned clips of their plans. No Django.
 
-A real study is a preset (``study_presets.PRESETS``: its sections, clips per participant, options, pools) filled
-with the clips of a plan (``study_presets.PRESET_PLANS``). The simulator (:mod:`analysis.simulate`) takes the same
+A real study is a preset (``protocol.presets.PRESETS``: its sections, clips per participant, options, pools) filled
+with the clips of a plan (``protocol.presets.PRESET_PLANS``). The simulator (:mod:`analysis.simulate`) takes the same
 two inputs, so a simulated study has the structure of a real export of that preset: the same sections in the same
 order, the same number of clips per participant, the same questions and answer options, and a clips.csv whose rows
 are the plan's entries.
 
-The plans' clips come as a planned clips table: clips.csv rows (the public columns, ``study_protocol.CLIP_COLUMNS``)
+The plans' clips come as a planned clips table: clips.csv rows (the public columns,
+``protocol.vocabulary.CLIP_COLUMNS``)
 plus :data:`EXTRA_COLUMNS`, one SYNTHETIC row ``sim-<plan>-<entry id>`` per plan entry. The table of the preset
 plans ships as :data:`PLANNED_CLIPS`; ``python -m generation.plans.planned PLAN --out FILE`` writes one for any plan
 (the analysis reads the file and never imports the generation library).
 
-Pools are matched as ``study_pools`` defines them (field, ``field__lookup``, lists, the ``transition`` and ``rbf``
+Pools are matched as ``protocol.pools`` defines them (field, ``field__lookup``, lists, the ``transition`` and ``rbf``
 shorthands, naturalness sub-pools), on the clip rows plus their ``plan``.
 """
 from __future__ import annotations
@@ -22,9 +23,9 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from study_pools import DEFAULT_GESTURE_OPTIONS, FLAGS, INCLUDE_FLAGGED, NORMS_RULE, SUB_POOLS, pool_errors
-from study_presets import PRESET_PLANS, PRESETS
-from study_protocol import CLIP_COLUMNS, FINAL_EMOTION_COLUMNS, GESTURE_EMOTIONS, SECTION_QUESTIONS
+from protocol.pools import DEFAULT_GESTURE_OPTIONS, FLAGS, INCLUDE_FLAGGED, NORMS_RULE, SUB_POOLS, pool_errors
+from protocol.presets import PRESET_PLANS, PRESETS
+from protocol.vocabulary import CLIP_COLUMNS, FINAL_EMOTION_COLUMNS, GESTURE_EMOTIONS, SECTION_QUESTIONS
 
 PAPER_PRESETS = ("gait_ismar2020", "gestures_ieeevr2021", "rbf_thms2016")
 """The three papers' studies; simulated one after the other as one SYNTHETIC study by default."""
@@ -45,7 +46,7 @@ class SectionDesign:
 
     Attributes:
         order: 1-based position in the study; preset: the preset it comes from.
-        section_type: one of study_protocol.SECTION_TYPES; questions: its question keys (SECTION_QUESTIONS).
+        section_type: one of protocol.vocabulary.SECTION_TYPES; questions: its question keys (SECTION_QUESTIONS).
         pool: indices into :attr:`StudyDesign.clips` of the clips the section may show (empty when ``reuse``).
         n_per_participant: clips each participant gets (0 = the whole pool, as the study app).
         reuse: index into :attr:`StudyDesign.sections` of the section whose clips this one shows again, or None.
@@ -133,7 +134,7 @@ def clip_table(clips: pd.DataFrame) -> pd.DataFrame:
     return pd.DataFrame(out, columns=list(clips.columns))
 
 
-# ---- pool filters (study_pools semantics) -----------------------------------------------------------------------
+# ---- pool filters (protocol.pools semantics) -----------------------------------------------------------------------
 def _text(s: pd.Series) -> pd.Series:
     return s.fillna("").astype(str)
 
@@ -204,8 +205,8 @@ def design_from_presets(presets: tuple[str, ...] | list[str] = PAPER_PRESETS, pl
     """The design of a study made of ``presets`` (one after the other), each drawing the clips of its plan.
 
     Args:
-        presets: keys of study_presets.PRESETS, e.g. ("demo",) or the default :data:`PAPER_PRESETS`.
-        plans: preset -> plan name (default study_presets.PRESET_PLANS).
+        presets: keys of protocol.presets.PRESETS, e.g. ("demo",) or the default :data:`PAPER_PRESETS`.
+        plans: preset -> plan name (default protocol.presets.PRESET_PLANS).
         clips: the planned clips table (a DataFrame of CLIP_COLUMNS + :data:`EXTRA_COLUMNS` or a CSV path; default
             :data:`PLANNED_CLIPS`) holding the rows of every chosen plan.
     Raises DesignError naming the preset, plan or section when a preset is unknown, a plan has no rows in the

@@ -23,7 +23,7 @@ import numpy as np
 import pandas as pd
 from scipy import stats
 
-from study_protocol import FINAL_EMOTION_COLUMNS, GAIT_EMOTIONS
+from protocol.vocabulary import FINAL_EMOTION_COLUMNS, GAIT_EMOTIONS
 
 P_FLOOR, P_CEIL = 0.001, 0.25
 

@@ -33,12 +33,12 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from study_protocol import ATTENTION_COLUMNS, INTEGER_RANGES, SECTION_QUESTIONS, attention_passed
+from protocol.vocabulary import ATTENTION_COLUMNS, INTEGER_RANGES, SECTION_QUESTIONS, attention_passed
 
 from .viewing import viewing_exclusions
 
 SCALE_SECTIONS = tuple(s for s, qs in SECTION_QUESTIONS.items() if all(k in INTEGER_RANGES for k in qs.values()))
-"""Sections whose answers are points of a rating scale (study_protocol: every question of an integer kind)."""
+"""Sections whose answers are points of a rating scale (protocol.vocabulary: every question of an integer kind)."""
 
 FAST_FRACTION, MAX_FAST_SHARE, MIN_STRAIGHT = 0.25, 0.5, 8
 MAX_STRAIGHTLINE, MIN_ATTENTION_PASS = 1.0, 1.0

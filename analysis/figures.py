@@ -16,7 +16,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 import pandas as pd  # noqa: E402
 
-from study_protocol import (  # noqa: E402
+from protocol.vocabulary import (  # noqa: E402
     GAIT_EMOTIONS,
     IMPORTED,
     LIKERT_FEATURES,

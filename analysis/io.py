@@ -17,7 +17,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import pandas as pd
 
-from study_protocol import (
+from protocol.vocabulary import (
     ANSWER_QUESTIONS,
     ATTENTION_CHECK,
     ATTENTION_COLUMNS,
@@ -46,7 +46,7 @@ from study_protocol import (
 )
 
 ANSWER_KINDS = tuple(dict.fromkeys(kind for questions in ANSWER_QUESTIONS.values() for kind in questions.values()))
-"""Every answer kind the sections use (:data:`study_protocol.ANSWER_QUESTIONS`: each section's own questions and
+"""Every answer kind the sections use (:data:`protocol.vocabulary.ANSWER_QUESTIONS`: each section's own questions and
 the norming questions), in first-use order."""
 
 MAX_LISTED = 20
@@ -271,12 +271,12 @@ def read_participants(src) -> pd.DataFrame:
 
 
 def read_viewing(src, participants: pd.DataFrame | None = None) -> pd.DataFrame:
-    """Read and validate viewing.csv (:data:`study_protocol.VIEWING_COLUMNS`, one row per answered clip page).
+    """Read and validate viewing.csv (:data:`protocol.vocabulary.VIEWING_COLUMNS`, one row per answered clip page).
 
-    ``participant_id`` and ``clip_id`` must be set; every field of :data:`study_protocol.VIEWING_FIELDS`, and
+    ``participant_id`` and ``clip_id`` must be set; every field of :data:`protocol.vocabulary.VIEWING_FIELDS`, and
     ``page_ms`` and ``shows``, is blank (unknown, or no record) or a non-negative integer (times in ms, counts);
-    ``record`` is blank or one of :data:`study_protocol.VIEWING_RECORDS`. The columns of the first version
-    (:data:`study_protocol.VIEWING_COLUMNS_V1`) are required; a later one that is absent (an older export) reads
+    ``record`` is blank or one of :data:`protocol.vocabulary.VIEWING_RECORDS`. The columns of the first version
+    (:data:`protocol.vocabulary.VIEWING_COLUMNS_V1`) are required; a later one that is absent (an older export) reads
     as blank. With ``participants`` (as from :func:`read_participants`) every participant_id must be one of them.
     Returns the rows with the numeric fields as floats (NaN where blank) and ``record`` as a string; extra columns
     are kept."""
@@ -499,7 +499,7 @@ def _check_response_ms(rms: _CodedColumn, rows: _RowProblems) -> np.ndarray:
 def read_responses(src, clips: pd.DataFrame, participants: pd.DataFrame | None = None) -> pd.DataFrame:
     """Read and validate responses.csv against validated ``clips`` (and ``participants`` if given).
 
-    Checks: known section_type; question allowed for that section (:data:`study_protocol.ANSWER_QUESTIONS`: its own
+    Checks: known section_type; question allowed for that section (:data:`protocol.vocabulary.ANSWER_QUESTIONS`: its own
     and, for a norming section type, intensity and naturalness); answer of the right kind and range; clip_id known
     and carrying what the section needs (an intended vector for emotion_choice, a final vector for
     emotion_transition, theme/weight/n_features for theme_rating, theme for theme_inversion, an NRC-VAD label or VAD
@@ -511,7 +511,7 @@ def read_responses(src, clips: pd.DataFrame, participants: pd.DataFrame | None =
     Returns columns participant_id, section_type, clip_id, question, answer (categoricals of cleaned strings;
     labels lower-cased, multi-select labels without spaces), value (float for integer scales, NaN otherwise),
     response_ms (float, NaN if blank) and _line (file line number). Attention-check answers (section_type
-    ``study_protocol.ATTENTION_CHECK``) are not answers about clips: they are left out of the table and kept in
+    ``protocol.vocabulary.ATTENTION_CHECK``) are not answers about clips: they are left out of the table and kept in
     ``attrs["attention_checks"]`` ({participant_id, question, answer: lists of text}) for the exclusion rules.
     """
     name = _name(src, "responses.csv")

@@ -10,7 +10,7 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from study_protocol import GAIT_EMOTIONS, LIKERT_FEATURES
+from protocol.vocabulary import GAIT_EMOTIONS, LIKERT_FEATURES
 
 from .adtest import anderson_ksamp_groups
 from .emotion import P_CEIL, P_FLOOR, ad_ksamp

@@ -30,7 +30,7 @@ import numpy as np
 import pandas as pd
 import statsmodels.formula.api as smf
 
-from study_protocol import GAIT_EMOTIONS, LIKERT_FEATURES
+from protocol.vocabulary import GAIT_EMOTIONS, LIKERT_FEATURES
 
 from .likert import dominant_emotion
 

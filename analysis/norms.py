@@ -2,8 +2,8 @@
 
 One row per clip and normed question (:data:`NORMED_KINDS`: every label question -- gait emotions, gesture
 emotions, the neutral validation choice -- and the theme scales), with the columns of
-:data:`study_protocol.CLIP_NORMS_COLUMNS` then ``share_<label>`` for each label of the question's domain
-(:func:`study_protocol.norms_domain`; cells of labels outside a row's domain are blank):
+:data:`protocol.vocabulary.CLIP_NORMS_COLUMNS` then ``share_<label>`` for each label of the question's domain
+(:func:`protocol.vocabulary.norms_domain`; cells of labels outside a row's domain are blank):
 
 - ``n_ratings``: answers to the question for the clip (after the study's exclusion rules, which
   :func:`analysis.report.build_report` applies before calling :func:`clip_norms`);
@@ -41,7 +41,7 @@ import pandas as pd
 from scipy import stats
 from statsmodels.stats.proportion import proportion_confint
 
-from study_protocol import (
+from protocol.vocabulary import (
     CLIP_NORMS_COLUMNS,
     FINAL_EMOTION_COLUMNS,
     GAIT_EMOTIONS,
@@ -175,7 +175,7 @@ def clip_norms(responses: pd.DataFrame, clips: pd.DataFrame) -> pd.DataFrame:
     participants to keep already chosen) with ``clips`` (:func:`analysis.io.read_clips`).
 
     Returns one row per (clip, normed question), rows ordered by the protocol's sections and questions, then
-    clip_id; columns :data:`study_protocol.CLIP_NORMS_COLUMNS` then ``share_<label>`` for the union of the domains
+    clip_id; columns :data:`protocol.vocabulary.CLIP_NORMS_COLUMNS` then ``share_<label>`` for the union of the domains
     present (in the order met). Empty (with the fixed columns) when no normed question was answered.
     """
     naturalness = _clip_scale_means(responses, (responses["question"].astype(str) == "naturalness").to_numpy())
@@ -197,7 +197,7 @@ def read_clip_norms(src, known_clips=None) -> pd.DataFrame:
     """Read and validate a clip_norms.csv (a path or text file object).
 
     Every problem is gathered into one :class:`analysis.io.ValidationError` naming file, line and column: a missing
-    column of :data:`study_protocol.CLIP_NORMS_COLUMNS`; a blank required cell; a number that is not one; an
+    column of :data:`protocol.vocabulary.CLIP_NORMS_COLUMNS`; a blank required cell; a number that is not one; an
     unknown (section_type, question); with ``known_clips`` (an iterable of clip ids) a clip not among them; shares
     outside 0..1, a share of a label outside the question's domain, shares of a row that do not sum to 1 (within
     :data:`SHARE_SUM_TOLERANCE`), or a missing share column of a row's domain. Returns the rows with numeric

@@ -5,7 +5,7 @@ Nothing here is data from people. Participant ids start with ``sim-``, every ``e
 Each candidate clip gets a simulated true perception: a label distribution ``p`` over its question's domain drawn
 from a Dirichlet around the intended label (concentration ``concentration`` times
 ``(1 - noise) * intended + noise / L``), so clips differ as real stimuli do. Participants follow the cyclic norming
-design of :mod:`study_norming` (M clips each, section by section). An answer:
+design of :mod:`protocol.norming` (M clips each, section by section). An answer:
 
 - gait (emotion_choice, multi-select): a first label drawn from ``p``; with probability ``multi_select_prob`` a
   second, different label drawn from ``p`` without the first; the answer is the label(s) joined by ';';
@@ -27,8 +27,8 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
-from study_norming import clip_order, cyclic_block
-from study_protocol import (
+from protocol.norming import clip_order, cyclic_block
+from protocol.vocabulary import (
     CLIP_COLUMNS,
     GAIT_EMOTIONS,
     PARTICIPANT_COLUMNS,

@@ -29,7 +29,7 @@ import pandas as pd
 from scipy import stats
 from statsmodels.stats.multitest import multipletests
 
-from study_protocol import GAIT_EMOTIONS
+from protocol.vocabulary import GAIT_EMOTIONS
 
 DOMINANT_MIN = 0.5
 """A clip's dominant intended gait emotion must be the unique largest component and at least this share."""

@@ -24,7 +24,7 @@ import zipfile
 import numpy as np
 import pandas as pd
 
-from study_protocol import MODALITIES
+from protocol.vocabulary import MODALITIES
 
 from . import agreement, emotion, exclusion, likert, mixed, naturalness, norms, participants, recognition, themes, vad
 from . import figures as figure_mod

@@ -35,8 +35,8 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 import pandas as pd
 
-from study_presets import PRESETS
-from study_protocol import (
+from protocol.presets import PRESETS
+from protocol.vocabulary import (
     ASSIGNMENT_COLUMNS,
     FINAL_EMOTION_COLUMNS,
     GAIT_EMOTIONS,
@@ -284,7 +284,7 @@ def _all_answers(rng, design: StudyDesign, n_participants: int, m: PerceptionMod
 
 
 def _assignments(design: StudyDesign, shown_all: list, pid_list: np.ndarray) -> pd.DataFrame:
-    """assignments.csv rows (study_protocol.ASSIGNMENT_COLUMNS): who was shown which clip where, gesture options
+    """assignments.csv rows (protocol.vocabulary.ASSIGNMENT_COLUMNS): who was shown which clip where, gesture options
     joined by ';'; no times (the simulator has no clock per page)."""
     parts = []
     clip_ids = design.clips["clip_id"].to_numpy(dtype=object)

@@ -15,7 +15,7 @@ import pandas as pd
 import pingouin as pg
 from scipy import stats
 
-from study_protocol import NEUTRAL_CHOICES, THEMES
+from protocol.vocabulary import NEUTRAL_CHOICES, THEMES
 
 ANOVA_COLUMNS = ["theme", "effect", "F", "df1", "df2", "p_value", "p_gg", "eta2_partial", "epsilon", "n_subjects",
                  "n_dropped", "note"]

@@ -1,7 +1,7 @@
 """Intended vs perceived gesture emotions in VAD space (seed 003 section 6.3.1, Fig. 7).
 
 Section ``gesture_emotion``: each answer is one emotion category (a forced choice among four). The perceived
-category is mapped to (valence, arousal, dominance) with the NRC-VAD lexicon (:data:`study_protocol.GESTURE_VAD`).
+category is mapped to (valence, arousal, dominance) with the NRC-VAD lexicon (:data:`protocol.vocabulary.GESTURE_VAD`).
 The intended VAD of a clip is the NRC-VAD row of its ``emotion_label``; a clip whose label is blank or not in the
 lexicon uses its ``valence, arousal, dominance`` columns. Each answer gives one (intended, perceived) pair.
 """
@@ -12,7 +12,7 @@ import numpy as np
 import pandas as pd
 from scipy import stats
 
-from study_protocol import GESTURE_VAD, VAD_DIMENSIONS
+from protocol.vocabulary import GESTURE_VAD, VAD_DIMENSIONS
 
 
 def intended_vad(clips: pd.DataFrame) -> pd.DataFrame:

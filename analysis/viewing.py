@@ -26,7 +26,7 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from study_protocol import VIEWING_FIELDS
+from protocol.vocabulary import VIEWING_FIELDS
 
 COLUMNS = ["participant_id", "rule", "detail", "n_answers"]
 """Exclusion rows, as :data:`analysis.exclusion.COLUMNS`."""

@@ -33,7 +33,7 @@ from benchmarks.bench_record import one_thread
 from generation.mocap.real_corpus import RealCorpora, load_real_corpus
 from generation.quality import calibrated_observer as co
 from generation.quality import real_observer as ro
-from study_protocol import CAPTURE_GAIT_EMOTIONS, GAIT_EMOTIONS
+from protocol.vocabulary import CAPTURE_GAIT_EMOTIONS, GAIT_EMOTIONS
 
 ROOT = Path(__file__).resolve().parents[1]
 

@@ -46,7 +46,7 @@ from generation.quality.gait_guidance import (
     unseen_mixtures,
 )
 from generation.quality.observer import GaitObserver
-from study_protocol import GAIT_EMOTIONS
+from protocol.vocabulary import GAIT_EMOTIONS
 
 PREFIX, HORIZON = 18, 42
 

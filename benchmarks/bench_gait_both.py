@@ -34,7 +34,7 @@ from generation.gait.real_data import RealAugment, clip_sequences, stage_clips
 from generation.mocap.real_corpus import RealCorpora
 from generation.quality import calibrated_observer as co
 from generation.quality.realism import realism_measures
-from study_protocol import CAPTURE_GAIT_EMOTIONS, GAIT_EMOTIONS
+from protocol.vocabulary import CAPTURE_GAIT_EMOTIONS, GAIT_EMOTIONS
 
 ROOT = Path(__file__).resolve().parents[1]
 

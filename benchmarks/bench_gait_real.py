@@ -54,7 +54,7 @@ from generation.mocap.real_corpus import RealCorpora, load_real_corpus
 from generation.quality.observers import OBSERVERS
 from generation.quality.realism import MEASURES, realism_measures
 from generation.quality.realism_ranges import load_ranges
-from study_protocol import CAPTURE_GAIT_EMOTIONS, GAIT_EMOTIONS
+from protocol.vocabulary import CAPTURE_GAIT_EMOTIONS, GAIT_EMOTIONS
 
 ROOT = Path(__file__).resolve().parents[1]
 

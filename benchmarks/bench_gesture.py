@@ -47,7 +47,7 @@ from generation.gesture.model import GestureNetConfig
 from generation.gesture.train import TrainConfig, train
 from generation.quality.gesture_observer import corpus_descriptors, motion_descriptors, positions_of
 from generation.render.offscreen import prepare_render_process
-from study_protocol import GESTURE_EMOTIONS
+from protocol.vocabulary import GESTURE_EMOTIONS
 
 ROOT = Path(__file__).resolve().parents[1]
 

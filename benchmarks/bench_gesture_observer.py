@@ -35,7 +35,7 @@ from generation.quality.gesture_observer import (
     motion_descriptors,
     positions_of,
 )
-from study_protocol import GESTURE_EMOTIONS, GESTURE_VAD
+from protocol.vocabulary import GESTURE_EMOTIONS, GESTURE_VAD
 
 ROOT = Path(__file__).resolve().parents[1]
 

@@ -36,7 +36,7 @@ from generation.quality.real_gesture_observer import (
 )
 from generation.quality.real_gestures import real_gesture_clips, real_stats_table
 from generation.render.offscreen import prepare_render_process
-from study_protocol import CAPTURE_GESTURE_EMOTIONS
+from protocol.vocabulary import CAPTURE_GESTURE_EMOTIONS
 
 ROOT = Path(__file__).resolve().parents[1]
 

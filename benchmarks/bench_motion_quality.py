@@ -33,7 +33,7 @@ from generation.core.features import detect_foot_contacts, foot_joints, foot_ska
 from generation.core.motion import Motion
 from generation.plans import clipgen
 from generation.plans.schema import load_plan
-from study_protocol import GAIT_EMOTIONS
+from protocol.vocabulary import GAIT_EMOTIONS
 
 
 def stance_knee_flexion(motion: Motion) -> np.ndarray:
@@ -145,7 +145,7 @@ def qa_table(plans: list[str]) -> tuple[str, dict]:
     """Per plan: clips, passed, flagged per check, and min / median / max of each measure."""
     from generation.pipeline.plan_qa import run as run_qa
     from generation.pipeline.plan_qa import summary_counts
-    from study_protocol import QA_CHECKS
+    from protocol.vocabulary import QA_CHECKS
 
     out, lines = {}, ["| plan | clips | passed | " + " | ".join(QA_CHECKS) + " |",
                       "|---|---|---|" + "---|" * len(QA_CHECKS)]

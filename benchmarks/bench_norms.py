@@ -3,7 +3,7 @@
     python -m benchmarks.bench_norms [--studies 200] [--json docs/benchmarks/norms.json]
 
 1. Speed: a SIMULATED norming study of 10,000 participants x 40 ratings (400 simulated gait clips, the cyclic design
-   of study_norming, each rating with its intensity and naturalness answers: 1.2 million rows of responses.csv):
+   of protocol.norming, each rating with its intensity and naturalness answers: 1.2 million rows of responses.csv):
    seconds to compute the norms (analysis.norms.clip_norms on validated data) and to read, validate and norm the
    three CSVs from text.
 2. Recovery: 200 SIMULATED norming studies of the demo plan's candidate clips (the norming preset's sections, K
@@ -13,7 +13,7 @@
    two labels) and with single-label answers only; the same for the seed000 plan's 22 walks, where each
    participant sees 8 (an incomplete design, N = 55).
 3. The design table: for the demo, seed000 and seed003 plans, each norming section's candidate clips C, clips per
-   participant M, ratings per clip K and the participants N = ceil(K C / M) needed (study_norming).
+   participant M, ratings per clip K and the participants N = ceil(K C / M) needed (protocol.norming).
 Nothing here is data from people.
 """
 from __future__ import annotations
@@ -30,9 +30,9 @@ from analysis.io import load_study
 from analysis.norms import clip_norms
 from analysis.norms_simulate import simulate_norming
 from benchmarks.bench_record import record
-from study_norming import min_ratings, ratings_per_clip, required_participants
-from study_presets import PRESETS
-from study_protocol import CLIP_COLUMNS, GAIT_EMOTIONS
+from protocol.norming import min_ratings, ratings_per_clip, required_participants
+from protocol.presets import PRESETS
+from protocol.vocabulary import CLIP_COLUMNS, GAIT_EMOTIONS
 
 DESIGN_PLANS = ("demo", "seed000", "seed003")
 

@@ -43,7 +43,7 @@ from generation.rbf.real_neutral import load_cycle, steady_cycles
 from generation.rbf.stylise import neutral_walk, stylise
 from generation.rbf.themes import THEME_NAMES, theme_features
 from generation.render.offscreen import prepare_render_process
-from study_protocol import CAPTURE_THEMES, GAIT_EMOTIONS
+from protocol.vocabulary import CAPTURE_THEMES, GAIT_EMOTIONS
 
 CHECKED = ("speed_m_s", "cadence_steps_min", "stance_knee_deg", "pelvis_bounce_cm")
 WEIGHTS = (0.7, 1.0)

@@ -40,7 +40,7 @@ from generation.quality import real_observer as ro
 from generation.quality.observers import OBSERVERS
 from generation.quality.realism import MEASURES
 from generation.quality.realism_ranges import load_ranges, measure_corpus
-from study_protocol import CAPTURE_GAIT_EMOTIONS, GAIT_EMOTIONS
+from protocol.vocabulary import CAPTURE_GAIT_EMOTIONS, GAIT_EMOTIONS
 
 
 def held_out(obs: ro.RealGaitObserver, test) -> dict:

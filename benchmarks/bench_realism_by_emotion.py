@@ -47,7 +47,7 @@ from generation.core.windows import windows
 from generation.gait.weights import weights_path
 from generation.mocap.real_corpus import load_real_corpus, real_corpus_path
 from generation.quality.realism import MEASURES, realism_measures
-from study_protocol import CAPTURE_GAIT_EMOTIONS, GAIT_EMOTIONS
+from protocol.vocabulary import CAPTURE_GAIT_EMOTIONS, GAIT_EMOTIONS
 
 ROOT = Path(__file__).resolve().parents[1]
 AREA = "realism_by_emotion"

@@ -50,7 +50,7 @@ def _motion(kind: str, frames: int, fps: float):
     import numpy as np
 
     from generation.procedural.emotion import gait_params_for_emotion, gesture_params_for_vad
-    from study_protocol import GESTURE_VAD
+    from protocol.vocabulary import GESTURE_VAD
     if kind == "walk":
         from generation.core.paths import curved
         from generation.procedural.walk import walk
@@ -156,7 +156,7 @@ def sheet_motion(build: str, height: float, spec: dict, fps: float = 25.0, secon
     """A motion made as a plan entry makes it (network gait, RBF theme, network gesture), scaled and labelled."""
     from generation.plans.clipgen import make_motion, resolve
     from generation.plans.schema import validate_plan
-    from study_protocol import THEMES
+    from protocol.vocabulary import THEMES
 
     entry = {"id": "x", **spec, "seed": 1}
     if spec["generator"] == "gait_net":
@@ -180,7 +180,7 @@ def sheet(args) -> list[dict]:
 
     from generation.render import RenderSettings, contact_sheet
     from generation.render import clip as clip_mod
-    from study_protocol import THEMES
+    from protocol.vocabulary import THEMES
 
     rows, paths, labels = [], [], []
     tmp = Path(tempfile.mkdtemp(prefix="render_sheet_"))

@@ -27,7 +27,7 @@ import pandas as pd
 
 from benchmarks.bench_record import record
 from generation.mocap.real_corpus import RealCorpora
-from study_protocol import CAPTURE_GAIT_EMOTIONS, CLIP_NORMS_COLUMNS, GAIT_EMOTIONS
+from protocol.vocabulary import CAPTURE_GAIT_EMOTIONS, CLIP_NORMS_COLUMNS, GAIT_EMOTIONS
 
 SIMULATED_SHARES = {          # (happy, sad, angry, neutral) perceived, per acted emotion: SIMULATED
     "happy": (0.57, 0.03, 0.05, 0.35),

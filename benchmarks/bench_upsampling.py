@@ -41,7 +41,7 @@ from generation.gait.generate import generate_gaits, load_default_model
 from generation.gait.real_seeds import STYLE_OF_EMOTION, shipped_walk
 from generation.quality.metrics import mean_jerk
 from generation.quality.realism import realism_measures
-from study_protocol import GAIT_EMOTIONS
+from protocol.vocabulary import GAIT_EMOTIONS
 
 ROOT = Path(__file__).resolve().parents[1]
 

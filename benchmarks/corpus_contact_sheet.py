@@ -25,7 +25,7 @@ from generation.core import paths
 from generation.procedural.emotion import GAIT_EMOTIONS, gait_params_for_emotion, gesture_params_for_vad
 from generation.procedural.gesture import seated_gesture
 from generation.procedural.walk import walk, walk_with_contacts
-from study_protocol import GESTURE_VAD
+from protocol.vocabulary import GESTURE_VAD
 
 torch.set_num_threads(1)
 

@@ -27,7 +27,7 @@ from generation.gait.data import DEFAULT_CORPUS, load_corpus_sequences
 from generation.gait.generate import load_model
 from generation.procedural.corpus import GaitCorpus
 from generation.quality.gait_guidance import heldout_corpus, seed_walks, single_dominant
-from study_protocol import GAIT_EMOTIONS
+from protocol.vocabulary import GAIT_EMOTIONS
 
 ROOT = Path(__file__).resolve().parents[1]
 

@@ -32,7 +32,7 @@ def write_takes(folder: Path, n_takes: int, n_frames: int) -> None:
 
     from generation.procedural.emotion import gait_params_for_emotion
     from generation.procedural.walk import walk
-    from study_protocol import GAIT_EMOTIONS
+    from protocol.vocabulary import GAIT_EMOTIONS
     from tests.mocap_conventions import export_as
 
     folder.mkdir(parents=True, exist_ok=True)

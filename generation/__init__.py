@@ -13,5 +13,5 @@ Packages, bottom layer first; each imports only the packages listed before it (t
     plans/       the generator registry, stimulus plans, plan entry -> Motion (clipgen), the clip catalogue
     pipeline/    the plan runner: jobs, workers, Dask, plan QA
     imports/     researchers' own clips from a manifest (videos and motion files)
-The study vocabulary comes from the top-level ``study_protocol`` module.
+The study vocabulary comes from the top-level ``protocol.vocabulary`` module.
 """

@@ -1,7 +1,8 @@
 """Print the package import graph of the project: one line per edge ``package -> package (n imports)``.
 
 Packages are the subpackages of ``generation`` (``generation.core``, ``generation.render``, ...), ``analysis``,
-``studyapp`` and the top-level protocol modules. Imports inside functions count as edges too (marked ``local``):
+``studyapp`` and ``protocol`` (the study protocol, the ground floor).
+Imports inside functions count as edges too (marked ``local``):
 they hide cycles as well as top-level ones do. Exits 1 when the package graph has a cycle, naming it.
 
     python -m scripts.import_graph            # edges, then cycles if any
@@ -19,8 +20,8 @@ from collections import defaultdict
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
-LIBRARIES = ("generation", "analysis", "studyapp")
-TOP_MODULES = ("study_protocol", "study_pools", "study_presets", "study_norming")
+LIBRARIES = ("protocol", "generation", "analysis", "studyapp")
+GROUND = "protocol"
 
 
 def package_of(module: str) -> str | None:
@@ -28,7 +29,7 @@ def package_of(module: str) -> str | None:
     parts = module.split(".")
     if parts[0] == "generation":
         return ".".join(parts[:2]) if len(parts) > 1 else "generation"
-    if parts[0] in LIBRARIES or parts[0] in TOP_MODULES:
+    if parts[0] in LIBRARIES:
         return parts[0]
     if parts[0] == "django":
         return "django"
@@ -72,8 +73,8 @@ def imports_of(path: Path, root: Path = ROOT) -> list[tuple[str, int, bool]]:
 
 
 def project_files(root: Path = ROOT) -> list[Path]:
-    """The top-level protocol modules and every module of the three libraries (migrations left out)."""
-    files = [root / f"{name}.py" for name in TOP_MODULES if (root / f"{name}.py").exists()]
+    """Every module of the protocol and the three libraries (migrations left out)."""
+    files = []
     for library in LIBRARIES:
         files += sorted(p for p in (root / library).rglob("*.py") if "migrations" not in p.parts)
     return files

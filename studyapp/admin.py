@@ -17,7 +17,7 @@ from django.template.response import TemplateResponse
 from django.urls import path, reverse
 from django.utils.html import format_html, format_html_join
 
-from study_pools import SUB_POOLS
+from protocol.pools import SUB_POOLS
 
 from . import admin_clip_qa, clip_import, pool_editor, views_pool, views_staff
 from .admin_norms import norms_table
@@ -32,7 +32,7 @@ COMPACT = {models.JSONField: {"widget": Textarea(attrs={"rows": 2, "cols": 90})}
            models.TextField: {"widget": Textarea(attrs={"rows": 3, "cols": 90})}}
 
 
-RAW_JSON_HELP = ("The pool and options as JSON (study_pools). The fields above win as soon as one of them is "
+RAW_JSON_HELP = ("The pool and options as JSON (protocol.pools). The fields above win as soon as one of them is "
                  "edited, and this JSON then only adds the keys they cannot show (e.g. <code>plan__startswith</code>, "
                  "<code>happy__gt</code>); it wins when the fields above are left as they were.")
 

@@ -5,7 +5,7 @@ from __future__ import annotations
 from django.contrib import admin
 from django.db.models import QuerySet
 
-from study_protocol import QA_CHECKS
+from protocol.vocabulary import QA_CHECKS
 
 PASSED, FLAGGED = "passed", "flagged"
 

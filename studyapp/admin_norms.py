@@ -6,8 +6,8 @@ from __future__ import annotations
 from django.utils.html import format_html, format_html_join
 from django.utils.safestring import SafeString
 
-from study_pools import INCLUDE_FLAGGED, NORMS_RULE, OBSERVER_ADVISORY
-from study_protocol import QA_ADVISORY_CHECKS
+from protocol.pools import INCLUDE_FLAGGED, NORMS_RULE, OBSERVER_ADVISORY
+from protocol.vocabulary import QA_ADVISORY_CHECKS
 
 from .catalogue import CatalogueError, pool_queryset
 from .norms_rule import NormsSourceError, verdicts

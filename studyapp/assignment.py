@@ -3,7 +3,7 @@
 Rules (seed 000 section 6.1, seed 003 section 6.1, seed 004 section V):
 - every participant gets a recorded random seed; the clips of each section are drawn with it;
 - balanced: within a section the clips with the fewest assignments so far come first (ties broken at random); a
-  norming section (``options["norming"]``) follows the cyclic balanced incomplete design of study_norming instead,
+  norming section (``options["norming"]``) follows the cyclic balanced incomplete design of protocol.norming instead,
   balanced over participants and positions;
 - no clip twice for one participant, except in a section that reuses another section's clips on purpose;
 - naturalness mixes generated and source clips, unlabelled, in random order, and never shows a generated clip
@@ -37,9 +37,9 @@ from django.db import OperationalError, connection, transaction
 from django.db.models import F
 from django.utils import timezone
 
-from study_norming import clip_order, cyclic_block, ratings_per_clip
-from study_pools import SUB_POOLS
-from study_protocol import NORMING_SECTION_TYPES
+from protocol.norming import clip_order, cyclic_block, ratings_per_clip
+from protocol.pools import SUB_POOLS
+from protocol.vocabulary import NORMING_SECTION_TYPES
 
 from .counterbalance import SectionInfo, section_order
 from .models import Assignment, Clip, Participant, Section, SectionClipCount, Study, StudyCounter
@@ -110,7 +110,7 @@ def plan_section(section: Section, seed: int, used: set[int], earlier: dict[int,
 def _plan_norming(section: Section, clips: list[Clip], used: set[int], counts: dict[int, int], k: int
                   ) -> list[Clip]:
     """A norming section's clips for the next participant, in the order shown: the cyclic balanced incomplete
-    design of study_norming over the pool in its fixed order (seeded by the section), the participant's ordinal
+    design of protocol.norming over the pool in its fixed order (seeded by the section), the participant's ordinal
     being the section's trial assignments so far / M. Clips this participant already has are skipped."""
     by_id = {c.clip_id: c for c in clips}
     order = clip_order(list(by_id), str(section.pk))

@@ -16,8 +16,8 @@ from itertools import combinations
 from django.db import transaction
 from django.db.models import Q, QuerySet
 
-from study_pools import INCLUDE_FLAGGED, NORMS_RULE, OBSERVER_ADVISORY, PoolError, pool_lookups
-from study_protocol import (
+from protocol.pools import INCLUDE_FLAGGED, NORMS_RULE, OBSERVER_ADVISORY, PoolError, pool_lookups
+from protocol.vocabulary import (
     CLIP_FLOAT_COLUMNS,
     CLIP_MODALITIES,
     CLIP_THEMES,
@@ -180,7 +180,7 @@ def retire_replaced(plan: str, entry_id: str, clip_id: str) -> list[str]:
 
 def section_queryset(section_type: str | None, pool: dict | None, include_flagged: bool | None = None) -> QuerySet:
     """The clips a section of ``section_type`` draws from its pool: :func:`pool_queryset` limited to the modality
-    the section type shows (``study_protocol.SECTION_MODALITY``: a gait section never shows a gesture or an
+    the section type shows (``protocol.vocabulary.SECTION_MODALITY``: a gait section never shows a gesture or an
     imported ``other`` video, whatever its filters say; naturalness sections take any modality)."""
     qs = pool_queryset(pool, include_flagged)
     wanted = SECTION_MODALITY.get(section_type or "")
@@ -188,11 +188,11 @@ def section_queryset(section_type: str | None, pool: dict | None, include_flagge
 
 
 def pool_queryset(pool: dict | None, include_flagged: bool | None = None) -> QuerySet:
-    """Clips (not retired) matching a section's pool filter (see study_pools for the filter language).
+    """Clips (not retired) matching a section's pool filter (see protocol.pools for the filter language).
 
     Clips that failed a quality check (``qa_flag`` not empty) are left out unless the pool says
     ``"include_flagged": true`` or ``include_flagged`` is given (True for a sub-pool, which only narrows its
-    section's pool); failing only advisory checks (``study_protocol.QA_ADVISORY_CHECKS``) does not count.
+    section's pool); failing only advisory checks (``protocol.vocabulary.QA_ADVISORY_CHECKS``) does not count.
     A ``norms`` rule (studyapp.norms_rule) keeps only clips whose norms pass, and makes the ``observer`` check
     advisory for clips that have norms; ``"observer_advisory": true`` makes it advisory for every clip. Raises
     CatalogueError naming the filter (or the norms source's file, line and column) when the pool is not valid;

@@ -15,8 +15,8 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from study_norming import ratings_per_clip
-from study_protocol import SECTION_QUESTIONS, section_questions
+from protocol.norming import ratings_per_clip
+from protocol.vocabulary import SECTION_QUESTIONS, section_questions
 
 from .models import Section, Study
 from .pool_cache import SectionPool, section_pools

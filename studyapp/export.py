@@ -1,5 +1,5 @@
 """Export a study's data in the public DESIGN.md formats: responses.csv, clips.csv, participants.csv (columns:
-study_protocol), plus assignments.csv (what each participant was shown, for audits).
+protocol.vocabulary), plus assignments.csv (what each participant was shown, for audits).
 
 Rows are produced by generators over `.iterator()` queries, so a large study streams in constant memory (an
 HTTP StreamingHttpResponse or a file on disk); no export builds the whole file as one string.
@@ -14,7 +14,7 @@ LibreOffice and Google Sheets show it as text instead of running it; plain numbe
 
 Practice items and attention checks (studyapp.trial_extras): practice answers are never stored, and practice
 items are left out of assignments.csv. Attention checks are rows of responses.csv and assignments.csv with
-section_type ``attention_check`` (study_protocol.ATTENTION_CHECK) and question ``<key>=<instructed answer>``;
+section_type ``attention_check`` (protocol.vocabulary.ATTENTION_CHECK) and question ``<key>=<instructed answer>``;
 participants.csv counts them per participant (``attention_passed``, ``attention_total``). Its ``section_order``
 column lists the ``order`` numbers (Section.order, as in assignments.csv's section_order) of the sections in the
 order the participant took them, joined by ';' (empty for a participant who has not started).
@@ -29,8 +29,8 @@ from pathlib import Path
 
 from django.db.models import Case, F, Q, When
 
-from study_pools import NORMS_RULE
-from study_protocol import (
+from protocol.pools import NORMS_RULE
+from protocol.vocabulary import (
     ASSIGNMENT_COLUMNS,
     ATTENTION_CHECK,
     CLIP_COLUMNS,

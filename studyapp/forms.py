@@ -8,7 +8,7 @@ from django.utils.translation import gettext
 from django.utils.translation import gettext_lazy as _
 
 from analysis.exclusion import rule_errors
-from study_pools import SUB_POOLS
+from protocol.pools import SUB_POOLS
 
 from . import clip_import, pool_editor
 from .i18n import display
@@ -97,7 +97,7 @@ class SectionForm(forms.ModelForm, PoolEditorFields):
     as an advanced field. The raw JSON wins only when none of its group's structured fields was edited (their
     initial values are read from the saved JSON); otherwise the fields win and the raw JSON adds only the keys
     they cannot show. Every bad pool filter, option or count is an error on the field it comes from
-    (study_pools), so a study can never reach a participant with a pool or options the assignment cannot use.
+    (protocol.pools), so a study can never reach a participant with a pool or options the assignment cannot use.
     (A field with an error leaves cleaned_data, so Section.clean, which repeats the check, does not report it
     twice.)
 

@@ -6,7 +6,7 @@ every request in the default language and resets it after the response, so a stu
 the next request served by the same thread (the admin, another study).
 
 Only what is *displayed* is translated. The answer values posted, stored and exported stay the protocol's labels
-(study_protocol.py): `answer_label()` turns a value into the text shown next to it. Researcher-written text
+(protocol/vocabulary.py): `answer_label()` turns a value into the text shown next to it. Researcher-written text
 (title, introduction, consent, section titles and instructions, custom questions and anchors) is shown as
 entered; text that is one of this app's defaults (e.g. the naturalness anchors a preset copies into a section's
 options) has a msgid and is translated.
@@ -20,7 +20,7 @@ from django.conf import settings
 from django.utils import translation
 from django.utils.translation import gettext, gettext_noop, pgettext, pgettext_lazy
 
-from study_protocol import LABEL_CHOICES, LIKERT_LEVELS, NEUTRAL_CHOICE
+from protocol.vocabulary import LABEL_CHOICES, LIKERT_LEVELS, NEUTRAL_CHOICE
 
 EMOTION_CONTEXT = "emotion"             # an emotion as an answer option ("Happy" -> "Glücklich")
 THEME_CONTEXT = "theme"                 # a style theme as an answer option ("Happy" -> "Fröhlich")
@@ -83,7 +83,7 @@ def display(text: str) -> str:
 
 
 def likert_texts() -> list[str]:
-    """Every display string of study_protocol.LIKERT_LEVELS (feature names and the wording of the levels)."""
+    """Every display string of protocol.vocabulary.LIKERT_LEVELS (feature names and the wording of the levels)."""
     texts = []
     for label, levels in LIKERT_LEVELS.values():
         texts.append(label)
@@ -101,7 +101,7 @@ def label_msgids() -> list[tuple[str, str]]:
 
 
 # Marked for makemessages only (never used at run time): the protocol's display strings, which live in
-# study_protocol.py (no Django there), and the preset defaults that presets copy into studies.
+# protocol/vocabulary.py (no Django there), and the preset defaults that presets copy into studies.
 _MARKED_FOR_EXTRACTION = (
     # LIKERT_LEVELS (seed 000 Table 2)
     gettext_noop("Torso"), gettext_noop("Arms"), gettext_noop("Gait pace"), gettext_noop("Gait flow"),

@@ -13,8 +13,8 @@ from django.core.exceptions import ValidationError
 from django.db import models
 from django.utils import timezone
 
-from study_pools import NORMS_RULE, errors_by_field, validate_section
-from study_protocol import ATTENTION_CHECK, CLIP_MODALITIES, ORIGINS
+from protocol.pools import NORMS_RULE, errors_by_field, validate_section
+from protocol.vocabulary import ATTENTION_CHECK, CLIP_MODALITIES, ORIGINS
 
 from .permissions import STUDY_PERMISSIONS
 from .questions import section_type_choices
@@ -202,7 +202,7 @@ class Section(models.Model):
         return f"{self.study.slug} #{self.order} {self.section_type}"
 
     def protocol_errors(self) -> dict[str, list[str]]:
-        """Field -> messages for a bad pool, options or count (study_pools; no database query)."""
+        """Field -> messages for a bad pool, options or count (protocol.pools; no database query)."""
         return errors_by_field(validate_section(self.section_type, self.pool, self.options,
                                                 self.clips_per_participant))
 
@@ -293,7 +293,7 @@ class Assignment(models.Model):
     kind = models.CharField(max_length=20, choices=Kind.choices, default=Kind.TRIAL, blank=True)
     # Attention check: the answer the participant is told to give (Section.options["attention_checks"]["answer"]).
     instructed = models.CharField(max_length=40, blank=True, default="")
-    # How the clip was watched before the answer (studyapp.viewing): study_protocol.VIEWING_FIELDS -> int or null;
+    # How the clip was watched before the answer (studyapp.viewing): protocol.vocabulary.VIEWING_FIELDS -> int or null;
     # null when the browser sent no record. Exported as viewing.csv.
     viewing = models.JSONField(null=True, blank=True, editable=False)
     # The clip's playback as the player reported it while the page was open (studyapp.viewing.record_playback), kept

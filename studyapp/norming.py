@@ -1,7 +1,7 @@
 """A norming study's design and progress: K ratings per clip, M clips per participant, the N it needs.
 
-A section is a norming section when its options hold ``"norming": {"ratings_per_clip": K}`` (study_norming) and
-its type is one of study_protocol.NORMING_SECTION_TYPES. The planned N is the study's participant limit
+A section is a norming section when its options hold ``"norming": {"ratings_per_clip": K}`` (protocol.norming) and
+its type is one of protocol.vocabulary.NORMING_SECTION_TYPES. The planned N is the study's participant limit
 (``Study.max_participants``). :func:`design_rows` is what the admin shows before the study opens; :func:`open_errors`
 is why it refuses to open (the admin action and the study form both ask); :func:`ratings_so_far` feeds the staff
 monitor page.
@@ -12,8 +12,8 @@ from dataclasses import dataclass, field
 
 from django.db.models import Count
 
-from study_norming import design_errors, min_ratings, ratings_per_clip, required_participants
-from study_protocol import NORMING_SECTION_TYPES, SECTION_QUESTIONS
+from protocol.norming import design_errors, min_ratings, ratings_per_clip, required_participants
+from protocol.vocabulary import NORMING_SECTION_TYPES, SECTION_QUESTIONS
 
 from .models import Response, Section, SectionClipCount, Study
 from .pool_cache import load_section_pool

@@ -1,4 +1,4 @@
-"""The pool rule ``norms``: admit only clips whose per-clip norms pass (study_pools.NORMS_RULE).
+"""The pool rule ``norms``: admit only clips whose per-clip norms pass (protocol.pools.NORMS_RULE).
 
 ``{"norms": {"from": "<study slug>" | "<path to clip_norms.csv>", "min_ratings": 10, "min_intended_share": 0.5,
 "max_entropy_bits": 1.5}}``. The norms come from a study of this site (computed from its exports with its
@@ -31,7 +31,7 @@ from django.conf import settings
 from analysis import exclusion
 from analysis.io import StudyData, ValidationError, load_study
 from analysis.norms import clip_norms, read_clip_norms
-from study_pools import NORMS_RULE
+from protocol.pools import NORMS_RULE
 
 from .export import stream_csv
 from .models import Clip, Response, Study

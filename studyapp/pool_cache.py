@@ -16,8 +16,8 @@ from dataclasses import dataclass, field
 from django.core.cache import cache
 from django.db.models import Count, Max, Q
 
-from study_pools import SUB_POOLS
-from study_protocol import SECTION_MODALITY
+from protocol.pools import SUB_POOLS
+from protocol.vocabulary import SECTION_MODALITY
 
 from .catalogue import pool_queryset, section_queryset
 from .models import Clip, Section

@@ -1,11 +1,11 @@
 """The admin's pool editor: form fields <-> a section's ``pool`` and ``options`` JSON (the language of
-study_pools), and the rule that decides which of the two a save uses.
+protocol.pools), and the rule that decides which of the two a save uses.
 
 Every *spec* below owns some keys of the JSON and one or more form fields:
 
 - ``read(json) -> (field values, the json without the keys it took)``
 - ``write(field values) -> the json fragment those values mean``
-- ``owner(message) -> the field a study_pools message is about`` (messages name their key, e.g. ``'weight__gte'``)
+- ``owner(message) -> the field a protocol.pools message is about`` (messages name their key, e.g. ``'weight__gte'``)
 
 ``pool_to_fields`` / ``fields_to_pool`` (and ``options_to_fields`` / ``fields_to_options``) run every spec. Keys no
 spec can show (``plan__startswith``, ``happy__gt``, a key added to the pool language later) come back as the
@@ -25,7 +25,7 @@ from __future__ import annotations
 from django import forms
 from django.utils.html import format_html, format_html_join
 
-from study_pools import (
+from protocol.pools import (
     COMMON_OPTIONS,
     DEFAULT_GESTURE_OPTIONS,
     DEFAULT_PLAYER_CONTROLS,
@@ -37,7 +37,7 @@ from study_pools import (
     SUB_POOLS,
     validate_section,
 )
-from study_protocol import CLIP_MODALITIES, CLIP_THEMES, GESTURE_EMOTIONS, NATURALNESS, ORIGINS, answer_values
+from protocol.vocabulary import CLIP_MODALITIES, CLIP_THEMES, GESTURE_EMOTIONS, NATURALNESS, ORIGINS, answer_values
 
 ANY = ""
 TRISTATE = [(ANY, "any"), ("yes", "yes"), ("no", "no")]
@@ -149,7 +149,7 @@ class ChoiceSpec:
         return {self.key: chosen[0] if len(chosen) == 1 else chosen}
 
     def owner(self, keys: tuple[str, ...]) -> str | None:
-        """The form field of an error about these JSON keys (study_pools.SectionError.keys), or None."""
+        """The form field of an error about these JSON keys (protocol.pools.SectionError.keys), or None."""
         return self.field if self.key in keys or f"{self.key}__in" in keys else None
 
     def check(self, values: dict) -> dict[str, str]:
@@ -478,7 +478,7 @@ def write_specs(specs: list[ChoiceSpec], values: dict) -> dict:
 # ---- the editor's groups ------------------------------------------------------------------------------------------
 
 SUB_POOL_SECTION_TYPE = "naturalness"
-"""The section type whose pool may hold ``generated`` / ``source`` sub-pools (study_pools)."""
+"""The section type whose pool may hold ``generated`` / ``source`` sub-pools (protocol.pools)."""
 
 
 def _main_pool_specs() -> list[ChoiceSpec]:
@@ -537,7 +537,7 @@ def _option_specs() -> dict[str, list[ChoiceSpec]]:
 
 
 def _common_option_specs() -> list[ChoiceSpec]:
-    """Options every section type takes (study_pools.COMMON_OPTIONS)."""
+    """Options every section type takes (protocol.pools.COMMON_OPTIONS)."""
     o = OPTIONS_PREFIX
     specs = [FlagSpec(o + "practice", "practice", (), "Practice item first",
                       "one practice clip (not exported) from outside the pool, of the section's modality"),
@@ -635,7 +635,7 @@ def touched_groups(changed: list[str] | set[str]) -> dict[str, bool]:
 
 
 def _owner(specs: list[ChoiceSpec], keys: tuple[str, ...], values: dict) -> str | None:
-    """The structured field an error about these JSON keys (study_pools.SectionError.keys) belongs to: the spec
+    """The structured field an error about these JSON keys (protocol.pools.SectionError.keys) belongs to: the spec
     that wrote the key (a key that came from the raw JSON's leftover is the raw field's)."""
     for spec in specs:
         if isinstance(spec, SubPoolSpec):

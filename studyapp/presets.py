@@ -1,6 +1,6 @@
 """Study presets: one per paper's web study, and a demo with every section type.
 
-A preset is plain data (defined Django-free in the top-level ``study_presets`` module, which the study simulator
+A preset is plain data (defined Django-free in the top-level ``protocol.presets`` module, which the study simulator
 ``analysis.design`` reads too); `create_study_from_preset` turns it into Study + Section rows that the researcher can
 then edit in the admin. Section `reuse` is the index of an earlier section of the same preset.
 """
@@ -10,7 +10,7 @@ import copy
 
 from django.db import transaction
 
-from study_presets import CONSENT, PRESET_PLANS, PRESETS
+from protocol.presets import CONSENT, PRESET_PLANS, PRESETS
 
 from .models import Section, Study
 

@@ -1,5 +1,5 @@
 """Questions of each section type: wording (REFERENCE.md section 4, verbatim where the papers give it), answer
-choices, and validation of posted answers. The question keys and answer values are study_protocol's
+choices, and validation of posted answers. The question keys and answer values are protocol.vocabulary's
 (SECTION_QUESTIONS, answer_values); only the sentences shown live here. The sentences and labels are marked for
 translation (English msgids) and `questions_for` returns them in the active language (studyapp.i18n); the values
 posted and stored never change with the language.
@@ -14,8 +14,8 @@ from dataclasses import dataclass, field
 from django.utils.translation import gettext
 from django.utils.translation import gettext_noop as _
 
-from study_norming import ratings_per_clip
-from study_protocol import (
+from protocol.norming import ratings_per_clip
+from protocol.vocabulary import (
     GESTURE_EMOTIONS,
     INTEGER_RANGES,
     LIKERT_LEVELS,
@@ -47,7 +47,7 @@ class SectionWording:
     questions: dict[str, tuple[str, str]]
 
 
-# The keys and the answers are study_protocol.SECTION_QUESTIONS'; theme sections fill in {theme} and {opposite},
+# The keys and the answers are protocol.vocabulary.SECTION_QUESTIONS'; theme sections fill in {theme} and {opposite},
 # naturalness may replace its text (Section.options["question"]).
 WORDING: dict[str, SectionWording] = {
     "emotion_choice": SectionWording("Perceived gait emotion (multi-select)", {
@@ -72,7 +72,7 @@ WORDING: dict[str, SectionWording] = {
 }
 
 
-# The questions a norming section asks after its own (study_protocol.NORMING_QUESTIONS).
+# The questions a norming section asks after its own (protocol.vocabulary.NORMING_QUESTIONS).
 NORMING_WORDING: dict[str, tuple[str, str]] = {
     "intensity": (_("How intense is the emotion or style you perceive?"), ""),
     "naturalness": (_("How natural and smooth does this animation look?"), ""),
@@ -81,7 +81,7 @@ INTENSITY_ANCHORS = {"1": _("very weak"), "3": _("moderate"), "5": _("very stron
 
 
 def section_type_choices() -> list[tuple[str, str]]:
-    """(section type, admin label) for every study_protocol.SECTION_TYPES entry, in the protocol's order."""
+    """(section type, admin label) for every protocol.vocabulary.SECTION_TYPES entry, in the protocol's order."""
     return [(t, WORDING[t].label if t in WORDING else t) for t in SECTION_TYPES]
 
 
@@ -105,7 +105,7 @@ class Question:
     kind: str                      # how it is shown: "multi" | "single" | "scale"
     choices: list[tuple[str, str]] = field(default_factory=list)   # (value, label)
     help: str = ""
-    answer_kind: str = ""          # study_protocol's answer kind (SECTION_QUESTIONS)
+    answer_kind: str = ""          # protocol.vocabulary's answer kind (SECTION_QUESTIONS)
 
     def clean(self, raw: list[str]) -> str:
         """Validate the posted values of this question (a list, as from QueryDict.getlist) -> stored answer."""
@@ -161,7 +161,7 @@ def _values(section_type: str, kind: str, shown_options: list[str] | None) -> tu
 def questions_for(section_type: str, options: dict | None = None, clip_theme: str = "",
                   shown_options: list[str] | None = None) -> list[Question]:
     """The questions asked about one clip in a section of `section_type`: the keys and answer values of
-    study_protocol.SECTION_QUESTIONS with the wording above.
+    protocol.vocabulary.SECTION_QUESTIONS with the wording above.
 
     options: Section.options (anchors and question for naturalness...); clip_theme: the clip's RBF theme (theme
     sections name it); shown_options: the emotions drawn for this participant and clip (gesture_emotion).

@@ -120,7 +120,7 @@ if MEDIA_ACCEL_REDIRECT and not (MEDIA_ACCEL_REDIRECT.startswith("/") and MEDIA_
 
     raise ImproperlyConfigured(f"MEDIA_ACCEL_REDIRECT must start and end with '/', got {MEDIA_ACCEL_REDIRECT!r}")
 REPORTS_DIR = Path(os.environ.get("REPORTS_DIR", DATA_DIR / "reports"))
-# The gait observer of the quality gate for plans that name none in their qa: block (study_protocol.QA_OBSERVERS).
+# The gait observer of the quality gate for plans that name none in their qa: block (protocol.vocabulary.QA_OBSERVERS).
 QA_GAIT_OBSERVER = os.environ.get("QA_GAIT_OBSERVER", "").strip() or "real"
 # The real-capture corpora of the real gait observers (generation.mocap.real_corpus.RealCorpora.of); "" = the built
 # ones under var/mocap/.

@@ -14,11 +14,11 @@ import imageio_ffmpeg
 import numpy as np
 from django import forms
 
-from study_protocol import GAIT_EMOTIONS, GESTURE_EMOTIONS, NEUTRAL_THEME, THEMES
+from protocol.vocabulary import GAIT_EMOTIONS, GESTURE_EMOTIONS, NEUTRAL_THEME, THEMES
 
 from .catalogue import upsert_clips
 
-GAIT_VECTORS = [   # in study_protocol.GAIT_EMOTIONS order; GAIT_VECTORS[3] is pure neutral
+GAIT_VECTORS = [   # in protocol.vocabulary.GAIT_EMOTIONS order; GAIT_VECTORS[3] is pure neutral
     (1, 0, 0, 0), (0, 1, 0, 0), (0, 0, 1, 0), (0, 0, 0, 1), (0.5, 0, 0, 0.5), (0, 0.5, 0.5, 0),
     (0.6, 0.1, 0, 0.3), (0, 0.7, 0, 0.3), (0.25, 0.25, 0.25, 0.25), (0, 0, 0.8, 0.2)]
 

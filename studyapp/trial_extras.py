@@ -1,5 +1,5 @@
 """Practice trials and attention checks added to a section's planned clips (Section.options, checked by
-study_pools.options_errors).
+protocol.pools.options_errors).
 
 - ``"practice": true`` or ``"practice_clip": "<clip_id>"``: one practice item first in the section, on a clip
   outside the section's pool (``practice``: a clip of the section's modality drawn with the participant's seed),
@@ -11,15 +11,15 @@ study_pools.options_errors).
   first) and the instruction to give ``answer``. ``positions``: 1-based places among the section's rated items
   (trials and checks, practice not counted), clamped to the section's length; ``"random"`` draws them with the
   participant's seed, never the first place when the section has more than one item. The answer is stored with
-  section_type ``attention_check`` and question ``<key>=<answer>`` (study_protocol.attention_question).
+  section_type ``attention_check`` and question ``<key>=<answer>`` (protocol.vocabulary.attention_question).
 """
 from __future__ import annotations
 
 import random
 from dataclasses import dataclass, field
 
-from study_pools import DEFAULT_GESTURE_OPTIONS
-from study_protocol import ATTENTION_CHECK, GESTURE_EMOTIONS, SECTION_QUESTIONS, attention_question
+from protocol.pools import DEFAULT_GESTURE_OPTIONS
+from protocol.vocabulary import ATTENTION_CHECK, GESTURE_EMOTIONS, SECTION_QUESTIONS, attention_question
 
 from .models import Assignment, Clip, Section
 

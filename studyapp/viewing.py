@@ -2,10 +2,10 @@
 server knows, and marked with what it is worth.
 
 static/studyapp/study.js measures how the clip was watched and posts each field of
-``study_protocol.VIEWING_FIELDS`` as a hidden input named ``view_<field>`` (times in ms from the page's display,
+``protocol.vocabulary.VIEWING_FIELDS`` as a hidden input named ``view_<field>`` (times in ms from the page's display,
 counts as integers), and ``view_script=1`` to say that it ran. Every clip page ships the player, so the server
 knows a record is due with every answer; nothing here rejects an answer, but the record says what happened
-(``study_protocol.VIEWING_RECORDS``):
+(``protocol.vocabulary.VIEWING_RECORDS``):
 
 - ``missing``: the POST has none of the page's record fields (it did not come from the page);
 - ``no_script``: the fields came back blank without ``view_script`` (the browser ran no JavaScript);
@@ -22,8 +22,8 @@ answered.
 """
 from __future__ import annotations
 
-from study_pools import DEFAULT_PLAYER_CONTROLS, player_errors
-from study_protocol import VIEWING_FIELDS, VIEWING_TIME_FIELDS
+from protocol.pools import DEFAULT_PLAYER_CONTROLS, player_errors
+from protocol.vocabulary import VIEWING_FIELDS, VIEWING_TIME_FIELDS
 
 FIELD_PREFIX = "view_"
 SCRIPT_FIELD = "view_script"
@@ -46,7 +46,7 @@ VIEWING_FORM_FIELDS = tuple(field_name(f) for f in VIEWING_FIELDS)
 
 
 def player_options(options) -> dict:
-    """The clip player of a section: {"controls": one of study_pools.PLAYER_CONTROLS, "max_replays": int or None
+    """The clip player of a section: {"controls": one of protocol.pools.PLAYER_CONTROLS, "max_replays": int or None
     (unlimited)}. Options that do not validate (a section saved before a check existed) fall back to the default
     player rather than breaking the participant's page."""
     options = options if isinstance(options, dict) else {}

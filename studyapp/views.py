@@ -23,7 +23,7 @@ from django.utils.translation import gettext
 from django.views.decorators.cache import never_cache
 from django.views.decorators.http import require_http_methods, require_POST
 
-from study_protocol import ATTENTION_CHECK
+from protocol.vocabulary import ATTENTION_CHECK
 
 from .assignment import StudyUnavailable, check_open, current_step, start_participant
 from .device_check import device_context

@@ -24,8 +24,8 @@ from django.db import DatabaseError
 from django.http import JsonResponse
 from django.views.decorators.cache import never_cache
 
-from study_pools import SUB_POOLS, pool_errors
-from study_protocol import ORIGINS
+from protocol.pools import SUB_POOLS, pool_errors
+from protocol.vocabulary import ORIGINS
 
 from .admin_norms import norms_table
 from .catalogue import CatalogueError, pool_queryset, section_queryset

@@ -19,7 +19,7 @@ from django.urls import reverse
 from django.views.decorators.http import require_http_methods
 
 from generation.render import contact_sheet
-from study_protocol import ATTENTION_CHECK
+from protocol.vocabulary import ATTENTION_CHECK
 
 from .assignment import plan_study
 from .catalogue import clip_label

@@ -11,8 +11,8 @@ import pytest
 from analysis.design import PAPER_PRESETS, DesignError, design_from_presets, pool_mask
 from analysis.simulate import simulate_design
 from generation.plans.schema import load_plan
-from study_presets import PRESET_PLANS, PRESETS
-from study_protocol import GAIT_EMOTIONS, SECTION_QUESTIONS
+from protocol.presets import PRESET_PLANS, PRESETS
+from protocol.vocabulary import GAIT_EMOTIONS, SECTION_QUESTIONS
 
 
 def test_counts_and_pools_come_from_preset_and_plan():
@@ -91,7 +91,7 @@ def test_no_django_imported():
 def test_preset_anchors_are_the_study_apps():
     """study_presets keeps the naturalness anchors as plain text (no Django); studyapp.questions marks the same
     strings for translation. They must not drift apart."""
-    import study_presets
+    from protocol import presets as study_presets
     from studyapp import questions
 
     assert study_presets.NATURALNESS_ANCHORS_GAIT == {k: str(v) for k, v in questions.NATURALNESS_ANCHORS_GAIT.items()}

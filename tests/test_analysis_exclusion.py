@@ -8,7 +8,7 @@ import pandas as pd
 from analysis import exclusion as X
 from analysis.report import write_report
 from analysis.simulate import simulate_study
-from study_protocol import GAIT_EMOTIONS
+from protocol.vocabulary import GAIT_EMOTIONS
 
 CLIPS = pd.DataFrame({"duration_s": [10.0, 10.0, np.nan]}, index=["c1", "c2", "c3"])
 
@@ -134,7 +134,7 @@ def test_report_applies_and_states_study_rules():
 def test_attention_check_answers_in_responses_are_counted():
     """Attention-check rows of responses.csv (section_type ATTENTION_CHECK) are not clip answers: analysis.io keeps
     them aside, and without participants.csv counts the attention rule counts them."""
-    from study_protocol import ATTENTION_CHECK, attention_question
+    from protocol.vocabulary import ATTENTION_CHECK, attention_question
 
     r, c, p = simulate_study(6, seed=2, completion_rate=1.0)
     ids = sorted(p["participant_id"])

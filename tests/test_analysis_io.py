@@ -7,7 +7,7 @@ import pytest
 
 from analysis.io import ValidationError, load_study, read_clips, read_participants
 from analysis.simulate import simulate_study
-from study_protocol import SECTION_QUESTIONS
+from protocol.vocabulary import SECTION_QUESTIONS
 
 
 @pytest.fixture(scope="module")

@@ -16,7 +16,7 @@ from analysis.io import ValidationError, load_study
 from analysis.norms import clip_norms, read_clip_norms
 from analysis.norms_simulate import simulate_norming
 from analysis.report import write_report
-from study_protocol import CLIP_NORMS_COLUMNS
+from protocol.vocabulary import CLIP_NORMS_COLUMNS
 
 
 def _csv(df: pd.DataFrame) -> io.StringIO:

@@ -8,7 +8,7 @@ from statsmodels.stats.inter_rater import cohens_kappa as sm_cohens_kappa
 from statsmodels.stats.multitest import multipletests
 
 from analysis import recognition as R
-from study_protocol import GAIT_EMOTIONS
+from protocol.vocabulary import GAIT_EMOTIONS
 
 
 def test_rates_2x2_by_hand():

@@ -4,11 +4,11 @@ import numpy as np
 import pandas as pd
 import pytest
 
-import study_protocol as P
 from analysis import participants as parts_mod
 from analysis import themes, vad
 from analysis.io import load_study
 from analysis.simulate import simulate_study
+from protocol import vocabulary as P
 
 
 def _load(r, c, p):
@@ -31,7 +31,7 @@ def test_marked_synthetic():
 
 
 def _protocol_violations(r, c, p) -> list[str]:
-    """What in a simulated study breaks the study protocol (study_protocol), checked row by row."""
+    """What in a simulated study breaks the study protocol (protocol.vocabulary), checked row by row."""
     problems = []
     modality = c.set_index("clip_id")["modality"]
     for row in r.itertuples(index=False):

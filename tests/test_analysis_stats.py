@@ -10,7 +10,7 @@ from scipy import stats
 
 from analysis import adtest, emotion, likert, naturalness, participants, themes, vad
 from analysis.io import read_clips, read_participants, read_responses
-from study_protocol import GESTURE_VAD
+from protocol.vocabulary import GESTURE_VAD
 
 pytestmark = pytest.mark.filterwarnings("ignore:p-value (capped|floored):UserWarning")  # scipy's own calls here
 

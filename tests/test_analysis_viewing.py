@@ -14,7 +14,7 @@ from analysis import viewing as V
 from analysis.io import ValidationError, read_viewing
 from analysis.report import write_report
 from analysis.simulate import simulate_study
-from study_protocol import VIEWING_COLUMNS, VIEWING_COLUMNS_V1, VIEWING_FIELDS
+from protocol.vocabulary import VIEWING_COLUMNS, VIEWING_COLUMNS_V1, VIEWING_FIELDS
 
 FULL = {"first_play_ms": 150, "ended_ms": 3200, "plays": 1, "pauses": 0, "seeks": 0, "stalls": 0, "stall_ms": 0,
         "hidden": 0}

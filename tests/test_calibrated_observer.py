@@ -16,7 +16,7 @@ from generation.quality import calibrated_observer as co
 from generation.quality import evaluate, resolve_thresholds
 from generation.quality import real_observer as ro
 from generation.quality.observers import Observers
-from study_protocol import GAIT_EMOTIONS
+from protocol.vocabulary import GAIT_EMOTIONS
 
 
 def _clip(performer: str, acted: str, perceived: str, split: str, seed: int) -> CorpusClip:

@@ -10,7 +10,7 @@ import pytest
 ROOT = Path(__file__).resolve().parent.parent
 
 TORCH_FREE = (
-    "study_protocol",
+    "protocol.vocabulary",
     "generation.core.skeleton",
     "generation.core.motion",
     "generation.core.features",

@@ -20,7 +20,7 @@ from generation.procedural.emotion import (
     simulate_annotators,
     vad_for,
 )
-from study_protocol import GAIT_EMOTIONS, GESTURE_EMOTIONS, GESTURE_VAD
+from protocol.vocabulary import GAIT_EMOTIONS, GESTURE_EMOTIONS, GESTURE_VAD
 
 
 @pytest.fixture(scope="module")

@@ -95,7 +95,8 @@ def test_every_digit_on_every_scale_records_the_number_shown(chromium, live_serv
     expected: dict[tuple[str, str], str] = {}
     swept_kinds = set()
     for n, item in enumerate(items, start=1):
-        wait_for(driver, lambda d: f"/clip/{n}/" in d.current_url, what=f"clip {n}")
+        page = f"/clip/{n}/"
+        wait_for(driver, lambda d, page=page: page in d.current_url, what=f"clip {n}")
         wait_for(driver, lambda d: d.find_element("id", "next").is_enabled(), timeout=10 + 3 * CLIP_SECONDS,
                  what="clip played")
         keys = [q.get_attribute("data-key") for q in
@@ -112,7 +113,7 @@ def test_every_digit_on_every_scale_records_the_number_shown(chromium, live_serv
                 if box.is_selected() != (box.get_attribute("value") == answer):
                     driver.execute_script("arguments[0].click()", box)
         press(driver, Keys.ENTER)
-        wait_for(driver, lambda d: f"/clip/{n}/" not in d.current_url, what=f"leave clip {n}")
+        wait_for(driver, lambda d, page=page: page not in d.current_url, what=f"leave clip {n}")
     assert ("-7", "-6", "-5", "-4", "-3", "-2", "-1", "0", "1", "2", "3", "4", "5", "6", "7") in swept_kinds
     assert ("0", "1", "2", "3", "4") in swept_kinds
     stored = {(r.clip_id, r.section.section_type, r.question): r.answer

@@ -25,7 +25,7 @@ from pathlib import Path
 import pytest
 from django.urls import reverse
 
-from study_protocol import ATTENTION_CHECK, SECTION_QUESTIONS, SECTION_TYPES, answer_values
+from protocol.vocabulary import ATTENTION_CHECK, SECTION_QUESTIONS, SECTION_TYPES, answer_values
 from studyapp.export import stream_csv
 from studyapp.models import Assignment, Participant, Response, Study
 from studyapp.presets import create_study_from_preset

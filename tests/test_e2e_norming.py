@@ -13,7 +13,7 @@ import pytest
 from django.contrib.auth.models import User
 from django.urls import reverse
 
-from study_protocol import ATTENTION_CHECK, CLIP_NORMS_COLUMNS, GAIT_EMOTIONS
+from protocol.vocabulary import ATTENTION_CHECK, CLIP_NORMS_COLUMNS, GAIT_EMOTIONS
 from studyapp.models import Clip, Participant, Response, Study
 from studyapp.presets import create_study_from_preset
 from studyapp.testing import consent_and_demographics, make_catalogue, tiny_mp4, wait_for

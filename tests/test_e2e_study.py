@@ -18,7 +18,7 @@ from pathlib import Path
 import pytest
 from django.urls import reverse
 
-from study_protocol import SECTION_TYPES
+from protocol.vocabulary import SECTION_TYPES
 from studyapp.export import stream_csv
 from studyapp.models import Participant, Response, Study
 from studyapp.presets import create_study_from_preset

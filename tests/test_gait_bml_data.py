@@ -15,7 +15,7 @@ from generation.mocap.emotion_gait_bml import DATASET as BML_DATASET
 from generation.mocap.real_corpus import CorpusClip, save_real_corpus
 from generation.procedural.emotion import gait_params_for_emotion
 from generation.procedural.walk import walk
-from study_protocol import CAPTURE_GAIT_EMOTIONS
+from protocol.vocabulary import CAPTURE_GAIT_EMOTIONS
 
 
 @pytest.fixture(scope="module")

@@ -26,7 +26,7 @@ from generation.gait.real_data import (
 from generation.gait.weights import NAMED_WEIGHTS, weights_path
 from generation.mocap.real_corpus import CorpusClip, save_real_corpus
 from generation.procedural.walk import WalkParams, walk
-from study_protocol import GAIT_EMOTIONS
+from protocol.vocabulary import GAIT_EMOTIONS
 
 DATA = GaitDataConfig(seq_len=12)     # windows of 45 frames (+3 offsets)
 

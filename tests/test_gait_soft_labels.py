@@ -17,7 +17,7 @@ from generation.gait.soft_labels import SoftLabelError, load_soft_label_sequence
 from generation.gait.train import main
 from generation.plans.clipgen import write_motion_bvh
 from generation.procedural.walk import WalkParams, walk
-from study_protocol import CLIP_NORMS_COLUMNS, GAIT_EMOTIONS
+from protocol.vocabulary import CLIP_NORMS_COLUMNS, GAIT_EMOTIONS
 
 SHARES = {"sim-walk-a": (0.6, 0.1, 0.1, 0.2), "sim-walk-b": (0.05, 0.7, 0.05, 0.2)}
 

@@ -9,7 +9,7 @@ import yaml
 from django.core.management import CommandError, call_command
 
 from generation.plans.catalogue import CLIP_COLUMNS, check_catalogue, read_clips_csv
-from study_protocol import CLIP_PROVENANCE_COLUMNS, QA_COLUMNS
+from protocol.vocabulary import CLIP_PROVENANCE_COLUMNS, QA_COLUMNS
 
 TINY_RENDER = {"width": 160, "height": 120, "fps": 10, "duration_s": 1.0}
 CLIPS = [

@@ -13,7 +13,7 @@ import pytest
 from scipy import stats
 
 from generation.gesture import config
-from study_protocol import GESTURE_EMOTIONS
+from protocol.vocabulary import GESTURE_EMOTIONS
 
 N_SENTENCES = 11  # held-out sentences (one per emotion); each is also generated with all 11 emotions
 R_MIN = 0.4  # the liveliness goal for r(peak wrist speed, arousal)

@@ -14,7 +14,7 @@ from generation.pipeline import plan_qa
 from generation.quality import checks, evaluate, failed_checks, qa_columns, resolve_thresholds
 from generation.quality import gesture_observer as go
 from generation.quality.observers import Observers
-from study_protocol import GESTURE_EMOTIONS, GESTURE_VAD, QA_THRESHOLDS
+from protocol.vocabulary import GESTURE_EMOTIONS, GESTURE_VAD, QA_THRESHOLDS
 from tests.test_render import seated, swinging_walk
 
 PER_CLASS = 20  # training gestures per emotion for the fast test observer (the shipped one uses all 792)

@@ -19,7 +19,7 @@ from generation.mocap.seated_gesture import ARM_JOINTS, J, SeatingError, heading
 from generation.plans.schema import PlanError, load_plan, validate_plan
 from generation.procedural.gesture import seated_rest_pose
 from generation.quality.real_gesture_observer import gate_ready, held_out_accuracy
-from study_protocol import CAPTURE_GESTURE_EMOTIONS, GESTURE_EMOTIONS, capture_gesture_emotion
+from protocol.vocabulary import CAPTURE_GESTURE_EMOTIONS, GESTURE_EMOTIONS, capture_gesture_emotion
 
 SHIPPED = "generation/data/mocap/bandai-namco/Bandai-Namco-Research-Motiondataset-1/data"
 

@@ -19,7 +19,7 @@ from generation.gesture.data import SentenceRow, procedural_gesture
 from generation.gesture.soft_labels import SoftLabelError, load_soft_label_dataset, soft_vad
 from generation.gesture.train import main
 from generation.plans.clipgen import write_motion_bvh
-from study_protocol import CLIP_NORMS_COLUMNS, GESTURE_EMOTIONS, GESTURE_VAD
+from protocol.vocabulary import CLIP_NORMS_COLUMNS, GESTURE_EMOTIONS, GESTURE_VAD
 
 SHARE_COLUMNS = [f"share_{e}" for e in GESTURE_EMOTIONS]
 SENTENCE = "We finally did it, look at this!"

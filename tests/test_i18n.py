@@ -16,7 +16,7 @@ from django.urls import reverse
 from django.utils import translation
 from django.utils.translation.template import templatize
 
-from study_protocol import LABEL_CHOICES, SECTION_QUESTIONS, answer_values
+from protocol.vocabulary import LABEL_CHOICES, SECTION_QUESTIONS, answer_values
 from studyapp.export import stream_csv
 from studyapp.i18n import activate_study_language, answer_label, label_msgids, likert_texts
 from studyapp.models import Participant, Response, Study

@@ -586,7 +586,7 @@ def test_webm_delivery_and_a_file_given_twice(media, lab):
 
 
 def test_other_clips_only_in_sections_that_take_either_modality():
-    from study_pools import pool_errors
+    from protocol.pools import pool_errors
 
     assert pool_errors({"origin": "imported", "modality": "other"}, "naturalness") == []
     assert any("gait clips" in e for e in pool_errors({"modality": "other"}, "emotion_choice"))

@@ -16,7 +16,7 @@ from django.urls import reverse
 from django.utils import timezone
 
 from analysis.io import load_study
-from study_protocol import ATTENTION_CHECK
+from protocol.vocabulary import ATTENTION_CHECK
 from studyapp import norms_rule
 from studyapp.assignment import current_step
 from studyapp.models import Assignment, Clip, Participant, Response, Section, Study

@@ -3,7 +3,7 @@
 - generation and analysis never import studyapp or Django;
 - analysis never imports generation;
 - generation.core imports no other project package (it is the bottom layer);
-- the top-level vocabulary (study_protocol, study_pools, study_presets) imports none of the libraries nor Django;
+- the protocol package (the ground floor: vocabulary, pools, presets, norming) imports none of the libraries nor Django;
 - inside generation, a package imports only the packages below it in LAYERS (core < formats < procedural < render
   < gesture < mocap < gait < rbf < quality < plans < pipeline < imports, the order of the design notes), and
   every package of generation has its place in that order;
@@ -17,7 +17,7 @@ from pathlib import Path
 
 import pytest
 
-from scripts.import_graph import ROOT, TOP_MODULES, find_cycles, package_edges, package_of
+from scripts.import_graph import GROUND, ROOT, find_cycles, package_edges, package_of
 
 #: The packages of generation, bottom first: each may import only those before it.
 LAYERS = ("core", "formats", "procedural", "render", "gesture", "mocap", "gait", "rbf", "quality", "plans",
@@ -27,9 +27,9 @@ LOCAL_IMPORT_BUDGET = 10
 FORBIDDEN = [
     ("generation", ("studyapp", "django"), "generation never imports studyapp or Django"),
     ("analysis", ("studyapp", "django", "generation"), "analysis never imports studyapp, Django or generation"),
-    ("generation.core", ("generation", "analysis", "studyapp", "django", *TOP_MODULES),
+    ("generation.core", ("generation", "analysis", "studyapp", "django", GROUND),
      "generation.core imports nothing above it"),
-    (TOP_MODULES, ("generation", "analysis", "studyapp", "django"), "the top-level vocabulary imports no library"),
+    (GROUND, ("generation", "analysis", "studyapp", "django"), "the protocol imports no library"),
 ]
 
 
@@ -113,7 +113,7 @@ def _tree(root: Path, files: dict[str, str]) -> Path:
 def test_the_checks_see_local_imports_and_cycles(tmp_path):
     """The rules fail on a wrong-way import hidden in a function and on a cycle made of local imports."""
     root = _tree(tmp_path, {
-        "study_protocol.py": "X = 1\n",
+        "protocol/vocabulary.py": "X = 1\n",
         "analysis/__init__.py": "",
         "analysis/a.py": "def f():\n    from generation.plans import schema\n    return schema\n",
         "generation/__init__.py": "",

@@ -7,7 +7,7 @@ import pytest
 from generation.mocap.cli import main
 from generation.procedural.corpus import GaitCorpus
 from generation.procedural.walk import WalkParams, walk
-from study_protocol import GAIT_EMOTIONS
+from protocol.vocabulary import GAIT_EMOTIONS
 from tests.mocap_conventions import export_as
 
 

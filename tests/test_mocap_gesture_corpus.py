@@ -12,7 +12,7 @@ from generation.core.skeleton import gesture_skeleton
 from generation.mocap.cli import main
 from generation.procedural.emotion import gesture_params_for_vad
 from generation.procedural.gesture import seated_gesture
-from study_protocol import GAIT_EMOTIONS, GESTURE_TASKS, GESTURE_VAD
+from protocol.vocabulary import GAIT_EMOTIONS, GESTURE_TASKS, GESTURE_VAD
 from tests.mocap_conventions import export_as
 
 EMOTIONS = ("proud", "sad", "afraid", "joyous")

@@ -20,7 +20,7 @@ from generation.mocap.labels import Label, LabelError, compile_pattern, label_fr
 from generation.mocap.positions import LAYOUTS
 from generation.procedural.gesture import GestureParams, seated_gesture
 from generation.procedural.walk import WalkParams, walk
-from study_protocol import GAIT_EMOTIONS, GESTURE_VAD
+from protocol.vocabulary import GAIT_EMOTIONS, GESTURE_VAD
 from tests.mocap_conventions import CONVENTIONS, convention_motion, export_as
 
 EG16 = ("root", "spine", "neck", "head", "left_shoulder", "left_elbow", "left_hand", "right_shoulder",

@@ -12,7 +12,7 @@ from generation.mocap import ImportOptions, import_file
 from generation.mocap.labels import Label
 from generation.plans import clipgen
 from generation.plans.schema import PlanError, validate_plan
-from study_protocol import GAIT_EMOTIONS
+from protocol.vocabulary import GAIT_EMOTIONS
 from tests.mocap_conventions import export_as
 
 TINY = {"width": 160, "height": 120, "fps": 30, "duration_s": 1.0}

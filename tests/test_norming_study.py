@@ -15,8 +15,8 @@ from django.urls import reverse
 from analysis.io import load_study, read_clips
 from analysis.norms import clip_norms
 from analysis.norms_simulate import expected_shares, true_perception
-from study_norming import required_participants
-from study_protocol import ATTENTION_CHECK, GESTURE_EMOTIONS
+from protocol.norming import required_participants
+from protocol.vocabulary import ATTENTION_CHECK, GESTURE_EMOTIONS
 from studyapp.admin import StudyAdmin
 from studyapp.assignment import current_step
 from studyapp.export import stream_csv

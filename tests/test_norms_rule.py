@@ -11,8 +11,8 @@ from django.contrib.auth.models import User
 from django.core.exceptions import ValidationError
 from django.urls import reverse
 
-from study_pools import pool_errors
-from study_protocol import CLIP_NORMS_COLUMNS, GAIT_EMOTIONS
+from protocol.pools import pool_errors
+from protocol.vocabulary import CLIP_NORMS_COLUMNS, GAIT_EMOTIONS
 from studyapp import norms_rule
 from studyapp.admin_norms import norms_table
 from studyapp.catalogue import CatalogueError, pool_queryset

@@ -39,6 +39,6 @@ def test_the_packages_and_their_data_are_declared():
     config = tomllib.loads((ROOT / "pyproject.toml").read_text())
     assert config["build-system"]["build-backend"] == "setuptools.build_meta"
     tool = config["tool"]["setuptools"]
-    assert set(tool["py-modules"]) >= {"study_protocol", "study_pools", "study_presets"}
-    assert set(tool["packages"]["find"]["include"]) == {"generation*", "analysis*", "studyapp*"}
+    assert "py-modules" not in tool, "the project installs packages only, no top-level modules"
+    assert set(tool["packages"]["find"]["include"]) == {"protocol*", "generation*", "analysis*", "studyapp*"}
     assert (ROOT / "analysis" / "data" / "planned_clips.csv").is_file()

@@ -7,7 +7,7 @@ import pytest
 
 from generation.plans.generators import get_generator
 from generation.plans.schema import PlanError, builtin_plans, clip_hash, intent_fields, load_plan, validate_plan
-from study_protocol import GESTURE_EMOTIONS, SECTION_TYPES
+from protocol.vocabulary import GESTURE_EMOTIONS, SECTION_TYPES
 
 
 def _plan(*clips, render=None):

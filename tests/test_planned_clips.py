@@ -10,7 +10,7 @@ import pytest
 from analysis.design import PLANNED_CLIPS, DesignError, design_from_presets, read_planned_clips
 from generation.plans.planned import planned_clip_rows, write_planned_clips
 from generation.plans.schema import load_plan
-from study_presets import PRESET_PLANS
+from protocol.presets import PRESET_PLANS
 
 
 def test_shipped_table_is_the_current_plans(tmp_path):

@@ -11,7 +11,7 @@ from django.contrib.auth.models import Permission, User
 from django.test import Client
 from django.urls import reverse
 
-from study_protocol import CLIP_THEMES, GESTURE_EMOTIONS, MODALITIES, ORIGINS
+from protocol.vocabulary import CLIP_THEMES, GESTURE_EMOTIONS, MODALITIES, ORIGINS
 from studyapp import pool_editor as pe
 from studyapp.catalogue import pool_queryset
 from studyapp.forms import SectionForm, SectionPreviewForm

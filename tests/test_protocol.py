@@ -1,4 +1,4 @@
-"""The study protocol is defined once (study_protocol.py): no library keeps a copy of a vocabulary."""
+"""The study protocol is defined once (protocol/vocabulary.py): no library keeps a copy of a vocabulary."""
 from __future__ import annotations
 
 import ast
@@ -8,7 +8,7 @@ from pathlib import Path
 
 import pytest
 
-import study_protocol as P
+from protocol import vocabulary as P
 
 ROOT = Path(__file__).resolve().parents[1]
 LIBRARIES = ("generation", "studyapp", "analysis")
@@ -77,7 +77,7 @@ def library_files():
 
 def test_no_library_defines_a_vocabulary_again():
     copies = copies_of_vocabularies(library_files())
-    assert not copies, "define these once in study_protocol.py and import them:\n" + "\n".join(copies)
+    assert not copies, "define these once in protocol/vocabulary.py and import them:\n" + "\n".join(copies)
 
 
 def test_the_scan_finds_a_copy(tmp_path):
@@ -96,7 +96,7 @@ def test_the_scan_finds_a_copy(tmp_path):
 
 
 def test_protocol_imports_nothing_heavy():
-    code = ("import sys, study_protocol; heavy = {'numpy', 'torch', 'django', 'pandas'} & set(sys.modules); "
+    code = ("import sys, protocol.vocabulary; heavy = {'numpy', 'torch', 'django', 'pandas'} & set(sys.modules); "
             "assert not heavy, heavy")
     subprocess.run([sys.executable, "-c", code], cwd=ROOT, check=True)
 

@@ -1,6 +1,6 @@
 """Round trip of the study protocol: the demo study, answered by participants through the real pages, exported by
 studyapp.export and read back by analysis.io without a single problem; every section type, question and answer of
-the export lies inside study_protocol's vocabularies."""
+the export lies inside protocol.vocabulary's vocabularies."""
 from __future__ import annotations
 
 import random
@@ -10,7 +10,7 @@ from django.test import Client
 from django.urls import reverse
 
 from analysis.io import read_clips, read_participants, read_responses
-from study_protocol import (
+from protocol.vocabulary import (
     CLIP_COLUMNS,
     MULTI_SELECT_KINDS,
     PARTICIPANT_COLUMNS,

@@ -13,7 +13,7 @@ from generation.plans.schema import PlanError, validate_plan
 from generation.quality import QAThresholdError, evaluate, failed_checks, motion_metrics, resolve_thresholds
 from generation.quality.metrics import bone_error_mm, mean_jerk
 from generation.quality.observer import GaitObserver
-from study_protocol import CLIP_COLUMNS, CLIP_PROVENANCE_COLUMNS, QA_COLUMNS, QA_THRESHOLDS
+from protocol.vocabulary import CLIP_COLUMNS, CLIP_PROVENANCE_COLUMNS, QA_COLUMNS, QA_THRESHOLDS
 from tests.test_render import seated, swinging_walk
 
 

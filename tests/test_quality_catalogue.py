@@ -10,7 +10,7 @@ import yaml
 from django.core.management import call_command
 
 from generation.plans.catalogue import read_clips_csv
-from study_pools import pool_errors
+from protocol.pools import pool_errors
 from studyapp.catalogue import CatalogueError, pool_queryset, upsert_clips
 from studyapp.models import Clip
 

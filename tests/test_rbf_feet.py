@@ -7,7 +7,7 @@ from generation.quality.metrics import motion_metrics
 from generation.rbf.neutral_base import neutral_cycle
 from generation.rbf.stylise import neutral_walk, stylise
 from generation.rbf.themes import BODY_PARTS, theme_features
-from study_protocol import QA_THRESHOLDS
+from protocol.vocabulary import QA_THRESHOLDS
 
 FPS = 25.0  # the paper plans' render rate
 
@@ -101,7 +101,7 @@ def test_chained_captured_source_walk_is_planted_and_labelled():
 def test_sub_pools_keep_the_flagged_clips_their_section_pool_includes():
     """A naturalness section whose pool includes flagged clips (e.g. a sliding source walk) keeps them in its
     source/generated sub-pools: a sub-pool only narrows the section's pool (studyapp.pool_cache)."""
-    from study_pools import INCLUDE_FLAGGED, SUB_POOLS
+    from protocol.pools import INCLUDE_FLAGGED, SUB_POOLS
     from studyapp.catalogue import upsert_clips
     from studyapp.models import Section
     from studyapp.pool_cache import load_section_pool

@@ -11,7 +11,7 @@ import pytest
 from generation.core.motion import Motion, MotionFormatError
 from generation.core.skeleton import gait_skeleton, gesture_skeleton
 from generation.mocap import real_corpus as rc
-from study_protocol import capture_label
+from protocol.vocabulary import capture_label
 
 
 def _motion(skeleton, frames, seed):

@@ -11,7 +11,7 @@ from generation.pipeline.plan_qa import observer_for, unread_line
 from generation.quality import evaluate, resolve_thresholds
 from generation.quality import real_observer as ro
 from generation.quality.observers import OBSERVERS, Observers
-from study_protocol import CAPTURE_GAIT_EMOTIONS
+from protocol.vocabulary import CAPTURE_GAIT_EMOTIONS
 
 
 @pytest.fixture(scope="module")

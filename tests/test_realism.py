@@ -20,7 +20,7 @@ from generation.quality.realism_ranges import (
     realism_thresholds,
     threshold_keys,
 )
-from study_protocol import CLIP_COLUMNS, QA_COLUMNS, QA_REALISM_COLUMNS
+from protocol.vocabulary import CLIP_COLUMNS, QA_COLUMNS, QA_REALISM_COLUMNS
 
 FPS = 30.0
 SK = gait_skeleton()

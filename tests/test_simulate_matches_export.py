@@ -13,7 +13,7 @@ from test_protocol_roundtrip import take_part
 from analysis.design import design_from_presets
 from analysis.io import read_clips, read_participants, read_responses
 from analysis.simulate import simulate_design
-from study_protocol import CLIP_COLUMNS, GESTURE_EMOTIONS, MULTI_SELECT_KINDS, SECTION_QUESTIONS, answer_values
+from protocol.vocabulary import CLIP_COLUMNS, GESTURE_EMOTIONS, MULTI_SELECT_KINDS, SECTION_QUESTIONS, answer_values
 from studyapp.catalogue import upsert_clips
 from studyapp.export import run_report, write_study_csvs
 from studyapp.models import Study

@@ -12,7 +12,7 @@ from django.http import StreamingHttpResponse
 from django.test import Client
 from django.urls import reverse
 
-from study_protocol import CLIP_COLUMNS, LIKERT_FEATURES, PARTICIPANT_COLUMNS, RESPONSE_COLUMNS
+from protocol.vocabulary import CLIP_COLUMNS, LIKERT_FEATURES, PARTICIPANT_COLUMNS, RESPONSE_COLUMNS
 from studyapp.assignment import current_step, start_participant
 from studyapp.models import Participant, Response, Study
 from studyapp.presets import create_study_from_preset

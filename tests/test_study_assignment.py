@@ -7,7 +7,7 @@ from collections import Counter
 import pytest
 from django.db import connection
 
-from study_protocol import SECTION_TYPES
+from protocol.vocabulary import SECTION_TYPES
 from studyapp.assignment import StudyUnavailable, plan_study, start_participant
 from studyapp.models import Assignment, Participant, Section, Study
 from studyapp.presets import PRESETS, create_study_from_preset

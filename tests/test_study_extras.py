@@ -10,7 +10,7 @@ import pytest
 from django.test import Client
 from django.urls import reverse
 
-from study_protocol import ATTENTION_CHECK, ATTENTION_COLUMNS, PARTICIPANT_COLUMNS, SECTION_QUESTIONS
+from protocol.vocabulary import ATTENTION_CHECK, ATTENTION_COLUMNS, PARTICIPANT_COLUMNS, SECTION_QUESTIONS
 from studyapp.assignment import current_step, start_participant
 from studyapp.catalogue import pool_queryset
 from studyapp.counterbalance import williams_rows

@@ -11,7 +11,7 @@ from pathlib import Path
 import pytest
 from django.urls import reverse
 
-from study_protocol import ATTENTION_CHECK
+from protocol.vocabulary import ATTENTION_CHECK
 from studyapp.duration import expected_minutes
 from studyapp.models import Assignment, Participant, Response, Study
 from studyapp.presets import create_study_from_preset

@@ -9,7 +9,7 @@ from django.test import Client
 from django.urls import reverse
 from django.utils import timezone
 
-from study_protocol import SECTION_TYPES
+from protocol.vocabulary import SECTION_TYPES
 from studyapp.assignment import current_step
 from studyapp.models import Assignment, Participant, Response, Study
 from studyapp.presets import create_study_from_preset

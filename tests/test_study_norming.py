@@ -1,9 +1,16 @@
-"""The cyclic balanced incomplete design of a norming study (study_norming, no Django)."""
+"""The cyclic balanced incomplete design of a norming study (protocol.norming, no Django)."""
 from collections import Counter
 
 import pytest
 
-from study_norming import clip_order, cyclic_block, design_errors, min_ratings, ratings_per_clip, required_participants
+from protocol.norming import (
+    clip_order,
+    cyclic_block,
+    design_errors,
+    min_ratings,
+    ratings_per_clip,
+    required_participants,
+)
 
 
 @pytest.mark.parametrize("c, m", [(14, 7), (22, 8), (71, 8), (16, 4), (8, 8), (5, 3)])

@@ -16,7 +16,7 @@ from pathlib import Path
 import pytest
 from django.urls import reverse
 
-from study_protocol import VIEWING_COLUMNS
+from protocol.vocabulary import VIEWING_COLUMNS
 from studyapp.export import stream_csv
 from studyapp.models import Participant, Study
 from studyapp.presets import create_study_from_preset

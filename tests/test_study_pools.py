@@ -1,4 +1,4 @@
-"""Section pools and options: study_pools checks them against the protocol without Django or a database, and
+"""Section pools and options: protocol.pools checks them against the protocol without Django or a database, and
 the admin reports every bad pool filter or option as an error on its field (never a 500 at participant time)."""
 from __future__ import annotations
 
@@ -10,8 +10,8 @@ import pytest
 from django.contrib.auth.models import User
 from django.test import Client
 
-from study_pools import SectionError, errors_by_field, validate_section
-from study_protocol import SECTION_TYPES
+from protocol.pools import SectionError, errors_by_field, validate_section
+from protocol.vocabulary import SECTION_TYPES
 from studyapp.models import Section, Study
 from studyapp.presets import PRESETS, create_study_from_preset
 from studyapp.testing import admin_form_data, make_catalogue
@@ -20,7 +20,7 @@ ROOT = Path(__file__).resolve().parent.parent
 
 
 def test_pools_module_imports_no_django():
-    tree = ast.parse((ROOT / "study_pools.py").read_text())
+    tree = ast.parse((ROOT / "protocol/pools.py").read_text())
     names = [a.name for n in ast.walk(tree) if isinstance(n, ast.Import) for a in n.names]
     names += [n.module or "" for n in ast.walk(tree) if isinstance(n, ast.ImportFrom)]
     assert names and not [n for n in names if n.startswith(("django", "studyapp")) or n.startswith(".")]
@@ -35,9 +35,9 @@ def _imports(module: str) -> set[str]:
 
 
 def test_models_do_not_import_the_catalogue():
-    """catalogue -> models -> study_pools -> study_protocol: no cycle."""
+    """catalogue -> models -> protocol.pools -> protocol.vocabulary: no cycle."""
     assert not {".catalogue", "studyapp.catalogue"} & _imports("models")
-    assert ".models" in _imports("catalogue") and "study_pools" in _imports("models")
+    assert ".models" in _imports("catalogue") and "protocol.pools" in _imports("models")
 
 
 @pytest.mark.parametrize("preset", sorted(PRESETS))

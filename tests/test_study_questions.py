@@ -1,10 +1,10 @@
 """Question wording (REFERENCE.md section 4, verbatim) and answer validation of every section type; the keys and
-answer values are exactly study_protocol's."""
+answer values are exactly protocol.vocabulary's."""
 from __future__ import annotations
 
 import pytest
 
-from study_protocol import (
+from protocol.vocabulary import (
     GAIT_EMOTIONS,
     GESTURE_EMOTIONS,
     LIKERT_FEATURES,

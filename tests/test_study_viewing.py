@@ -11,8 +11,8 @@ from django.test import Client
 from django.test.utils import CaptureQueriesContext
 from django.urls import reverse
 
-from study_pools import options_errors, player_errors
-from study_protocol import VIEWING_COLUMNS, VIEWING_FIELDS
+from protocol.pools import options_errors, player_errors
+from protocol.vocabulary import VIEWING_COLUMNS, VIEWING_FIELDS
 from studyapp.assignment import current_step
 from studyapp.export import stream_csv
 from studyapp.models import Assignment, Participant, Study

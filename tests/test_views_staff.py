@@ -11,7 +11,7 @@ from django.contrib.auth.models import User
 from django.test import Client
 from django.urls import reverse
 
-from study_presets import PRESETS
+from protocol.presets import PRESETS
 from studyapp.assignment import start_participant
 from studyapp.models import Assignment, Participant, Response, Study
 from studyapp.presets import create_study_from_preset

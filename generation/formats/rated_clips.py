@@ -26,7 +26,7 @@ import numpy as np
 from generation.core.digest import file_sha256
 from generation.core.motion import Motion, MotionFormatError
 from generation.core.skeleton import Skeleton
-from study_protocol import CLIP_NORMS_COLUMNS, NORMS_SHARE_PREFIX
+from protocol.vocabulary import CLIP_NORMS_COLUMNS, NORMS_SHARE_PREFIX
 
 from .bvh import read_bvh
 

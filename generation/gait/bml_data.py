@@ -38,7 +38,7 @@ from generation.mocap.real_corpus import (
     load_real_corpus,
     read_meta,
 )
-from study_protocol import CAPTURE_GAIT_EMOTIONS, GAIT_EMOTIONS
+from protocol.vocabulary import CAPTURE_GAIT_EMOTIONS, GAIT_EMOTIONS
 
 from .config import GaitDataConfig
 from .data import GaitSequences

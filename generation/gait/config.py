@@ -23,7 +23,7 @@ from __future__ import annotations
 import math
 from dataclasses import asdict, dataclass, field, fields, replace
 
-from study_protocol import GAIT_EMOTIONS
+from protocol.vocabulary import GAIT_EMOTIONS
 
 NUM_JOINTS = 21                    # gait skeleton of seed 000 (Fig. 2)
 NUM_EMOTIONS = len(GAIT_EMOTIONS)  # components of the emotion vector m (section 3.2.2)

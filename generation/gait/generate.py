@@ -29,7 +29,7 @@ from generation.core.paths import GroundPath, straight
 from generation.core.quaternion import np_qfix, np_qnormalize
 from generation.procedural.emotion import gait_params_for_emotion
 from generation.procedural.walk import WalkParams, walk
-from study_protocol import GAIT_EMOTIONS
+from protocol.vocabulary import GAIT_EMOTIONS
 
 from .config import NUM_EMOTIONS, NUM_JOINTS, GaitDataConfig, GaitNetConfig
 from .data import (

@@ -5,7 +5,7 @@ arXiv:2306.08861, licence CC BY-NC 4.0), already on our 21-joint gait skeleton a
 
 - ``pretrain``: the forward locomotion of both datasets (dataset 1 ``walk`` in its 15 styles, dataset 2 ``walk``,
   ``walk-turn-left``, ``walk-turn-right`` in its 7 styles). Styles that map to a gait emotion
-  (``study_protocol.CAPTURE_GAIT_EMOTIONS``: happy, sad, angry, normal = neutral, in either dataset) carry that
+  (``protocol.vocabulary.CAPTURE_GAIT_EMOTIONS``: happy, sad, angry, normal = neutral, in either dataset) carry that
   label; every other style (proud, tired, active, feminine, elderly, ...) enters unlabelled, with the uniform
   emotion vector, which is also what emotion guidance uses as "no emotion asked".
 - ``finetune``: dataset 1's happy, sad, angry and normal ``walk`` takes with their labels.
@@ -30,7 +30,7 @@ from generation.core.digest import file_sha256
 from generation.core.motion import Motion
 from generation.core.windows import windows
 from generation.mocap.real_corpus import DEFAULT_PATH, load_real_corpus
-from study_protocol import CAPTURE_GAIT_EMOTIONS, GAIT_EMOTIONS
+from protocol.vocabulary import CAPTURE_GAIT_EMOTIONS, GAIT_EMOTIONS
 
 from .config import GaitDataConfig
 from .data import GaitSequences, prepare_sequences

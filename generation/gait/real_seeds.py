@@ -15,7 +15,7 @@ from generation.core.motion import Motion
 from generation.mocap.bandai_namco import shipped_takes
 from generation.mocap.importer import ImportOptions, import_file
 from generation.mocap.real_corpus import CITATION, LICENCE
-from study_protocol import CAPTURE_GAIT_EMOTIONS, GAIT_EMOTIONS
+from protocol.vocabulary import CAPTURE_GAIT_EMOTIONS, GAIT_EMOTIONS
 
 STYLE_OF_EMOTION = {emotion: style for style, emotion in CAPTURE_GAIT_EMOTIONS.items()}
 """Gait emotion -> the dataset's style (neutral -> normal)."""

@@ -41,7 +41,7 @@ from generation.formats.rated_clips import (
     share_columns,
     where,
 )
-from study_protocol import GAIT_EMOTIONS
+from protocol.vocabulary import GAIT_EMOTIONS
 
 from .config import GaitDataConfig
 from .data import GaitSequences

@@ -5,8 +5,8 @@ import hashlib
 from collections.abc import Mapping
 from pathlib import Path
 
-from study_protocol import GENDERS, HANDEDNESS  # noqa: F401 - the attribute one-hot orders
-from study_protocol import GESTURE_TASKS as TASKS  # noqa: F401
+from protocol.vocabulary import GENDERS, HANDEDNESS  # noqa: F401 - the attribute one-hot orders
+from protocol.vocabulary import GESTURE_TASKS as TASKS  # noqa: F401
 
 PACKAGE_DIR = Path(__file__).resolve().parent
 GENERATION_DIR = PACKAGE_DIR.parent

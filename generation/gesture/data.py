@@ -38,7 +38,7 @@ from generation.core.skeleton import gesture_skeleton
 from generation.core.splits import SPLITS
 from generation.procedural.emotion import gesture_params_for_vad
 from generation.procedural.gesture import seated_gesture, seated_rest_pose
-from study_protocol import GESTURE_VAD
+from protocol.vocabulary import GESTURE_VAD
 
 from . import config
 from .text import EMBED_DIM, cached_encodings, count_words, pad_tokens

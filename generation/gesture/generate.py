@@ -185,7 +185,8 @@ def generate_gesture(sentence: str, task: str = "narration", emotion: str = "joy
 
     Args:
         sentence: the text the agent says (at least one word).
-        task: "narration" or "conversation". emotion: one of the 11 MPI categories (study_protocol.GESTURE_EMOTIONS).
+        task: "narration" or "conversation". emotion: one of the 11 MPI categories
+            (protocol.vocabulary.GESTURE_EMOTIONS).
         gender: "female" or "male" (picks the body build). handedness: "left" or "right".
         fps: output frame rate. model: a network (default: the shipped one). seed, noise: the network is
         deterministic; with ``noise`` > 0 the decoder inputs are jittered (seeded) for variations.

@@ -5,7 +5,7 @@ section 3.3: a categorical term mapped through the NRC-VAD lexicon), not on a ca
 compares intended and perceived emotion the same way: each perceived category mapped to its VAD values
 (section 6.3). So the soft target of a rated gesture is its perceived shares over the 11 gesture_emotion categories
 (``share_afraid .. share_surprised`` of ``clip_norms.csv``, section ``gesture_emotion``, question ``perceived``)
-times their NRC-VAD values (``study_protocol.GESTURE_VAD``): the share-weighted VAD, which goes into the attribute
+times their NRC-VAD values (``protocol.vocabulary.GESTURE_VAD``): the share-weighted VAD, which goes into the attribute
 vector where a category's VAD would (:func:`soft_vad`).
 
 What a training example needs besides the target:
@@ -47,7 +47,7 @@ from generation.formats.rated_clips import (
     read_norm_rows,
     where,
 )
-from study_protocol import GESTURE_EMOTIONS, GESTURE_VAD
+from protocol.vocabulary import GESTURE_EMOTIONS, GESTURE_VAD
 
 from . import config
 from .data import GestureDataset, SentenceRow, attribute_vector, rest_rotations

@@ -8,9 +8,9 @@ misspelt label is not silently dropped):
     origin      imported (blank means imported)
     happy, sad, angry, neutral, final_*     intended gait emotion vector (all four or none, each 0..1, not all 0;
                 l1-normalised on import); final_*: a transition's final vector (gait only)
-    emotion_label   a gesture emotion (study_protocol.GESTURE_EMOTIONS); not for gait clips
+    emotion_label   a gesture emotion (protocol.vocabulary.GESTURE_EMOTIONS); not for gait clips
     valence, arousal, dominance             intended VAD, each 0..1
-    theme, weight   a style theme (study_protocol.CLIP_THEMES) and its weight (required with a theme)
+    theme, weight   a style theme (protocol.vocabulary.CLIP_THEMES) and its weight (required with a theme)
     title, licence, citation, notes         free text, kept with the clip
     keep_audio  yes | no (blank: the command's --keep-audio); videos only
     body        mannequin | stick | points (blank: mannequin); BVH only: how the figure is drawn
@@ -30,7 +30,7 @@ from dataclasses import dataclass, field
 from pathlib import Path, PurePosixPath
 
 from generation.render.settings import BODIES
-from study_protocol import (
+from protocol.vocabulary import (
     CLIP_MODALITIES,
     CLIP_THEMES,
     FINAL_EMOTION_COLUMNS,

@@ -21,7 +21,7 @@ from generation.pipeline.plan_qa import clip_qa, observer_for
 from generation.quality.checks import resolve_thresholds
 from generation.render.clip import render_clip
 from generation.render.settings import RenderSettings
-from study_protocol import GAIT_EMOTIONS
+from protocol.vocabulary import GAIT_EMOTIONS
 
 
 class MotionImportError(ValueError):

@@ -32,7 +32,7 @@ from pathlib import Path, PurePosixPath
 from generation.core.digest import file_sha256
 from generation.plans.catalogue import write_clips_csv
 from generation.render.settings import RenderSettings
-from study_protocol import CLIP_COLUMNS, IMPORTED
+from protocol.vocabulary import CLIP_COLUMNS, IMPORTED
 
 from .manifest import BadRow, ManifestError, ManifestRow, read_manifest
 from .motion import MotionImportError, load_motion, render_settings, stage_motion

@@ -15,7 +15,7 @@ import zlib
 from dataclasses import dataclass
 from pathlib import Path
 
-from study_protocol import capture_label
+from protocol.vocabulary import capture_label
 
 DATASET_IDS = {"1": "bandai-namco-1", "2": "bandai-namco-2"}
 """Dataset number in the file name -> the corpus's ``dataset`` value."""
@@ -84,7 +84,7 @@ class Take:
     Attributes:
         path: the .bvh file.
         dataset, content, style, take: from the file name (the JSON labels agree).
-        label: the study vocabulary's name for the style (``study_protocol.capture_label``).
+        label: the study vocabulary's name for the style (``protocol.vocabulary.capture_label``).
         split: "train", "val" or "test" (:func:`split_for`).
         skeleton: "gait", "gesture", or None for contents this importer does not take (punch, dance, ...).
     """

@@ -20,7 +20,7 @@ import os
 import sys
 from pathlib import Path
 
-from study_protocol import GENDERS, MODALITIES
+from protocol.vocabulary import GENDERS, MODALITIES
 
 from .bandai_namco import (
     FAST_CONTENTS,

@@ -15,7 +15,7 @@ import numpy as np
 
 from generation.core.motion import Motion, MotionFormatError
 from generation.procedural.corpus import GaitCorpus
-from study_protocol import GAIT_EMOTIONS
+from protocol.vocabulary import GAIT_EMOTIONS
 
 
 def _file_splits(dominant: list[str], rng: np.random.Generator) -> list[str]:

@@ -17,7 +17,7 @@ from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
 from generation.core.skeleton import REFERENCE_HEIGHT_M
-from study_protocol import GAIT_EMOTIONS, GESTURE_VAD
+from protocol.vocabulary import GAIT_EMOTIONS, GESTURE_VAD
 
 from . import bandai_namco as bn
 from .importer import REPORT_COLUMNS, ImportOptions, import_file

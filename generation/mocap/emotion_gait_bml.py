@@ -43,7 +43,7 @@ import numpy as np
 
 from generation.core.motion import Motion
 from generation.core.skeleton import REFERENCE_HEIGHT_M, gait_skeleton
-from study_protocol import GAIT_EMOTIONS
+from protocol.vocabulary import GAIT_EMOTIONS
 
 from .dataset_import import TAKE_COLUMNS, write_report
 from .importer import REPORT_COLUMNS, solve_onto, standing_height_m

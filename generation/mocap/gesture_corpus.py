@@ -7,7 +7,7 @@
 Seed 003 trains on text + captured gestures (the MPI Emotional Body Expressions database: each take is an actor
 narrating or conversing one sentence with one of 11 emotions). The sentences CSV pairs each take with its text:
 columns ``source`` (the imported .npz's name or stem, or the original file's name or stem), ``sentence``,
-``task`` (``study_protocol.GESTURE_TASKS``) and optionally ``handedness`` (default right). The emotion is the
+``task`` (``protocol.vocabulary.GESTURE_TASKS``) and optionally ``handedness`` (default right). The emotion is the
 take's label (``emotion_label`` metadata, from ``import --labels`` / ``--label-pattern``); the body build is the
 skeleton's (``import --build``). Takes are resampled to the network's frame rate
 (``generation.gesture.config.TRAIN_FPS``) and cut to its longest gesture (``MAX_SECONDS``).
@@ -27,7 +27,7 @@ import numpy as np
 from generation.core.quaternion import np_qfix, np_qnormalize
 from generation.gesture import config
 from generation.gesture.text import cached_encodings
-from study_protocol import GESTURE_TASKS, GESTURE_VAD, HANDEDNESS
+from protocol.vocabulary import GESTURE_TASKS, GESTURE_VAD, HANDEDNESS
 
 from .labels import LabelError, open_csv
 

@@ -1,12 +1,12 @@
 """Emotion labels of imported files: a labels CSV or a regular expression on the file names.
 
 Labels CSV: a ``source`` column (the file's name, stem or path as given; matched in that order) and either one
-column per gait emotion (``study_protocol.GAIT_EMOTIONS``, a vector, l1-normalised on import) or an ``emotion``
-column (a category: a gait emotion or a gesture emotion of ``study_protocol.GESTURE_EMOTIONS``).
+column per gait emotion (``protocol.vocabulary.GAIT_EMOTIONS``, a vector, l1-normalised on import) or an ``emotion``
+column (a category: a gait emotion or a gesture emotion of ``protocol.vocabulary.GESTURE_EMOTIONS``).
 ``--label-pattern REGEX``: the named group ``emotion`` (or the first named group) of a search in the file name.
 
 Stored in the Motion's metadata as the procedural corpora do: gait ``emotion`` {happy: .., ...} (l1-normalised);
-gestures ``emotion_label`` and ``vad`` [valence, arousal, dominance] from ``study_protocol.GESTURE_VAD``.
+gestures ``emotion_label`` and ``vad`` [valence, arousal, dominance] from ``protocol.vocabulary.GESTURE_VAD``.
 """
 from __future__ import annotations
 
@@ -15,7 +15,7 @@ import re
 from dataclasses import dataclass
 from pathlib import Path
 
-from study_protocol import GAIT_EMOTIONS, GESTURE_VAD
+from protocol.vocabulary import GAIT_EMOTIONS, GESTURE_VAD
 
 
 class LabelError(ValueError):

@@ -28,7 +28,7 @@ import numpy as np
 from generation.core.motion import Motion, MotionFormatError
 from generation.core.skeleton import Skeleton
 from generation.core.splits import SPLITS
-from study_protocol import MODALITIES
+from protocol.vocabulary import MODALITIES
 
 REPO_ROOT = Path(__file__).resolve().parents[2]
 DEFAULT_PATH = REPO_ROOT / "var" / "mocap" / "bandai-namco.npz"
@@ -59,7 +59,7 @@ class CorpusClip:
         dataset: "bandai-namco-1" or "bandai-namco-2".
         content: the dataset's content name (walk, walk-turn-left, bow, wave-left-hand, ...).
         style: the dataset's own style name (happy, normal, exhausted, masculinity, ...).
-        label: study vocabulary where ``study_protocol.capture_label`` maps the style, else the style.
+        label: study vocabulary where ``protocol.vocabulary.capture_label`` maps the style, else the style.
         take: take number from the file name (1, 2, ...).
         split: "train", "val" or "test", held out by take (a pure function of the file name).
         skeleton: "gait" (21 joints, whole body) or "gesture" (23 joints).

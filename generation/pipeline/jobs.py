@@ -20,7 +20,7 @@ class Job:
     clip_id: str
     generator_version: str
     fallback_reason: str | None = None
-    qa_thresholds: dict | None = None  # the plan's quality thresholds (resolved); None = study_protocol defaults
+    qa_thresholds: dict | None = None  # the plan's quality thresholds (resolved); None = protocol.vocabulary defaults
     # torch device of the network generators, fixed where the jobs are planned and carried to every worker
     # (local processes and Dask workers on other machines alike)
     device: str = "cpu"

@@ -28,7 +28,7 @@ from generation.quality.checks import QAResult, evaluate, gait_observer_kind, re
 from generation.quality.observers import OBSERVERS
 from generation.quality.realism_ranges import out_of_range
 from generation.render.clip import plan_cameras, prepare
-from study_protocol import QA_CHECKS, QA_OBSERVERS
+from protocol.vocabulary import QA_CHECKS, QA_OBSERVERS
 
 from .jobs import plan_jobs
 from .section_coverage import coverage_lines, presets_of_plan

@@ -363,7 +363,7 @@ def run_plan(plan: Plan, clips_dir: str | Path, records_dir: str | Path, media_p
         scheduler: a Dask distributed scheduler address (``tcp://host:port``) or Client: render there instead of
             in local processes (``workers`` is then ignored; the workers need the shared media folder).
         device: torch device of the network generators (gait_net, gesture_net), carried to every worker.
-        gait_observer: the gait observer (:data:`study_protocol.QA_OBSERVERS`: real, real-perceived or synthetic)
+        gait_observer: the gait observer (:data:`protocol.vocabulary.QA_OBSERVERS`: real, real-perceived or synthetic)
             that reads the clips of a plan that names none.
         corpora: where the real-capture corpora of the real gait observers are (default: the built ones under
             ``var/mocap/``), carried to every worker.

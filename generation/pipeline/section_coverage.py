@@ -1,8 +1,9 @@
 """Do a preset's sections still get the clips they ask for after the quality gate? Which section is short, and why.
 
-A study made from a preset (``study_presets.PRESETS``) draws each section's clips from its pool (catalogue filters,
-``study_pools``; :func:`create_study_from_preset` adds the preset's plan, ``study_presets.PRESET_PLANS``) and leaves
-out clips that failed a non-advisory quality check (``qa_flag`` other than ``study_protocol.QA_ADVISORY_CHECKS``)
+A study made from a preset (``protocol.presets.PRESETS``) draws each section's clips from its pool (catalogue filters,
+``protocol.pools``; :func:`create_study_from_preset` adds the preset's plan, ``protocol.presets.PRESET_PLANS``) and
+leaves
+out clips that failed a non-advisory quality check (``qa_flag`` other than ``protocol.vocabulary.QA_ADVISORY_CHECKS``)
 unless the pool says ``include_flagged`` (or failed only the observer's check in a pool that says
 ``observer_advisory``). :func:`section_coverage` applies the same filters to the plan's planned
 clip rows (:func:`generation.plans.planned.planned_clip_rows`, the rows the catalogue will hold) with each entry's
@@ -15,10 +16,10 @@ from __future__ import annotations
 
 from generation.plans.planned import planned_clip_rows
 from generation.plans.schema import load_plan
-from study_norming import ratings_per_clip
-from study_pools import INCLUDE_FLAGGED, OBSERVER_ADVISORY, SUB_POOLS, pool_lookups
-from study_presets import PRESET_PLANS, PRESETS
-from study_protocol import QA_ADVISORY_CHECKS
+from protocol.norming import ratings_per_clip
+from protocol.pools import INCLUDE_FLAGGED, OBSERVER_ADVISORY, SUB_POOLS, pool_lookups
+from protocol.presets import PRESET_PLANS, PRESETS
+from protocol.vocabulary import QA_ADVISORY_CHECKS
 
 
 def _value(row: dict, field: str):
@@ -45,7 +46,7 @@ def _match(row: dict, key: str, want) -> bool:
 
 
 def matches(row: dict, pool: dict | None) -> bool:
-    """Whether a planned clip row is in ``pool`` (its filters as ``study_pools.pool_lookups`` turns them into ORM
+    """Whether a planned clip row is in ``pool`` (its filters as ``protocol.pools.pool_lookups`` turns them into ORM
     calls; sub-pools and ``include_flagged`` are not filters)."""
     for method, kwargs in pool_lookups(pool):
         ok = all(_match(row, k, v) for k, v in kwargs.items())
@@ -68,7 +69,7 @@ def section_coverage(preset: str, flags: dict[str, str], plan=None) -> list[dict
     sections with halves ``halves`` ({generated|source: {asks, usable}}).
 
     Args:
-        preset: a key of ``study_presets.PRESETS``.
+        preset: a key of ``protocol.presets.PRESETS``.
         flags: entry id -> its quality flag (``qa_flag``; "" passed). Entries missing from it count as passed.
         plan: the validated plan (default: ``load_plan(PRESET_PLANS[preset])``).
     """

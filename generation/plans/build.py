@@ -14,7 +14,7 @@ The plans are plain YAML afterwards; researchers copy and edit them. What each r
   The generated gestures' sentences come from the gesture network's held-out test split (each entry says
   ``sentence_split: test``), so the study shows the network on inputs it was not trained on. Beside them, REAL
   source gestures: the shipped Bandai Namco ``bye`` takes in the five styles that name a gesture emotion
-  (``study_protocol.CAPTURE_GESTURE_EMOTIONS``), seated on the chair (``seated: true``), for the naturalness and
+  (``protocol.vocabulary.CAPTURE_GESTURE_EMOTIONS``), seated on the chair (``seated: true``), for the naturalness and
   gesture-emotion sections.
 - seed004 (THMS 2016, section V): the neutral input walk, 6 themes x weights (0.4, 0.7, 1.0, 1.3) x feature
   counts (1, 4, 7, 10), and the inversions at w = -0.7 with all ten features; short looping clips. The neutral base
@@ -33,7 +33,7 @@ from generation.gesture.config import gesture_seconds
 from generation.gesture.data import load_sentences, split_sentences
 from generation.gesture.text import count_words
 from generation.gesture.train import TrainConfig
-from study_protocol import CAPTURE_GESTURE_EMOTIONS, GAIT_EMOTIONS, GESTURE_EMOTIONS, GESTURE_TASKS, THEMES
+from protocol.vocabulary import CAPTURE_GESTURE_EMOTIONS, GAIT_EMOTIONS, GESTURE_EMOTIONS, GESTURE_TASKS, THEMES
 
 from .generators.captured import CAPTURED_CLIPS
 
@@ -142,7 +142,7 @@ REAL_SOURCE_CONTENT = "bye"
 
 def real_source_gestures(content: str = REAL_SOURCE_CONTENT, styles=None) -> list[dict]:
     """``captured_file`` entries of the shipped real ``content`` takes (take 001) in each captured style that names a
-    gesture emotion (``study_protocol.CAPTURE_GESTURE_EMOTIONS``; default all five), seated on the chair, labelled
+    gesture emotion (``protocol.vocabulary.CAPTURE_GESTURE_EMOTIONS``; default all five), seated on the chair, labelled
     with that emotion, for the naturalness and gesture-emotion sections."""
 
     styles = tuple(CAPTURE_GESTURE_EMOTIONS) if styles is None else tuple(styles)

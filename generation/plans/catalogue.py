@@ -14,7 +14,7 @@ from collections.abc import Iterable
 from pathlib import Path
 
 from generation.quality.checks import qa_columns
-from study_protocol import (
+from protocol.vocabulary import (
     CLIP_COLUMNS,
     CLIP_FLOAT_COLUMNS,
     CLIP_INT_COLUMNS,

@@ -50,8 +50,8 @@ def availability(generator: str, inputs: PlanInputs | None = None) -> str | None
 
 
 PACKAGE_DIR = Path(__file__).resolve().parent.parent
-#: The shared study protocol (vocabularies); generators that import it depend on it too.
-PROTOCOL_MODULE = PACKAGE_DIR.parent / "study_protocol.py"
+#: The shared study protocol package (vocabularies); generators that import it depend on it too.
+PROTOCOL_PACKAGE = "protocol"
 
 
 def _imported_files(path: Path) -> set[Path]:
@@ -68,9 +68,8 @@ def _imported_files(path: Path) -> set[Path]:
             parts = node.module.split(".") if node.module else []
         elif node.module and node.module.split(".")[0] == "generation":
             base, parts = PACKAGE_DIR, node.module.split(".")[1:]
-        elif node.module == PROTOCOL_MODULE.stem:
-            out.add(PROTOCOL_MODULE)
-            continue
+        elif node.module and node.module.split(".")[0] == PROTOCOL_PACKAGE:
+            base, parts = PACKAGE_DIR.parent, node.module.split(".")
         else:
             continue
         target = base.joinpath(*parts)

@@ -1,7 +1,7 @@
 """A plan's planned clips as clips.csv rows, before anything is rendered: the study simulator's input.
 
 Each plan entry becomes one SYNTHETIC clip row with id ``sim-<plan>-<entry id>``: the public clips.csv columns
-(``study_protocol.CLIP_COLUMNS``; intent columns as the renderer records them, :func:`schema.intent_fields`) plus
+(``protocol.vocabulary.CLIP_COLUMNS``; intent columns as the renderer records them, :func:`schema.intent_fields`) plus
 :data:`EXTRA_COLUMNS` (the plan's name, the entry id, the id of the entry's source clip and its section hints).
 Its ``duration_s`` is the planned one: the entry's ``duration_s`` input, else its pair's (a generated gesture and
 its source), else the plan's render duration -- a rendered clip's real length may differ a little.
@@ -19,8 +19,8 @@ import csv
 import sys
 from pathlib import Path
 
-from study_presets import PRESET_PLANS
-from study_protocol import CLIP_COLUMNS
+from protocol.presets import PRESET_PLANS
+from protocol.vocabulary import CLIP_COLUMNS
 
 from .schema import ClipEntry, Plan, PlanError, intent_fields, load_plan
 
@@ -73,7 +73,7 @@ def write_planned_clips(plan_refs, out: str | Path) -> int:
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(prog="python -m generation.plans.planned", description=__doc__.splitlines()[0])
     ap.add_argument("plans", nargs="*", help="plan names or files (default: every preset's plan, "
-                                              "study_presets.PRESET_PLANS)")
+                                              "protocol.presets.PRESET_PLANS)")
     ap.add_argument("--out", required=True, help="CSV file to write")
     args = ap.parse_args(argv)
     try:

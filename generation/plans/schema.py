@@ -5,7 +5,7 @@ A plan is a YAML (or JSON) file::
     name: demo
     description: ...
     render: {width: 640, height: 480, fps: 30, duration_s: 10}   # defaults for every clip
-    qa: {foot_skate_cm_s: 5, jerk: null}   # optional: quality thresholds (study_protocol.QA_THRESHOLDS; null = off)
+    qa: {foot_skate_cm_s: 5, jerk: null}   # optional: thresholds (protocol.vocabulary.QA_THRESHOLDS; null = off)
     clips:
       - id: happy_straight          # unique within the plan; never shown to participants
         modality: gait              # gait | gesture
@@ -43,7 +43,7 @@ import yaml
 
 from generation.quality.checks import QAThresholdError, resolve_thresholds
 from generation.render.settings import RENDERER_VERSION, RenderSettings, RenderSettingsError
-from study_protocol import MODALITIES, SECTION_TYPES
+from protocol.vocabulary import MODALITIES, SECTION_TYPES
 
 from .generators import InputContext, PlanInputs, generator_names, get_generator
 from .generators.fields import FieldError, choice, integer, text
@@ -107,7 +107,7 @@ class Plan:
     entries: tuple[ClipEntry, ...]
     source: str = ""
     meta: dict = field(default_factory=dict)
-    qa: dict = field(default_factory=dict)  # quality thresholds overriding study_protocol.QA_THRESHOLDS
+    qa: dict = field(default_factory=dict)  # quality thresholds overriding protocol.vocabulary.QA_THRESHOLDS
 
     def entry(self, entry_id: str) -> ClipEntry:
         for e in self.entries:

@@ -29,7 +29,7 @@ from generation.core.motion import Motion
 from generation.core.paths import PATH_KINDS, random_path
 from generation.core.skeleton import gait_skeleton, gesture_skeleton
 from generation.core.splits import SPLITS
-from study_protocol import GAIT_EMOTIONS, GENDERS, GESTURE_EMOTIONS, GESTURE_TASKS, HANDEDNESS
+from protocol.vocabulary import GAIT_EMOTIONS, GENDERS, GESTURE_EMOTIONS, GESTURE_TASKS, HANDEDNESS
 
 from .emotion import gait_params_for_emotion, gesture_params_for_vad, simulate_annotators, vad_for
 from .gesture import GESTURE_KINDS, seated_gesture

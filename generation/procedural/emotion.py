@@ -4,7 +4,7 @@ Gait (seed 000, section 3.2.2): an emotion is a vector over (happy, sad, angry, 
 entries are the relative counts of annotators who chose each term (l1-normalised).
 
 Gestures (seed 003, section 3.1): a categorical emotion term is mapped to valence, arousal and
-dominance in [0, 1] with the NRC-VAD lexicon (Mohammad, ACL 2018): :data:`study_protocol.GESTURE_VAD`, which
+dominance in [0, 1] with the NRC-VAD lexicon (Mohammad, ACL 2018): :data:`protocol.vocabulary.GESTURE_VAD`, which
 cites it.
 
 The parameter mappings are hand-made from the literature the papers cite, not learned:
@@ -22,7 +22,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from study_protocol import GAIT_EMOTIONS, GESTURE_VAD
+from protocol.vocabulary import GAIT_EMOTIONS, GESTURE_VAD
 
 from .gesture import GESTURE_KINDS, GestureParams
 from .walk import WalkParams

@@ -21,7 +21,7 @@ from generation.core.motion import Motion
 from generation.core.quaternion import np_qmul, np_qrot
 from generation.core.rigging import axis_angle, hinge_rotations, locals_from_globals, smoothstep, two_bone_ik, yaw_quat
 from generation.core.skeleton import GESTURE_JOINTS, Skeleton, gesture_skeleton
-from study_protocol import HANDEDNESS
+from protocol.vocabulary import HANDEDNESS
 
 GESTURE_KINDS = ("beat", "pointing", "descriptive")
 

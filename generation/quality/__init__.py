@@ -4,7 +4,7 @@ height in frame, realism against real capture, and an observer's reading of the 
 Public interface:
     motion_metrics(motion) -> dict          the motion measures (units in the keys)
     evaluate(motion, ...) -> QAResult       measures + failed checks against thresholds
-    resolve_thresholds(plan_qa) -> dict     QA_THRESHOLDS (study_protocol) overridden by a plan's ``qa:`` block
+    resolve_thresholds(plan_qa) -> dict     QA_THRESHOLDS (protocol.vocabulary) overridden by a plan's ``qa:`` block
     gait_observer_kind(plan_qa, default)    the gait observer a plan names (``qa: {observer: ...}``), else default
     observers.Observer, OBSERVERS           the observer protocol (``reads``, ``read(motion) -> reading``) and the
                                             process's observers, each loaded once per corpus version

@@ -47,7 +47,7 @@ from generation.core.digest import cached_file_sha256, file_sha256
 from generation.core.motion import Motion
 from generation.mocap.emotion_gait_bml import DATASET as BML_DATASET
 from generation.mocap.real_corpus import RealCorpora, load_real_corpus, read_meta
-from study_protocol import CAPTURE_GAIT_EMOTIONS, GAIT_EMOTIONS
+from protocol.vocabulary import CAPTURE_GAIT_EMOTIONS, GAIT_EMOTIONS
 
 from . import real_observer as ro
 from .pickle_cache import load_or_build
@@ -141,7 +141,7 @@ class CalibratedGaitObserver(ro.WindowedGaitObserver):
         X, y, w = ro._take_windows([c.motion for c, _ in fit], [GAIT_EMOTIONS.index(e) for _, e in fit])
         self.clf = ro._fit(X, y, w, C)
         self.variant = labels
-        # the record's ``observer`` value and the gate's observer kind (study_protocol.QA_OBSERVERS)
+        # the record's ``observer`` value and the gate's observer kind (protocol.vocabulary.QA_OBSERVERS)
         self.kind = "real" if labels == "acted" else "real-perceived"
         self.C = C
         self.source = source

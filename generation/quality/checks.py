@@ -1,7 +1,8 @@
 """Quality checks of one clip against thresholds: the record that goes into clips.csv (``qa_*`` columns), the
 Clip row (``qa``, ``qa_flag``) and the render record (``record["qa"]``).
 
-Checks (names in :data:`study_protocol.QA_CHECKS`), each against :data:`study_protocol.QA_THRESHOLDS` or a plan's
+Checks (names in :data:`protocol.vocabulary.QA_CHECKS`), each against
+:data:`protocol.vocabulary.QA_THRESHOLDS` or a plan's
 ``qa:`` overrides (a threshold set to null switches its check off):
 
 - ``foot_skate``: mean foot slide in contact > ``foot_skate_cm_s``;
@@ -44,7 +45,7 @@ import numpy as np
 
 from generation.core.motion import Motion
 from generation.core.skeleton import GAIT_JOINTS
-from study_protocol import GAIT_EMOTIONS, GESTURE_VAD, QA_CHECKS, QA_COLUMNS, QA_OBSERVERS, QA_THRESHOLDS
+from protocol.vocabulary import GAIT_EMOTIONS, GESTURE_VAD, QA_CHECKS, QA_COLUMNS, QA_OBSERVERS, QA_THRESHOLDS
 
 from .calibrated_observer import advisory_reason
 from .metrics import motion_metrics
@@ -84,7 +85,7 @@ class QAResult:
 
 
 def check_gait_observer(kind, where: str = "gait observer") -> str:
-    """``kind`` when it names a gait observer (:data:`study_protocol.QA_OBSERVERS`: real, real-perceived or
+    """``kind`` when it names a gait observer (:data:`protocol.vocabulary.QA_OBSERVERS`: real, real-perceived or
     synthetic), else
     QAThresholdError naming ``where`` (the plan field, setting or option it came from)."""
     if kind not in QA_OBSERVERS:

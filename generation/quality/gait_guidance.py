@@ -29,7 +29,7 @@ from generation.core.paths import straight
 from generation.gait.data import DEFAULT_CORPUS, load_corpus_sequences
 from generation.gait.generate import generate_gaits, load_model
 from generation.procedural.corpus import GaitCorpus, build_and_save
-from study_protocol import GAIT_EMOTIONS
+from protocol.vocabulary import GAIT_EMOTIONS
 
 from .observer import GaitObserver
 

@@ -1,5 +1,5 @@
 """A synthetic observer of gesture emotion: a multinomial logistic regression over the 11 gesture emotions
-(study_protocol.GESTURE_EMOTIONS) on motion descriptors of the seated upper body, trained on the procedural
+(protocol.vocabulary.GESTURE_EMOTIONS) on motion descriptors of the seated upper body, trained on the procedural
 gestures of the SYNTHETIC gesture corpus's training split (:func:`generation.gesture.data.build_dataset`).
 
 It stands in for a participant when checking clips; it is not a human judgement, and what it learned is the
@@ -29,7 +29,7 @@ from generation.core.skeleton import GESTURE_JOINTS, gesture_skeleton
 from generation.gesture import config
 from generation.gesture.config import MIN_SECONDS
 from generation.gesture.metrics import wrist_speed_of_positions
-from study_protocol import GESTURE_EMOTIONS, GESTURE_VAD
+from protocol.vocabulary import GESTURE_EMOTIONS, GESTURE_VAD
 
 from .pickle_cache import load_or_build
 

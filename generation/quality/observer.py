@@ -16,7 +16,7 @@ from generation.core.digest import file_sha256
 from generation.core.features import np_gait_affective_features
 from generation.core.motion import Motion
 from generation.core.skeleton import GAIT_JOINTS
-from study_protocol import GAIT_EMOTIONS
+from protocol.vocabulary import GAIT_EMOTIONS
 
 from .pickle_cache import load_or_build
 

@@ -5,7 +5,7 @@ on held-out takes.
 Inputs per clip (:func:`real_gesture_features`, (42,)): the synthetic observer's 32 descriptors
 (:func:`generation.quality.gesture_observer.motion_descriptors`) and the 10 statistics of
 :func:`generation.gesture.real_stats.gesture_stats`, at the network's 10 fps. Classes: the styles that name a
-gesture emotion (``study_protocol.CAPTURE_GESTURE_EMOTIONS``: joyous, sad, angry, proud, neutral) or, with
+gesture emotion (``protocol.vocabulary.CAPTURE_GESTURE_EMOTIONS``: joyous, sad, angry, proud, neutral) or, with
 ``labels="style"``, every dataset-1 style. Model: multinomial logistic regression on standardised features.
 
 Held-out accuracy (:func:`held_out_accuracy`): dataset 1 has one take per content and style (bow, bye, byebye,
@@ -19,7 +19,7 @@ import numpy as np
 
 from generation.core.motion import Motion
 from generation.gesture.real_stats import STAT_NAMES, STATS_FPS, gesture_stats
-from study_protocol import CAPTURE_GESTURE_EMOTIONS
+from protocol.vocabulary import CAPTURE_GESTURE_EMOTIONS
 
 from .gesture_observer import is_gesture_motion, motion_descriptors
 

@@ -8,7 +8,7 @@ Real clips: the Bandai Namco Research Motion Dataset 1's bow, bye, byebye and gu
 style; Kobayashi et al. 2023, arXiv:2306.08861, CC BY-NC 4.0), from the real corpus
 (``--corpus``, else ``$REAL_CORPUS``, else ``var/mocap/bandai-namco.npz``), seated with
 :func:`generation.mocap.seated_gesture.seat_gesture`, measured with :func:`generation.gesture.real_stats.motion_stats`
-and labelled with the gesture emotion their style names (``study_protocol.CAPTURE_GESTURE_EMOTIONS``).
+and labelled with the gesture emotion their style names (``protocol.vocabulary.CAPTURE_GESTURE_EMOTIONS``).
 """
 from __future__ import annotations
 
@@ -21,7 +21,7 @@ from generation.core.motion import Motion
 from generation.gesture.real_stats import RANGES_FILE, STAT_NAMES, STATS_FPS, motion_stats, real_ranges
 from generation.mocap.real_corpus import CITATION, LICENCE, load_real_corpus, real_corpus_path
 from generation.mocap.seated_gesture import seat_gesture
-from study_protocol import CAPTURE_GESTURE_EMOTIONS
+from protocol.vocabulary import CAPTURE_GESTURE_EMOTIONS
 
 REAL_CONTENTS = ("bow", "bye", "byebye", "guide")
 

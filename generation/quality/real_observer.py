@@ -1,7 +1,8 @@
 """A real-capture observer of gait emotion: a classifier trained on real captured walks, for the quality gate.
 
-The four gait emotions (study_protocol.GAIT_EMOTIONS: happy, sad, angry, neutral) are the real corpus's dataset-1
-styles happy, sad, angry and normal (study_protocol.CAPTURE_GAIT_EMOTIONS; the Bandai Namco Research Motion Dataset,
+The four gait emotions (protocol.vocabulary.GAIT_EMOTIONS: happy, sad, angry, neutral) are the real corpus's dataset-1
+styles happy, sad, angry and normal (protocol.vocabulary.CAPTURE_GAIT_EMOTIONS; the
+Bandai Namco Research Motion Dataset,
 Kobayashi et al. 2023, arXiv:2306.08861, CC BY-NC 4.0). Dataset 2's normal walks are left out of the emotion
 classifier: only one emotion of the four is in dataset 2, so its actors would teach "dataset 2 = neutral".
 
@@ -40,7 +41,7 @@ from generation.core.windows import windows
 from generation.mocap.bandai_namco import shipped_takes
 from generation.mocap.dataset_import import import_take
 from generation.mocap.real_corpus import DEFAULT_PATH, load_real_corpus
-from study_protocol import CAPTURE_GAIT_EMOTIONS, GAIT_EMOTIONS
+from protocol.vocabulary import CAPTURE_GAIT_EMOTIONS, GAIT_EMOTIONS
 
 from .pickle_cache import load_or_build
 

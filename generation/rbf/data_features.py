@@ -7,7 +7,7 @@ train split only):
 1. Representation (the paper's): Cartesian joint trajectories of one gait cycle, time-normalised per cycle
    (contact-based warping, left strike -> 0, right -> m/2, next left -> m), in the walker's frame, divided by
    the walker's height (:func:`generation.rbf.real_neutral.steady_cycles`).
-2. Difference: per dataset, mean cycle of the theme's styles (``study_protocol.CAPTURE_THEMES``) minus the mean
+2. Difference: per dataset, mean cycle of the theme's styles (``protocol.vocabulary.CAPTURE_THEMES``) minus the mean
    cycle of the same dataset's normal walks (the corpus has no actor ids; each dataset's takes come from its
    own recording sessions, so a dataset is the closest thing to "the same actors"); then the mean over the
    datasets that have the theme. Shape (m, J, 3) in heights.
@@ -28,7 +28,7 @@ from pathlib import Path
 
 import numpy as np
 
-from study_protocol import CAPTURE_THEMES
+from protocol.vocabulary import CAPTURE_THEMES
 
 from .basis import MAX_RBFS_PER_DOF, rbf_sum, validate_params
 from .real_neutral import steady_cycles
@@ -43,7 +43,7 @@ PAPER_JOINTS = tuple(PART_OF)
 
 
 def theme_styles(theme: str) -> tuple[str, ...]:
-    """The corpus styles that stand for a theme (``study_protocol.CAPTURE_THEMES``)."""
+    """The corpus styles that stand for a theme (``protocol.vocabulary.CAPTURE_THEMES``)."""
     if theme not in THEME_NAMES:
         raise ValueError(f"unknown theme {theme!r}; expected one of {list(THEME_NAMES)}")
     return tuple(style for style, t in CAPTURE_THEMES.items() if t == theme)

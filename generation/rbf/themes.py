@@ -21,7 +21,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-from study_protocol import THEMES as THEME_NAMES  # the six theme names; THEMES below is Table III by theme
+from protocol.vocabulary import THEMES as THEME_NAMES  # the six theme names; THEMES below is Table III by theme
 
 AXES = {"X": 0, "Y": 1, "Z": 2}
 

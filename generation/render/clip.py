@@ -13,7 +13,7 @@ from pathlib import Path
 import numpy as np
 
 from generation.core.motion import Motion
-from study_protocol import GENDERS
+from protocol.vocabulary import GENDERS
 
 from .body import head_top
 from .camera import body_outline, choose_cameras, facing_direction

@@ -44,7 +44,7 @@
   //   ended; "full": the browser's own controls. Outside "full" every seek is undone (the seek bar of picture-in-
   //   picture, the keyboard, media keys, a script) and the speed is kept at 1.
   // - data-max-replays (blank: unlimited) limits the plays after the first.
-  // - the viewing record goes with the answer as hidden fields view_<field> (study_protocol.VIEWING_FIELDS; times
+  // - the viewing record goes with the answer as hidden fields view_<field> (protocol.vocabulary.VIEWING_FIELDS; times
   //   in ms from the page's display): first playing frame, first end, plays, pauses, seek attempts, stalls (playback
   //   waiting for data after the first frame) and their total time, start-up time (first play request to first
   //   frame), how often and how long the page was hidden while the clip played; view_script=1 says this ran.

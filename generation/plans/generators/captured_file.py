@@ -43,7 +43,7 @@ from generation.core.digest import cached_file_sha256
 from generation.core.motion import Motion, MotionFormatError
 from generation.mocap import ImportOptions, import_file
 from generation.mocap.seated_gesture import seat_gesture
-from study_protocol import GAIT_EMOTIONS, GESTURE_VAD, MODALITIES
+from protocol.vocabulary import GAIT_EMOTIONS, GESTURE_VAD, MODALITIES
 
 from .fields import FieldError
 from .registry import ClipGenerationError, GeneratorSpec, InputContext, MakeContext, PlanInputs, register

@@ -4,7 +4,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from study_protocol import GAIT_EMOTIONS, GESTURE_VAD
+from protocol.vocabulary import GAIT_EMOTIONS, GESTURE_VAD
 
 
 class FieldError(Exception):

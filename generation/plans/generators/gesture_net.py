@@ -9,7 +9,7 @@ from pathlib import Path
 from generation.core.motion import Motion
 from generation.core.splits import SPLITS
 from generation.gesture.config import gesture_seconds
-from study_protocol import GENDERS, GESTURE_TASKS, HANDEDNESS
+from protocol.vocabulary import GENDERS, GESTURE_TASKS, HANDEDNESS
 
 from .fields import FieldError, choice, gesture_label, number, text
 from .procedural_gesture import ProceduralGestureInputs

@@ -8,7 +8,7 @@ from dataclasses import dataclass
 from generation.core.motion import Motion
 from generation.rbf.neutral_base import neutral_cycle
 from generation.rbf.real_neutral import load_cycle
-from study_protocol import NEUTRAL_THEME
+from protocol.vocabulary import NEUTRAL_THEME
 
 from .fields import choice, integer, number
 from .registry import GeneratorSpec, InputContext, MakeContext, PlanInputs, register

@@ -10,7 +10,7 @@ from generation.core.motion import Motion
 from generation.core.skeleton import gesture_skeleton
 from generation.procedural.emotion import gesture_params_for_vad
 from generation.procedural.gesture import seated_gesture
-from study_protocol import GENDERS, GESTURE_VAD, HANDEDNESS
+from protocol.vocabulary import GENDERS, GESTURE_VAD, HANDEDNESS
 
 from .fields import FieldError, choice, gesture_label, number, vad
 from .registry import GeneratorSpec, InputContext, MakeContext, PlanInputs, register

@@ -5,7 +5,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from generation.core.motion import Motion
-from study_protocol import THEMES
+from protocol.vocabulary import THEMES
 
 from .fields import FieldError, choice, integer, number
 from .neutral_walk import RBF_BASES, base_cycle

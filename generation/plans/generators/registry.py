@@ -31,7 +31,7 @@ from pathlib import Path
 from typing import Any, ClassVar
 
 from generation.core.motion import Motion
-from study_protocol import FINAL_EMOTION_COLUMNS, GAIT_EMOTIONS, GESTURE_VAD, VAD_DIMENSIONS
+from protocol.vocabulary import FINAL_EMOTION_COLUMNS, GAIT_EMOTIONS, GESTURE_VAD, VAD_DIMENSIONS
 
 from .fields import FieldError
 

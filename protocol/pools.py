@@ -14,8 +14,8 @@ from __future__ import annotations
 import math
 from typing import NamedTuple
 
-from study_norming import NORMING_OPTION
-from study_protocol import (
+from .norming import NORMING_OPTION
+from .vocabulary import (
     CLIP_MODALITIES,
     CLIP_THEMES,
     FINAL_EMOTION_COLUMNS,

@@ -2,13 +2,13 @@
 
 ``studyapp.presets`` turns a preset into Study + Section rows (the researcher then edits them in the admin); the
 synthetic-study simulator (``analysis.design``) reads the same sections to simulate a study of that preset. Each
-section: ``section_type``, ``title``, ``instructions``, ``pool`` (catalogue filters, see ``study_pools``),
+section: ``section_type``, ``title``, ``instructions``, ``pool`` (catalogue filters, see ``protocol.pools``),
 ``clips_per_participant`` (0 = every clip of the pool), ``options`` (type-specific), or ``reuse`` (the index of an
 earlier section of the same preset whose clips it shows again).
 """
 from __future__ import annotations
 
-from study_protocol import NEUTRAL_THEME
+from .vocabulary import NEUTRAL_THEME
 
 # Seed 000 section 6.3.4 anchors and seed 003 Table 2 markers (1..5), verbatim. studyapp.questions marks the same
 # strings for translation (a test keeps the two equal); the study pages show them in the participant's language.
@@ -143,8 +143,8 @@ PRESETS["demo"]["sections"][4]["title"] = "Perceived emotion: gestures"
 
 
 # Norming: every candidate clip of a plan rated by at least K participants while each sees M clips per section (the
-# cyclic balanced incomplete design of study_norming); the modality's emotion question, then intensity and
-# naturalness (study_protocol.NORMING_QUESTIONS). Set the participant limit to the planned N before opening: the
+# cyclic balanced incomplete design of protocol.norming); the modality's emotion question, then intensity and
+# naturalness (protocol.vocabulary.NORMING_QUESTIONS). Set the participant limit to the planned N before opening: the
 # admin shows K, M and the N needed, and refuses to open a study whose N cannot give K.
 NORMING_RATINGS_PER_CLIP = 20
 _NORMING = {"norming": {"ratings_per_clip": NORMING_RATINGS_PER_CLIP}, "practice": True}
