@@ -7,3 +7,4 @@
 
 ``generation``, ``analysis`` and ``studyapp`` import from here; nothing here imports them.
 """
+from . import section_types  # noqa: F401,E402 - fills the section-type registry the vocabulary's views read

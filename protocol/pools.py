@@ -15,16 +15,20 @@ import math
 from typing import NamedTuple
 
 from .norming import NORMING_OPTION
+from .section_types import find_section_type
+from .section_types.checks import count_error as _count_error
+from .section_types.checks import is_int as _is_int
+from .section_types.gesture_emotion import DEFAULT_OPTIONS as DEFAULT_GESTURE_OPTIONS  # noqa: F401 - the editor reads it here
+from .section_types.naturalness import HALVES
+from .section_types.registry import TypeMapView
 from .vocabulary import (
     CLIP_MODALITIES,
     CLIP_THEMES,
     FINAL_EMOTION_COLUMNS,
     GAIT_EMOTIONS,
     GESTURE_EMOTIONS,
-    NATURALNESS,
     ORIGINS,
     SECTION_MODALITY,
-    SECTION_QUESTIONS,
     SECTION_TYPES,
     VAD_DIMENSIONS,
     answer_values,
@@ -53,16 +57,13 @@ NORMS_RULE = "norms"
 NORMS_FIELDS = {"from": None, "min_ratings": (int, 1, 1_000_000), "min_intended_share": (float, 0.0, 1.0),
                 "max_entropy_bits": (float, 0.0, 64.0)}
 """Fields of the norms rule -> (type, lowest, highest); ``from`` is text."""
-SUB_POOLS = ("generated", "source")
-"""Sub-pools of a naturalness section: extra filters for its generated and its source clips."""
+SUB_POOLS = HALVES
+"""Sub-pools a section type may declare (``SectionType.sub_pools``, naturalness): extra filters for its generated
+and its source clips."""
 
-SECTION_OPTIONS: dict[str, tuple[str, ...]] = {
-    "naturalness": ("anchors", "question", "n_generated", "n_source"),
-    "gesture_emotion": ("n_options", "categories", NORMING_OPTION),
-    "emotion_choice": (NORMING_OPTION,),
-    "theme_rating": (NORMING_OPTION,),
-}
-"""section_type -> the option keys it understands besides COMMON_OPTIONS."""
+SECTION_OPTIONS = TypeMapView(lambda t: t.option_keys, keep=lambda t: bool(t.options))
+"""section_type -> the option keys it understands besides COMMON_OPTIONS (a live view of the section-type
+registry)."""
 
 PLAYER_CONTROLS = ("replay-only", "full", "none")
 """``controls`` option: play/pause and replay only (no seek bar, no speed menu; the default), the browser's full
@@ -76,8 +77,6 @@ MAX_REPLAYS_LIMIT = 100
 COMMON_OPTIONS = ("attention_checks", "practice", "practice_clip", *PLAYER_OPTIONS)
 """Options of every section type (studyapp.trial_extras): attention checks, a practice item, the clip player."""
 ATTENTION_KEYS = ("count", "answer", "positions", "question")
-
-DEFAULT_GESTURE_OPTIONS = 4
 
 
 class SectionError(NamedTuple):
@@ -109,10 +108,6 @@ class PoolError(ValueError):
     def __init__(self, errors: dict[str, list[str]]):
         self.errors = errors
         super().__init__("; ".join(f"{field}: {msg}" for field, msgs in errors.items() for msg in msgs))
-
-
-def _is_int(value) -> bool:
-    return isinstance(value, int) and not isinstance(value, bool)
 
 
 def _is_number(value) -> bool:
@@ -174,8 +169,9 @@ def pool_problems(pool, section_type: str | None = None, sub_pools: bool = True)
             if not isinstance(value, bool):
                 found.append(((key,), f"{key!r} takes true or false, got {value!r}"))
         elif key in SUB_POOLS and sub_pools:
-            if section_type not in (None, "naturalness"):
-                found.append(((key,), f"sub-pool {key!r} is only for naturalness sections"))
+            if section_type is not None and key not in _sub_pools_of(section_type):
+                takers = " or ".join(t for t in _sub_pool_takers() if key in _sub_pools_of(t))
+                found.append(((key,), f"sub-pool {key!r} is only for {takers} sections"))
             elif not isinstance(value, dict):
                 found.append(((key,), f"sub-pool {key!r} must be a JSON object of filters, got {value!r}"))
             else:
@@ -243,64 +239,15 @@ def pool_lookups(pool: dict | None) -> list[tuple[str, dict]]:
     return calls
 
 
-def _count_error(options: dict, key: str, low: int, high: int | None = None) -> str | None:
-    value = options[key]
-    if not _is_int(value) or value < low or (high is not None and value > high):
-        bound = f"from {low} to {high}" if high is not None else f"{low} or more"
-        return f"{key!r} must be an integer {bound}, got {value!r}"
-    return None
+def _sub_pools_of(section_type: str | None) -> tuple[str, ...]:
+    """The sub-pools a section type declares (none for an unknown type)."""
+    spec = find_section_type(section_type)
+    return spec.sub_pools if spec else ()
 
 
-def _naturalness_errors(options: dict, clips_per_participant: int | None) -> Found:
-    found: Found = []
-    anchors = options.get("anchors")
-    scale = answer_values(NATURALNESS)
-    if "anchors" in options:
-        if not isinstance(anchors, dict):
-            found.append((("anchors",), f"'anchors' must map scale values ({', '.join(scale)}) to labels, got "
-                                        f"{anchors!r}"))
-        else:
-            found += [((f"anchors.{k}",), f"'anchors': {k!r} is not a value of the naturalness scale "
-                                          f"({', '.join(scale)})") for k in anchors if str(k) not in scale]
-            found += [((f"anchors.{k}",), f"'anchors': the label of {k!r} must be text") for k, v in anchors.items()
-                      if not isinstance(v, str)]
-    if "question" in options and not (isinstance(options["question"], str) and options["question"].strip()):
-        found.append((("question",), f"'question' must be non-empty text, got {options['question']!r}"))
-    counts = [k for k in ("n_generated", "n_source") if k in options]
-    count_errors = [((k,), msg) for k in counts if (msg := _count_error(options, k, 0))]
-    found += count_errors
-    if counts and not count_errors:
-        given = {k: options[k] for k in counts}
-        both = ("n_generated", "n_source")
-        if len(counts) == 1 and not clips_per_participant:
-            found.append((both, "give both 'n_generated' and 'n_source' when every clip of the pool is shown"))
-        elif len(counts) == 2 and clips_per_participant and sum(given.values()) != clips_per_participant:
-            found.append((both, f"'n_generated' + 'n_source' = {sum(given.values())} must equal the clips per "
-                                f"participant ({clips_per_participant})"))
-        elif len(counts) == 2 and sum(given.values()) == 0:
-            found.append((both, "'n_generated' + 'n_source' must be at least 1"))
-    return found
-
-
-def _gesture_errors(options: dict) -> Found:
-    found: Found = []
-    categories = options.get("categories", list(GESTURE_EMOTIONS))
-    if not isinstance(categories, list) or not categories or not all(isinstance(c, str) for c in categories):
-        found.append((("categories",), f"'categories' must be a non-empty list of gesture emotions, got "
-                                       f"{categories!r}"))
-        categories = list(GESTURE_EMOTIONS)
-    else:
-        found += _at("categories", [f"'categories': {c!r} is not one of {', '.join(GESTURE_EMOTIONS)}"
-                                    for c in categories if c not in GESTURE_EMOTIONS])
-        if len(set(categories)) != len(categories):
-            found.append((("categories",), "'categories' lists an emotion twice"))
-    if "n_options" in options:
-        msg = _count_error(options, "n_options", 2, len(set(categories)))
-        found += _at("n_options", [msg] if msg else [])
-    elif len(set(categories)) < DEFAULT_GESTURE_OPTIONS:
-        found.append((("categories",), f"'categories' needs at least {DEFAULT_GESTURE_OPTIONS} emotions (or set "
-                                       "'n_options')"))
-    return found
+def _sub_pool_takers() -> tuple[str, ...]:
+    """The registered section types that declare sub-pools."""
+    return tuple(t for t in SECTION_TYPES if _sub_pools_of(t))
 
 
 def _attention_errors(section_type: str, config, clips_per_participant: int | None, categories) -> Found:
@@ -312,12 +259,13 @@ def _attention_errors(section_type: str, config, clips_per_participant: int | No
                                         f"\"positions\": \"random\"}}, got {config!r}")]
     errors = [((f"attention_checks.{k}",), f"{name}: unknown field {k!r} (fields: {', '.join(ATTENTION_KEYS)})")
               for k in config if k not in ATTENTION_KEYS]
-    questions = SECTION_QUESTIONS.get(section_type, {})
+    spec = find_section_type(section_type)
+    questions = spec.question_kinds if spec else {}
     key = config.get("question", next(iter(questions), ""))
     if key not in questions:
         return errors + [(("attention_checks.question",), f"{name}: 'question' {key!r} is not a question of "
                                                           f"{section_type} sections ({', '.join(questions)})")]
-    allowed = list(categories) if section_type == "gesture_emotion" else list(answer_values(questions[key]))
+    allowed = list(categories) if spec.drawn_choices else list(answer_values(questions[key]))
     answer = config.get("answer")
     if not isinstance(answer, (str, int)) or isinstance(answer, bool) or str(answer) not in allowed:
         errors.append((("attention_checks.answer",), f"{name}: 'answer' must be one of the answers to {key!r} "
@@ -400,10 +348,9 @@ def options_problems(section_type: str, options, clips_per_participant: int | No
     found += _extras_errors(section_type, options, clips_per_participant)
     if NORMING_OPTION in options and NORMING_OPTION in own:
         found += _norming_errors(options[NORMING_OPTION])
-    if section_type == "naturalness":
-        found += _naturalness_errors(options, clips_per_participant)
-    elif section_type == "gesture_emotion":
-        found += _gesture_errors(options)
+    spec = find_section_type(section_type)
+    if spec is not None and spec.check_options is not None:
+        found += spec.check_options(options, clips_per_participant)
     return found
 
 

@@ -14,6 +14,8 @@ Lexicon v1:
 """
 from __future__ import annotations
 
+from .section_types.registry import NamesView, TypeMapView
+
 # ---- vocabularies ----------------------------------------------------------------------------------------
 GAIT_EMOTIONS = ("happy", "sad", "angry", "neutral")
 """Components of seed 000's gait emotion vector, in column order (clips.csv, the network's input)."""
@@ -109,8 +111,9 @@ ORIGINS = ("generated", "source", IMPORTED)
 stimulus brought in with ``manage.py import_clips`` (a video or motion file made elsewhere)."""
 
 # ---- sections and their answers ----------------------------------------------------------------------
-SECTION_TYPES = ("emotion_choice", "emotion_transition", "affect_likert", "naturalness", "gesture_emotion",
-                 "neutral_validation", "theme_rating", "theme_inversion")
+SECTION_TYPES = NamesView()
+"""The registered section types (protocol.section_types), in registration order: a live, read-only tuple-like view
+of the registry."""
 
 LIKERT_FEATURES = ("torso", "arms", "pace", "flow")
 """Seed 000 Table 2's broad pose affective features, each rated 0..4."""
@@ -146,36 +149,24 @@ LABEL_CHOICES = {GAIT_MULTI: GAIT_EMOTIONS, GESTURE_CHOICE: GESTURE_EMOTIONS, NE
 MULTI_SELECT_KINDS = (GAIT_MULTI,)
 """Answer kinds where several labels may be chosen (joined by ';' in the protocol's order)."""
 
-SECTION_QUESTIONS: dict[str, dict[str, str]] = {
-    "emotion_choice": {"perceived": GAIT_MULTI},
-    "emotion_transition": {"initial": GAIT_MULTI, "final": GAIT_MULTI},
-    "affect_likert": {feature: LIKERT for feature in LIKERT_FEATURES},
-    "naturalness": {"naturalness": NATURALNESS},
-    "gesture_emotion": {"perceived": GESTURE_CHOICE},
-    "neutral_validation": {"perceived": NEUTRAL_CHOICE},
-    "theme_rating": {"rating": THEME_RATING},
-    "theme_inversion": {"rating": INVERSION},
-}
-"""section_type -> question key -> answer kind: exactly what the study app writes and the analysis reads."""
+SECTION_QUESTIONS = TypeMapView(lambda t: t.question_kinds)
+"""section_type -> question key -> answer kind: exactly what the study app writes and the analysis reads (a live view
+of the section-type registry)."""
 
-SECTION_MODALITY = {"emotion_choice": "gait", "emotion_transition": "gait", "affect_likert": "gait",
-                    "naturalness": None, "gesture_emotion": "gesture", "neutral_validation": "gait",
-                    "theme_rating": "gait", "theme_inversion": "gait"}
-"""The modality of the clips each section shows (None: either)."""
+SECTION_MODALITY = TypeMapView(lambda t: t.modality)
+"""The modality of the clips each section shows (None: either); a live view of the registry."""
 
 
-NORMING_SECTION_TYPES = ("emotion_choice", "gesture_emotion", "theme_rating")
+NORMING_SECTION_TYPES = NamesView(lambda t: t.norming)
 """Sections a norming study rates its candidate clips in: the emotion question of each modality (gait walks,
-gestures, RBF theme clips)."""
+gestures, RBF theme clips); the registered types declared ``norming``."""
 
 NORMING_QUESTIONS = {"intensity": INTENSITY, "naturalness": NATURALNESS}
 """Questions a norming section (``Section.options["norming"]``) asks about each clip after its own: how intense the
 perceived emotion is (1 "very weak" .. 5 "very strong") and the naturalness scale (1..5). Stored in responses.csv
 under the section's own section_type with these question keys."""
 
-ANSWER_QUESTIONS: dict[str, dict[str, str]] = {
-    section: {**questions, **(NORMING_QUESTIONS if section in NORMING_SECTION_TYPES else {})}
-    for section, questions in SECTION_QUESTIONS.items()}
+ANSWER_QUESTIONS = TypeMapView(lambda t: {**t.question_kinds, **(NORMING_QUESTIONS if t.norming else {})})
 """section_type -> every question key responses.csv may hold for it -> answer kind: SECTION_QUESTIONS plus the
 norming questions of NORMING_SECTION_TYPES."""
 

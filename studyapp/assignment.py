@@ -39,7 +39,7 @@ from django.utils import timezone
 
 from protocol.norming import clip_order, cyclic_block, ratings_per_clip
 from protocol.pools import SUB_POOLS
-from protocol.vocabulary import NORMING_SECTION_TYPES
+from protocol.section_types import get_section_type
 
 from .counterbalance import SectionInfo, section_order
 from .models import Assignment, Clip, Participant, Section, SectionClipCount, Study, StudyCounter
@@ -87,12 +87,12 @@ def plan_section(section: Section, seed: int, used: set[int], earlier: dict[int,
     pool = pool if pool is not None else load_section_pool(section)
     base = [c for c in pool.clips if c.pk not in used]
     k = section.clips_per_participant
-    if section.section_type == "naturalness" and (any(key in section.pool for key in SUB_POOLS)
-                                                  or "n_source" in section.options):
+    spec = get_section_type(section.section_type)
+    if spec.sub_pools and (any(key in section.pool for key in SUB_POOLS) or "n_source" in section.options):
         chosen = _plan_naturalness(section, rng, base, pool, counts, k)
         rng.shuffle(chosen)          # mixed, unlabelled, random order (seed 003)
         return [PlannedItem(c) for c in chosen]
-    if section.section_type in NORMING_SECTION_TYPES and ratings_per_clip(section.options) is not None:
+    if spec.norming and ratings_per_clip(section.options) is not None:
         chosen = _plan_norming(section, pool.clips, used, counts, k)   # the design fixes the order too
     else:
         chosen = _balanced_pick(rng, base, counts, k)
@@ -101,7 +101,7 @@ def plan_section(section: Section, seed: int, used: set[int], earlier: dict[int,
         else:
             chosen.sort(key=lambda c: c.clip_id)
     items = [PlannedItem(c) for c in chosen]
-    if section.section_type == "gesture_emotion":
+    if spec.drawn_choices:
         for it in items:
             it.options = gesture_options(rng, section, it.clip.emotion_label or "neutral")
     return items

@@ -171,7 +171,7 @@ class Section(models.Model):
 
     study = models.ForeignKey(Study, on_delete=models.CASCADE, related_name="sections")
     order = models.PositiveIntegerField(default=0)
-    section_type = models.CharField(max_length=30, choices=section_type_choices())
+    section_type = models.CharField(max_length=30, choices=section_type_choices)
     title = models.CharField(max_length=200, blank=True)
     instructions = models.TextField(blank=True)
     pool = models.JSONField(

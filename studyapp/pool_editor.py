@@ -37,6 +37,7 @@ from protocol.pools import (
     SUB_POOLS,
     validate_section,
 )
+from protocol.section_types import find_section_type, registered
 from protocol.vocabulary import CLIP_MODALITIES, CLIP_THEMES, GESTURE_EMOTIONS, NATURALNESS, ORIGINS, answer_values
 
 ANY = ""
@@ -477,8 +478,14 @@ def write_specs(specs: list[ChoiceSpec], values: dict) -> dict:
 
 # ---- the editor's groups ------------------------------------------------------------------------------------------
 
-SUB_POOL_SECTION_TYPE = "naturalness"
-"""The section type whose pool may hold ``generated`` / ``source`` sub-pools (protocol.pools)."""
+SUB_POOL_SECTION_TYPE = next(t.name for t in registered() if t.sub_pools)
+"""The section type whose pool may hold ``generated`` / ``source`` sub-pools (its declaration's ``sub_pools``)."""
+
+
+def takes_sub_pools(section_type: str | None) -> bool:
+    """Whether a section type's pool may hold the ``generated`` / ``source`` sub-pools (protocol.section_types)."""
+    spec = find_section_type(section_type)
+    return bool(spec and spec.sub_pools)
 
 
 def _main_pool_specs() -> list[ChoiceSpec]:
@@ -588,7 +595,7 @@ def _option_specs_of(section_type: str | None) -> list[ChoiceSpec]:
 
 
 def _pool_specs(section_type: str | None) -> list[ChoiceSpec]:
-    return MAIN_POOL_SPECS + (SUB_POOL_SPECS if section_type == SUB_POOL_SECTION_TYPE else [])
+    return MAIN_POOL_SPECS + (SUB_POOL_SPECS if takes_sub_pools(section_type) else [])
 
 
 def pool_to_fields(pool) -> tuple[dict, dict]:

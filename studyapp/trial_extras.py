@@ -19,7 +19,8 @@ import random
 from dataclasses import dataclass, field
 
 from protocol.pools import DEFAULT_GESTURE_OPTIONS
-from protocol.vocabulary import ATTENTION_CHECK, GESTURE_EMOTIONS, SECTION_QUESTIONS, attention_question
+from protocol.section_types import get_section_type
+from protocol.vocabulary import ATTENTION_CHECK, answer_values, attention_question
 
 from .models import Assignment, Clip, Section
 
@@ -38,7 +39,8 @@ class PlannedItem:
 
 def gesture_options(rng: random.Random, section: Section, intended: str) -> list[str]:
     """The shuffled answer options of a gesture_emotion clip: ``intended`` and n_options - 1 other categories."""
-    categories = list(section.options.get("categories") or GESTURE_EMOTIONS)
+    (kind,) = get_section_type(section.section_type).question_kinds.values()
+    categories = list(section.options.get("categories") or answer_values(kind))
     n_options = int(section.options.get("n_options", DEFAULT_GESTURE_OPTIONS))
     others = [c for c in categories if c != intended]
     shown = [intended, *rng.sample(others, min(n_options - 1, len(others)))]
@@ -46,10 +48,15 @@ def gesture_options(rng: random.Random, section: Section, intended: str) -> list
     return shown
 
 
+def draws_choices(section: Section) -> bool:
+    """Whether the section's type draws its answer choices per participant and clip (gesture_emotion)."""
+    return get_section_type(section.section_type).drawn_choices
+
+
 def check_question(section: Section) -> str:
     """The question key an attention check of this section asks."""
     config = section.options.get("attention_checks") or {}
-    return config.get("question") or next(iter(SECTION_QUESTIONS[section.section_type]))
+    return config.get("question") or get_section_type(section.section_type).questions[0].key
 
 
 def check_count(config: dict) -> int:
@@ -91,7 +98,7 @@ def _attention_items(section: Section, trials: list[PlannedItem], pool: list[Cli
     instructed = attention_question(check_question(section), answer)
     checks = []
     for clip in clips[:len(positions)]:
-        options = gesture_options(rng, section, answer) if section.section_type == "gesture_emotion" else []
+        options = gesture_options(rng, section, answer) if draws_choices(section) else []
         checks.append(PlannedItem(clip, options, ATTENTION_CHECK, instructed))
     items, trial_iter, check_iter = [], iter(trials), iter(checks)
     for place in range(1, len(trials) + len(checks) + 1):
@@ -110,7 +117,7 @@ def _practice_item(section: Section, candidates: list[Clip], used: set[int], rng
         return None
     clip = free[0] if options.get("practice_clip") else rng.choice(free)
     shown = (gesture_options(rng, section, clip.emotion_label or "neutral")
-             if section.section_type == "gesture_emotion" else [])
+             if draws_choices(section) else [])
     return PlannedItem(clip, shown, PRACTICE)
 
 

@@ -32,7 +32,7 @@ from .catalogue import CatalogueError, pool_queryset, section_queryset
 from .forms import SectionPreviewForm
 from .norms_rule import NormsSourceError, check_reader
 from .permissions import has_staff_permission
-from .pool_editor import SUB_POOL_SECTION_TYPE
+from .pool_editor import takes_sub_pools
 
 REUSED = "this section reuses the clips of an earlier section: its pool is not used"
 HALVES = tuple(name for name in SUB_POOLS if name in ORIGINS)
@@ -88,7 +88,7 @@ def count_pool(section_type: str | None, pool, reader=None) -> PoolCount:
         base = section_queryset(section_type, pool or {})
         total = base.count()
         by_origin = {}
-        if section_type == SUB_POOL_SECTION_TYPE:
+        if takes_sub_pools(section_type):
             for name in HALVES:
                 half = base.filter(origin=name)
                 if pool and pool.get(name):

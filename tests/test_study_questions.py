@@ -75,7 +75,7 @@ def test_scales_and_choices():
     assert tuple(values(nv)) == NEUTRAL_CHOICES and labels(nv)[0] == "Neutral"
     with pytest.raises(ValueError):
         questions_for("gesture_emotion")
-    with pytest.raises(ValueError, match="not gesture emotions"):
+    with pytest.raises(ValueError, match="not among its answers"):
         questions_for("gesture_emotion", shown_options=["proud", "happy"])
     with pytest.raises(ValueError, match="unknown"):
         questions_for("dance_rating")
@@ -101,10 +101,11 @@ def test_clean_answers():
 
 
 def test_wording_covers_exactly_the_protocol():
+    from protocol.section_types import get_section_type
     from studyapp.models import Section
     from studyapp.questions import WORDING
 
     assert set(WORDING) == set(SECTION_TYPES)
     for stype, wording in WORDING.items():
-        assert set(wording.questions) == set(SECTION_QUESTIONS[stype]) and wording.label
+        assert set(wording.questions) == set(SECTION_QUESTIONS[stype]) and get_section_type(stype).label
     assert [value for value, _ in Section._meta.get_field("section_type").choices] == list(SECTION_TYPES)
