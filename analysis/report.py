@@ -24,27 +24,15 @@ import zipfile
 import numpy as np
 import pandas as pd
 
-from protocol.vocabulary import MODALITIES
-
-from . import agreement, emotion, exclusion, likert, mixed, naturalness, norms, participants, recognition, themes, vad
+from . import exclusion, participants, recognition, vad
 from . import figures as figure_mod
 from . import viewing as viewing_mod
 from .io import StudyData, load_study
+from .report_tables import TableInputs, TableKeys, exclusion_method, report_tables
 
-TABLE_KEYS = ("exclusions", "exclusion_counts", "viewing_incomplete", "gait_emotion_ad", "transition_ad",
-              "likert_consistency_ad", "likert_distribution",
-              "naturalness", "naturalness_test", "vad_pearson", "theme_anova", "theme_descriptives", "theme_inversion",
-              "neutral_validation", "demographic_differences", "agreement",
-              "mixed_models", "clip_norms")
-"""Keys of report.json holding a list of records (one CSV each). ``participants``, ``viewing`` and ``meta`` are
-objects."""
-SCREENING_KEYS = ("exclusions", "exclusion_counts", "viewing_incomplete")
-"""Tables about the data rather than findings: an empty one is not "no data for this analysis"."""
-
-AD_LABEL_BLIND = ("It is label-blind: it compares two sets of four numbers without which emotion each number "
-                  "belongs to, so intended happy (1,0,0,0) against perceived pure neutral (0,0,0,1) is not rejected; "
-                  "whether emotions were recognised is answered by the recognition section (Wagner's Hu).")
-"""One sentence shown beside seed 000's 4-value Anderson-Darling test wherever the report shows it."""
+TABLE_KEYS = TableKeys()
+"""Keys of report.json holding a list of records (one CSV each), in registration order (analysis.report_tables: a live
+view of the registry). ``participants``, ``viewing``, ``recognition`` and ``meta`` are objects."""
 
 RECOGNITION_KEYS = {"gait_emotion": "Gait emotion (section emotion_choice)",
                     "gesture_emotion": "Gesture emotion (section gesture_emotion)"}
@@ -57,122 +45,12 @@ RECOGNITION_METHOD = ("Confusion matrix, rows intended, columns perceived; an an
                       "1993); Cohen's kappa. Per participant: Hu and chance per emotion, arcsin(sqrt(x)), paired "
                       "t-test across participants (scipy.stats.ttest_rel), Holm-corrected across emotions.")
 
-METHODS = {
-    "exclusions": "",  # depends on the rules in force: exclusion_method()
-    "exclusion_counts": "Per rule: participants it excludes and their answers (rows of responses.csv) removed; "
-                        "'any rule' counts each excluded participant once.",
-    "viewing_incomplete": "Answers with a viewing record (viewing.csv) given before the clip had played to its end "
-                          "(ended_ms blank): first_play_ms blank = never played; seeks = seek attempts; hidden = "
-                          "times the page was hidden while the clip played. Answers without a record are not "
-                          "listed.",
-    "gait_emotion_ad": "Seed 000's test, kept for fidelity. Each answer -> indicator vector / number of labels; "
-                       "mean over answers, l1-normalised; scipy.stats.anderson_ksamp (midrank) on the 4 intended vs "
-                       "the 4 perceived components; p interpolated and capped to [0.001, 0.25]. " + AD_LABEL_BLIND,
-    "transition_ad": "As above, for question 'initial' vs happy..neutral and 'final' vs final_*.",
-    "likert_consistency_ad": "k samples = participants (each: all their values for gaits of that dominant intended "
-                             "emotion); midrank k-sample Anderson-Darling.",
-    "likert_distribution": "Share of each value 0..4 per dominant intended emotion and feature.",
-    "naturalness": "Counts and shares of ratings 1..5 per origin and modality; share >= 3 = satisfactory.",
-    "naturalness_test": "Mann-Whitney U (two-sided) and chi-square with Yates correction on >= 3 vs < 3 "
-                        "(Fisher's exact when an expected count < 5).",
-    "vad_pearson": "Intended (clip's emotion_label) and perceived words mapped to NRC-VAD; scipy.stats.pearsonr "
-                   "with 95% Fisher-z confidence interval; n = answers.",
-    "theme_anova": "pingouin.rm_anova, within = weight x n_features, subject = participant; Greenhouse-Geisser "
-                   "corrected p; partial eta squared; participants with missing cells dropped.",
-    "theme_descriptives": "Rating normalised (r - 1) / 6; mean and SE = SD/sqrt(n) over participants.",
-    "theme_inversion": "Per-participant mean per theme; mean, SE, one-sample t-test against 0 (two-sided).",
-    "neutral_validation": "Share of each of the seven choices.",
-    "demographic_differences": "Pearson chi-square of group x perceived-label counts (no correction), Cramer's V; "
-                               "groups with < 5 selections left out.",
-    "agreement": "Ratings: ICC(2,1) and ICC(2,k) (two-way random raters, absolute agreement; clips = targets, "
-                 "participants = raters; only participants who rated every clip of the set; F-based 95% CI as "
-                 "pingouin.intraclass_corr). Choices: Fleiss' kappa on the clip x label table (multi-select 1/k), "
-                 "95% CI by bootstrap over clips.",
-    "clip_norms": "Per clip and question (analysis.norms): n_ratings; shares = the perceived vector (an answer "
-                  "selecting k labels adds 1/k to each; mean over the clip's answers); intended = the dominant "
-                  "intended label (gait: unique largest component >= 0.5; gesture: emotion_label; neutral "
-                  "validation: the theme); its share with the 95% Wilson score interval (statsmodels "
-                  "proportion_confint, method='wilson'; summed shares as successes); Shannon entropy in bits; "
-                  "seed 000's 2-sample Anderson-Darling test as gait_emotion_ad (gait emotion questions); mean "
-                  "norming intensity of the section; mean and n of the clip's naturalness answers. Written as "
-                  "clip_norms.csv (docs/study.md).",
-    "mixed_models": "statsmodels MixedLM (REML), crossed random intercepts for participant and clip as variance "
-                    "components of a single group. Theme: rating ~ weight * n_features (centred, numeric) per "
-                    "theme; Likert: value ~ dominant intended emotion (reference neutral) per feature. Wald z "
-                    f"tests; at most {mixed.MAX_PARTICIPANTS} participants per model (seeded random sample).",
-}
-
-def exclusion_method(rules: dict) -> str:
-    """The exclusion rules in force (resolved, :func:`analysis.exclusion.resolve_rules`) in one paragraph."""
-    straight = ("all" if rules["max_straightline"] >= 1 else f"at least {rules['max_straightline']:.0%}")
-    return (f"Excluded before every analysis: participants with more than {rules['max_fast_share']:.0%} of timed "
-            f"answers faster than {rules['min_rt_fraction']:g} x the clip duration (too_fast); with {straight} of at "
-            f"least {rules['min_straight']} answers of a rating-scale section equal (straight_lining); who passed "
-            f"less than {rules['min_attention_pass']:.0%} of their attention checks (failed_attention, when "
-            "participants.csv has attention columns)" + _viewing_method(rules)
-            + ". The participants summary describes everyone.")
-
-
-def _viewing_method(rules: dict) -> str:
-    """The viewing rules in force as the end of exclusion_method's sentence ('' when both are off)."""
-    bits = [f"; with more than {rules[key]:.0%} of their recorded answers {what} ({rule}, from viewing.csv)"
-            for key, rule, what in (("max_unended_share", "answered_before_end", "given before the clip ended"),
-                                    ("max_hidden_share", "tab_hidden", "with the page hidden during playback"))
-            if rules[key] < 1]
-    if rules.get("max_untrusted_share", 1.0) < 1:
-        bits.append(f"; with more than {rules['max_untrusted_share']:.0%} of their answers' viewing records missing "
-                    "or implausible (record_untrusted, from viewing.csv)")
-    return "".join(bits)
-
-
-METHODS["exclusions"] = exclusion_method(exclusion.resolve_rules())
-
-TITLES = {
-    "exclusions": "Excluded participants and why",
-    "exclusion_counts": "What each exclusion rule removed",
-    "viewing_incomplete": "Answers given without a full view of the clip",
-    "gait_emotion_ad": "Single gait emotions: seed 000's test, 2-sample Anderson-Darling of the 4 intended vs the 4 "
-                       "perceived values (seed 000 6.3.1)",
-    "transition_ad": "Emotion transitions: seed 000's test, initial and final, 2-sample Anderson-Darling (seed 000 "
-                     "6.3.2)",
-    "likert_consistency_ad": "Pose affective features: consistency across participants, k-sample Anderson-Darling "
-                             "(seed 000 6.3.3)",
-    "likert_distribution": "Pose affective features: share of each Likert value (seed 000 Fig. 8)",
-    "naturalness": "Naturalness ratings by origin and modality (seed 000 6.3.4, seed 003 6.3.2)",
-    "naturalness_test": "Naturalness: generated vs source",
-    "vad_pearson": "Gesture emotions: intended vs perceived VAD, Pearson r (seed 003 6.3.1)",
-    "theme_anova": "Theme ratings: two-way RM-ANOVA weight x number of features (seed 004 Table IV)",
-    "theme_descriptives": "Theme ratings: normalised mean and SE per cell (seed 004 Fig. 7)",
-    "theme_inversion": "Inverted themes: mean, SE and one-sample t-test against 0 (seed 004 Fig. 8)",
-    "neutral_validation": "Neutral input walk: 7-way forced choice (seed 004 Table I)",
-    "demographic_differences": "Perceived emotions across gender and age group, chi-square (seed 000 6.2)",
-    "agreement": "Agreement between participants: ICC of ratings, Fleiss' kappa of choices",
-    "mixed_models": "Mixed models with crossed random intercepts (participant, clip) beside the papers' tests",
-    "clip_norms": "Per-clip norms: perceived shares, intended share with its Wilson interval, entropy",
-}
-
-
 def analyse(data: StudyData, alpha: float = 0.05, permutations: int = 0) -> tuple[dict, dict]:
     """Run every analysis on validated data. Returns (tables: key -> DataFrame, extras: participants summary,
-    VAD pairs for the figure)."""
+    VAD pairs for the figure). The tables are the registered findings (analysis.report_tables), in their order."""
     r, c, p = data.responses, data.clips, data.participants
-    tables = {
-        "gait_emotion_ad": emotion.gait_emotion_ad(r, c, alpha, permutations),
-        "transition_ad": emotion.transition_ad(r, c, alpha, permutations),
-        "likert_consistency_ad": likert.likert_consistency_ad(r, c, alpha),
-        "likert_distribution": likert.likert_distribution(r, c),
-        "naturalness": naturalness.naturalness(r, c),
-        "naturalness_test": naturalness.naturalness_test(r, c, alpha),
-        "vad_pearson": vad.vad_pearson(r, c),
-        "theme_anova": themes.theme_anova(r, c),
-        "theme_descriptives": themes.theme_descriptives(r, c),
-        "theme_inversion": themes.theme_inversion(r, c, alpha),
-        "neutral_validation": themes.neutral_validation(r),
-        "demographic_differences": participants.demographic_differences(r, p, alpha),
-        "agreement": agreement.agreement(r, c),
-        "mixed_models": mixed.mixed_models(r, c),
-        "clip_norms": norms.clip_norms(r, c),
-    }
+    inputs = TableInputs(r, c, p, alpha, permutations)
+    tables = {t.key: t.compute(inputs) for t in report_tables() if t.compute is not None}
     extras = {"participants": participants.participant_summary(p, r), "vad_pairs": vad.vad_pairs(r, c),
               "recognition": {"gait_emotion": recognition.gait_recognition(r, c, alpha),
                               "gesture_emotion": recognition.gesture_recognition(r, c, alpha)}}
@@ -197,13 +75,8 @@ def _clean(v):
 
 
 def _records(df: pd.DataFrame, key: str) -> list[dict]:
-    recs = df.to_dict("records")
-    if key == "naturalness":
-        for rec in recs:
-            rec["counts"] = {str(k): int(rec[f"count_{k}"]) for k in naturalness.RATINGS}
-        order = ["origin", "modality", "counts", "share_at_least_3", "n"]
-        recs = [{**{k: rec[k] for k in order}, **{k: v for k, v in rec.items() if k not in order}} for rec in recs]
-    return _clean(recs)
+    hook = next((t.records for t in report_tables() if t.key == key), None)
+    return _clean(hook(df) if hook else df.to_dict("records"))
 
 
 def _recognition_summary(name: str, res: dict, alpha: float) -> str | None:
@@ -252,53 +125,10 @@ def _summary(tables: dict, parts: dict, alpha: float, recog: dict | None = None,
         line = _recognition_summary(RECOGNITION_KEYS[key].split(" (")[0], res, alpha)
         if line:
             out.append(line)
-    g = tables["gait_emotion_ad"]
-    if len(g):
-        out.append(f"Seed 000's 4-value Anderson-Darling test, single emotions: for {int((~g['reject']).sum())} of "
-                   f"{len(g)} gaits the null hypothesis (intended and perceived emotion vectors from the same "
-                   f"distribution) is not rejected at alpha = {alpha}. {AD_LABEL_BLIND}")
-    t = tables["transition_ad"]
-    if len(t):
-        ok = t.groupby("clip_id")["reject"].any()
-        out.append(f"Transitions (seed 000's AD test): not rejected for {int((~ok).sum())} of {len(ok)} gaits "
-                   "(initial and final).")
-    lc = tables["likert_consistency_ad"]
-    if len(lc):
-        out.append(f"Pose affective features: consistency across participants rejected in {int(lc['reject'].sum())} "
-                   f"of {len(lc)} emotion x feature tests.")
-    n = tables["naturalness"]
-    for _, row in n.iterrows():
-        out.append(f"Naturalness, {row['modality']} {row['origin']}: {row['share_at_least_3']:.1%} of {int(row['n'])}"
-                   f" ratings >= 3.")
-    v = tables["vad_pearson"]
-    if len(v):
-        out.append("Gesture VAD correlation: " + ", ".join(f"{r['dimension']} r = {r['r']:.2f}"
-                                                            for _, r in v.iterrows()) + ".")
-    a = tables["theme_anova"]
-    if len(a):
-        sig = a[a["p_gg"] < alpha]
-        out.append(f"Theme RM-ANOVA: {len(sig)} of {len(a)} effects significant (Greenhouse-Geisser p < {alpha}).")
-    inv = tables["theme_inversion"]
-    if len(inv):
-        out.append(f"Inversion: mean rating below 0 with p < {alpha} for "
-                   f"{int(((inv['mean'] < 0) & inv['reject']).sum())} of {len(inv)} themes.")
-    ag = tables.get("agreement", pd.DataFrame())
-    if len(ag):
-        icc = ag[ag["statistic"] == "ICC2"].dropna(subset=["value"])
-        fk = ag[ag["statistic"] == "fleiss_kappa"].dropna(subset=["value"])
-        bits = []
-        if len(icc):
-            bits.append(f"single-rater ICC(2,1) of ratings {icc['value'].min():.2f} to {icc['value'].max():.2f}")
-        if len(fk):
-            bits.append("Fleiss' kappa " + ", ".join(f"{r['section_type']}/{r['question']} {r['value']:.2f}"
-                                                     for _, r in fk.iterrows()))
-        if bits:
-            out.append("Agreement between participants: " + "; ".join(bits) + ".")
-    mm = tables.get("mixed_models", pd.DataFrame())
-    if len(mm):
-        fx = mm[(mm["kind"] == "fixed") & (mm["term"] != "Intercept")]
-        out.append(f"Mixed models (crossed random participant and clip intercepts): "
-                   f"{int((fx['p_value'] < alpha).sum())} of {len(fx)} fixed effects with p < {alpha}.")
+    for table in report_tables():
+        df = tables.get(table.key)
+        if table.summary is not None and df is not None and len(df):
+            out += table.summary(df, alpha)
     ex = tables.get("exclusions", pd.DataFrame())
     if exclude:
         by_rule = ex.groupby("rule")["participant_id"].nunique().to_dict() if len(ex) else {}
@@ -362,25 +192,10 @@ def build_report(data: StudyData, alpha: float = 0.05, permutations: int = 0,
     report["participants"] = _clean(extras["participants"])
     report["viewing"] = _clean(viewing_summary)
     report["recognition"] = {k: _clean(recognition.recognition_json(v)) for k, v in extras["recognition"].items()}
-    notes = []
-    a = tables["theme_anova"]
-    if len(a) and a["n_dropped"].max() > 0:
-        notes.append(f"Theme RM-ANOVA: participants with missing cells were dropped per theme "
-                     f"(up to {int(a['n_dropped'].max())} per theme).")
-    for k in TABLE_KEYS:
-        if tables[k].empty and k not in SCREENING_KEYS:
-            notes.append(f"{k}: no data for this analysis in responses.csv.")
-    for key in ("gait_emotion_ad", "transition_ad"):
-        t = tables[key]
-        if t.empty:
-            continue
-        intended = t[[c for c in t.columns if c.startswith("intended_")]].to_numpy()
-        pure = t.loc[t["reject"].to_numpy() & ((intended > 0).sum(axis=1) == 1), "clip_id"].unique()
-        if len(pure):
-            notes.append(f"{key}: rejected clip(s) {', '.join(map(str, pure))} have a single intended emotion; "
-                         "against any perceived vector with four non-zero components the 4-value AD test gives about "
-                         "2.1, p ~ 0.04 (2.111 without ties, as seed 000's Gait 2) whatever their size. Judge the "
-                         "vectors in the figure.")
+    notes = [line for t in report_tables() if t.preface_notes for line in t.preface_notes(tables[t.key])]
+    notes += [f"{t.key}: no data for this analysis in responses.csv." for t in report_tables()
+              if tables[t.key].empty and not t.screening]
+    notes += [line for t in report_tables() if t.notes for line in t.notes(tables[t.key])]
     for name, cols in data.ignored_columns.items():
         notes.append(f"{name}: unknown column(s) not used: {', '.join(cols)}.")
     synthetic = bool(extras["participants"].get("synthetic"))
@@ -398,19 +213,13 @@ def build_report(data: StudyData, alpha: float = 0.05, permutations: int = 0,
     return report, tables, extras
 
 
-def _make_figures(tables: dict, extras: dict) -> dict:
-    return {
-        "fig_emotion_vectors": figure_mod.fig_emotion_vectors(tables["gait_emotion_ad"]),
-        "fig_transitions": figure_mod.fig_transitions(tables["transition_ad"]),
-        "fig_likert": figure_mod.fig_likert(tables["likert_distribution"]),
-        "fig_vad": figure_mod.fig_vad(extras["vad_pairs"], tables["vad_pearson"]),
-        "fig_naturalness": figure_mod.fig_naturalness(tables["naturalness"]),
-        "fig_theme_ratings": figure_mod.fig_theme_ratings(tables["theme_descriptives"]),
-        "fig_inversion": figure_mod.fig_inversion(tables["theme_inversion"]),
-        "fig_confusion": figure_mod.fig_confusion({RECOGNITION_KEYS[k].split(" (")[0]: v
-                                                   for k, v in extras["recognition"].items()}),
-        **{f"fig_clip_norms_{m}": figure_mod.fig_clip_norms(tables["clip_norms"], m) for m in MODALITIES},
-    }
+def make_figures(tables: dict, extras: dict) -> dict:
+    """Every report figure: name -> matplotlib Figure (None when its table is empty): the registered tables' figures
+    in registration order, then the recognition confusion matrices."""
+    figs = {spec.name: spec.make(tables, extras) for t in report_tables() for spec in t.figures}
+    figs["fig_confusion"] = figure_mod.fig_confusion({RECOGNITION_KEYS[k].split(" (")[0]: v
+                                                      for k, v in extras["recognition"].items()})
+    return figs
 
 
 def write_report(responses_csv, clips_csv, participants_csv, out_dir, alpha: float = 0.05,
@@ -438,7 +247,7 @@ def write_report(responses_csv, clips_csv, participants_csv, out_dir, alpha: flo
         json.dump(report["participants"], f, indent=2)
     figs = {}
     if figures:
-        for name, fig in _make_figures(tables, extras).items():
+        for name, fig in make_figures(tables, extras).items():
             if fig is not None:
                 figs[name] = figure_mod.save_figure(fig, out_dir, name)
     report["meta"]["figures"] = {k: {t: os.path.basename(p) for t, p in v.items()} for k, v in figs.items()}
@@ -471,13 +280,7 @@ text-align:right}th{background:#f3f3f3}.banner{background:#fff3cd;border:1px sol
 font-weight:bold}.fig svg{max-width:100%;height:auto}details{margin:.3em 0}ul.summary li{margin:.2em 0}
 .wide{overflow-x:auto}.method{color:#555;font-size:.85em}.tables{display:flex;flex-wrap:wrap;gap:1.5em;align-items:flex-start}"""
 
-FIG_FOR_TABLE = {"clip_norms": tuple(f"fig_clip_norms_{m}" for m in MODALITIES),
-                 "gait_emotion_ad": "fig_emotion_vectors", "transition_ad": "fig_transitions",
-                 "likert_distribution": "fig_likert", "vad_pearson": "fig_vad", "naturalness": "fig_naturalness",
-                 "theme_descriptives": "fig_theme_ratings", "theme_inversion": "fig_inversion"}
 MAX_HTML_ROWS = 60
-EMPTY_TABLE_HTML = {"exclusions": "<p>No participant excluded.</p>", "exclusion_counts": "<p>Nothing removed.</p>",
-                    "viewing_incomplete": "<p>None (or no viewing.csv).</p>"}
 
 
 def _inline_svg(path: str) -> str:
@@ -561,23 +364,23 @@ def render_html(report: dict, tables: dict, figs: dict, extras: dict | None = No
     if extras:
         parts.append(_recognition_html(extras, figs))
     parts.append("<h2>Participants</h2>" + _participants_html(report["participants"]))
-    for k in TABLE_KEYS:
+    for table in report_tables():
+        k = table.key
         method = meta.get("exclusion_rules", {}).get("method") if k == "exclusions" else None
-        parts.append(f"<h2 id='{k}'>{h(TITLES[k])}</h2><p class='method'>{h(method or METHODS[k])}</p>")
+        parts.append(f"<h2 id='{k}'>{h(table.title)}</h2><p class='method'>{h(method or table.method)}</p>")
         if k == "exclusions" and meta.get("exclusion_rules", {}).get("applied"):
             ex_meta = meta["exclusion_rules"]
             parts.append(f"<p class='method'>Thresholds from the {h(ex_meta['source'])}. "
                          f"{h(ex_meta.get('attention', ''))}. {h(ex_meta.get('viewing', ''))}.</p>")
         df = tables[k]
         if df.empty:
-            parts.append(EMPTY_TABLE_HTML.get(k, "<p>No data.</p>"))
+            parts.append(table.empty_html)
             continue
-        shown = FIG_FOR_TABLE.get(k, ())
-        for fig in (shown,) if isinstance(shown, str) else shown:
-            if fig in figs:
-                parts.append(f"<div class='fig'>{_inline_svg(figs[fig]['svg'])}</div>")
-        if k in ("gait_emotion_ad", "transition_ad"):
-            parts.append(f"<p class='method'><b>Read with care:</b> {h(AD_LABEL_BLIND)}</p>")
+        for spec in table.figures:
+            if spec.name in figs:
+                parts.append(f"<div class='fig'>{_inline_svg(figs[spec.name]['svg'])}</div>")
+        if table.caution:
+            parts.append(f"<p class='method'><b>Read with care:</b> {h(table.caution)}</p>")
         parts.append(_table_html(df))
     parts.append("</body></html>")
     return "\n".join(parts)

@@ -46,7 +46,7 @@ def main(argv=None) -> int:
         _, tables, extras = report.build_report(data)
         t_analyse = time.perf_counter() - t
         t = time.perf_counter()
-        figs = report._make_figures(tables, extras)
+        figs = report.make_figures(tables, extras)
         for name, fig in figs.items():
             if fig is not None:
                 report.figure_mod.save_figure(fig, tmp, name)
