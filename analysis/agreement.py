@@ -19,7 +19,8 @@ import pandas as pd
 from scipy.stats import f as f_dist
 from statsmodels.stats.inter_rater import fleiss_kappa as sm_fleiss_kappa
 
-from protocol.vocabulary import LABEL_CHOICES, LIKERT_FEATURES, SECTION_QUESTIONS
+from protocol.section_types import registered
+from protocol.vocabulary import LABEL_CHOICES, MULTI_SELECT_KINDS
 
 from .recognition import selection_weights
 
@@ -110,18 +111,25 @@ def _record(section, question, statistic, value, lo, hi, n_raters, n_items, subs
 
 
 def rating_icc(responses: pd.DataFrame, clips: pd.DataFrame) -> pd.DataFrame:
-    """ICC (:func:`icc_two_way`) of affect_likert ratings per feature over the rated gait clips, and of
-    theme_rating ratings per theme over that theme's clips. Targets are clips, raters participants; a participant
-    who rated a clip twice contributes the mean. ICC needs a complete matrix, so only participants who rated
-    every clip of the set are raters (``note`` says how many were left out). Returns the ``agreement`` columns."""
+    """ICC (:func:`icc_two_way`) of the ratings of every section type declared with ``agreement="icc"``
+    (protocol.section_types), per question, split into rater sets by its ``agreement_by`` clip column: affect_likert
+    per feature over the rated gait clips, theme_rating per theme over that theme's clips. Targets are clips, raters
+    participants; a participant who rated a clip twice contributes the mean. ICC needs a complete matrix, so only
+    participants who rated every clip of the set are raters (``note`` says how many were left out). Returns the
+    ``agreement`` columns."""
     rows = []
-    sets = [("affect_likert", feat, "", responses[(responses["section_type"] == "affect_likert")
-                                                  & (responses["question"] == feat)]) for feat in LIKERT_FEATURES]
-    th = responses[responses["section_type"] == "theme_rating"]
-    if len(th):
-        theme = clips["theme"].reindex(th["clip_id"].astype(str)).to_numpy()
-        for t in sorted(pd.unique(theme[pd.notna(theme)])):
-            sets.append(("theme_rating", "rating", str(t), th[theme == t]))
+    sets = []
+    for spec in registered():
+        if spec.agreement != "icc":
+            continue
+        for question in spec.question_kinds:
+            r = responses[(responses["section_type"] == spec.name) & (responses["question"] == question)]
+            if not spec.agreement_by:
+                sets.append((spec.name, question, "", r))
+            elif len(r):
+                by = clips[spec.agreement_by].reindex(r["clip_id"].astype(str)).to_numpy()
+                for value in sorted(pd.unique(by[pd.notna(by)])):
+                    sets.append((spec.name, question, str(value), r[by == value]))
     for section, question, subset, r in sets:
         if r.empty:
             continue
@@ -145,13 +153,17 @@ def rating_icc(responses: pd.DataFrame, clips: pd.DataFrame) -> pd.DataFrame:
 
 def choice_fleiss_kappa(responses: pd.DataFrame, seed: int = 0) -> pd.DataFrame:
     """Fleiss' kappa (:func:`fleiss_kappa`) of each categorical question (answer kinds of
-    protocol.vocabulary.LABEL_CHOICES): items = clips, categories = the question's labels, counts = answers
-    (multi-select answers add 1/k to each of their k labels). 95% interval: percentile bootstrap over clips
-    (2000 resamples, seeded), NaN for fewer than 3 clips. Returns the ``agreement`` columns."""
+    protocol.vocabulary.LABEL_CHOICES) of the section types declared with ``agreement="kappa"``: items = clips,
+    categories = the question's labels, counts = answers (multi-select answers add 1/k to each of their k labels).
+    95% interval: percentile bootstrap over clips (2000 resamples, seeded), NaN for fewer than 3 clips. Returns the
+    ``agreement`` columns."""
     rng = np.random.default_rng(seed)
     rows = []
-    for section, questions in SECTION_QUESTIONS.items():
-        for question, kind in questions.items():
+    for spec in registered():
+        if spec.agreement != "kappa":
+            continue
+        section = spec.name
+        for question, kind in spec.question_kinds.items():
             if kind not in LABEL_CHOICES:
                 continue
             r = responses[(responses["section_type"] == section) & (responses["question"] == question)]
@@ -165,7 +177,7 @@ def choice_fleiss_kappa(responses: pd.DataFrame, seed: int = 0) -> pd.DataFrame:
             used = table[table.sum(axis=1) >= 2 - 1e-9]
             kappa = fleiss_kappa(table)
             lo, hi = _bootstrap_items(used, rng) if len(used) >= 3 else (np.nan, np.nan)
-            note = "multi-select answers weighted 1/k" if kind == "gait_multi" else ""
+            note = "multi-select answers weighted 1/k" if kind in MULTI_SELECT_KINDS else ""
             if len(used) < 2:
                 note = "fewer than 2 clips with 2 or more answers"
             rows.append(_record(section, question, "fleiss_kappa", kappa, lo, hi,

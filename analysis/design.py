@@ -25,7 +25,8 @@ import pandas as pd
 
 from protocol.pools import DEFAULT_GESTURE_OPTIONS, FLAGS, INCLUDE_FLAGGED, NORMS_RULE, SUB_POOLS, pool_errors
 from protocol.presets import PRESET_PLANS, PRESETS
-from protocol.vocabulary import CLIP_COLUMNS, FINAL_EMOTION_COLUMNS, GESTURE_EMOTIONS, SECTION_QUESTIONS
+from protocol.section_types import get_section_type
+from protocol.vocabulary import CLIP_COLUMNS, FINAL_EMOTION_COLUMNS, SECTION_QUESTIONS, answer_values
 
 PAPER_PRESETS = ("gait_ismar2020", "gestures_ieeevr2021", "rbf_thms2016")
 """The three papers' studies; simulated one after the other as one SYNTHETIC study by default."""
@@ -68,9 +69,15 @@ class SectionDesign:
         return tuple(SECTION_QUESTIONS[self.section_type])
 
     @property
+    def draws_choices(self) -> bool:
+        """Its type draws answer choices per participant and clip (gesture_emotion)."""
+        return get_section_type(self.section_type).drawn_choices
+
+    @property
     def mixed_naturalness(self) -> bool:
         """A naturalness section that mixes given numbers of generated and source clips (studyapp.assignment)."""
-        return self.section_type == "naturalness" and (bool(self.sub_pools) or "n_source" in self.options)
+        return bool(get_section_type(self.section_type).sub_pools) and (bool(self.sub_pools)
+                                                                        or "n_source" in self.options)
 
     def naturalness_counts(self) -> tuple[int, int]:
         """(n_generated, n_source) of a mixed naturalness section, with the study app's defaults."""
@@ -82,7 +89,9 @@ class SectionDesign:
         return int(self.options.get("n_options", DEFAULT_GESTURE_OPTIONS))
 
     def categories(self) -> tuple[str, ...]:
-        return tuple(self.options.get("categories") or GESTURE_EMOTIONS)
+        """The categories a section with drawn choices offers from (its ``categories``, else its question's domain)."""
+        (kind,) = get_section_type(self.section_type).question_kinds.values()
+        return tuple(self.options.get("categories") or answer_values(kind))
 
 
 @dataclass(frozen=True)

@@ -33,11 +33,13 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
+from protocol.section_types.registry import LiveTuple
 from protocol.vocabulary import ATTENTION_COLUMNS, INTEGER_RANGES, SECTION_QUESTIONS, attention_passed
 
 from .viewing import viewing_exclusions
 
-SCALE_SECTIONS = tuple(s for s, qs in SECTION_QUESTIONS.items() if all(k in INTEGER_RANGES for k in qs.values()))
+SCALE_SECTIONS = LiveTuple(lambda: tuple(s for s, qs in SECTION_QUESTIONS.items()
+                                         if all(k in INTEGER_RANGES for k in qs.values())))
 """Sections whose answers are points of a rating scale (protocol.vocabulary: every question of an integer kind)."""
 
 FAST_FRACTION, MAX_FAST_SHARE, MIN_STRAIGHT = 0.25, 0.5, 8
@@ -118,7 +120,7 @@ def straight_lining(responses: pd.DataFrame, min_straight: int = MIN_STRAIGHT,
     """Participants who gave one and the same value to at least ``max_straightline`` (default 1.0: all) of at least
     ``min_straight`` answers of a rating-scale section (:data:`SCALE_SECTIONS`). Returns rows participant_id, rule
     ``straight_lining``, detail, n_answers."""
-    r = responses[responses["section_type"].isin(SCALE_SECTIONS)]
+    r = responses[responses["section_type"].isin(list(SCALE_SECTIONS))]
     # only each section's own scale questions: a norming section's intensity and naturalness are other scales
     own = r["section_type"].astype(str).str.cat(r["question"].astype(str), sep="|").isin(
         {f"{s}|{q}" for s in SCALE_SECTIONS for q in SECTION_QUESTIONS[s]})

@@ -17,6 +17,8 @@ from dataclasses import dataclass, field
 import numpy as np
 import pandas as pd
 
+from protocol.section_types import registered
+from protocol.section_types.registry import LiveTuple
 from protocol.vocabulary import (
     ANSWER_QUESTIONS,
     ATTENTION_CHECK,
@@ -45,7 +47,8 @@ from protocol.vocabulary import (
     VIEWING_SERVER_FIELDS,
 )
 
-ANSWER_KINDS = tuple(dict.fromkeys(kind for questions in ANSWER_QUESTIONS.values() for kind in questions.values()))
+ANSWER_KINDS = LiveTuple(lambda: tuple(dict.fromkeys(kind for questions in ANSWER_QUESTIONS.values()
+                                                     for kind in questions.values())))
 """Every answer kind the sections use (:data:`protocol.vocabulary.ANSWER_QUESTIONS`: each section's own questions and
 the norming questions), in first-use order."""
 
@@ -395,11 +398,12 @@ def _answer_kinds(sec: _CodedColumn, qst: _CodedColumn) -> np.ndarray:
     """Row -> index into :data:`ANSWER_KINDS` of its (section_type, question) pair, -1 where the pair is not in
     ANSWER_QUESTIONS. Looked up once per distinct pair."""
     table = np.full((len(sec.values), len(qst.values)), -1, dtype=np.int8)
+    kinds = tuple(ANSWER_KINDS)
     for i, section in enumerate(sec.values):
         for j, question in enumerate(qst.values):
             kind = ANSWER_QUESTIONS.get(section, {}).get(question)
             if kind is not None:
-                table[i, j] = ANSWER_KINDS.index(kind)
+                table[i, j] = kinds.index(kind)
     return table[sec.codes, qst.codes]
 
 
@@ -442,6 +446,7 @@ def _check_answers(kind: np.ndarray, ans: _CodedColumn, col: _Collector):
     """Validate each distinct (kind, answer) pair once (rows of unknown questions are not checked).
 
     Returns (per-pair cleaned label, per-pair value, row -> pair index)."""
+    kinds = tuple(ANSWER_KINDS)
     pair = kind.astype(np.int64) * len(ans.values) + ans.codes
     upair, pair_inv = np.unique(pair, return_inverse=True)
     pair_value = np.full(len(upair), np.nan)
@@ -450,8 +455,8 @@ def _check_answers(kind: np.ndarray, ans: _CodedColumn, col: _Collector):
     for u, code in enumerate(upair):
         k_i, a_i = divmod(int(code), len(ans.values))
         pair_label[u] = ans.values[a_i]
-        if 0 <= k_i < len(ANSWER_KINDS):
-            pair_msg[u], pair_label[u], pair_value[u] = _check_answer(ANSWER_KINDS[k_i], ans.values[a_i])
+        if 0 <= k_i < len(kinds):
+            pair_msg[u], pair_label[u], pair_value[u] = _check_answer(kinds[k_i], ans.values[a_i])
     pair_bad = np.fromiter((m is not None for m in pair_msg), dtype=bool, count=len(pair_msg))
     bad = np.flatnonzero(pair_bad[pair_inv])
     col.total += len(bad)
@@ -460,23 +465,31 @@ def _check_answers(kind: np.ndarray, ans: _CodedColumn, col: _Collector):
     return pair_label, pair_value, pair_inv
 
 
+CLIP_FIELD_DOMAINS = {"emotion_label": GESTURE_EMOTIONS}
+"""clips.csv label columns a section's clip need counts only with a value of this vocabulary."""
+
+
+def _has(cu: pd.DataFrame, column: str) -> np.ndarray:
+    """Per clip of ``cu``: ``column`` holds a value (non-blank; in its vocabulary for CLIP_FIELD_DOMAINS)."""
+    values = cu[column]
+    if column in CLIP_FIELD_DOMAINS:
+        return values.isin(CLIP_FIELD_DOMAINS[column]).to_numpy()
+    return ~(values.isna().to_numpy() | values.isin([""]).to_numpy())
+
+
 def _clip_needs(cu: pd.DataFrame) -> dict[str, tuple[np.ndarray, str]]:
-    """section_type -> (per clip of ``cu``: lacks what the section needs, message)."""
-    first, last = GAIT_EMOTIONS[0], GAIT_EMOTIONS[-1]
-    no_intended = cu[first].isna().to_numpy()
-    no_theme = cu["theme"].isin(["", None]).to_numpy() | cu["theme"].isna().to_numpy()
-    no_vad = cu[list(VAD_DIMENSIONS)].isna().any(axis=1).to_numpy()
-    return {
-        # emotion_choice needs no intended vector: an unlabelled real walk may be rated (norms); the tests of
-        # intended against perceived leave such clips out
-        "emotion_transition": (no_intended | cu[FINAL_EMOTION_COLUMNS[0]].isna().to_numpy(),
-                               f"needs initial ({first}..{last}) and final_* emotion vectors in clips.csv"),
-        "theme_rating": (no_theme | (cu["weight"].isna() | cu["n_features"].isna()).to_numpy(),
-                         "needs theme, weight and n_features in clips.csv"),
-        "theme_inversion": (no_theme, "needs a theme in clips.csv"),
-        "gesture_emotion": (~cu["emotion_label"].isin(GESTURE_EMOTIONS).to_numpy() & no_vad,
-                            f"needs an NRC-VAD emotion_label or {'/'.join(VAD_DIMENSIONS)} in clips.csv"),
-    }
+    """section_type -> (per clip of ``cu``: lacks what the section needs, message), from the section types'
+    declared clip needs (``SectionType.clip_need``: every field of one of its alternatives). A type without one
+    (emotion_choice: an unlabelled real walk may be rated for norms) needs nothing beyond a known clip."""
+    out = {}
+    for spec in registered():
+        if spec.clip_need is None:
+            continue
+        has = np.zeros(len(cu), bool)
+        for group in spec.clip_need.any_of:
+            has |= np.logical_and.reduce([_has(cu, c) for c in group])
+        out[spec.name] = (~has, spec.clip_need.text)
+    return out
 
 
 def _check_clips(clip: _CodedColumn, section_rows: np.ndarray, clips: pd.DataFrame, rows: _RowProblems) -> None:

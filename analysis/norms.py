@@ -41,6 +41,7 @@ import pandas as pd
 from scipy import stats
 from statsmodels.stats.proportion import proportion_confint
 
+from protocol.section_types.registry import LiveTuple
 from protocol.vocabulary import (
     CLIP_NORMS_COLUMNS,
     FINAL_EMOTION_COLUMNS,
@@ -62,8 +63,8 @@ from .recognition import dominant_intended_label, selection_weights
 NORMED_KINDS = (GAIT_MULTI, GESTURE_CHOICE, NEUTRAL_CHOICE, THEME_RATING, INVERSION)
 """Answer kinds whose per-clip distribution is normed: the label questions and the theme scales."""
 
-NORMED_QUESTIONS = tuple((s, q) for s, qs in SECTION_QUESTIONS.items() for q, kind in qs.items()
-                         if kind in NORMED_KINDS)
+NORMED_QUESTIONS = LiveTuple(lambda: tuple((s, q) for s, qs in SECTION_QUESTIONS.items() for q, kind in qs.items()
+                                           if kind in NORMED_KINDS))
 """(section_type, question) pairs that get norms, in the protocol's order."""
 
 CONFIDENCE = 0.95

@@ -6,9 +6,10 @@ import numpy as np
 import pandas as pd
 from scipy import stats
 
-from protocol.vocabulary import GAIT_EMOTIONS
+from protocol.section_types import SectionType, registered
+from protocol.vocabulary import LABEL_CHOICES, MULTI_SELECT_KINDS
 
-from .emotion import answer_vectors
+from .recognition import selection_weights
 
 SYNTHETIC_PREFIX = "sim-"
 
@@ -54,12 +55,17 @@ def participant_summary(participants: pd.DataFrame, responses: pd.DataFrame) -> 
     }
 
 
-def _label_counts(responses: pd.DataFrame, participants: pd.DataFrame, section: str, factor: str) -> pd.DataFrame:
-    """Contingency table group x perceived label: how often each label was selected by each group."""
-    r = responses[(responses["section_type"] == section) & (responses["question"] == "perceived")]
+def _label_counts(responses: pd.DataFrame, participants: pd.DataFrame, spec: SectionType, factor: str
+                  ) -> pd.DataFrame:
+    """Contingency table group x perceived label: how often each label was selected by each group (a multi-select
+    answer selects each of its labels once)."""
+    question = spec.demographics
+    r = responses[(responses["section_type"] == spec.name) & (responses["question"] == question)]
     group = participants[factor].reindex(r["participant_id"]).to_numpy()
-    if section == "emotion_choice":
-        ind = pd.DataFrame((answer_vectors(r["answer"]) > 0).astype(int), columns=list(GAIT_EMOTIONS))
+    kind = spec.question_kinds[question]
+    if kind in MULTI_SELECT_KINDS:
+        labels = LABEL_CHOICES[kind]
+        ind = pd.DataFrame((selection_weights(r["answer"], labels) > 0).astype(int), columns=list(labels))
         ind["group"] = group
         return ind.groupby("group").sum()
     return pd.crosstab(pd.Series(group, name="group"), pd.Series(r["answer"].to_numpy(), name="label"))
@@ -69,12 +75,13 @@ def demographic_differences(responses: pd.DataFrame, participants: pd.DataFrame,
                             alpha: float = 0.05) -> pd.DataFrame:
     """Whether perceived emotions differ across gender and age group (seed 000 section 6.2).
 
-    For each perceived-label section (emotion_choice: each selected gait emotion counts once; gesture_emotion: the
-    chosen category) and each factor (gender, age_group), Pearson's chi-square test of independence on the table
-    group x label counts (scipy.stats.chi2_contingency, no continuity correction; empty rows/columns removed),
-    with Cramer's V = sqrt(chi2 / (N (min(r, c) - 1))). Groups (including "undisclosed") with fewer than
-    ``min_count`` = 5 selections are left out and listed. Selections are treated as independent although one
-    participant answers several clips; clips are assigned at random, so groups see the same clips on average.
+    For each section type declaring a ``demographics`` question (protocol.section_types; emotion_choice: each selected
+    gait emotion counts once; gesture_emotion: the chosen category) and each factor (gender, age_group), Pearson's
+    chi-square test of independence on the table group x label counts (scipy.stats.chi2_contingency, no continuity
+    correction; empty rows/columns removed), with Cramer's V = sqrt(chi2 / (N (min(r, c) - 1))). Groups (including
+    "undisclosed") with fewer than ``min_count`` = 5 selections are left out and listed. Selections are treated as
+    independent although one participant answers several clips; clips are assigned at random, so groups see the
+    same clips on average.
 
     ``share_expected_below_5`` is the share of cells with an expected count below 5 (Cochran's rule asks for at
     most 0.2 for the chi-square approximation to hold).
@@ -82,9 +89,12 @@ def demographic_differences(responses: pd.DataFrame, participants: pd.DataFrame,
     Returns section, factor, chi2, dof, p_value, cramers_v, n, share_expected_below_5, groups, left_out, reject.
     """
     rows = []
-    for section in ("emotion_choice", "gesture_emotion"):
+    for spec in registered():
+        if not spec.demographics:
+            continue
+        section = spec.name
         for factor in ("gender", "age_group"):
-            t = _label_counts(responses, participants, section, factor)
+            t = _label_counts(responses, participants, spec, factor)
             if t.empty:
                 continue
             small = t.index[t.sum(axis=1) < 5]

@@ -38,21 +38,16 @@ import pandas as pd
 from protocol.presets import PRESETS
 from protocol.vocabulary import (
     ASSIGNMENT_COLUMNS,
-    FINAL_EMOTION_COLUMNS,
     GAIT_EMOTIONS,
-    GESTURE_VAD,
-    LIKERT_FEATURES,
-    NEUTRAL_CHOICES,
     PARTICIPANT_COLUMNS,
     RESPONSE_COLUMNS,
     THEMES,
 )
 
+from .answer_models import Shown as _Shown
+from .answer_models import answer_model, has_answer_model
+from .answer_models import categorical as _categorical
 from .design import PAPER_PRESETS, DesignError, SectionDesign, StudyDesign, design_from_presets
-
-E = len(GAIT_EMOTIONS)
-NEUTRAL = GAIT_EMOTIONS.index("neutral")
-
 
 GENDER_SHARES = (("male", 0.55), ("female", 0.42), ("non-binary", 0.02), ("", 0.01))
 """Self-reported gender of the simulated participants (participants.csv) and its share."""
@@ -66,7 +61,7 @@ class PerceptionModel:
     emotion_noise: float = 0.3
     multi_select_prob: float = 0.3
     likert_means: dict = field(default_factory=lambda: dict(zip(GAIT_EMOTIONS, (  # (torso, arms, pace, flow), 0..4
-        (3.4, 3.0, 3.0, 1.2), (0.5, 0.8, 0.6, 2.0), (2.6, 2.9, 3.5, 3.3), (2.0, 2.0, 2.0, 2.0)))))
+        (3.4, 3.0, 3.0, 1.2), (0.5, 0.8, 0.6, 2.0), (2.6, 2.9, 3.5, 3.3), (2.0, 2.0, 2.0, 2.0)), strict=True)))
     likert_sd: float = 0.6
     naturalness_probs: dict = field(default_factory=lambda: {  # shares of ratings 1..5
         ("gait", "generated"): (0.04, 0.07, 0.24, 0.43, 0.22), ("gait", "source"): (0.0, 0.0, 0.07, 0.35, 0.58),
@@ -80,42 +75,9 @@ class PerceptionModel:
     feature_effect: float = 2.0
     theme_subject_sd: float = 0.6
     theme_noise_sd: float = 0.9
-    inversion_mean: dict = field(default_factory=lambda: dict(zip(THEMES, (-3.5, -2.5, -1.8, -1.6, -3.2, -3.8))))
+    inversion_mean: dict = field(default_factory=lambda: dict(zip(THEMES, (-3.5, -2.5, -1.8, -1.6, -3.2, -3.8),
+                                                                  strict=True)))
     inversion_sd: float = 2.0
-
-
-def _categorical(rng, probs: np.ndarray) -> np.ndarray:
-    """One draw per row of ``probs`` (N, K) (rows sum to 1) -> (N,) indices."""
-    c = np.cumsum(probs, axis=1)
-    u = rng.random((probs.shape[0], 1)) * c[:, -1:]
-    return np.minimum((u >= c).sum(axis=1), probs.shape[1] - 1)
-
-
-def _gait_answers(rng, intended: np.ndarray, m: PerceptionModel) -> np.ndarray:
-    """(N, 4) intended vectors -> (N,) answer strings like "happy;neutral"."""
-    p = (1 - m.emotion_noise) * intended + m.emotion_noise / E
-    first = _categorical(rng, p)
-    p2 = p + 1e-9  # a second label is possible even when the intended vector has one non-zero component
-    p2[np.arange(len(p)), first] = 0
-    second = _categorical(rng, p2 / p2.sum(axis=1, keepdims=True))
-    two = rng.random(len(p)) < m.multi_select_prob
-    lo, hi = np.minimum(first, second), np.maximum(first, second)
-    names = np.asarray(GAIT_EMOTIONS, dtype=object)
-    table = np.array([[names[i] if i == j else f"{names[i]};{names[j]}" for j in range(E)] for i in range(E)],
-                     dtype=object)
-    return np.where(two, table[lo, hi], names[first])
-
-
-@dataclass
-class _Shown:
-    """The clips one section shows: parallel arrays over shown items (participant index, clip row, 0-based position)
-    and, for gesture_emotion, the offered categories as (N, n_options) indices into ``labels``."""
-
-    p: np.ndarray
-    clip: np.ndarray
-    pos: np.ndarray
-    options: np.ndarray | None = None
-    labels: tuple[str, ...] = ()
 
 
 def _positions(rng, p: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -168,9 +130,10 @@ def _naturalness_pick(rng, sec: SectionDesign, design: StudyDesign, used: np.nda
     return _Shown(p[order], clip[order], pos)
 
 
-def _gesture_options(rng, sec: SectionDesign, design: StudyDesign, shown: _Shown) -> _Shown:
-    """Offered categories of each gesture_emotion item: the intended and ``n_options - 1`` others of the section's
-    categories, in random order (studyapp.assignment)."""
+def _drawn_options(rng, sec: SectionDesign, design: StudyDesign, shown: _Shown) -> _Shown:
+    """Offered categories of each item of a section with drawn choices (gesture_emotion): the intended (the clip's
+    emotion_label, else neutral) and ``n_options - 1`` others of the section's categories, in random order
+    (studyapp.assignment)."""
     intended = design.clips["emotion_label"].fillna("").astype(str).to_numpy()[shown.clip]
     intended = np.where(intended == "", "neutral", intended)
     cats = sec.categories()
@@ -196,60 +159,26 @@ def _assign(rng, sec: SectionDesign, design: StudyDesign, used: np.ndarray, earl
         shown = _naturalness_pick(rng, sec, design, used)
     else:
         shown = _pick(rng, used.shape[0], sec.pool, ~used[:, sec.pool], sec.n_per_participant)
-        if sec.section_type == "gesture_emotion":
-            shown = _gesture_options(rng, sec, design, shown)
+        if sec.draws_choices:
+            shown = _drawn_options(rng, sec, design, shown)
     used[shown.p, shown.clip] = True
     return shown
 
 
-# ---- answers -------------------------------------------------------------------------------------------------------
-def _vectors(clips: pd.DataFrame, columns) -> np.ndarray:
-    """(n_clips, 4) intended vectors from ``columns``; a clip without one counts as pure neutral."""
-    v = clips[list(columns)].to_numpy(float)
-    blank = ~np.isfinite(v).all(axis=1) | (np.nan_to_num(v).sum(axis=1) <= 0)
-    v = np.nan_to_num(v)
-    v[blank] = np.eye(E)[NEUTRAL]
-    return v / v.sum(axis=1, keepdims=True)
-
-
+# ---- answers ----------------------------------------------------------------------------------------------------
 def _section_answers(rng, sec: SectionDesign, shown: _Shown, clips: pd.DataFrame, m: PerceptionModel,
                      effects: dict) -> list[np.ndarray]:
-    """One answer array per question of the section (``sec.questions`` order), aligned with ``shown``."""
-    t, n = sec.section_type, len(shown.clip)
-    if t in ("emotion_choice", "emotion_transition"):
-        cols = (GAIT_EMOTIONS, FINAL_EMOTION_COLUMNS)[:len(sec.questions)]
-        return [_gait_answers(rng, _vectors(clips, c)[shown.clip], m) for c in cols]
-    if t == "affect_likert":
-        means = np.array([m.likert_means[e] for e in GAIT_EMOTIONS])  # (emotions, features)
-        mu = _vectors(clips, GAIT_EMOTIONS)[shown.clip] @ means + effects["likert"][shown.p][:, None]
-        lik = np.clip(np.rint(mu + rng.normal(0, m.likert_sd, mu.shape)), 0, 4).astype(int)
-        return [lik[:, LIKERT_FEATURES.index(q)] for q in sec.questions]
-    if t == "naturalness":
-        keys = list(zip(clips["modality"].to_numpy()[shown.clip], clips["origin"].to_numpy()[shown.clip]))
-        probs = np.array([m.naturalness_probs[k] for k in keys], float).reshape(n, -1)
-        return [_categorical(rng, probs) + 1]
-    if t == "gesture_emotion":
-        vad = np.array([GESTURE_VAD[c] for c in shown.labels])
-        intended = clips["emotion_label"].fillna("").astype(str).to_numpy()[shown.clip]
-        want = np.array([shown.labels.index(c or "neutral") for c in intended], dtype=int)
-        w = np.exp(-np.linalg.norm(vad[shown.options] - vad[want][:, None, :], axis=2) / m.gesture_temperature)
-        pick = shown.options[np.arange(n), _categorical(rng, w / w.sum(axis=1, keepdims=True))]
-        return [np.asarray(shown.labels, dtype=object)[pick]]
-    if t == "neutral_validation":
-        nv = _categorical(rng, np.tile(np.asarray(m.neutral_probs, float), (n, 1)))
-        return [np.asarray(NEUTRAL_CHOICES, dtype=object)[nv]]
-    theme = clips["theme"].fillna("").astype(str).to_numpy()[shown.clip]
-    if t == "theme_rating":
-        wt, nf = clips["weight"].to_numpy(float)[shown.clip], clips["n_features"].to_numpy(float)[shown.clip]
-        features = (1 - np.exp(-(nf - 1) / 3)) / (1 - np.exp(-3))
-        mean = (m.theme_base + np.array([m.theme_offsets.get(x, 0.0) for x in theme])
-                + m.weight_effect * (wt - 0.4) / 0.9 + m.feature_effect * features)
-        lat = mean + effects["theme"][shown.p] + rng.normal(0, m.theme_noise_sd, n)
-        return [np.clip(np.rint(lat), 1, 7).astype(int)]
-    if t == "theme_inversion":
-        mean = np.array([m.inversion_mean[x] for x in theme])
-        return [np.clip(np.rint(mean + rng.normal(0, m.inversion_sd, n)), -7, 7).astype(int)]
-    raise ValueError(f"no perception model for section type {t!r}")
+    """One answer array per question of the section (``sec.questions`` order), aligned with ``shown``: the section
+    type's answer model (analysis.answer_models)."""
+    return answer_model(sec.section_type)(rng, sec, shown, clips, m, effects)
+
+
+def check_answer_models(design: StudyDesign) -> None:
+    """DesignError naming the section types of ``design`` the simulator has no answer model for (before drawing)."""
+    missing = sorted({s.section_type for s in design.sections if not has_answer_model(s.section_type)})
+    if missing:
+        raise DesignError(f"no answer model for section type(s) {', '.join(missing)} "
+                          "(analysis.answer_models.register_answer_model)")
 
 
 def _all_answers(rng, design: StudyDesign, n_participants: int, m: PerceptionModel) -> tuple[pd.DataFrame, list]:
@@ -266,7 +195,8 @@ def _all_answers(rng, design: StudyDesign, n_participants: int, m: PerceptionMod
     for k, sec in enumerate(design.sections):
         shown = _assign(rng, sec, design, used, shown_all)
         shown_all.append(shown)
-        for qi, (q, ans) in enumerate(zip(sec.questions, _section_answers(rng, sec, shown, clips, m, effects))):
+        answers = _section_answers(rng, sec, shown, clips, m, effects)
+        for qi, (q, ans) in enumerate(zip(sec.questions, answers, strict=True)):
             n = len(ans)
             cols["_p"].append(shown.p)
             cols["_s"].append(np.full(n, k))
@@ -288,7 +218,7 @@ def _assignments(design: StudyDesign, shown_all: list, pid_list: np.ndarray) -> 
     joined by ';'; no times (the simulator has no clock per page)."""
     parts = []
     clip_ids = design.clips["clip_id"].to_numpy(dtype=object)
-    for sec, shown in zip(design.sections, shown_all):
+    for sec, shown in zip(design.sections, shown_all, strict=True):
         options = np.full(len(shown.p), "", dtype=object)
         if shown.options is not None and len(shown.p):
             labels = np.asarray(shown.labels, dtype=object)[shown.options]
@@ -356,6 +286,7 @@ def simulate_design(n_participants: int, design: StudyDesign, seed: int = 0, mod
     if not 0 <= completion_rate <= 1:
         raise ValueError(f"completion_rate must be in [0, 1], not {completion_rate}")
     m = replace(model or PerceptionModel(), **overrides)
+    check_answer_models(design)
     rng = np.random.default_rng(seed)
     pid_list = np.array([f"sim-{i:05d}" for i in range(1, n_participants + 1)], dtype=object)
     answers, shown = _all_answers(rng, design, n_participants, m)

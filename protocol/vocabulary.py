@@ -180,6 +180,32 @@ def section_questions(section_type: str, norming: bool = False) -> dict[str, str
     return questions
 
 
+def register_answer_kind(kind: str, *, scale: tuple[int, int] | None = None,
+                         labels: tuple[str, ...] | None = None) -> str:
+    """Add an answer kind a new section type asks: an integer ``scale`` (lowest, highest) or a set of ``labels``
+    (exactly one of them); returns ``kind``. ValueError when the kind exists with another domain or the domain is
+    empty."""
+    if (scale is None) == (labels is None):
+        raise ValueError(f"answer kind {kind!r}: give a scale or labels")
+    if scale is not None and not (len(scale) == 2 and isinstance(scale[0], int) and isinstance(scale[1], int)
+                                  and scale[0] < scale[1]):
+        raise ValueError(f"answer kind {kind!r}: the scale must be (lowest, highest) integers, got {scale!r}")
+    if labels is not None and (not labels or len(set(labels)) != len(labels)):
+        raise ValueError(f"answer kind {kind!r}: give distinct labels")
+    table, domain = (INTEGER_RANGES, tuple(scale)) if scale is not None else (LABEL_CHOICES, tuple(labels))
+    other = INTEGER_RANGES if table is LABEL_CHOICES else LABEL_CHOICES
+    if kind in other or table.get(kind, domain) != domain:
+        raise ValueError(f"answer kind {kind!r} exists already with another domain")
+    table[kind] = domain
+    return kind
+
+
+def unregister_answer_kind(kind: str) -> None:
+    """Remove an answer kind (tests that register toy section types clean up with this)."""
+    INTEGER_RANGES.pop(kind, None)
+    LABEL_CHOICES.pop(kind, None)
+
+
 def answer_values(kind: str) -> tuple[str, ...]:
     """Every value one answer of ``kind`` may take, as the strings stored in responses.csv."""
     if kind in INTEGER_RANGES:

@@ -82,3 +82,33 @@ def test_the_docs_command_prints_the_page():
     out = subprocess.run([sys.executable, "-m", "protocol.section_types"], cwd=ROOT, check=True,
                          capture_output=True, text=True).stdout
     assert out.rstrip("\n") == render_page().rstrip("\n")
+
+
+def test_every_type_has_its_wording_its_answer_model_and_registered_analyses():
+    from analysis.answer_models import has_answer_model
+    from analysis.report_tables import report_tables
+    from studyapp.questions import WORDING
+
+    tables = {t.key for t in report_tables()} | {"recognition"}
+    for spec in st.registered():
+        assert set(WORDING[spec.name].questions) == set(spec.wording_keys), spec.name
+        assert has_answer_model(spec.name), spec.name
+        assert set(spec.analyses) <= tables, (spec.name, set(spec.analyses) - tables)
+
+
+def test_a_design_without_an_answer_model_is_refused_before_drawing():
+    from analysis.design import DesignError, design_from_presets
+    from analysis.simulate import simulate_design
+
+    design = design_from_presets(("demo",))
+    toy = st.register(st.SectionType(name="toy_nomodel", label="Toy", summary="", modality="gait",
+                                     questions=(st.Ask("rating", P.INTENSITY),)))
+    try:
+        sec = design.sections[0]
+        broken = type(design)(design.name, design.presets, design.plans,
+                              (type(sec)(sec.order, sec.preset, toy.name, sec.pool, sec.n_per_participant),),
+                              design.clips)
+        with pytest.raises(DesignError, match="no answer model for section type.*toy_nomodel"):
+            simulate_design(3, broken)
+    finally:
+        st.unregister(toy.name)

@@ -201,6 +201,34 @@ class NamesView(Sequence):
         return repr(self._names())
 
 
+class LiveTuple(Sequence):
+    """A read-only tuple-like view whose items ``items()`` computes on each use (a name derived from the registry
+    that must follow later registrations)."""
+
+    def __init__(self, items: Callable[[], tuple]):
+        self._items = items
+
+    def __getitem__(self, i):
+        return self._items()[i]
+
+    def __len__(self) -> int:
+        return len(self._items())
+
+    def __iter__(self) -> Iterator:
+        return iter(self._items())
+
+    def __contains__(self, item) -> bool:
+        return item in self._items()
+
+    def __eq__(self, other) -> bool:
+        return tuple(self) == tuple(other) if isinstance(other, (tuple, list, Sequence)) else NotImplemented
+
+    __hash__ = None
+
+    def __repr__(self) -> str:
+        return repr(self._items())
+
+
 class TypeMapView(Mapping):
     """A read-only mapping view: registered name (passing ``keep``) -> ``value(section type)``."""
 
