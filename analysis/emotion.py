@@ -106,8 +106,8 @@ def _ad_table(perceived: pd.DataFrame, intended: pd.DataFrame, alpha, permutatio
         res = ad_2samp(want, got, alpha, permutations)
         rows.append({"clip_id": clip_id, **{k: res[k] for k in ("statistic", "p_value", "p_capped", "reject")},
                      "n": int(p["n"]), "p_display": res["p_display"], "p_perm": res["p_perm"],
-                     **{f"intended_{e}": w for e, w in zip(GAIT_EMOTIONS, want)},
-                     **{f"perceived_{e}": v for e, v in zip(GAIT_EMOTIONS, got)}})
+                     **{f"intended_{e}": w for e, w in zip(GAIT_EMOTIONS, want, strict=True)},
+                     **{f"perceived_{e}": v for e, v in zip(GAIT_EMOTIONS, got, strict=True)}})
     return pd.DataFrame(rows, columns=_COLUMNS)
 
 

@@ -28,8 +28,10 @@ from protocol.vocabulary import (  # noqa: E402
 plt.rcParams.update({"svg.hashsalt": "analysis", "svg.fonttype": "none", "font.size": 9, "axes.titlesize": 9,
                      "figure.dpi": 100})
 INTENDED_COLOR, PERCEIVED_COLOR = "#4C72B0", "#DD8452"
-EMOTION_COLORS = dict(zip(GAIT_EMOTIONS, ("#E1A100", "#4C72B0", "#C44E52", "#8C8C8C")))
-"""Bar colour of each gait emotion (happy, sad, angry, neutral)."""
+PAPER_EMOTION_COLORS = ("#E1A100", "#4C72B0", "#C44E52", "#8C8C8C")
+"""Bar colours of seed 000's four gait emotions (happy, sad, angry, neutral), the first four of GAIT_EMOTIONS."""
+EMOTION_COLORS = dict(zip(GAIT_EMOTIONS[:len(PAPER_EMOTION_COLORS)], PAPER_EMOTION_COLORS, strict=True))
+"""Bar colour of each of seed 000's gait emotions; a gait emotion added after them takes each figure's default."""
 
 
 def save_figure(fig, out_dir: str, name: str, dpi: int = 110) -> dict[str, str]:
@@ -95,7 +97,7 @@ def fig_transitions(table: pd.DataFrame):
     x = np.arange(len(GAIT_EMOTIONS))
     for ax, clip in zip(axes, clips):
         title = [clip]
-        for offset, phase in ((0, "initial"), (5, "final")):
+        for offset, phase in ((0, "initial"), (len(GAIT_EMOTIONS) + 1, "final")):
             r = table[(table["clip_id"] == clip) & (table["phase"] == phase)]
             if r.empty:
                 continue
@@ -105,8 +107,8 @@ def fig_transitions(table: pd.DataFrame):
             ax.bar(x + offset + 0.2, [row[f"perceived_{e}"] for e in GAIT_EMOTIONS], 0.4, color=PERCEIVED_COLOR,
                    label="perceived")
             title.append(f"{phase[:3]}: p {_p(row)}{' *' if row['reject'] else ''}")
-        ax.axvline(4, color="#bbb", lw=0.8)
-        ax.set_xticks(np.r_[x, x + 5], [e[:2] for e in GAIT_EMOTIONS] * 2, fontsize=7)
+        ax.axvline(len(GAIT_EMOTIONS), color="#bbb", lw=0.8)
+        ax.set_xticks(np.r_[x, x + len(GAIT_EMOTIONS) + 1], [e[:2] for e in GAIT_EMOTIONS] * 2, fontsize=7)
         ax.set_ylim(0, 1.05)
         ax.set_title("\n".join([title[0], ", ".join(title[1:])]), fontsize=8)
     h, lab = axes[0].get_legend_handles_labels()

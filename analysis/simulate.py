@@ -54,14 +54,27 @@ GENDER_SHARES = (("male", 0.55), ("female", 0.42), ("non-binary", 0.02), ("", 0.
 AGE_GROUPS = (("18-24", 0.55), ("25-34", 0.38), ("35+", 0.07))
 
 
+PAPER_LIKERT_MEANS = ((3.4, 3.0, 3.0, 1.2), (0.5, 0.8, 0.6, 2.0), (2.6, 2.9, 3.5, 3.3), (2.0, 2.0, 2.0, 2.0))
+"""Default Likert means (torso, arms, pace, flow; 0..4) of seed 000's gait emotions, in GAIT_EMOTIONS order."""
+
+
+def _paper_defaults(name: str, rows: tuple) -> dict:
+    """gait emotion -> default row of a perception parameter; ValueError naming the gait emotions without one (a
+    vocabulary with more emotions than seed 000's needs the parameter given)."""
+    if len(rows) != len(GAIT_EMOTIONS):
+        raise ValueError(f"PerceptionModel.{name}: no default for gait emotion(s) "
+                         f"{', '.join(GAIT_EMOTIONS[len(rows):])}; give {name} for every one of "
+                         f"{', '.join(GAIT_EMOTIONS)}")
+    return dict(zip(GAIT_EMOTIONS, rows, strict=True))
+
+
 @dataclass(frozen=True)
 class PerceptionModel:
     """Parameters of the synthetic observers (see the module docstring for how each is used)."""
 
     emotion_noise: float = 0.3
     multi_select_prob: float = 0.3
-    likert_means: dict = field(default_factory=lambda: dict(zip(GAIT_EMOTIONS, (  # (torso, arms, pace, flow), 0..4
-        (3.4, 3.0, 3.0, 1.2), (0.5, 0.8, 0.6, 2.0), (2.6, 2.9, 3.5, 3.3), (2.0, 2.0, 2.0, 2.0)), strict=True)))
+    likert_means: dict = field(default_factory=lambda: _paper_defaults("likert_means", PAPER_LIKERT_MEANS))
     likert_sd: float = 0.6
     naturalness_probs: dict = field(default_factory=lambda: {  # shares of ratings 1..5
         ("gait", "generated"): (0.04, 0.07, 0.24, 0.43, 0.22), ("gait", "source"): (0.0, 0.0, 0.07, 0.35, 0.58),

@@ -43,9 +43,9 @@ class Label:
                     raise LabelError(f"gesture emotion {self.emotion!r} is not one of {', '.join(GESTURE_VAD)}")
                 out["vad"] = [float(x) for x in GESTURE_VAD[self.emotion]]
             if vector is not None and self.vector is not None:
-                out["emotion"] = dict(zip(GAIT_EMOTIONS, vector))
+                out["emotion"] = dict(zip(GAIT_EMOTIONS, vector, strict=True))
         elif vector is not None:
-            out["emotion"] = dict(zip(GAIT_EMOTIONS, vector))
+            out["emotion"] = dict(zip(GAIT_EMOTIONS, vector, strict=True))
         elif self.emotion is not None:
             raise LabelError(f"gait emotion {self.emotion!r} is not one of {', '.join(GAIT_EMOTIONS)}")
         return out

@@ -123,8 +123,8 @@ class GaitCorpus:
     def motion(self, i: int) -> Motion:
         """Sequence ``i`` as a Motion (float64), with its labels in the metadata."""
         meta = {"origin": "procedural", "synthetic": True, "corpus_index": int(i),
-                "emotion": dict(zip(GAIT_EMOTIONS, map(float, self.emotion[i]))),
-                "true_emotion": dict(zip(GAIT_EMOTIONS, map(float, self.true_emotion[i]))),
+                "emotion": dict(zip(GAIT_EMOTIONS, map(float, self.emotion[i]), strict=True)),
+                "true_emotion": dict(zip(GAIT_EMOTIONS, map(float, self.true_emotion[i]), strict=True)),
                 "split": str(self.split[i]), "path_kind": str(self.path_kind[i]), "params": self.params[i]}
         return Motion(self.skeleton(i), self.rotations[i], self.root_positions[i], self.fps, meta)
 

@@ -232,7 +232,7 @@ def captured_file_motion(inputs: dict, modality: str, fps: float):
     meta.update(provenance(path))
     for key in ("emotion", "emotion_label", "vad"):
         if key in inputs:
-            meta[key] = dict(zip(GAIT_EMOTIONS, inputs[key])) if key == "emotion" else inputs[key]
+            meta[key] = dict(zip(GAIT_EMOTIONS, inputs[key], strict=True)) if key == "emotion" else inputs[key]
     motion.metadata = meta
     return motion
 

@@ -102,16 +102,16 @@ class PlanInputs(Mapping):
         out = dict.fromkeys(INTENT_COLUMNS)
         emotion, transition = self.get("emotion"), self.get("transition")
         if emotion is not None:
-            out.update(zip(GAIT_EMOTIONS, emotion))
+            out.update(zip(GAIT_EMOTIONS, emotion, strict=True))
         elif transition is not None:
-            out.update(zip(GAIT_EMOTIONS, transition["initial"]))
-            out.update(zip(FINAL_EMOTION_COLUMNS, transition["final"]))
+            out.update(zip(GAIT_EMOTIONS, transition["initial"], strict=True))
+            out.update(zip(FINAL_EMOTION_COLUMNS, transition["final"], strict=True))
         if modality == "gesture":
             if self.get("emotion_label") is not None:
                 out["emotion_label"] = self["emotion_label"]
-                out.update(zip(VAD_DIMENSIONS, GESTURE_VAD[self["emotion_label"]]))
+                out.update(zip(VAD_DIMENSIONS, GESTURE_VAD[self["emotion_label"]], strict=True))
             elif self.get("vad") is not None:
-                out.update(zip(VAD_DIMENSIONS, self["vad"]))
+                out.update(zip(VAD_DIMENSIONS, self["vad"], strict=True))
         return out
 
 
