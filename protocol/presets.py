@@ -183,3 +183,12 @@ PRESETS["norming"] = {
 #: the admin.
 PRESET_PLANS = {"gait_ismar2020": "seed000", "gestures_ieeevr2021": "seed003", "rbf_thms2016": "seed004",
                 "demo": "demo", "norming": "demo"}
+
+
+def preset_plan_names() -> list[str]:
+    """The plans the presets draw on, sorted, each once (what ``analysis/data/planned_clips.csv`` holds)."""
+    return sorted(set(PRESET_PLANS.values()))
+
+
+if __name__ == "__main__":  # python -m protocol.presets: the presets' plans, for generation.plans.planned
+    print(" ".join(preset_plan_names()))

@@ -17,7 +17,7 @@ from pathlib import Path
 
 import pytest
 
-from scripts.import_graph import GROUND, ROOT, find_cycles, package_edges, package_of
+from scripts.import_graph import GROUND, ROOT, find_cycles, imports_of, package_edges, package_of
 
 #: The packages of generation, bottom first: each may import only those before it.
 LAYERS = ("core", "formats", "procedural", "render", "gesture", "mocap", "gait", "rbf", "quality", "plans",
@@ -139,3 +139,15 @@ def test_the_checks_see_local_imports_and_cycles(tmp_path):
     assert {(p.name, line) for p, line, _ in local} == {("a.py", 2), ("__init__.py", 2), ("y.py", 2)}
     assert sorted(text for _, text in local_project_imports(local, root) if "#" not in text) == [
         "from generation.core import y", "from generation.plans import schema", "from generation.quality import z"]
+
+
+STUDY_DESIGN = ("protocol.presets", "protocol.pools", "protocol.norming", "protocol.coverage")
+"""The study design in protocol: the motion library reads the vocabulary only."""
+
+
+def test_generation_reads_no_study_design():
+    found = [f"{path.relative_to(ROOT)}:{line} imports {module}"
+             for path in sorted((ROOT / "generation").rglob("*.py"))
+             for module, line, _local in imports_of(path)
+             if any(module == m or module.startswith(m + ".") for m in STUDY_DESIGN)]
+    assert not found, "generation must not import the study design (presets, pools, norming):\n" + "\n".join(found)

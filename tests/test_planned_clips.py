@@ -15,7 +15,7 @@ from protocol.presets import PRESET_PLANS
 
 def test_shipped_table_is_the_current_plans(tmp_path):
     """analysis/data/planned_clips.csv must follow the plans; rewrite it with
-    python -m generation.plans.planned --out analysis/data/planned_clips.csv"""
+    python -m generation.plans.planned $(python -m protocol.presets) --out analysis/data/planned_clips.csv"""
     write_planned_clips(sorted(set(PRESET_PLANS.values())), tmp_path / "now.csv")
     assert (tmp_path / "now.csv").read_text() == PLANNED_CLIPS.read_text()
 

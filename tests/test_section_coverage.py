@@ -1,7 +1,26 @@
 """After the quality gate: which section of a preset is short of the clips it asks for, and why."""
 from __future__ import annotations
 
-from generation.pipeline.section_coverage import blocking, coverage_lines, matches, section_coverage
+import json
+import subprocess
+import sys
+
+import pytest
+
+from analysis.coverage import planned_rows
+from generation.plans.planned import planned_clip_rows
+from generation.plans.schema import load_plan
+from protocol import coverage
+from protocol.coverage import blocking, matches
+from protocol.presets import PRESET_PLANS
+
+
+def section_coverage(preset, flags):
+    return coverage.section_coverage(preset, planned_clip_rows(load_plan(PRESET_PLANS[preset])), flags)
+
+
+def coverage_lines(preset, flags):
+    return coverage.coverage_lines(preset, planned_clip_rows(load_plan(PRESET_PLANS[preset])), flags)
 
 
 def test_pool_filters_on_planned_rows():
@@ -49,3 +68,21 @@ def test_norming_candidates_keep_observer_flags_and_a_pool_smaller_than_m_is_not
                                           "source_walk_sad": "jerk", "source_walk_angry": "jerk",
                                           "source_walk_normal": "jerk"})[0]
     assert broken["usable"] == 0 and broken["short"]
+
+
+@pytest.mark.parametrize("preset", ["demo", "norming"])
+def test_the_shipped_planned_table_gives_the_same_coverage_as_the_plan(preset):
+    flags = {"sad_loop": "penetration", "happy_neutral_mix": "observer"}
+    from_table = coverage.section_coverage(preset, planned_rows(PRESET_PLANS[preset]), flags)
+    assert from_table == section_coverage(preset, flags)
+
+
+def test_the_coverage_command_reads_plan_qa_flags(tmp_path):
+    qa = tmp_path / "qa.json"
+    qa.write_text(json.dumps([{"entry": e, "flag": "penetration"} for e in ("happy_loop", "sad_loop", "angry_hairpin",
+                                                                             "happy_neutral_mix")]))
+    out = subprocess.run([sys.executable, "-m", "analysis.coverage", "--plan", "demo", "--flags", str(qa)],
+                         capture_output=True, text=True, check=True).stdout
+    assert "plan demo, preset demo: section 1 (emotion_choice)" in out and "SHORT" in out
+    bad = subprocess.run([sys.executable, "-m", "analysis.coverage", "--plan", "nope"], capture_output=True, text=True)
+    assert bad.returncode == 2 and "plan 'nope' has no rows" in bad.stderr

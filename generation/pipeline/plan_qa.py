@@ -31,7 +31,6 @@ from generation.render.clip import plan_cameras, prepare
 from protocol.vocabulary import QA_CHECKS, QA_OBSERVERS
 
 from .jobs import plan_jobs
-from .section_coverage import coverage_lines, presets_of_plan
 
 PASSED = "passed"
 
@@ -169,11 +168,7 @@ def main(argv=None) -> int:
     rows = run(args.plan, args.limit, modality=args.modality, figure_height=not args.no_figure_height,
                gait_observer=args.observer, corpora=RealCorpora.from_environ(os.environ))
     print(f"plan {args.plan}: {len(rows)} clips; " + summary_line(r["flag"] for r in rows))
-
-    for preset in presets_of_plan(args.plan):      # which section of the preset is short after the gate, and why
-        scope = f" ({args.modality} entries checked only)" if args.modality else ""
-        for line in coverage_lines(preset, {r["entry"]: r["flag"] for r in rows}):
-            print(f"plan {args.plan}, preset {preset}{scope}: {line}")
+    # which study section is short after the gate is the study side's question: python -m analysis.coverage
     if args.json:
         with open(args.json, "w", encoding="utf-8") as f:
             json.dump(rows, f, indent=1)

@@ -9,8 +9,11 @@ its source), else the plan's render duration -- a rendered clip's real length ma
 The analysis reads these rows from a CSV file and never imports this package; the table it ships for the preset
 plans (``analysis/data/planned_clips.csv``) is written with
 
-    python -m generation.plans.planned --out analysis/data/planned_clips.csv          # every preset's plan
+    python -m generation.plans.planned $(python -m protocol.presets) --out analysis/data/planned_clips.csv
     python -m generation.plans.planned my_plan.yaml --out var/my_planned_clips.csv   # any plan (name or file)
+
+(``python -m protocol.presets`` prints the plans the study presets draw on; the motion library does not read the
+presets.)
 """
 from __future__ import annotations
 
@@ -19,7 +22,6 @@ import csv
 import sys
 from pathlib import Path
 
-from protocol.presets import PRESET_PLANS
 from protocol.vocabulary import CLIP_COLUMNS
 
 from .schema import ClipEntry, Plan, PlanError, intent_fields, load_plan
@@ -72,12 +74,11 @@ def write_planned_clips(plan_refs, out: str | Path) -> int:
 
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(prog="python -m generation.plans.planned", description=__doc__.splitlines()[0])
-    ap.add_argument("plans", nargs="*", help="plan names or files (default: every preset's plan, "
-                                              "protocol.presets.PRESET_PLANS)")
+    ap.add_argument("plans", nargs="+", help="plan names or files (the presets' plans: python -m protocol.presets)")
     ap.add_argument("--out", required=True, help="CSV file to write")
     args = ap.parse_args(argv)
     try:
-        n = write_planned_clips(args.plans or sorted(set(PRESET_PLANS.values())), args.out)
+        n = write_planned_clips(args.plans, args.out)
     except PlanError as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 2

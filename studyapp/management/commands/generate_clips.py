@@ -23,11 +23,12 @@ from generation.core.device import resolve_device
 from generation.mocap.real_corpus import RealCorpora
 from generation.pipeline.plan_qa import summary_line, unread_line
 from generation.pipeline.runner import run_plan
-from generation.pipeline.section_coverage import coverage_lines, presets_of_plan
 from generation.plans.catalogue import write_clips_csv
+from generation.plans.planned import planned_clip_rows
 from generation.plans.schema import PlanError, load_plan
 from generation.quality.checks import QAThresholdError, gait_observer_kind
 from generation.render import contact_sheet, prepare_render_process
+from protocol.coverage import coverage_lines, presets_of_plan
 from studyapp.catalogue import clip_label, retire_superseded, upsert_clips
 
 
@@ -120,8 +121,9 @@ class Command(BaseCommand):
             if unread := unread_line(records, gait_observer):
                 self.stdout.write(f"plan {plan.name}: {unread}")
             flags = {str(r.get("metadata", {}).get("entry_id")): r.get("qa_flag", "") for r in records}
+            rows = planned_clip_rows(plan)
             for preset in presets_of_plan(plan.name):
-                for line in coverage_lines(preset, flags, plan):
+                for line in coverage_lines(preset, rows, flags, plan.name):
                     self.stdout.write(f"plan {plan.name}, preset {preset}: {line}")
         if opts["contact_sheet"] is not None and records:
             out = Path(opts["contact_sheet"]) if opts["contact_sheet"] else (

@@ -1,25 +1,26 @@
 """Do a preset's sections still get the clips they ask for after the quality gate? Which section is short, and why.
 
+The study side of a plan: given the plan's planned clip rows (the rows the catalogue will hold, as
+``generation.plans.planned.planned_clip_rows`` makes them or ``analysis.design.read_planned_clips`` reads them) and
+each entry's quality flag, it tells which preset section is short. The motion library does not import it: the study
+app's ``generate_clips`` command and ``python -m analysis.coverage`` call it.
+
 A study made from a preset (``protocol.presets.PRESETS``) draws each section's clips from its pool (catalogue filters,
-``protocol.pools``; :func:`create_study_from_preset` adds the preset's plan, ``protocol.presets.PRESET_PLANS``) and
-leaves
-out clips that failed a non-advisory quality check (``qa_flag`` other than ``protocol.vocabulary.QA_ADVISORY_CHECKS``)
-unless the pool says ``include_flagged`` (or failed only the observer's check in a pool that says
-``observer_advisory``). :func:`section_coverage` applies the same filters to the plan's planned
-clip rows (:func:`generation.plans.planned.planned_clip_rows`, the rows the catalogue will hold) with each entry's
-quality flag from the gate (:func:`generation.pipeline.plan_qa.run`), and compares what is left with the section's
-``clips_per_participant`` (0: every clip of the pool; naturalness sections also their ``n_generated`` /
-``n_source`` halves; a norming section, which shows each participant min(M, C) of its C candidates, is full with
-one usable candidate). Plain Python: the pool filters are evaluated on dict rows, no Django.
+``protocol.pools``; the study app adds the preset's plan, ``protocol.presets.PRESET_PLANS``) and leaves out clips
+that failed a non-advisory quality check (``qa_flag`` other than ``protocol.vocabulary.QA_ADVISORY_CHECKS``) unless
+the pool says ``include_flagged`` (or failed only the observer's check in a pool that says ``observer_advisory``).
+:func:`section_coverage` applies the same filters to the plan's planned clip rows with each entry's quality flag from
+the gate (``generation.pipeline.plan_qa``), and compares what is left with the section's ``clips_per_participant``
+(0: every clip of the pool; naturalness sections also their ``n_generated`` / ``n_source`` halves; a norming
+section, which shows each participant min(M, C) of its C candidates, is full with one usable candidate). Plain
+Python: the pool filters are evaluated on dict rows, no Django.
 """
 from __future__ import annotations
 
-from generation.plans.planned import planned_clip_rows
-from generation.plans.schema import load_plan
-from protocol.norming import ratings_per_clip
-from protocol.pools import INCLUDE_FLAGGED, OBSERVER_ADVISORY, SUB_POOLS, pool_lookups
-from protocol.presets import PRESET_PLANS, PRESETS
-from protocol.vocabulary import QA_ADVISORY_CHECKS
+from .norming import ratings_per_clip
+from .pools import INCLUDE_FLAGGED, OBSERVER_ADVISORY, SUB_POOLS, pool_lookups
+from .presets import PRESET_PLANS, PRESETS
+from .vocabulary import QA_ADVISORY_CHECKS
 
 
 def _value(row: dict, field: str):
@@ -62,7 +63,8 @@ def blocking(flag: str | None, observer_advisory: bool = False) -> list[str]:
     return [c for c in (flag or "").split(";") if c and c not in advisory]
 
 
-def section_coverage(preset: str, flags: dict[str, str], plan=None) -> list[dict]:
+def section_coverage(preset: str, rows: list[dict], flags: dict[str, str], plan_name: str | None = None
+                     ) -> list[dict]:
     """Per section of ``preset``: ``index``, ``title``, ``section_type``, ``asks`` (clips per participant; None for a
     section that reuses another's clips), ``in_pool``, ``usable`` (in the pool and not kept out by the gate),
     ``left_out`` ([(entry id, blocking checks)]), ``short`` (bool) and ``why`` (a sentence), and for naturalness
@@ -70,12 +72,12 @@ def section_coverage(preset: str, flags: dict[str, str], plan=None) -> list[dict
 
     Args:
         preset: a key of ``protocol.presets.PRESETS``.
+        rows: the plan's planned clip rows (dicts: ``entry_id`` and the catalogue fields a pool filters on; blank
+            cells None).
         flags: entry id -> its quality flag (``qa_flag``; "" passed). Entries missing from it count as passed.
-        plan: the validated plan (default: ``load_plan(PRESET_PLANS[preset])``).
+        plan_name: the plan the rows come from (default: the preset's own, ``PRESET_PLANS[preset]``).
     """
-
-    plan = plan if plan is not None else load_plan(PRESET_PLANS[preset])
-    rows = planned_clip_rows(plan)
+    plan_name = plan_name or PRESET_PLANS[preset]
     out = []
     for i, sec in enumerate(PRESETS[preset]["sections"]):
         base = {"index": i, "title": sec.get("title", ""), "section_type": sec["section_type"]}
@@ -83,7 +85,7 @@ def section_coverage(preset: str, flags: dict[str, str], plan=None) -> list[dict
             out.append({**base, "asks": None, "in_pool": None, "usable": None, "left_out": [], "short": False,
                         "why": f"shows the clips of section {sec['reuse'] + 1} again"})
             continue
-        pool = {**(sec.get("pool") or {}), "plan": plan.name}
+        pool = {**(sec.get("pool") or {}), "plan": plan_name}
         keep_flagged = bool(pool.get(INCLUDE_FLAGGED, False))
         in_pool = [r for r in rows if matches(r, pool)]
         left = [(r["entry_id"], blocking(flags.get(r["entry_id"]), bool(pool.get(OBSERVER_ADVISORY))))
@@ -104,7 +106,7 @@ def section_coverage(preset: str, flags: dict[str, str], plan=None) -> list[dict
             n = options.get(f"n_{half}")
             if n is None:
                 continue
-            sub = {**(sec.get("pool") or {}).get(half, {"origin": half}), "plan": plan.name}
+            sub = {**(sec.get("pool") or {}).get(half, {"origin": half}), "plan": plan_name}
             halves[half] = {"asks": int(n), "usable": sum(matches(r, sub) for r in usable)}
         if halves:
             item["halves"] = halves
@@ -125,10 +127,11 @@ def section_coverage(preset: str, flags: dict[str, str], plan=None) -> list[dict
     return out
 
 
-def coverage_lines(preset: str, flags: dict[str, str], plan=None) -> list[str]:
+def coverage_lines(preset: str, rows: list[dict], flags: dict[str, str], plan_name: str | None = None) -> list[str]:
     """One line per section: 'section 1 (emotion_choice) Perceived emotion: walks: full: asks 2, ...' or SHORT."""
     return [f"section {s['index'] + 1} ({s['section_type']}) {s['title']}: "
-            f"{'SHORT' if s['short'] else 'full'}: {s['why']}" for s in section_coverage(preset, flags, plan)]
+            f"{'SHORT' if s['short'] else 'full'}: {s['why']}"
+            for s in section_coverage(preset, rows, flags, plan_name)]
 
 
 def presets_of_plan(plan_name: str) -> list[str]:
