@@ -11,42 +11,26 @@ and `qa_flag` (failed checks joined by ';', also read from qa["flag"]).
 from __future__ import annotations
 
 import math
-from itertools import combinations
 
 from django.db import transaction
-from django.db.models import Q, QuerySet
+from django.db.models import QuerySet
 
-from protocol.pools import INCLUDE_FLAGGED, NORMS_RULE, OBSERVER_ADVISORY, PoolError, pool_lookups
+from protocol.pools import NORMS_RULE
 from protocol.vocabulary import (
     CLIP_FLOAT_COLUMNS,
     CLIP_MODALITIES,
     CLIP_THEMES,
     GESTURE_EMOTIONS,
     ORIGINS,
-    QA_ADVISORY_CHECKS,
     QA_CHECKS,
     SECTION_MODALITY,
 )
 
 from .models import Clip
-
-#: ``qa_flag`` values that keep a clip in pools: passed, or failed only advisory checks (in QA_CHECKS order).
-ADVISORY_FLAGS = ("", *(";".join(c for c in QA_CHECKS if c in subset)
-                        for n in range(1, len(QA_ADVISORY_CHECKS) + 1)
-                        for subset in combinations(QA_ADVISORY_CHECKS, n)))
-
-#: ``qa_flag`` values that failed only the observer check and advisory ones: they keep a clip in a pool that says
-#: ``observer_advisory`` (a norming section's candidates), and a clip with norms in a pool with a norms rule.
-OBSERVER_ADVISORY_FLAGS = tuple(";".join(c for c in QA_CHECKS if c in subset)
-                                for n in range(1, len(QA_ADVISORY_CHECKS) + 2)
-                                for subset in combinations(("observer", *QA_ADVISORY_CHECKS), n)
-                                if "observer" in subset)
+from .norms_rule import NormsSourceError, passing_ids
+from .pool_filters import CatalogueError, filtered_clips, pool_calls
 
 TEXT_FIELDS = ("emotion_label", "theme", "webm", "poster", "plan", "source_clip_id")
-
-
-class CatalogueError(ValueError):
-    """A clip record or pool filter that cannot be used; the message names the record/field."""
 
 
 def _blank(value) -> bool:
@@ -198,31 +182,16 @@ def pool_queryset(pool: dict | None, include_flagged: bool | None = None) -> Que
     CatalogueError naming the filter (or the norms source's file, line and column) when the pool is not valid;
     sub-pools are left to the assignment.
     """
-    try:
-        calls = pool_lookups(pool)
-    except PoolError as exc:
-        raise CatalogueError(f"pool: {'; '.join(exc.errors['pool'])}") from exc
-    qs = Clip.objects.filter(retired=False)
-    if include_flagged is None:
-        include_flagged = bool((pool or {}).get(INCLUDE_FLAGGED, False))
+    pool_calls(pool)                       # a bad filter is named before any norms source is read
+    passing: set[str] | None = None
     normed: set[str] | None = None
     if isinstance((pool or {}).get(NORMS_RULE), dict):
-        from .norms_rule import NormsSourceError, passing_ids  # cycle: norms_rule -> export -> this module
         try:
             passing, normed = passing_ids(pool)
         except NormsSourceError as exc:
             raise CatalogueError(str(exc)) from exc
-        qs = qs.filter(clip_id__in=passing)
-    if not include_flagged:
-        flags = Q(qa_flag__in=ADVISORY_FLAGS)
-        if (pool or {}).get(OBSERVER_ADVISORY):
-            flags |= Q(qa_flag__in=OBSERVER_ADVISORY_FLAGS)
-        elif normed:      # a norm outranks an observer: its verdict is advisory for clips people rated
-            flags |= Q(qa_flag__in=OBSERVER_ADVISORY_FLAGS, clip_id__in=normed)
-        qs = qs.filter(flags)
-    for method, kwargs in calls:
-        qs = getattr(qs, method)(**kwargs)
-    return qs
+    qs = filtered_clips(pool, include_flagged, normed)
+    return qs if passing is None else qs.filter(clip_id__in=passing)
 
 
 def clip_label(record: dict) -> str:

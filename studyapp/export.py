@@ -42,8 +42,8 @@ from protocol.vocabulary import (
     attention_passed,
 )
 
-from .catalogue import pool_queryset
 from .models import Assignment, Clip, Response, Study
+from .pool_filters import filtered_clips
 
 __all__ = ["ASSIGNMENT_COLUMNS", "CLIP_COLUMNS", "EXPORT_CLIP_COLUMNS", "EXPORT_KINDS", "PARTICIPANT_COLUMNS",
            "RESPONSE_COLUMNS", "VIEWING_COLUMNS", "run_report", "stream_csv", "write_study_csvs"]
@@ -111,7 +111,7 @@ def study_clips(study: Study):
         if section.pool:
             pool = {k: v for k, v in section.pool.items() if k != NORMS_RULE} if isinstance(section.pool, dict) \
                 else section.pool
-            q |= Q(pk__in=pool_queryset(pool).values("pk"))
+            q |= Q(pk__in=filtered_clips(pool).values("pk"))
     return Clip.objects.filter(q).distinct().order_by("clip_id")
 
 

@@ -8,14 +8,14 @@ from django.utils.translation import gettext
 from django.utils.translation import gettext_lazy as _
 
 from analysis.exclusion import rule_errors
-from protocol.pools import SUB_POOLS
+from protocol.pools import NORMS_RULE, SUB_POOLS, pool_errors
 
 from . import clip_import, pool_editor
 from .i18n import display
 from .inputs import refuse_control_characters, refuse_control_characters_in_text
 from .models import Clip, Section, Study
 from .norming import open_errors
-from .norms_rule import NormsSourceError, check_reader, norms_source
+from .norms_rule import NormsSourceError, check_reader, load_norms, norms_source
 from .pool_editor import PoolEditorFields
 from .presets import preset_choices
 from .questions import section_type_choices
@@ -124,7 +124,19 @@ class SectionForm(forms.ModelForm, PoolEditorFields):
         data = super().clean()
         pool_editor.resolve_section_json(self, data, pool_editor.touched_groups(self.changed_data))
         self._check_norms_reader(data)
+        self._check_norms_source(data)
         return data
+
+    def _check_norms_source(self, data: dict) -> None:
+        """An error on the pool when its norms rule's source gives no norms (an unknown study, a study without
+        norms yet, a bad clip_norms.csv: studyapp.norms_service names the file, line and column)."""
+        pool = data.get("pool")
+        if self.has_error("pool") or norms_source(pool) is None or pool_errors(pool, data.get("section_type")):
+            return                # a bad pool is named by the section's own checks first (Section.clean)
+        try:
+            load_norms(pool[NORMS_RULE].get("from", ""))
+        except NormsSourceError as exc:
+            self.add_error("pool", str(exc))
 
     def _check_norms_reader(self, data: dict) -> None:
         """An error on the pool (which then keeps its saved value) when the reader may not read its new source."""

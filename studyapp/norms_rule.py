@@ -4,7 +4,7 @@
 "max_entropy_bits": 1.5}}``. The norms come from a study of this site (computed from its exports with its
 exclusion rules, as the report does: analysis.norms) or from a clip_norms.csv file (a path, relative to
 ``settings.DATA_DIR`` unless absolute), read and checked whole by analysis.norms.read_clip_norms before anything is
-used, so a bad file changes nothing.
+used, so a bad file changes nothing. The norms themselves come from the one norms service (studyapp.norms_service).
 
 Who may read what: a file must be a .csv inside DATA_DIR once symbolic links and ``..`` are resolved (``norms_file``,
 whoever reads it), so no other file of the server is opened. Where a user acts (the pool editor's live count, a
@@ -20,27 +20,12 @@ with a norms rule -- people's ratings outrank an observer's.
 """
 from __future__ import annotations
 
-import io
-import os
-import threading
 from dataclasses import dataclass, field
-from pathlib import Path
 
-from django.conf import settings
-
-from analysis import exclusion
-from analysis.io import StudyData, ValidationError, load_study
-from analysis.norms import clip_norms, read_clip_norms
 from protocol.pools import NORMS_RULE
 
-from .export import stream_csv
-from .models import Clip, Response, Study
+from .norms_service import NormsSourceError, clear, is_file_source, load_norms, norms_file  # noqa: F401 - the rule's API
 from .permissions import studies_for
-
-
-class NormsSourceError(ValueError):
-    """The ``from`` of a norms rule cannot give norms; the message names the field, and the file, line and column
-    of each problem of a clip_norms.csv."""
 
 
 @dataclass
@@ -54,68 +39,6 @@ class ClipVerdict:
         return not self.reasons
 
 
-_cache: dict[tuple, dict[str, dict]] = {}
-_lock = threading.Lock()
-
-
-def _is_path(source: str) -> bool:
-    return source.endswith(".csv") or "/" in source or os.sep in source
-
-
-def norms_file(source: str) -> Path:
-    """The file a ``from`` path names: relative to settings.DATA_DIR unless absolute, and, with symbolic links and
-    ``..`` resolved, a .csv inside DATA_DIR; NormsSourceError before the file is opened otherwise."""
-    root = Path(getattr(settings, "DATA_DIR", ".")).resolve()
-    path = (root / source).resolve()           # an absolute source replaces root
-    if path.suffix.lower() != ".csv":
-        raise NormsSourceError(f"pool.norms.from: {source!r} is not a .csv file (give a study's slug or the path of "
-                               "a clip_norms.csv under the data folder, DATA_DIR)")
-    if not path.is_relative_to(root):
-        raise NormsSourceError(f"pool.norms.from: {source!r} is outside the data folder: a clip_norms.csv must lie "
-                               "under DATA_DIR (give it relative to that folder, e.g. norms/clip_norms.csv)")
-    return path
-
-
-def _from_file(source: str) -> tuple[tuple, callable]:
-    path = norms_file(source)
-    try:
-        stat = path.stat()
-    except OSError as exc:
-        raise NormsSourceError(f"pool.norms.from: cannot read {source!r} ({exc.strerror or exc})") from None
-
-    def load():
-        try:
-            return read_clip_norms(path, known_clips=Clip.objects.values_list("clip_id", flat=True))
-        except ValidationError as exc:
-            more = f"; and {exc.total - len(exc.problems)} more" if exc.total > len(exc.problems) else ""
-            raise NormsSourceError("pool.norms.from: " + "; ".join(map(str, exc.problems)) + more) from None
-    return ("file", str(path), stat.st_mtime_ns, stat.st_size), load
-
-
-def _from_study(slug: str) -> tuple[tuple, callable]:
-    study = Study.objects.filter(slug=slug).first()
-    if study is None:
-        raise NormsSourceError(f"pool.norms.from: no study {slug!r} on this site (give a study's slug or a "
-                               "clip_norms.csv path)")
-    answers = Response.objects.filter(section__study=study)
-    last = answers.order_by("-id").values_list("id", flat=True).first()
-
-    def load():
-        texts = {k: io.StringIO("".join(stream_csv(study, k)))
-                 for k in ("responses", "clips", "participants", "viewing")}
-        data = load_study(texts["responses"], texts["clips"], texts["participants"], texts["viewing"])
-        rules = exclusion.resolve_rules(study.exclusion_rules)
-        excl = exclusion.exclusions(data.responses, data.clips, participants=data.participants, rules=rules,
-                                    viewing=data.viewing)
-        kept = StudyData(exclusion.apply_exclusions(data.responses, excl), data.clips, data.participants)
-        norms = clip_norms(kept.responses, kept.clips)
-        if norms.empty:
-            raise NormsSourceError(f"pool.norms.from: study {slug!r} has no norms yet (no answers to an emotion "
-                                   "question of its clips)")
-        return norms
-    return ("study", study.pk, last, answers.count()), load
-
-
 def norms_source(pool) -> str | None:
     """The ``from`` of a pool's norms rule (stripped), None when the pool has no norms rule."""
     rule = pool.get(NORMS_RULE) if isinstance(pool, dict) else None
@@ -127,31 +50,11 @@ def check_reader(pool, reader) -> None:
     one of studies_for(reader). The message is the same for another lab's study and for none, so a slug is not
     confirmed. A file source is left to norms_file, which holds for everyone."""
     source = norms_source(pool)
-    if not source or _is_path(source):
+    if not source or is_file_source(source):
         return
     if not studies_for(reader).filter(slug=source).exists():
         raise NormsSourceError(f"pool.norms.from: no study {source!r} among the studies you may see (give the slug "
                                "of a study you own or collaborate on, or a clip_norms.csv path)")
-
-
-def load_norms(source: str) -> dict[str, dict]:
-    """clip_id -> its norm (the chosen clip_norms row as a dict) from a norms rule's ``from``; cached per source
-    version (file mtime and size, or the study's answers). Raises NormsSourceError."""
-    source = (source or "").strip()
-    key, load = _from_file(source) if _is_path(source) else _from_study(source)
-    with _lock:
-        if key in _cache:
-            return _cache[key]
-    table = load()
-    with_intended = table.assign(_has=table["intended"].notna() & (table["intended"].astype(str) != ""))
-    best = (with_intended.sort_values(["clip_id", "_has", "n_ratings"], ascending=[True, False, False])
-            .drop_duplicates("clip_id").drop(columns="_has"))
-    norms = {row["clip_id"]: row for row in best.to_dict("records")}
-    with _lock:
-        _cache[key] = norms
-        while len(_cache) > 16:
-            _cache.pop(next(iter(_cache)))
-    return norms
 
 
 def judge(rule: dict, norm: dict | None) -> ClipVerdict:
@@ -192,6 +95,3 @@ def passing_ids(pool: dict) -> tuple[set[str], set[str]]:
     return {cid for cid, norm in norms.items() if judge(rule, norm).passes}, set(norms)
 
 
-def clear() -> None:
-    with _lock:
-        _cache.clear()

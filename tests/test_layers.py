@@ -13,11 +13,12 @@
 """
 from __future__ import annotations
 
+import ast
 from pathlib import Path
 
 import pytest
 
-from scripts.import_graph import GROUND, ROOT, find_cycles, imports_of, package_edges, package_of
+from scripts.import_graph import GROUND, ROOT, find_cycles, imports_of, module_name, package_edges, package_of
 
 #: The packages of generation, bottom first: each may import only those before it.
 LAYERS = ("core", "formats", "procedural", "render", "gesture", "mocap", "gait", "rbf", "quality", "plans",
@@ -151,3 +152,47 @@ def test_generation_reads_no_study_design():
              for module, line, _local in imports_of(path)
              if any(module == m or module.startswith(m + ".") for m in STUDY_DESIGN)]
     assert not found, "generation must not import the study design (presets, pools, norming):\n" + "\n".join(found)
+
+
+def studyapp_module_cycles(root: Path = ROOT) -> list[list[str]]:
+    """Import cycles between the modules of studyapp (function-local imports included), each as a closed path."""
+    graph: dict[str, set[str]] = {}
+    for path in sorted((root / "studyapp").rglob("*.py")):
+        if "migrations" not in path.parts:
+            package = module_name(path, root).rpartition(".")[0] if path.name != "__init__.py" \
+                else module_name(path, root)
+            siblings = {f"{package}.{alias.name}" for node in ast.walk(ast.parse(path.read_text()))
+                        if isinstance(node, ast.ImportFrom) and node.level == 1 and node.module is None
+                        for alias in node.names}          # from . import a, b: the modules a and b
+            graph[module_name(path, root)] = {m for m, _line, _local in imports_of(path, root)} | siblings
+    graph = {m: {d for d in deps if d in graph and d != m} for m, deps in graph.items()}
+    found, state, stack = [], {}, []
+
+    def visit(module: str) -> None:
+        state[module] = "open"
+        stack.append(module)
+        for dep in sorted(graph[module]):
+            if state.get(dep) == "open":
+                found.append([*stack[stack.index(dep):], dep])
+            elif dep not in state:
+                visit(dep)
+        stack.pop()
+        state[module] = "done"
+
+    for module in sorted(graph):
+        if module not in state:
+            visit(module)
+    return found
+
+
+def test_studyapp_modules_have_no_import_cycle():
+    cycles = studyapp_module_cycles()
+    assert not cycles, "studyapp import cycles:\n" + "\n".join(" -> ".join(c) for c in cycles)
+
+
+def test_the_module_cycle_check_finds_one(tmp_path):
+    (tmp_path / "studyapp").mkdir()
+    (tmp_path / "studyapp" / "__init__.py").write_text("")
+    (tmp_path / "studyapp" / "a.py").write_text("from .b import f\n")
+    (tmp_path / "studyapp" / "b.py").write_text("def f():\n    from . import a\n")
+    assert studyapp_module_cycles(tmp_path) == [["studyapp.a", "studyapp.b", "studyapp.a"]]
