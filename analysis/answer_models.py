@@ -95,6 +95,7 @@ def gait_emotions(rng, sec, shown: Shown, clips, m, effects) -> list[np.ndarray]
 
 
 def affect_likert(rng, sec, shown: Shown, clips, m, effects) -> list[np.ndarray]:
+    """Each feature 0..4: round(intended @ likert_means + participant bias + N(0, likert_sd)), clipped."""
     means = likert_mean_matrix(m.likert_means)  # (emotions, features)
     mu = intended_vectors(clips, GAIT_EMOTIONS)[shown.clip] @ means + effects["likert"][shown.p][:, None]
     lik = np.clip(np.rint(mu + rng.normal(0, m.likert_sd, mu.shape)), 0, 4).astype(int)
@@ -102,6 +103,7 @@ def affect_likert(rng, sec, shown: Shown, clips, m, effects) -> list[np.ndarray]
 
 
 def naturalness(rng, sec, shown: Shown, clips, m, effects) -> list[np.ndarray]:
+    """1..5 drawn from the shares of ``naturalness_probs`` for the clip's (modality, origin)."""
     n = len(shown.clip)
     keys = list(zip(clips["modality"].to_numpy()[shown.clip], clips["origin"].to_numpy()[shown.clip], strict=True))
     probs = np.array([m.naturalness_probs[k] for k in keys], float).reshape(n, -1)
@@ -109,6 +111,7 @@ def naturalness(rng, sec, shown: Shown, clips, m, effects) -> list[np.ndarray]:
 
 
 def gesture_emotion(rng, sec, shown: Shown, clips, m, effects) -> list[np.ndarray]:
+    """One of the offered categories, the nearer in NRC-VAD to the intended one the likelier (gesture_temperature)."""
     n = len(shown.clip)
     vad = np.array([GESTURE_VAD[c] for c in shown.labels])
     intended = clips["emotion_label"].fillna("").astype(str).to_numpy()[shown.clip]
@@ -119,6 +122,7 @@ def gesture_emotion(rng, sec, shown: Shown, clips, m, effects) -> list[np.ndarra
 
 
 def neutral_validation(rng, sec, shown: Shown, clips, m, effects) -> list[np.ndarray]:
+    """One of the seven choices with the shares of ``neutral_probs``; ValueError when they do not match the choices."""
     if len(m.neutral_probs) != len(NEUTRAL_CHOICES):
         raise ValueError(f"neutral_probs: give one share per choice ({', '.join(NEUTRAL_CHOICES)})")
     nv = categorical(rng, np.tile(np.asarray(m.neutral_probs, float), (len(shown.clip), 1)))
@@ -130,6 +134,8 @@ def _themes(clips, shown: Shown) -> np.ndarray:
 
 
 def theme_rating(rng, sec, shown: Shown, clips, m, effects) -> list[np.ndarray]:
+    """1..7 rising with the clip's weight and feature count, with participant and answer noise (module docstring of
+    analysis.simulate)."""
     n, theme = len(shown.clip), _themes(clips, shown)
     wt, nf = clips["weight"].to_numpy(float)[shown.clip], clips["n_features"].to_numpy(float)[shown.clip]
     features = (1 - np.exp(-(nf - 1) / 3)) / (1 - np.exp(-3))
@@ -140,6 +146,7 @@ def theme_rating(rng, sec, shown: Shown, clips, m, effects) -> list[np.ndarray]:
 
 
 def theme_inversion(rng, sec, shown: Shown, clips, m, effects) -> list[np.ndarray]:
+    """-7..7 around the theme's ``inversion_mean`` with noise ``inversion_sd``."""
     theme = _themes(clips, shown)
     mean = np.array([m.inversion_mean[x] for x in theme])
     return [np.clip(np.rint(mean + rng.normal(0, m.inversion_sd, len(shown.clip))), -7, 7).astype(int)]
@@ -169,6 +176,7 @@ def answer_model(section_type: str) -> AnswerModel:
 
 
 def has_answer_model(section_type: str) -> bool:
+    """Whether the simulator can answer sections of ``section_type``."""
     return section_type in _MODELS
 
 

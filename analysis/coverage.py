@@ -38,6 +38,7 @@ def flags_of(qa_rows: list[dict]) -> dict[str, str]:
 
 
 def main(argv=None) -> int:
+    """Print the coverage lines of every preset drawing on ``--plan``; 2 on bad input."""
     ap = argparse.ArgumentParser(prog="python -m analysis.coverage", description=__doc__.splitlines()[0])
     ap.add_argument("--plan", required=True)
     ap.add_argument("--flags", default=None, help="plan_qa --json output (default: every entry passed)")

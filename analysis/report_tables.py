@@ -101,6 +101,7 @@ def report_tables() -> tuple[ReportTable, ...]:
 
 
 def get_table(key: str) -> ReportTable:
+    """The registered table ``key``; KeyError listing the registered keys."""
     try:
         return _REGISTRY[key]
     except KeyError:

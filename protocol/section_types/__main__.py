@@ -72,6 +72,7 @@ def render_page() -> str:
 
 
 def main(argv=None) -> int:
+    """Print the page, or write it to ``--out``; returns the exit status."""
     ap = argparse.ArgumentParser(prog="python -m protocol.section_types", description=__doc__.splitlines()[0])
     ap.add_argument("--out", default=None, help="file to write (default: print)")
     args = ap.parse_args(argv)

@@ -108,6 +108,7 @@ class SectionType:
 
     @property
     def option_keys(self) -> tuple[str, ...]:
+        """Its own ``Section.options`` keys, in declaration order."""
         return tuple(spec.key for spec in self.options)
 
     @property
@@ -153,6 +154,7 @@ def unregister(name: str) -> None:
 
 
 def get_section_type(name: str) -> SectionType:
+    """The declaration of ``name``; UnknownSectionTypeError listing the registered types."""
     try:
         return _REGISTRY[name]
     except KeyError:
@@ -170,6 +172,7 @@ def section_type_names() -> tuple[str, ...]:
 
 
 def registered() -> tuple[SectionType, ...]:
+    """Every declaration, in registration order (the protocol's order)."""
     return tuple(_REGISTRY.values())
 
 
