@@ -183,3 +183,13 @@ PRESETS["norming"] = {
 #: the admin.
 PRESET_PLANS = {"gait_ismar2020": "seed000", "gestures_ieeevr2021": "seed003", "rbf_thms2016": "seed004",
                 "demo": "demo", "norming": "demo"}
+
+
+#: The quality switch every preset pool carries: a clip flagged only by the advisory realism check stays in (it also
+#: flags about 10 % of real captured takes, so it informs rather than excludes); every other failed check keeps a clip
+#: out. A researcher may untick it in the admin's pool editor to leave realism-flagged clips out too.
+PRESET_POOL_SWITCHES = {"keep_advisory": True}
+for _preset in PRESETS.values():
+    for _sec in _preset["sections"]:
+        if "reuse" not in _sec:
+            _sec["pool"] = {**(_sec.get("pool") or {}), **PRESET_POOL_SWITCHES}

@@ -44,7 +44,7 @@ def section_fieldsets() -> list:
             ("randomize_order", "require_full_play", "loop", "counterbalance")]
     pool = ["matching_clips", ("pool_modality", "pool_origin"), "pool_plan", "pool_emotion_label", "pool_theme",
             ("pool_weight_sign", "pool_weight_min", "pool_weight_max"), ("pool_n_features_min", "pool_n_features_max"),
-            ("pool_transition", "pool_rbf"), ("pool_include_flagged", "pool_observer_advisory")]
+            ("pool_transition", "pool_rbf"), ("pool_include_flagged", "pool_keep_advisory", "pool_observer_advisory")]
     halves = [tuple(name for name in pool_editor.SUB_POOL_FIELDS if name.startswith(f"pool_{sub}_"))
               for sub in SUB_POOLS]
     option_sets = [(f"{section_type_label(stype)}: options", {

@@ -16,31 +16,25 @@ from itertools import combinations
 from django.db import transaction
 from django.db.models import Q, QuerySet
 
-from protocol.pools import INCLUDE_FLAGGED, NORMS_RULE, OBSERVER_ADVISORY, PoolError, pool_lookups
+from protocol.pools import INCLUDE_FLAGGED, NORMS_RULE, PoolError, kept_checks, pool_lookups
 from protocol.vocabulary import (
     CLIP_FLOAT_COLUMNS,
     CLIP_MODALITIES,
     CLIP_THEMES,
     GESTURE_EMOTIONS,
     ORIGINS,
-    QA_ADVISORY_CHECKS,
     QA_CHECKS,
     SECTION_MODALITY,
 )
 
 from .models import Clip
 
-#: ``qa_flag`` values that keep a clip in pools: passed, or failed only advisory checks (in QA_CHECKS order).
-ADVISORY_FLAGS = ("", *(";".join(c for c in QA_CHECKS if c in subset)
-                        for n in range(1, len(QA_ADVISORY_CHECKS) + 1)
-                        for subset in combinations(QA_ADVISORY_CHECKS, n)))
 
-#: ``qa_flag`` values that failed only the observer check and advisory ones: they keep a clip in a pool that says
-#: ``observer_advisory`` (a norming section's candidates), and a clip with norms in a pool with a norms rule.
-OBSERVER_ADVISORY_FLAGS = tuple(";".join(c for c in QA_CHECKS if c in subset)
-                                for n in range(1, len(QA_ADVISORY_CHECKS) + 2)
-                                for subset in combinations(("observer", *QA_ADVISORY_CHECKS), n)
-                                if "observer" in subset)
+def kept_flags(checks: tuple[str, ...]) -> tuple[str, ...]:
+    """Every ``qa_flag`` value made only of ``checks`` (joined in QA_CHECKS order), "" (passed) first."""
+    ordered = [c for c in QA_CHECKS if c in checks]
+    return ("", *(";".join(subset) for n in range(1, len(ordered) + 1) for subset in combinations(ordered, n)))
+
 
 TEXT_FIELDS = ("emotion_label", "theme", "webm", "poster", "plan", "source_clip_id")
 
@@ -192,9 +186,10 @@ def pool_queryset(pool: dict | None, include_flagged: bool | None = None) -> Que
 
     Clips that failed a quality check (``qa_flag`` not empty) are left out unless the pool says
     ``"include_flagged": true`` or ``include_flagged`` is given (True for a sub-pool, which only narrows its
-    section's pool); failing only advisory checks (``protocol.vocabulary.QA_ADVISORY_CHECKS``) does not count.
-    A ``norms`` rule (studyapp.norms_rule) keeps only clips whose norms pass, and makes the ``observer`` check
-    advisory for clips that have norms; ``"observer_advisory": true`` makes it advisory for every clip. Raises
+    section's pool), or the pool's switches keep the checks they failed (``protocol.pools.kept_checks``:
+    ``keep_advisory`` the advisory ones, ``observer_advisory`` the observer's). A ``norms`` rule
+    (studyapp.norms_rule) keeps only clips whose norms pass, and keeps the ``observer`` check's flag of clips that
+    have norms. Raises
     CatalogueError naming the filter (or the norms source's file, line and column) when the pool is not valid;
     sub-pools are left to the assignment.
     """
@@ -214,11 +209,11 @@ def pool_queryset(pool: dict | None, include_flagged: bool | None = None) -> Que
             raise CatalogueError(str(exc)) from exc
         qs = qs.filter(clip_id__in=passing)
     if not include_flagged:
-        flags = Q(qa_flag__in=ADVISORY_FLAGS)
-        if (pool or {}).get(OBSERVER_ADVISORY):
-            flags |= Q(qa_flag__in=OBSERVER_ADVISORY_FLAGS)
-        elif normed:      # a norm outranks an observer: its verdict is advisory for clips people rated
-            flags |= Q(qa_flag__in=OBSERVER_ADVISORY_FLAGS, clip_id__in=normed)
+        kept = kept_checks(pool)
+        flags = Q(qa_flag__in=kept_flags(kept))
+        with_norms = kept_checks(pool, normed=True)
+        if normed and with_norms != kept:      # a norm outranks an observer for clips people rated
+            flags |= Q(qa_flag__in=kept_flags(with_norms), clip_id__in=normed)
         qs = qs.filter(flags)
     for method, kwargs in calls:
         qs = getattr(qs, method)(**kwargs)

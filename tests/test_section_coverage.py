@@ -1,7 +1,8 @@
 """After the quality gate: which section of a preset is short of the clips it asks for, and why."""
 from __future__ import annotations
 
-from generation.pipeline.section_coverage import blocking, coverage_lines, matches, section_coverage
+from generation.pipeline.section_coverage import coverage_lines, matches, section_coverage
+from protocol.pools import blocking_checks
 
 
 def test_pool_filters_on_planned_rows():
@@ -11,9 +12,13 @@ def test_pool_filters_on_planned_rows():
     assert not matches(row, {"transition": True})
     assert matches(row, {"sections__contains": "naturalness", "happy__gte": 0.5})
     assert not matches(row, {"origin": ["source"]})
-    assert blocking("observer;realism") == ["observer"] and blocking("realism") == [] and blocking("") == []
-    assert blocking("observer;realism", observer_advisory=True) == []
-    assert blocking("penetration;observer", observer_advisory=True) == ["penetration"]
+    advisory = {"keep_advisory": True}
+    assert blocking_checks("realism", {}) == ["realism"] and blocking_checks("", {}) == []
+    assert blocking_checks("observer;realism", advisory) == ["observer"] and blocking_checks("realism", advisory) == []
+    assert blocking_checks("observer;realism", {**advisory, "observer_advisory": True}) == []
+    assert blocking_checks("observer;realism", {"observer_advisory": True}) == ["realism"]
+    assert blocking_checks("penetration;observer", {"observer_advisory": True}) == ["penetration"]
+    assert blocking_checks("penetration;observer", {"include_flagged": True}) == []
 
 
 def test_demo_sections_full_when_nothing_is_flagged_and_short_when_the_gate_takes_clips():
