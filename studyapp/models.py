@@ -13,7 +13,7 @@ from django.core.exceptions import ValidationError
 from django.db import models
 from django.utils import timezone
 
-from protocol.pools import NORMS_RULE, errors_by_field, validate_section
+from protocol.pools import errors_by_field, validate_section
 from protocol.vocabulary import ATTENTION_CHECK, CLIP_MODALITIES, ORIGINS
 
 from .permissions import STUDY_PERMISSIONS
@@ -217,13 +217,13 @@ class Section(models.Model):
         practice_clip = (self.options or {}).get("practice_clip") if isinstance(self.options, dict) else None
         if isinstance(practice_clip, str) and practice_clip and not Clip.objects.filter(clip_id=practice_clip).exists():
             errors.setdefault("options", []).append(f"'practice_clip': no clip {practice_clip!r} in the catalogue")
-        pool = self.pool if isinstance(self.pool, dict) else {}
-        if isinstance(pool.get(NORMS_RULE), dict) and "pool" not in errors:
-            from .norms_rule import NormsSourceError, load_norms  # cycle: norms_rule reads these models
-            try:
-                load_norms(pool[NORMS_RULE].get("from", ""))
-            except NormsSourceError as exc:
-                errors["pool"] = [str(exc)]
+        if "pool" not in errors:
+            from .norms_rule import NormsSourceError, load_norms, norms_rules  # cycle: norms_rule reads these models
+            for where, rule in norms_rules(self.pool):           # the pool's own rule and each sub-pool's
+                try:
+                    load_norms(rule.get("from", ""))
+                except NormsSourceError as exc:
+                    errors.setdefault("pool", []).append(str(exc).replace("pool.norms.", f"pool.{where}.", 1))
         if errors:
             raise ValidationError(errors)
 
