@@ -155,7 +155,7 @@ class StudyAdmin(StudyScopedAdmin):
     readonly_fields = ["links", "preset", "created_at", "norming_design"]
     form = StudyAdminForm
     fieldsets = [
-        (None, {"fields": ["title", "slug", "status", "preset", "links"]}),
+        (None, {"fields": ["title", "slug", "status", "listed_publicly", "preset", "links"]}),
         ("Participant pages", {"fields": ["language", "introduction", "consent_text", "ask_demographics",
                                           "feedback_questions", "counterbalance_sections"]}),
         ("Recruitment", {"fields": ["max_participants", "norming_design", "abandon_after_minutes", "completion_code",

@@ -25,6 +25,7 @@ from django.views.decorators.http import require_http_methods, require_POST
 
 from protocol.vocabulary import ATTENTION_CHECK
 
+from . import start_throttle
 from .assignment import StudyUnavailable, check_open, current_step, start_participant
 from .device_check import device_context
 from .duration import expected_minutes
@@ -64,7 +65,9 @@ MIN_PLAY_FRACTION = 0.8
 
 
 def home(request):
-    studies = Study.objects.filter(status=Study.Status.OPEN).order_by("title")
+    """The site's front page: lists only open studies that ask to be listed (Study.listed_publicly); the others
+    are reached by their link (Prolific, e-mail), so their slugs are not handed to anyone who asks."""
+    studies = Study.objects.filter(status=Study.Status.OPEN, listed_publicly=True).order_by("title")
     return render(request, "studyapp/home.html", {"studies": studies})
 
 
@@ -125,6 +128,16 @@ def _prolific_conflict(request, study: Study):
     return _unavailable(request, study, PROLIFIC_CONFLICT, status=403)
 
 
+def _too_many_starts(request, study: Study, wait_s: float):
+    """429 with Retry-After: this address started many participants just now (studyapp.start_throttle)."""
+    seconds = max(1, math.ceil(wait_s))
+    response = _unavailable(request, study, gettext(
+        "Many people have just started this study from your network. Please wait %(seconds)d seconds, then open "
+        "the study link again.") % {"seconds": seconds}, status=429)
+    response["Retry-After"] = str(seconds)
+    return response
+
+
 @never_cache
 @require_http_methods(["GET", "HEAD", "POST"])
 def study_entry(request, slug: str):
@@ -162,6 +175,9 @@ def study_entry(request, slug: str):
         if form.is_valid():
             data = form.cleaned_data
             key = _consent_key(request, study, request.POST.get("consent_key", ""), data["PROLIFIC_PID"])
+            wait = start_throttle.admit(request)
+            if wait and not (key and Participant.objects.filter(study=study, consent_key=key).exists()):
+                return _too_many_starts(request, study, wait)
             try:
                 with transaction.atomic():
                     participant = Participant.objects.create(
@@ -179,6 +195,7 @@ def study_entry(request, slug: str):
                         participant = other
                 if participant is None:
                     return _prolific_conflict(request, study)
+            request.session.cycle_key()      # a session planted before consent does not carry over to the answers
             _remember(request, participant)
             _retire_consent_key(request, study)
             return redirect("studyapp:resume", token=participant.token)
