@@ -311,6 +311,8 @@ class Assignment(models.Model):
     plays = models.PositiveIntegerField(default=0, editable=False)
     play_ended_ms = models.PositiveIntegerField(null=True, blank=True, editable=False)
     shows = models.PositiveIntegerField(default=0, editable=False)
+    # when this session's player first fetched the clip (studyapp.views.media): the viewing record's server evidence
+    fetched_at = models.DateTimeField(null=True, blank=True, editable=False)
     carried = models.JSONField(default=dict, blank=True, editable=False)
 
     class Meta:

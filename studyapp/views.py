@@ -402,10 +402,12 @@ def item(request, token: str, n: int):
     response_ms = client_ms(request.POST.get("rt", ""), server_ms)
     if response_ms is None:
         response_ms = server_ms
+    player = player_options(section.options)
     viewing = parse_viewing(request.POST, min(MAX_RESPONSE_MS, server_ms), clip.duration_s,
                             {"plays": assignment.plays, "ended_ms": assignment.play_ended_ms,
                              "shows": assignment.shows, "carried": assignment.carried},
-                            time_slack_ms=RT_SLACK_MS, max_replays=player_options(section.options)["max_replays"])
+                            time_slack_ms=RT_SLACK_MS, max_replays=player["max_replays"],
+                            fetched=assignment.fetched_at is not None, controls=player["controls"])
     save_answers(assignment, answers, response_ms, viewing)
     if request.POST.get(INLINE_NEXT_FIELD) == "1" and n < participant.n_items:
         nxt = current_step(participant, lookahead=True)
@@ -549,13 +551,26 @@ def media_allowed(request, clip: Clip) -> bool:
     pages by seq), or a staff member who may see the catalogue (admin and preview). The URL alone is never
     enough; a clip further on in the study is not served until its page comes near, and a clip's URL stops
     working for a participant once it is answered. One query per participant of the session."""
+    return bool(_near_assignments(request, clip)) or has_staff_permission(request.user, "studyapp.view_clip")
+
+
+def _near_assignments(request, clip: Clip) -> list[tuple[int, object]]:
+    """(pk, fetched_at) of the session's participants' near pages (MEDIA_PAGES) that show ``clip``."""
     tokens = [t for t in request.session.get(SESSION_KEY, {}).values() if isinstance(t, str)]
     for token in tokens:
-        near = (Assignment.objects.filter(participant__token=token, answered_at__isnull=True)
-                .order_by("seq").values_list("clip_id", flat=True)[:MEDIA_PAGES])
-        if clip.pk in list(near):
-            return True
-    return has_staff_permission(request.user, "studyapp.view_clip")
+        near = list(Assignment.objects.filter(participant__token=token, answered_at__isnull=True)
+                    .order_by("seq").values_list("pk", "clip_id", "fetched_at")[:MEDIA_PAGES])
+        found = [(pk, fetched) for pk, clip_id, fetched in near if clip_id == clip.pk]
+        if found:
+            return found
+    return []
+
+
+def _record_fetch(assignments: list[tuple[int, object]]) -> None:
+    """Mark the pages whose clip this session fetched (the viewing record's server evidence), once each."""
+    first = [pk for pk, fetched in assignments if fetched is None]
+    if first:
+        Assignment.objects.filter(pk__in=first, fetched_at__isnull=True).update(fetched_at=timezone.now())
 
 
 def media(request, key: str, ext: str):
@@ -566,9 +581,12 @@ def media(request, key: str, ext: str):
     relative = {"mp4": clip.video, "webm": clip.webm, "png": clip.poster}.get(ext, "")
     if not relative:
         return HttpResponse(status=404)
-    if not media_allowed(request, clip):
+    near = _near_assignments(request, clip)
+    if not near and not has_staff_permission(request.user, "studyapp.view_clip"):
         return HttpResponse("This clip is shown on its study page only.", status=403,
                             content_type="text/plain; charset=utf-8")
+    if ext != "png" and request.method == "GET":
+        _record_fetch(near)
     if settings.MEDIA_ACCEL_REDIRECT:
         return accel_redirect_response(media_path(relative), settings.MEDIA_ACCEL_REDIRECT)
     return ranged_file_response(request, media_path(relative))
