@@ -126,6 +126,10 @@ class Study(models.Model):
         default=DEFAULT_ABANDON_MINUTES,
         help_text="A started participant inactive this long stops counting towards the participant limit, so the "
                   "places of people (or scripts) who left free up; they may still come back and finish (0 = never)")
+    export_external_ids = models.BooleanField(
+        default=False, help_text="Exports and reports carry participants' external ids (Prolific IDs) as given. Off: "
+                                 "each is a pseudonym, the same for one participant in every export of this study; "
+                                 "the ids for payment are a separate download (permission: download payment ids)")
     listed_publicly = models.BooleanField(
         default=False, help_text="List this study on the site's front page while it is open. Off: only people "
                                  "with its link (Prolific, e-mail) find it")

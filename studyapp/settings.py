@@ -156,6 +156,8 @@ INSTALLED_APPS = [
 MIDDLEWARE = [
     "django.middleware.security.SecurityMiddleware",
     "studyapp.security.ContentSecurityPolicyMiddleware",
+    # Cache-Control: no-store on the admin and the researcher pages and downloads (studyapp.security)
+    "studyapp.security.NoStoreMiddleware",
     # 400 for a control character (NUL, ...) in the path, a query or form value or a cookie: before any lookup
     "studyapp.inputs.ControlCharacterMiddleware",
     "whitenoise.middleware.WhiteNoiseMiddleware",

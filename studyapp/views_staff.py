@@ -2,7 +2,9 @@
 
 Each page needs a staff account (else the admin login) and one Django permission (else 403): creating a study
 studyapp.add_study, preview and progress studyapp.view_study, CSV exports and the analysis report (participant
-data, Prolific IDs included) studyapp.export_participant_data. A study's pages also need access to that study
+data, external ids pseudonymised unless the study asks) studyapp.export_participant_data, the external ids for
+payment studyapp.download_payment_ids (studyapp.privacy). Every staff page and download is sent with
+``Cache-Control: no-store`` (studyapp.security.NoStoreMiddleware). A study's pages also need access to that study
 (its owner or a collaborator, or a superuser): another lab's study is a 404 (studyapp.permissions.study_of). The
 researcher who creates a study from a preset becomes its owner.
 """
@@ -23,13 +25,14 @@ from protocol.vocabulary import ATTENTION_CHECK
 
 from .assignment import plan_study
 from .catalogue import clip_label
-from .export import EXPORT_KINDS, stream_csv
+from .export import EXPORT_KINDS, csv_lines, stream_csv
 from .forms import ConsentForm, PresetStudyForm
 from .i18n import activate_study_language
 from .media import media_path
 from .models import Assignment, Participant, Response, Study
 from .permissions import EXPORT_PERMISSION, staff_permission_required, study_of
 from .presets import create_study_from_preset
+from .privacy import PAYMENT_COLUMNS, PAYMENT_PERMISSION, payment_rows
 from .questions import AnswerError, clean_answers
 from .reports import report_state, start_build
 from .views import item_context, item_questions
@@ -139,6 +142,17 @@ def export_csv(request, study_id: int, kind: str):
         raise Http404("unknown export")
     response = StreamingHttpResponse(stream_csv(study, kind), content_type="text/csv; charset=utf-8")
     response["Content-Disposition"] = f'attachment; filename="{study.slug}-{kind}.csv"'
+    return response
+
+
+@staff_permission_required(PAYMENT_PERMISSION)
+def payment_ids(request, study_id: int):
+    """The study's external ids (Prolific IDs) with status and completion time, for paying participants: no
+    participant id and no answer, so the file cannot be joined to the data."""
+    study = study_of(request, study_id)
+    response = StreamingHttpResponse(csv_lines(PAYMENT_COLUMNS, payment_rows(study)),
+                                     content_type="text/csv; charset=utf-8")
+    response["Content-Disposition"] = f'attachment; filename="{study.slug}-payment-ids.csv"'
     return response
 
 
