@@ -15,9 +15,10 @@ from pathlib import Path
 
 from django.contrib import messages
 from django.db.models import Count, Q
-from django.http import FileResponse, Http404, StreamingHttpResponse
+from django.http import Http404, StreamingHttpResponse
 from django.shortcuts import redirect, render
 from django.urls import reverse
+from django.utils.http import content_disposition_header
 from django.views.decorators.http import require_http_methods
 
 from generation.render import contact_sheet
@@ -35,6 +36,7 @@ from .presets import create_study_from_preset
 from .privacy import PAYMENT_COLUMNS, PAYMENT_PERMISSION, payment_rows
 from .questions import AnswerError, clean_answers
 from .reports import report_state, start_build
+from .streaming import body, file_body
 from .views import item_context, item_questions
 
 
@@ -140,7 +142,7 @@ def export_csv(request, study_id: int, kind: str):
     study = study_of(request, study_id)
     if kind not in EXPORT_KINDS:
         raise Http404("unknown export")
-    response = StreamingHttpResponse(stream_csv(study, kind), content_type="text/csv; charset=utf-8")
+    response = StreamingHttpResponse(body(request, stream_csv(study, kind)), content_type="text/csv; charset=utf-8")
     response["Content-Disposition"] = f'attachment; filename="{study.slug}-{kind}.csv"'
     return response
 
@@ -150,7 +152,7 @@ def payment_ids(request, study_id: int):
     """The study's external ids (Prolific IDs) with status and completion time, for paying participants: no
     participant id and no answer, so the file cannot be joined to the data."""
     study = study_of(request, study_id)
-    response = StreamingHttpResponse(csv_lines(PAYMENT_COLUMNS, payment_rows(study)),
+    response = StreamingHttpResponse(body(request, csv_lines(PAYMENT_COLUMNS, payment_rows(study))),
                                      content_type="text/csv; charset=utf-8")
     response["Content-Disposition"] = f'attachment; filename="{study.slug}-payment-ids.csv"'
     return response
@@ -176,14 +178,21 @@ def report_zip(request, study_id: int):
         return redirect(reverse("studyapp:progress", args=[study.pk]) + "#report")
     state = report_state(study)
     try:
-        fh = open(state.zip_path, "rb") if state.status == "ready" else None
+        size = state.zip_path.stat().st_size if state.status == "ready" else None
     except FileNotFoundError:        # pruned by a newer build a moment ago
-        fh = None
-    if fh is None:
+        size = None
+    if size is None:
         messages.warning(request, "No report of the current data yet: build it first.")
         return redirect(reverse("studyapp:progress", args=[study.pk]) + "#report")
-    return FileResponse(fh, as_attachment=True, content_type="application/zip",
-                        filename=f"{study.slug}-report-{state.version}.zip")
+    return file_download(request, state.zip_path, size, "application/zip", f"{study.slug}-report-{state.version}.zip")
+
+
+def file_download(request, path: Path, size: int, content_type: str, filename: str) -> StreamingHttpResponse:
+    """An attachment streamed from ``path`` (studyapp.streaming: async under ASGI, never read whole)."""
+    response = StreamingHttpResponse(file_body(request, path, 0, size), content_type=content_type)
+    response["Content-Length"] = str(size)
+    response["Content-Disposition"] = content_disposition_header(True, filename)
+    return response
 
 
 def contact_sheet_response(request, clips):
@@ -206,5 +215,4 @@ def contact_sheet_response(request, clips):
     contact_sheet(posters, [clip_label({"clip_id": c.clip_id, "origin": c.origin, "metadata": c.metadata})
                             for c in clips], out)
     plans = sorted({c.plan for c in clips if c.plan}) or ["clips"]
-    return FileResponse(open(out, "rb"), as_attachment=True, filename=f"{'-'.join(plans)}-contact-sheet.png",
-                        content_type="image/png")
+    return file_download(request, out, out.stat().st_size, "image/png", f"{'-'.join(plans)}-contact-sheet.png")
