@@ -85,3 +85,25 @@ def test_unticked_include_flagged_keeps_each_flag_kind_out(catalogue, flag):
     kept = set(pool_queryset({"plan": "matrix", "keep_advisory": True}).values_list("clip_id", flat=True))
     flagged = [c for c, f in catalogue.items() if f == flag]
     assert (flagged[0] in kept) == (flag == "realism")
+
+
+@pytest.mark.django_db(transaction=True)
+def test_saved_pools_keep_drawing_realism_flagged_clips_after_the_migration():
+    from django.db import connection
+    from django.db.migrations.executor import MigrationExecutor
+
+    before, after = [("studyapp", "0010_assignment_playback")], [("studyapp", "0011_integrity_probe_and_privacy")]
+    executor = MigrationExecutor(connection)
+    executor.migrate(before)
+    apps = executor.loader.project_state(before).apps
+    Study, Section = apps.get_model("studyapp", "Study"), apps.get_model("studyapp", "Section")
+    study = Study.objects.create(slug="old", title="old")
+    kept = Section.objects.create(study=study, order=1, section_type="emotion_choice", pool={"modality": "gait"})
+    flagged = Section.objects.create(study=study, order=2, section_type="emotion_choice",
+                                     pool={"modality": "gait", "include_flagged": True})
+    executor = MigrationExecutor(connection)
+    executor.migrate(after)
+    apps = executor.loader.project_state(after).apps
+    Section = apps.get_model("studyapp", "Section")
+    assert Section.objects.get(pk=kept.pk).pool == {"modality": "gait", "keep_advisory": True}
+    assert Section.objects.get(pk=flagged.pk).pool == {"modality": "gait", "include_flagged": True}
