@@ -6,10 +6,10 @@ participants removed from stored reports, and the separate download of the ids a
   with the site's SECRET_KEY over the study and the id, the same in every export of one study (duplicates stay
   visible) and not reversible without the key.
 - Stored reports: a finished report zip (studyapp.reports) holds the study's exports. When a participant is deleted
-  or withdrawn, :func:`forget_reports` deletes every stored report of their study (the admin says so); a build
-  running at that moment finds the ``purged`` mark in its folder and discards its zip. Exports themselves are
-  never stored; they are made from the database on each download, which has the participant no more (deleted)
-  or leaves them out (withdrawn: studyapp.export).
+  or withdrawn, ``studyapp.reports.forget_reports`` deletes every stored report of their study (the admin says
+  so); a build running at that moment finds the ``purged`` mark in its folder and discards its zip. Exports
+  themselves are never stored; they are made from the database on each download, which has the participant no
+  more (deleted) or leaves them out (withdrawn: studyapp.export).
 - :data:`PAYMENT_PERMISSION`: who may download the external ids for payment (``payment_rows``): no participant
   id, no answer in that file, so it cannot be joined to the data.
 """
@@ -17,8 +17,6 @@ from __future__ import annotations
 
 import hashlib
 import hmac
-import shutil
-from pathlib import Path
 
 from django.conf import settings
 
@@ -36,25 +34,6 @@ def pseudonym(study_id: int, external_id: str) -> str:
     key = str(settings.SECRET_KEY).encode()
     digest = hmac.new(key, f"external-id\0{int(study_id)}\0{external_id}".encode(), hashlib.sha256).hexdigest()
     return "x" + digest[:12]
-
-
-def forget_reports(study_id: int) -> int:
-    """Delete every stored report zip of the study (running builds are marked and discard theirs); returns how many
-    stored zips were deleted."""
-    from .reports import REPORT_NAME, _lock_is_held  # cycle: reports -> export -> models
-
-    root = Path(settings.REPORTS_DIR) / str(int(study_id))
-    removed = 0
-    for folder in root.iterdir() if root.is_dir() else []:
-        if not folder.is_dir():
-            continue
-        removed += (folder / REPORT_NAME).is_file()
-        if _lock_is_held(folder):
-            (folder / PURGED_NAME).write_text("a participant was removed while this report was being built\n")
-            (folder / REPORT_NAME).unlink(missing_ok=True)
-        else:
-            shutil.rmtree(folder, ignore_errors=True)
-    return removed
 
 
 def payment_rows(study) -> list[list]:

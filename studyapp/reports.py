@@ -211,6 +211,24 @@ def prune_old_versions(study_id: int, keep: str) -> list[Path]:
     return removed
 
 
+def forget_reports(study_id: int) -> int:
+    """Delete every stored report zip of the study, because a participant of it was deleted or withdrew
+    (studyapp.privacy): idle version folders go whole; a running build's folder gets the PURGED_NAME mark, so the
+    build discards its zip. Returns how many stored zips were deleted."""
+    root = Path(settings.REPORTS_DIR) / str(int(study_id))
+    removed = 0
+    for folder in root.iterdir() if root.is_dir() else []:
+        if not folder.is_dir():
+            continue
+        removed += (folder / REPORT_NAME).is_file()
+        if _lock_is_held(folder):
+            (folder / PURGED_NAME).write_text("a participant was removed while this report was being built\n")
+            (folder / REPORT_NAME).unlink(missing_ok=True)
+        else:
+            shutil.rmtree(folder, ignore_errors=True)
+    return removed
+
+
 def build_report(study: Study, version: str, lock_fd: int) -> Path:
     """Write version's report.zip (the caller holds the lock through lock_fd). On failure error.txt says why and
     the exception propagates."""

@@ -21,7 +21,8 @@ from studyapp.export import stream_csv
 from studyapp.models import Participant, Response, Study
 from studyapp.permissions import RESEARCHER_GROUP
 from studyapp.presets import create_study_from_preset
-from studyapp.privacy import PURGED_NAME, forget_reports, pseudonym
+from studyapp.privacy import PURGED_NAME, pseudonym
+from studyapp.reports import forget_reports
 from studyapp.testing import make_catalogue
 
 pytestmark = pytest.mark.django_db
