@@ -194,3 +194,17 @@ def test_a_killed_jobs_upload_is_removed_when_its_status_is_read(media, lab):
     assert (clip_import.job_dir(job) / clip_import.FILES_DIR).is_dir()
     assert clip_import.import_state(job).status == "failed"
     assert not (clip_import.job_dir(job) / clip_import.FILES_DIR).exists()
+
+
+@pytest.mark.django_db
+def test_a_manifest_over_its_limit_is_refused_before_it_is_read(media, tmp_path, monkeypatch):
+    from django.core.management import CommandError
+
+    from generation.imports import manifest as manifest_module
+
+    folder = tmp_path / "lab"
+    folder.mkdir()
+    path = write_manifest(folder, [{"path": f"walk{i}.mp4", "modality": "gait"} for i in range(50)])
+    monkeypatch.setattr(manifest_module, "MAX_MANIFEST_BYTES", 100)
+    with pytest.raises(CommandError, match="larger than the manifest limit"):
+        run(path)
