@@ -23,7 +23,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from protocol.pools import DEFAULT_GESTURE_OPTIONS, FLAGS, INCLUDE_FLAGGED, NORMS_RULE, SUB_POOLS, pool_errors
+from protocol.pools import DEFAULT_GESTURE_OPTIONS, FLAGS, NORMS_RULE, SUB_POOLS, SWITCHES, pool_errors
 from protocol.presets import PRESET_PLANS, PRESETS
 from protocol.section_types import get_section_type
 from protocol.vocabulary import CLIP_COLUMNS, FINAL_EMOTION_COLUMNS, SECTION_QUESTIONS, answer_values
@@ -181,7 +181,7 @@ def pool_mask(clips: pd.DataFrame, pool: dict | None) -> np.ndarray:
         raise DesignError("; ".join(errors))
     mask = np.ones(len(clips), bool)
     for key, value in (pool or {}).items():
-        if key in SUB_POOLS or key == INCLUDE_FLAGGED or key == NORMS_RULE:
+        if key in SUB_POOLS or key in SWITCHES or key == NORMS_RULE:
             continue     # simulated clips have no quality flags and no norms
         if key not in FLAGS and key.partition("__")[0] not in clips.columns:
             raise DesignError(f"pool filter {key!r}: the simulated catalogue has no such column")

@@ -875,7 +875,10 @@ def main(argv=None) -> dict:
         study = setup_django(db_url, out / "media")
         env = dict(os.environ, MEDIA_ROOT=str(out / "media"), DATA_DIR=str(out),
                    DJANGO_SETTINGS_MODULE="studyapp.settings", OMP_NUM_THREADS="1", MKL_NUM_THREADS="1",
-                   DB_CONNECTIONS=str(args.db_connections), WEB_CONCURRENCY=str(args.workers))
+                   DB_CONNECTIONS=str(args.db_connections), WEB_CONCURRENCY=str(args.workers),
+                   # every simulated participant comes from 127.0.0.1: the start rate limit (measured by
+                   # bench_start_rate.py) would admit only its burst
+                   START_RATE_BURST="0")
         if postgres:
             env["DATABASE_URL"] = db_url
         else:

@@ -7,8 +7,8 @@ app's ``generate_clips`` command and ``python -m analysis.coverage`` call it.
 
 A study made from a preset (``protocol.presets.PRESETS``) draws each section's clips from its pool (catalogue filters,
 ``protocol.pools``; the study app adds the preset's plan, ``protocol.presets.PRESET_PLANS``) and leaves out clips
-that failed a non-advisory quality check (``qa_flag`` other than ``protocol.vocabulary.QA_ADVISORY_CHECKS``) unless
-the pool says ``include_flagged`` (or failed only the observer's check in a pool that says ``observer_advisory``).
+that failed a quality check (``qa_flag``) unless the pool keeps those checks (``protocol.pools.kept_checks``:
+``include_flagged`` all, ``keep_advisory`` the advisory ones, ``observer_advisory`` the observer's).
 :func:`section_coverage` applies the same filters to the plan's planned clip rows with each entry's quality flag from
 the gate (``generation.pipeline.plan_qa``), and compares what is left with the section's ``clips_per_participant``
 (0: every clip of the pool; naturalness sections also their ``n_generated`` / ``n_source`` halves; a norming
@@ -18,9 +18,8 @@ Python: the pool filters are evaluated on dict rows, no Django.
 from __future__ import annotations
 
 from .norming import ratings_per_clip
-from .pools import INCLUDE_FLAGGED, OBSERVER_ADVISORY, SUB_POOLS, pool_lookups
+from .pools import SUB_POOLS, blocking_checks, pool_lookups
 from .presets import PRESET_PLANS, PRESETS
-from .vocabulary import QA_ADVISORY_CHECKS
 
 
 def _value(row: dict, field: str):
@@ -56,13 +55,6 @@ def matches(row: dict, pool: dict | None) -> bool:
     return True
 
 
-def blocking(flag: str | None, observer_advisory: bool = False) -> list[str]:
-    """The failed checks of a ``qa_flag`` that keep a clip out of pools (all but the advisory ones, and but the
-    observer's in a pool that says ``observer_advisory``)."""
-    advisory = (*QA_ADVISORY_CHECKS, "observer") if observer_advisory else QA_ADVISORY_CHECKS
-    return [c for c in (flag or "").split(";") if c and c not in advisory]
-
-
 def section_coverage(preset: str, rows: list[dict], flags: dict[str, str], plan_name: str | None = None
                      ) -> list[dict]:
     """Per section of ``preset``: ``index``, ``title``, ``section_type``, ``asks`` (clips per participant; None for a
@@ -86,11 +78,9 @@ def section_coverage(preset: str, rows: list[dict], flags: dict[str, str], plan_
                         "why": f"shows the clips of section {sec['reuse'] + 1} again"})
             continue
         pool = {**(sec.get("pool") or {}), "plan": plan_name}
-        keep_flagged = bool(pool.get(INCLUDE_FLAGGED, False))
         in_pool = [r for r in rows if matches(r, pool)]
-        left = [(r["entry_id"], blocking(flags.get(r["entry_id"]), bool(pool.get(OBSERVER_ADVISORY))))
-                for r in in_pool]
-        left = [(e, b) for e, b in left if b and not keep_flagged]
+        left = [(r["entry_id"], blocking_checks(flags.get(r["entry_id"]), pool)) for r in in_pool]
+        left = [(e, b) for e, b in left if b]
         gone = {e for e, _ in left}
         usable = [r for r in in_pool if r["entry_id"] not in gone]
         options = sec.get("options") or {}

@@ -5,8 +5,9 @@ whether a pool or an option is well formed.
 A pool is a JSON object of catalogue filters: ``field`` or ``field__lookup`` -> value (a list without a lookup
 means ``in``), plus two boolean shorthands, ``transition`` (the clip has a final emotion) and ``rbf`` (the clip
 has a theme), and the switches ``include_flagged`` (true: clips whose quality record failed a check, ``qa_flag``, are
-in the pool too; they are left out otherwise) and ``observer_advisory`` (true: only the automatic observer's flag is
-disregarded). A naturalness section may add ``generated`` and ``source``
+in the pool too; every flagged clip is left out otherwise), ``keep_advisory`` (true: a clip that failed only advisory
+checks, ``protocol.vocabulary.QA_ADVISORY_CHECKS``, stays in) and ``observer_advisory`` (true: the automatic
+observer's flag is disregarded too). A naturalness section may add ``generated`` and ``source``
 sub-pools (filters of the same kind) for its two halves. Options are type-specific (``SECTION_OPTIONS``).
 """
 from __future__ import annotations
@@ -28,6 +29,8 @@ from .vocabulary import (
     GAIT_EMOTIONS,
     GESTURE_EMOTIONS,
     ORIGINS,
+    QA_ADVISORY_CHECKS,
+    QA_CHECKS,
     SECTION_MODALITY,
     SECTION_TYPES,
     VAD_DIMENSIONS,
@@ -46,17 +49,44 @@ TEXT_LOOKUPS = ("", "in", "startswith", "contains")
 NUMBER_LOOKUPS = ("", "in", "lt", "lte", "gt", "gte", "isnull")
 FLAGS = ("transition", "rbf")
 INCLUDE_FLAGGED = "include_flagged"
-"""Pool switch: also draw clips that failed a quality check (``Clip.qa_flag`` not empty)."""
+"""Pool switch: also draw clips that failed any quality check (``Clip.qa_flag`` not empty); off, every flagged clip is
+left out unless one of the two switches below names its checks."""
+KEEP_ADVISORY = "keep_advisory"
+"""Pool switch: a clip that failed only advisory checks (``protocol.vocabulary.QA_ADVISORY_CHECKS``: realism, which
+also flags about 10 % of real takes) stays in; any other failed check still keeps it out."""
 OBSERVER_ADVISORY = "observer_advisory"
 """Pool switch: the automatic observer's flag does not keep a clip out (people judge the clip: a norming section's
 candidates are rated precisely because an observer's reading is a weak judge); other failed checks still do."""
-SWITCHES = (INCLUDE_FLAGGED, OBSERVER_ADVISORY)
+SWITCHES = (INCLUDE_FLAGGED, KEEP_ADVISORY, OBSERVER_ADVISORY)
 NORMS_RULE = "norms"
 """Pool rule admitting only clips whose per-clip norms pass: ``{"from": <study slug or clip_norms.csv path>,
 "min_ratings": 10, "min_intended_share": 0.5, "max_entropy_bits": 1.5}`` (studyapp.norms_rule applies it)."""
 NORMS_FIELDS = {"from": None, "min_ratings": (int, 1, 1_000_000), "min_intended_share": (float, 0.0, 1.0),
                 "max_entropy_bits": (float, 0.0, 64.0)}
 """Fields of the norms rule -> (type, lowest, highest); ``from`` is text."""
+OBSERVER_CHECK = "observer"
+
+
+def kept_checks(pool: dict | None, normed: bool = False) -> tuple[str, ...]:
+    """The quality checks (``QA_CHECKS`` order) whose failure does not keep a clip out of ``pool``: all of them with
+    ``include_flagged``; else the advisory ones with ``keep_advisory`` and the observer's with ``observer_advisory``
+    or, ``normed``, for a clip with norms under the pool's norms rule (people's ratings outrank the observer's
+    reading); none otherwise, so an unticked "include flagged" keeps every flagged clip out."""
+    pool = pool if isinstance(pool, dict) else {}
+    if pool.get(INCLUDE_FLAGGED) is True:
+        return QA_CHECKS
+    kept = set(QA_ADVISORY_CHECKS) if pool.get(KEEP_ADVISORY) is True else set()
+    if pool.get(OBSERVER_ADVISORY) is True or normed:
+        kept.add(OBSERVER_CHECK)
+    return tuple(c for c in QA_CHECKS if c in kept)
+
+
+def blocking_checks(flag: str | None, pool: dict | None, normed: bool = False) -> list[str]:
+    """The failed checks of a clip's ``qa_flag`` (names joined by ';') that keep it out of ``pool`` ([] = in)."""
+    kept = kept_checks(pool, normed)
+    return [c for c in (flag or "").split(";") if c and c not in kept]
+
+
 SUB_POOLS = HALVES
 """Sub-pools a section type may declare (``SectionType.sub_pools``, naturalness): extra filters for its generated
 and its source clips."""

@@ -190,5 +190,15 @@ def preset_plan_names() -> list[str]:
     return sorted(set(PRESET_PLANS.values()))
 
 
+#: The quality switch every preset pool carries: a clip flagged only by the advisory realism check stays in (it also
+#: flags about 10 % of real captured takes, so it informs rather than excludes); every other failed check keeps a clip
+#: out. A researcher may untick it in the admin's pool editor to leave realism-flagged clips out too.
+PRESET_POOL_SWITCHES = {"keep_advisory": True}
+for _preset in PRESETS.values():
+    for _sec in _preset["sections"]:
+        if "reuse" not in _sec:
+            _sec["pool"] = {**(_sec.get("pool") or {}), **PRESET_POOL_SWITCHES}
+
+
 if __name__ == "__main__":  # python -m protocol.presets: the presets' plans, for generation.plans.planned
     print(" ".join(preset_plan_names()))

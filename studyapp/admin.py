@@ -44,7 +44,7 @@ def section_fieldsets() -> list:
             ("randomize_order", "require_full_play", "loop", "counterbalance")]
     pool = ["matching_clips", ("pool_modality", "pool_origin"), "pool_plan", "pool_emotion_label", "pool_theme",
             ("pool_weight_sign", "pool_weight_min", "pool_weight_max"), ("pool_n_features_min", "pool_n_features_max"),
-            ("pool_transition", "pool_rbf"), ("pool_include_flagged", "pool_observer_advisory")]
+            ("pool_transition", "pool_rbf"), ("pool_include_flagged", "pool_keep_advisory", "pool_observer_advisory")]
     halves = [tuple(name for name in pool_editor.SUB_POOL_FIELDS if name.startswith(f"pool_{sub}_"))
               for sub in SUB_POOLS]
     option_sets = [(f"{section_type_label(stype)}: options", {
@@ -155,7 +155,10 @@ class StudyAdmin(StudyScopedAdmin):
     readonly_fields = ["links", "preset", "created_at", "norming_design"]
     form = StudyAdminForm
     fieldsets = [
-        (None, {"fields": ["title", "slug", "status", "preset", "links"]}),
+        (None, {"fields": ["title", "slug", "status", "listed_publicly", "preset", "links"]}),
+        ("Participant data", {"fields": ["export_external_ids"],
+                              "description": "Exports and reports pseudonymise external ids unless this is ticked; "
+                                             "withdrawn participants are left out of them."}),
         ("Participant pages", {"fields": ["language", "introduction", "consent_text", "ask_demographics",
                                           "feedback_questions", "counterbalance_sections"]}),
         ("Recruitment", {"fields": ["max_participants", "norming_design", "abandon_after_minutes", "completion_code",
@@ -352,8 +355,41 @@ class ParticipantAdmin(StudyScopedAdmin):
     list_filter = [("study", admin.RelatedOnlyFieldListFilter), "status"]
     search_fields = ["public_id", "external_id"]
     readonly_fields = ["token", "public_id", "seed", "consented_at", "started_at", "completed_at", "user_agent",
-                       "external_id", "external_study_id", "external_session_id", "feedback"]
+                       "external_id", "external_study_id", "external_session_id", "feedback", "gender", "age_group",
+                       "demographics_done", "feedback_done", "last_active_at", "section_order"]
     inlines = [AssignmentInline]
+
+    def has_add_permission(self, request):
+        return False              # participants come from the consent page only
+
+    def _say_reports_forgotten(self, request, participants) -> None:
+        n = sum(getattr(p, "_reports_forgotten", 0) for p in participants)
+        studies = sorted({p.study.title for p in participants})
+        if n:
+            messages.warning(request, f"Deleted {n} stored analysis report(s) of {', '.join(studies)} that held "
+                                      "this participant's data; build the report again on the study's progress page.")
+        else:
+            messages.info(request, "No stored analysis report held this participant's data; exports are made from "
+                                   "the database on each download and no longer include them.")
+
+    def save_model(self, request, obj, form, change):
+        super().save_model(request, obj, form, change)
+        if "status" in form.changed_data and obj.status == Participant.Status.WITHDRAWN:
+            self._say_reports_forgotten(request, [obj])
+
+    def delete_model(self, request, obj):
+        super().delete_model(request, obj)
+        self._say_reports_forgotten(request, [obj])
+
+    def delete_queryset(self, request, queryset):
+        gone = list(queryset.select_related("study"))
+        for participant in gone:               # one by one: each deletion forgets its study's reports
+            participant.delete()
+        self._say_reports_forgotten(request, gone)
+
+
+PARTICIPANT_DELETE_VIEWS = ("studyapp_participant_delete", "studyapp_participant_changelist")
+"""Admin views that delete participants (one, or the list's delete action) and with them their answers."""
 
 
 @admin.register(Response)
@@ -363,8 +399,18 @@ class ResponseAdmin(StudyScopedAdmin):
     list_filter = [("section__study", admin.RelatedOnlyFieldListFilter), "section__section_type", "question"]
     search_fields = ["participant__public_id", "clip__clip_id"]
 
+    def has_add_permission(self, request):
+        return False              # answers come from participants only
+
     def has_change_permission(self, request, obj=None):
         return False
+
+    def has_delete_permission(self, request, obj=None):
+        """Only as part of deleting their participant (the participant pages' delete views ask about the answers
+        that go with them); never one answer on its own."""
+        match = getattr(request, "resolver_match", None)
+        whole = match is not None and match.url_name in PARTICIPANT_DELETE_VIEWS
+        return whole and super().has_delete_permission(request, obj)
 
     def formfield_for_foreignkey(self, db_field, request, **kwargs):
         if db_field.name == "participant":

@@ -6,8 +6,7 @@ from __future__ import annotations
 from django.utils.html import format_html, format_html_join
 from django.utils.safestring import SafeString
 
-from protocol.pools import INCLUDE_FLAGGED, NORMS_RULE, OBSERVER_ADVISORY
-from protocol.vocabulary import QA_ADVISORY_CHECKS
+from protocol.pools import NORMS_RULE, OBSERVER_ADVISORY, OBSERVER_CHECK, blocking_checks
 
 from .catalogue import CatalogueError, pool_queryset
 from .norms_rule import NormsSourceError, verdicts
@@ -39,14 +38,15 @@ def _norm_text(norm: dict | None) -> str:
 
 def _flag_reason(clip, has_norm: bool, pool: dict) -> tuple[str, str]:
     """(reason the quality gate keeps the clip out or '', note on an observer flag made advisory or '')."""
-    failed = [c for c in (clip.qa_flag or "").split(";") if c and c not in QA_ADVISORY_CHECKS]
-    if pool.get(INCLUDE_FLAGGED) or not failed:
+    left = blocking_checks(clip.qa_flag, pool, normed=has_norm)
+    if left:
+        return f"failed quality check(s): {', '.join(left)}", ""
+    plain = blocking_checks(clip.qa_flag, {k: v for k, v in pool.items() if k != OBSERVER_ADVISORY})
+    if OBSERVER_CHECK not in plain:
         return "", ""
-    if failed == ["observer"] and pool.get(OBSERVER_ADVISORY):
+    if pool.get(OBSERVER_ADVISORY) is True:
         return "", "observer flag advisory in this pool"
-    if has_norm and failed == ["observer"]:
-        return "", "observer flag advisory: people rated this clip"
-    return f"failed quality check(s): {', '.join(failed)}", ""
+    return "", "observer flag advisory: people rated this clip"
 
 
 def norms_table(pool: dict | None) -> SafeString:

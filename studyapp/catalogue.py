@@ -176,9 +176,10 @@ def pool_queryset(pool: dict | None, include_flagged: bool | None = None) -> Que
 
     Clips that failed a quality check (``qa_flag`` not empty) are left out unless the pool says
     ``"include_flagged": true`` or ``include_flagged`` is given (True for a sub-pool, which only narrows its
-    section's pool); failing only advisory checks (``protocol.vocabulary.QA_ADVISORY_CHECKS``) does not count.
-    A ``norms`` rule (studyapp.norms_rule) keeps only clips whose norms pass, and makes the ``observer`` check
-    advisory for clips that have norms; ``"observer_advisory": true`` makes it advisory for every clip. Raises
+    section's pool), or the pool's switches keep the checks they failed (``protocol.pools.kept_checks``:
+    ``keep_advisory`` the advisory ones, ``observer_advisory`` the observer's). A ``norms`` rule
+    (studyapp.norms_rule) keeps only clips whose norms pass, and keeps the ``observer`` check's flag of clips that
+    have norms. Raises
     CatalogueError naming the filter (or the norms source's file, line and column) when the pool is not valid;
     sub-pools are left to the assignment.
     """

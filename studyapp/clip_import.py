@@ -11,11 +11,20 @@ request), and the job's state read back for the status page.
 ``IMPORTS_DIR`` is ``DATA_DIR/imports`` (never served). Zip members and file names that could leave the job
 folder (absolute, ``..``, links) are refused before anything is written; the manifest's own paths are checked
 again by the import (generation.imports.manifest).
+
+Bounds, each checked before the bytes are written: every uploaded file at most MAX_UPLOAD_BYTES (the archive too,
+and all files of one upload together), a zip of at most MAX_ZIP_MEMBERS members unpacking to at most MAX_ZIP_BYTES,
+no member more than MAX_ZIP_RATIO times its compressed size, and the bytes actually unpacked counted against the
+declared sizes. A zip that cannot be unpacked (a file and a folder of one name, an over-long name, an unsupported
+compression method, a false size or checksum) is an UploadError saying so, never a server error. The ``files``
+folder is removed when the job ends, whether it imported, failed or was a dry run (``import_clips --remove-after``;
+:func:`import_state` removes one a killed job left); the report, log and job.json stay for the status page.
 """
 from __future__ import annotations
 
 import csv
 import json
+import lzma
 import os
 import secrets
 import shutil
@@ -24,6 +33,7 @@ import subprocess
 import sys
 import threading
 import zipfile
+import zlib
 from dataclasses import dataclass
 from datetime import UTC, datetime
 from pathlib import Path, PurePosixPath
@@ -38,8 +48,16 @@ from .models import Clip
 LOG_NAME = "import.log"
 JOB_NAME = "job.json"
 PID_NAME = "import.pid"
-MAX_ZIP_BYTES = 4 * 1024**3
-"""Largest total unpacked size of an uploaded zip."""
+MAX_UPLOAD_BYTES = 1024**3
+"""Largest uploaded file (the zip, the manifest or one file), and largest upload in all (bytes): the import's own
+video limit (generation.imports.video.VideoLimits.max_bytes)."""
+MAX_ZIP_BYTES = 2 * 1024**3
+"""Largest total unpacked size of an uploaded zip (bytes)."""
+MAX_ZIP_MEMBERS = 2000
+"""Most members (files and folders) in an uploaded zip."""
+MAX_ZIP_RATIO = 200
+"""Largest unpacked / compressed size of one zip member above 1 MiB (videos barely compress; text ~10x)."""
+FILES_DIR = "files"
 COLLECTION_MAX_LENGTH = 40
 
 
@@ -67,30 +85,77 @@ def _safe_name(name: str) -> PurePosixPath:
     return pure
 
 
+def _zip_members(zf: zipfile.ZipFile) -> list[zipfile.ZipInfo]:
+    """The file members of an open zip, every one checked (names, links, count, sizes) before any is written."""
+    infos = zf.infolist()
+    if len(infos) > MAX_ZIP_MEMBERS:
+        raise UploadError(f"the archive holds {len(infos)} members, more than {MAX_ZIP_MEMBERS}")
+    members = [m for m in infos if not m.is_dir()]
+    total = 0
+    files: set[PurePosixPath] = set()
+    for m in members:
+        name = _safe_name(m.filename)
+        if stat.S_ISLNK(m.external_attr >> 16):
+            raise UploadError(f"{m.filename!r}: links are not imported")
+        if any(len(part.encode()) > 255 for part in name.parts):
+            raise UploadError(f"{m.filename[:80]!r}...: a name in the archive is longer than 255 bytes")
+        if m.compress_type not in (zipfile.ZIP_STORED, zipfile.ZIP_DEFLATED, zipfile.ZIP_BZIP2, zipfile.ZIP_LZMA):
+            raise UploadError(f"{m.filename!r}: compression method {m.compress_type} is not supported (store or "
+                              "deflate it; encrypted archives are not read)")
+        if m.flag_bits & 0x1:
+            raise UploadError(f"{m.filename!r}: encrypted members are not read")
+        if m.file_size > 2**20 and m.file_size > MAX_ZIP_RATIO * max(m.compress_size, 1):
+            raise UploadError(f"{m.filename!r}: unpacks to {m.file_size / 2**20:.0f} MiB from "
+                              f"{m.compress_size / 2**10:.0f} KiB: not an archive of stimuli")
+        total += m.file_size
+        files.add(name)
+    if total > MAX_ZIP_BYTES:
+        raise UploadError(f"the archive unpacks to {total / 2**30:.1f} GiB, more than "
+                          f"{MAX_ZIP_BYTES / 2**30:.0f} GiB")
+    clash = next((f for f in files if any(parent in files for parent in f.parents)), None)
+    if clash is not None:
+        raise UploadError(f"{str(clash)!r}: the archive holds a file and a folder of the same name "
+                          f"({str(next(p for p in clash.parents if p in files))!r})")
+    return members
+
+
+def _copy_member(zf: zipfile.ZipFile, m: zipfile.ZipInfo, target: Path, budget: int) -> int:
+    """Write one member to ``target``, counting the bytes: never more than its declared size or ``budget``."""
+    written = 0
+    with zf.open(m) as src, target.open("wb") as dst:
+        while chunk := src.read(1 << 20):
+            written += len(chunk)
+            if written > m.file_size or written > budget:
+                raise UploadError(f"{m.filename!r}: unpacks to more than its declared size")
+            dst.write(chunk)
+    return written
+
+
 def unpack_zip(archive, dest: Path) -> list[Path]:
-    """Unpack an uploaded zip into ``dest``: every member checked first (relative names, no links, the total size
-    at most MAX_ZIP_BYTES), then written. Returns the files written."""
+    """Unpack an uploaded zip into ``dest``: every member checked first (relative names of at most 255 bytes, no
+    links, no file and folder of one name, at most MAX_ZIP_MEMBERS, total at most MAX_ZIP_BYTES, a supported
+    compression method), then written, counting the bytes. Returns the files written; UploadError (never another
+    exception) for an archive that cannot be unpacked."""
     try:
         zf = zipfile.ZipFile(archive)
-    except zipfile.BadZipFile as exc:
+    except (zipfile.BadZipFile, zipfile.LargeZipFile, OSError, ValueError, EOFError) as exc:
         raise UploadError(f"the archive is not a zip file ({exc})") from None
     with zf:
-        members = [m for m in zf.infolist() if not m.is_dir()]
-        total = 0
-        for m in members:
-            _safe_name(m.filename)
-            if stat.S_ISLNK(m.external_attr >> 16):
-                raise UploadError(f"{m.filename!r}: links are not imported")
-            total += m.file_size
-        if total > MAX_ZIP_BYTES:
-            raise UploadError(f"the archive unpacks to {total / 2**30:.1f} GiB, more than "
-                              f"{MAX_ZIP_BYTES / 2**30:.0f} GiB")
+        members = _zip_members(zf)
         out = []
+        budget = MAX_ZIP_BYTES
         for m in members:
             target = dest / Path(*_safe_name(m.filename).parts)
-            target.parent.mkdir(parents=True, exist_ok=True)
-            with zf.open(m) as src, target.open("wb") as dst:
-                shutil.copyfileobj(src, dst, 1 << 20)
+            try:
+                target.parent.mkdir(parents=True, exist_ok=True)
+                budget -= _copy_member(zf, m, target, budget)
+            except UploadError:
+                raise
+            except (zipfile.BadZipFile, EOFError, zlib.error, lzma.LZMAError, ValueError, NotImplementedError,
+                    RuntimeError) as exc:
+                raise UploadError(f"{m.filename!r}: cannot be unpacked ({exc})") from None
+            except OSError as exc:
+                raise UploadError(f"{m.filename!r}: cannot be written ({exc.strerror or exc})") from None
             out.append(target)
     return out
 
@@ -113,8 +178,16 @@ def save_upload(manifest=None, files=(), archive=None) -> tuple[str, Path]:
     The job folder is removed again when the upload is refused."""
     if archive is None and manifest is None:
         raise UploadError("upload a manifest (with its files) or a zip of them")
+    uploads = [u for u in (archive, manifest, *files) if u is not None]
+    for upload in uploads:
+        if upload.size > MAX_UPLOAD_BYTES:
+            raise UploadError(f"{Path(upload.name).name!r}: {upload.size / 2**20:.0f} MiB, larger than the upload "
+                              f"limit of {MAX_UPLOAD_BYTES / 2**20:.0f} MiB per file")
+    if sum(u.size for u in uploads) > MAX_UPLOAD_BYTES:
+        raise UploadError(f"the upload is {sum(u.size for u in uploads) / 2**20:.0f} MiB, more than "
+                          f"{MAX_UPLOAD_BYTES / 2**20:.0f} MiB in all: import it in parts")
     job = f"{datetime.now(UTC):%Y%m%d-%H%M%S}-{secrets.token_hex(4)}"
-    root = job_dir(job) / "files"
+    root = job_dir(job) / FILES_DIR
     root.mkdir(parents=True)
     try:
         written: list[Path] = []
@@ -123,9 +196,12 @@ def save_upload(manifest=None, files=(), archive=None) -> tuple[str, Path]:
         for upload in ([manifest] if manifest is not None else []) + list(files):
             name = _safe_name(Path(upload.name).name)
             target = root / name.name
-            with target.open("wb") as dst:
-                for chunk in upload.chunks():
-                    dst.write(chunk)
+            try:
+                with target.open("wb") as dst:
+                    for chunk in upload.chunks():
+                        dst.write(chunk)
+            except OSError as exc:
+                raise UploadError(f"{upload.name[:80]!r}: cannot be saved ({exc.strerror or exc})") from None
             written.append(target)
         found = (root / _safe_name(Path(manifest.name).name).name) if manifest is not None else find_manifest(
             written, root)
@@ -166,7 +242,8 @@ def default_collection(upload_name: str) -> str:
 def import_command(manifest: Path, job: str, name: str, keep_audio: bool, dry_run: bool) -> list[str]:
     """The ``manage.py import_clips`` command line of a job."""
     cmd = [sys.executable, str(Path(settings.BASE_DIR) / "manage.py"), "import_clips", str(manifest),
-           "--report", str(job_dir(job) / REPORT_NAME), "--name", name]
+           "--report", str(job_dir(job) / REPORT_NAME), "--name", name,
+           "--remove-after", str(job_dir(job) / FILES_DIR)]
     return cmd + (["--keep-audio"] if keep_audio else []) + (["--dry-run"] if dry_run else [])
 
 
@@ -245,5 +322,8 @@ def import_state(job: str) -> ImportState:
         with report.open(newline="", encoding="utf-8") as f:
             rows = [{k: without_server_paths(v or "", folder) for k, v in row.items()} for row in csv.DictReader(f)]
     info = _job_info(folder)
-    status = "running" if _running(folder) else "done" if report.is_file() else "failed"
+    running = _running(folder)
+    if not running and (folder / PID_NAME).is_file():
+        shutil.rmtree(folder / FILES_DIR, ignore_errors=True)      # a job killed before it could remove them
+    status = "running" if running else "done" if report.is_file() else "failed"
     return ImportState(job, status, rows, log, str(info.get("collection", "")), bool(info.get("dry_run")))

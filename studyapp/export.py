@@ -12,6 +12,11 @@ that starts with =, +, -, @, a tab or a carriage return is written with a leadin
 LibreOffice and Google Sheets show it as text instead of running it; plain numbers (e.g. an inversion rating of
 -7 or a response time) are written unchanged. docs/study.md tells researchers.
 
+Privacy (studyapp.privacy): participants.csv's ``external_id`` is a pseudonym (the same for one participant in
+every export of the study) unless the study asks for the ids themselves (``Study.export_external_ids``); the ids
+for payment are a separate download. Withdrawn participants are left out of every file (their rows, answers,
+assignments and viewing records); deleted ones are gone from the database.
+
 Practice items and attention checks (studyapp.trial_extras): practice answers are never stored, and practice
 items are left out of assignments.csv. Attention checks are rows of responses.csv and assignments.csv with
 section_type ``attention_check`` (protocol.vocabulary.ATTENTION_CHECK) and question ``<key>=<instructed answer>``;
@@ -42,8 +47,11 @@ from protocol.vocabulary import (
     attention_passed,
 )
 
-from .models import Assignment, Clip, Response, Study
+from .models import Assignment, Clip, Participant, Response, Study
 from .pool_filters import filtered_clips
+from .privacy import pseudonym
+
+WITHDRAWN = Participant.Status.WITHDRAWN
 
 __all__ = ["ASSIGNMENT_COLUMNS", "CLIP_COLUMNS", "EXPORT_CLIP_COLUMNS", "EXPORT_KINDS", "PARTICIPANT_COLUMNS",
            "RESPONSE_COLUMNS", "VIEWING_COLUMNS", "run_report", "stream_csv", "write_study_csvs"]
@@ -77,7 +85,7 @@ def safe_cell(value):
     return value
 
 
-def _csv_lines(header: Iterable[str], rows: Iterable[list]) -> Iterator[str]:
+def csv_lines(header: Iterable[str], rows: Iterable[list]) -> Iterator[str]:
     writer = csv.writer(_Echo(), lineterminator="\n")
     yield writer.writerow([safe_cell(h) for h in header])
     for row in rows:
@@ -94,7 +102,7 @@ def _exported_type():
 
 
 def response_rows(study: Study) -> Iterator[list]:
-    qs = (Response.objects.filter(section__study=study)
+    qs = (Response.objects.filter(section__study=study).exclude(participant__status=WITHDRAWN)
           .annotate(exported_type=_exported_type())
           .order_by("participant_id", "section__order", "id")
           .values_list("participant__public_id", "exported_type", "clip__clip_id", "question", "answer",
@@ -133,7 +141,7 @@ def attention_counts(study: Study) -> dict[int, tuple[int, int]]:
     """Participant pk -> (attention checks passed, answered), from the study's attention-check responses."""
     counts: dict[int, tuple[int, int]] = {}
     rows = (Response.objects.filter(section__study=study, kind=ATTENTION_CHECK)
-            .values_list("participant_id", "question", "answer"))
+            .exclude(participant__status=WITHDRAWN).values_list("participant_id", "question", "answer"))
     for pk, question, answer in rows.iterator(chunk_size=CHUNK):
         passed, total = counts.get(pk, (0, 0))
         counts[pk] = (passed + attention_passed(question, answer), total + 1)
@@ -144,16 +152,17 @@ def participant_rows(study: Study) -> Iterator[list]:
     keys = feedback_keys(study)
     attention = attention_counts(study)
     orders = dict(study.sections.values_list("pk", "order"))
-    for p in study.participants.order_by("id").iterator(chunk_size=CHUNK):
+    for p in study.participants.exclude(status=WITHDRAWN).order_by("id").iterator(chunk_size=CHUNK):
         passed, total = attention.get(p.pk, (0, 0))
         order = ";".join(str(orders[pk]) for pk in p.section_order or [] if pk in orders)
+        external = p.external_id if study.export_external_ids else pseudonym(study.pk, p.external_id)
         yield [p.public_id, p.gender, p.age_group, _iso(p.started_at), _iso(p.completed_at), p.status,
-               p.external_id, passed, total, order] + [p.feedback.get(k, "") for k in keys]
+               external, passed, total, order] + [p.feedback.get(k, "") for k in keys]
 
 
 def assignment_rows(study: Study) -> Iterator[list]:
     qs = (Assignment.objects.filter(section__study=study).exclude(kind=Assignment.Kind.PRACTICE)
-          .annotate(exported_type=_exported_type())
+          .exclude(participant__status=WITHDRAWN).annotate(exported_type=_exported_type())
           .order_by("participant_id", "seq")
           .values_list("participant__public_id", "exported_type", "section__order", "position",
                        "clip__clip_id", "options", "shown_at", "answered_at"))
@@ -166,7 +175,7 @@ def viewing_rows(study: Study) -> Iterator[list]:
     VIEWING_FIELDS (blank where unknown or when the browser sent none) and VIEWING_SERVER_FIELDS (blank for an
     answer stored before the server kept them)."""
     qs = (Assignment.objects.filter(section__study=study, answered_at__isnull=False)
-          .exclude(kind=Assignment.Kind.PRACTICE)
+          .exclude(kind=Assignment.Kind.PRACTICE).exclude(participant__status=WITHDRAWN)
           .annotate(exported_type=_exported_type())
           .order_by("participant_id", "seq")
           .values_list("participant__public_id", "clip__clip_id", "exported_type", "viewing"))
@@ -179,15 +188,15 @@ def viewing_rows(study: Study) -> Iterator[list]:
 def stream_csv(study: Study, kind: str) -> Iterator[str]:
     """Lines of `kind` in EXPORT_KINDS."""
     if kind == "responses":
-        return _csv_lines(RESPONSE_COLUMNS, response_rows(study))
+        return csv_lines(RESPONSE_COLUMNS, response_rows(study))
     if kind == "clips":
-        return _csv_lines(EXPORT_CLIP_COLUMNS, clip_rows(study))
+        return csv_lines(EXPORT_CLIP_COLUMNS, clip_rows(study))
     if kind == "participants":
-        return _csv_lines([*PARTICIPANT_COLUMNS, *feedback_keys(study)], participant_rows(study))
+        return csv_lines([*PARTICIPANT_COLUMNS, *feedback_keys(study)], participant_rows(study))
     if kind == "assignments":
-        return _csv_lines(ASSIGNMENT_COLUMNS, assignment_rows(study))
+        return csv_lines(ASSIGNMENT_COLUMNS, assignment_rows(study))
     if kind == "viewing":
-        return _csv_lines(VIEWING_COLUMNS, viewing_rows(study))
+        return csv_lines(VIEWING_COLUMNS, viewing_rows(study))
     raise ValueError(f"unknown export {kind!r}; choose {', '.join(EXPORT_KINDS)}")
 
 

@@ -8,14 +8,14 @@ from django.utils.translation import gettext
 from django.utils.translation import gettext_lazy as _
 
 from analysis.exclusion import rule_errors
-from protocol.pools import NORMS_RULE, SUB_POOLS, pool_errors
+from protocol.pools import SUB_POOLS, pool_errors
 
 from . import clip_import, pool_editor
 from .i18n import display
 from .inputs import refuse_control_characters, refuse_control_characters_in_text
 from .models import Clip, Section, Study
 from .norming import open_errors
-from .norms_rule import NormsSourceError, check_reader, load_norms, norms_source
+from .norms_rule import NormsSourceError, check_reader, load_norms, norms_rules, norms_sources
 from .pool_editor import PoolEditorFields
 from .presets import preset_choices
 from .questions import section_type_choices
@@ -101,9 +101,9 @@ class SectionForm(forms.ModelForm, PoolEditorFields):
     (A field with an error leaves cleaned_data, so Section.clean, which repeats the check, does not report it
     twice.)
 
-    ``reader``: the user saving (the admin passes it). A norms rule whose source this save changes may name only a
-    study of theirs (studyapp.norms_rule.check_reader); a source already saved stays as it is, so a collaborator
-    can still save a section a superuser pointed at another study's norms."""
+    ``reader``: the user saving (the admin passes it). A norms rule (the pool's or a sub-pool's) whose source this
+    save adds may name only a study of theirs (studyapp.norms_rule.check_reader); a source already saved stays as
+    it is, so a collaborator can still save a section a superuser pointed at another study's norms."""
 
     class Meta:
         model = Section
@@ -112,7 +112,7 @@ class SectionForm(forms.ModelForm, PoolEditorFields):
     def __init__(self, *args, reader=None, **kwargs):
         super().__init__(*args, **kwargs)
         self.reader = reader
-        self.saved_norms_source = norms_source(self.instance.pool)
+        self.saved_norms_sources = norms_sources(self.instance.pool)
         for name, value in pool_editor.initial_values(self.instance.pool, self.instance.options).items():
             self.initial.setdefault(name, value)
         plans = catalogue_plans()
@@ -128,23 +128,25 @@ class SectionForm(forms.ModelForm, PoolEditorFields):
         return data
 
     def _check_norms_source(self, data: dict) -> None:
-        """An error on the pool when its norms rule's source gives no norms (an unknown study, a study without
-        norms yet, a bad clip_norms.csv: studyapp.norms_service names the file, line and column)."""
+        """An error on the pool when a norms rule of its tree (its own or a sub-pool's) gives no norms (an unknown
+        study, a study without norms yet, a bad clip_norms.csv: studyapp.norms_service names the file, line and
+        column)."""
         pool = data.get("pool")
-        if self.has_error("pool") or norms_source(pool) is None or pool_errors(pool, data.get("section_type")):
+        if self.has_error("pool") or not norms_rules(pool) or pool_errors(pool, data.get("section_type")):
             return                # a bad pool is named by the section's own checks first (Section.clean)
-        try:
-            load_norms(pool[NORMS_RULE].get("from", ""))
-        except NormsSourceError as exc:
-            self.add_error("pool", str(exc))
+        for where, rule in norms_rules(pool):
+            try:
+                load_norms(rule.get("from", ""))
+            except NormsSourceError as exc:
+                self.add_error("pool", str(exc).replace("pool.norms.", f"pool.{where}.", 1))
 
     def _check_norms_reader(self, data: dict) -> None:
-        """An error on the pool (which then keeps its saved value) when the reader may not read its new source."""
-        source = norms_source(data.get("pool"))
-        if self.reader is None or source is None or source == self.saved_norms_source:
+        """An error on the pool (which then keeps its saved value) when the reader may not read a new source of a
+        norms rule anywhere in the pool tree (its own rule or a sub-pool's)."""
+        if self.reader is None or "pool" not in data:
             return
         try:
-            check_reader(data["pool"], self.reader)
+            check_reader(data["pool"], self.reader, already_saved=self.saved_norms_sources)
         except NormsSourceError as exc:
             self.add_error("pool", str(exc))
 

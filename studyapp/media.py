@@ -3,7 +3,8 @@
 Django's FileResponse ignores `Range`; Safari will not play an MP4 without byte ranges, and no browser can seek
 without them. `ranged_file_response` answers `Range: bytes=a-b` (single range; suffix and open-ended forms) with
 206 + Content-Range, an unsatisfiable range with 416, and anything else with the whole file (200). The body is
-streamed in 64 KiB blocks. Every answer carries an ETag (size and modification time) and Last-Modified: a
+streamed block by block and reads only the requested range (studyapp.streaming: an async iterator under ASGI, so
+no body is ever held whole in memory). Every answer carries an ETag (size and modification time) and Last-Modified: a
 revalidation with a matching If-None-Match (or, without one, an If-Modified-Since not older than the file) gets
 304 with no body, and an If-Range that no longer matches turns a range request into the whole file.
 
@@ -24,7 +25,8 @@ from django.conf import settings
 from django.http import Http404, HttpResponse, StreamingHttpResponse
 from django.utils.http import http_date, parse_http_date_safe
 
-BLOCK = 64 * 1024
+from .streaming import file_body
+
 RANGE_RE = re.compile(r"^bytes=(\d*)-(\d*)$")
 CONTENT_TYPES = {".mp4": "video/mp4", ".webm": "video/webm", ".png": "image/png", ".jpg": "image/jpeg"}
 
@@ -40,18 +42,6 @@ def media_path(relative: str) -> Path:
     if root not in path.parents or not path.is_file():
         raise Http404("clip file not found")
     return path
-
-
-def _iter_file(path: Path, start: int, length: int):
-    with open(path, "rb") as fh:
-        fh.seek(start)
-        remaining = length
-        while remaining > 0:
-            chunk = fh.read(min(BLOCK, remaining))
-            if not chunk:
-                break
-            remaining -= len(chunk)
-            yield chunk
 
 
 def parse_range(header: str, size: int) -> tuple[int, int] | None:
@@ -123,11 +113,11 @@ def ranged_file_response(request, path: Path, content_type: str | None = None):
         response = HttpResponse(content_type=content_type)
         response["Content-Length"] = str(size)
     elif rng is None:
-        response = StreamingHttpResponse(_iter_file(path, 0, size), content_type=content_type)
+        response = StreamingHttpResponse(file_body(request, path, 0, size), content_type=content_type)
         response["Content-Length"] = str(size)
     else:
         start, end = rng
-        response = StreamingHttpResponse(_iter_file(path, start, end - start + 1), status=206,
+        response = StreamingHttpResponse(file_body(request, path, start, end - start + 1), status=206,
                                          content_type=content_type)
         response["Content-Length"] = str(end - start + 1)
         response["Content-Range"] = f"bytes {start}-{end}/{size}"

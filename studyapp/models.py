@@ -20,6 +20,9 @@ from .permissions import STUDY_PERMISSIONS
 from .questions import section_type_choices
 from .redirects import check_completion_url, safe_completion_url
 
+DEFAULT_ABANDON_MINUTES = 120
+"""A new study's ``abandon_after_minutes``: two hours, longer than any preset's expected duration several times over."""
+
 
 def new_token() -> str:
     """An unguessable participant credential (URL-safe, 32 random bytes)."""
@@ -120,7 +123,16 @@ class Study(models.Model):
         help_text='List of {"key": "camera", "text": "Were you distracted ...?", "kind": "yesno"|"text"}')
     max_participants = models.PositiveIntegerField(default=0, help_text="0 = no limit")
     abandon_after_minutes = models.PositiveIntegerField(
-        default=0, help_text="A started participant inactive this long stops counting towards the limit (0 = never)")
+        default=DEFAULT_ABANDON_MINUTES,
+        help_text="A started participant inactive this long stops counting towards the participant limit, so the "
+                  "places of people (or scripts) who left free up; they may still come back and finish (0 = never)")
+    export_external_ids = models.BooleanField(
+        default=False, help_text="Exports and reports carry participants' external ids (Prolific IDs) as given. Off: "
+                                 "each is a pseudonym, the same for one participant in every export of this study; "
+                                 "the ids for payment are a separate download (permission: download payment ids)")
+    listed_publicly = models.BooleanField(
+        default=False, help_text="List this study on the site's front page while it is open. Off: only people "
+                                 "with its link (Prolific, e-mail) find it")
     completion_code = models.CharField(max_length=40, default=new_completion_code)
     completion_redirect = models.CharField(
         max_length=500, blank=True,
@@ -296,6 +308,8 @@ class Assignment(models.Model):
     plays = models.PositiveIntegerField(default=0, editable=False)
     play_ended_ms = models.PositiveIntegerField(null=True, blank=True, editable=False)
     shows = models.PositiveIntegerField(default=0, editable=False)
+    # when this session's player first fetched the clip (studyapp.views.media): the viewing record's server evidence
+    fetched_at = models.DateTimeField(null=True, blank=True, editable=False)
     carried = models.JSONField(default=dict, blank=True, editable=False)
 
     class Meta:

@@ -8,8 +8,10 @@ used, so a bad file changes nothing. The norms themselves come from the one norm
 
 Who may read what: a file must be a .csv inside DATA_DIR once symbolic links and ``..`` are resolved (``norms_file``,
 whoever reads it), so no other file of the server is opened. Where a user acts (the pool editor's live count, a
-section saved in the admin) a study source must be one of the user's studies (``check_reader``; superusers: any);
-the assignment of a participant, where no user acts, reads the rule as saved.
+section saved in the admin) every study source of the pool tree, the naturalness sub-pools' rules included, must be
+one of the user's studies (``check_reader``; superusers: any), checked before any norms are read, with one message
+for another lab's study and for a slug that does not exist; the assignment of a participant, where no user acts,
+reads the rules as saved.
 
 A clip's norm is its row with an intended label and the most ratings (a clip rated in several sections: the
 norming section's emotion question). A clip passes when it has a norm with at least ``min_ratings`` ratings, an
@@ -22,7 +24,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-from protocol.pools import NORMS_RULE
+from protocol.pools import NORMS_RULE, SUB_POOLS
 
 from .norms_service import NormsSourceError, clear, is_file_source, load_norms, norms_file  # noqa: F401 - the rule's API
 from .permissions import studies_for
@@ -39,22 +41,46 @@ class ClipVerdict:
         return not self.reasons
 
 
+def norms_rules(pool) -> list[tuple[str, dict]]:
+    """(where, rule) of every norms rule in a pool tree: the pool's own (``"norms"``) and each sub-pool's
+    (``"generated.norms"``, ``"source.norms"``), in that order; [] when there is none."""
+    if not isinstance(pool, dict):
+        return []
+    found = [(NORMS_RULE, pool[NORMS_RULE])] if isinstance(pool.get(NORMS_RULE), dict) else []
+    for key in SUB_POOLS:
+        sub = pool.get(key)
+        if isinstance(sub, dict) and isinstance(sub.get(NORMS_RULE), dict):
+            found.append((f"{key}.{NORMS_RULE}", sub[NORMS_RULE]))
+    return found
+
+
+def norms_sources(pool) -> set[str]:
+    """The ``from`` of every norms rule of a pool tree (stripped)."""
+    return {str(rule.get("from") or "").strip() for _, rule in norms_rules(pool)}
+
+
 def norms_source(pool) -> str | None:
-    """The ``from`` of a pool's norms rule (stripped), None when the pool has no norms rule."""
+    """The ``from`` of a pool's own norms rule (stripped), None when the pool has no norms rule."""
     rule = pool.get(NORMS_RULE) if isinstance(pool, dict) else None
     return str(rule.get("from") or "").strip() if isinstance(rule, dict) else None
 
 
-def check_reader(pool, reader) -> None:
-    """Raise NormsSourceError unless ``reader`` (the user acting) may read the study the pool's norms rule names:
-    one of studies_for(reader). The message is the same for another lab's study and for none, so a slug is not
-    confirmed. A file source is left to norms_file, which holds for everyone."""
-    source = norms_source(pool)
-    if not source or is_file_source(source):
-        return
-    if not studies_for(reader).filter(slug=source).exists():
-        raise NormsSourceError(f"pool.norms.from: no study {source!r} among the studies you may see (give the slug "
-                               "of a study you own or collaborate on, or a clip_norms.csv path)")
+def check_reader(pool, reader, already_saved: set[str] | frozenset = frozenset()) -> None:
+    """Raise NormsSourceError unless ``reader`` (the user acting) may read every study that a norms rule of the
+    pool tree names (the pool's own rule and each sub-pool's): one of studies_for(reader). Sources in
+    ``already_saved`` (the saved section's, :func:`norms_sources`) pass as they are. The message is the same for
+    another lab's study and for none, so a slug is not confirmed. A file source is left to norms_file, which holds
+    for everyone."""
+    readable = None
+    for where, rule in norms_rules(pool):
+        source = str(rule.get("from") or "").strip()
+        if not source or is_file_source(source) or source in already_saved:
+            continue
+        if readable is None:
+            readable = set(studies_for(reader).values_list("slug", flat=True))
+        if source not in readable:
+            raise NormsSourceError(f"pool.{where}.from: no study {source!r} among the studies you may see (give the "
+                                   "slug of a study you own or collaborate on, or a clip_norms.csv path)")
 
 
 def judge(rule: dict, norm: dict | None) -> ClipVerdict:

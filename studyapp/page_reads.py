@@ -27,7 +27,7 @@ from .models import Assignment, Clip, Participant, Section, Study
 
 ASSIGNMENT_FIELDS = ("id", "participant_id", "section_id", "position", "clip_id", "options", "shown_at",
                      "answered_at", "seq", "kind", "instructed", "plays", "play_ended_ms", "shows",
-                     "carried")
+                     "carried", "fetched_at")
 """What a clip page reads of an assignment (its other fields stay deferred)."""
 CLIP_FIELDS = ("id", "clip_id", "theme", "duration_s", "media_key", "video", "webm", "poster", "loop")
 """What a clip page reads of a clip (the rest stays deferred)."""

@@ -13,10 +13,12 @@ from django.db.models import Q
 from django.http import Http404
 
 EXPORT_PERMISSION = "studyapp.export_participant_data"
-"""Download a study's CSV exports and analysis report (participant data, Prolific IDs included)."""
+"""Download a study's CSV exports and analysis report (participant data; external ids pseudonymised unless the
+study asks for them: studyapp.privacy)."""
 
 STUDY_PERMISSIONS = [
     ("export_participant_data", "Can download participant data (CSV exports and analysis reports)"),
+    ("download_payment_ids", "Can download participants' external ids (Prolific IDs) for payment"),
 ]
 """Custom permissions declared in Study.Meta: what no add/change/delete/view model permission covers."""
 
@@ -30,7 +32,8 @@ RESEARCHER_PERMISSIONS = [
     "export_participant_data",
 ]
 """Codenames (app studyapp) the "researcher" group holds: run studies and read their data; no deleting
-studies, participants or answers and no editing of the catalogue or of collected data."""
+studies, participants or answers and no editing of the catalogue or of collected data. Not the payment download
+(download_payment_ids): grant it to whoever pays participants."""
 
 
 def has_staff_permission(user, perm: str) -> bool:

@@ -30,6 +30,7 @@ from protocol.pools import (
     DEFAULT_GESTURE_OPTIONS,
     DEFAULT_PLAYER_CONTROLS,
     INCLUDE_FLAGGED,
+    KEEP_ADVISORY,
     MAX_REPLAYS_LIMIT,
     OBSERVER_ADVISORY,
     PLAYER_CONTROLS,
@@ -38,7 +39,15 @@ from protocol.pools import (
     validate_section,
 )
 from protocol.section_types import find_section_type, registered
-from protocol.vocabulary import CLIP_MODALITIES, CLIP_THEMES, GESTURE_EMOTIONS, NATURALNESS, ORIGINS, answer_values
+from protocol.vocabulary import (
+    CLIP_MODALITIES,
+    CLIP_THEMES,
+    GESTURE_EMOTIONS,
+    NATURALNESS,
+    ORIGINS,
+    QA_ADVISORY_CHECKS,
+    answer_values,
+)
 
 ANY = ""
 TRISTATE = [(ANY, "any"), ("yes", "yes"), ("no", "no")]
@@ -506,10 +515,16 @@ def _main_pool_specs() -> list[ChoiceSpec]:
                      "yes: clips whose emotion changes (they have a final emotion)"),
         TristateSpec(p + "rbf", "rbf", (), "Styled", "yes: clips with a theme (RBF styled, or the neutral input walk)"),
         FlagSpec(p + "include_flagged", INCLUDE_FLAGGED, (), "Include clips that failed a quality check",
-                 "off: clips with a quality flag (Clip.qa_flag) are left out"),
+                 "on: every clip, whatever its quality flag (Clip.qa_flag); off: every flagged clip is left out "
+                 "unless one of the two boxes below keeps its kind of flag"),
+        FlagSpec(p + "keep_advisory", KEEP_ADVISORY, (), "Keep clips flagged only by advisory checks",
+                 f"advisory checks ({', '.join(QA_ADVISORY_CHECKS)}): the realism check compares a walk's foot "
+                 "skate, knee, pelvis bounce and speed with real captured walks and flags about 10 % of real takes "
+                 "too; on: a clip that failed only these stays in; off: it is left out"),
         FlagSpec(p + "observer_advisory", OBSERVER_ADVISORY, (), "Observer flag is advisory",
                  "on: a clip the automatic emotion observer flagged stays in (people judge it, as in a norming "
-                 "study); other failed checks still keep a clip out"),
+                 "study); other failed checks still keep a clip out. A norms rule keeps the observer flag of "
+                 "clips people have rated"),
     ]
 
 

@@ -9,22 +9,16 @@ from itertools import combinations
 
 from django.db.models import Q, QuerySet
 
-from protocol.pools import INCLUDE_FLAGGED, OBSERVER_ADVISORY, PoolError, pool_lookups
-from protocol.vocabulary import QA_ADVISORY_CHECKS, QA_CHECKS
+from protocol.pools import INCLUDE_FLAGGED, PoolError, kept_checks, pool_lookups
+from protocol.vocabulary import QA_CHECKS
 
 from .models import Clip
 
-#: ``qa_flag`` values that keep a clip in pools: passed, or failed only advisory checks (in QA_CHECKS order).
-ADVISORY_FLAGS = ("", *(";".join(c for c in QA_CHECKS if c in subset)
-                        for n in range(1, len(QA_ADVISORY_CHECKS) + 1)
-                        for subset in combinations(QA_ADVISORY_CHECKS, n)))
 
-#: ``qa_flag`` values that failed only the observer check and advisory ones: they keep a clip in a pool that says
-#: ``observer_advisory`` (a norming section's candidates), and a clip with norms in a pool with a norms rule.
-OBSERVER_ADVISORY_FLAGS = tuple(";".join(c for c in QA_CHECKS if c in subset)
-                                for n in range(1, len(QA_ADVISORY_CHECKS) + 2)
-                                for subset in combinations(("observer", *QA_ADVISORY_CHECKS), n)
-                                if "observer" in subset)
+def kept_flags(checks: tuple[str, ...]) -> tuple[str, ...]:
+    """Every ``qa_flag`` value made only of ``checks`` (joined in QA_CHECKS order), "" (passed) first."""
+    ordered = [c for c in QA_CHECKS if c in checks]
+    return ("", *(";".join(subset) for n in range(1, len(ordered) + 1) for subset in combinations(ordered, n)))
 
 
 class CatalogueError(ValueError):
@@ -41,20 +35,21 @@ def pool_calls(pool: dict | None) -> list[tuple[str, dict]]:
 
 def filtered_clips(pool: dict | None, include_flagged: bool | None = None, normed: set[str] | None = None
                    ) -> QuerySet:
-    """Clips (not retired) matching the pool's filters, a norms rule aside. Clips that failed a non-advisory quality
-    check are left out unless ``include_flagged`` (default: the pool's ``include_flagged``); the observer's check is
-    advisory in a pool that says ``observer_advisory`` and, for the clips in ``normed`` (those with norms), in a
-    pool with a norms rule. CatalogueError naming the filter when the pool is not valid."""
+    """Clips (not retired) matching the pool's filters, a norms rule aside. Clips that failed a quality check are
+    left out unless ``include_flagged`` (default: the pool's ``include_flagged``) or the pool's switches keep the
+    checks they failed (``protocol.pools.kept_checks``: ``keep_advisory`` the advisory ones, ``observer_advisory``
+    the observer's); for the clips in ``normed`` (those with norms) under a norms rule the observer's check is kept
+    too. CatalogueError naming the filter when the pool is not valid."""
     calls = pool_calls(pool)
     qs = Clip.objects.filter(retired=False)
     if include_flagged is None:
         include_flagged = bool((pool or {}).get(INCLUDE_FLAGGED, False))
     if not include_flagged:
-        flags = Q(qa_flag__in=ADVISORY_FLAGS)
-        if (pool or {}).get(OBSERVER_ADVISORY):
-            flags |= Q(qa_flag__in=OBSERVER_ADVISORY_FLAGS)
-        elif normed:      # a norm outranks an observer: its verdict is advisory for clips people rated
-            flags |= Q(qa_flag__in=OBSERVER_ADVISORY_FLAGS, clip_id__in=normed)
+        kept = kept_checks(pool)
+        flags = Q(qa_flag__in=kept_flags(kept))
+        with_norms = kept_checks(pool, normed=True)
+        if normed and with_norms != kept:      # a norm outranks an observer for clips people rated
+            flags |= Q(qa_flag__in=kept_flags(with_norms), clip_id__in=normed)
         qs = qs.filter(flags)
     for method, kwargs in calls:
         qs = getattr(qs, method)(**kwargs)

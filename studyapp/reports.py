@@ -9,6 +9,7 @@ folder. Files, per study and data version:
                                           build.lock   flock()ed by the running build; released when it exits
                                           error.txt    why the last build failed
                                           build.log    the build's stdout/stderr
+                                          purged       a participant was removed during the build: no zip
 
 The data version (`data_version`) is a digest of the study's participant and response counts, largest ids and
 latest times, sections, exclusion rules and the catalogue's latest change: equal digests mean equal exports, so a
@@ -41,6 +42,7 @@ from django.db.models import Count, Max, Q
 
 from .export import run_report
 from .models import Clip, Participant, Response, Study
+from .privacy import PURGED_NAME
 
 REPORT_NAME = "report.zip"
 LOCK_NAME = "build.lock"
@@ -209,6 +211,24 @@ def prune_old_versions(study_id: int, keep: str) -> list[Path]:
     return removed
 
 
+def forget_reports(study_id: int) -> int:
+    """Delete every stored report zip of the study, because a participant of it was deleted or withdrew
+    (studyapp.privacy): idle version folders go whole; a running build's folder gets the PURGED_NAME mark, so the
+    build discards its zip. Returns how many stored zips were deleted."""
+    root = Path(settings.REPORTS_DIR) / str(int(study_id))
+    removed = 0
+    for folder in root.iterdir() if root.is_dir() else []:
+        if not folder.is_dir():
+            continue
+        removed += (folder / REPORT_NAME).is_file()
+        if _lock_is_held(folder):
+            (folder / PURGED_NAME).write_text("a participant was removed while this report was being built\n")
+            (folder / REPORT_NAME).unlink(missing_ok=True)
+        else:
+            shutil.rmtree(folder, ignore_errors=True)
+    return removed
+
+
 def build_report(study: Study, version: str, lock_fd: int) -> Path:
     """Write version's report.zip (the caller holds the lock through lock_fd). On failure error.txt says why and
     the exception propagates."""
@@ -220,6 +240,9 @@ def build_report(study: Study, version: str, lock_fd: int) -> Path:
         with tempfile.TemporaryDirectory(prefix=".build-", dir=folder) as tmp:
             run_report(study, tmp)
             zip_folder(Path(tmp), folder / REPORT_NAME)
+        if (folder / PURGED_NAME).exists():         # a participant was removed meanwhile (studyapp.privacy)
+            (folder / REPORT_NAME).unlink(missing_ok=True)
+            raise RuntimeError("a participant was deleted or withdrew while the report was built: build it again")
     except Exception as exc:
         if isinstance(exc, ImportError):
             message = f"the analysis library is not available in this deployment ({exc})"

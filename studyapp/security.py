@@ -3,6 +3,9 @@
 - `ContentSecurityPolicyMiddleware`: a Content-Security-Policy on every response (no inline script or style: every
   script and style sheet is a file under static/), and a Permissions-Policy that turns off the browser features
   the site never uses (camera, microphone, location, sensors, payment, USB, ...).
+- `NoStoreMiddleware`: ``Cache-Control: no-store`` (and no caching at all) on every response under the admin and the
+  researcher pages (settings.NO_STORE_PREFIXES, default /admin/ and /staff/): exports, reports, payment ids and
+  the pages showing participants' data are never kept by a browser or a proxy.
 - `RedactTokensFilter`: a logging filter that blanks participant credentials (the /p/<token>/ path segment and the
   PROLIFIC_PID / STUDY_ID / SESSION_ID query values) in any log line, e.g. Django's "Not Found: /p/<token>/...".
 - `redact()`: the same rewriting for one string (the gunicorn access logger of studyapp.gunicorn_logging uses it).
@@ -13,6 +16,7 @@ import logging
 import re
 
 from django.conf import settings
+from django.utils.cache import add_never_cache_headers
 
 CONTENT_SECURITY_POLICY = "; ".join([
     "default-src 'self'",
@@ -79,4 +83,25 @@ class ContentSecurityPolicyMiddleware:
         for header, policy in self.headers.items():
             if policy and header not in response:
                 response[header] = policy
+        return response
+
+
+NO_STORE_PREFIXES = ("/admin/", "/staff/")
+
+
+class NoStoreMiddleware:
+    """Marks every response below settings.NO_STORE_PREFIXES (default NO_STORE_PREFIXES) not to be stored:
+    ``Cache-Control: max-age=0, no-cache, no-store, must-revalidate, private`` (django.utils.cache's never-cache
+    headers), whatever the view set."""
+
+    def __init__(self, get_response):
+        self.get_response = get_response
+        self.prefixes = tuple(getattr(settings, "NO_STORE_PREFIXES", NO_STORE_PREFIXES))
+
+    def __call__(self, request):
+        response = self.get_response(request)
+        if request.path.startswith(self.prefixes):
+            if "Cache-Control" in response:
+                del response["Cache-Control"]
+            add_never_cache_headers(response)
         return response

@@ -23,6 +23,8 @@ Variables (all optional for the demo):
     LOGIN_LOCKOUT_MINUTES how long such a lockout lasts (default 15)
     TRUSTED_PROXY_COUNT   reverse proxies in front of the app whose X-Forwarded-For is trusted for the client
                       address of the login throttle (default: 1 with PRODUCTION=1, the nginx recipe; else 0)
+    START_RATE_BURST  new participants one client address may start at once (default 6; 0 turns the limit off)
+    START_RATE_INTERVAL_S then one more every this many seconds (default 20; studyapp.start_throttle)
     QA_GAIT_OBSERVER  the quality gate's gait observer for plans that name none: real (default), real-perceived
                       or synthetic
     REAL_CORPUS       the Bandai Namco real-capture corpus the real gait observers are trained on (default:
@@ -154,6 +156,8 @@ INSTALLED_APPS = [
 MIDDLEWARE = [
     "django.middleware.security.SecurityMiddleware",
     "studyapp.security.ContentSecurityPolicyMiddleware",
+    # Cache-Control: no-store on the admin and the researcher pages and downloads (studyapp.security)
+    "studyapp.security.NoStoreMiddleware",
     # 400 for a control character (NUL, ...) in the path, a query or form value or a cookie: before any lookup
     "studyapp.inputs.ControlCharacterMiddleware",
     "whitenoise.middleware.WhiteNoiseMiddleware",
@@ -260,6 +264,8 @@ AXES_LOCKOUT_CALLABLE = "studyapp.login_throttle.lockout_response"
 AXES_CLIENT_IP_CALLABLE = "studyapp.login_throttle.client_ip"
 AXES_HTTP_RESPONSE_CODE = 429
 TRUSTED_PROXY_COUNT = env_int("TRUSTED_PROXY_COUNT", 1 if PRODUCTION else 0)
+START_RATE_BURST = env_int("START_RATE_BURST", 6, minimum=0)
+START_RATE_INTERVAL_S = env_int("START_RATE_INTERVAL_S", 20, minimum=1)
 
 if PRODUCTION:
     SECURE_SSL_REDIRECT = env_bool("SECURE_SSL_REDIRECT", True)

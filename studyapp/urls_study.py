@@ -23,4 +23,5 @@ urlpatterns = [
     path("staff/study/<int:study_id>/norming/", views_norming.norming_monitor, name="norming_monitor"),
     path("staff/study/<int:study_id>/export/<str:kind>.csv", views_staff.export_csv, name="export_csv"),
     path("staff/study/<int:study_id>/report.zip", views_staff.report_zip, name="report_zip"),
+    path("staff/study/<int:study_id>/payment-ids.csv", views_staff.payment_ids, name="payment_ids"),
 ]

@@ -12,7 +12,12 @@ knows a record is due with every answer; nothing here rejects an answer, but the
 - ``implausible``: a field is not an integer within its bound, an end comes before the first play, a start-up time
   (first play request to first frame) is longer than the time to the first frame or comes without one, there
   are more plays than the time the page was shown fits (``max_plays``), or more than the section's player allows
-  (1 + ``max_replays``; the player refuses them, so they did not come from it): kept as sent, but not to be trusted;
+  (1 + ``max_replays``; the player refuses them, so they did not come from it), or the record disagrees with the
+  server's own evidence: a play or an end reported while the server never sent this session the clip
+  (``Assignment.fetched_at``, set by the media view), or an end reported sooner than ENDED_FRACTION of the clip's
+  duration after the page was shown (by the server's clock: the answer's time and the player's ``ended`` report)
+  or after the reported first play (where the player cannot seek or change speed: controls other than ``full``):
+  kept as sent, but not to be trusted;
 - ``ok`` otherwise.
 
 While the page is open the script also reports each play start and the clip's first end (``record_playback`` via
@@ -33,6 +38,10 @@ MAX_COUNT = 1000
 PLAYBACK_EVENTS = ("play", "ended", "leave")
 """What the player reports while the page is open: a play from the start (first play or replay), the first end,
 and, when the page is left without an answer (a reload), its counts so far (CARRIED_FIELDS)."""
+ENDED_FRACTION = 0.8
+"""An end is reported no sooner than this fraction of the clip's duration after the clip could start playing."""
+SEEKING_CONTROLS = "full"
+"""The player controls under which a participant may seek or change speed, so an early end proves nothing."""
 CARRIED_FIELDS = ("pauses", "seeks", "stalls", "stall_ms", "hidden", "hidden_ms")
 """Record fields a display left without an answer hands on to the next (added up on the assignment)."""
 
@@ -94,7 +103,8 @@ def _integer(raw, high: int) -> int | None:
 
 
 def parse_viewing(post, page_ms: int, duration_s: float | None = None, playback: dict | None = None,
-                  time_slack_ms: int = 5_000, max_replays: int | None = None) -> dict:
+                  time_slack_ms: int = 5_000, max_replays: int | None = None, fetched: bool | None = None,
+                  controls: str | None = None) -> dict:
     """The viewing record of an answer POST: every field of VIEWING_FIELDS (int or None) plus ``record`` (one of
     VIEWING_RECORDS), ``page_ms`` and ``shows``.
 
@@ -103,7 +113,9 @@ def parse_viewing(post, page_ms: int, duration_s: float | None = None, playback:
     what the player reported while the page was open (``{"plays": int, "ended_ms": int | None, "shows": int,
     "carried": {field: int}}``, from the assignment): the plays count is at least its plays, an end reached before a
     reload of the page is kept as ``ended_ms`` 0 ("before this display"), and the counts of displays left without
-    an answer are added to this display's. max_replays: the section player's limit (None: unlimited)."""
+    an answer are added to this display's. max_replays: the section player's limit (None: unlimited). fetched:
+    whether the server sent this session the clip (None: not known, not checked). controls: the section player's
+    controls (``full`` allows seeking, so an early end is not held against the record)."""
     playback = playback or {}
     record: dict = {name: None for name in VIEWING_FIELDS}
     record.update(page_ms=page_ms, shows=max(1, int(playback.get("shows") or 0)))
@@ -144,4 +156,25 @@ def parse_viewing(post, page_ms: int, duration_s: float | None = None, playback:
         implausible = True
     if max_replays is not None and (record["plays"] or 0) > 1 + max_replays:
         implausible = True                        # more plays than the player lets a participant start
+    if fetched is False and ((record["plays"] or 0) > 0 or record["ended_ms"] is not None):
+        implausible = True                        # a play of a clip the server never sent
+    if _ended_too_soon(record, page_ms, duration_s, playback.get("ended_ms"), controls):
+        implausible = True
     return {**record, "record": "implausible" if implausible else "ok"}
+
+
+def _ended_too_soon(record: dict, page_ms: int, duration_s: float | None, server_ended_ms: int | None,
+                    controls: str | None) -> bool:
+    """An end sooner than ENDED_FRACTION of the duration after the page was shown (server clock: the answer's
+    page_ms, the player's ``ended`` report) or after the reported first play, where the player cannot seek."""
+    if not duration_s or duration_s <= 0 or controls == SEEKING_CONTROLS:
+        return False
+    shortest = ENDED_FRACTION * duration_s * 1000
+    if server_ended_ms is not None and server_ended_ms < shortest:
+        return True
+    if record["ended_ms"] is None:
+        return False
+    if page_ms < shortest:
+        return True
+    first = record["first_play_ms"]
+    return bool(record["ended_ms"] > 0 and first is not None and record["ended_ms"] - first < shortest)

@@ -25,6 +25,7 @@ from django.views.decorators.http import require_http_methods, require_POST
 
 from protocol.vocabulary import ATTENTION_CHECK
 
+from . import start_throttle
 from .assignment import StudyUnavailable, check_open, current_step, start_participant
 from .device_check import device_context
 from .duration import expected_minutes
@@ -64,7 +65,9 @@ MIN_PLAY_FRACTION = 0.8
 
 
 def home(request):
-    studies = Study.objects.filter(status=Study.Status.OPEN).order_by("title")
+    """The site's front page: lists only open studies that ask to be listed (Study.listed_publicly); the others
+    are reached by their link (Prolific, e-mail), so their slugs are not handed to anyone who asks."""
+    studies = Study.objects.filter(status=Study.Status.OPEN, listed_publicly=True).order_by("title")
     return render(request, "studyapp/home.html", {"studies": studies})
 
 
@@ -125,6 +128,16 @@ def _prolific_conflict(request, study: Study):
     return _unavailable(request, study, PROLIFIC_CONFLICT, status=403)
 
 
+def _too_many_starts(request, study: Study, wait_s: float):
+    """429 with Retry-After: this address started many participants just now (studyapp.start_throttle)."""
+    seconds = max(1, math.ceil(wait_s))
+    response = _unavailable(request, study, gettext(
+        "Many people have just started this study from your network. Please wait %(seconds)d seconds, then open "
+        "the study link again.") % {"seconds": seconds}, status=429)
+    response["Retry-After"] = str(seconds)
+    return response
+
+
 @never_cache
 @require_http_methods(["GET", "HEAD", "POST"])
 def study_entry(request, slug: str):
@@ -162,6 +175,9 @@ def study_entry(request, slug: str):
         if form.is_valid():
             data = form.cleaned_data
             key = _consent_key(request, study, request.POST.get("consent_key", ""), data["PROLIFIC_PID"])
+            wait = start_throttle.admit(request)
+            if wait and not (key and Participant.objects.filter(study=study, consent_key=key).exists()):
+                return _too_many_starts(request, study, wait)
             try:
                 with transaction.atomic():
                     participant = Participant.objects.create(
@@ -179,6 +195,7 @@ def study_entry(request, slug: str):
                         participant = other
                 if participant is None:
                     return _prolific_conflict(request, study)
+            request.session.cycle_key()      # a session planted before consent does not carry over to the answers
             _remember(request, participant)
             _retire_consent_key(request, study)
             return redirect("studyapp:resume", token=participant.token)
@@ -385,10 +402,12 @@ def item(request, token: str, n: int):
     response_ms = client_ms(request.POST.get("rt", ""), server_ms)
     if response_ms is None:
         response_ms = server_ms
+    player = player_options(section.options)
     viewing = parse_viewing(request.POST, min(MAX_RESPONSE_MS, server_ms), clip.duration_s,
                             {"plays": assignment.plays, "ended_ms": assignment.play_ended_ms,
                              "shows": assignment.shows, "carried": assignment.carried},
-                            time_slack_ms=RT_SLACK_MS, max_replays=player_options(section.options)["max_replays"])
+                            time_slack_ms=RT_SLACK_MS, max_replays=player["max_replays"],
+                            fetched=assignment.fetched_at is not None, controls=player["controls"])
     save_answers(assignment, answers, response_ms, viewing)
     if request.POST.get(INLINE_NEXT_FIELD) == "1" and n < participant.n_items:
         nxt = current_step(participant, lookahead=True)
@@ -532,13 +551,26 @@ def media_allowed(request, clip: Clip) -> bool:
     pages by seq), or a staff member who may see the catalogue (admin and preview). The URL alone is never
     enough; a clip further on in the study is not served until its page comes near, and a clip's URL stops
     working for a participant once it is answered. One query per participant of the session."""
+    return bool(_near_assignments(request, clip)) or has_staff_permission(request.user, "studyapp.view_clip")
+
+
+def _near_assignments(request, clip: Clip) -> list[tuple[int, object]]:
+    """(pk, fetched_at) of the session's participants' near pages (MEDIA_PAGES) that show ``clip``."""
     tokens = [t for t in request.session.get(SESSION_KEY, {}).values() if isinstance(t, str)]
     for token in tokens:
-        near = (Assignment.objects.filter(participant__token=token, answered_at__isnull=True)
-                .order_by("seq").values_list("clip_id", flat=True)[:MEDIA_PAGES])
-        if clip.pk in list(near):
-            return True
-    return has_staff_permission(request.user, "studyapp.view_clip")
+        near = list(Assignment.objects.filter(participant__token=token, answered_at__isnull=True)
+                    .order_by("seq").values_list("pk", "clip_id", "fetched_at")[:MEDIA_PAGES])
+        found = [(pk, fetched) for pk, clip_id, fetched in near if clip_id == clip.pk]
+        if found:
+            return found
+    return []
+
+
+def _record_fetch(assignments: list[tuple[int, object]]) -> None:
+    """Mark the pages whose clip this session fetched (the viewing record's server evidence), once each."""
+    first = [pk for pk, fetched in assignments if fetched is None]
+    if first:
+        Assignment.objects.filter(pk__in=first, fetched_at__isnull=True).update(fetched_at=timezone.now())
 
 
 def media(request, key: str, ext: str):
@@ -549,9 +581,12 @@ def media(request, key: str, ext: str):
     relative = {"mp4": clip.video, "webm": clip.webm, "png": clip.poster}.get(ext, "")
     if not relative:
         return HttpResponse(status=404)
-    if not media_allowed(request, clip):
+    near = _near_assignments(request, clip)
+    if not near and not has_staff_permission(request.user, "studyapp.view_clip"):
         return HttpResponse("This clip is shown on its study page only.", status=403,
                             content_type="text/plain; charset=utf-8")
+    if ext != "png" and request.method == "GET":
+        _record_fetch(near)
     if settings.MEDIA_ACCEL_REDIRECT:
         return accel_redirect_response(media_path(relative), settings.MEDIA_ACCEL_REDIRECT)
     return ranged_file_response(request, media_path(relative))

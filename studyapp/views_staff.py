@@ -2,7 +2,9 @@
 
 Each page needs a staff account (else the admin login) and one Django permission (else 403): creating a study
 studyapp.add_study, preview and progress studyapp.view_study, CSV exports and the analysis report (participant
-data, Prolific IDs included) studyapp.export_participant_data. A study's pages also need access to that study
+data, external ids pseudonymised unless the study asks) studyapp.export_participant_data, the external ids for
+payment studyapp.download_payment_ids (studyapp.privacy). Every staff page and download is sent with
+``Cache-Control: no-store`` (studyapp.security.NoStoreMiddleware). A study's pages also need access to that study
 (its owner or a collaborator, or a superuser): another lab's study is a 404 (studyapp.permissions.study_of). The
 researcher who creates a study from a preset becomes its owner.
 """
@@ -13,9 +15,10 @@ from pathlib import Path
 
 from django.contrib import messages
 from django.db.models import Count, Q
-from django.http import FileResponse, Http404, StreamingHttpResponse
+from django.http import Http404, StreamingHttpResponse
 from django.shortcuts import redirect, render
 from django.urls import reverse
+from django.utils.http import content_disposition_header
 from django.views.decorators.http import require_http_methods
 
 from generation.render import contact_sheet
@@ -23,15 +26,17 @@ from protocol.vocabulary import ATTENTION_CHECK
 
 from .assignment import plan_study
 from .catalogue import clip_label
-from .export import EXPORT_KINDS, stream_csv
+from .export import EXPORT_KINDS, csv_lines, stream_csv
 from .forms import ConsentForm, PresetStudyForm
 from .i18n import activate_study_language
 from .media import media_path
 from .models import Assignment, Participant, Response, Study
 from .permissions import EXPORT_PERMISSION, staff_permission_required, study_of
 from .presets import create_study_from_preset
+from .privacy import PAYMENT_COLUMNS, PAYMENT_PERMISSION, payment_rows
 from .questions import AnswerError, clean_answers
 from .reports import report_state, start_build
+from .streaming import body, file_body
 from .views import item_context, item_questions
 
 
@@ -137,8 +142,19 @@ def export_csv(request, study_id: int, kind: str):
     study = study_of(request, study_id)
     if kind not in EXPORT_KINDS:
         raise Http404("unknown export")
-    response = StreamingHttpResponse(stream_csv(study, kind), content_type="text/csv; charset=utf-8")
+    response = StreamingHttpResponse(body(request, stream_csv(study, kind)), content_type="text/csv; charset=utf-8")
     response["Content-Disposition"] = f'attachment; filename="{study.slug}-{kind}.csv"'
+    return response
+
+
+@staff_permission_required(PAYMENT_PERMISSION)
+def payment_ids(request, study_id: int):
+    """The study's external ids (Prolific IDs) with status and completion time, for paying participants: no
+    participant id and no answer, so the file cannot be joined to the data."""
+    study = study_of(request, study_id)
+    response = StreamingHttpResponse(body(request, csv_lines(PAYMENT_COLUMNS, payment_rows(study))),
+                                     content_type="text/csv; charset=utf-8")
+    response["Content-Disposition"] = f'attachment; filename="{study.slug}-payment-ids.csv"'
     return response
 
 
@@ -162,14 +178,21 @@ def report_zip(request, study_id: int):
         return redirect(reverse("studyapp:progress", args=[study.pk]) + "#report")
     state = report_state(study)
     try:
-        fh = open(state.zip_path, "rb") if state.status == "ready" else None
+        size = state.zip_path.stat().st_size if state.status == "ready" else None
     except FileNotFoundError:        # pruned by a newer build a moment ago
-        fh = None
-    if fh is None:
+        size = None
+    if size is None:
         messages.warning(request, "No report of the current data yet: build it first.")
         return redirect(reverse("studyapp:progress", args=[study.pk]) + "#report")
-    return FileResponse(fh, as_attachment=True, content_type="application/zip",
-                        filename=f"{study.slug}-report-{state.version}.zip")
+    return file_download(request, state.zip_path, size, "application/zip", f"{study.slug}-report-{state.version}.zip")
+
+
+def file_download(request, path: Path, size: int, content_type: str, filename: str) -> StreamingHttpResponse:
+    """An attachment streamed from ``path`` (studyapp.streaming: async under ASGI, never read whole)."""
+    response = StreamingHttpResponse(file_body(request, path, 0, size), content_type=content_type)
+    response["Content-Length"] = str(size)
+    response["Content-Disposition"] = content_disposition_header(True, filename)
+    return response
 
 
 def contact_sheet_response(request, clips):
@@ -192,5 +215,4 @@ def contact_sheet_response(request, clips):
     contact_sheet(posters, [clip_label({"clip_id": c.clip_id, "origin": c.origin, "metadata": c.metadata})
                             for c in clips], out)
     plans = sorted({c.plan for c in clips if c.plan}) or ["clips"]
-    return FileResponse(open(out, "rb"), as_attachment=True, filename=f"{'-'.join(plans)}-contact-sheet.png",
-                        content_type="image/png")
+    return file_download(request, out, out.stat().st_size, "image/png", f"{'-'.join(plans)}-contact-sheet.png")

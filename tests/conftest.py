@@ -43,6 +43,13 @@ def _single_threaded_torch():
     torch.set_num_threads(1)
 
 
+@pytest.fixture(autouse=True)
+def _start_rate_limit_off(settings):
+    """Tests start many participants from one address (127.0.0.1): the start rate limit (studyapp.start_throttle)
+    is off unless a test turns it on (tests/test_start_rate_limit.py)."""
+    settings.START_RATE_BURST = 0
+
+
 @pytest.fixture
 def chromium():
     """A Selenium WebDriver on Debian's headless Chromium (/usr/bin/chromium + chromedriver).

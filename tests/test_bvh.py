@@ -127,7 +127,10 @@ def malformed_cases():
         ("frame count", good.replace("Frames: 3", "Frames: 4"), "'Frames: 4' but the file holds 3"),
         ("no hierarchy", good.replace("HIERARCHY", "HIERARCH"), "line 1: expected 'HIERARCHY'"),
         ("truncated", good.split("MOTION")[0][:-30], "unexpected end of file"),
-        ("bad frame time", good.replace("Frame Time: 0.04", "Frame Time: 0"), "Frame Time must be positive"),
+        ("bad frame time", good.replace("Frame Time: 0.04", "Frame Time: 0"), "Frame Time must be from 0.001 to 1 s"),
+        ("tiny frame time", good.replace("Frame Time: 0.04", "Frame Time: 1e-300"),
+         "line 27: Frame Time must be from 0.001 to 1 s (1000 to 1 frames per second), got 1e-300"),
+        ("long frame time", good.replace("Frame Time: 0.04", "Frame Time: 2"), "Frame Time must be from"),
         ("text in frame", good.replace("0 100 0 0 90 90", "0 100 0 0 ninety 90"),
          "line 30: frame 2: expected a number"),
         ("duplicate joint", good.replace("JOINT Leg", "JOINT Chest"), "duplicate joint name 'Chest'"),
@@ -142,6 +145,35 @@ def test_malformed_files_rejected_with_line(tmp_path, name, text, message):
         read_bvh(path)
     assert str(path) in str(exc.value)
     assert message in str(exc.value)
+
+
+def test_frame_time_limits_are_inclusive(tmp_path):
+    for frame_time, fps in (("0.001", 1000.0), ("1", 1.0)):
+        path = tmp_path / f"ok_{frame_time}.bvh"
+        path.write_text(HAND_WRITTEN.replace("Frame Time: 0.04", f"Frame Time: {frame_time}"))
+        assert read_bvh(path).fps == pytest.approx(fps)
+
+
+def test_a_bvh_over_the_size_limit_is_refused_before_it_is_read(tmp_path, monkeypatch):
+    from generation.formats import bvh as bvh_module
+
+    path = tmp_path / "huge.bvh"
+    with path.open("wb") as f:                     # 100 MB: a valid header, then a sparse hole of frame "lines"
+        f.write(HAND_WRITTEN.encode())
+        f.truncate(100 * 1000 * 1000)
+
+    def no_read(*args, **kwargs):
+        raise AssertionError("the file was read")
+
+    monkeypatch.setattr(type(path), "read_text", no_read)
+    with pytest.raises(MotionFormatError, match=r"huge.bvh: 95.4 MiB, larger than the BVH limit of 32 MiB"):
+        read_bvh(path)
+    monkeypatch.undo()
+    small = tmp_path / "small.bvh"
+    small.write_text(HAND_WRITTEN)
+    with pytest.raises(MotionFormatError, match="larger than the BVH limit"):
+        bvh_module.parse_bvh(small, max_bytes=100)
+    assert bvh_module.parse_bvh(small, max_bytes=None).fps == pytest.approx(25.0)
 
 
 def test_missing_file(tmp_path):

@@ -302,6 +302,8 @@ def test_german_errors_and_no_leak_into_the_next_request(client, german_study):
     html = r.content.decode()
     assert "Bitte setzen Sie vor dem Start das Häkchen" in html
     assert r["Content-Language"] == "de"
+    german_study.listed_publicly = True
+    german_study.save(update_fields=["listed_publicly"])
     home = client.get("/")                    # same thread: the default language again
     assert home["Content-Language"] == "en" and "Open studies" in home.content.decode()
     assert translation.get_language() in (None, "en", "en-us")

@@ -23,7 +23,7 @@ from scripts.import_graph import GROUND, ROOT, find_cycles, imports_of, module_n
 #: The packages of generation, bottom first: each may import only those before it.
 LAYERS = ("core", "formats", "procedural", "render", "gesture", "mocap", "gait", "rbf", "quality", "plans",
           "pipeline", "imports")
-LOCAL_IMPORT_BUDGET = 10
+LOCAL_IMPORT_BUDGET = 11      # 10, and studyapp.apps.ready connecting the signal receivers (Django's way)
 
 FORBIDDEN = [
     ("generation", ("studyapp", "django"), "generation never imports studyapp or Django"),

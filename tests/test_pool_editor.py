@@ -290,7 +290,7 @@ def test_structured_fields_win_once_edited_and_keep_raw_only_keys(admin_client, 
         "sections-0-pool": json.dumps({"modality": "gait", "plan": "test", "clip_id__startswith": "gest_"})})
     assert r.status_code == 302, r.context["inline_admin_formsets"][0].formset.errors
     section = study.sections.get(order=1)
-    assert section.pool == {"modality": "gesture", "origin": "generated", "plan": "test",
+    assert section.pool == {"modality": "gesture", "origin": "generated", "plan": "test", "keep_advisory": True,
                             "emotion_label": ["proud", "sad"], "clip_id__startswith": "gest_"}
     assert section.options == {"n_options": 3}
     messages = [m.message for m in r.wsgi_request._messages]

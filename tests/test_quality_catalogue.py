@@ -38,9 +38,11 @@ def test_flagged_clip_stays_out_of_pools_unless_included():
 
 
 @pytest.mark.django_db
-def test_advisory_realism_flag_keeps_a_clip_in_pools():
+def test_advisory_realism_flag_keeps_a_clip_in_pools_that_keep_advisory_flags():
     upsert_clips([rec("real_like", "realism"), rec("off_emotion", "observer;realism"), rec("good")])
-    assert set(pool_queryset({"modality": "gait"}).values_list("clip_id", flat=True)) == {"real_like", "good"}
+    assert set(pool_queryset({"modality": "gait"}).values_list("clip_id", flat=True)) == {"good"}
+    kept = pool_queryset({"modality": "gait", "keep_advisory": True})
+    assert set(kept.values_list("clip_id", flat=True)) == {"real_like", "good"}
     flagged = pool_queryset({"modality": "gait", "include_flagged": True})
     assert set(flagged.values_list("clip_id", flat=True)) == {"real_like", "off_emotion", "good"}
 
@@ -52,7 +54,9 @@ def test_observer_advisory_pool_keeps_observer_flags_but_not_other_failures():
     plain = pool_queryset({"modality": "gait"})
     assert set(plain.values_list("clip_id", flat=True)) == {"good"}
     candidates = pool_queryset({"modality": "gait", "observer_advisory": True})
-    assert set(candidates.values_list("clip_id", flat=True)) == {"off_emotion", "off_and_real", "good"}
+    assert set(candidates.values_list("clip_id", flat=True)) == {"off_emotion", "good"}
+    both = pool_queryset({"modality": "gait", "observer_advisory": True, "keep_advisory": True})
+    assert set(both.values_list("clip_id", flat=True)) == {"off_emotion", "off_and_real", "good"}
 
 
 def test_include_flagged_and_observer_advisory_are_boolean_pool_switches():

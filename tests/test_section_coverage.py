@@ -11,7 +11,8 @@ from analysis.coverage import planned_rows
 from generation.plans.planned import planned_clip_rows
 from generation.plans.schema import load_plan
 from protocol import coverage
-from protocol.coverage import blocking, matches
+from protocol.coverage import matches
+from protocol.pools import blocking_checks
 from protocol.presets import PRESET_PLANS
 
 
@@ -30,9 +31,13 @@ def test_pool_filters_on_planned_rows():
     assert not matches(row, {"transition": True})
     assert matches(row, {"sections__contains": "naturalness", "happy__gte": 0.5})
     assert not matches(row, {"origin": ["source"]})
-    assert blocking("observer;realism") == ["observer"] and blocking("realism") == [] and blocking("") == []
-    assert blocking("observer;realism", observer_advisory=True) == []
-    assert blocking("penetration;observer", observer_advisory=True) == ["penetration"]
+    advisory = {"keep_advisory": True}
+    assert blocking_checks("realism", {}) == ["realism"] and blocking_checks("", {}) == []
+    assert blocking_checks("observer;realism", advisory) == ["observer"] and blocking_checks("realism", advisory) == []
+    assert blocking_checks("observer;realism", {**advisory, "observer_advisory": True}) == []
+    assert blocking_checks("observer;realism", {"observer_advisory": True}) == ["realism"]
+    assert blocking_checks("penetration;observer", {"observer_advisory": True}) == ["penetration"]
+    assert blocking_checks("penetration;observer", {"include_flagged": True}) == []
 
 
 def test_demo_sections_full_when_nothing_is_flagged_and_short_when_the_gate_takes_clips():

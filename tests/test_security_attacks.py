@@ -198,6 +198,8 @@ def test_safe_cell(value, written):
 
 
 def test_exports_neutralise_participant_text_but_keep_negative_ratings(study):
+    Study.objects.filter(pk=study.pk).update(export_external_ids=True)      # the ids as given: the risky case
+    study.refresh_from_db()
     browser = Client()
     p = consent(browser, study, qs(PROLIFIC_PID='=HYPERLINK("http://evil.example","open")'))
     Participant.objects.filter(pk=p.pk).update(feedback={"comments": "@SUM(1+1)*cmd|' /C calc'!A0",

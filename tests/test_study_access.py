@@ -105,7 +105,8 @@ def test_staff_pages_of_ones_own_study_open(labs, who, monkeypatch):
         r = getattr(c, method)(url)
         assert r.status_code in (200, 302), (who, method, url, r.status_code)
     export = c.get(reverse("studyapp:export_csv", args=[labs["ours"].pk, "participants"]))
-    assert b"PID-ours" in b"".join(export.streaming_content)
+    from studyapp.privacy import pseudonym
+    assert pseudonym(labs["ours"].pk, "PID-ours").encode() in b"".join(export.streaming_content)
     if who == "root":
         for method, url in staff_pages(labs["theirs"]):
             assert getattr(c, method)(url).status_code in (200, 302), url
@@ -214,3 +215,41 @@ def test_a_section_may_name_only_a_readable_study_as_its_norms(labs):
     # a source a superuser saved stays: the lab can still save its study without naming it anew
     Section.objects.filter(pk=section.pk).update(pool={**before, "norms": {"from": "ours", "min_ratings": 1}})
     assert mallory.post(url, admin_form_data(mallory.get(url))).status_code == 302
+
+
+def live_sub_pool_norms(c: Client, source: str) -> dict:
+    """The live count of a naturalness pool whose ``generated`` sub-pool carries a norms rule reading ``source``."""
+    pool = {"modality": "gait", "generated": {"norms": {"from": source, "min_intended_share": 0.0}}}
+    return c.get(reverse("admin:studyapp_pool_count"), {"section_type": "naturalness", "pool": json.dumps(pool),
+                                                         "clips_per_participant": "2"}).json()
+
+
+def test_a_sub_pools_norms_rule_is_checked_like_the_pools_own(labs, monkeypatch):
+    from studyapp import norms_rule
+
+    read = []
+    monkeypatch.setattr(norms_rule, "load_norms", lambda source: read.append(source) or {})
+    mallory = client_of(labs["mallory"])
+    refused = {source: pool_messages(live_sub_pool_norms(mallory, source)).replace(source, "<slug>")
+               for source in ("ours", "no-such-study")}
+    assert read == [], "another lab's norms were read through a sub-pool"
+    assert refused["ours"] == refused["no-such-study"] and "pool.generated.norms.from" in refused["ours"]
+    assert live_sub_pool_norms(client_of(labs["alice"]), "ours")["count"] is not None
+
+
+def test_a_sub_pool_naming_another_labs_study_does_not_save(labs):
+    theirs = labs["theirs"]
+    section = theirs.sections.get(section_type="naturalness", order=4)
+    before = section.pool
+    url = reverse("admin:studyapp_study_change", args=[theirs.pk])
+    mallory = client_of(labs["mallory"])
+    data = admin_form_data(mallory.get(url))
+    index = list(theirs.sections.order_by("order")).index(section)
+    data[f"sections-{index}-pool"] = json.dumps(
+        {**before, "generated": {"origin": "generated", "norms": {"from": "ours", "min_ratings": 1}}})
+    page = mallory.post(url, data)
+    assert page.status_code == 200, "a sub-pool naming another lab's study was saved"
+    errors = page.context["inline_admin_formsets"][0].formset.errors[index]
+    assert "pool.generated.norms.from" in " ".join(errors["pool"]), errors
+    section.refresh_from_db()
+    assert section.pool == before

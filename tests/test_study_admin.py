@@ -165,7 +165,9 @@ def test_exports_match_design_formats(staff, study):
     assert tr["final_happy"] != "" and next(c for c in clips if c["clip_id"] == "gait_gen_00")["final_happy"] == ""
     people = read_csv(staff.get(reverse("studyapp:export_csv", args=[study.pk, "participants"])))
     assert tuple(people[0])[:len(PARTICIPANT_COLUMNS)] == PARTICIPANT_COLUMNS and "distracted_camera" in people[0]
-    row = next(x for x in people if x["external_id"] == "PID1")
+    from studyapp.privacy import pseudonym
+    assert "PID1" not in {x["external_id"] for x in people}          # pseudonymised by default
+    row = next(x for x in people if x["external_id"] == pseudonym(study.pk, "PID1"))
     assert row["gender"] == "female" and row["status"] == "completed" and row["started_at"]
     assert staff.get(reverse("studyapp:export_csv", args=[study.pk, "secrets"])).status_code == 404
 

@@ -54,10 +54,14 @@ def demographics(client, p):
     assert r.status_code == 302
 
 
-def test_home_page_lists_open_studies_only(client, study):
-    create_study_from_preset("rbf_thms2016", "draft-study", plan="test", title="A draft study")
+def test_home_page_lists_open_studies_that_ask_to_be_listed_only(client, study):
+    assert "No study is open" in client.get("/").content.decode()      # open, but not listed: its slug stays unseen
+    assert study.slug not in client.get("/").content.decode()
+    Study.objects.filter(pk=study.pk).update(listed_publicly=True)
+    create_study_from_preset("rbf_thms2016", "draft-study", plan="test", title="A draft study",
+                             listed_publicly=True)
     create_study_from_preset("rbf_thms2016", "closed-study", plan="test", title="A closed study",
-                             status=Study.Status.CLOSED)
+                             status=Study.Status.CLOSED, listed_publicly=True)
     r = client.get("/")
     assert r.status_code == 200
     html = r.content.decode()

@@ -172,6 +172,12 @@ def started(client: Client, study: Study) -> Participant:
     return p
 
 
+def fetch_clip(client, p) -> None:
+    """What the player does first: fetch the current page's clip (the server's evidence that it was sent)."""
+    clip = cur(p).assignment.clip
+    assert client.get(reverse("studyapp:media", args=[clip.media_key, "mp4"])).status_code == 200
+
+
 def answer(client, p, n, extra):
     step = cur(p)
     r = client.post(reverse("studyapp:item", args=[p.token, n]), {**answer_for(step.assignment), **extra})
@@ -212,9 +218,11 @@ def test_start_up_buffering_is_stored_as_start_up_time_not_as_stalls(client, stu
     startup_ms 800 and no stall, and a stall after the first frame is counted as one."""
     p = started(client, study)
     client.get(reverse("studyapp:item", args=[p.token, 1]))
+    fetch_clip(client, p)
     answer(client, p, 1, posted({**GOOD_RECORD, "first_play_ms": 900, "ended_ms": 3900, "startup_ms": 800,
                                  "stalls": 0, "stall_ms": 0}))
     client.get(reverse("studyapp:item", args=[p.token, 2]))
+    fetch_clip(client, p)
     answer(client, p, 2, posted({**GOOD_RECORD, "first_play_ms": 300, "ended_ms": 3500, "startup_ms": 250,
                                  "stalls": 1, "stall_ms": 400}))
     rows = list(csv.DictReader(io.StringIO("".join(stream_csv(study, "viewing")))))
@@ -230,6 +238,7 @@ def test_viewing_csv_has_one_row_per_answered_clip_page(client, study):
     answer(client, p, 1, {})
     client.get(reverse("studyapp:item", args=[p.token, 2]))
     client.get(reverse("studyapp:item", args=[p.token, 2]))      # a reload
+    fetch_clip(client, p)
     a2 = answer(client, p, 2, posted(GOOD_RECORD | {"ended_ms": 400}))
     rows = list(csv.reader(io.StringIO("".join(stream_csv(study, "viewing")))))
     assert tuple(rows[0]) == VIEWING_COLUMNS
@@ -304,6 +313,7 @@ def test_a_reload_keeps_the_plays_and_max_replays_holds(client, study):
     html = client.get(url).content.decode()                     # no plays left: the clip does not start again
     video = html[html.index("<video"):html.index(">", html.index("<video"))]
     assert 'data-plays-before="2"' in video and " autoplay" not in video
+    fetch_clip(client, p)
     a = answer(client, p, 1, posted({"plays": 0, "pauses": 0}))      # the last display's own record: no play
     a.refresh_from_db()
     assert a.plays == 2 and a.play_ended_ms is not None and a.shows == 3
@@ -413,3 +423,68 @@ def test_staff_who_may_see_the_catalogue_get_media(study, django_user_model):
     plain = Client()
     plain.force_login(django_user_model.objects.create_user("member", password="pw-member-12345"))
     assert plain.get(url).status_code == 403
+
+
+# ---- the record against the server's evidence ------------------------------------------------------------------
+
+def shown_ago(p, seconds: float) -> None:
+    """Move the current page's first display back in time (as if the participant had been on it that long)."""
+    from datetime import timedelta
+
+    from django.utils import timezone
+
+    Assignment.objects.filter(pk=cur(p).assignment.pk).update(shown_at=timezone.now() - timedelta(seconds=seconds))
+
+
+def six_second_clips(study) -> None:
+    from studyapp.models import Clip
+
+    Clip.objects.update(duration_s=6.0)
+    study.sections.update(require_full_play=False)
+
+
+@pytest.mark.django_db
+def test_a_forged_record_of_a_clip_never_fetched_is_implausible(client, study):
+    p = started(client, study)
+    client.get(reverse("studyapp:item", args=[p.token, 1]))
+    forged = answer(client, p, 1, posted(GOOD_RECORD))          # invented fields: the clip was never sent
+    forged.refresh_from_db()
+    assert forged.fetched_at is None and forged.viewing["record"] == "implausible"
+    client.get(reverse("studyapp:item", args=[p.token, 2]))
+    fetch_clip(client, p)
+    honest = answer(client, p, 2, posted(GOOD_RECORD))
+    honest.refresh_from_db()
+    assert honest.fetched_at is not None and honest.viewing["record"] == "ok"
+
+
+@pytest.mark.django_db
+def test_an_end_reported_sooner_than_the_clip_lasts_is_implausible(client, study):
+    six_second_clips(study)
+    p = started(client, study)
+    client.get(reverse("studyapp:item", args=[p.token, 1]))
+    fetch_clip(client, p)
+    assert report(client, p, 1, "play").status_code == 204
+    assert report(client, p, 1, "ended").status_code == 204     # 'ended' a few ms after the page of a 6 s clip
+    shown_ago(p, 10)                                             # the answer itself comes late enough
+    early = answer(client, p, 1, posted({"first_play_ms": 100, "ended_ms": 6300, "plays": 1}))
+    early.refresh_from_db()
+    assert early.play_ended_ms < 1000 and early.viewing["record"] == "implausible"
+    # the same record after the clip had time to play: ok
+    client.get(reverse("studyapp:item", args=[p.token, 2]))
+    fetch_clip(client, p)
+    shown_ago(p, 7)
+    assert report(client, p, 2, "ended").status_code == 204
+    fair = answer(client, p, 2, posted({"first_play_ms": 100, "ended_ms": 6300, "plays": 1}))
+    fair.refresh_from_db()
+    assert fair.viewing["record"] == "ok"
+
+
+def test_ends_too_soon_after_the_first_play_or_the_page_are_implausible():
+    record = {"first_play_ms": 100, "ended_ms": 160, "plays": 1}
+    assert parse_viewing(posted(record), 10_000, 6.0, fetched=True)["record"] == "implausible"
+    assert parse_viewing(posted(record), 10_000, 6.0, fetched=True, controls="full")["record"] == "ok"   # seekable
+    ok = {"first_play_ms": 100, "ended_ms": 6200, "plays": 1}
+    assert parse_viewing(posted(ok), 6_300, 6.0, fetched=True)["record"] == "ok"
+    assert parse_viewing(posted(ok), 3_000, 6.0, fetched=True)["record"] == "implausible"    # the page was shorter
+    assert parse_viewing(posted(ok), 6_300, 6.0, fetched=False)["record"] == "implausible"   # never sent
+    assert parse_viewing(posted({"plays": 0}), 6_300, 6.0, fetched=False)["record"] == "ok"  # nothing claimed

@@ -38,14 +38,23 @@ from generation.formats.units import guess_unit
 _CHANNELS = ("Xposition", "Yposition", "Zposition", "Xrotation", "Yrotation", "Zrotation")
 
 
-class _Tokens:
-    """Whitespace tokens with their 1-based line numbers."""
+MAX_BVH_BYTES = 32 * 1024 * 1024
+"""Largest BVH file read (bytes), checked before the file is opened: parsing holds the text, its lines and the
+(T, channels) values, a few times the file's size (docs/benchmarks/study.md, "BVH size limit")."""
+FRAME_TIME_RANGE = (1e-3, 1.0)
+"""Accepted ``Frame Time`` (seconds per frame): 1000 down to 1 frame per second."""
+_FRAME_TIME_LINE = re.compile(r"^[ \t]*Frame[ \t]+Time:[^\n]*\n?", re.M)
 
-    def __init__(self, text: str, path: Path):
+
+class _Tokens:
+    """Whitespace tokens with their 1-based line numbers; ``tokenized_lines`` (default all) limits the tokens to
+    the first lines (the header: the frame lines are read row by row, not as tokens)."""
+
+    def __init__(self, text: str, path: Path, tokenized_lines: int | None = None):
         self.path = path
         self.items: list[tuple[str, int]] = []
         self.lines = text.splitlines()
-        for ln, line in enumerate(self.lines, 1):
+        for ln, line in enumerate(self.lines[:tokenized_lines], 1):
             for tok in line.split():
                 self.items.append((tok, ln))
         self.pos = 0
@@ -219,18 +228,26 @@ def _fk_with_translations(rotations: np.ndarray, translations: np.ndarray, paren
     return world_P, world_R
 
 
-def parse_bvh(path: str | Path) -> BvhData:
+def parse_bvh(path: str | Path, max_bytes: int | None = MAX_BVH_BYTES) -> BvhData:
     """Read a BVH file exactly as written (file units; see :class:`BvhData`).
 
+    Args:
+        path: the file.
+        max_bytes: the largest file read (checked before it is opened; None: no limit).
     Raises:
-        MotionFormatError: naming the file and the line of the first problem.
+        MotionFormatError: naming the file and the line of the first problem, or the file's size.
     """
     path = Path(path)
     try:
+        size = path.stat().st_size
+        if max_bytes is not None and size > max_bytes:
+            raise MotionFormatError(f"{path}: {size / 2**20:.1f} MiB, larger than the BVH limit of "
+                                    f"{max_bytes / 2**20:.0f} MiB")
         text = path.read_text(encoding="utf-8", errors="replace")
     except OSError as exc:
         raise MotionFormatError(f"{path}: cannot read ({exc.strerror or exc})") from None
-    tk = _Tokens(text, path)
+    header = _FRAME_TIME_LINE.search(text)
+    tk = _Tokens(text, path, len(text[:header.end()].splitlines()) if header else None)
     names, parents, offsets, channels, end_site = _parse_hierarchy(tk)
     values, frame_time = _read_frames(tk, sum(len(c) for c in channels))
     rotations, translations = _apply_channels(values, offsets, channels)
@@ -319,29 +336,33 @@ def _read_frames(tk: _Tokens, n_ch: int) -> tuple[np.ndarray, float]:
     tk.expect("Frame")
     tk.expect("Time:")
     frame_time = tk.number("Frame Time")
-    if frame_time <= 0:
-        raise tk.error(f"Frame Time must be positive, got {frame_time}", tk.items[tk.pos - 1][1])
+    lo, hi = FRAME_TIME_RANGE
+    if not lo <= frame_time <= hi:
+        raise tk.error(f"Frame Time must be from {lo:g} to {hi:g} s (1000 to 1 frames per second), got "
+                       f"{frame_time:g}", tk.items[tk.pos - 1][1])
     if n_frames == 0:
         raise tk.error("the file has no frames (Frames: 0)", tk.items[tk.pos - 1][1])
-    data_line = tk.items[tk.pos][1] if tk.pos < len(tk.items) else len(tk.lines) + 1
-    rows = []
+    data_line = tk.items[tk.pos][1] if tk.pos < len(tk.items) else tk.items[tk.pos - 1][1] + 1
+    # one row per non-blank line, filled in place: no Python float per value
+    values = np.empty((sum(1 for line in tk.lines[data_line - 1:] if line.strip()), n_ch), dtype=np.float64)
+    n = 0
     for ln in range(data_line, len(tk.lines) + 1):
         line = tk.lines[ln - 1].split()
         if not line:
             continue
         if len(line) != n_ch:
-            raise tk.error(f"frame {len(rows)} has {len(line)} values, expected {n_ch} (one per channel)", ln)
+            raise tk.error(f"frame {n} has {len(line)} values, expected {n_ch} (one per channel)", ln)
         try:
-            row = [float(v) for v in line]
+            values[n] = line
         except ValueError:
             bad = next(v for v in line if not _is_float(v))
-            raise tk.error(f"frame {len(rows)}: expected a number, got {bad!r}", ln) from None
-        if not np.all(np.isfinite(row)):
-            raise tk.error(f"frame {len(rows)}: value is not finite", ln)
-        rows.append(row)
-    if len(rows) != n_frames:
-        raise tk.error(f"'Frames: {n_frames}' but the file holds {len(rows)} frame lines")
-    return np.array(rows, dtype=np.float64).reshape(n_frames, n_ch), frame_time
+            raise tk.error(f"frame {n}: expected a number, got {bad!r}", ln) from None
+        if not np.all(np.isfinite(values[n])):
+            raise tk.error(f"frame {n}: value is not finite", ln)
+        n += 1
+    if n != n_frames:
+        raise tk.error(f"'Frames: {n_frames}' but the file holds {n} frame lines")
+    return values, frame_time
 
 
 def _apply_channels(values: np.ndarray, offsets: np.ndarray, channels: list[list[str]]):

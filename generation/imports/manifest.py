@@ -43,6 +43,8 @@ from protocol.vocabulary import (
 
 VIDEO_SUFFIXES = (".mp4", ".m4v", ".mov", ".webm", ".mkv", ".avi")
 MOTION_SUFFIXES = (".bvh",)
+MAX_MANIFEST_BYTES = 8 * 1024 * 1024
+"""Largest manifest read (bytes), checked before it is opened."""
 LABEL_COLUMNS = (*GAIT_EMOTIONS, *FINAL_EMOTION_COLUMNS, "emotion_label", *VAD_DIMENSIONS, "theme", "weight")
 TEXT_COLUMNS = ("title", "licence", "citation", "notes")
 OPTION_COLUMNS = ("keep_audio", "body")
@@ -257,6 +259,10 @@ def read_manifest(path: str | Path) -> list[ManifestRow | BadRow]:
     meant when it differs only in case or spelling)."""
     path = Path(path)
     try:
+        size = path.stat().st_size
+        if size > MAX_MANIFEST_BYTES:
+            raise ManifestError(path, None, None, f"{size / 2**20:.1f} MiB, larger than the manifest limit of "
+                                                  f"{MAX_MANIFEST_BYTES / 2**20:.0f} MiB (one line per file)")
         text = path.read_text(encoding="utf-8-sig")
     except UnicodeDecodeError as exc:
         raise ManifestError(path, None, None, f"cannot read ({exc}): save it as UTF-8 text (a spreadsheet's "

@@ -1,7 +1,11 @@
 """What a video file holds, as the bundled ffmpeg (imageio-ffmpeg) reads it: container, codecs, duration, frame
 size, frame rate and audio. ``ffmpeg -i`` prints the streams of its input on stderr; ffprobe is not bundled.
 
-A file ffmpeg cannot open raises :class:`VideoProbeError` with ffmpeg's reason; :func:`decode_check` decodes every
+ffmpeg never chooses its reader from a file's content: :func:`input_args` names the demuxer from the file's extension
+(:data:`DEMUXERS`, an allow-list of self-contained containers: no dash, hls, concat or other formats that refer to
+further files or URLs) and allows only the ``file`` protocol, so a playlist saved as ``walk.mp4`` is a decoding
+error, not a read of a video outside the upload. A file ffmpeg cannot open raises :class:`VideoProbeError` with
+ffmpeg's reason; :func:`decode_check` decodes every
 video frame (``-xerror``: the first corrupt packet fails) for files whose streams are kept as they are.
 """
 from __future__ import annotations
@@ -21,8 +25,22 @@ _SIZE = re.compile(r"(?<![\w.])(?P<w>\d{2,5})x(?P<h>\d{2,5})(?![\w.])")
 _FPS = re.compile(r"(?P<fps>\d+(?:\.\d+)?) (?:fps|tbr)")
 
 
+DEMUXERS = {".mp4": "mov", ".m4v": "mov", ".mov": "mov", ".webm": "matroska", ".mkv": "matroska", ".avi": "avi"}
+"""File extension -> the one ffmpeg demuxer that may read it (``mov`` reads no external data references unless
+asked: ``enable_drefs`` stays off)."""
+
+
 class VideoProbeError(ValueError):
     """A video ffmpeg cannot open or decode; the message names the file and ffmpeg's reason."""
+
+
+def input_args(path: Path) -> list[str]:
+    """ffmpeg input options for ``path``: its demuxer named from the extension (:data:`DEMUXERS`), only local files,
+    then ``-i path``; VideoProbeError for an extension outside the allow-list."""
+    demuxer = DEMUXERS.get(Path(path).suffix.lower())
+    if demuxer is None:
+        raise VideoProbeError(f"{Path(path).name}: not a video type the import reads ({', '.join(DEMUXERS)})")
+    return ["-f", demuxer, "-protocol_whitelist", "file", "-i", str(path)]
 
 
 @dataclass(frozen=True)
@@ -69,7 +87,7 @@ def probe_video(path: str | Path, timeout_s: float = 60.0) -> VideoProbe:
     if size == 0:
         raise VideoProbeError(f"{path.name}: empty file (0 bytes)")
     try:
-        proc = subprocess.run([ffmpeg_exe(), "-hide_banner", "-nostdin", "-i", str(path)], capture_output=True,
+        proc = subprocess.run([ffmpeg_exe(), "-hide_banner", "-nostdin", *input_args(path)], capture_output=True,
                               text=True, errors="replace", timeout=timeout_s)
     except subprocess.TimeoutExpired:
         raise VideoProbeError(f"{path.name}: ffmpeg did not finish reading the header in {timeout_s:g} s") from None
@@ -99,7 +117,7 @@ def _video_to_null(path: Path, timeout_s: float, doing: str, input_options=(), o
                    ) -> subprocess.CompletedProcess:
     """Run ffmpeg on the first video stream of ``path`` into the null muxer with progress statistics on stderr;
     VideoProbeError when ``doing`` (e.g. "decoding") takes longer than ``timeout_s``."""
-    cmd = [ffmpeg_exe(), "-hide_banner", "-nostdin", "-v", "error", "-stats", *input_options, "-i", str(path),
+    cmd = [ffmpeg_exe(), "-hide_banner", "-nostdin", "-v", "error", "-stats", *input_options, *input_args(path),
            "-map", "0:v:0", *output_options, "-f", "null", "-"]
     try:
         return subprocess.run(cmd, capture_output=True, text=True, errors="replace", timeout=timeout_s)

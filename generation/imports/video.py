@@ -16,7 +16,15 @@ from pathlib import Path
 
 from generation.render.encode import codec_params
 
-from .probe import VideoProbe, VideoProbeError, count_video_packets, decode_check, ffmpeg_exe, probe_video
+from .probe import (
+    VideoProbe,
+    VideoProbeError,
+    count_video_packets,
+    decode_check,
+    ffmpeg_exe,
+    input_args,
+    probe_video,
+)
 
 PLAYABLE_CODECS = ("h264",)
 PLAYABLE_PIX_FMTS = ("yuv420p", "yuvj420p")
@@ -120,7 +128,7 @@ def stage_video(path: Path, stage: Path, stem: str, limits: VideoLimits, keep_au
     probe = check_video(path, limits)
     mp4 = stage / f"{stem}.mp4"
     audio_args, audio = _audio_args(probe, keep_audio)
-    base = [ffmpeg_exe(), "-hide_banner", "-nostdin", "-v", "error", "-y", "-xerror", "-i", str(path),
+    base = [ffmpeg_exe(), "-hide_banner", "-nostdin", "-v", "error", "-y", "-xerror", *input_args(path),
             "-map", "0:v:0", *(["-map", "0:a:0"] if audio == "kept" else []), "-map_metadata", "-1", "-sn", "-dn"]
     if needs_transcode(probe):
         action = "transcode"
@@ -140,15 +148,15 @@ def stage_video(path: Path, stage: Path, stem: str, limits: VideoLimits, keep_au
         raise VideoImportError("the video has no duration (zero frames)")
     poster = stage / f"{stem}.png"
     _run([ffmpeg_exe(), "-hide_banner", "-nostdin", "-v", "error", "-y", "-ss", f"{POSTER_FRACTION * duration:.3f}",
-          "-i", str(mp4), "-frames:v", "1", "-update", "1", str(poster)], "making the poster", 120.0)
+          *input_args(mp4), "-frames:v", "1", "-update", "1", str(poster)], "making the poster", 120.0)
     if not poster.is_file() or poster.stat().st_size == 0:
-        _run([ffmpeg_exe(), "-hide_banner", "-nostdin", "-v", "error", "-y", "-i", str(mp4), "-frames:v", "1",
+        _run([ffmpeg_exe(), "-hide_banner", "-nostdin", "-v", "error", "-y", *input_args(mp4), "-frames:v", "1",
               "-update", "1", str(poster)], "making the poster", 120.0)
     out_webm = None
     if webm:
         out_webm = stage / f"{stem}.webm"
         codec, params = codec_params("webm", threads=threads)
         webm_audio = ["-c:a", "libopus", "-b:a", "96k"] if audio == "kept" else ["-an"]
-        _run([ffmpeg_exe(), "-hide_banner", "-nostdin", "-v", "error", "-y", "-i", str(mp4), "-c:v", codec, *params,
+        _run([ffmpeg_exe(), "-hide_banner", "-nostdin", "-v", "error", "-y", *input_args(mp4), "-c:v", codec, *params,
               *webm_audio, str(out_webm)], "encoding the WebM", timeout_s)
     return StagedVideo(mp4, poster, out_webm, probe, delivered, action, round(duration, 4), n_frames, audio)

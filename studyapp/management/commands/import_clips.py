@@ -1,7 +1,7 @@
 """Import a researcher's own videos and motion files into the clip catalogue (origin ``imported``).
 
     python manage.py import_clips MANIFEST.csv [--dry-run] [--report PATH] [--keep-audio] [--webm]
-                                  [--max-duration S] [--max-size-mb MB] [--name NAME]
+                                  [--max-duration S] [--max-size-mb MB] [--name NAME] [--remove-after DIR]
 
 Thin wrapper over :mod:`generation.imports`: every manifest row is checked, its file probed (videos) or imported and
 rendered (BVH), and committed all-or-nothing with its Clip row; the report ``import_report.csv`` (row, path,
@@ -12,6 +12,7 @@ format is in docs/study.md ("Bring your own stimuli").
 from __future__ import annotations
 
 import contextlib
+import shutil
 from pathlib import Path
 
 from django.conf import settings
@@ -105,8 +106,21 @@ class Command(BaseCommand):
         parser.add_argument("--no-observer", action="store_true",
                             help="no observer reading in the quality record of motion files")
         parser.add_argument("--threads", type=int, default=0, help="ffmpeg threads per encode (0: ffmpeg decides)")
+        parser.add_argument("--remove-after", default=None, metavar="DIR",
+                            help="a folder holding the manifest (an upload) to remove when the command ends, "
+                                 "whether it imported, failed or was a dry run")
 
     def handle(self, *args, **opts):
+        folder = Path(opts["remove_after"]).resolve() if opts.get("remove_after") else None
+        if folder is not None and not Path(opts["manifest"]).resolve().is_relative_to(folder):
+            raise CommandError(f"--remove-after {folder}: the manifest is not inside it")
+        try:
+            self._import(opts)
+        finally:
+            if folder is not None:
+                shutil.rmtree(folder, ignore_errors=True)
+
+    def _import(self, opts):
         manifest = Path(opts["manifest"])
         if not manifest.is_file():
             raise CommandError(f"{manifest}: no such manifest")

@@ -30,7 +30,8 @@ class Command(BaseCommand):
                                "then run setup_demo again.")
         study = Study.objects.filter(slug=slug).first()
         if study is None:
-            study = create_study_from_preset(preset, slug, status=Study.Status.OPEN)
+            # the demo asks to be listed on the front page; a real study is reached through its link only
+            study = create_study_from_preset(preset, slug, status=Study.Status.OPEN, listed_publicly=True)
             self.stdout.write(f"Created study '{study.title}' (slug {slug}) from preset {preset}.")
         else:
             if study.status != Study.Status.OPEN:
