@@ -217,12 +217,14 @@ class Section(models.Model):
         practice_clip = (self.options or {}).get("practice_clip") if isinstance(self.options, dict) else None
         if isinstance(practice_clip, str) and practice_clip and not Clip.objects.filter(clip_id=practice_clip).exists():
             errors.setdefault("options", []).append(f"'practice_clip': no clip {practice_clip!r} in the catalogue")
+        from . import check_clips, norms_rule  # cycle: both read these models
+        if "options" not in errors and "pool" not in errors:
+            errors.update({"options": problems} if (problems := check_clips.check_clip_problems(self)) else {})
         pool = self.pool if isinstance(self.pool, dict) else {}
         if isinstance(pool.get(NORMS_RULE), dict) and "pool" not in errors:
-            from .norms_rule import NormsSourceError, load_norms  # cycle: norms_rule reads these models
             try:
-                load_norms(pool[NORMS_RULE].get("from", ""))
-            except NormsSourceError as exc:
+                norms_rule.load_norms(pool[NORMS_RULE].get("from", ""))
+            except norms_rule.NormsSourceError as exc:
                 errors["pool"] = [str(exc)]
         if errors:
             raise ValidationError(errors)

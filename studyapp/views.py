@@ -33,6 +33,7 @@ from .i18n import activate_study_language
 from .item_questions import questions_html
 from .media import accel_redirect_response, media_path, ranged_file_response
 from .models import Assignment, Clip, Participant, Response, Study
+from .page_notes import page_note
 from .page_reads import participant_by_token
 from .permissions import has_staff_permission
 from .questions import AnswerError, clean_answers, questions_for
@@ -279,27 +280,14 @@ def item_context(section, clip, index: int, total: int, next_clip: Clip | None, 
             "plays_before": plays_before, "ended_before": ended_before, "playback_url": playback_url,
             "autoplay": left is None or left > 0,
             "index": index, "total": total, "percent": int(round(100 * (index - 1) / max(total, 1))),
-            "practice": kind == Assignment.Kind.PRACTICE, **attention_context(questions, kind, instructed)}
+            "practice": kind == Assignment.Kind.PRACTICE,
+            "page_note": page_note(questions, kind, instructed, section.pk or 0, index)}
 
 
 def item_questions(section, clip, options: list[str] | None, kind: str = "", instructed: str = "") -> list:
-    """The questions of one clip page: the section's, or for an attention check the one it instructs."""
-    questions = questions_for(section.section_type, section.options, clip.theme, options)
-    if kind == ATTENTION_CHECK:
-        key = instructed.partition("=")[0]
-        questions = [q for q in questions if q.key == key]
-    return questions
-
-
-def attention_context(questions: list, kind: str, instructed: str) -> dict:
-    """The instruction of an attention check: the label of the answer to give (its value for a scale), and
-    whether the question is multi-select (the page then says "only")."""
-    if kind != ATTENTION_CHECK or not questions:
-        return {"attention": ""}
-    value = instructed.partition("=")[2]
-    q = questions[0]
-    label = next((lbl for v, lbl in q.choices if v == value), value)
-    return {"attention": value if q.kind == "scale" or not label else label, "attention_multi": q.kind == "multi"}
+    """The questions of one clip page: the section's, an attention check's too (its page looks like any other
+    of the section; only the instructed question's answer is stored, studyapp.page_notes)."""
+    return questions_for(section.section_type, section.options, clip.theme, options)
 
 
 def client_ms(raw, server_ms: int) -> int | None:
@@ -418,8 +406,8 @@ def save_answers(assignment: Assignment, answers: dict[str, str], response_ms: i
                  viewing: dict | None = None) -> bool:
     """Store the answers of one clip exactly once (one transaction: a conditional UPDATE claims the assignment
     and stores its viewing record, one INSERT of its responses, one UPDATE of the participant's last activity).
-    Returns False if they were already stored. A practice item stores no responses; an attention check stores its
-    one answer with kind ATTENTION_CHECK and question ``<key>=<instructed answer>``."""
+    Returns False if they were already stored. A practice item stores no responses; an attention check stores the
+    answer to its instructed question only, with kind ATTENTION_CHECK and question ``<key>=<instructed answer>``."""
     now = timezone.now()
     try:
         with transaction.atomic():
@@ -429,11 +417,12 @@ def save_answers(assignment: Assignment, answers: dict[str, str], response_ms: i
                 return False
             if assignment.kind != Assignment.Kind.PRACTICE:
                 attention = assignment.kind == ATTENTION_CHECK
+                asked = assignment.instructed.partition("=")[0]
                 Response.objects.bulk_create([
                     Response(participant_id=assignment.participant_id, section_id=assignment.section_id,
                              clip_id=assignment.clip_id, question=assignment.instructed if attention else key,
                              answer=value, response_ms=response_ms, kind=assignment.kind)
-                    for key, value in answers.items()])
+                    for key, value in answers.items() if not attention or key == asked])
             Participant.objects.filter(pk=assignment.participant_id).update(last_active_at=now)
     except IntegrityError:      # unique_response caught a concurrent duplicate
         return False
