@@ -158,6 +158,10 @@ class StudyAdmin(StudyScopedAdmin):
         (None, {"fields": ["title", "slug", "status", "preset", "links"]}),
         ("Participant pages", {"fields": ["language", "introduction", "consent_text", "ask_demographics",
                                           "feedback_questions", "counterbalance_sections"]}),
+        ("Screens and devices", {"fields": [("min_viewport_width", "min_viewport_height"),
+                                            ("admit_phones", "admit_tablets")],
+                                 "description": "Checked on the consent page before the study starts; a participant "
+                                                "turned away gets a page that says why, and nothing is recorded."}),
         ("Recruitment", {"fields": ["max_participants", "norming_design", "abandon_after_minutes", "completion_code",
                                     "completion_redirect", "redirect_automatically", "created_at"]}),
         ("Analysis", {"fields": ["exclusion_rules"],

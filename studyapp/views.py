@@ -26,7 +26,7 @@ from django.views.decorators.http import require_http_methods, require_POST
 from protocol.vocabulary import ATTENTION_CHECK
 
 from .assignment import StudyUnavailable, check_open, current_step, start_participant
-from .device_check import device_context
+from .device_check import device_context, device_record, refusal
 from .duration import expected_minutes
 from .forms import PARAM_MAX_LENGTH, PARAM_TOO_LONG, ConsentForm, DemographicsForm, FeedbackForm
 from .i18n import activate_study_language
@@ -160,6 +160,9 @@ def study_entry(request, slug: str):
             if not data.get(key) and request.GET.get(key):
                 data[key] = request.GET[key]
         form = ConsentForm(data)
+        device = device_record(request.POST, request.headers.get("User-Agent", ""))
+        if (turned_away := refusal(study, device)) is not None:
+            return render(request, "studyapp/device_refused.html", {"study": study, "message": turned_away})
         if form.is_valid():
             data = form.cleaned_data
             key = _consent_key(request, study, request.POST.get("consent_key", ""), data["PROLIFIC_PID"])
@@ -168,7 +171,7 @@ def study_entry(request, slug: str):
                     participant = Participant.objects.create(
                         study=study, external_id=data["PROLIFIC_PID"], external_study_id=data["STUDY_ID"],
                         external_session_id=data["SESSION_ID"], consent_key=key,
-                        user_agent=request.headers.get("User-Agent", "")[:300])
+                        user_agent=request.headers.get("User-Agent", "")[:300], **device)
             except IntegrityError:
                 # The same consent form submitted twice (double click), or the same Prolific PID consenting in
                 # another tab a moment ago: only the same browser session or the same full Prolific triple
@@ -192,7 +195,7 @@ def study_entry(request, slug: str):
                                                      "expected_minutes": expected_minutes(study),
                                                      "link_params": link_params,
                                                      "consent_key": _issue_consent_key(request, study),
-                                                     **device_context()})
+                                                     **device_context(study)})
 
 
 def _store_missing_ids(participant: Participant, params: dict[str, str]) -> None:
