@@ -40,7 +40,7 @@ RAW_JSON_HELP = ("The pool and options as JSON (protocol.pools). The fields abov
 def section_fieldsets() -> list:
     """The section form: main settings, the clip pool's fields with the live count, the naturalness halves, the
     options of each section type (the page shows those of the chosen type) and the raw JSON (collapsed)."""
-    main = [("order", "section_type", "title"), "instructions", ("clips_per_participant", "reuse_section"),
+    main = [("order", "section_type", "name"), "title", "instructions", ("clips_per_participant", "reuse_section"),
             ("randomize_order", "require_full_play", "loop", "counterbalance")]
     pool = ["matching_clips", ("pool_modality", "pool_origin"), "pool_plan", "pool_emotion_label", "pool_theme",
             ("pool_weight_sign", "pool_weight_min", "pool_weight_max"), ("pool_n_features_min", "pool_n_features_max"),

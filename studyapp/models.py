@@ -218,7 +218,7 @@ class Section(models.Model):
         ordering = ["study", "order", "id"]
 
     def __str__(self) -> str:
-        return f"{self.study.slug} #{self.order} {self.section_type}"
+        return f"{self.study.slug} #{self.order} {self.section_type}" + (f" ({self.name})" if self.name else "")
 
     def protocol_errors(self) -> dict[str, list[str]]:
         """Field -> messages for a bad pool, options or count (protocol.pools; no database query)."""

@@ -66,9 +66,10 @@ WORDING: dict[str, SectionWording] = {
         "perceived": (_("Which of these best describes the walk?"), _("Choose one."))}),
     "theme_rating": SectionWording("Theme rating (1..7)", {
         "rating": (_("How {theme} does this walk look?"), _("Seven-point scale; choose one."))}),
+    # seed 004: -7 the maximum opposite theme, 0 neutral, +7 the maximum original theme, said in the styles' words
     "theme_inversion": SectionWording("Theme inversion (-7..+7)", {
         "rating": (_("Does this walk look {opposite} or {theme}?"),
-                   _("From -7 (maximum opposite theme) through 0 (neutral) to +7 (maximum {theme})."))}),
+                   _("From -7 (very {opposite}) through 0 (neutral) to +7 (very {theme})."))}),
 }
 
 
@@ -139,11 +140,11 @@ def _value_labels(section_type: str, key: str, options: dict, theme: str, opposi
     if section_type == "naturalness":
         return {str(k): display(v) for k, v in (options.get("anchors") or NATURALNESS_ANCHORS_GAIT).items()}
     if section_type == "theme_rating":
-        return {"1": gettext("not at all"), "7": gettext("maximum {theme}").format(theme=theme)}
+        return {"1": gettext("not {theme} at all").format(theme=theme),
+                "7": gettext("very {theme}").format(theme=theme)}
     if section_type == "theme_inversion":
-        return {"-7": gettext("maximum {opposite} (opposite theme)").format(opposite=opposite),
-                "0": gettext("neutral"),
-                "7": gettext("maximum {theme} (original theme)").format(theme=theme)}
+        return {"-7": gettext("very {theme}").format(theme=opposite), "0": gettext("neutral"),
+                "7": gettext("very {theme}").format(theme=theme)}
     return {}
 
 
@@ -203,12 +204,9 @@ def _norming_questions(section_type: str) -> list[Question]:
 
 def _theme_words(section_type: str, clip_theme: str) -> tuple[str, str]:
     """(theme, opposite) as the adjectives shown in the active language; neutral words when the clip has none."""
-    if clip_theme:
-        theme = theme_adjective(clip_theme)
-    else:
-        theme = gettext("original theme") if section_type == "theme_inversion" else gettext("styled")
+    theme = theme_adjective(clip_theme) if clip_theme else gettext("styled")
     opposite = OPPOSITE_THEME.get(clip_theme)
-    return theme, theme_adjective(opposite) if opposite else gettext("opposite theme")
+    return theme, theme_adjective(opposite) if opposite else gettext("plain")
 
 
 def clean_answers(questions: list[Question], data) -> dict[str, str]:

@@ -37,6 +37,7 @@ from .page_notes import page_note
 from .page_reads import participant_by_token
 from .permissions import has_staff_permission
 from .questions import AnswerError, clean_answers, questions_for
+from .section_wording import participant_wording
 from .viewing import (
     MAX_COUNT,
     PLAYBACK_EVENTS,
@@ -275,7 +276,9 @@ def item_context(section, clip, index: int, total: int, next_clip: Clip | None, 
     fields = [{"q": q, "selected": posted.getlist(q.key) if posted is not None else []} for q in questions]
     player = player_options(section.options)
     left = plays_left(plays_before, player["max_replays"])
-    return {"section": section, "fields": fields, "questions_html": questions_html(fields),
+    section_title, section_text = participant_wording(section)
+    return {"section": section, "section_title": section_title, "section_text": section_text, "fields": fields,
+            "questions_html": questions_html(fields),
             "sources": clip_sources(clip),
             "next_sources": clip_sources(next_clip) if next_clip else None,
             "loop": section.loop or clip.loop, "require_play": section.require_full_play,
