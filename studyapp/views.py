@@ -341,6 +341,8 @@ def mark_completed(participant: Participant) -> None:
 # (static/studyapp/study.js puts that page's own URL into the address bar), one request per answered clip instead
 # of POST + redirect + GET. A POST without it (a script, a page from before) gets the redirect.
 INLINE_NEXT_FIELD = "inline_next"
+# The clip number the form was shown for: an answer POST whose number is not its URL's is refused (see item).
+PAGE_FIELD = "page"
 
 
 @never_cache
@@ -363,6 +365,11 @@ def item(request, token: str, n: int):
     assignment = step.assignment
     if request.method != "POST":
         return _show_item(request, participant, step)
+    if request.POST.get(PAGE_FIELD, str(n)) != str(n):
+        # The answers of another clip page sent to this page's URL: a browser that resends the POST which brought
+        # this page when the page is reloaded (WebKit keeps that POST's data after history.replaceState). They are
+        # not this clip's answers: show the page again.
+        return redirect(step_url(token, step))
     section, clip = assignment.section, assignment.clip
     questions = item_questions(section, clip, assignment.options, assignment.kind, assignment.instructed)
     try:
@@ -452,7 +459,7 @@ def _render_item(request, participant: Participant, step, status: int = 200, err
     ctx.update({"participant": participant, "study": participant.study, "error": error,
                 "first_of_section": assignment.position == 0,
                 "form_action": reverse("studyapp:item", kwargs={"token": participant.token, "n": step.index}),
-                "inline_next_field": INLINE_NEXT_FIELD})
+                "inline_next_field": INLINE_NEXT_FIELD, "page_field": PAGE_FIELD})
     return render(request, "studyapp/item.html", ctx, status=status)
 
 

@@ -109,10 +109,13 @@ def take_study(driver, base_url: str, study: Study, external_id: str, reload_at:
         assert step.kind == "item" and f"/clip/{step.index}/" in path_of(driver), (step.kind, path_of(driver))
         if step.index == reload_at and not run.reloaded_at:
             wait(driver, PLAYED, what=f"clip {step.index} played")
+            driver.execute_script("window.beforeReload = true")
             driver.refresh()                          # the participant reloads in the middle of the study
             run.reloaded_at = step.index
-            wait(driver, "return document.readyState === 'complete'", what="the reloaded page")
-            assert f"/clip/{step.index}/" in path_of(driver), "a reload must resume on the same clip page"
+            wait(driver, "return !window.beforeReload && document.readyState === 'complete'",
+                 what="the reloaded page")
+            assert f"/clip/{step.index}/" in path_of(driver), f"a reload must resume on the same clip page, not " \
+                                                              f"{path_of(driver)}"
         played = wait(driver, PLAYED, what=f"clip {step.index} played")
         rendition = played["src"].rsplit(".", 1)[-1].split("?")[0]
         a = step.assignment
