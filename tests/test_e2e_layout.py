@@ -9,10 +9,11 @@ import time
 from pathlib import Path
 
 import pytest
-from browser_flow import take_study
+from browser_flow import take_study, wait
+from django.urls import reverse
 
 from protocol.vocabulary import SECTION_TYPES
-from studyapp.models import Study
+from studyapp.models import Participant, Study
 from studyapp.presets import create_study_from_preset
 from studyapp.testing import make_catalogue, wide_clip
 
@@ -87,3 +88,27 @@ def test_clip_and_current_question_in_view_on_every_section_type(chromium, live_
     assert set(checked) == set(SECTION_TYPES)
     # the likert page's four questions each shared the laptop's window with the clip
     assert sum(1 for size, _ in checked["affect_likert"] if size == LAPTOP) == 4
+
+
+def test_consent_page_turns_phones_away_when_the_study_admits_none(chromium, live_server, demo):
+    """The consent page's script: a phone (touch screen, narrow) is told why and cannot start; a desktop window
+    below the study's minimum is told its size; a large enough desktop starts, and its window is recorded."""
+    Study.objects.filter(pk=demo.pk).update(admit_phones=False, min_viewport_width=1200, min_viewport_height=700)
+    url = live_server.url + reverse("studyapp:study_entry", args=[demo.slug]) + "?PROLIFIC_PID=device-1"
+    state = "var b = document.getElementById('device-check'); return [b.hidden, b.textContent, " \
+            "document.getElementById('start-study').disabled]"
+    emulate(chromium, PHONE, mobile=True)
+    chromium.get(url)
+    hidden, text, disabled = chromium.execute_script(state)
+    assert not hidden and disabled and "cannot be taken on a phone" in text, text
+    emulate(chromium, (1000, 700), mobile=False)
+    hidden, text, disabled = chromium.execute_script(state)     # re-checked on resize
+    assert "at least 1200 × 700" in text and "1000 × 700" in text and disabled, text
+    emulate(chromium, LAPTOP, mobile=False)
+    hidden, text, disabled = chromium.execute_script(state)
+    assert hidden and not disabled, text
+    chromium.execute_script("document.getElementById('id_consent').click(); "
+                            "document.getElementById('start-study').click()")
+    wait(chromium, "return location.pathname.indexOf('/about-you/') >= 0", what="the demographics page")
+    p = Participant.objects.get(external_id="device-1")
+    assert (p.viewport_width, p.viewport_height, p.device_kind) == (1366, 768, "desktop")
