@@ -356,7 +356,8 @@ class ParticipantAdmin(StudyScopedAdmin):
     list_filter = [("study", admin.RelatedOnlyFieldListFilter), "status"]
     search_fields = ["public_id", "external_id"]
     readonly_fields = ["token", "public_id", "seed", "consented_at", "started_at", "completed_at", "user_agent",
-                       "external_id", "external_study_id", "external_session_id", "feedback"]
+                       "external_id", "external_study_id", "external_session_id", "feedback", "device_kind",
+                       "viewport_width", "viewport_height"]
     inlines = [AssignmentInline]
 
 

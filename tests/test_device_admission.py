@@ -97,3 +97,14 @@ def test_refusal_rules():
     record = device_record({"viewport_w": "300", "viewport_h": "500", "device_kind": "phone"}, "")
     assert "at least 320 × 300" in refusal(study, record)              # the player's own minimum holds
     assert refusal(study, {**record, "viewport_width": 320}) is None
+
+
+def test_admin_shows_the_recorded_device(study, django_user_model):
+    consent(study, viewport_w="1366", viewport_h="768", device_kind="desktop")
+    p = Participant.objects.get()
+    admin = django_user_model.objects.create_user("staff", password="pw-staff-12345", is_staff=True,
+                                                  is_superuser=True)
+    client = Client()
+    client.force_login(admin)
+    page = client.get(reverse("admin:studyapp_participant_change", args=[p.pk])).content.decode()
+    assert "1366" in page and "768" in page and "Desktop" in page
