@@ -106,7 +106,8 @@ MAX_REPLAYS_LIMIT = 100
 
 COMMON_OPTIONS = ("attention_checks", "practice", "practice_clip", *PLAYER_OPTIONS)
 """Options of every section type (studyapp.trial_extras): attention checks, a practice item, the clip player."""
-ATTENTION_KEYS = ("count", "answer", "positions", "question")
+ATTENTION_KEYS = ("count", "answer", "positions", "question", "clip")
+"""``clip``: the clip_id of a dedicated check clip, one no participant rates (studyapp.trial_extras)."""
 
 
 class SectionError(NamedTuple):
@@ -300,6 +301,10 @@ def _attention_errors(section_type: str, config, clips_per_participant: int | No
     if not isinstance(answer, (str, int)) or isinstance(answer, bool) or str(answer) not in allowed:
         errors.append((("attention_checks.answer",), f"{name}: 'answer' must be one of the answers to {key!r} "
                                                      f"({', '.join(allowed)}), got {answer!r}"))
+    clip = config.get("clip")
+    if clip is not None and not (isinstance(clip, str) and clip.strip()):
+        errors.append((("attention_checks.clip",), f"{name}: 'clip' must be the clip_id of a catalogue clip that "
+                                                   f"no participant rates, got {clip!r}"))
     count = config.get("count", 1)
     if not _is_int(count) or count < 1:
         errors.append((("attention_checks.count",), f"{name}: 'count' must be an integer 1 or more, got "

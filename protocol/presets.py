@@ -2,7 +2,9 @@
 
 ``studyapp.presets`` turns a preset into Study + Section rows (the researcher then edits them in the admin); the
 synthetic-study simulator (``analysis.design``) reads the same sections to simulate a study of that preset. Each
-section: ``section_type``, ``title``, ``instructions``, ``pool`` (catalogue filters, see ``protocol.pools``),
+section: ``section_type``, ``name`` (the researchers' name for it, never shown to participants), ``title`` and
+``instructions`` (what participants see: plain words, never the researchers' terms such as "theme" or "inversion"),
+``pool`` (catalogue filters, see ``protocol.pools``),
 ``clips_per_participant`` (0 = every clip of the pool), ``options`` (type-specific), or ``reuse`` (the index of an
 earlier section of the same preset whose clips it shows again).
 """
@@ -35,27 +37,35 @@ GAIT_TRANSITION = {"modality": "gait", "origin": "generated", "transition": True
 PRESETS: dict[str, dict] = {
     "gait_ismar2020": {
         "title": "Emotive gaits (ISMAR 2020 study)",
-        "introduction": "The study has three sections. Each clip shows a virtual character walking.",
+        "introduction": "The study has four sections. Each clip shows a virtual character walking.",
         "feedback_questions": [
             {"key": "distracted_camera", "text": "Were you distracted by the camera during the study?",
              "kind": "yesno"},
             {"key": "comments", "text": "Any other comments (optional)?", "kind": "text"},
         ],
         "sections": [
-            {"section_type": "emotion_choice", "title": "Section 1: perceived emotion",
-             "instructions": "Watch each walk and report the emotion(s) you perceive. You can choose more than one: "
+            # seed 000 section 6.1: "report the emotion they perceived ... Users could report multiple emotions"
+            {"section_type": "emotion_choice", "name": "Section 1: perceived emotion (seed 000 6.1)",
+             "title": "Which emotions do you see?",
+             "instructions": "Watch each walk and choose the emotion(s) you see in it. You can choose more than one: "
                              "for example, a walk that looks a little happy but mostly neutral can be marked both "
                              "happy and neutral.",
              "pool": GAIT_GENERATED, "clips_per_participant": 8},
-            {"section_type": "emotion_transition", "title": "Section 2: emotion transitions",
-             "instructions": "In these walks the emotion changes during the clip. Report the emotion(s) you perceive "
-                             "at the start and at the end.",
+            # seed 000 section 6.1: "report the initial and the final emotions they perceived"
+            {"section_type": "emotion_transition", "name": "Section 2: emotion transitions (seed 000 6.1)",
+             "title": "Emotions that change",
+             "instructions": "In these walks the emotion changes during the clip. Choose the emotion(s) you see at "
+                             "the start and at the end.",
              "pool": GAIT_TRANSITION, "clips_per_participant": 6},
-            {"section_type": "affect_likert", "title": "Section 3: posture and movement",
-             "instructions": "You will see the walks of section 1 again. Rate the torso, the arms, the pace and the "
-                             "flow of each walk.",
+            # seed 000 section 6.1 and Table 2: the four pose affective features on a five-point scale
+            {"section_type": "affect_likert", "name": "Section 3: pose affective features (seed 000 Table 2)",
+             "title": "Posture and movement",
+             "instructions": "You will see the walks of the first section again. Rate the torso, the arms, the pace "
+                             "and the flow of each walk.",
              "reuse": 0},
-            {"section_type": "naturalness", "title": "Naturalness",
+            # seed 000 section 6.3.4: "how natural and smooth they felt the animations to be"
+            {"section_type": "naturalness", "name": "Naturalness, generated and source (seed 000 6.3.4)",
+             "title": "How natural the walks look",
              "instructions": "Rate how natural and smooth each animation looks, from 1 (not natural at all) through "
                              "3 (satisfactory) to 5 (very natural).",
              "pool": {"modality": "gait", "transition": False, "rbf": False}, "clips_per_participant": 4,
@@ -73,12 +83,15 @@ PRESETS: dict[str, dict] = {
                                                     "alone?", "kind": "yesno"},
         ],
         "sections": [
-            {"section_type": "gesture_emotion", "title": "Section 1: perceived emotion",
-             "instructions": "Watch each clip and choose the emotion you perceive from the gestures.",
+            {"section_type": "gesture_emotion", "name": "Section 1: perceived emotion (seed 003 6.1)",
+             "title": "Which emotion do the gestures show?",
+             "instructions": "Watch each clip and choose the emotion you see in the gestures.",
              "pool": {"modality": "gesture", "origin": "generated"}, "clips_per_participant": 6,
              "options": {"n_options": 4}},
-            {"section_type": "naturalness", "title": "Section 2: quality of the gestures",
-             "instructions": "Rate the naturalness of the gestures in each clip.",
+            # seed 003 Table 2: the five markers, from "Very Unnatural" to "Looks great!"
+            {"section_type": "naturalness", "name": "Section 2: plausibility of the gestures (seed 003 Table 2)",
+             "title": "How natural the gestures look",
+             "instructions": "Rate how natural the gestures in each clip look.",
              "pool": {"modality": "gesture"}, "clips_per_participant": 6,
              "options": {"anchors": NATURALNESS_ANCHORS_GESTURE, "n_generated": 3, "n_source": 3,
                          "question": "How natural do the gestures look?"}},
@@ -89,15 +102,23 @@ PRESETS: dict[str, dict] = {
         "introduction": "Each clip shows a virtual character walking. You will rate the style of each walk.",
         "feedback_questions": [],
         "sections": [
-            {"section_type": "neutral_validation", "title": "The input walk",
-             "instructions": "Which of these best describes the walk?",
+            # seed 004 section V-A: the input walk validated as neutral, forced choice among neutral and the themes
+            {"section_type": "neutral_validation", "name": "Neutral validation of the input walk (seed 004 V-A)",
+             "title": "Describe the walk",
+             "instructions": "Choose the word that best describes the walk.",
              "pool": {"modality": "gait", "theme": NEUTRAL_THEME}, "clips_per_participant": 1},
-            {"section_type": "theme_rating", "title": "Theme ratings",
-             "instructions": "Rate the amount of the named style in each walk on a seven-point scale.",
+            # seed 004 section V: "rate the amount of affect or style in the displayed sequences", seven points
+            {"section_type": "theme_rating", "name": "Theme ratings, weight x number of features (seed 004 V)",
+             "title": "Walking styles",
+             "instructions": "Rate how much of the style named in the question you see in each walk, from 1 (not at "
+                             "all) to 7 (very).",
              "pool": {"rbf": True, "weight__gt": 0}, "clips_per_participant": 0, "loop": True},
-            {"section_type": "theme_inversion", "title": "Inversion",
-             "instructions": "Rate each walk from -7 (maximum opposite theme) through 0 (neutral) to +7 (maximum "
-                             "original theme).",
+            # seed 004 section V-E: -7 the maximum opposite theme, 0 neutral, +7 the maximum original theme; the
+            # question names the two styles (the opposite first), so the ends read "very sad" ... "very happy"
+            {"section_type": "theme_inversion", "name": "Inversion, w = -0.7 (seed 004 V-E)",
+             "title": "Walking styles: one or the other",
+             "instructions": "Each walk may look like one of two opposite styles. Rate it from -7 (very much the "
+                             "first style named) through 0 (neither) to +7 (very much the second).",
              "pool": {"rbf": True, "weight__lt": 0}, "clips_per_participant": 0, "loop": True},
         ],
     },
@@ -136,10 +157,9 @@ PRESETS["demo"] = {
 
 
 for _sec in PRESETS["demo"]["sections"]:       # the demo mixes the papers' sections: drop their "Section N:" prefixes
-    _title = _sec["title"].split(": ", 1)[-1]
-    _sec["title"] = _title[:1].upper() + _title[1:]
-PRESETS["demo"]["sections"][0]["title"] = "Perceived emotion: walks"
-PRESETS["demo"]["sections"][4]["title"] = "Perceived emotion: gestures"
+    _sec["name"] = _sec["name"].split(": ", 1)[-1]
+PRESETS["demo"]["sections"][0]["title"] = "Emotions in walks"
+PRESETS["demo"]["sections"][4]["title"] = "Emotions in gestures"
 
 
 # Norming: every candidate clip of a plan rated by at least K participants while each sees M clips per section (the
@@ -157,18 +177,18 @@ PRESETS["norming"] = {
                     "answers.",
     "feedback_questions": [{"key": "comments", "text": "Any other comments (optional)?", "kind": "text"}],
     "sections": [
-        {"section_type": "emotion_choice", "title": "Walks",
-         "instructions": "Watch each walk. Report the emotion(s) you perceive (more than one is allowed), how "
+        {"section_type": "emotion_choice", "name": "Norming: walks", "title": "Walks",
+         "instructions": "Watch each walk. Choose the emotion(s) you see (more than one is allowed), how "
                          "intense it looks and how natural the motion looks.",
          "pool": {"modality": "gait", "transition": False, "rbf": False, **_CANDIDATES}, "clips_per_participant": 8,
          "options": {**_NORMING, "attention_checks": {"count": 1, "answer": "sad", "positions": "random"}}},
-        {"section_type": "gesture_emotion", "title": "Gestures",
-         "instructions": "Watch each clip. Choose the emotion you perceive from the gestures, how intense it looks "
+        {"section_type": "gesture_emotion", "name": "Norming: gestures", "title": "Gestures",
+         "instructions": "Watch each clip. Choose the emotion you see in the gestures, how intense it looks "
                          "and how natural the gestures look.",
          "pool": {"modality": "gesture", **_CANDIDATES}, "clips_per_participant": 8,
          "options": {**_NORMING, "n_options": 4,
                      "attention_checks": {"count": 1, "answer": "sad", "positions": "random"}}},
-        {"section_type": "theme_rating", "title": "Walking styles",
+        {"section_type": "theme_rating", "name": "Norming: walking styles", "title": "Walking styles",
          "instructions": "Rate the amount of the named style in each walk, how intense the style looks and how "
                          "natural the motion looks.",
          "pool": {"rbf": True, "weight__gt": 0, **_CANDIDATES}, "clips_per_participant": 8, "loop": True,

@@ -7,6 +7,10 @@ cd "$(dirname "$0")/.."
 PYTHON="${PYTHON:-python3}"
 VENV="${VENV:-.venv}"
 SYSTEM_PACKAGES=(chromium chromium-driver libegl1 libgl1-mesa-dri)
+# Best effort: the other browsers participants use, for the browser tests (tests/test_e2e_browsers.py skips a
+# browser that is missing): WebKitGTK (Safari's engine) with its WebDriver, GStreamer's H.264 decoder and a virtual
+# X display, and Firefox ESR (driven through Marionette, PyPI marionette-driver).
+OPTIONAL_PACKAGES=(webkit2gtk-driver gstreamer1.0-libav xvfb firefox-esr)
 
 missing=()
 for pkg in "${SYSTEM_PACKAGES[@]}"; do
@@ -22,6 +26,16 @@ if ((${#missing[@]})); then
         echo "   sudo apt-get install ${missing[*]}"
         echo "   (rendering needs libegl1 libgl1-mesa-dri; browser tests need chromium chromium-driver)"
     fi
+fi
+
+optional=()
+for pkg in "${OPTIONAL_PACKAGES[@]}"; do
+    dpkg -s "$pkg" >/dev/null 2>&1 || optional+=("$pkg")
+done
+if ((${#optional[@]})) && [ "$(id -u)" = 0 ] && command -v apt-get >/dev/null; then
+    echo "==> installing optional browsers for the browser tests: ${optional[*]}"
+    { apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends \
+        "${optional[@]}" >/dev/null; } || echo "!! optional browsers not installed (their browser tests skip)"
 fi
 
 if [ ! -x "$VENV/bin/python" ]; then

@@ -40,7 +40,7 @@ RAW_JSON_HELP = ("The pool and options as JSON (protocol.pools). The fields abov
 def section_fieldsets() -> list:
     """The section form: main settings, the clip pool's fields with the live count, the naturalness halves, the
     options of each section type (the page shows those of the chosen type) and the raw JSON (collapsed)."""
-    main = [("order", "section_type", "title"), "instructions", ("clips_per_participant", "reuse_section"),
+    main = [("order", "section_type", "name"), "title", "instructions", ("clips_per_participant", "reuse_section"),
             ("randomize_order", "require_full_play", "loop", "counterbalance")]
     pool = ["matching_clips", ("pool_modality", "pool_origin"), "pool_plan", "pool_emotion_label", "pool_theme",
             ("pool_weight_sign", "pool_weight_min", "pool_weight_max"), ("pool_n_features_min", "pool_n_features_max"),
@@ -161,6 +161,10 @@ class StudyAdmin(StudyScopedAdmin):
                                              "withdrawn participants are left out of them."}),
         ("Participant pages", {"fields": ["language", "introduction", "consent_text", "ask_demographics",
                                           "feedback_questions", "counterbalance_sections"]}),
+        ("Screens and devices", {"fields": [("min_viewport_width", "min_viewport_height"),
+                                            ("admit_phones", "admit_tablets")],
+                                 "description": "Checked on the consent page before the study starts; a participant "
+                                                "turned away gets a page that says why, and nothing is recorded."}),
         ("Recruitment", {"fields": ["max_participants", "norming_design", "abandon_after_minutes", "completion_code",
                                     "completion_redirect", "redirect_automatically", "created_at"]}),
         ("Analysis", {"fields": ["exclusion_rules"],
@@ -356,7 +360,8 @@ class ParticipantAdmin(StudyScopedAdmin):
     search_fields = ["public_id", "external_id"]
     readonly_fields = ["token", "public_id", "seed", "consented_at", "started_at", "completed_at", "user_agent",
                        "external_id", "external_study_id", "external_session_id", "feedback", "gender", "age_group",
-                       "demographics_done", "feedback_done", "last_active_at", "section_order"]
+                       "demographics_done", "feedback_done", "last_active_at", "section_order", "device_kind",
+                       "viewport_width", "viewport_height"]
     inlines = [AssignmentInline]
 
     def has_add_permission(self, request):

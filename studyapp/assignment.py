@@ -192,10 +192,24 @@ def plan_study(study: Study, seed: int, balanced: bool = True, sections: list[Se
             used.update(it.clip.pk for it in items)
         plan.append((section, items))
     if extras:
-        plan = [(section, with_extras(section, items, pools.get(section.pk, SectionPool()).clips,
-                                      pools.get(section.pk, SectionPool()).practice, used, seed))
+        taken: set[int] = set()
+        plan = [(section, with_extras(section, items, _check_pool(section, pools), _pool(section, pools).practice,
+                                      used, seed, _pool(section, pools).check_clip, taken))
                 for section, items in plan]
     return plan
+
+
+def _pool(section: Section, pools: dict[int, SectionPool]) -> SectionPool:
+    return pools.get(section.pk) or SectionPool()
+
+
+def _check_pool(section: Section, pools: dict[int, SectionPool]) -> list[Clip]:
+    """The clips a section's attention checks may draw (those the participant rates are skipped later): its
+    pool, or for a section that reuses another's clips the reused section's pool."""
+    own = _pool(section, pools)
+    if section.reuse_section_id:
+        return (pools.get(section.reuse_section_id) or SectionPool()).clips
+    return own.clips
 
 
 def active_count(study: Study) -> int:

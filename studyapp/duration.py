@@ -3,7 +3,7 @@ duration, computed from what the participant will get rather than typed in.
 
     seconds = sum over sections of  items x (mean clip duration of the section's pool + PAGE_SECONDS
                                               + questions x ANSWER_SECONDS_PER_QUESTION)
-              + practice items and attention checks (a check asks one question)
+              + practice items and attention checks (each a clip page like a trial's)
               + DEMOGRAPHICS_SECONDS (when asked) + FEEDBACK_SECONDS_PER_QUESTION x feedback questions
     minutes = ceil(seconds / 60)
 
@@ -43,9 +43,8 @@ class SectionTime:
 
     @property
     def seconds(self) -> float:
-        per_trial = self.mean_clip_s + PAGE_SECONDS + self.questions * ANSWER_SECONDS_PER_QUESTION
-        per_check = self.mean_clip_s + PAGE_SECONDS + ANSWER_SECONDS_PER_QUESTION
-        return (self.items + self.practice) * per_trial + self.checks * per_check
+        per_page = self.mean_clip_s + PAGE_SECONDS + self.questions * ANSWER_SECONDS_PER_QUESTION
+        return (self.items + self.practice + self.checks) * per_page
 
 
 def mean_duration(pool: SectionPool) -> float:

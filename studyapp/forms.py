@@ -11,6 +11,7 @@ from analysis.exclusion import rule_errors
 from protocol.pools import SUB_POOLS, pool_errors
 
 from . import clip_import, pool_editor
+from .check_clips import check_clip_problems
 from .i18n import display
 from .inputs import refuse_control_characters, refuse_control_characters_in_text
 from .models import Clip, Section, Study
@@ -126,6 +127,14 @@ class SectionForm(forms.ModelForm, PoolEditorFields):
         self._check_norms_reader(data)
         self._check_norms_source(data)
         return data
+
+    def _post_clean(self):
+        """After the model's own checks: an error on the options when the section's attention checks would find no
+        clip the participant does not rate (studyapp.check_clips; the model layer does not read the catalogue)."""
+        super()._post_clean()
+        if not self.has_error("options") and not self.has_error("pool"):
+            for problem in check_clip_problems(self.instance):
+                self.add_error("options", problem)
 
     def _check_norms_source(self, data: dict) -> None:
         """An error on the pool when a norms rule of its tree (its own or a sub-pool's) gives no norms (an unknown

@@ -10,6 +10,7 @@ import secrets
 
 from django.conf import settings
 from django.core.exceptions import ValidationError
+from django.core.validators import MaxValueValidator
 from django.db import models
 from django.utils import timezone
 
@@ -22,6 +23,9 @@ from .redirects import check_completion_url, safe_completion_url
 
 DEFAULT_ABANDON_MINUTES = 120
 """A new study's ``abandon_after_minutes``: two hours, longer than any preset's expected duration several times over."""
+
+MAX_STUDY_VIEWPORT_PX = 4000
+"""The largest minimum viewport side (CSS pixels) a study may ask for."""
 
 
 def new_token() -> str:
@@ -146,6 +150,15 @@ class Study(models.Model):
     counterbalance_sections = models.BooleanField(
         default=False, help_text="Rotate the order of the sections across participants (Latin square); each "
                                  "participant's order is recorded and exported")
+    min_viewport_width = models.PositiveSmallIntegerField(
+        default=0, validators=[MaxValueValidator(MAX_STUDY_VIEWPORT_PX)],
+        help_text="Smallest browser window width (CSS pixels) a participant may start with; checked on the consent "
+                  "page (0: the player's own minimum, 320)")
+    min_viewport_height = models.PositiveSmallIntegerField(
+        default=0, validators=[MaxValueValidator(MAX_STUDY_VIEWPORT_PX)],
+        help_text="Smallest browser window height (CSS pixels); 0: the player's own minimum, 300")
+    admit_phones = models.BooleanField(default=True, help_text="Participants on a phone may take part")
+    admit_tablets = models.BooleanField(default=True, help_text="Participants on a tablet may take part")
     exclusion_rules = models.JSONField(
         default=dict, blank=True,
         help_text="Rules the analysis applies (raw exports stay unchanged), e.g. "
@@ -184,8 +197,14 @@ class Section(models.Model):
     study = models.ForeignKey(Study, on_delete=models.CASCADE, related_name="sections")
     order = models.PositiveIntegerField(default=0)
     section_type = models.CharField(max_length=30, choices=section_type_choices)
-    title = models.CharField(max_length=200, blank=True)
-    instructions = models.TextField(blank=True)
+    name = models.CharField(max_length=200, blank=True,
+                            help_text="The researchers' name for the section (admin, previews, reports); never shown "
+                                      "to participants")
+    title = models.CharField(max_length=200, blank=True,
+                             help_text="The heading participants see on its clip pages, in their words (blank: plain "
+                                       "words for the section type, e.g. \"How does this walk look?\")")
+    instructions = models.TextField(blank=True, help_text="What participants are asked to do, shown above the clip "
+                                                          "(blank: the section type's plain-words default)")
     pool = models.JSONField(
         default=dict, blank=True,
         help_text='Clip pool as catalogue filters, e.g. {"modality": "gait", "origin": "generated", '
@@ -211,7 +230,7 @@ class Section(models.Model):
         ordering = ["study", "order", "id"]
 
     def __str__(self) -> str:
-        return f"{self.study.slug} #{self.order} {self.section_type}"
+        return f"{self.study.slug} #{self.order} {self.section_type}" + (f" ({self.name})" if self.name else "")
 
     def protocol_errors(self) -> dict[str, list[str]]:
         """Field -> messages for a bad pool, options or count (protocol.pools; no database query)."""
@@ -258,6 +277,11 @@ class Participant(models.Model):
     last_active_at = models.DateTimeField(null=True, blank=True)
     completed_at = models.DateTimeField(null=True, blank=True)
     user_agent = models.CharField(max_length=300, blank=True)
+    # The browser window and kind of device at consent (studyapp.device_check): CSS pixels, null when not reported.
+    viewport_width = models.PositiveSmallIntegerField(null=True, blank=True, editable=False)
+    viewport_height = models.PositiveSmallIntegerField(null=True, blank=True, editable=False)
+    device_kind = models.CharField(max_length=10, blank=True, default="", editable=False,
+                                   choices=[("phone", "Phone"), ("tablet", "Tablet"), ("desktop", "Desktop")])
     # Section pks in the order this participant takes them (counterbalanced studies); empty = the study's order.
     section_order = models.JSONField(default=list, blank=True)
     # SHA-256 of the one-time key the consent page gave this browser session: a second submit of the same

@@ -31,10 +31,13 @@ CACHE_SECONDS = 600
 
 @dataclass
 class SectionPool:
-    """A section's pool: clips in clip_id order, sub-pool pks (naturalness) and practice candidates."""
+    """A section's pool: clips in clip_id order, sub-pool pks (naturalness), practice candidates and the dedicated
+    attention-check clip (``attention_checks.clip``; None when the section names none or it is not in the
+    catalogue)."""
     clips: list[Clip] = field(default_factory=list)
     sub_pools: dict[str, set[int]] = field(default_factory=dict)
     practice: list[Clip] = field(default_factory=list)
+    check_clip: Clip | None = None
 
     @property
     def pks(self) -> set[int]:
@@ -53,10 +56,21 @@ def practice_modality(section: Section) -> str | None:
     return wanted or (pool_modality if isinstance(pool_modality, str) else None)
 
 
+def dedicated_check_clip(section: Section) -> Clip | None:
+    """The clip the section's options name for its attention checks (``attention_checks.clip``), if any."""
+    options = section.options if isinstance(section.options, dict) else {}
+    config = options.get("attention_checks")
+    clip_id = config.get("clip") if isinstance(config, dict) else None
+    if not isinstance(clip_id, str) or not clip_id:
+        return None
+    return light(Clip.objects.filter(clip_id=clip_id, retired=False)).first()
+
+
 def load_section_pool(section: Section) -> SectionPool:
-    """Query one section's pool (no cache). A reusing section has no pool of its own."""
+    """Query one section's pool (no cache). A reusing section has no pool of its own (its checks draw on the
+    reused section's)."""
     if section.reuse_section_id:
-        return SectionPool()
+        return SectionPool(check_clip=dedicated_check_clip(section))
     clips = list(light(section_queryset(section.section_type, section.pool)).order_by("clip_id"))
     # a sub-pool only narrows the section's pool, which already decided about flagged clips
     subs = {key: set(pool_queryset(section.pool[key], include_flagged=True).filter(pk__in=[c.pk for c in clips])
@@ -72,7 +86,7 @@ def load_section_pool(section: Section) -> SectionPool:
         if modality:
             qs = qs.filter(modality=modality)
         practice = list(light(qs).order_by("clip_id")[:50])
-    return SectionPool(clips, subs, practice)
+    return SectionPool(clips, subs, practice, dedicated_check_clip(section))
 
 
 def catalogue_version() -> str:

@@ -410,7 +410,8 @@ class AttentionSpec(ChoiceSpec):
     """``attention_checks`` (every section type, studyapp.trial_extras): ``{"answer": "sad", "count": 1,
     "positions": "random" | [3, 7], "question": "perceived"}`` as four fields; blank answer and count: none."""
 
-    PARTS = {"answer": "instructed answer", "count": "how many", "positions": "positions", "question": "question"}
+    PARTS = {"answer": "instructed answer", "count": "how many", "positions": "positions", "question": "question",
+             "clip": "check clip"}
 
     def __init__(self, field: str):
         super().__init__(field, "attention_checks", (), "Attention checks")
@@ -426,7 +427,10 @@ class AttentionSpec(ChoiceSpec):
             f"{f}_positions": forms.CharField(required=False, max_length=200, label="Attention check positions",
                                               help_text="random, or places in the section such as 3, 7"),
             f"{f}_question": forms.CharField(required=False, max_length=40, label="Attention check question",
-                                             help_text="a question key of the section; blank: its first question")}
+                                             help_text="a question key of the section; blank: its first question"),
+            f"{f}_clip": forms.CharField(required=False, max_length=200, label="Attention check clip",
+                                         help_text="clip_id of a clip kept for checks, one no participant rates; "
+                                                   "blank: a spare clip of the pool, else the practice clip")}
 
     @staticmethod
     def _places(text: str) -> list[int] | None:
@@ -438,7 +442,8 @@ class AttentionSpec(ChoiceSpec):
         if not isinstance(config, dict) or not config or set(config) - set(self.PARTS):
             return {}, data
         positions = config.get("positions", "random")
-        ok = (all(isinstance(config.get(k, "x"), str) and config.get(k, "x").strip() for k in ("answer", "question"))
+        ok = (all(isinstance(config.get(k, "x"), str) and config.get(k, "x").strip()
+                  for k in ("answer", "question", "clip"))
               and (_is_int(config.get("count", 1)) and 1 <= config.get("count", 1) <= 100)
               and (positions == "random" or isinstance(positions, list) and positions
                    and all(_is_int(p) and p >= 1 for p in positions)))

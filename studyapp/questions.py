@@ -79,9 +79,9 @@ def unregister_wording(section_type: str) -> None:
     WORDING.pop(section_type, None)
 
 
-_THEME_ANCHORS = {"1": _("not at all"), "7": _("maximum {theme}")}
-_INVERSION_ANCHORS = {"-7": _("maximum {opposite} (opposite theme)"), "0": _("neutral"),
-                      "7": _("maximum {theme} (original theme)")}
+_THEME_ANCHORS = {"1": _("not {theme} at all"), "7": _("very {theme}")}
+# seed 004: -7 the maximum opposite theme, 0 neutral, +7 the maximum original theme, said in the styles' words
+_INVERSION_ANCHORS = {"-7": _("very {opposite}"), "0": _("neutral"), "7": _("very {theme}")}
 _MULTI_HELP = _("More than one is allowed.")
 
 register_wording("emotion_choice", SectionWording({
@@ -105,8 +105,8 @@ register_wording("theme_rating", SectionWording(
     anchors={"rating": _THEME_ANCHORS}))
 register_wording("theme_inversion", SectionWording(
     {"rating": (_("Does this walk look {opposite} or {theme}?"),
-                _("From -7 (maximum opposite theme) through 0 (neutral) to +7 (maximum {theme})."))},
-    anchors={"rating": _INVERSION_ANCHORS}, theme=_("original theme")))
+                _("From -7 (very {opposite}) through 0 (neutral) to +7 (very {theme})."))},
+    anchors={"rating": _INVERSION_ANCHORS}))
 
 
 # The questions a norming section asks after its own (protocol.vocabulary.NORMING_QUESTIONS).
@@ -249,7 +249,7 @@ def _theme_words(wording: SectionWording, clip_theme: str) -> tuple[str, str]:
     """(theme, opposite) as the adjectives shown in the active language; neutral words when the clip has none."""
     theme = theme_adjective(clip_theme) if clip_theme else gettext(wording.theme)
     opposite = OPPOSITE_THEME.get(clip_theme)
-    return theme, theme_adjective(opposite) if opposite else gettext("opposite theme")
+    return theme, theme_adjective(opposite) if opposite else gettext("plain")
 
 
 def clean_answers(questions: list[Question], data) -> dict[str, str]:

@@ -17,6 +17,7 @@ from django import forms
 from protocol.vocabulary import GAIT_EMOTIONS, GESTURE_EMOTIONS, NEUTRAL_THEME, THEMES
 
 from .catalogue import upsert_clips
+from .forms import SectionForm
 
 GAIT_VECTORS = [   # in protocol.vocabulary.GAIT_EMOTIONS order; GAIT_VECTORS[3] is pure neutral
     (1, 0, 0, 0), (0, 1, 0, 0), (0, 0, 1, 0), (0, 0, 0, 1), (0.5, 0, 0, 0.5), (0, 0.5, 0.5, 0),
@@ -50,11 +51,32 @@ def tiny_mp4(path: Path, seconds: float = 1.0, fps: int = 10, size: int = 64, sh
     return path
 
 
+def wide_clip(path: Path, seconds: float = 1.0, fps: int = 10, size: tuple[int, int] = (320, 180),
+              codec: str = "libx264") -> Path:
+    """A SYNTHETIC 16:9 test clip, the shape of the rendered ones: a light figure-sized bar walking over grey.
+    codec: libx264 (an MP4: yuv420p, faststart) or libvpx-vp9 (a WebM)."""
+    w, h = size
+    path.parent.mkdir(parents=True, exist_ok=True)
+    extra = ["-movflags", "+faststart"] if codec == "libx264" else ["-b:v", "200k", "-deadline", "realtime"]
+    writer = imageio_ffmpeg.write_frames(str(path), (w, h), fps=fps, codec=codec, pix_fmt_out="yuv420p",
+                                         output_params=extra, macro_block_size=4)
+    writer.send(None)
+    for i in range(int(seconds * fps)):
+        frame = np.full((h, w, 3), 60, dtype=np.uint8)
+        frame[int(h * 0.85):, :] = 90                                      # floor
+        x = int((0.1 + 0.8 * i / max(seconds * fps - 1, 1)) * (w - w // 16))
+        frame[int(h * 0.25):int(h * 0.85), x:x + w // 16] = 220            # the "figure"
+        writer.send(frame.tobytes())
+    writer.close()
+    return path
+
+
 def make_catalogue(media_root: Path, video_bytes: bytes | None = None, duration_s: float | None = None,
                    n_gait: int = 10, n_transition: int = 6, n_gait_source: int = 4, n_gesture: int = 12,
-                   gesture_video_bytes: bytes | None = None) -> int:
+                   gesture_video_bytes: bytes | None = None, webm_bytes: bytes | None = None) -> int:
     """Insert a synthetic catalogue: generated/source gaits, transitions, gestures (each generated gesture made from
-    a source gesture), one neutral RBF input walk and RBF theme clips with positive and negative weights."""
+    a source gesture), one neutral RBF input walk and RBF theme clips with positive and negative weights.
+    webm_bytes: a WebM every clip gets beside its MP4 (none when None)."""
     records = []
 
     def media(tag: str, modality: str) -> str:
@@ -63,7 +85,7 @@ def make_catalogue(media_root: Path, video_bytes: bytes | None = None, duration_
 
     def base(clip_id: str, modality: str, origin: str, **extra) -> dict:
         rec = {"clip_id": clip_id, "modality": modality, "origin": origin, "video": media(clip_id, modality),
-               "webm": "",
+               "webm": write_media(media_root, webm_bytes, ".webm") if webm_bytes is not None else "",
                "poster": "", "plan": "test", "loop": False, "duration_s": duration_s,
                "metadata": {"synthetic": True, "note": "test placeholder, not rendered motion"}}
         rec.update(extra)
@@ -151,3 +173,22 @@ def consent_and_demographics(driver) -> None:
         driver.find_element(By.CSS_SELECTOR, f"input[name={name}]").find_element(By.XPATH, "..").click()
     driver.find_element(By.CSS_SELECTOR, "button[type=submit]").click()
     wait_for(driver, lambda d: "/clip/1/" in d.current_url, what="first clip")
+
+
+def section_form_errors(section) -> dict[str, list[str]]:
+    """The errors of the admin's section form when ``section`` is posted as it stands in memory (its fields
+    unchanged, its pool and options as raw JSON): the checks that need the catalogue or norms run there, not in the
+    model layer."""
+    data = {}
+    for bound in SectionForm(instance=section):
+        value = bound.value()
+        if isinstance(bound.field, forms.BooleanField):
+            if value:
+                data[bound.html_name] = "on"
+        elif isinstance(value, (list, tuple)):
+            data[bound.html_name] = [str(v) for v in value]
+        else:
+            data[bound.html_name] = "" if value is None else str(value)
+    form = SectionForm(data=data, instance=section)
+    form.is_valid()
+    return dict(form.errors)

@@ -4,11 +4,15 @@ protocol.pools.options_errors).
 - ``"practice": true`` or ``"practice_clip": "<clip_id>"``: one practice item first in the section, on a clip
   outside the section's pool (``practice``: a clip of the section's modality drawn with the participant's seed),
   with the section's questions, marked "Practice" on the page. Its answers are never stored as responses.
-- ``"attention_checks": {"count": 1, "answer": "sad", "positions": "random" | [3], "question": "perceived"}``:
-  instructed-response items (Prolific's rules: the instruction is explicit and shown above the question, no trick,
-  no memory test). Each shows a real clip of the section's pool (one this participant does not rate in the section
-  when there is one, else one of the section's clips) with one question of the section (``question``, default the
-  first) and the instruction to give ``answer``. ``positions``: 1-based places among the section's rated items
+- ``"attention_checks": {"count": 1, "answer": "sad", "positions": "random" | [3], "question": "perceived",
+  "clip": "<clip_id>"}``: instructed-response items (Prolific's rules: the instruction is explicit and shown above
+  the question, no trick, no memory test). A check never shows a clip the participant rates anywhere in the study
+  (an instruction on a rated clip primes the very answer the study measures): its clip is, in this order, the
+  dedicated ``clip``, a clip of the section's pool (a reusing section: of the reused section's pool) that this
+  participant rates nowhere, or the section's practice clip; with none left the participant gets fewer checks
+  (the admin refuses such a section when it is saved: ``studyapp.check_clips``). The page shows the section's
+  questions as on every clip page, the instruction being the page's note line (studyapp.page_notes), and only the
+  answer to ``question`` (default the first) is stored. ``positions``: 1-based places among the section's rated items
   (trials and checks, practice not counted), clamped to the section's length; ``"random"`` draws them with the
   participant's seed, never the first place when the section has more than one item. The answer is stored with
   section_type ``attention_check`` and question ``<key>=<answer>`` (protocol.vocabulary.attention_question).
@@ -75,26 +79,28 @@ def check_positions(config: dict, n_items: int, rng: random.Random) -> list[int]
     return sorted(rng.sample(places, min(count, len(places))))
 
 
-def _check_clips(rng: random.Random, pool: list[Clip], trials: list[PlannedItem], count: int) -> list[Clip]:
-    """Distinct clips for the checks: pool clips the participant does not rate here first, then rated ones."""
-    rated = {it.clip.pk for it in trials}
-    spare = [c for c in pool if c.pk not in rated]
+def check_clips(rng: random.Random, pool: list[Clip], rated: set[int], taken: set[int], dedicated: Clip | None,
+                practice: Clip | None, count: int) -> list[Clip]:
+    """Up to ``count`` distinct clips for a section's checks, none of them rated by the participant: the dedicated
+    check clip, then spare pool clips (not rated, not already another section's check; random order), then the
+    practice clip. rated: pks of every clip the participant rates in the study; taken: pks of earlier checks."""
+    spare = [c for c in pool if c.pk not in rated and c.pk not in taken]
     rng.shuffle(spare)
-    own = [it.clip for it in trials]
-    rng.shuffle(own)
-    return (spare + own)[:count]
+    out: list[Clip] = []
+    for clip in ([dedicated] if dedicated else []) + spare + ([practice] if practice else []):
+        if clip.pk not in rated and all(clip.pk != c.pk for c in out):
+            out.append(clip)
+    return out[:count]
 
 
-def _attention_items(section: Section, trials: list[PlannedItem], pool: list[Clip], rng: random.Random
+def _attention_items(section: Section, trials: list[PlannedItem], clips: list[Clip], rng: random.Random
                      ) -> list[PlannedItem]:
-    """The section's rated items with its attention checks placed among the trials."""
+    """The section's rated items with its attention checks (one per clip of ``clips``) placed among the trials."""
     config = section.options.get("attention_checks")
-    if not config or not trials:
+    if not config or not trials or not clips:
         return list(trials)
     answer = str(config["answer"])
-    count = check_count(config)
-    clips = _check_clips(rng, pool, trials, count)
-    positions = check_positions(config, len(trials) + len(clips), rng)
+    positions = check_positions({**config, "count": len(clips)}, len(trials) + len(clips), rng)
     instructed = attention_question(check_question(section), answer)
     checks = []
     for clip in clips[:len(positions)]:
@@ -122,15 +128,22 @@ def _practice_item(section: Section, candidates: list[Clip], used: set[int], rng
 
 
 def with_extras(section: Section, trials: list[PlannedItem], pool: list[Clip], practice_candidates: list[Clip],
-                used: set[int], seed: int) -> list[PlannedItem]:
+                used: set[int], seed: int, check_clip: Clip | None = None, taken: set[int] | None = None
+                ) -> list[PlannedItem]:
     """A section's items in the order shown: its practice item (if any), then trials and attention checks.
 
-    trials: the planned clips; pool: the section's pool clips (check clips come from it, or from the trials
-    when it is empty, as in a reusing section); used: pks of clips this participant sees elsewhere (practice
-    avoids them); seed: the participant's seed (a separate stream, so the trials do not change)."""
+    trials: the planned clips; pool: the clips checks may draw (the section's pool, or the reused section's);
+    used: pks of every clip this participant rates in the study (practice and checks avoid them); seed: the
+    participant's seed (a separate stream, so the trials do not change); check_clip: the dedicated check clip
+    (``attention_checks.clip``); taken: pks of earlier sections' check clips (updated with this section's)."""
     if not isinstance(section.options, dict) or not section.options:
         return list(trials)
     rng = random.Random(f"{seed}:{section.pk}:extras")
-    items = _attention_items(section, trials, pool or [it.clip for it in trials], rng)
     practice = _practice_item(section, practice_candidates, used, rng)
+    config = section.options.get("attention_checks")
+    clips = check_clips(rng, pool, used, taken if taken is not None else set(), check_clip,
+                        practice.clip if practice else None, check_count(config)) if config else []
+    if taken is not None:
+        taken.update(c.pk for c in clips)
+    items = _attention_items(section, trials, clips, rng)
     return ([practice] if practice else []) + items

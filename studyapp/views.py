@@ -27,16 +27,18 @@ from protocol.vocabulary import ATTENTION_CHECK
 
 from . import start_throttle
 from .assignment import StudyUnavailable, check_open, current_step, start_participant
-from .device_check import device_context
+from .device_check import device_context, device_record, refusal
 from .duration import expected_minutes
 from .forms import PARAM_MAX_LENGTH, PARAM_TOO_LONG, ConsentForm, DemographicsForm, FeedbackForm
 from .i18n import activate_study_language
 from .item_questions import questions_html
 from .media import accel_redirect_response, media_path, ranged_file_response
 from .models import Assignment, Clip, Participant, Response, Study
+from .page_notes import page_note
 from .page_reads import participant_by_token
 from .permissions import has_staff_permission
 from .questions import AnswerError, clean_answers, questions_for
+from .section_wording import participant_wording
 from .viewing import (
     MAX_COUNT,
     PLAYBACK_EVENTS,
@@ -172,6 +174,9 @@ def study_entry(request, slug: str):
             if not data.get(key) and request.GET.get(key):
                 data[key] = request.GET[key]
         form = ConsentForm(data)
+        device = device_record(request.POST, request.headers.get("User-Agent", ""))
+        if (turned_away := refusal(study, device)) is not None:
+            return render(request, "studyapp/device_refused.html", {"study": study, "message": turned_away})
         if form.is_valid():
             data = form.cleaned_data
             key = _consent_key(request, study, request.POST.get("consent_key", ""), data["PROLIFIC_PID"])
@@ -183,7 +188,7 @@ def study_entry(request, slug: str):
                     participant = Participant.objects.create(
                         study=study, external_id=data["PROLIFIC_PID"], external_study_id=data["STUDY_ID"],
                         external_session_id=data["SESSION_ID"], consent_key=key,
-                        user_agent=request.headers.get("User-Agent", "")[:300])
+                        user_agent=request.headers.get("User-Agent", "")[:300], **device)
             except IntegrityError:
                 # The same consent form submitted twice (double click), or the same Prolific PID consenting in
                 # another tab a moment ago: only the same browser session or the same full Prolific triple
@@ -208,7 +213,7 @@ def study_entry(request, slug: str):
                                                      "expected_minutes": expected_minutes(study),
                                                      "link_params": link_params,
                                                      "consent_key": _issue_consent_key(request, study),
-                                                     **device_context()})
+                                                     **device_context(study)})
 
 
 def _store_missing_ids(participant: Participant, params: dict[str, str]) -> None:
@@ -288,7 +293,9 @@ def item_context(section, clip, index: int, total: int, next_clip: Clip | None, 
     fields = [{"q": q, "selected": posted.getlist(q.key) if posted is not None else []} for q in questions]
     player = player_options(section.options)
     left = plays_left(plays_before, player["max_replays"])
-    return {"section": section, "fields": fields, "questions_html": questions_html(fields),
+    section_title, section_text = participant_wording(section)
+    return {"section": section, "section_title": section_title, "section_text": section_text, "fields": fields,
+            "questions_html": questions_html(fields),
             "sources": clip_sources(clip),
             "next_sources": clip_sources(next_clip) if next_clip else None,
             "loop": section.loop or clip.loop, "require_play": section.require_full_play,
@@ -296,27 +303,14 @@ def item_context(section, clip, index: int, total: int, next_clip: Clip | None, 
             "plays_before": plays_before, "ended_before": ended_before, "playback_url": playback_url,
             "autoplay": left is None or left > 0,
             "index": index, "total": total, "percent": int(round(100 * (index - 1) / max(total, 1))),
-            "practice": kind == Assignment.Kind.PRACTICE, **attention_context(questions, kind, instructed)}
+            "practice": kind == Assignment.Kind.PRACTICE,
+            "page_note": page_note(questions, kind, instructed, section.pk or 0, index)}
 
 
 def item_questions(section, clip, options: list[str] | None, kind: str = "", instructed: str = "") -> list:
-    """The questions of one clip page: the section's, or for an attention check the one it instructs."""
-    questions = questions_for(section.section_type, section.options, clip.theme, options)
-    if kind == ATTENTION_CHECK:
-        key = instructed.partition("=")[0]
-        questions = [q for q in questions if q.key == key]
-    return questions
-
-
-def attention_context(questions: list, kind: str, instructed: str) -> dict:
-    """The instruction of an attention check: the label of the answer to give (its value for a scale), and
-    whether the question is multi-select (the page then says "only")."""
-    if kind != ATTENTION_CHECK or not questions:
-        return {"attention": ""}
-    value = instructed.partition("=")[2]
-    q = questions[0]
-    label = next((lbl for v, lbl in q.choices if v == value), value)
-    return {"attention": value if q.kind == "scale" or not label else label, "attention_multi": q.kind == "multi"}
+    """The questions of one clip page: the section's, an attention check's too (its page looks like any other
+    of the section; only the instructed question's answer is stored, studyapp.page_notes)."""
+    return questions_for(section.section_type, section.options, clip.theme, options)
 
 
 def client_ms(raw, server_ms: int) -> int | None:
@@ -364,6 +358,8 @@ def mark_completed(participant: Participant) -> None:
 # (static/studyapp/study.js puts that page's own URL into the address bar), one request per answered clip instead
 # of POST + redirect + GET. A POST without it (a script, a page from before) gets the redirect.
 INLINE_NEXT_FIELD = "inline_next"
+# The clip number the form was shown for: an answer POST whose number is not its URL's is refused (see item).
+PAGE_FIELD = "page"
 
 
 @never_cache
@@ -386,6 +382,11 @@ def item(request, token: str, n: int):
     assignment = step.assignment
     if request.method != "POST":
         return _show_item(request, participant, step)
+    if request.POST.get(PAGE_FIELD, str(n)) != str(n):
+        # The answers of another clip page sent to this page's URL: a browser that resends the POST which brought
+        # this page when the page is reloaded (WebKit keeps that POST's data after history.replaceState). They are
+        # not this clip's answers: show the page again.
+        return redirect(step_url(token, step))
     section, clip = assignment.section, assignment.clip
     questions = item_questions(section, clip, assignment.options, assignment.kind, assignment.instructed)
     try:
@@ -437,8 +438,8 @@ def save_answers(assignment: Assignment, answers: dict[str, str], response_ms: i
                  viewing: dict | None = None) -> bool:
     """Store the answers of one clip exactly once (one transaction: a conditional UPDATE claims the assignment
     and stores its viewing record, one INSERT of its responses, one UPDATE of the participant's last activity).
-    Returns False if they were already stored. A practice item stores no responses; an attention check stores its
-    one answer with kind ATTENTION_CHECK and question ``<key>=<instructed answer>``."""
+    Returns False if they were already stored. A practice item stores no responses; an attention check stores the
+    answer to its instructed question only, with kind ATTENTION_CHECK and question ``<key>=<instructed answer>``."""
     now = timezone.now()
     try:
         with transaction.atomic():
@@ -448,11 +449,12 @@ def save_answers(assignment: Assignment, answers: dict[str, str], response_ms: i
                 return False
             if assignment.kind != Assignment.Kind.PRACTICE:
                 attention = assignment.kind == ATTENTION_CHECK
+                asked = assignment.instructed.partition("=")[0]
                 Response.objects.bulk_create([
                     Response(participant_id=assignment.participant_id, section_id=assignment.section_id,
                              clip_id=assignment.clip_id, question=assignment.instructed if attention else key,
                              answer=value, response_ms=response_ms, kind=assignment.kind)
-                    for key, value in answers.items()])
+                    for key, value in answers.items() if not attention or key == asked])
             Participant.objects.filter(pk=assignment.participant_id).update(last_active_at=now)
     except IntegrityError:      # unique_response caught a concurrent duplicate
         return False
@@ -476,7 +478,7 @@ def _render_item(request, participant: Participant, step, status: int = 200, err
     ctx.update({"participant": participant, "study": participant.study, "error": error,
                 "first_of_section": assignment.position == 0,
                 "form_action": reverse("studyapp:item", kwargs={"token": participant.token, "n": step.index}),
-                "inline_next_field": INLINE_NEXT_FIELD})
+                "inline_next_field": INLINE_NEXT_FIELD, "page_field": PAGE_FIELD})
     return render(request, "studyapp/item.html", ctx, status=status)
 
 

@@ -254,10 +254,14 @@ def press_instructed(driver, instructed: str) -> None:
     number key of the instructed answer chooses it."""
     from selenium.webdriver.common.by import By
 
-    assert driver.find_element(By.CSS_SELECTOR, ".attention-instruction").is_displayed()
+    key, _, value = instructed.partition("=")
+    note = driver.find_element(By.ID, "page-note")
+    label = driver.find_element(By.CSS_SELECTOR, f"#answer-form input[name='{key}'][value='{value}']").find_element(
+        By.XPATH, "..").text.strip()
+    assert note.is_displayed() and label in note.text, note.text      # the instruction names the answer
     values = [e.get_attribute("value") for e in driver.find_elements(By.CSS_SELECTOR, "#answer-form input")
               if e.get_attribute("type") in ("checkbox", "radio")]
-    press(driver, str(values.index(instructed.split("=", 1)[1]) + 1))
+    press(driver, str(values.index(value) + 1))
 
 
 def answer_clip_page(driver, n: int, section_type: str, seen: set[str], shots, instructed: str = "") -> None:

@@ -5,6 +5,7 @@ STUDY_SCREENSHOTS=<folder> saves norming_item.png, norming_monitor.png and admin
 from __future__ import annotations
 
 import os
+import re
 import time
 from pathlib import Path
 
@@ -37,20 +38,24 @@ def shot(driver, folder: str | None, name: str, element=None) -> None:
     driver.set_window_size(1280, 900)
 
 
+INSTRUCTION = re.compile(r"\u201c(?P<question>.+)\u201d with (?P<answer>.+) only\.")
+
+
 def answer_page(driver, folder: str | None = None, name: str = "") -> None:
     """Wait until the clip has played, answer every question (the instructed answer on an attention check, else
     the first choice of each question), submit."""
     from selenium.webdriver.common.by import By
 
     wait_for(driver, lambda d: d.find_element(By.ID, "next").is_enabled(), timeout=15, what="clip played")
-    instructed = driver.find_elements(By.CSS_SELECTOR, ".attention-instruction")
+    # the note line: on an attention check it names a question ("...") and the answer to give it ("with X only")
+    instructed = INSTRUCTION.search(driver.find_element(By.ID, "page-note").text)
     for fieldset in driver.find_elements(By.CSS_SELECTOR, "fieldset.question"):
         inputs = fieldset.find_elements(By.CSS_SELECTOR, "input")
         target = inputs[0]
-        if instructed:      # the choice the instruction quotes, by its label or its value
-            quoted = instructed[0].text.split("\u201c", 1)[1].split("\u201d", 1)[0].strip()
-            target = next(i for i in inputs if quoted in (i.get_attribute("value"),
-                                                          i.find_element(By.XPATH, "..").text.strip()))
+        legend = fieldset.find_element(By.TAG_NAME, "legend").text.strip()
+        if instructed and instructed["question"] == legend:      # the choice the instruction names
+            target = next(i for i in inputs if instructed["answer"] in (
+                i.get_attribute("value"), i.find_element(By.XPATH, "..").text.strip()))
         target.find_element(By.XPATH, "..").click()
     if name:
         shot(driver, folder, name)
@@ -75,12 +80,11 @@ def simulated_participant(study: Study, external_id: str) -> None:
     client.get(reverse("studyapp:resume", args=[p.token]))
     while (step := current_step(Participant.objects.get(pk=p.pk))).kind == "item":
         a = step.assignment
-        if a.kind == ATTENTION_CHECK:
+        data = {q.key: q.choices[0][0]
+                for q in questions_for(a.section.section_type, a.section.options, a.clip.theme, a.options)}
+        if a.kind == ATTENTION_CHECK:               # the section's questions, the instructed one as told
             key, _, value = a.instructed.partition("=")
-            data = {key: value}
-        else:
-            data = {q.key: q.choices[0][0]
-                    for q in questions_for(a.section.section_type, a.section.options, a.clip.theme, a.options)}
+            data[key] = value
         assert client.post(reverse("studyapp:item", args=[p.token, step.index]), data).status_code == 302
     client.post(reverse("studyapp:feedback", args=[p.token]), {"comments": ""})
 

@@ -181,7 +181,7 @@ def test_german_questions_show_german_labels_and_keep_protocol_values():
         assert [v for v, _ in q.choices] == list(answer_values(SECTION_QUESTIONS["emotion_choice"]["perceived"]))
         rating = questions_for("theme_rating", clip_theme="happy")[0]
         assert rating.text == "Wie fröhlich wirkt dieser Gang?"
-        assert dict(rating.choices)["7"] == "maximal fröhlich"
+        assert dict(rating.choices)["7"] == "sehr fröhlich"
         inversion = questions_for("theme_inversion", clip_theme="tired")[0]
         assert inversion.text == "Wirkt dieser Gang eher energiegeladen oder eher müde?"
         neutral = dict(questions_for("neutral_validation")[0].choices)

@@ -214,9 +214,10 @@ def test_simulated_norming_study_through_the_pages_recovers_the_truth(norming):
         p = _start(client, norming, f"?PROLIFIC_PID=sim{i:04d}&STUDY_ID=s&SESSION_ID=x{i}")
         while (step := current_step(Participant.objects.get(pk=p.pk))).kind == "item":
             a = step.assignment
-            if a.kind == ATTENTION_CHECK:
+            if a.kind == ATTENTION_CHECK:                  # a check page asks the section's questions too
                 key, _, value = a.instructed.partition("=")
-                data = {key: value}
+                data = {**{q.key: q.choices[0][0] for q in questions_for(
+                    a.section.section_type, a.section.options, a.clip.theme, a.options)}, key: value}
             elif a.kind:                                   # practice
                 data = {q.key: q.choices[0][0] for q in questions_for(a.section.section_type, a.section.options,
                                                                       a.clip.theme, a.options)}

@@ -7,7 +7,6 @@ import json
 
 import pandas as pd
 import pytest
-from django import forms
 from django.contrib.auth.models import User
 from django.urls import reverse
 
@@ -16,10 +15,10 @@ from protocol.vocabulary import CLIP_NORMS_COLUMNS, GAIT_EMOTIONS
 from studyapp import norms_rule
 from studyapp.admin_norms import norms_table
 from studyapp.catalogue import CatalogueError, pool_queryset
-from studyapp.forms import SectionForm
 from studyapp.models import Clip, Participant, Response, Section, Study
 from studyapp.presets import create_study_from_preset
 from studyapp.testing import make_catalogue
+from studyapp.testing import section_form_errors as section_errors
 
 pytestmark = pytest.mark.django_db
 WALKS = {"modality": "gait", "origin": "generated", "transition": False, "rbf": False}
@@ -33,24 +32,6 @@ def catalogue(settings, tmp_path):
     norms_rule.clear()
     yield
     norms_rule.clear()
-
-
-def section_errors(section: Section) -> dict[str, list[str]]:
-    """The errors of the admin's section form when ``section`` is posted as it stands (its fields unchanged, its
-    pool as raw JSON): where a norms source is checked (the model layer does not read norms)."""
-    data = {}
-    for bound in SectionForm(instance=section):
-        value = bound.value()
-        if isinstance(bound.field, forms.BooleanField):
-            if value:
-                data[bound.html_name] = "on"
-        elif isinstance(value, (list, tuple)):
-            data[bound.html_name] = [str(v) for v in value]
-        else:
-            data[bound.html_name] = "" if value is None else str(value)
-    form = SectionForm(data=data, instance=section)
-    form.is_valid()
-    return dict(form.errors)
 
 
 def norm_row(clip_id: str, intended: str, share: float, n: int, **extra) -> dict:

@@ -4,6 +4,7 @@ from __future__ import annotations
 import csv
 import io
 import math
+import re
 from collections import Counter
 
 import pytest
@@ -72,9 +73,18 @@ def first_section(study: Study):
     return study.sections.get(order=1)
 
 
+def tag_outline(page: str) -> list[str]:
+    """The page's tags with their class and type attributes, in order (what a script could tell pages apart by
+    without reading their text)."""
+    body = page[page.index("<main"):page.index("</main>")]
+    return re.findall(r'<(\w+)(?:[^>]*?\s(?:class|type)="([^"]*)")?', body)
+
+
 def test_attention_check_at_fixed_position_shown_exported_and_counted(study):
     section = first_section(study)
     section.options = {"attention_checks": {"count": 1, "answer": "sad", "positions": [3]}}
+    section.clips_per_participant = 6           # the pool holds 8: two spare clips for checks
+    section.full_clean()
     section.save()
     client, p = started(study)
     items = list(p.assignments.filter(section=section).order_by("position"))
@@ -83,15 +93,20 @@ def test_attention_check_at_fixed_position_shown_exported_and_counted(study):
     assert [a.kind for a in items].count(ATTENTION_CHECK) == 1 and check.kind == ATTENTION_CHECK
     assert check.instructed == "perceived=sad"
     assert check.clip_id in set(pool_queryset(section.pool).values_list("pk", flat=True))
-    # the page shows the instruction above the one question, with the instructed answer among the options
+    assert not p.assignments.filter(kind="", clip_id=check.clip_id).exists()      # rated nowhere in the study
+    # the page looks like every clip page of the section: the same question, the instruction in the note line
+    normal = ""
     while current_step(p).assignment.pk != check.pk:
         a = current_step(p).assignment
+        normal = client.get(reverse("studyapp:item", args=[p.token, a.seq])).content.decode()
         client.post(reverse("studyapp:item", args=[p.token, a.seq]), {"perceived": "happy"})
         p.refresh_from_db()
     page = client.get(reverse("studyapp:item", args=[p.token, check.seq])).content.decode()
-    assert "Attention check" in page and "select only “Sad”" in page
-    assert page.index("attention-instruction") < page.index("<fieldset")
-    assert page.count("<fieldset") == 1 and 'value="sad"' in page
+    assert "Attention check" not in page and "attention" not in page.lower()
+    note = re.search(r'<p class="page-note" id="page-note">(.*?)</p>', page).group(1)
+    assert "“Which emotion(s) do you perceive from this walk?” with Sad only" in note.replace("&#x27;", "'")
+    assert page.index("page-note") < page.index("<fieldset") and page.count("<fieldset") == 1
+    assert tag_outline(page) == tag_outline(normal)
     client.post(reverse("studyapp:item", args=[p.token, check.seq]), {"perceived": "sad"})
     p.refresh_from_db()
     answer(client, p)
@@ -108,6 +123,7 @@ def test_attention_check_at_fixed_position_shown_exported_and_counted(study):
 def test_failed_attention_check_counts_and_random_positions_never_first(study):
     section = first_section(study)
     section.options = {"attention_checks": {"count": 2, "answer": "angry", "positions": "random"}}
+    section.clips_per_participant = 6
     section.save()
     places = Counter()
     for _ in range(6):
@@ -234,7 +250,7 @@ def test_duration_from_pool_durations(study):
         seconds += n * (mean + PAGE_SECONDS + questions * ANSWER_SECONDS_PER_QUESTION)
         if sec.pk == section.pk:
             seconds += (mean + PAGE_SECONDS + questions * ANSWER_SECONDS_PER_QUESTION)     # practice
-            seconds += mean + PAGE_SECONDS + ANSWER_SECONDS_PER_QUESTION                   # one check
+            seconds += mean + PAGE_SECONDS + questions * ANSWER_SECONDS_PER_QUESTION       # one check
     seconds += DEMOGRAPHICS_SECONDS + FEEDBACK_SECONDS_PER_QUESTION * len(study.feedback_questions)
     assert expected_minutes(study) == math.ceil(seconds / 60)
     page = Client().get(reverse("studyapp:study_entry", args=[study.slug])).content.decode()
@@ -266,10 +282,12 @@ def test_checks_in_a_reusing_likert_section_and_gesture_practice(settings, tmp_p
     p = Participant.objects.create(study=study, demographics_done=True)
     start_participant(p)
     check = p.assignments.get(section=likert, kind=ATTENTION_CHECK)
-    source_clips = set(p.assignments.filter(section=likert.reuse_section, kind="").values_list("clip_id", flat=True))
-    assert check.clip_id in source_clips and check.instructed == "pace=2" and check.position > 0
+    rated = set(p.assignments.filter(kind="").values_list("clip_id", flat=True))
+    assert check.clip_id not in rated and check.instructed == "pace=2" and check.position > 0
+    assert check.clip_id in set(pool_queryset(likert.reuse_section.pool).values_list("pk", flat=True))
+    # the check page asks the section's four questions, like its other pages; only the instructed one is stored
     assert [q.key for q in item_questions(likert, check.clip, check.options, check.kind, check.instructed)] == \
-        ["pace"]
+        list(SECTION_QUESTIONS["affect_likert"])
     practice = p.assignments.get(section=gesture, kind=Assignment.Kind.PRACTICE)
     assert practice.position == 0 and practice.clip.modality == "gesture"
     assert practice.clip_id not in set(pool_queryset(gesture.pool).values_list("pk", flat=True))
@@ -293,8 +311,8 @@ def test_preview_shows_practice_and_attention_check_and_records_nothing(study, s
     first = staff_client.get(url(1)).content.decode()
     assert "Practice" in first and "(practice, never stored)" in first
     check = staff_client.get(url(3)).content.decode()
-    assert "Attention check" in check and "instructed perceived=sad" in check
-    assert "please select only" in check and "Sad" in check         # the participant's instruction, shown
+    assert "(attention check, instructed perceived=sad)" in check      # the researcher's banner
+    assert "with Sad only" in check                                    # the participant's instruction, shown
     assert staff_client.post(url(3), {}).status_code == 400           # validated like a participant's page
     r = staff_client.post(url(3), {"perceived": "sad"})
     assert r.status_code == 302 and r["Location"] == url(4)
@@ -307,6 +325,7 @@ def test_preview_shows_practice_and_attention_check_and_records_nothing(study, s
 def test_admin_participant_page_lists_seq_kind_and_instructed_answer(study, staff_client):
     section = first_section(study)
     section.options = {"attention_checks": {"count": 1, "answer": "sad", "positions": [2]}}
+    section.clips_per_participant = 6
     section.save()
     _, p = started(study)
     page = staff_client.get(reverse("admin:studyapp_participant_change", args=[p.pk])).content.decode()

@@ -59,6 +59,7 @@ def test_practice_and_attention_check_in_chromium(chromium, live_server, setting
     study = create_study_from_preset("gait_ismar2020", "extras", plan="test", status=Study.Status.OPEN)
     section = study.sections.get(order=1)
     section.options = {"practice": True, "attention_checks": {"answer": "sad", "positions": [2]}}
+    section.full_clean()
     section.save()
     shots = os.environ.get("STUDY_SCREENSHOTS")
     driver = chromium
@@ -73,15 +74,15 @@ def test_practice_and_attention_check_in_chromium(chromium, live_server, setting
     answer_when_played(driver, 1, "happy", shots, "study_practice.png")
     # 2: a trial; 3: the attention check (second rated item of the section)
     answer_when_played(driver, 2, "neutral")
-    instruction = driver.find_element(By.CSS_SELECTOR, ".attention-instruction")
-    assert instruction.is_displayed() and "“Sad”" in instruction.text
+    instruction = driver.find_element(By.ID, "page-note")
+    assert instruction.is_displayed() and "with Sad only" in instruction.text
     assert instruction.location["y"] < driver.find_element(By.CSS_SELECTOR, "fieldset.question").location["y"]
     assert len(driver.find_elements(By.CSS_SELECTOR, "fieldset.question")) == 1
     answer_when_played(driver, 3, "sad", shots, "study_attention_check.png")
     p = Participant.objects.get(external_id="x-1")
     practice = p.assignments.get(kind=Assignment.Kind.PRACTICE)
     assert practice.answered_at is not None
-    assert not Response.objects.filter(participant=p, clip_id=practice.clip_id, section=section).exists()
+    assert not Response.objects.filter(participant=p, clip_id=practice.clip_id, section=section, kind="").exists()
     check = Response.objects.get(participant=p, kind=ATTENTION_CHECK)
     assert (check.question, check.answer) == ("perceived=sad", "sad")
     assert Response.objects.filter(participant=p, kind="").count() == 1

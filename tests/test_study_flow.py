@@ -123,6 +123,25 @@ def test_double_submit_and_back_button_store_one_answer(client, study):
     assert client.get(r["Location"])["Location"].endswith("/clip/2/")
 
 
+def test_answers_of_one_page_resent_to_the_next_page_are_not_stored_there(client, study):
+    """A browser that resends the POST which brought clip page 2 when page 2 is reloaded (WebKit, after the page
+    put its own URL into the address bar) posts clip 1's answers to clip 2's URL: they are not clip 2's answers."""
+    p = consent(client, study)
+    demographics(client, p)
+    client.get(reverse("studyapp:resume", args=[p.token]))
+    first = cur(p).assignment
+    data = {**answer_for(first), "page": "1", "inline_next": "1"}
+    page2 = client.post(reverse("studyapp:item", args=[p.token, 1]), data)
+    assert page2.status_code == 200 and 'name="page" value="2"' in page2.content.decode()
+    second = cur(p).assignment
+    r = client.post(reverse("studyapp:item", args=[p.token, 2]), data)        # the resent POST
+    assert r.status_code == 302 and r["Location"].endswith("/clip/2/")
+    assert not Response.objects.filter(participant=p, clip=second.clip, section=second.section).exists()
+    assert cur(p).assignment.pk == second.pk
+    r = client.post(reverse("studyapp:item", args=[p.token, 2]), {**answer_for(second), "page": "2"})
+    assert r.status_code == 302 and Response.objects.filter(participant=p, clip=second.clip).exists()
+
+
 def test_reload_second_tab_and_new_client_resume(client, study):
     p = consent(client, study)
     demographics(client, p)
