@@ -19,7 +19,7 @@ from django.utils.html import format_html, format_html_join
 
 from protocol.pools import SUB_POOLS
 
-from . import admin_clip_qa, clip_import, pool_editor, views_pool, views_staff
+from . import admin_clip_qa, clip_display, clip_import, pool_editor, views_pool, views_staff
 from .admin_norms import norms_table
 from .forms import ClipImportForm, SectionForm, StudyAdminForm
 from .models import Assignment, Clip, Participant, Response, Section, Study
@@ -126,7 +126,7 @@ class SectionInline(admin.StackedInline):
 
     class Media:
         js = ["studyapp/admin_pool.js"]
-        css = {"all": ["studyapp/admin_pool.css"]}
+        css = {"all": ["studyapp/admin_pool.css", clip_display.STYLESHEET]}
 
     def formfield_for_foreignkey(self, db_field, request, **kwargs):
         if db_field.name == "reuse_section":        # never offer (and so name) another lab's sections
@@ -136,11 +136,15 @@ class SectionInline(admin.StackedInline):
     @admin.display(description="matching clips")
     def matching_clips(self, section):
         summary, warnings = pool_notes(section)
+        sample = [] if section.reuse_section_id else views_pool.pool_sample(section.section_type or None,
+                                                                             section.pool)
         return format_html('<span class="pool-count" data-url="{}" aria-live="polite">{}</span>'
-                           '<ul class="pool-warnings">{}</ul><code class="pool-json">pool (saved): {}</code>'
+                           '<ul class="pool-warnings">{}</ul><ul class="clip-samples" aria-label="some of the '
+                           'matching clips">{}</ul><code class="pool-json">pool (saved): {}</code>'
                            '<div class="norms-slot">{}</div>',
                            reverse("admin:studyapp_pool_count"), summary,
                            format_html_join("", '<li class="pool-warning">{}</li>', ((w,) for w in warnings)),
+                           format_html_join("", "<li>{}</li>", ((c.html(),) for c in sample)),
                            json.dumps(section.pool), norms_table(section.pool))
 
 
@@ -271,13 +275,18 @@ class StudyAdmin(StudyScopedAdmin):
 
 @admin.register(Clip)
 class ClipAdmin(admin.ModelAdmin):
-    list_display = ["thumbnail", "clip_id", "modality", "origin", "emotion_label", "theme", "weight", "n_features",
-                    "duration_s", "plan", admin_clip_qa.quality_flag, admin_clip_qa.observer_reading]
+    list_display = ["thumbnail", "title_or_id", "modality", "origin", "emotion_label", "theme", "weight",
+                    "n_features", "duration_s", "plan", admin_clip_qa.quality_flag, admin_clip_qa.observer_reading]
+    list_display_links = ["title_or_id"]
     list_filter = ["retired", admin_clip_qa.QualityFlagFilter, "modality", "origin", "plan", "theme", "emotion_label"]
-    search_fields = ["clip_id", "plan", "licence", "citation"]
+    search_fields = ["clip_id", "title", "plan", "licence", "citation"]
     readonly_fields = ["preview", "media_key", "created_at", "updated_at"]
     actions = ["download_contact_sheet"]
     change_list_template = "admin/studyapp/clip/change_list.html"
+    list_per_page = 25
+
+    class Media:
+        css = {"all": [clip_display.STYLESHEET]}
 
     def get_urls(self):
         custom = [path("import/", self.admin_site.admin_view(self.import_view), name="studyapp_clip_import"),
@@ -318,10 +327,11 @@ class ClipAdmin(admin.ModelAdmin):
 
     @admin.display(description="poster")
     def thumbnail(self, clip):
-        if not clip.poster:
-            return "-"
-        return format_html('<img src="{}" alt="" style="height:48px">', reverse("studyapp:media", args=[
-            clip.media_key, "png"]))
+        return clip_display.clip_cell(clip).thumb()
+
+    @admin.display(description="clip", ordering="title")
+    def title_or_id(self, clip):
+        return format_html('{}<br><code class="clip-id">{}</code>', clip.title or clip.clip_id, clip.clip_id)
 
     @admin.display(description="poster and video")
     def preview(self, clip):

@@ -34,6 +34,7 @@ from protocol.vocabulary import (
     ASSIGNMENT_COLUMNS,
     ATTENTION_CHECK,
     CLIP_COLUMNS,
+    CLIP_PROVENANCE_COLUMNS,
     PARTICIPANT_COLUMNS,
     RESPONSE_COLUMNS,
     VIEWING_COLUMNS,
@@ -115,9 +116,10 @@ def study_clips(study: Study):
     return Clip.objects.filter(q).distinct().order_by("clip_id")
 
 
-#: The study's clips.csv: the public columns, then the licence and citation of what each clip was made from (blank
-#: where the catalogue has none), which travel with the clips into every report and reuse.
-EXPORT_CLIP_COLUMNS = (*CLIP_COLUMNS, "licence", "citation")
+#: The study's clips.csv: the public columns, then the clip's readable title (protocol.titles) and the licence and
+#: citation of what it was made from (blank where the catalogue has none), which travel with the clips into every
+#: report and reuse.
+EXPORT_CLIP_COLUMNS = (*CLIP_COLUMNS, *CLIP_PROVENANCE_COLUMNS)
 
 
 def clip_rows(study: Study) -> Iterator[list]:

@@ -14,6 +14,7 @@ from django.db import models
 from django.utils import timezone
 
 from protocol.pools import NORMS_RULE, errors_by_field, validate_section
+from protocol.titles import TITLE_MAX_LENGTH
 from protocol.vocabulary import ATTENTION_CHECK, CLIP_MODALITIES, ORIGINS
 
 from .permissions import STUDY_PERMISSIONS
@@ -47,6 +48,9 @@ class Clip(models.Model):
     """One pre-rendered stimulus; fields follow the `clips.csv` columns of DESIGN.md."""
 
     clip_id = models.CharField(max_length=200, unique=True)
+    # A readable label for staff pages and exports (protocol.titles: generator, condition, variant); never shown
+    # to participants.
+    title = models.CharField(max_length=TITLE_MAX_LENGTH, blank=True)
     modality = models.CharField(max_length=10, choices=[(m, m) for m in CLIP_MODALITIES])
     origin = models.CharField(max_length=10, choices=[(o, o) for o in ORIGINS])
     happy = models.FloatField(null=True, blank=True)

@@ -23,6 +23,7 @@ from protocol.vocabulary import ATTENTION_CHECK
 
 from .assignment import plan_study
 from .catalogue import clip_label
+from .clip_display import clip_cells
 from .export import EXPORT_KINDS, stream_csv
 from .forms import ConsentForm, PresetStudyForm
 from .i18n import activate_study_language
@@ -123,6 +124,10 @@ def progress(request, study_id: int):
                     .order_by("clip__clip_id"))
         sections.append({"section": section, "clips": list(per_clip),
                          "responses": Response.objects.filter(section=section).count()})
+    cells = clip_cells(c["clip__clip_id"] for s in sections for c in s["clips"])
+    for s in sections:
+        for c in s["clips"]:
+            c["cell"] = cells.get(c["clip__clip_id"])
     ctx = {"study": study, "counts": counts, "sections": sections, "title": f"Progress: {study.title}",
            "report": report_state(study),
            "started": counts.get(Participant.Status.STARTED, 0),

@@ -28,6 +28,7 @@ from generation.plans.catalogue import write_clips_csv
 from generation.plans.schema import PlanError, load_plan
 from generation.quality.checks import QAThresholdError, gait_observer_kind
 from generation.render import contact_sheet, prepare_render_process
+from protocol.titles import clip_titles
 from studyapp.catalogue import clip_label, retire_superseded, upsert_clips
 
 
@@ -102,6 +103,9 @@ class Command(BaseCommand):
         for _where, msg in result.failed:
             self.stderr.write(f"FAILED {msg}")
         records = result.records
+        titles = clip_titles(records)
+        for rec in records:
+            rec["title"] = titles[rec["clip_id"]]
         csv_path = media_root / "clips.csv"
         if records:
             write_clips_csv(records, csv_path)
