@@ -19,7 +19,7 @@ from django.utils.html import format_html, format_html_join
 
 from protocol.pools import SUB_POOLS
 
-from . import admin_clip_qa, clip_display, clip_import, pool_editor, views_pool, views_staff
+from . import admin_clip_qa, admin_stimuli, clip_display, clip_import, pool_editor, views_pool, views_staff
 from .admin_norms import norms_table
 from .forms import ClipImportForm, SectionForm, StudyAdminForm
 from .models import Assignment, Clip, Participant, Response, Section, Study
@@ -289,7 +289,16 @@ class ClipAdmin(admin.ModelAdmin):
         css = {"all": [clip_display.STYLESHEET]}
 
     def get_urls(self):
-        custom = [path("import/", self.admin_site.admin_view(self.import_view), name="studyapp_clip_import"),
+        def wrap(view):
+            return self.admin_site.admin_view(lambda request, *args, **kwargs: view(request, self, *args, **kwargs))
+
+        custom = [path("stimuli/", wrap(admin_stimuli.stimuli_view), name="studyapp_clip_stimuli"),
+                  path("stimuli/<str:job>/", wrap(admin_stimuli.render_view), name="studyapp_clip_render"),
+                  path("stimuli/<str:job>/plan.yaml", wrap(admin_stimuli.render_file_view),
+                       {"kind": "plan"}, name="studyapp_clip_render_plan"),
+                  path("stimuli/<str:job>/contact-sheet.png", wrap(admin_stimuli.render_file_view),
+                       {"kind": "sheet"}, name="studyapp_clip_render_sheet"),
+                  path("import/", self.admin_site.admin_view(self.import_view), name="studyapp_clip_import"),
                   path("import/<str:job>/", self.admin_site.admin_view(self.import_status_view),
                        name="studyapp_clip_import_status")]
         return custom + super().get_urls()

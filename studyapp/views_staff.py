@@ -16,9 +16,12 @@ from django.db.models import Count, Q
 from django.http import FileResponse, Http404, StreamingHttpResponse
 from django.shortcuts import redirect, render
 from django.urls import reverse
+from django.utils.html import format_html
 from django.views.decorators.http import require_http_methods
 
+from generation.plans.schema import PlanError, load_plan
 from generation.render import contact_sheet
+from protocol.presets import PRESET_PLANS
 from protocol.vocabulary import ATTENTION_CHECK
 
 from .assignment import plan_study
@@ -28,7 +31,7 @@ from .export import EXPORT_KINDS, stream_csv
 from .forms import ConsentForm, PresetStudyForm
 from .i18n import activate_study_language
 from .media import media_path
-from .models import Assignment, Participant, Response, Study
+from .models import Assignment, Clip, Participant, Response, Study
 from .permissions import EXPORT_PERMISSION, staff_permission_required, study_of
 from .presets import create_study_from_preset
 from .questions import AnswerError, clean_answers
@@ -45,8 +48,30 @@ def create_from_preset(request):
         study = create_study_from_preset(d["preset"], d["slug"], d["title"] or None)
         study.owners.add(request.user)
         messages.success(request, f"Created '{study.title}' from preset {d['preset']} (status: draft).")
+        offer = render_offer(d["preset"])
+        if offer:
+            messages.warning(request, offer)
         return redirect(reverse("admin:studyapp_study_change", args=[study.pk]))
     return render(request, "studyapp/staff/create_from_preset.html", {"form": form, "title": "New study from preset"})
+
+
+def render_offer(preset: str):
+    """A message offering to render the preset's plan when the catalogue lacks some of its clips (None when it has
+    them all): the study's pools draw only clips of that plan."""
+    plan = PRESET_PLANS.get(preset)
+    if not plan:
+        return None
+    try:
+        planned = len(load_plan(plan).entries)
+    except PlanError:
+        return None
+    have = Clip.objects.filter(plan=plan, retired=False).count()
+    if have >= planned:
+        return None
+    url = reverse("admin:studyapp_clip_stimuli") + f"?plan={plan}#builtin-{plan}"
+    return format_html('Its sections draw the clips of plan {}: the catalogue holds {} of its {}. '
+                       '<a href="{}" id="render-preset-plan">Render the stimulus set {} now</a> (in the background).',
+                       plan, have, planned, url, plan)
 
 
 def _preview_plan(study: Study, seed: int):
