@@ -164,6 +164,9 @@ class StudyAdmin(StudyScopedAdmin):
                                           "feedback_questions", "counterbalance_sections"]}),
         ("Recruitment", {"fields": ["max_participants", "norming_design", "abandon_after_minutes", "completion_code",
                                     "completion_redirect", "redirect_automatically", "created_at"]}),
+        ("Pilot", {"fields": ["pilot", "report_includes_pilot"],
+                   "description": "Run a pilot before opening: its participants stay apart (see the progress page "
+                                  "to delete their data). Opening the study ends pilot mode."}),
         ("Analysis", {"fields": ["exclusion_rules"],
                       "description": "Exclusion rules the analysis report applies (checked by analysis.exclusion); "
                                      "the raw exports stay unchanged. Empty: the defaults."}),
@@ -229,11 +232,12 @@ class StudyAdmin(StudyScopedAdmin):
         if not obj.pk:
             return "-"
         return format_html(
-            '<a href="{}">participant link</a> | <a href="{}">preview</a> | <a href="{}">progress</a> | '
+            '<a href="{}">participant link</a> | <a href="{}">preview</a> | <a href="{}">progress, Prolific, '
+            'pilot, sharing</a> | <a href="{}">clone</a> | '
             '<a href="{}">responses.csv</a> | <a href="{}">clips.csv</a> | <a href="{}">participants.csv</a> | '
             '<a href="{}">report.zip</a>',
             reverse("studyapp:study_entry", args=[obj.slug]), reverse("studyapp:preview_start", args=[obj.pk]),
-            reverse("studyapp:progress", args=[obj.pk]),
+            reverse("studyapp:progress", args=[obj.pk]), reverse("studyapp:clone_study", args=[obj.pk]),
             reverse("studyapp:export_csv", args=[obj.pk, "responses"]),
             reverse("studyapp:export_csv", args=[obj.pk, "clips"]),
             reverse("studyapp:export_csv", args=[obj.pk, "participants"]),
@@ -247,7 +251,13 @@ class StudyAdmin(StudyScopedAdmin):
             if errors:
                 refused[study.pk] = errors
                 self.message_user(request, f"Not opened: {study.slug}: {'; '.join(errors)}", messages.ERROR)
-        n = queryset.exclude(pk__in=refused).update(status=Study.Status.OPEN)
+        opened = queryset.exclude(pk__in=refused)
+        for study in opened.filter(participants__pilot=True).distinct():
+            self.message_user(request, format_html(
+                "{} still holds pilot data: <a href=\"{}\">delete it on the progress page</a> (it stays marked "
+                "and out of the report meanwhile).", study.slug,
+                reverse("studyapp:progress", args=[study.pk]) + "#pilot"), messages.WARNING)
+        n = opened.update(status=Study.Status.OPEN, pilot=False)     # opening ends pilot mode
         self.message_user(request, f"Opened {n} stud{'y' if n == 1 else 'ies'}.",
                           messages.SUCCESS if n else messages.WARNING)
 

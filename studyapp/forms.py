@@ -92,6 +92,21 @@ class PresetStudyForm(forms.Form):
         return slug
 
 
+class CloneStudyForm(forms.Form):
+    slug = forms.SlugField(max_length=80, help_text="The copy's participant URL /s/<slug>/")
+    title = forms.CharField(max_length=200)
+
+    def clean_slug(self):
+        slug = self.cleaned_data["slug"]
+        if Study.objects.filter(slug=slug).exists():
+            raise forms.ValidationError(f"A study with slug '{slug}' already exists.")
+        return slug
+
+
+class SharePreviewForm(forms.Form):
+    days = forms.IntegerField(min_value=1, max_value=90, initial=14, label="Valid for (days)")
+
+
 class SectionForm(forms.ModelForm, PoolEditorFields):
     """A section in the admin: the pool and options as structured fields (studyapp.pool_editor) with the raw JSON
     as an advanced field. The raw JSON wins only when none of its group's structured fields was edited (their

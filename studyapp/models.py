@@ -32,6 +32,10 @@ def new_public_id() -> str:
     return "p" + secrets.token_hex(6)
 
 
+PILOT_PREFIX = "pilot-"
+"""The start of a pilot participant's public_id (exports: participant_id)."""
+
+
 def new_media_key() -> str:
     return secrets.token_hex(16)
 
@@ -142,6 +146,14 @@ class Study(models.Model):
         default=dict, blank=True,
         help_text="Rules the analysis applies (raw exports stay unchanged), e.g. "
                   '{"min_rt_fraction": 0.25, "max_straightline": 0.9, "min_attention_pass": 1.0}')
+    pilot = models.BooleanField(
+        default=False, help_text="Pilot mode: the study takes participants while it is still a draft, and everyone "
+                                 "who consents while this is on is a pilot participant: marked in every export (their "
+                                 "id starts with 'pilot-'), left out of the analysis report unless the box below is "
+                                 "ticked, and removed by 'delete pilot data' on the progress page")
+    report_includes_pilot = models.BooleanField(
+        default=False, help_text="Include the pilot participants in the analysis report (they are always in the "
+                                 "CSV exports, marked)")
     # Who may see, preview, export and analyse the study (studyapp.permissions.studies_for); superusers see every
     # study. Owners also decide who the owners and collaborators are.
     owners = models.ManyToManyField(settings.AUTH_USER_MODEL, blank=True, related_name="owned_studies",
@@ -264,6 +276,8 @@ class Participant(models.Model):
     consent_key = models.CharField(max_length=64, blank=True, default="", editable=False)
     # Number of clip pages (assignments) fixed at start: the "of N" of the progress, without counting rows.
     n_items = models.PositiveIntegerField(default=0, editable=False)
+    # Consented while the study was in pilot mode (Study.pilot): public_id starts with PILOT_PREFIX.
+    pilot = models.BooleanField(default=False, editable=False, db_index=True)
 
     class Meta:
         constraints = [
@@ -275,6 +289,15 @@ class Participant(models.Model):
 
     def __str__(self) -> str:
         return self.public_id
+
+    def save(self, *args, **kwargs):
+        """A participant who consents while the study is in pilot mode is a pilot participant, and says so in the
+        id every export carries."""
+        if self._state.adding and not self.pilot and self.study.pilot:
+            self.pilot = True
+        if self.pilot and not self.public_id.startswith(PILOT_PREFIX):
+            self.public_id = PILOT_PREFIX + self.public_id
+        super().save(*args, **kwargs)
 
 
 class Assignment(models.Model):

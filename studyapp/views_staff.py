@@ -28,14 +28,17 @@ from .assignment import plan_study
 from .catalogue import clip_label
 from .clip_display import clip_cells
 from .export import EXPORT_KINDS, stream_csv
-from .forms import ConsentForm, PresetStudyForm
+from .forms import CloneStudyForm, ConsentForm, PresetStudyForm, SharePreviewForm
 from .i18n import activate_study_language
 from .media import media_path
 from .models import Assignment, Clip, Participant, Response, Study
 from .permissions import EXPORT_PERMISSION, staff_permission_required, study_of
+from .pilots import delete_pilot_data, pilot_count
 from .presets import create_study_from_preset
 from .questions import AnswerError, clean_answers
 from .reports import report_state, start_build
+from .sharing import preview_token, prolific_completion_url, prolific_study_url
+from .study_clone import clone_study
 from .views import item_context, item_questions
 
 
@@ -158,8 +161,56 @@ def progress(request, study_id: int):
            "started": counts.get(Participant.Status.STARTED, 0),
            "completed": counts.get(Participant.Status.COMPLETED, 0),
            "consented": counts.get(Participant.Status.CONSENTED, 0),
-           "participant_url": request.build_absolute_uri(reverse("studyapp:study_entry", args=[study.slug]))}
+           "participant_url": request.build_absolute_uri(reverse("studyapp:study_entry", args=[study.slug])),
+           "prolific_url": prolific_study_url(request, study), "prolific_completion": prolific_completion_url(study),
+           "n_pilot": pilot_count(study), "share_form": SharePreviewForm()}
     return render(request, "studyapp/staff/progress.html", ctx)
+
+
+@staff_permission_required("studyapp.add_study")
+@require_http_methods(["GET", "POST"])
+def clone(request, study_id: int):
+    """A draft copy of the study (texts, sections, pools; no participants), owned by whoever clones it."""
+    study = study_of(request, study_id)
+    form = CloneStudyForm(request.POST or None, initial={"slug": f"{study.slug}-copy"[:80],
+                                                         "title": f"Copy of {study.title}"[:200]})
+    if request.method == "POST" and form.is_valid():
+        copy = clone_study(study, form.cleaned_data["slug"], form.cleaned_data["title"], request.user)
+        messages.success(request, f"Cloned '{study.title}' as '{copy.title}' (a draft, no participants).")
+        return redirect(reverse("admin:studyapp_study_change", args=[copy.pk]))
+    return render(request, "studyapp/staff/clone.html", {"form": form, "study": study,
+                                                         "title": f"Clone {study.title}"})
+
+
+@staff_permission_required("studyapp.change_study")
+@require_http_methods(["POST"])
+def delete_pilot(request, study_id: int):
+    """Delete the study's pilot participants and their answers (a ticked confirmation is required)."""
+    study = study_of(request, study_id)
+    if request.POST.get("confirm") != "yes":
+        messages.error(request, "Tick the box to confirm deleting the pilot data.")
+    else:
+        n = delete_pilot_data(study)
+        messages.success(request, f"Deleted {n} pilot participant(s) with their answers.")
+    return redirect(reverse("studyapp:progress", args=[study.pk]) + "#pilot")
+
+
+@staff_permission_required("studyapp.view_study")
+@require_http_methods(["POST"])
+def share_preview(request, study_id: int):
+    """Make a signed preview link of the study (studyapp.sharing) and show it on the progress page."""
+    study = study_of(request, study_id)
+    form = SharePreviewForm(request.POST)
+    if not form.is_valid():
+        messages.error(request, "A preview link lasts between 1 and 90 days.")
+    else:
+        days = form.cleaned_data["days"]
+        url = request.build_absolute_uri(reverse("studyapp:shared_preview", args=[preview_token(study, days)]))
+        messages.success(request, format_html(
+            'Preview link, valid for {} day(s), for anyone who has it (no account; nothing is recorded): '
+            '<input type="text" readonly class="copy-text" id="shared-preview-url" value="{}" size="60"> '
+            '<button type="button" class="copy-button" data-copy="shared-preview-url">Copy</button>', days, url))
+    return redirect(reverse("studyapp:progress", args=[study.pk]) + "#share")
 
 
 @staff_permission_required(EXPORT_PERMISSION)
