@@ -23,6 +23,7 @@ order the participant took them, joined by ';' (empty for a participant who has 
 from __future__ import annotations
 
 import csv
+import json
 import re
 import unicodedata
 from collections.abc import Iterable, Iterator
@@ -30,6 +31,7 @@ from pathlib import Path
 
 from django.db.models import Case, F, Q, When
 
+from protocol.dictionary import DICTIONARY_COLUMNS, dataset_description, dictionary_rows
 from protocol.pools import NORMS_RULE
 from protocol.vocabulary import (
     ASSIGNMENT_COLUMNS,
@@ -216,13 +218,44 @@ def write_study_csvs(study: Study, out_dir: str | Path, include_pilot: bool = Tr
     return paths
 
 
+DICTIONARY_NAME = "data_dictionary.csv"
+DESCRIPTION_NAME = "dataset_description.json"
+
+
+def _header(path: Path) -> list[str]:
+    with open(path, newline="", encoding="utf-8") as fh:
+        return next(csv.reader(fh), [])
+
+
+def write_data_package(study: Study, out_dir: str | Path, include_pilot: bool = True) -> dict[str, Path]:
+    """write_study_csvs, then the data dictionary of exactly the headers written (protocol.dictionary: every file,
+    every column, ``answer`` per section type and question) and a Psych-DS dataset_description.json (authors: the
+    study's owners; the licence left for the researcher). Returns every path by kind ("dictionary",
+    "description" for the two)."""
+    out = Path(out_dir)
+    paths = write_study_csvs(study, out, include_pilot)
+    rows = dictionary_rows({p.name: _header(p) for p in paths.values()}, study.feedback_questions or [])
+    with open(out / DICTIONARY_NAME, "w", newline="", encoding="utf-8") as fh:
+        writer = csv.DictWriter(fh, fieldnames=DICTIONARY_COLUMNS, lineterminator="\n")
+        writer.writeheader()
+        writer.writerows({k: safe_cell(v) for k, v in row.items()} for row in rows)
+    authors = [u.get_full_name() or u.get_username() for u in study.owners.order_by("username")]
+    description = dataset_description(
+        study.title, (study.introduction or "").strip() or f"Perceptual study {study.slug}", authors, rows,
+        study.created_at.date().isoformat() if study.created_at else "",
+        keywords=["perception", "virtual agents", "emotion", *([study.preset] if study.preset else [])])
+    (out / DESCRIPTION_NAME).write_text(json.dumps(description, indent=2, ensure_ascii=False) + "\n",
+                                        encoding="utf-8")
+    return {**paths, "dictionary": out / DICTIONARY_NAME, "description": out / DESCRIPTION_NAME}
+
+
 def run_report(study: Study, out_dir: str | Path) -> dict:
     """Export the CSVs (pilot participants only when ``Study.report_includes_pilot``) and call the analysis
     library's report writer (analysis.report.write_report, viewing.csv included) with the study's
     exclusion rules (``Study.exclusion_rules``; empty = the analysis defaults), which the report states. Invalid rules
     raise ValueError naming the key (the admin form checks them with analysis.exclusion.rule_errors)."""
     out = Path(out_dir)
-    paths = write_study_csvs(study, out / "data", include_pilot=study.report_includes_pilot)
+    paths = write_data_package(study, out / "data", include_pilot=study.report_includes_pilot)
     from analysis.report import write_report  # imported lazily: the analysis library is optional at runtime
 
     return write_report(paths["responses"], paths["clips"], paths["participants"], out,

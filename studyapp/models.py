@@ -13,6 +13,7 @@ from django.core.exceptions import ValidationError
 from django.db import models
 from django.utils import timezone
 
+from protocol.dictionary import PILOT_PREFIX
 from protocol.pools import NORMS_RULE, errors_by_field, validate_section
 from protocol.titles import TITLE_MAX_LENGTH
 from protocol.vocabulary import ATTENTION_CHECK, CLIP_MODALITIES, ORIGINS
@@ -30,10 +31,6 @@ def new_token() -> str:
 def new_public_id() -> str:
     """The participant id written to exports: opaque, not a credential."""
     return "p" + secrets.token_hex(6)
-
-
-PILOT_PREFIX = "pilot-"
-"""The start of a pilot participant's public_id (exports: participant_id)."""
 
 
 def new_media_key() -> str:

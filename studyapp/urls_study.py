@@ -27,5 +27,6 @@ urlpatterns = [
     path("staff/study/<int:study_id>/share/", views_staff.share_preview, name="share_preview"),
     path("staff/study/<int:study_id>/norming/", views_norming.norming_monitor, name="norming_monitor"),
     path("staff/study/<int:study_id>/export/<str:kind>.csv", views_staff.export_csv, name="export_csv"),
+    path("staff/study/<int:study_id>/data.zip", views_staff.data_zip, name="data_zip"),
     path("staff/study/<int:study_id>/report.zip", views_staff.report_zip, name="report_zip"),
 ]

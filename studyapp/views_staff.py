@@ -9,6 +9,7 @@ researcher who creates a study from a preset becomes its owner.
 from __future__ import annotations
 
 import tempfile
+import zipfile
 from pathlib import Path
 
 from django.contrib import messages
@@ -27,7 +28,7 @@ from protocol.vocabulary import ATTENTION_CHECK
 from .assignment import plan_study
 from .catalogue import clip_label
 from .clip_display import clip_cells
-from .export import EXPORT_KINDS, stream_csv
+from .export import EXPORT_KINDS, stream_csv, write_data_package
 from .forms import CloneStudyForm, ConsentForm, PresetStudyForm, SharePreviewForm
 from .i18n import activate_study_language
 from .media import media_path
@@ -35,6 +36,7 @@ from .models import Assignment, Clip, Participant, Response, Study
 from .permissions import EXPORT_PERMISSION, staff_permission_required, study_of
 from .pilots import delete_pilot_data, pilot_count
 from .presets import create_study_from_preset
+from .progress_stats import progress_stats
 from .questions import AnswerError, clean_answers
 from .reports import report_state, start_build
 from .sharing import preview_token, prolific_completion_url, prolific_study_url
@@ -156,8 +158,9 @@ def progress(request, study_id: int):
     for s in sections:
         for c in s["clips"]:
             c["cell"] = cells.get(c["clip__clip_id"])
+    report = report_state(study)
     ctx = {"study": study, "counts": counts, "sections": sections, "title": f"Progress: {study.title}",
-           "report": report_state(study),
+           "report": report, "stats": progress_stats(study, report),
            "started": counts.get(Participant.Status.STARTED, 0),
            "completed": counts.get(Participant.Status.COMPLETED, 0),
            "consented": counts.get(Participant.Status.CONSENTED, 0),
@@ -221,6 +224,22 @@ def export_csv(request, study_id: int, kind: str):
     response = StreamingHttpResponse(stream_csv(study, kind), content_type="text/csv; charset=utf-8")
     response["Content-Disposition"] = f'attachment; filename="{study.slug}-{kind}.csv"'
     return response
+
+
+@staff_permission_required(EXPORT_PERMISSION)
+def data_zip(request, study_id: int):
+    """Every CSV export in one zip with its data dictionary and a Psych-DS dataset_description.json (pilot
+    participants included, marked by their ids)."""
+    study = study_of(request, study_id)
+    archive = tempfile.TemporaryFile(suffix=".zip")        # unlinked: gone when the response closes it
+    with tempfile.TemporaryDirectory(prefix="data-zip-") as tmp:
+        paths = write_data_package(study, tmp)
+        with zipfile.ZipFile(archive, "w", zipfile.ZIP_DEFLATED) as zf:
+            for path in paths.values():
+                zf.write(path, f"{study.slug}/data/{path.name}")
+    archive.seek(0)
+    return FileResponse(archive, as_attachment=True, content_type="application/zip",
+                        filename=f"{study.slug}-data.zip")
 
 
 @staff_permission_required(EXPORT_PERMISSION)
