@@ -128,9 +128,16 @@ class SectionInline(admin.StackedInline):
         js = ["studyapp/admin_pool.js"]
         css = {"all": ["studyapp/admin_pool.css", clip_display.STYLESHEET]}
 
+    def get_formset(self, request, obj=None, **kwargs):
+        request.studyapp_section_study = obj          # the study whose sections a reused section may be
+        return super().get_formset(request, obj, **kwargs)
+
     def formfield_for_foreignkey(self, db_field, request, **kwargs):
-        if db_field.name == "reuse_section":        # never offer (and so name) another lab's sections
-            kwargs["queryset"] = Section.objects.filter(study__in=studies_for(request.user).values("pk"))
+        if db_field.name == "reuse_section":
+            # only this study's sections (each form narrows to the earlier ones: SectionForm); never another lab's
+            study = getattr(request, "studyapp_section_study", None)
+            mine = Section.objects.filter(study__in=studies_for(request.user).values("pk"))
+            kwargs["queryset"] = mine.filter(study=study) if study is not None else mine.none()
         return super().formfield_for_foreignkey(db_field, request, **kwargs)
 
     @admin.display(description="matching clips")

@@ -4,6 +4,7 @@ fields or raw JSON, checked against the study protocol) with the preview form of
 from __future__ import annotations
 
 from django import forms
+from django.db.models import Q
 from django.utils.translation import gettext
 from django.utils.translation import gettext_lazy as _
 
@@ -134,6 +135,19 @@ class SectionForm(forms.ModelForm, PoolEditorFields):
         for name in ("pool_plan", *(f"pool_{sub}_plan" for sub in SUB_POOLS)):
             if name in self.fields:
                 self.fields[name].widget.suggestions = plans
+        self._earlier_sections_only()
+
+    def _earlier_sections_only(self) -> None:
+        """"Reuse section" offers only sections that come before this one in its own study (a saved section: by
+        order, then id; a new one: every saved section of the study); Section.clean checks the same on save."""
+        field = self.fields.get("reuse_section")
+        if field is None or not self.instance.study_id:
+            return
+        earlier = field.queryset.filter(study_id=self.instance.study_id)
+        if self.instance.pk:
+            earlier = earlier.filter(Q(order__lt=self.instance.order) |
+                                     Q(order=self.instance.order, pk__lt=self.instance.pk))
+        field.queryset = earlier.order_by("order", "id")
 
     def clean(self):
         data = super().clean()
