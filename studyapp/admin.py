@@ -19,7 +19,16 @@ from django.utils.html import format_html, format_html_join
 
 from protocol.pools import SUB_POOLS
 
-from . import admin_clip_qa, admin_stimuli, clip_display, clip_import, pool_editor, views_pool, views_staff
+from . import (
+    admin_clip_qa,
+    admin_stimuli,
+    clip_display,
+    clip_import,
+    pool_editor,
+    study_fields,
+    views_pool,
+    views_staff,
+)
 from .admin_norms import norms_table
 from .forms import ClipImportForm, SectionForm, StudyAdminForm
 from .models import Assignment, Clip, Participant, Response, Section, Study
@@ -168,15 +177,24 @@ class StudyAdmin(StudyScopedAdmin):
     fieldsets = [
         (None, {"fields": ["title", "slug", "status", "preset", "links"]}),
         ("Participant pages", {"fields": ["language", "introduction", "consent_text", "ask_demographics",
-                                          "feedback_questions", "counterbalance_sections"]}),
+                                          "counterbalance_sections"]}),
+        ("Feedback questions (the last page)", {
+            "fields": [study_fields.feedback_names(i) for i in range(study_fields.FEEDBACK_ROWS)],
+            "description": "Up to six questions; a row without key and text is left out. The raw JSON below "
+                           "wins only while these rows are left as they were."}),
         ("Recruitment", {"fields": ["max_participants", "norming_design", "abandon_after_minutes", "completion_code",
                                     "completion_redirect", "redirect_automatically", "created_at"]}),
         ("Pilot", {"fields": ["pilot", "report_includes_pilot"],
                    "description": "Run a pilot before opening: its participants stay apart (see the progress page "
                                   "to delete their data). Opening the study ends pilot mode."}),
-        ("Analysis", {"fields": ["exclusion_rules"],
+        ("Analysis", {"fields": [tuple(study_fields.RULE_FIELDS[i:i + 2])
+                                 for i in range(0, len(study_fields.RULE_FIELDS), 2)],
                       "description": "Exclusion rules the analysis report applies (checked by analysis.exclusion); "
-                                     "the raw exports stay unchanged. Empty: the defaults."}),
+                                     "the raw exports stay unchanged. Blank: the defaults."}),
+        ("Advanced: feedback questions and exclusion rules as JSON", {
+            "fields": ["feedback_questions", "exclusion_rules"], "classes": ["collapse"],
+            "description": "The fields above win as soon as one of them is edited; this JSON wins when they are "
+                           "left as they were (paste a study's JSON here to import it)."}),
         ("Access", {"fields": ["owners", "collaborators"],
                     "description": "Who may see, preview, export and analyse this study (superusers see every "
                                    "study). Only owners and superusers change this; whoever creates a study owns "

@@ -11,7 +11,7 @@ from django.utils.translation import gettext_lazy as _
 from analysis.exclusion import rule_errors
 from protocol.pools import SUB_POOLS
 
-from . import clip_import, pool_editor
+from . import clip_import, pool_editor, study_fields
 from .i18n import display
 from .inputs import refuse_control_characters, refuse_control_characters_in_text
 from .models import Clip, Section, Study
@@ -197,6 +197,10 @@ class StudyAdminForm(forms.ModelForm):
         model = Study
         fields = "__all__"
 
+    def __init__(self, *args, **kwargs):
+        super().__init__(*args, **kwargs)
+        study_fields.set_initial(self)
+
     def clean_completion_redirect(self):
         value = (self.cleaned_data.get("completion_redirect") or "").strip()
         check_completion_url(value)
@@ -205,6 +209,14 @@ class StudyAdminForm(forms.ModelForm):
     def clean(self):
         """A norming study opens only when its planned N (the participant limit) gives every clip K ratings."""
         data = super().clean()
+        if study_fields.touched(self, study_fields.FEEDBACK_FIELDS):
+            data["feedback_questions"] = study_fields.feedback_from_fields(self, data)
+        if study_fields.touched(self, study_fields.RULE_FIELDS):
+            rules = study_fields.rules_from_fields(data)
+            errors = rule_errors(rules)
+            if errors:
+                self.add_error(None, errors)
+            data["exclusion_rules"] = rules
         if self.instance.pk and data.get("status") == Study.Status.OPEN:
             errors = open_errors(self.instance, n_planned=data.get("max_participants") or 0)
             if errors:
@@ -218,6 +230,10 @@ class StudyAdminForm(forms.ModelForm):
         if errors:
             raise forms.ValidationError(errors)
         return rules
+
+
+StudyAdminForm.base_fields.update(study_fields.declared_fields())
+StudyAdminForm.declared_fields.update(study_fields.declared_fields())
 
 
 class MultipleFileInput(forms.ClearableFileInput):
