@@ -34,7 +34,7 @@ def shared_preview(request, token: str):
     start = reverse("studyapp:shared_preview_item", args=[token, 1]) + f"?seed={seed}"
     return render(request, "studyapp/shared_preview.html", {
         "study": study, "form": ConsentForm(), "preview": True, "seed": seed, "start_url": start,
-        "expires": datetime.fromtimestamp(expires, UTC)})
+        "expires": datetime.fromtimestamp(expires, UTC)})      # (the researcher's page says when it expires)
 
 
 @never_cache
@@ -47,7 +47,7 @@ def shared_preview_item(request, token: str, n: int):
     again = reverse("studyapp:shared_preview", args=[token]) + f"?seed={seed + 1}"
     if n < 1 or n > len(flat):
         return render(request, "studyapp/shared_preview_done.html", {"study": study, "preview": True,
-                                                                      "again_url": again, "empty": not flat})
+                                                                      "again_url": again})
     section, it, position = flat[n - 1]
     here = reverse("studyapp:shared_preview_item", args=[token, n]) + f"?seed={seed}"
     error = ""
