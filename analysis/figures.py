@@ -10,6 +10,7 @@ import os
 import re
 
 import matplotlib
+import matplotlib.transforms
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
@@ -55,6 +56,54 @@ def _adjust(fig, top: float = 0.85, bottom: float = 0.45, left: float = 0.55, ri
                         hspace=hgap / ax_h, wspace=wgap / ax_w)
 
 
+def _text_bbox(fig, renderer):
+    """The tight bounding box (inches) of the text of ``fig``: each visible axes with its ticks, labels, title and
+    legend (not its bars and lines, which stay inside the axes), the figure's texts and legends."""
+    boxes = []
+    for ax in fig.axes:
+        if ax.get_visible():
+            legend = ax.get_legend()
+            boxes.append(ax.get_tightbbox(renderer, bbox_extra_artists=[legend] if legend else []))
+    boxes += [t.get_window_extent(renderer) for t in fig.texts if t.get_visible() and t.get_text()]
+    boxes += [leg.get_window_extent(renderer) for leg in fig.legends]
+    title = getattr(fig, "_suptitle", None)
+    if title is not None and title.get_text():
+        boxes.append(title.get_window_extent(renderer))
+    box = matplotlib.transforms.Bbox.union([b for b in boxes if b is not None and b.width > 0])
+    return box.transformed(fig.dpi_scale_trans.inverted())
+
+
+def fit_to_canvas(fig, pad: float = 0.05, rounds: int = 4):
+    """Keep every text of ``fig`` inside its canvas: a suptitle wider than the figure widens it (the panels keep
+    their size, the margins grow), then the subplot margins grow by whatever the drawn tight bounding box
+    (titles, tick and axis labels, legends; inches) overshoots the canvas by, ``pad`` inches inside the edge, until
+    nothing overshoots (at most ``rounds`` layouts; the text is measured, nothing is rasterised). Returns ``fig``."""
+    renderer = fig.canvas.get_renderer()
+    title = getattr(fig, "_suptitle", None)
+    if title is not None and title.get_text():
+        need = title.get_window_extent(renderer).width / fig.dpi + 2 * pad
+        width, height = fig.get_size_inches()
+        if need > width:
+            sp = fig.subplotpars
+            grow = need - width
+            fig.set_size_inches(need, height)
+            fig.subplots_adjust(left=(sp.left * width + grow / 2) / need,
+                                right=1 - ((1 - sp.right) * width + grow / 2) / need)
+    for _ in range(rounds):
+        width, height = fig.get_size_inches()
+        box = _text_bbox(fig, renderer)
+        over = {"left": pad - box.x0, "right": box.x1 - (width - pad), "bottom": pad - box.y0,
+                "top": box.y1 - (height - pad)}
+        if all(v <= 0.005 for v in over.values()):
+            break
+        sp = fig.subplotpars
+        fig.subplots_adjust(left=sp.left + max(0.0, over["left"]) / width,
+                            right=sp.right - max(0.0, over["right"]) / width,
+                            bottom=sp.bottom + max(0.0, over["bottom"]) / height,
+                            top=sp.top - max(0.0, over["top"]) / height)
+    return fig
+
+
 def _grid(n: int, ncols: int, w: float, h: float, **kw):
     ncols = max(1, min(ncols, n))
     nrows = int(np.ceil(n / ncols))
@@ -84,7 +133,7 @@ def fig_emotion_vectors(table: pd.DataFrame, title: str = "Intended vs perceived
     axes[0].legend(loc="upper right", fontsize=7, frameon=False)
     fig.suptitle(title)
     _adjust(fig)
-    return fig
+    return fit_to_canvas(fig)
 
 
 def fig_transitions(table: pd.DataFrame):
@@ -115,7 +164,7 @@ def fig_transitions(table: pd.DataFrame):
     axes[0].legend(h[:2], lab[:2], loc="upper center", fontsize=7, frameon=False)
     fig.suptitle("Emotion transitions: initial (left) and final (right), intended vs perceived (* rejected)")
     _adjust(fig)
-    return fig
+    return fit_to_canvas(fig)
 
 
 def _p(row) -> str:
@@ -146,7 +195,7 @@ def fig_likert(dist: pd.DataFrame):
                 ax.set_xlabel("Likert value")
     fig.suptitle("Pose affective features by intended emotion (share of answers)")
     _adjust(fig, left=0.7, hgap=0.25, wgap=0.15)
-    return fig
+    return fit_to_canvas(fig)
 
 
 def fig_vad(pairs: pd.DataFrame, pearson: pd.DataFrame):
@@ -170,7 +219,7 @@ def fig_vad(pairs: pd.DataFrame, pearson: pd.DataFrame):
         ax.set_aspect("equal")
     fig.suptitle("Intended vs perceived gesture emotion in NRC-VAD space (bubble area = answers)")
     fig.tight_layout(rect=(0, 0, 1, 0.95))
-    return fig
+    return fit_to_canvas(fig)
 
 
 ORIGIN_COLORS = {"generated": PERCEIVED_COLOR, "source": INTENDED_COLOR, IMPORTED: "#55A868"}
@@ -204,7 +253,7 @@ def fig_naturalness(nat: pd.DataFrame):
     axes[0, 0].set_ylabel("share of answers")
     fig.suptitle(f"Naturalness by clip origin ({', '.join(origins)})")
     fig.tight_layout()
-    return fig
+    return fit_to_canvas(fig)
 
 
 def fig_theme_ratings(desc: pd.DataFrame):
@@ -230,7 +279,7 @@ def fig_theme_ratings(desc: pd.DataFrame):
     axes[0].legend(fontsize=7, frameon=False)
     fig.suptitle("Theme ratings by weight and number of features (mean ± SE)")
     _adjust(fig, hgap=0.75, wgap=0.2)
-    return fig
+    return fit_to_canvas(fig)
 
 
 def fig_inversion(inv: pd.DataFrame):
@@ -246,7 +295,7 @@ def fig_inversion(inv: pd.DataFrame):
     ax.set_ylabel("rating (-7 opposite .. +7 original)")
     ax.set_title("Ratings of inverted themes (w = -0.7), mean ± SE")
     fig.tight_layout()
-    return fig
+    return fit_to_canvas(fig)
 
 
 def fig_confusion(results: dict):
@@ -278,7 +327,7 @@ def fig_confusion(results: dict):
         ax.set_title(f"{name}: kappa = {res['kappa']:.2f}, n = {res['n_answers']}", fontsize=8)
     fig.suptitle("Emotion recognition: row shares of the confusion matrix (diagonal = hit rate)")
     fig.subplots_adjust(left=0.12, right=0.98, bottom=0.28, top=0.86, wspace=0.45)
-    return fig
+    return fit_to_canvas(fig)
 
 
 def _short_id(clip_id: str) -> str:
@@ -322,4 +371,4 @@ def fig_clip_norms(norms: pd.DataFrame, modality: str, max_clips: int = 120):
                  "ratings per clip", fontsize=8)
     ax.legend(loc="upper left", bbox_to_anchor=(1.0, 1.0), fontsize=7, frameon=False)
     fig.subplots_adjust(left=0.6 / width, right=1 - 1.9 / width, bottom=0.34, top=0.86)
-    return fig
+    return fit_to_canvas(fig)

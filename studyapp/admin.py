@@ -19,7 +19,16 @@ from django.utils.html import format_html, format_html_join
 
 from protocol.pools import SUB_POOLS
 
-from . import admin_clip_qa, clip_import, pool_editor, views_pool, views_staff
+from . import (
+    admin_clip_qa,
+    admin_stimuli,
+    clip_display,
+    clip_import,
+    pool_editor,
+    study_fields,
+    views_pool,
+    views_staff,
+)
 from .admin_norms import norms_table
 from .forms import ClipImportForm, SectionForm, StudyAdminForm
 from .models import Assignment, Clip, Participant, Response, Section, Study
@@ -126,21 +135,32 @@ class SectionInline(admin.StackedInline):
 
     class Media:
         js = ["studyapp/admin_pool.js"]
-        css = {"all": ["studyapp/admin_pool.css"]}
+        css = {"all": ["studyapp/admin_pool.css", clip_display.STYLESHEET]}
+
+    def get_formset(self, request, obj=None, **kwargs):
+        request.studyapp_section_study = obj          # the study whose sections a reused section may be
+        return super().get_formset(request, obj, **kwargs)
 
     def formfield_for_foreignkey(self, db_field, request, **kwargs):
-        if db_field.name == "reuse_section":        # never offer (and so name) another lab's sections
-            kwargs["queryset"] = Section.objects.filter(study__in=studies_for(request.user).values("pk"))
+        if db_field.name == "reuse_section":
+            # only this study's sections (each form narrows to the earlier ones: SectionForm); never another lab's
+            study = getattr(request, "studyapp_section_study", None)
+            mine = Section.objects.filter(study__in=studies_for(request.user).values("pk"))
+            kwargs["queryset"] = mine.filter(study=study) if study is not None else mine.none()
         return super().formfield_for_foreignkey(db_field, request, **kwargs)
 
     @admin.display(description="matching clips")
     def matching_clips(self, section):
         summary, warnings = pool_notes(section)
+        sample = [] if section.reuse_section_id else views_pool.pool_sample(section.section_type or None,
+                                                                             section.pool)
         return format_html('<span class="pool-count" data-url="{}" aria-live="polite">{}</span>'
-                           '<ul class="pool-warnings">{}</ul><code class="pool-json">pool (saved): {}</code>'
+                           '<ul class="pool-warnings">{}</ul><ul class="clip-samples" aria-label="some of the '
+                           'matching clips">{}</ul><code class="pool-json">pool (saved): {}</code>'
                            '<div class="norms-slot">{}</div>',
                            reverse("admin:studyapp_pool_count"), summary,
                            format_html_join("", '<li class="pool-warning">{}</li>', ((w,) for w in warnings)),
+                           format_html_join("", "<li>{}</li>", ((c.html(),) for c in sample)),
                            json.dumps(section.pool), norms_table(section.pool))
 
 
@@ -160,16 +180,28 @@ class StudyAdmin(StudyScopedAdmin):
                               "description": "Exports and reports pseudonymise external ids unless this is ticked; "
                                              "withdrawn participants are left out of them."}),
         ("Participant pages", {"fields": ["language", "introduction", "consent_text", "ask_demographics",
-                                          "feedback_questions", "counterbalance_sections"]}),
+                                          "counterbalance_sections"]}),
         ("Screens and devices", {"fields": [("min_viewport_width", "min_viewport_height"),
                                             ("admit_phones", "admit_tablets")],
                                  "description": "Checked on the consent page before the study starts; a participant "
                                                 "turned away gets a page that says why, and nothing is recorded."}),
+        ("Feedback questions (the last page)", {
+            "fields": [study_fields.feedback_names(i) for i in range(study_fields.FEEDBACK_ROWS)],
+            "description": "Up to six questions; a row without key and text is left out. The raw JSON below "
+                           "wins only while these rows are left as they were."}),
         ("Recruitment", {"fields": ["max_participants", "norming_design", "abandon_after_minutes", "completion_code",
                                     "completion_redirect", "redirect_automatically", "created_at"]}),
-        ("Analysis", {"fields": ["exclusion_rules"],
+        ("Pilot", {"fields": ["pilot", "report_includes_pilot"],
+                   "description": "Run a pilot before opening: its participants stay apart (see the progress page "
+                                  "to delete their data). Opening the study ends pilot mode."}),
+        ("Analysis", {"fields": [tuple(study_fields.RULE_FIELDS[i:i + 2])
+                                 for i in range(0, len(study_fields.RULE_FIELDS), 2)],
                       "description": "Exclusion rules the analysis report applies (checked by analysis.exclusion); "
-                                     "the raw exports stay unchanged. Empty: the defaults."}),
+                                     "the raw exports stay unchanged. Blank: the defaults."}),
+        ("Advanced: feedback questions and exclusion rules as JSON", {
+            "fields": ["feedback_questions", "exclusion_rules"], "classes": ["collapse"],
+            "description": "The fields above win as soon as one of them is edited; this JSON wins when they are "
+                           "left as they were (paste a study's JSON here to import it)."}),
         ("Access", {"fields": ["owners", "collaborators"],
                     "description": "Who may see, preview, export and analyse this study (superusers see every "
                                    "study). Only owners and superusers change this; whoever creates a study owns "
@@ -232,11 +264,12 @@ class StudyAdmin(StudyScopedAdmin):
         if not obj.pk:
             return "-"
         return format_html(
-            '<a href="{}">participant link</a> | <a href="{}">preview</a> | <a href="{}">progress</a> | '
+            '<a href="{}">participant link</a> | <a href="{}">preview</a> | <a href="{}">progress, Prolific, '
+            'pilot, sharing</a> | <a href="{}">clone</a> | '
             '<a href="{}">responses.csv</a> | <a href="{}">clips.csv</a> | <a href="{}">participants.csv</a> | '
             '<a href="{}">report.zip</a>',
             reverse("studyapp:study_entry", args=[obj.slug]), reverse("studyapp:preview_start", args=[obj.pk]),
-            reverse("studyapp:progress", args=[obj.pk]),
+            reverse("studyapp:progress", args=[obj.pk]), reverse("studyapp:clone_study", args=[obj.pk]),
             reverse("studyapp:export_csv", args=[obj.pk, "responses"]),
             reverse("studyapp:export_csv", args=[obj.pk, "clips"]),
             reverse("studyapp:export_csv", args=[obj.pk, "participants"]),
@@ -250,7 +283,13 @@ class StudyAdmin(StudyScopedAdmin):
             if errors:
                 refused[study.pk] = errors
                 self.message_user(request, f"Not opened: {study.slug}: {'; '.join(errors)}", messages.ERROR)
-        n = queryset.exclude(pk__in=refused).update(status=Study.Status.OPEN)
+        opened = queryset.exclude(pk__in=refused)
+        for study in opened.filter(participants__pilot=True).distinct():
+            self.message_user(request, format_html(
+                "{} still holds pilot data: <a href=\"{}\">delete it on the progress page</a> (it stays marked "
+                "and out of the report meanwhile).", study.slug,
+                reverse("studyapp:progress", args=[study.pk]) + "#pilot"), messages.WARNING)
+        n = opened.update(status=Study.Status.OPEN, pilot=False)     # opening ends pilot mode
         self.message_user(request, f"Opened {n} stud{'y' if n == 1 else 'ies'}.",
                           messages.SUCCESS if n else messages.WARNING)
 
@@ -278,16 +317,30 @@ class StudyAdmin(StudyScopedAdmin):
 
 @admin.register(Clip)
 class ClipAdmin(admin.ModelAdmin):
-    list_display = ["thumbnail", "clip_id", "modality", "origin", "emotion_label", "theme", "weight", "n_features",
-                    "duration_s", "plan", admin_clip_qa.quality_flag, admin_clip_qa.observer_reading]
+    list_display = ["thumbnail", "title_or_id", "modality", "origin", "emotion_label", "theme", "weight",
+                    "n_features", "duration_s", "plan", admin_clip_qa.quality_flag, admin_clip_qa.observer_reading]
+    list_display_links = ["title_or_id"]
     list_filter = ["retired", admin_clip_qa.QualityFlagFilter, "modality", "origin", "plan", "theme", "emotion_label"]
-    search_fields = ["clip_id", "plan", "licence", "citation"]
+    search_fields = ["clip_id", "title", "plan", "licence", "citation"]
     readonly_fields = ["preview", "media_key", "created_at", "updated_at"]
     actions = ["download_contact_sheet"]
     change_list_template = "admin/studyapp/clip/change_list.html"
+    list_per_page = 25
+
+    class Media:
+        css = {"all": [clip_display.STYLESHEET]}
 
     def get_urls(self):
-        custom = [path("import/", self.admin_site.admin_view(self.import_view), name="studyapp_clip_import"),
+        def wrap(view):
+            return self.admin_site.admin_view(lambda request, *args, **kwargs: view(request, self, *args, **kwargs))
+
+        custom = [path("stimuli/", wrap(admin_stimuli.stimuli_view), name="studyapp_clip_stimuli"),
+                  path("stimuli/<str:job>/", wrap(admin_stimuli.render_view), name="studyapp_clip_render"),
+                  path("stimuli/<str:job>/plan.yaml", wrap(admin_stimuli.render_file_view),
+                       {"kind": "plan"}, name="studyapp_clip_render_plan"),
+                  path("stimuli/<str:job>/contact-sheet.png", wrap(admin_stimuli.render_file_view),
+                       {"kind": "sheet"}, name="studyapp_clip_render_sheet"),
+                  path("import/", self.admin_site.admin_view(self.import_view), name="studyapp_clip_import"),
                   path("import/<str:job>/", self.admin_site.admin_view(self.import_status_view),
                        name="studyapp_clip_import_status")]
         return custom + super().get_urls()
@@ -325,10 +378,11 @@ class ClipAdmin(admin.ModelAdmin):
 
     @admin.display(description="poster")
     def thumbnail(self, clip):
-        if not clip.poster:
-            return "-"
-        return format_html('<img src="{}" alt="" style="height:48px">', reverse("studyapp:media", args=[
-            clip.media_key, "png"]))
+        return clip_display.clip_cell(clip).thumb()
+
+    @admin.display(description="clip", ordering="title")
+    def title_or_id(self, clip):
+        return format_html('{}<br><code class="clip-id">{}</code>', clip.title or clip.clip_id, clip.clip_id)
 
     @admin.display(description="poster and video")
     def preview(self, clip):

@@ -226,8 +226,9 @@ STUDY_FULL = "This study is full: it has all the participants it needs. Thank yo
 
 
 def check_open(study: Study) -> None:
-    """Raise StudyUnavailable when the study is not open or has all the participants it needs."""
-    if study.status != Study.Status.OPEN:
+    """Raise StudyUnavailable when the study is not open (a draft in pilot mode is) or has all the participants it
+    needs."""
+    if study.status != Study.Status.OPEN and not (study.pilot and study.status == Study.Status.DRAFT):
         raise StudyUnavailable(STUDY_CLOSED)
     if study.max_participants and active_count(study) >= study.max_participants:
         raise StudyUnavailable(STUDY_FULL)

@@ -6,7 +6,8 @@ record carries the DESIGN.md clips.csv fields (``licence`` and ``citation`` too,
 optional `source_clip_id` (the clip_id of the source clip a generated clip was made from; also read from `pair` or
 metadata["source_clip_id"] / metadata["pair"]) and `sections` (the plan's section-type hints, a list or
 comma-separated; also read from metadata["sections"]); optional `qa` (the quality record, a dict: generation.quality)
-and `qa_flag` (failed checks joined by ';', also read from qa["flag"]).
+and `qa_flag` (failed checks joined by ';', also read from qa["flag"]); optional `title` (else metadata["title"],
+else derived by protocol.titles from the records written together: generator, condition, variant).
 """
 from __future__ import annotations
 
@@ -16,6 +17,7 @@ from django.db import transaction
 from django.db.models import QuerySet
 
 from protocol.pools import NORMS_RULE
+from protocol.titles import clip_titles
 from protocol.vocabulary import (
     CLIP_FLOAT_COLUMNS,
     CLIP_MODALITIES,
@@ -131,6 +133,10 @@ def upsert_clips(records: list[dict]) -> int:
     All records are validated first; nothing is written if one is bad (CatalogueError names it).
     """
     cleaned = [(str(rec.get("clip_id")).strip(), clean_record(rec, i)) for i, rec in enumerate(records)]
+    titles = clip_titles({**fields, "clip_id": clip_id, "title": rec.get("title")}
+                         for (clip_id, fields), rec in zip(cleaned, records, strict=True))
+    for clip_id, fields in cleaned:
+        fields["title"] = titles[clip_id]
     with transaction.atomic():
         for clip_id, fields in cleaned:
             Clip.objects.update_or_create(clip_id=clip_id, defaults={**fields, "retired": False})

@@ -25,13 +25,10 @@ from __future__ import annotations
 import csv
 import json
 import lzma
-import os
 import secrets
 import shutil
 import stat
-import subprocess
 import sys
-import threading
 import zipfile
 import zlib
 from dataclasses import dataclass
@@ -43,6 +40,7 @@ from django.utils.text import slugify
 
 from generation.imports.run import REPORT_NAME
 
+from . import background
 from .models import Clip
 
 LOG_NAME = "import.log"
@@ -249,14 +247,7 @@ def import_command(manifest: Path, job: str, name: str, keep_audio: bool, dry_ru
 
 def launch(cmd: list[str], job: str) -> None:
     """Run ``cmd`` detached (own session, output to the job's log), recording its pid; returns at once."""
-    folder = job_dir(job)
-    env = dict(os.environ, DJANGO_SETTINGS_MODULE=os.environ.get("DJANGO_SETTINGS_MODULE", "studyapp.settings"),
-               DATA_DIR=str(settings.DATA_DIR), MEDIA_ROOT=str(settings.MEDIA_ROOT))
-    with open(folder / LOG_NAME, "ab") as log:
-        proc = subprocess.Popen(cmd, cwd=settings.BASE_DIR, env=env, stdin=subprocess.DEVNULL, stdout=log,
-                                stderr=subprocess.STDOUT, start_new_session=True)
-    (folder / PID_NAME).write_text(str(proc.pid))
-    threading.Thread(target=proc.wait, name=f"clip-import-{proc.pid}", daemon=True).start()   # no zombie
+    background.launch(cmd, job_dir(job), LOG_NAME, PID_NAME)
 
 
 def start_import(manifest: Path, job: str, name: str, keep_audio: bool = False, dry_run: bool = False) -> None:
@@ -280,15 +271,7 @@ class ImportState:
 
 
 def _running(folder: Path) -> bool:
-    try:
-        pid = int((folder / PID_NAME).read_text())
-        os.kill(pid, 0)
-    except (OSError, ValueError):
-        return False
-    try:      # a finished child not yet reaped still answers kill(0): read its state
-        return Path(f"/proc/{pid}/stat").read_text().split(")")[-1].split()[0] != "Z"
-    except OSError:
-        return True
+    return background.is_running(folder, PID_NAME)
 
 
 def _job_info(folder: Path) -> dict:

@@ -3,9 +3,10 @@ protocol.vocabulary), plus assignments.csv (what each participant was shown, for
 
 Rows are produced by generators over `.iterator()` queries, so a large study streams in constant memory (an
 HTTP StreamingHttpResponse or a file on disk); no export builds the whole file as one string.
-Preview runs record nothing, so every participant row is a real participant. viewing.csv (VIEWING_COLUMNS) has
-one row per answered clip page: how the clip was watched (studyapp.viewing), blank fields where the browser sent
-no record.
+Preview runs record nothing, so every participant row is a real participant; pilot participants (Study.pilot) are
+marked by their id (``pilot-...``) in every file, and left out of the analysis report unless the study says.
+viewing.csv (VIEWING_COLUMNS) has one row per answered clip page: how the clip was watched (studyapp.viewing),
+blank fields where the browser sent no record.
 
 Spreadsheet formula injection: participants type some of these cells (external_id, feedback). Every text cell
 that starts with =, +, -, @, a tab or a carriage return is written with a leading single quote (') so Excel,
@@ -27,6 +28,7 @@ order the participant took them, joined by ';' (empty for a participant who has 
 from __future__ import annotations
 
 import csv
+import json
 import re
 import unicodedata
 from collections.abc import Iterable, Iterator
@@ -34,11 +36,13 @@ from pathlib import Path
 
 from django.db.models import Case, F, Q, When
 
+from protocol.dictionary import DICTIONARY_COLUMNS, dataset_description, dictionary_rows
 from protocol.pools import NORMS_RULE
 from protocol.vocabulary import (
     ASSIGNMENT_COLUMNS,
     ATTENTION_CHECK,
     CLIP_COLUMNS,
+    CLIP_PROVENANCE_COLUMNS,
     PARTICIPANT_COLUMNS,
     RESPONSE_COLUMNS,
     VIEWING_COLUMNS,
@@ -101,8 +105,14 @@ def _exported_type():
     return Case(When(kind="", then=F("section__section_type")), default=F("kind"))
 
 
-def response_rows(study: Study) -> Iterator[list]:
-    qs = (Response.objects.filter(section__study=study).exclude(participant__status=WITHDRAWN)
+def _without_pilots(qs, include_pilot: bool, lookup: str = "participant__pilot"):
+    """``qs`` without the pilot participants' rows unless ``include_pilot``."""
+    return qs if include_pilot else qs.filter(**{lookup: False})
+
+
+def response_rows(study: Study, include_pilot: bool = True) -> Iterator[list]:
+    qs = (_without_pilots(Response.objects.filter(section__study=study), include_pilot)
+          .exclude(participant__status=WITHDRAWN)
           .annotate(exported_type=_exported_type())
           .order_by("participant_id", "section__order", "id")
           .values_list("participant__public_id", "exported_type", "clip__clip_id", "question", "answer",
@@ -123,9 +133,10 @@ def study_clips(study: Study):
     return Clip.objects.filter(q).distinct().order_by("clip_id")
 
 
-#: The study's clips.csv: the public columns, then the licence and citation of what each clip was made from (blank
-#: where the catalogue has none), which travel with the clips into every report and reuse.
-EXPORT_CLIP_COLUMNS = (*CLIP_COLUMNS, "licence", "citation")
+#: The study's clips.csv: the public columns, then the clip's readable title (protocol.titles) and the licence and
+#: citation of what it was made from (blank where the catalogue has none), which travel with the clips into every
+#: report and reuse.
+EXPORT_CLIP_COLUMNS = (*CLIP_COLUMNS, *CLIP_PROVENANCE_COLUMNS)
 
 
 def clip_rows(study: Study) -> Iterator[list]:
@@ -148,11 +159,12 @@ def attention_counts(study: Study) -> dict[int, tuple[int, int]]:
     return counts
 
 
-def participant_rows(study: Study) -> Iterator[list]:
+def participant_rows(study: Study, include_pilot: bool = True) -> Iterator[list]:
     keys = feedback_keys(study)
     attention = attention_counts(study)
     orders = dict(study.sections.values_list("pk", "order"))
-    for p in study.participants.exclude(status=WITHDRAWN).order_by("id").iterator(chunk_size=CHUNK):
+    people = _without_pilots(study.participants.exclude(status=WITHDRAWN), include_pilot, "pilot")
+    for p in people.order_by("id").iterator(chunk_size=CHUNK):
         passed, total = attention.get(p.pk, (0, 0))
         order = ";".join(str(orders[pk]) for pk in p.section_order or [] if pk in orders)
         external = p.external_id if study.export_external_ids else pseudonym(study.pk, p.external_id)
@@ -160,9 +172,10 @@ def participant_rows(study: Study) -> Iterator[list]:
                external, passed, total, order] + [p.feedback.get(k, "") for k in keys]
 
 
-def assignment_rows(study: Study) -> Iterator[list]:
-    qs = (Assignment.objects.filter(section__study=study).exclude(kind=Assignment.Kind.PRACTICE)
-          .exclude(participant__status=WITHDRAWN).annotate(exported_type=_exported_type())
+def assignment_rows(study: Study, include_pilot: bool = True) -> Iterator[list]:
+    qs = (_without_pilots(Assignment.objects.filter(section__study=study), include_pilot)
+          .exclude(kind=Assignment.Kind.PRACTICE).exclude(participant__status=WITHDRAWN)
+          .annotate(exported_type=_exported_type())
           .order_by("participant_id", "seq")
           .values_list("participant__public_id", "exported_type", "section__order", "position",
                        "clip__clip_id", "options", "shown_at", "answered_at"))
@@ -170,11 +183,11 @@ def assignment_rows(study: Study) -> Iterator[list]:
         yield [pid, stype, order, pos, clip_id, ";".join(options or []), _iso(shown), _iso(answered)]
 
 
-def viewing_rows(study: Study) -> Iterator[list]:
+def viewing_rows(study: Study, include_pilot: bool = True) -> Iterator[list]:
     """One row per answered clip page (practice items left out): participant, clip, section type, then
     VIEWING_FIELDS (blank where unknown or when the browser sent none) and VIEWING_SERVER_FIELDS (blank for an
     answer stored before the server kept them)."""
-    qs = (Assignment.objects.filter(section__study=study, answered_at__isnull=False)
+    qs = (_without_pilots(Assignment.objects.filter(section__study=study, answered_at__isnull=False), include_pilot)
           .exclude(kind=Assignment.Kind.PRACTICE).exclude(participant__status=WITHDRAWN)
           .annotate(exported_type=_exported_type())
           .order_by("participant_id", "seq")
@@ -185,43 +198,74 @@ def viewing_rows(study: Study) -> Iterator[list]:
                *(record.get(f) for f in VIEWING_SERVER_FIELDS)]
 
 
-def stream_csv(study: Study, kind: str) -> Iterator[str]:
-    """Lines of `kind` in EXPORT_KINDS."""
+def stream_csv(study: Study, kind: str, include_pilot: bool = True) -> Iterator[str]:
+    """Lines of `kind` in EXPORT_KINDS; ``include_pilot=False`` leaves the pilot participants out."""
     if kind == "responses":
-        return csv_lines(RESPONSE_COLUMNS, response_rows(study))
+        return csv_lines(RESPONSE_COLUMNS, response_rows(study, include_pilot))
     if kind == "clips":
         return csv_lines(EXPORT_CLIP_COLUMNS, clip_rows(study))
     if kind == "participants":
-        return csv_lines([*PARTICIPANT_COLUMNS, *feedback_keys(study)], participant_rows(study))
+        return csv_lines([*PARTICIPANT_COLUMNS, *feedback_keys(study)], participant_rows(study, include_pilot))
     if kind == "assignments":
-        return csv_lines(ASSIGNMENT_COLUMNS, assignment_rows(study))
+        return csv_lines(ASSIGNMENT_COLUMNS, assignment_rows(study, include_pilot))
     if kind == "viewing":
-        return csv_lines(VIEWING_COLUMNS, viewing_rows(study))
+        return csv_lines(VIEWING_COLUMNS, viewing_rows(study, include_pilot))
     raise ValueError(f"unknown export {kind!r}; choose {', '.join(EXPORT_KINDS)}")
 
 
-def write_study_csvs(study: Study, out_dir: str | Path) -> dict[str, Path]:
-    """Write responses.csv, clips.csv, participants.csv (DESIGN.md), assignments.csv and viewing.csv into out_dir;
-    returns their paths by kind."""
+def write_study_csvs(study: Study, out_dir: str | Path, include_pilot: bool = True) -> dict[str, Path]:
+    """Write responses.csv, clips.csv, participants.csv (DESIGN.md), assignments.csv and viewing.csv into out_dir
+    (the pilot participants left out unless ``include_pilot``); returns their paths by kind."""
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     paths = {}
     for kind in EXPORT_KINDS:
         path = out / f"{kind}.csv"
         with open(path, "w", newline="", encoding="utf-8") as fh:
-            for line in stream_csv(study, kind):
+            for line in stream_csv(study, kind, include_pilot):
                 fh.write(line)
         paths[kind] = path
     return paths
 
 
+DICTIONARY_NAME = "data_dictionary.csv"
+DESCRIPTION_NAME = "dataset_description.json"
+
+
+def _header(path: Path) -> list[str]:
+    with open(path, newline="", encoding="utf-8") as fh:
+        return next(csv.reader(fh), [])
+
+
+def write_data_package(study: Study, out_dir: str | Path, include_pilot: bool = True) -> dict[str, Path]:
+    """write_study_csvs, then the data dictionary of exactly the headers written (protocol.dictionary: every file,
+    every column, ``answer`` per section type and question) and a Psych-DS dataset_description.json (authors: the
+    study's owners; the licence left for the researcher). Returns every path by kind ("dictionary",
+    "description" for the two)."""
+    out = Path(out_dir)
+    paths = write_study_csvs(study, out, include_pilot)
+    rows = dictionary_rows({p.name: _header(p) for p in paths.values()}, study.feedback_questions or [])
+    with open(out / DICTIONARY_NAME, "w", newline="", encoding="utf-8") as fh:
+        writer = csv.DictWriter(fh, fieldnames=DICTIONARY_COLUMNS, lineterminator="\n")
+        writer.writeheader()
+        writer.writerows({k: safe_cell(v) for k, v in row.items()} for row in rows)
+    authors = [u.get_full_name() or u.get_username() for u in study.owners.order_by("username")]
+    description = dataset_description(
+        study.title, (study.introduction or "").strip() or f"Perceptual study {study.slug}", authors, rows,
+        study.created_at.date().isoformat() if study.created_at else "",
+        keywords=["perception", "virtual agents", "emotion", *([study.preset] if study.preset else [])])
+    (out / DESCRIPTION_NAME).write_text(json.dumps(description, indent=2, ensure_ascii=False) + "\n",
+                                        encoding="utf-8")
+    return {**paths, "dictionary": out / DICTIONARY_NAME, "description": out / DESCRIPTION_NAME}
+
+
 def run_report(study: Study, out_dir: str | Path) -> dict:
-    """Export the CSVs and call the analysis library's report writer (analysis.report.write_report, viewing.csv
-    included) with the study's
+    """Export the CSVs (pilot participants only when ``Study.report_includes_pilot``) and call the analysis
+    library's report writer (analysis.report.write_report, viewing.csv included) with the study's
     exclusion rules (``Study.exclusion_rules``; empty = the analysis defaults), which the report states. Invalid rules
     raise ValueError naming the key (the admin form checks them with analysis.exclusion.rule_errors)."""
     out = Path(out_dir)
-    paths = write_study_csvs(study, out / "data")
+    paths = write_data_package(study, out / "data", include_pilot=study.report_includes_pilot)
     from analysis.report import write_report  # imported lazily: the analysis library is optional at runtime
 
     return write_report(paths["responses"], paths["clips"], paths["participants"], out,

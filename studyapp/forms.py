@@ -4,13 +4,14 @@ fields or raw JSON, checked against the study protocol) with the preview form of
 from __future__ import annotations
 
 from django import forms
+from django.db.models import Q
 from django.utils.translation import gettext
 from django.utils.translation import gettext_lazy as _
 
 from analysis.exclusion import rule_errors
 from protocol.pools import SUB_POOLS, pool_errors
 
-from . import clip_import, pool_editor
+from . import clip_import, pool_editor, study_fields
 from .check_clips import check_clip_problems
 from .i18n import display
 from .inputs import refuse_control_characters, refuse_control_characters_in_text
@@ -93,6 +94,21 @@ class PresetStudyForm(forms.Form):
         return slug
 
 
+class CloneStudyForm(forms.Form):
+    slug = forms.SlugField(max_length=80, help_text="The copy's participant URL /s/<slug>/")
+    title = forms.CharField(max_length=200)
+
+    def clean_slug(self):
+        slug = self.cleaned_data["slug"]
+        if Study.objects.filter(slug=slug).exists():
+            raise forms.ValidationError(f"A study with slug '{slug}' already exists.")
+        return slug
+
+
+class SharePreviewForm(forms.Form):
+    days = forms.IntegerField(min_value=1, max_value=90, initial=14, label="Valid for (days)")
+
+
 class SectionForm(forms.ModelForm, PoolEditorFields):
     """A section in the admin: the pool and options as structured fields (studyapp.pool_editor) with the raw JSON
     as an advanced field. The raw JSON wins only when none of its group's structured fields was edited (their
@@ -120,6 +136,19 @@ class SectionForm(forms.ModelForm, PoolEditorFields):
         for name in ("pool_plan", *(f"pool_{sub}_plan" for sub in SUB_POOLS)):
             if name in self.fields:
                 self.fields[name].widget.suggestions = plans
+        self._earlier_sections_only()
+
+    def _earlier_sections_only(self) -> None:
+        """"Reuse section" offers only sections that come before this one in its own study (a saved section: by
+        order, then id; a new one: every saved section of the study); Section.clean checks the same on save."""
+        field = self.fields.get("reuse_section")
+        if field is None or not self.instance.study_id:
+            return
+        earlier = field.queryset.filter(study_id=self.instance.study_id)
+        if self.instance.pk:
+            earlier = earlier.filter(Q(order__lt=self.instance.order) |
+                                     Q(order=self.instance.order, pk__lt=self.instance.pk))
+        field.queryset = earlier.order_by("order", "id")
 
     def clean(self):
         data = super().clean()
@@ -191,6 +220,10 @@ class StudyAdminForm(forms.ModelForm):
         model = Study
         fields = "__all__"
 
+    def __init__(self, *args, **kwargs):
+        super().__init__(*args, **kwargs)
+        study_fields.set_initial(self)
+
     def clean_completion_redirect(self):
         value = (self.cleaned_data.get("completion_redirect") or "").strip()
         check_completion_url(value)
@@ -199,6 +232,14 @@ class StudyAdminForm(forms.ModelForm):
     def clean(self):
         """A norming study opens only when its planned N (the participant limit) gives every clip K ratings."""
         data = super().clean()
+        if study_fields.touched(self, study_fields.FEEDBACK_FIELDS):
+            data["feedback_questions"] = study_fields.feedback_from_fields(self, data)
+        if study_fields.touched(self, study_fields.RULE_FIELDS):
+            rules = study_fields.rules_from_fields(data)
+            errors = rule_errors(rules)
+            if errors:
+                self.add_error(None, errors)
+            data["exclusion_rules"] = rules
         if self.instance.pk and data.get("status") == Study.Status.OPEN:
             errors = open_errors(self.instance, n_planned=data.get("max_participants") or 0)
             if errors:
@@ -212,6 +253,10 @@ class StudyAdminForm(forms.ModelForm):
         if errors:
             raise forms.ValidationError(errors)
         return rules
+
+
+StudyAdminForm.base_fields.update(study_fields.declared_fields())
+StudyAdminForm.declared_fields.update(study_fields.declared_fields())
 
 
 class MultipleFileInput(forms.ClearableFileInput):

@@ -14,7 +14,9 @@ from django.core.validators import MaxValueValidator
 from django.db import models
 from django.utils import timezone
 
+from protocol.dictionary import PILOT_PREFIX
 from protocol.pools import errors_by_field, validate_section
+from protocol.titles import TITLE_MAX_LENGTH
 from protocol.vocabulary import ATTENTION_CHECK, CLIP_MODALITIES, ORIGINS
 
 from .permissions import STUDY_PERMISSIONS
@@ -54,6 +56,9 @@ class Clip(models.Model):
     """One pre-rendered stimulus; fields follow the `clips.csv` columns of DESIGN.md."""
 
     clip_id = models.CharField(max_length=200, unique=True)
+    # A readable label for staff pages and exports (protocol.titles: generator, condition, variant); never shown
+    # to participants.
+    title = models.CharField(max_length=TITLE_MAX_LENGTH, blank=True)
     modality = models.CharField(max_length=10, choices=[(m, m) for m in CLIP_MODALITIES])
     origin = models.CharField(max_length=10, choices=[(o, o) for o in ORIGINS])
     happy = models.FloatField(null=True, blank=True)
@@ -163,6 +168,14 @@ class Study(models.Model):
         default=dict, blank=True,
         help_text="Rules the analysis applies (raw exports stay unchanged), e.g. "
                   '{"min_rt_fraction": 0.25, "max_straightline": 0.9, "min_attention_pass": 1.0}')
+    pilot = models.BooleanField(
+        default=False, help_text="Pilot mode: the study takes participants while it is still a draft, and everyone "
+                                 "who consents while this is on is a pilot participant: marked in every export (their "
+                                 "id starts with 'pilot-'), left out of the analysis report unless the box below is "
+                                 "ticked, and removed by 'delete pilot data' on the progress page")
+    report_includes_pilot = models.BooleanField(
+        default=False, help_text="Include the pilot participants in the analysis report (they are always in the "
+                                 "CSV exports, marked)")
     # Who may see, preview, export and analyse the study (studyapp.permissions.studies_for); superusers see every
     # study. Owners also decide who the owners and collaborators are.
     owners = models.ManyToManyField(settings.AUTH_USER_MODEL, blank=True, related_name="owned_studies",
@@ -289,6 +302,8 @@ class Participant(models.Model):
     consent_key = models.CharField(max_length=64, blank=True, default="", editable=False)
     # Number of clip pages (assignments) fixed at start: the "of N" of the progress, without counting rows.
     n_items = models.PositiveIntegerField(default=0, editable=False)
+    # Consented while the study was in pilot mode (Study.pilot): public_id starts with PILOT_PREFIX.
+    pilot = models.BooleanField(default=False, editable=False, db_index=True)
 
     class Meta:
         constraints = [
@@ -300,6 +315,15 @@ class Participant(models.Model):
 
     def __str__(self) -> str:
         return self.public_id
+
+    def save(self, *args, **kwargs):
+        """A participant who consents while the study is in pilot mode is a pilot participant, and says so in the
+        id every export carries."""
+        if self._state.adding and not self.pilot and self.study.pilot:
+            self.pilot = True
+        if self.pilot and not self.public_id.startswith(PILOT_PREFIX):
+            self.public_id = PILOT_PREFIX + self.public_id
+        super().save(*args, **kwargs)
 
 
 class Assignment(models.Model):

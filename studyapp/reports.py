@@ -89,7 +89,7 @@ def data_version(study: Study) -> str:
         n=Count("id"), max_id=Max("id"), last=Max("created_at"))
     clips = Clip.objects.aggregate(n=Count("id"), changed=Max("updated_at"))
     sections = list(study.sections.order_by("id").values_list("id", "order", "section_type", "options"))
-    record = [study.pk, study.exclusion_rules, sections, people, answers, clips]
+    record = [study.pk, study.exclusion_rules, sections, people, answers, clips, study.report_includes_pilot]
     return hashlib.sha256(json.dumps(record, sort_keys=True, default=str).encode()).hexdigest()[:16]
 
 

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 from django.shortcuts import render
 
+from .clip_display import clip_cells
 from .norming import design_rows, ratings_so_far
 from .permissions import staff_permission_required, study_of
 
@@ -16,7 +17,9 @@ def norming_monitor(request, study_id: int):
     for row in design_rows(study):
         clips = ratings_so_far(row.section)
         below = [c for c in clips if c.rated < row.k]
+        cells = clip_cells(c.clip_id for c in clips)
         sections.append({"design": row, "clips": clips, "below": len(below),
+                         "rows": [{"c": c, "cell": cells.get(c.clip_id)} for c in clips],
                          "total_ratings": sum(c.rated for c in clips)})
     return render(request, "studyapp/staff/norming.html",
                   {"study": study, "sections": sections, "title": f"Norming monitor: {study.title}"})

@@ -7,7 +7,11 @@ the fields of one section form (names without the formset prefix) and answers JS
     {"count": 12, "by_origin": {"generated": 8, "source": 4}, "summary": "12 clips match ...",
      "warnings": [...], "errors": [{"field": "pool_weight_min", "label": "Weight from",
      "messages": ["Enter a number."]}], "pool": {...}, "options": {...}, "used": {"pool": "fields", ...},
-     "norms_html": "<details class=\"norms-table\">..."}
+     "norms_html": "<details class=\"norms-table\">...",
+     "sample": [{"clip_id": "...", "title": "gait net, happy, path 1", "thumb_url": "/m/<key>.png"}, ...]}
+
+``sample`` is the first SAMPLE_SIZE matching clips by title (studyapp.clip_display), so the researcher sees which
+clips a pool means, not only how many.
 
 ``norms_html`` is the norms table of a pool with a ``norms`` rule (studyapp.admin_norms; escaped HTML, "" without
 a rule). A norms rule may read only a study the user may see (studyapp.norms_rule.check_reader): another lab's
@@ -29,11 +33,13 @@ from protocol.vocabulary import ORIGINS
 
 from .admin_norms import norms_table
 from .catalogue import CatalogueError, pool_queryset, section_queryset
+from .clip_display import ClipCell, clip_cell
 from .forms import SectionPreviewForm
 from .norms_rule import NormsSourceError, check_reader
 from .permissions import has_staff_permission
 from .pool_editor import takes_sub_pools
 
+SAMPLE_SIZE = 8
 REUSED = "this section reuses the clips of an earlier section: its pool is not used"
 HALVES = tuple(name for name in SUB_POOLS if name in ORIGINS)
 """The naturalness halves: each sub-pool is the clips of that origin (studyapp.assignment)."""
@@ -100,6 +106,17 @@ def count_pool(section_type: str | None, pool, reader=None) -> PoolCount:
     return PoolCount(total, by_origin)
 
 
+def pool_sample(section_type: str | None, pool, n: int = SAMPLE_SIZE) -> list[ClipCell]:
+    """The first ``n`` clips (by title, then id) a valid pool matches; [] when it cannot be counted."""
+    if pool_errors(pool, section_type):
+        return []
+    try:
+        clips = section_queryset(section_type, pool or {}).order_by("title", "clip_id")[:n]
+        return [clip_cell(c) for c in clips]
+    except (CatalogueError, DatabaseError, OverflowError, ValueError, TypeError):
+        return []
+
+
 def _field_errors(form) -> list[dict]:
     out = []
     for name, messages in form.errors.items():
@@ -126,7 +143,9 @@ def preview(form: SectionPreviewForm, reuse_section: str = "", reader=None) -> d
         answer["errors"].append({"field": "pool", "label": "pool", "messages": counted.errors})
     answer.update(count=counted.total, by_origin=counted.by_origin, summary=counted.summary(),
                   warnings=counted.warnings(data.get("clips_per_participant"), data.get("options")),
-                  norms_html=str(norms_table(data["pool"])) if counted.total is not None else "")
+                  norms_html=str(norms_table(data["pool"])) if counted.total is not None else "",
+                  sample=[vars(c) for c in pool_sample(data["section_type"], data["pool"])]
+                  if counted.total is not None else [])
     if reuse_section:
         answer["warnings"].insert(0, REUSED)
     return answer

@@ -11,6 +11,7 @@ researcher who creates a study from a preset becomes its owner.
 from __future__ import annotations
 
 import tempfile
+import zipfile
 from pathlib import Path
 
 from django.contrib import messages
@@ -18,25 +19,33 @@ from django.db.models import Count, Q
 from django.http import Http404, StreamingHttpResponse
 from django.shortcuts import redirect, render
 from django.urls import reverse
+from django.utils.html import format_html
 from django.utils.http import content_disposition_header
 from django.views.decorators.http import require_http_methods
 
+from generation.plans.schema import PlanError, load_plan
 from generation.render import contact_sheet
+from protocol.presets import PRESET_PLANS
 from protocol.vocabulary import ATTENTION_CHECK
 
 from .assignment import plan_study
 from .catalogue import clip_label
-from .export import EXPORT_KINDS, csv_lines, stream_csv
-from .forms import ConsentForm, PresetStudyForm
+from .clip_display import clip_cells
+from .export import EXPORT_KINDS, csv_lines, stream_csv, write_data_package
+from .forms import CloneStudyForm, ConsentForm, PresetStudyForm, SharePreviewForm
 from .i18n import activate_study_language
 from .media import media_path
-from .models import Assignment, Participant, Response, Study
+from .models import Assignment, Clip, Participant, Response, Study
 from .permissions import EXPORT_PERMISSION, staff_permission_required, study_of
+from .pilots import delete_pilot_data, pilot_count
 from .presets import create_study_from_preset
 from .privacy import PAYMENT_COLUMNS, PAYMENT_PERMISSION, payment_rows
+from .progress_stats import progress_stats
 from .questions import AnswerError, clean_answers
 from .reports import report_state, start_build
+from .sharing import preview_token, prolific_completion_url, prolific_study_url
 from .streaming import body, file_body
+from .study_clone import clone_study
 from .views import item_context, item_questions
 
 
@@ -49,8 +58,30 @@ def create_from_preset(request):
         study = create_study_from_preset(d["preset"], d["slug"], d["title"] or None)
         study.owners.add(request.user)
         messages.success(request, f"Created '{study.title}' from preset {d['preset']} (status: draft).")
+        offer = render_offer(d["preset"])
+        if offer:
+            messages.warning(request, offer)
         return redirect(reverse("admin:studyapp_study_change", args=[study.pk]))
     return render(request, "studyapp/staff/create_from_preset.html", {"form": form, "title": "New study from preset"})
+
+
+def render_offer(preset: str):
+    """A message offering to render the preset's plan when the catalogue lacks some of its clips (None when it has
+    them all): the study's pools draw only clips of that plan."""
+    plan = PRESET_PLANS.get(preset)
+    if not plan:
+        return None
+    try:
+        planned = len(load_plan(plan).entries)
+    except PlanError:
+        return None
+    have = Clip.objects.filter(plan=plan, retired=False).count()
+    if have >= planned:
+        return None
+    url = reverse("admin:studyapp_clip_stimuli") + f"?plan={plan}#builtin-{plan}"
+    return format_html('Its sections draw the clips of plan {}: the catalogue holds {} of its {}. '
+                       '<a href="{}" id="render-preset-plan">Render the stimulus set {} now</a> (in the background).',
+                       plan, have, planned, url, plan)
 
 
 def _preview_plan(study: Study, seed: int):
@@ -128,13 +159,66 @@ def progress(request, study_id: int):
                     .order_by("clip__clip_id"))
         sections.append({"section": section, "clips": list(per_clip),
                          "responses": Response.objects.filter(section=section).count()})
+    cells = clip_cells(c["clip__clip_id"] for s in sections for c in s["clips"])
+    for s in sections:
+        for c in s["clips"]:
+            c["cell"] = cells.get(c["clip__clip_id"])
+    report = report_state(study)
     ctx = {"study": study, "counts": counts, "sections": sections, "title": f"Progress: {study.title}",
-           "report": report_state(study),
+           "report": report, "stats": progress_stats(study, report),
            "started": counts.get(Participant.Status.STARTED, 0),
            "completed": counts.get(Participant.Status.COMPLETED, 0),
            "consented": counts.get(Participant.Status.CONSENTED, 0),
-           "participant_url": request.build_absolute_uri(reverse("studyapp:study_entry", args=[study.slug]))}
+           "participant_url": request.build_absolute_uri(reverse("studyapp:study_entry", args=[study.slug])),
+           "prolific_url": prolific_study_url(request, study), "prolific_completion": prolific_completion_url(study),
+           "n_pilot": pilot_count(study), "share_form": SharePreviewForm()}
     return render(request, "studyapp/staff/progress.html", ctx)
+
+
+@staff_permission_required("studyapp.add_study")
+@require_http_methods(["GET", "POST"])
+def clone(request, study_id: int):
+    """A draft copy of the study (texts, sections, pools; no participants), owned by whoever clones it."""
+    study = study_of(request, study_id)
+    form = CloneStudyForm(request.POST or None, initial={"slug": f"{study.slug}-copy"[:80],
+                                                         "title": f"Copy of {study.title}"[:200]})
+    if request.method == "POST" and form.is_valid():
+        copy = clone_study(study, form.cleaned_data["slug"], form.cleaned_data["title"], request.user)
+        messages.success(request, f"Cloned '{study.title}' as '{copy.title}' (a draft, no participants).")
+        return redirect(reverse("admin:studyapp_study_change", args=[copy.pk]))
+    return render(request, "studyapp/staff/clone.html", {"form": form, "study": study,
+                                                         "title": f"Clone {study.title}"})
+
+
+@staff_permission_required("studyapp.change_study")
+@require_http_methods(["POST"])
+def delete_pilot(request, study_id: int):
+    """Delete the study's pilot participants and their answers (a ticked confirmation is required)."""
+    study = study_of(request, study_id)
+    if request.POST.get("confirm") != "yes":
+        messages.error(request, "Tick the box to confirm deleting the pilot data.")
+    else:
+        n = delete_pilot_data(study)
+        messages.success(request, f"Deleted {n} pilot participant(s) with their answers.")
+    return redirect(reverse("studyapp:progress", args=[study.pk]) + "#pilot")
+
+
+@staff_permission_required("studyapp.view_study")
+@require_http_methods(["POST"])
+def share_preview(request, study_id: int):
+    """Make a signed preview link of the study (studyapp.sharing) and show it on the progress page."""
+    study = study_of(request, study_id)
+    form = SharePreviewForm(request.POST)
+    if not form.is_valid():
+        messages.error(request, "A preview link lasts between 1 and 90 days.")
+    else:
+        days = form.cleaned_data["days"]
+        url = request.build_absolute_uri(reverse("studyapp:shared_preview", args=[preview_token(study, days)]))
+        messages.success(request, format_html(
+            'Preview link, valid for {} day(s), for anyone who has it (no account; nothing is recorded): '
+            '<input type="text" readonly class="copy-text" id="shared-preview-url" value="{}" size="60"> '
+            '<button type="button" class="copy-button" data-copy="shared-preview-url">Copy</button>', days, url))
+    return redirect(reverse("studyapp:progress", args=[study.pk]) + "#share")
 
 
 @staff_permission_required(EXPORT_PERMISSION)
@@ -155,6 +239,25 @@ def payment_ids(request, study_id: int):
     response = StreamingHttpResponse(body(request, csv_lines(PAYMENT_COLUMNS, payment_rows(study))),
                                      content_type="text/csv; charset=utf-8")
     response["Content-Disposition"] = f'attachment; filename="{study.slug}-payment-ids.csv"'
+    return response
+
+
+@staff_permission_required(EXPORT_PERMISSION)
+def data_zip(request, study_id: int):
+    """Every CSV export in one zip with its data dictionary and a Psych-DS dataset_description.json (pilot
+    participants included, marked by their ids)."""
+    study = study_of(request, study_id)
+    archive = tempfile.TemporaryFile(suffix=".zip")        # unlinked: gone when the response closes it
+    with tempfile.TemporaryDirectory(prefix="data-zip-") as tmp:
+        paths = write_data_package(study, tmp)
+        with zipfile.ZipFile(archive, "w", zipfile.ZIP_DEFLATED) as zf:
+            for path in paths.values():
+                zf.write(path, f"{study.slug}/data/{path.name}")
+    archive.seek(0)
+    blocks = iter(lambda: archive.read(1 << 20), b"")     # read as sent (async under ASGI), closed with the file
+    response = StreamingHttpResponse(body(request, blocks), content_type="application/zip")
+    response["Content-Disposition"] = content_disposition_header(True, f"{study.slug}-data.zip")
+    response._resource_closers.append(archive.close)
     return response
 
 

@@ -81,6 +81,11 @@ def test_plan_renders_once_then_nothing(media, tmp_path):
     if happy.metadata["generator"] == "procedural_walk":
         assert happy.metadata["fallback_for"] == "gait_net" and happy.metadata["synthetic"] is True
     assert happy.plan == "tiny" and happy.loop is False
+    # Readable titles in clips.csv and the catalogue: generator, condition (a source take by its file).
+    titles = {entry: row["title"] for entry, row in by_entry.items()}
+    assert titles["walk_transition"] == "procedural walk, sad to happy"
+    assert titles["source_walk"] == "captured, take 0walk_forward"
+    assert titles["walk_happy"].endswith(", happy") and happy.title == titles["walk_happy"]
     # File names reveal nothing about the condition.
     assert all(len(r["clip_id"]) == 16 and "happy" not in r["clip_id"] for r in rows)
 

@@ -66,6 +66,37 @@
     list.appendChild(li);
   }
 
+  function clipCell(c) {
+    /* one matching clip as studyapp.clip_display draws it: poster thumbnail, title, id */
+    var li = document.createElement("li"), cell = document.createElement("span"), thumb;
+    cell.className = "clip-cell";
+    if (c.thumb_url) {
+      thumb = document.createElement("img");
+      thumb.src = c.thumb_url;
+      thumb.alt = "";
+      thumb.width = 85;
+      thumb.height = 48;
+      thumb.loading = "lazy";
+    } else {
+      thumb = document.createElement("span");
+      thumb.className = "clip-thumb-none";
+    }
+    thumb.classList.add("clip-thumb");
+    var name = document.createElement("span"), title = document.createElement("span");
+    var id = document.createElement("code");
+    name.className = "clip-name";
+    title.className = "clip-title";
+    title.textContent = c.title || c.clip_id;
+    id.className = "clip-id";
+    id.textContent = c.clip_id;
+    name.appendChild(title);
+    name.appendChild(id);
+    cell.appendChild(thumb);
+    cell.appendChild(name);
+    li.appendChild(cell);
+    return li;
+  }
+
   function show(row, status, body) {
     var out = row.querySelector(".pool-count");
     var list = row.querySelector(".pool-warnings");
@@ -78,6 +109,11 @@
       e.messages.forEach(function (m) { item(list, e.label + ": " + m, "pool-error"); });
     });
     (body.warnings || []).forEach(function (w) { item(list, w, "pool-warning"); });
+    var samples = row.querySelector(".clip-samples");
+    if (samples) {
+      samples.textContent = "";
+      (status === 200 && body.sample || []).forEach(function (c) { samples.appendChild(clipCell(c)); });
+    }
     var norms = row.querySelector(".norms-slot");
     if (norms && status === 200) {
       norms.innerHTML = body.norms_html || "";     // escaped by the server (studyapp.admin_norms)

@@ -11,6 +11,9 @@ the clips render on a Dask distributed cluster whose workers share this media fo
 """
 from __future__ import annotations
 
+import json
+import os
+import time
 from pathlib import Path
 
 from django.conf import settings
@@ -29,6 +32,7 @@ from generation.plans.schema import PlanError, load_plan
 from generation.quality.checks import QAThresholdError, gait_observer_kind
 from generation.render import contact_sheet, prepare_render_process
 from protocol.coverage import coverage_lines, presets_of_plan
+from protocol.titles import clip_titles
 from studyapp.catalogue import clip_label, retire_superseded, upsert_clips
 
 
@@ -62,6 +66,9 @@ class Command(BaseCommand):
         parser.add_argument("--device", default="cpu",
                             help="torch device of the network generators (gait_net, gesture_net): auto, cpu, cuda or "
                                  "cuda:N (default cpu: the same stimuli as on a machine without a GPU)")
+        parser.add_argument("--progress-file", default=None, metavar="JSON",
+                            help="keep the counts (total, to do, done, failed) in this JSON file while rendering, "
+                                 "with finished: true at the end (the admin's render jobs read it)")
         parser.add_argument("--scheduler", default=None, metavar="tcp://HOST:PORT",
                             help="render on a Dask distributed cluster (its workers must share MEDIA_ROOT) instead "
                                  "of local worker processes")
@@ -91,9 +98,16 @@ class Command(BaseCommand):
         clips_dir = media_root / "clips"
         records_dir = Path(opts["records_dir"]) if opts["records_dir"] else media_root / "clip_records"
         bars = _Bars(self.stdout, disabled=opts["no_progress"])
+        progress = ProgressFile(opts["progress_file"], self.stdout) if opts["progress_file"] else None
+
+        def on_event(kind: str, info: dict) -> None:
+            bars.event(kind, info)
+            if progress is not None:
+                progress.event(kind, info)
+
         try:
             result = run_plan(plan, clips_dir, records_dir, media_prefix="clips/", workers=opts["workers"],
-                              webm=opts["webm"], limit=opts["limit"], on_event=bars.event,
+                              webm=opts["webm"], limit=opts["limit"], on_event=on_event,
                               scheduler=opts["scheduler"], device=device, gait_observer=gait_observer,
                               corpora=RealCorpora.of(settings.REAL_CORPUS, settings.BML_CORPUS))
         except OSError as exc:  # e.g. no Dask scheduler at that address
@@ -103,6 +117,9 @@ class Command(BaseCommand):
         for _where, msg in result.failed:
             self.stderr.write(f"FAILED {msg}")
         records = result.records
+        titles = clip_titles(records)
+        for rec in records:
+            rec["title"] = titles[rec["clip_id"]]
         csv_path = media_root / "clips.csv"
         if records:
             write_clips_csv(records, csv_path)
@@ -131,9 +148,49 @@ class Command(BaseCommand):
             labels = [clip_label(r) for r in records]
             contact_sheet([clips_dir / f"{r['clip_id']}.png" for r in records], labels, out)
             self.stdout.write(f"contact sheet {out}")
+        if progress is not None:
+            progress.finish(len(result.rendered), len(result.skipped), len(result.failed),
+                            sorted(r["clip_id"] for r in records))
         if result.failed:
             raise CommandError(f"{len(result.failed)} clip(s) of plan {plan.name} failed (see above); the others "
                                "are catalogued; rerun to retry only the missing ones")
+
+
+class ProgressFile:
+    """The render's counts in a JSON file, rewritten atomically on every event: ``total`` clips of the plan,
+    ``todo`` (to render this run), ``skipped`` (already done), ``done`` and ``failed`` so far, and at the end
+    ``finished: true`` with the clip ids catalogued. A line per finished clip goes to ``stream`` (the job's log)."""
+
+    def __init__(self, path: str, stream):
+        self.path = Path(path)
+        self.stream = stream
+        self.state = {"total": 0, "todo": 0, "skipped": 0, "done": 0, "failed": 0, "finished": False,
+                      "started": time.time()}
+        self.write()
+
+    def write(self) -> None:
+        self.state["updated"] = time.time()
+        tmp = self.path.with_name(f".{self.path.name}.tmp{os.getpid()}")
+        tmp.write_text(json.dumps(self.state), encoding="utf-8")
+        os.replace(tmp, self.path)
+
+    def event(self, kind: str, info: dict) -> None:
+        if kind == "plan":
+            self.state.update(total=info["total"], todo=info["todo"], skipped=info["skipped"])
+        elif kind == "done":
+            self.state["done"] += 1
+            self.stream.write(f"rendered {info.get('entry', '')} ({self.state['done']} of {self.state['todo']})")
+        elif kind == "fail":
+            self.state["failed"] += 1
+            self.stream.write(f"failed {info.get('entry', '')}: {info.get('error', '')}")
+        else:
+            return
+        self.stream.flush()
+        self.write()
+
+    def finish(self, rendered: int, skipped: int, failed: int, clip_ids: list[str]) -> None:
+        self.state.update(done=rendered, skipped=skipped, failed=failed, finished=True, clip_ids=clip_ids)
+        self.write()
 
 
 class _Bars:
