@@ -75,31 +75,61 @@ def figure_outline(skel, positions: np.ndarray, body: str) -> np.ndarray:
     return body_outline(positions, head_top(skel, positions), 0.06 * s)
 
 
-def plan_cameras(motion: Motion, positions: np.ndarray, settings: RenderSettings) -> tuple[list, dict, tuple]:
-    """Per-frame camera poses of a prepared clip without rendering: (poses, info, (skeleton, ground_y, chair)).
+def body_preset_for(motion: Motion, settings: RenderSettings) -> str:
+    """The human body preset of a clip: the settings' ``body_preset``, else the one of the Motion's gender
+    (metadata "gender" or "build"), else the default preset."""
+    from .bodies import BY_GENDER, DEFAULT_PRESET
+
+    if settings.body_preset:
+        return settings.body_preset
+    gender = motion.metadata.get("gender") or motion.metadata.get("build")
+    return BY_GENDER.get(gender, DEFAULT_PRESET)
+
+
+def human_figure_for(motion: Motion, settings: RenderSettings):
+    """The posed human body of a prepared clip (:class:`generation.render.human.HumanFigure`)."""
+    from .human import human_figure
+
+    return human_figure(motion, body_preset_for(motion, settings), settings.face, settings.skin_tone)
+
+
+def plan_cameras(motion: Motion, positions: np.ndarray, settings: RenderSettings, figure=None
+                 ) -> tuple[list, dict, tuple]:
+    """Per-frame camera poses of a prepared clip without rendering: (poses, info, (skeleton, ground_y, chair,
+    figure)), ``figure`` the posed human body or None.
 
     ``info`` holds the camera rule and the projected figure height fractions (``min_figure_fraction``...), the
-    body look and build, and ``seated``."""
+    body look and build (and the human body's ``body_preset``), and ``seated``. ``figure``: the clip's posed human
+    body (made here when the look is "human" and none is given)."""
     skel = body_skeleton(motion)
     s = skel.height / 1.75
     ground_y = float(positions[..., 1].min() - 0.03 * s)
     chair = None
     extra = None
     seated = is_seated(motion)
+    if settings.body == "human" and figure is None:
+        figure = human_figure_for(motion, settings)
     if seated:
         facing = facing_direction(motion.rotations[0, 0])
-        chair = chair_boxes(positions, skel, facing, ground_y)
+        seat = None
+        if figure is not None:
+            from .human import seat_fit
+
+            seat = seat_fit(figure, facing)
+        chair = chair_boxes(positions, skel, facing, ground_y, seat)
         if settings.body != "points":
             extra = np.concatenate([np.stack([c + h * np.array(sgn) for sgn in ((1, 1, 1), (-1, -1, -1))])
                                     for c, h, _ in chair])
     root = positions[:, 0]
     extent = (root[:, 0].min() - GROUND_MARGIN_M, root[:, 0].max() + GROUND_MARGIN_M,
               root[:, 2].min() - GROUND_MARGIN_M, root[:, 2].max() + GROUND_MARGIN_M)
-    outline = figure_outline(skel, positions, settings.body)
+    outline = figure.outline if figure is not None else figure_outline(skel, positions, settings.body)
     cams, cam_info = choose_cameras(positions, motion.rotations[0, 0], outline, settings.fps, settings.width,
                                     settings.height, settings.camera, seated, extra)
     cam_info.update(body=settings.body, build=skel.build, seated=seated, extent=extent)
-    return cams, cam_info, (skel, ground_y, chair)
+    if figure is not None:
+        cam_info.update(body_preset=figure.body.name)
+    return cams, cam_info, (skel, ground_y, chair, figure)
 
 
 def anti_aliasing_for(setting: str, cams: list, seated: bool = True) -> str:
@@ -115,11 +145,16 @@ def anti_aliasing_for(setting: str, cams: list, seated: bool = True) -> str:
 def build_scene(motion: Motion, positions: np.ndarray, settings: RenderSettings, info: dict | None = None):
     """The scene and per-frame camera poses for a prepared clip; ``info`` (when given) receives the camera
     rule and the projected figure height fractions."""
-    cams, cam_info, (skel, ground_y, chair) = plan_cameras(motion, positions, settings)
+    cams, cam_info, (skel, ground_y, chair, figure) = plan_cameras(motion, positions, settings)
     extent = cam_info.pop("extent")
     aa = anti_aliasing_for(settings.anti_aliasing, cams, cam_info["seated"])
     cam_info["anti_aliasing"] = aa
-    scene = SCENES[settings.body](skel, settings.width, settings.height, aa, extent, ground_y, chair)
+    if figure is not None:
+        from .human import HumanScene
+
+        scene = HumanScene(skel, settings.width, settings.height, aa, extent, ground_y, chair, figure=figure)
+    else:
+        scene = SCENES[settings.body](skel, settings.width, settings.height, aa, extent, ground_y, chair)
     if info is not None:
         info.update(cam_info)
     return scene, cams
@@ -136,7 +171,7 @@ def _frames(clip: Motion, positions: np.ndarray, settings: RenderSettings, patch
             if not use_patches and cams[t] is not last_cam:
                 scene.set_camera(cams[t])
                 last_cam = cams[t]
-            scene.set_pose(positions[t])
+            scene.set_frame(t, positions[t])
             yield scene.frame_patch(t) if use_patches else scene.frame()
     finally:
         scene.close()
