@@ -32,6 +32,7 @@ class RenderResult:
     n_frames: int
     fps: float
     camera: dict = field(default_factory=dict)  # rule ("fixed"/"follow"), figure height fractions, body
+    body: dict | None = None  # the human body shown: preset, parameters, height, source, licence, citation
 
     @property
     def camera_rule(self) -> str | None:
@@ -77,12 +78,13 @@ def figure_outline(skel, positions: np.ndarray, body: str) -> np.ndarray:
 
 def body_preset_for(motion: Motion, settings: RenderSettings) -> str:
     """The human body preset of a clip: the settings' ``body_preset``, else the one of the Motion's gender
-    (metadata "gender" or "build"), else the default preset."""
+    (metadata "gender" or "build", else its skeleton's build; seed 003: the agent's gender picks its body), else
+    the default preset."""
     from .bodies import BY_GENDER, DEFAULT_PRESET
 
     if settings.body_preset:
         return settings.body_preset
-    gender = motion.metadata.get("gender") or motion.metadata.get("build")
+    gender = motion.metadata.get("gender") or motion.metadata.get("build") or motion.skeleton.build
     return BY_GENDER.get(gender, DEFAULT_PRESET)
 
 
@@ -248,8 +250,13 @@ def render_clip(motion: Motion, out_dir: str | Path, name: str, settings: Render
     finally:
         frames.close()  # closes the offscreen window
     write_png_atomic(poster, out_dir / f"{name}.png")
+    body = None
+    if info.get("body_preset"):
+        from .bodies import load_body
+
+        body = load_body(info["body_preset"]).record()
     return RenderResult(out_dir / f"{name}.mp4", out_dir / f"{name}.webm" if settings.webm else None,
-                        out_dir / f"{name}.png", n, settings.fps, info)
+                        out_dir / f"{name}.png", n, settings.fps, info, body)
 
 
 def clip_files_complete(out_dir: str | Path, name: str, webm: bool) -> bool:
