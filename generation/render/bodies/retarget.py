@@ -30,7 +30,7 @@ from generation.core.motion import Motion
 from generation.core.quaternion import np_qto_matrix
 from generation.core.skeleton import Skeleton
 
-from .skinning import bone_transforms
+from .skinning import Skinner, bone_transforms
 from .store import Body
 
 #: Lowest joint of the Motion's skeleton above its sole, as a fraction of a 1.75 m body: the renderer's floor lies
@@ -223,20 +223,50 @@ def _leg_fit(body: Body, skeleton: Skeleton) -> tuple[Skeleton, float, float]:
     return skeleton.with_offsets(off), float(np.mean(lifts_root)), float(np.mean(lifts_ankle))
 
 
-def body_motion(rig: Rig, motion: Motion) -> Motion:
+def body_motion(rig: Rig, motion: Motion, extra_lift: np.ndarray | None = None) -> Motion:
     """The Motion on the rig's leg skeleton: root raised to the body's hip height, legs solved so each ankle reaches
-    the Motion's own ankle (moved by the ankle-height difference)."""
+    the Motion's own ankle (moved by the ankle-height difference, plus ``extra_lift`` (T, 2) metres per foot)."""
     P = motion.positions()
     lifted = replace(motion, skeleton=rig.leg_skeleton,
                      root_positions=motion.root_positions + np.array([0.0, rig.root_lift, 0.0]))
-    targets = tuple(P[:, leg.ankle] + np.array([0.0, rig.ankle_lift, 0.0]) for leg in legs(motion.skeleton))
+    extra = np.zeros((len(P), 2)) if extra_lift is None else extra_lift
+    targets = tuple(P[:, leg.ankle] + np.array([0.0, rig.ankle_lift, 0.0]) + np.outer(extra[:, s], [0.0, 1.0, 0.0])
+                    for s, leg in enumerate(legs(motion.skeleton)))
     return reach_ankles(lifted, targets, lower_pelvis=True)
 
 
-def pose_transforms(rig: Rig, motion: Motion, feet: bool = True) -> np.ndarray:
-    """(T, B, 3, 4) bone transforms of the body following ``motion`` (feet on the Motion's feet unless ``feet`` is
-    False)."""
-    m = body_motion(rig, motion) if feet else motion
+def _transforms(rig: Rig, m: Motion, root_lift: float = 0.0) -> np.ndarray:
     Q = np_qto_matrix(global_rotations(m.rotations, m.skeleton.parents))          # (T, J, 3, 3)
     D = Q[:, rig.driver] @ rig.align[None]
-    return bone_transforms(rig.body, D, m.root_positions + (0.0 if feet else np.array([0.0, rig.root_lift, 0.0])))
+    return bone_transforms(rig.body, D, m.root_positions + np.array([0.0, root_lift, 0.0]))
+
+
+def sole_heights(rig: Rig, transforms: np.ndarray) -> np.ndarray:
+    """(T, 2) lowest point of the left and right shoe (metres, world y) under ``transforms`` (T, B, 3, 4)."""
+    body = rig.body
+    shoes = np.flatnonzero(body.vertex_region == body.region_names.index("shoes"))
+    pts = Skinner(body).points_many(transforms, shoes)
+    left = body.vertices[shoes, 0] > 0
+    return np.stack([pts[:, left, 1].min(1), pts[:, ~left, 1].min(1)], 1)
+
+
+def pose_transforms(rig: Rig, motion: Motion, feet: bool = True) -> np.ndarray:
+    """(T, B, 3, 4) bone transforms of the body following ``motion``.
+
+    With ``feet`` (default) the ankles land on the Motion's ankles (:func:`body_motion`), and where the body's
+    longer foot would dip its sole below the renderer's floor (a toe rolling over the ball of the foot) that ankle's
+    target is raised by the depth, smoothed over 0.1 s, and the legs solved again."""
+    if not feet:
+        return _transforms(rig, motion, rig.root_lift)
+    m = body_motion(rig, motion)
+    T = _transforms(rig, m)
+    P = motion.positions()
+    floor = P[..., 1].min() - SOLE_BELOW_LOWEST_JOINT * motion.skeleton.height / 1.75
+    depth = np.maximum(floor - sole_heights(rig, T), 0.0)                           # (T, 2)
+    if depth.max() <= 1e-4:
+        return T
+    k = max(1, int(round(0.1 * motion.fps)))
+    depth = np.stack([np.lib.stride_tricks.sliding_window_view(np.pad(d, k, mode="edge"), 2 * k + 1).max(1)
+                      for d in depth.T], 1)
+    m = body_motion(rig, motion, extra_lift=depth)
+    return _transforms(rig, m)
