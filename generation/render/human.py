@@ -25,7 +25,7 @@ REGION_COLOURS = {"top": (0.47, 0.50, 0.55), "trousers": (0.29, 0.30, 0.33), "sh
 SKIN_TONES = {"light": (0.88, 0.73, 0.63), "medium": (0.76, 0.58, 0.46), "tan": (0.63, 0.46, 0.34),
               "dark": (0.42, 0.29, 0.21)}
 FACES = ("neutral", "hidden")
-OUTLINE_STRIDE = 7  # every 7th vertex (about 2,000) outlines the body for framing and patch planning
+OUTLINE_STRIDE = 25  # every 25th vertex (about 550) and each bone's farthest vertex outline the body (framing)
 
 
 @dataclass
@@ -49,6 +49,19 @@ class HumanFigure:
     def heads(self) -> np.ndarray:
         """(T, B, 3) posed bone heads."""
         return posed_heads(self.body, self.transforms)
+
+
+def outline_vertices(body: Body, points: np.ndarray) -> np.ndarray:
+    """Indices of the vertices that outline the body for the camera and patch planning: every
+    :data:`OUTLINE_STRIDE`-th vertex, and per bone the vertex it carries most that lies farthest from its head
+    (fingertips, toe tips, the top of the head, heels, elbows)."""
+    top = body.weight_bones[np.arange(len(points)), np.argmax(body.weights, 1)]
+    far = []
+    for b in range(body.num_bones):
+        mine = np.flatnonzero(top == b)
+        if len(mine):
+            far.append(mine[np.argmax(np.linalg.norm(points[mine] - body.bone_heads[b], axis=1))])
+    return np.unique(np.concatenate([np.arange(0, len(points), OUTLINE_STRIDE), np.asarray(far, dtype=int)]))
 
 
 def smooth_head(body: Body) -> np.ndarray:
@@ -87,7 +100,7 @@ def human_figure(motion: Motion, preset: str, face: str = "neutral", skin_tone: 
         faces = faces[body.face_region != body.region_names.index("eyes")]
     else:
         points = body.vertices
-    index = np.arange(0, len(points), OUTLINE_STRIDE)
+    index = outline_vertices(body, points)
     outline = Skinner(body, points).points_many(transforms, index)
     return HumanFigure(body, points, faces, body_colours(body, skin_tone), transforms, outline, index)
 

