@@ -125,8 +125,8 @@ def seated_side(out_dir: Path) -> None:
         finally:
             scene.close()
     names = list(PRESETS)
-    grid([("seated, side\n" + " / ".join(names[:3]), images[:3]), ("seated, side\n" + " / ".join(names[3:]),
-                                                                     images[3:])],
+    grid([("seated, side:\n" + "\n".join(names[:3]), images[:3]), ("seated, side:\n" + "\n".join(names[3:]),
+                                                                      images[3:])],
          out_dir / "human_seated_side.png", thumb=300)
 
 

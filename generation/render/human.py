@@ -33,8 +33,10 @@ class HumanFigure:
     """One clip's posed body.
 
     Attributes:
-        body: the exported body; points/normals: (V, 3) rest mesh as drawn (the head smoothed for a hidden face).
+        body: the exported body; points: (V, 3) rest mesh as drawn (the head smoothed for a hidden face).
         faces: (F, 3) triangles drawn (no eyes for a hidden face); colours: (V, 3) uint8 per-vertex colour.
+        head: (indices (N,), normals (N, 3)) rest normals that replace the mesh's own there (a hidden face), or
+        None.
         transforms: (T, B, 3, 4) bone transforms per frame; outline: (T, K, 3) posed outline points.
     """
 
@@ -45,6 +47,7 @@ class HumanFigure:
     transforms: np.ndarray
     outline: np.ndarray
     outline_index: np.ndarray
+    head: tuple[np.ndarray, np.ndarray] | None = None
 
     def heads(self) -> np.ndarray:
         """(T, B, 3) posed bone heads."""
@@ -64,9 +67,11 @@ def outline_vertices(body: Body, points: np.ndarray) -> np.ndarray:
     return np.unique(np.concatenate([np.arange(0, len(points), OUTLINE_STRIDE), np.asarray(far, dtype=int)]))
 
 
-def smooth_head(body: Body) -> np.ndarray:
-    """(V, 3) rest vertices with the head (the vertices the ``head`` bone carries most) pressed onto the ellipsoid
-    through its extents: a smooth, featureless head; the change fades out over the lowest 4 cm, into the neck."""
+def smooth_head(body: Body) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """A smooth, featureless head: (V, 3) rest vertices with the head (the vertices the ``head`` bone carries most)
+    pressed onto the ellipsoid through its extents, the change fading out over the lowest 4 cm into the neck; the
+    (N,) indices of the head vertices, and their (N, 3) normals (the ellipsoid's, blended the same way, so folds
+    where ears and eye sockets were pressed flat do not show in the shading)."""
     v = body.vertices.copy()
     top = body.weight_bones[np.arange(len(v)), np.argmax(body.weights, 1)]
     head_bones = [body.bone(n) for n in ("head", "eye.L", "eye.R")]
@@ -79,7 +84,9 @@ def smooth_head(body: Body) -> np.ndarray:
     w = np.clip((hv[:, 1] - lo[1]) / 0.04, 0.0, 1.0)
     w = w * w * (3 - 2 * w)
     v[sel] = hv + w[:, None] * (proj - hv)
-    return v
+    normal = (proj - centre) / radii ** 2
+    normal /= np.linalg.norm(normal, axis=1, keepdims=True)
+    return v, np.flatnonzero(sel), normal * w[:, None]
 
 
 def body_colours(body: Body, skin_tone: str) -> np.ndarray:
@@ -95,14 +102,27 @@ def human_figure(motion: Motion, preset: str, face: str = "neutral", skin_tone: 
     rig = fit_rig(body, motion.skeleton)
     transforms = pose_transforms(rig, motion)
     faces = body.faces
+    colours = body_colours(body, skin_tone)
+    head = None
     if face == "hidden":
-        points = smooth_head(body)
+        points, sel, normals = smooth_head(body)
+        head = (sel, normals)
         faces = faces[body.face_region != body.region_names.index("eyes")]
+        # triangles turned inside out by the pressing (eye sockets, nostrils, the mouth) would show as dark flecks
+        # under two-sided lighting; their outward-facing neighbours cover the same patch of the ellipsoid
+        on_head = np.isin(faces, sel).all(1)
+        tri = points[faces[on_head]]
+        facing = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
+        outward = tri.mean(1) - points[sel].mean(0)
+        keep = np.ones(len(faces), dtype=bool)
+        keep[np.flatnonzero(on_head)[(facing * outward).sum(1) < 0]] = False
+        faces = faces[keep]
+        colours[sel] = np.round(np.array(SKIN_TONES[skin_tone]) * 255).astype(np.uint8)   # no hair, no brows
     else:
         points = body.vertices
     index = outline_vertices(body, points)
     outline = Skinner(body, points).points_many(transforms, index)
-    return HumanFigure(body, points, faces, body_colours(body, skin_tone), transforms, outline, index)
+    return HumanFigure(body, points, faces, colours, transforms, outline, index, head)
 
 
 def seat_fit(figure: HumanFigure, facing: np.ndarray) -> tuple[float, float]:
@@ -136,7 +156,12 @@ class HumanScene(StickFigureScene):
                            np.column_stack([np.full(len(fig.faces), 3), fig.faces]).ravel())
         mesh = mesh.compute_normals(point_normals=True, cell_normals=False, split_vertices=False,
                                     auto_orient_normals=False, consistent_normals=False)
-        self._skinner = Skinner(fig.body, fig.points, np.array(mesh.point_data["Normals"], dtype=float))
+        normals = np.array(mesh.point_data["Normals"], dtype=float)
+        if fig.head is not None:
+            sel, head_normals = fig.head
+            blended = normals[sel] * (1 - np.linalg.norm(head_normals, axis=1, keepdims=True)) + head_normals
+            normals[sel] = blended / np.maximum(np.linalg.norm(blended, axis=1, keepdims=True), 1e-9)
+        self._skinner = Skinner(fig.body, fig.points, normals)
         mesh.point_data["colours"] = fig.colours
         mesh.point_data["Normals"] = self._skinner.normals.copy()
         mesh.point_data.active_normals_name = "Normals"

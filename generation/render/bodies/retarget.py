@@ -38,7 +38,7 @@ from .store import Body
 SOLE_BELOW_LOWEST_JOINT = 0.03
 #: Relaxed finger curl in degrees per phalanx (proximal, middle, distal): thumb, then the four fingers.
 THUMB_CURL_DEG = (6.0, 12.0, 10.0)
-FINGER_CURL_DEG = (22.0, 34.0, 18.0)
+FINGER_CURL_DEG = (16.0, 26.0, 12.0)
 
 
 class RetargetError(ValueError):
