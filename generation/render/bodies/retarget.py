@@ -10,7 +10,8 @@ bone lies on. A bone's world orientation is that joint's world rotation times a 
 - limbs (thigh, shin, foot, upper arm, forearm, hand when the skeleton has one): ``S`` is the shortest rotation
   taking the body's rest segment onto the skeleton's rest segment, chained down the limb (the forearm's rotation
   straightens the elbow about its own hinge after the upper arm's), so limb directions are the Motion's exactly;
-- toes follow the foot, fingers and metacarpals the hand (or the forearm), eyes the head;
+- toes follow the foot, fingers and metacarpals the hand (or the forearm), the head and eyes the neck segment (the
+  skeletons' ``head`` joint ends the chain: its own rotation turns nothing the Motion shows);
 - ``C`` is a relaxed curl of the fingers (about each finger's own bend axis), identity elsewhere.
 
 The body keeps its own proportions, so its feet would not land where the Motion's do: the legs are solved by
@@ -117,7 +118,8 @@ def fit_rig(body: Body, skeleton: Skeleton) -> Rig:
     driver = np.full(B, -1)
     S = np.tile(np.eye(3), (B, 1, 1))
     root = 0
-    neck, head = _need(skeleton, "neck"), _need(skeleton, "head")
+    neck = _need(skeleton, "neck")
+    _need(skeleton, "head")
     # trunk chain root .. neck with each joint's height fraction
     chain, j = [], neck
     while j > 0:
@@ -140,10 +142,10 @@ def fit_rig(body: Body, skeleton: Skeleton) -> Rig:
             f = (H[label][1] - H["root"][1]) / body_span
             k = max(i for i, fc in enumerate(frac) if fc <= f + 0.02)
             set_bone(label, chain[k], np.eye(3))
-        elif base.startswith("neck"):
+        elif base.startswith("neck") or base in ("head", "eye"):
+            # the head turns with the neck segment (neck -> head): the skeletons' head joint ends the chain, and
+            # generators leave its own rotation unconstrained
             set_bone(label, neck, np.eye(3))
-        elif base in ("head", "eye"):
-            set_bone(label, head, np.eye(3))
     for side, sfx in (("left", ".L"), ("right", ".R")):
         hip = _need(skeleton, f"{side}_hip")
         knee = _need(skeleton, f"{side}_knee")
