@@ -139,6 +139,21 @@ def test_feet_stay_on_the_motions_feet(kind, preset):
         assert sole[c].min() < CONTACT_ON_HEIGHT_M
 
 
+@pytest.mark.parametrize("kind", ["walk", "gesture"])
+def test_hands_stay_out_of_the_thighs(kind):
+    """Resting on a seated lap or swinging past a walker's thighs, no hand vertex goes into the thighs or hips in any
+    frame (the body's own proportions put them there before the arms are solved)."""
+    from generation.render.bodies.retarget import HAND_CLEARANCE_M, hand_depths
+
+    motion = prepare(_procedural(kind), RenderSettings(fps=30.0))[0]
+    for preset in ("female", "male-heavy"):
+        rig = fit_rig(load_body(preset), motion.skeleton)
+        before, _ = hand_depths(rig, pose_transforms(rig, motion, hands=False))
+        after, _ = hand_depths(rig, pose_transforms(rig, motion))
+        assert (before > HAND_CLEARANCE_M + 1e-3).any()          # the case arises
+        assert (after <= HAND_CLEARANCE_M + 1e-4).all(), after.max()
+
+
 def test_unknown_preset_or_parameter_is_refused(capsys):
     with pytest.raises(RenderSettingsError, match="field 'body_preset': unknown body preset 'giant'"):
         RenderSettings(body_preset="giant")

@@ -284,6 +284,20 @@ def plant_feet(motion: Motion, contacts: np.ndarray | None = None, floor_y: floa
     return Motion(sk, rot, root, motion.fps, meta)
 
 
+def reach_targets(motion: Motion, chains, targets) -> Motion:
+    """The motion with each two-bone chain (a :class:`Leg`: ``hip`` -> ``knee`` -> ``ankle``, e.g. shoulder -> elbow
+    -> wrist) solved by two-bone IK so its end reaches its target (T, 3), bending in the plane of the chain's own
+    middle joint and keeping the end joint's world rotation (as :func:`plant_feet` solves legs)."""
+    sk = motion.skeleton
+    rot = motion.rotations.copy()
+    P = motion.positions()
+    G = global_rotations(rot, sk.parents)
+    lengths = sk.bone_lengths()
+    for chain, target in zip(chains, targets):
+        _solve_leg(rot, G, P, sk, chain, np.asarray(target, dtype=float), lengths)
+    return Motion(sk, rot, motion.root_positions.copy(), motion.fps, dict(motion.metadata))
+
+
 def reach_ankles(motion: Motion, targets: tuple[np.ndarray, np.ndarray], lower_pelvis: bool = True) -> Motion:
     """The motion with each leg solved by two-bone IK so its ankle reaches ``targets`` (left, right), each (T, 3)
     metres, the knee bending in the plane of the motion's own knee and each foot keeping its world orientation
@@ -310,4 +324,4 @@ def reach_ankles(motion: Motion, targets: tuple[np.ndarray, np.ndarray], lower_p
 
 __all__ = ["BLEND_FRAMES", "CONTACT_OFF_HEIGHT_M", "CONTACT_OFF_SPEED_M_S", "CONTACT_ON_HEIGHT_M",
            "CONTACT_ON_SPEED_M_S", "Leg", "detect_contacts_hysteresis", "global_rotations", "legs", "plant_feet",
-           "reach_ankles"]
+           "reach_ankles", "reach_targets"]

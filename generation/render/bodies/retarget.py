@@ -26,12 +26,12 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from generation.core.foot_contact import global_rotations, legs, reach_ankles
+from generation.core.foot_contact import Leg, global_rotations, legs, reach_ankles, reach_targets
 from generation.core.motion import Motion
 from generation.core.quaternion import np_qto_matrix
 from generation.core.skeleton import Skeleton
 
-from .skinning import Skinner, bone_transforms
+from .skinning import Skinner, bone_transforms, vertex_normals
 from .store import Body
 
 #: Lowest joint of the Motion's skeleton above its sole, as a fraction of a 1.75 m body: the renderer's floor lies
@@ -252,12 +252,14 @@ def sole_heights(rig: Rig, transforms: np.ndarray) -> np.ndarray:
     return np.stack([pts[:, left, 1].min(1), pts[:, ~left, 1].min(1)], 1)
 
 
-def pose_transforms(rig: Rig, motion: Motion, feet: bool = True) -> np.ndarray:
+def pose_transforms(rig: Rig, motion: Motion, feet: bool = True, hands: bool = True) -> np.ndarray:
     """(T, B, 3, 4) bone transforms of the body following ``motion``.
 
     With ``feet`` (default) the ankles land on the Motion's ankles (:func:`body_motion`), and where the body's
     longer foot would dip its sole below the renderer's floor (a toe rolling over the ball of the foot) that ankle's
-    target is raised by the depth, smoothed over 0.1 s, and the legs solved again."""
+    target is raised by the depth, smoothed over 0.1 s, and the legs solved again. With ``hands`` (default) a hand
+    that would go into a thigh or hip (a resting hand on a seated lap) is moved out by two-bone IK of the arm
+    (:func:`hand_depths`)."""
     if not feet:
         return _transforms(rig, motion, rig.root_lift)
     m = body_motion(rig, motion)
@@ -265,10 +267,75 @@ def pose_transforms(rig: Rig, motion: Motion, feet: bool = True) -> np.ndarray:
     P = motion.positions()
     floor = P[..., 1].min() - SOLE_BELOW_LOWEST_JOINT * motion.skeleton.height / 1.75
     depth = np.maximum(floor - sole_heights(rig, T), 0.0)                           # (T, 2)
-    if depth.max() <= 1e-4:
-        return T
-    k = max(1, int(round(0.1 * motion.fps)))
-    depth = np.stack([np.lib.stride_tricks.sliding_window_view(np.pad(d, k, mode="edge"), 2 * k + 1).max(1)
-                      for d in depth.T], 1)
-    m = body_motion(rig, motion, extra_lift=depth)
-    return _transforms(rig, m)
+    if depth.max() > 1e-4:
+        k = max(1, int(round(0.1 * motion.fps)))
+        depth = np.stack([np.lib.stride_tricks.sliding_window_view(np.pad(d, k, mode="edge"), 2 * k + 1).max(1)
+                          for d in depth.T], 1)
+        m = body_motion(rig, motion, extra_lift=depth)
+        T = _transforms(rig, m)
+    return T if not hands else _hands_clear(rig, m, T)
+
+
+#: Hands are kept this far (metres) outside the thighs and hips.
+HAND_CLEARANCE_M = 0.006
+
+
+def hand_depths(rig: Rig, transforms: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """How deep each hand is in the thighs and hips per frame: depths (T, 2) metres (left, right; 0 when clear)
+    and the unit directions (T, 2, 3) out of them (the surface normal at the deepest point)."""
+    from scipy.spatial import cKDTree
+
+    body = rig.body
+    top = body.weight_bones[np.arange(len(body.vertices)), np.argmax(body.weights, 1)]
+    labels = body.bone_labels
+    thigh = np.flatnonzero(np.isin(top, [i for i, n in enumerate(labels) if n.startswith(("upperleg", "pelvis"))]))
+    sk = Skinner(body, rest_normals=vertex_normals(body.vertices, body.faces))
+    tp, tn = sk.pose_many(transforms, thigh)
+    depth = np.zeros((len(transforms), 2))
+    direction = np.tile([0.0, 1.0, 0.0], (len(transforms), 2, 1))
+    for s, sfx in enumerate((".L", ".R")):
+        bones = [i for i, n in enumerate(labels) if n.endswith(sfx) and n.startswith(("wrist", "finger", "metacarpal"))]
+        hp = sk.points_many(transforms, np.flatnonzero(np.isin(top, bones)))
+        for t in range(len(transforms)):
+            d, i = cKDTree(tp[t]).query(hp[t], distance_upper_bound=0.06)
+            ok = np.isfinite(d)
+            if not ok.any():
+                continue
+            inside = -((hp[t][ok] - tp[t][i[ok]]) * tn[t][i[ok]]).sum(1)
+            k = int(np.argmax(inside))
+            if inside[k] > -HAND_CLEARANCE_M:
+                depth[t, s] = inside[k] + HAND_CLEARANCE_M
+                direction[t, s] = tn[t][i[ok][k]]
+    return depth, direction
+
+
+def _hands_clear(rig: Rig, m: Motion, T: np.ndarray, passes: int = 4) -> np.ndarray:
+    """Transforms with each hand moved out of the thighs and hips: the wrist is pushed out along the surface normal
+    by the hand's depth (smoothed over 0.2 s, never less than needed) and the arm solved by two-bone IK."""
+    sk = m.skeleton
+    chains = []
+    for side in ("left", "right"):
+        shoulder, elbow = sk.index(f"{side}_shoulder"), sk.index(f"{side}_elbow")
+        wrist = _joint(sk, f"{side}_hand", f"{side}_wrist")
+        chains.append(Leg(shoulder, elbow, wrist, wrist))
+    k = max(1, int(round(0.2 * m.fps)))
+    # a body that stays in place (seated) rests its hands on its lap: lift them; a walker's swinging hands brush the
+    # side of the thighs: push them out along the surface
+    in_place = float(np.ptp(m.root_positions[:, [0, 2]], axis=0).max()) < 0.5
+    for _ in range(passes):
+        depth, direction = hand_depths(rig, T)
+        if in_place:
+            direction[:] = (0.0, 1.0, 0.0)
+        if depth.max() <= 1e-4:
+            break
+        P = m.positions()
+        push = depth[..., None] * direction                                          # (T, 2, 3)
+        for s in range(2):
+            mag = np.lib.stride_tricks.sliding_window_view(np.pad(depth[:, s], k, mode="edge"), 2 * k + 1).max(1)
+            unit = push[:, s] / np.maximum(depth[:, s, None], 1e-9)
+            unit[depth[:, s] <= 0] = direction[depth[:, s] <= 0, s]
+            push[:, s] = unit * mag[:, None]
+        targets = [P[:, c.ankle] + push[:, s] for s, c in enumerate(chains)]
+        m = reach_targets(m, chains, targets)
+        T = _transforms(rig, m)
+    return T

@@ -25,6 +25,16 @@ def bone_transforms(body: Body, orientations: np.ndarray, root_head: np.ndarray)
     return np.concatenate([G, t[..., None]], axis=-1)
 
 
+def vertex_normals(points: np.ndarray, faces: np.ndarray) -> np.ndarray:
+    """(V, 3) unit vertex normals: the area-weighted sum of the faces' normals around each vertex."""
+    tri = points[faces]
+    fn = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
+    n = np.zeros_like(points, dtype=float)
+    for k in range(3):
+        np.add.at(n, faces[:, k], fn)
+    return n / np.maximum(np.linalg.norm(n, axis=1, keepdims=True), 1e-12)
+
+
 def posed_heads(body: Body, transforms: np.ndarray) -> np.ndarray:
     """(T, B, 3) bone head positions under ``transforms`` (T, B, 3, 4)."""
     return np.einsum("tbij,bj->tbi", transforms[..., :3], body.bone_heads) + transforms[..., 3]
@@ -58,6 +68,15 @@ class Skinner:
         n = np.einsum("vij,vj->vi", M[:, :, :3], self.normals)
         n /= np.maximum(np.linalg.norm(n, axis=1, keepdims=True), 1e-12)
         return pts, n
+
+    def pose_many(self, transforms: np.ndarray, index: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(T, N, 3) posed points and (T, N, 3) unit normals of the rows ``index`` (needs rest normals)."""
+        T = len(transforms)
+        coeffs = transforms.reshape(T, -1, 12).transpose(1, 0, 2).reshape(-1, T * 12)
+        M = np.asarray(self.W[index] @ coeffs).reshape(len(index), T, 3, 4)
+        pts = np.einsum("ntij,nj->tni", M[..., :3], self.points[index]) + M[..., 3].transpose(1, 0, 2)
+        n = np.einsum("ntij,nj->tni", M[..., :3], self.normals[index])
+        return pts, n / np.maximum(np.linalg.norm(n, axis=-1, keepdims=True), 1e-12)
 
     def points_many(self, transforms: np.ndarray, index: np.ndarray | None = None) -> np.ndarray:
         """(T, N, 3) posed points (all, or the rows ``index``) for transforms (T, B, 3, 4)."""
