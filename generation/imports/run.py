@@ -31,6 +31,7 @@ from pathlib import Path, PurePosixPath
 
 from generation.core.digest import file_sha256
 from generation.plans.catalogue import write_clips_csv
+from generation.render.bodies import load_body
 from generation.render.settings import RenderSettings
 from protocol.vocabulary import CLIP_COLUMNS, IMPORTED
 
@@ -186,8 +187,6 @@ def _stage(row: ManifestRow, rec: dict, stage: Path, settings: ImportSettings) -
     rec["duration_s"] = m.duration_s
     rec["qa"], rec["qa_flag"] = m.qa, m.qa_flag
     if (m.camera or {}).get("body_preset"):  # the human body shown, with its licence and citation
-        from generation.render.bodies import load_body
-
         rec["body"] = load_body(m.camera["body_preset"]).record()
     meta.update(action="render", n_frames=m.n_frames, fps=rs.fps, camera=m.camera, render=rs.content_dict(),
                 motion=m.motion_metadata, **{"import": m.import_row})

@@ -15,9 +15,11 @@ import numpy as np
 from generation.core.motion import Motion
 from protocol.vocabulary import GENDERS
 
+from .bodies import BY_GENDER, DEFAULT_PRESET, load_body
 from .body import head_top
 from .camera import body_outline, choose_cameras, facing_direction
 from .encode import VideoWriter, write_png_atomic
+from .human import HumanScene, human_figure, seat_fit
 from .scene import GROUND_MARGIN_M, SCENES, chair_boxes
 from .settings import RenderSettings
 
@@ -80,8 +82,6 @@ def body_preset_for(motion: Motion, settings: RenderSettings) -> str:
     """The human body preset of a clip: the settings' ``body_preset``, else the one of the Motion's gender
     (metadata "gender" or "build", else its skeleton's build; seed 003: the agent's gender picks its body), else
     the default preset."""
-    from .bodies import BY_GENDER, DEFAULT_PRESET
-
     if settings.body_preset:
         return settings.body_preset
     gender = motion.metadata.get("gender") or motion.metadata.get("build") or motion.skeleton.build
@@ -90,8 +90,6 @@ def body_preset_for(motion: Motion, settings: RenderSettings) -> str:
 
 def human_figure_for(motion: Motion, settings: RenderSettings):
     """The posed human body of a prepared clip (:class:`generation.render.human.HumanFigure`)."""
-    from .human import human_figure
-
     return human_figure(motion, body_preset_for(motion, settings), settings.face, settings.skin_tone)
 
 
@@ -115,8 +113,6 @@ def plan_cameras(motion: Motion, positions: np.ndarray, settings: RenderSettings
         facing = facing_direction(motion.rotations[0, 0])
         seat = None
         if figure is not None:
-            from .human import seat_fit
-
             seat = seat_fit(figure, facing)
         chair = chair_boxes(positions, skel, facing, ground_y, seat)
         if settings.body != "points":
@@ -152,8 +148,6 @@ def build_scene(motion: Motion, positions: np.ndarray, settings: RenderSettings,
     aa = anti_aliasing_for(settings.anti_aliasing, cams, cam_info["seated"])
     cam_info["anti_aliasing"] = aa
     if figure is not None:
-        from .human import HumanScene
-
         scene = HumanScene(skel, settings.width, settings.height, aa, extent, ground_y, chair, figure=figure)
     else:
         scene = SCENES[settings.body](skel, settings.width, settings.height, aa, extent, ground_y, chair)
@@ -252,8 +246,6 @@ def render_clip(motion: Motion, out_dir: str | Path, name: str, settings: Render
     write_png_atomic(poster, out_dir / f"{name}.png")
     body = None
     if info.get("body_preset"):
-        from .bodies import load_body
-
         body = load_body(info["body_preset"]).record()
     return RenderResult(out_dir / f"{name}.mp4", out_dir / f"{name}.webm" if settings.webm else None,
                         out_dir / f"{name}.png", n, settings.fps, info, body)

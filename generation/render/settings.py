@@ -7,6 +7,8 @@ from __future__ import annotations
 
 from dataclasses import asdict, dataclass, fields
 
+from .bodies import BodyPresetError, available_presets
+
 #: Bump when the look of clips changes for the same settings (scene, camera placement): it is part of
 #: every clip's content hash, so changed clips get new files instead of stale ones being reused.
 RENDERER_VERSION = "5"  # 3: one merged mannequin mesh, opaque shadow, anti_aliasing "auto"; 4: neck reaches the head;
@@ -90,8 +92,6 @@ class RenderSettings:
         if self.body not in BODIES:
             raise RenderSettingsError(f"field 'body': expected one of {list(BODIES)}, got {self.body!r}")
         if self.body_preset is not None:
-            from .bodies import BodyPresetError, available_presets  # numpy only
-
             if not isinstance(self.body_preset, str) or self.body_preset not in available_presets():
                 raise RenderSettingsError(str(BodyPresetError(
                     f"field 'body_preset': unknown body preset {self.body_preset!r}; expected one of "

@@ -13,6 +13,7 @@ import argparse
 import sys
 from pathlib import Path
 
+from .build import anny_model, export_body  # anny itself is imported by anny_model() only
 from .presets import PRESETS, BodyPresetError, check_name, check_parameters
 from .store import BODY_DIR, available_presets, load_body_file
 
@@ -58,8 +59,6 @@ def main(argv: list[str] | None = None) -> int:
     except BodyPresetError as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 2
-    from .build import anny_model, export_body  # anny only now
-
     model = anny_model()
     for name, params in jobs.items():
         body = export_body(model, name, params)
