@@ -234,3 +234,25 @@ def test_bodies_build_needs_anny(tmp_path):
                          env={**os.environ, "PYTHONPATH": str(ROOT)})
     assert out.returncode != 0 and "needs anny" in out.stderr + out.stdout
     assert not list(tmp_path.iterdir())
+
+
+def test_the_body_changes_clip_ids_not_motions():
+    """Entries that differ only in their body get different clip ids (the look is in the content hash) but the same
+    motion, to the bit."""
+    import hashlib
+
+    from generation.pipeline.jobs import plan_jobs
+    from generation.plans.clipgen import make_motion
+
+    walk = {"generator": "procedural_walk", "emotion": [1, 0, 0, 0], "seed": 4}
+    plan = validate_plan({"name": "t", "render": {"fps": 10, "duration_s": 1.0}, "clips": [
+        dict(walk, id="human"), dict(walk, id="older", render={"body_preset": "male-older"}),
+        dict(walk, id="mannequin", render={"body": "mannequin"})]})
+    jobs, failures = plan_jobs(plan)
+    assert not failures and len({j.clip_id for j in jobs}) == 3
+
+    def digest(job):
+        m = make_motion(job.run_entry)
+        return hashlib.sha256(m.rotations.tobytes() + m.root_positions.tobytes()).hexdigest()
+
+    assert len({digest(j) for j in jobs}) == 1
