@@ -22,8 +22,9 @@ PRESETS: dict[str, dict[str, float]] = {
     "male": {"gender": 0.0, "age": 0.70, "height": 0.35},
     "female-older": {"gender": 1.0, "age": 1.0, "height": 0.40},
     "male-older": {"gender": 0.0, "age": 1.0, "height": 0.35},
-    "female-heavy": {"gender": 1.0, "age": 0.70, "height": 0.40, "weight": 0.90},
-    "male-heavy": {"gender": 0.0, "age": 0.70, "height": 0.35, "weight": 0.90},
+    # anny's weight alone barely changes the build (1-2 cm); with low muscle it gives a heavy body (+5 cm at the waist)
+    "female-heavy": {"gender": 1.0, "age": 0.70, "height": 0.40, "weight": 1.0, "muscle": 0.15},
+    "male-heavy": {"gender": 0.0, "age": 0.70, "height": 0.35, "weight": 1.0, "muscle": 0.15},
 }
 #: The preset a gesture or gait gets for a gender when the plan names none (seed 003: the agent's gender picks the
 #: body).
