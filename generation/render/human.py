@@ -25,7 +25,7 @@ REGION_COLOURS = {"top": (0.47, 0.50, 0.55), "trousers": (0.29, 0.30, 0.33), "sh
 SKIN_TONES = {"light": (0.88, 0.73, 0.63), "medium": (0.76, 0.58, 0.46), "tan": (0.63, 0.46, 0.34),
               "dark": (0.42, 0.29, 0.21)}
 FACES = ("neutral", "hidden")
-OUTLINE_STRIDE = 25  # every 25th vertex (about 550) and each bone's farthest vertex outline the body (framing)
+OUTLINE_STRIDE = 25  # every 25th vertex and each bone's farthest one (about 370) outline the body (framing)
 
 
 @dataclass
