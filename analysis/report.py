@@ -26,7 +26,20 @@ import pandas as pd
 
 from protocol.vocabulary import MODALITIES
 
-from . import agreement, emotion, exclusion, likert, mixed, naturalness, norms, participants, recognition, themes, vad
+from . import (
+    agreement,
+    by_body,
+    emotion,
+    exclusion,
+    likert,
+    mixed,
+    naturalness,
+    norms,
+    participants,
+    recognition,
+    themes,
+    vad,
+)
 from . import figures as figure_mod
 from . import viewing as viewing_mod
 from .io import StudyData, load_study
@@ -35,7 +48,7 @@ TABLE_KEYS = ("exclusions", "exclusion_counts", "viewing_incomplete", "gait_emot
               "likert_consistency_ad", "likert_distribution",
               "naturalness", "naturalness_test", "vad_pearson", "theme_anova", "theme_descriptives", "theme_inversion",
               "neutral_validation", "demographic_differences", "agreement",
-              "mixed_models", "clip_norms")
+              "mixed_models", "clip_norms", "by_body")
 """Keys of report.json holding a list of records (one CSV each). ``participants``, ``viewing`` and ``meta`` are
 objects."""
 SCREENING_KEYS = ("exclusions", "exclusion_counts", "viewing_incomplete")
@@ -100,6 +113,9 @@ METHODS = {
                     "components of a single group. Theme: rating ~ weight * n_features (centred, numeric) per "
                     "theme; Likert: value ~ dominant intended emotion (reference neutral) per feature. Wald z "
                     f"tests; at most {mixed.MAX_PARTICIPANTS} participants per model (seeded random sample).",
+    "by_body": "Per body preset (clips.csv body) and measure: gait_emotion / gesture_emotion = overall hit rate "
+               "(confusion matrix trace / total, k selected labels 1/k each) and Cohen's kappa; naturalness = share "
+               "of ratings >= 3 and mean rating; n = answers. Clips without a body are left out.",
 }
 
 def exclusion_method(rules: dict) -> str:
@@ -149,6 +165,7 @@ TITLES = {
     "agreement": "Agreement between participants: ICC of ratings, Fleiss' kappa of choices",
     "mixed_models": "Mixed models with crossed random intercepts (participant, clip) beside the papers' tests",
     "clip_norms": "Per-clip norms: perceived shares, intended share with its Wilson interval, entropy",
+    "by_body": "Recognition and naturalness by the human body shown (clips.csv body)",
 }
 
 
@@ -172,6 +189,7 @@ def analyse(data: StudyData, alpha: float = 0.05, permutations: int = 0) -> tupl
         "agreement": agreement.agreement(r, c),
         "mixed_models": mixed.mixed_models(r, c),
         "clip_norms": norms.clip_norms(r, c),
+        "by_body": by_body.by_body(r, c),
     }
     extras = {"participants": participants.participant_summary(p, r), "vad_pairs": vad.vad_pairs(r, c),
               "recognition": {"gait_emotion": recognition.gait_recognition(r, c, alpha),
@@ -477,7 +495,8 @@ FIG_FOR_TABLE = {"clip_norms": tuple(f"fig_clip_norms_{m}" for m in MODALITIES),
                  "theme_descriptives": "fig_theme_ratings", "theme_inversion": "fig_inversion"}
 MAX_HTML_ROWS = 60
 EMPTY_TABLE_HTML = {"exclusions": "<p>No participant excluded.</p>", "exclusion_counts": "<p>Nothing removed.</p>",
-                    "viewing_incomplete": "<p>None (or no viewing.csv).</p>"}
+                    "viewing_incomplete": "<p>None (or no viewing.csv).</p>",
+                    "by_body": "<p>No clip names a human body (clips.csv without a body column).</p>"}
 
 
 def _inline_svg(path: str) -> str:
