@@ -23,6 +23,7 @@ from protocol.vocabulary import (
     ANSWER_QUESTIONS,
     ATTENTION_CHECK,
     ATTENTION_COLUMNS,
+    CLIP_BODY_COLUMNS,
     CLIP_COLUMNS,
     CLIP_MODALITIES,
     CLIP_PROVENANCE_COLUMNS,
@@ -209,11 +210,15 @@ def read_clips(src) -> pd.DataFrame:
     col.add_mask(df, bad_label, "emotion_label",
                  lambda v: f"{v!r} is not an NRC-VAD category ({', '.join(GESTURE_EMOTIONS)})")
     _read_qa_columns(df, out, col)
+    for c in CLIP_BODY_COLUMNS:  # the human body preset a clip shows (blank for the other looks)
+        if c in df.columns:
+            out[c] = df[c].fillna("").astype(str).str.strip().to_numpy()
     if col.total:
         raise ValidationError(col.problems, col.total)
     out = out.set_index("clip_id", drop=False)
     out.attrs["ignored_columns"] = [c for c in df.columns if c not in CLIP_COLUMNS and c not in QA_COLUMNS
-                                    and c not in CLIP_PROVENANCE_COLUMNS and c != "_line"]
+                                    and c not in CLIP_PROVENANCE_COLUMNS and c not in CLIP_BODY_COLUMNS
+                                    and c != "_line"]
     return out
 
 

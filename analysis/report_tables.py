@@ -21,7 +21,7 @@ import pandas as pd
 
 from protocol.vocabulary import MODALITIES
 
-from . import agreement, emotion, exclusion, likert, mixed, naturalness, norms, participants, themes, vad
+from . import agreement, by_body, emotion, exclusion, likert, mixed, naturalness, norms, participants, themes, vad
 from . import figures as figure_mod
 
 
@@ -351,3 +351,10 @@ register_table(ReportTable(
     "of the section; mean and n of the clip's naturalness answers. Written as clip_norms.csv (docs/study.md).",
     compute=lambda d: norms.clip_norms(d.responses, d.clips),
     figures=tuple(_clip_norm_figure(m) for m in MODALITIES)))
+register_table(ReportTable(
+    "by_body", "Recognition and naturalness by the human body shown (clips.csv body)",
+    "Per body preset (clips.csv body) and measure: gait_emotion / gesture_emotion = overall hit rate (confusion "
+    "matrix trace / total, k selected labels 1/k each) and Cohen's kappa; naturalness = share of ratings >= 3 and "
+    "mean rating; n = answers. Clips without a body are left out.",
+    compute=lambda d: by_body.by_body(d.responses, d.clips),
+    empty_html="<p>No clip names a human body (clips.csv without a body column).</p>"))

@@ -2,9 +2,10 @@
 
     python -m benchmarks.bench_render speed [--frames 300] [--aa auto none fxaa msaa ssaa2] [--procs 1 2]
                                             [--motion walk gesture] [--patches 1 0]
-                                            [--body mannequin stick points] [--width 1280 --height 720]
+                                            [--body human mannequin stick points] [--width 1280 --height 720]
     python -m benchmarks.bench_render sheet [--out docs/img/render_contact_sheet.png]
     python -m benchmarks.bench_render plans [--plans seed000 seed003 seed004] [--sample 6 10 12] [--workers 2]
+                                            [--body human|mannequin]
 
 ``speed`` renders a 10 s procedural walk (21 joints, a loop of 3 m radius) and/or a seated procedural gesture
 (23 joints, on a chair) at 1280x720 (``--width/--height``) with each ``--body`` to H.264 and reports
@@ -220,6 +221,8 @@ def plans(args) -> list[dict]:
         k = n if not sample or sample >= n else sample
         step = n / k
         picked = tuple(plan.entries[int(i * step)] for i in range(k))
+        if args.body:  # every entry in this look (the plan's own otherwise)
+            picked = tuple(replace(e, render=replace(e.render, body=args.body)) for e in picked)
         sub = replace(plan, entries=picked)
         with tempfile.TemporaryDirectory(prefix="bench_plan_") as tmp:
             c0, t0, load = _cpu(), time.perf_counter(), os.getloadavg()[0]
@@ -247,7 +250,8 @@ def main() -> None:
     s.add_argument("--frames", type=int, default=300)
     s.add_argument("--width", type=int, default=1280)
     s.add_argument("--height", type=int, default=720)
-    s.add_argument("--body", nargs="+", default=["mannequin", "stick"], choices=["mannequin", "stick", "points"])
+    s.add_argument("--body", nargs="+", default=["human", "mannequin"],
+                   choices=["human", "mannequin", "stick", "points"])
     s.add_argument("--aa", nargs="+", default=["auto"])
     s.add_argument("--procs", nargs="+", type=int, default=[1])
     s.add_argument("--motion", nargs="+", default=["walk", "gesture"], choices=["walk", "gesture"])
@@ -262,6 +266,8 @@ def main() -> None:
     q.add_argument("--sample", type=int, nargs="+", default=[12],
                    help="entries rendered per plan (0 = all), one number for all plans or one per plan")
     q.add_argument("--workers", type=int, default=2)
+    q.add_argument("--body", default=None, choices=["human", "mannequin", "stick", "points"],
+                   help="render every entry in this look (default: the plan's own)")
     for x in (s, c, q):
         x.add_argument("--json", default=None)
     args = p.parse_args()

@@ -225,6 +225,11 @@ CLIP_PROVENANCE_COLUMNS = ("title", "licence", "citation")
 """Optional extra columns of clips.csv after the quality columns: a clip's title and the licence and citation of
 what it was made from (imported files, captured data)."""
 
+CLIP_BODY_COLUMNS = ("body",)
+"""Optional extra column of clips.csv after the provenance columns: the human body preset the clip shows
+(``generation/data/bodies/<preset>.npz``; blank for the mannequin, stick and point-light looks). The clip's record
+keeps the body's parameters, licence and citation (``record["body"]``)."""
+
 CLIP_FLOAT_COLUMNS = (*GAIT_EMOTIONS, *FINAL_EMOTION_COLUMNS, *VAD_DIMENSIONS, "weight", "duration_s")
 CLIP_INT_COLUMNS = ("n_features",)
 

@@ -9,6 +9,7 @@ the same clips can take spares too; the planner then gives fewer checks, never a
 from __future__ import annotations
 
 from protocol.pools import PoolError
+from protocol.section_types import find_section_type
 
 from .catalogue import section_queryset
 from .models import Clip, Section
@@ -17,11 +18,13 @@ from .pool_cache import practice_modality
 
 def rated_per_participant(section: Section, pool_size: int) -> int:
     """How many clips of its pool one participant rates in ``section`` (0 = the whole pool; naturalness: the
-    generated + source counts when it sets them)."""
+    generated + source counts when it sets them: a type's sub-pools, each counted by ``n_<sub-pool>``)."""
     options = section.options if isinstance(section.options, dict) else {}
     k = section.clips_per_participant
-    if section.section_type == "naturalness" and ("n_generated" in options or "n_source" in options):
-        k = max(k, int(options.get("n_generated", 0) or 0) + int(options.get("n_source", 0) or 0))
+    spec = find_section_type(section.section_type)
+    halves = [f"n_{half}" for half in (spec.sub_pools if spec else ())]
+    if any(key in options for key in halves):
+        k = max(k, sum(int(options.get(key, 0) or 0) for key in halves))
     return pool_size if k <= 0 else min(k, pool_size)
 
 

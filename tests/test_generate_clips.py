@@ -9,7 +9,7 @@ import yaml
 from django.core.management import CommandError, call_command
 
 from generation.plans.catalogue import CLIP_COLUMNS, check_catalogue, read_clips_csv
-from protocol.vocabulary import CLIP_PROVENANCE_COLUMNS, QA_COLUMNS
+from protocol.vocabulary import CLIP_BODY_COLUMNS, CLIP_PROVENANCE_COLUMNS, QA_COLUMNS
 
 TINY_RENDER = {"width": 160, "height": 120, "fps": 10, "duration_s": 1.0}
 CLIPS = [
@@ -64,7 +64,8 @@ def test_plan_renders_once_then_nothing(media, tmp_path):
     assert check_catalogue(csv_path, clips_dir) == []
     rows = read_clips_csv(csv_path)
     assert len(rows) == 4
-    assert csv_path.read_text().splitlines()[0] == ",".join((*CLIP_COLUMNS, *QA_COLUMNS, *CLIP_PROVENANCE_COLUMNS))
+    assert csv_path.read_text().splitlines()[0] == ",".join((*CLIP_COLUMNS, *QA_COLUMNS, *CLIP_PROVENANCE_COLUMNS,
+                                                             *CLIP_BODY_COLUMNS))
     assert Clip.objects.count() == 4
     for row in rows:
         clip = Clip.objects.get(clip_id=row["clip_id"])
@@ -77,6 +78,13 @@ def test_plan_renders_once_then_nothing(media, tmp_path):
     assert by_entry["walk_transition"]["sad"] == 1.0 and by_entry["walk_transition"]["final_happy"] == 1.0
     assert by_entry["source_walk"]["origin"] == "source" and by_entry["source_walk"]["happy"] is None
     assert by_entry["gesture_sad"]["emotion_label"] == "sad" and by_entry["gesture_sad"]["valence"] == 0.225
+    # The human body is a clip field: the gesture's gender (female by default) picks its body, walks get the male one;
+    # every record names the body's parameters, licence and citation.
+    assert by_entry["gesture_sad"]["body"] == "female" and by_entry["walk_happy"]["body"] == "male"
+    for row in rows:
+        record = json.loads((media / "clip_records" / f"{row['clip_id']}.json").read_text())
+        assert record["body"]["preset"] == row["body"]
+        assert "CC0-1.0" in record["body"]["licence"]["assets"] and "2511.03589" in record["body"]["citation"]
     # Fallbacks are recorded, never passed off as the network's output (its weights are not shipped in tests).
     if happy.metadata["generator"] == "procedural_walk":
         assert happy.metadata["fallback_for"] == "gait_net" and happy.metadata["synthetic"] is True

@@ -13,7 +13,7 @@ from generation.plans.schema import PlanError, validate_plan
 from generation.quality import QAThresholdError, evaluate, failed_checks, motion_metrics, resolve_thresholds
 from generation.quality.metrics import bone_error_mm, mean_jerk
 from generation.quality.observer import GaitObserver
-from protocol.vocabulary import CLIP_COLUMNS, CLIP_PROVENANCE_COLUMNS, QA_COLUMNS, QA_THRESHOLDS
+from protocol.vocabulary import CLIP_BODY_COLUMNS, CLIP_COLUMNS, CLIP_PROVENANCE_COLUMNS, QA_COLUMNS, QA_THRESHOLDS
 from tests.test_render import seated, swinging_walk
 
 
@@ -115,7 +115,7 @@ def test_clips_csv_has_qa_columns_after_the_public_ones(tmp_path):
     path = tmp_path / "clips.csv"
     write_clips_csv([_record("a"), _record("b", "foot_skate", 9.0)], path)
     header = path.read_text().splitlines()[0].split(",")
-    assert tuple(header) == (*CLIP_COLUMNS, *QA_COLUMNS, *CLIP_PROVENANCE_COLUMNS)
+    assert tuple(header) == (*CLIP_COLUMNS, *QA_COLUMNS, *CLIP_PROVENANCE_COLUMNS, *CLIP_BODY_COLUMNS)
     rows = {r["clip_id"]: r for r in read_clips_csv(path)}
     assert rows["b"]["qa_flag"] == "foot_skate" and rows["b"]["qa_foot_skate_cm_s"] == 9.0
     assert rows["a"]["qa_flag"] == "" and rows["a"]["qa_observed"] == "happy"

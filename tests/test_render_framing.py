@@ -41,16 +41,18 @@ def _decode_ffmpeg(path) -> list[np.ndarray]:
     return [np.frombuffer(buf, np.uint8).reshape(h, w, 3) for buf in reader]
 
 
-def test_defaults_are_mannequin_720p_auto_camera():
+def test_defaults_are_human_720p_auto_camera():
     s = RenderSettings()
-    assert (s.width, s.height, s.body, s.camera) == (1280, 720, "mannequin", "auto")
-    assert s.content_dict()["body"] == "mannequin"  # the look is part of every clip's hash
+    assert (s.width, s.height, s.body, s.camera) == (1280, 720, "human", "auto")
+    assert (s.body_preset, s.face, s.skin_tone) == (None, "neutral", "medium")
+    assert s.content_dict()["body"] == "human"  # the look is part of every clip's hash
+    assert {"body_preset", "face", "skin_tone"} <= set(s.content_dict())
 
 
 def test_body_choice_is_validated():
     with pytest.raises(RenderSettingsError, match="field 'body'"):
         RenderSettings(body="avatar")
-    for body in ("mannequin", "stick", "points"):
+    for body in ("human", "mannequin", "stick", "points"):
         assert RenderSettings.from_dict({"body": body}).body == body
     walk = {"id": "w", "generator": "procedural_walk", "emotion": [1, 0, 0, 0]}
     with pytest.raises(PlanError, match="field 'render': field 'body'"):
@@ -105,7 +107,7 @@ def long_walk(T: int = 20, fps: float = 10.0) -> Motion:
 @pytest.mark.parametrize("motion_fn, kind, need", [(long_walk, "walk", 0.50), (seated, "seated", 0.60)])
 def test_framing_measured_in_decoded_video(tmp_path, motion_fn, kind, need):
     """Render (mannequin, 16:9, auto camera), decode the MP4, measure the figure's height per frame."""
-    settings = RenderSettings(width=256, height=144, fps=10, duration_s=2.0)
+    settings = RenderSettings(width=256, height=144, fps=10, duration_s=2.0, body="mannequin")
     result = render_clip(motion_fn(), tmp_path, kind, settings)
     assert result.camera["rule"] == ("follow" if kind == "walk" else "fixed")
     assert result.camera["min_figure_fraction"] >= need
@@ -119,6 +121,29 @@ def test_framing_measured_in_decoded_video(tmp_path, motion_fn, kind, need):
     assert min(fractions) >= need, fractions
     # The measured heights agree with the camera's projected outline (which pads the body a little).
     assert min(fractions) <= result.camera["max_figure_fraction"] + 0.03
+
+
+def _human_mask(img: np.ndarray) -> np.ndarray:
+    """Pixels of the human body's skin, hair, trousers and shoes: warm (skin) or dark and not bluish (the floor,
+    grid lines and shadow are light neutral greys, the sky bluish white)."""
+    r, g, b = (img[..., k].astype(int) for k in range(3))
+    return ((r - b) > 30) | ((np.maximum(np.maximum(r, g), b) < 100) & (b - r < 12))
+
+
+def test_human_framing_measured_in_decoded_video(tmp_path):
+    """The human body, head to shoes, fills at least half the frame height in every frame of a long walk, from the
+    first frame on, and never touches the border."""
+    settings = RenderSettings(width=256, height=144, fps=10, duration_s=2.0)
+    result = render_clip(long_walk(), tmp_path, "human", settings)
+    assert result.camera["body"] == "human" and result.camera["body_preset"] == "male"
+    assert result.camera["min_figure_fraction"] >= 0.5
+    fractions = []
+    for f in _decode_ffmpeg(result.mp4):
+        frac, touches = _height_fraction(f, _human_mask)
+        assert not touches, "the whole body stays in frame"
+        fractions.append(frac)
+    assert min(fractions) >= 0.5, fractions
+    assert max(fractions) <= result.camera["max_figure_fraction"] + 0.03
 
 
 def test_follow_camera_moves_smoothly(tmp_path):

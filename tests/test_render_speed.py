@@ -14,7 +14,8 @@ def test_merged_mannequin_poses_are_not_cumulative():
     """Setting a pose twice gives the same points and normals whatever was set in between (the merged mesh is
     rewritten from the rest-pose buffers, never from its own last state)."""
     motion = swinging_walk(T=12, fps=10.0)
-    settings = RenderSettings(width=160, height=120, fps=10.0, duration_s=1.2, anti_aliasing="none")
+    settings = RenderSettings(width=160, height=120, fps=10.0, duration_s=1.2, anti_aliasing="none",
+                              body="mannequin")
     clip, pos = clip_mod.prepare(motion, settings)
     scene, _ = clip_mod.build_scene(clip, pos, settings)
     try:

@@ -284,5 +284,44 @@ def plant_feet(motion: Motion, contacts: np.ndarray | None = None, floor_y: floa
     return Motion(sk, rot, root, motion.fps, meta)
 
 
+def reach_targets(motion: Motion, chains, targets) -> Motion:
+    """The motion with each two-bone chain (a :class:`Leg`: ``hip`` -> ``knee`` -> ``ankle``, e.g. shoulder -> elbow
+    -> wrist) solved by two-bone IK so its end reaches its target (T, 3), bending in the plane of the chain's own
+    middle joint and keeping the end joint's world rotation (as :func:`plant_feet` solves legs)."""
+    sk = motion.skeleton
+    rot = motion.rotations.copy()
+    P = motion.positions()
+    G = global_rotations(rot, sk.parents)
+    lengths = sk.bone_lengths()
+    for chain, target in zip(chains, targets):
+        _solve_leg(rot, G, P, sk, chain, np.asarray(target, dtype=float), lengths)
+    return Motion(sk, rot, motion.root_positions.copy(), motion.fps, dict(motion.metadata))
+
+
+def reach_ankles(motion: Motion, targets: tuple[np.ndarray, np.ndarray], lower_pelvis: bool = True) -> Motion:
+    """The motion with each leg solved by two-bone IK so its ankle reaches ``targets`` (left, right), each (T, 3)
+    metres, the knee bending in the plane of the motion's own knee and each foot keeping its world orientation
+    (as :func:`plant_feet` solves its legs). With ``lower_pelvis`` the root is lowered, smoothly, where a target is
+    out of a leg's reach. Used to put a body of other proportions on the feet of a motion (the renderer's human
+    bodies); the metadata gains ``"ankle_ik"`` with the largest pelvis drop."""
+    sk = motion.skeleton
+    rot = motion.rotations.copy()
+    root = motion.root_positions.copy()
+    P = motion.positions()
+    the_legs = legs(sk)
+    lengths = sk.bone_lengths()
+    drop = _pelvis_drop(P, the_legs, targets, lengths, motion.fps) if lower_pelvis else np.zeros(len(P))
+    if drop.any():
+        root[:, 1] -= drop
+        P = P - np.stack([np.zeros_like(drop), drop, np.zeros_like(drop)], -1)[:, None]
+    G = global_rotations(rot, sk.parents)
+    for leg, target in zip(the_legs, targets):
+        _solve_leg(rot, G, P, sk, leg, np.asarray(target, dtype=float), lengths)
+    meta = dict(motion.metadata)
+    meta["ankle_ik"] = {"pelvis_drop_max_m": round(float(drop.max()), 4)}
+    return Motion(sk, rot, root, motion.fps, meta)
+
+
 __all__ = ["BLEND_FRAMES", "CONTACT_OFF_HEIGHT_M", "CONTACT_OFF_SPEED_M_S", "CONTACT_ON_HEIGHT_M",
-           "CONTACT_ON_SPEED_M_S", "Leg", "detect_contacts_hysteresis", "global_rotations", "legs", "plant_feet"]
+           "CONTACT_ON_SPEED_M_S", "Leg", "detect_contacts_hysteresis", "global_rotations", "legs", "plant_feet",
+           "reach_ankles", "reach_targets"]

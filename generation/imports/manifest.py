@@ -13,7 +13,7 @@ misspelt label is not silently dropped):
     theme, weight   a style theme (protocol.vocabulary.CLIP_THEMES) and its weight (required with a theme)
     title, licence, citation, notes         free text, kept with the clip
     keep_audio  yes | no (blank: the command's --keep-audio); videos only
-    body        mannequin | stick | points (blank: mannequin); BVH only: how the figure is drawn
+    body        human | mannequin | stick | points (blank: human); BVH only: how the figure is drawn
 
 The columns are separated by commas, or by semicolons or tabs (as spreadsheets in decimal-comma locales write
 CSV; labels may then use decimal commas). Column names are lower case. A path that could leave the manifest's
@@ -80,7 +80,7 @@ class ManifestRow:
     labels: dict = field(default_factory=dict)
     text: dict = field(default_factory=dict)
     keep_audio: bool | None = None
-    body: str = "mannequin"
+    body: str = "human"
 
 
 @dataclass(frozen=True)
@@ -210,7 +210,7 @@ def check_row(raw: dict, row: int, folder: Path, manifest: str | Path) -> Manife
         fail("body", f"expected one of {', '.join(BODIES)}, got {raw['body']!r}")
     return ManifestRow(row=row, path=given, file=file, modality=modality, kind=kind, labels=labels,
                        text={c: raw.get(c, "") for c in TEXT_COLUMNS}, keep_audio=(keep in YES) if keep else None,
-                       body=body or "mannequin")
+                       body=body or "human")
 
 
 DELIMITERS = (",", ";", "\t")

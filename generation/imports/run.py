@@ -31,6 +31,7 @@ from pathlib import Path, PurePosixPath
 
 from generation.core.digest import file_sha256
 from generation.plans.catalogue import write_clips_csv
+from generation.render.bodies import load_body
 from generation.render.settings import RenderSettings
 from protocol.vocabulary import CLIP_COLUMNS, IMPORTED
 
@@ -158,7 +159,7 @@ def _with_media(rec: dict, stored: dict) -> dict:
     """``rec`` (from the manifest) with the media facts of a stored record (duration, probe, quality...)."""
     rec["duration_s"] = stored.get("duration_s")
     rec["metadata"].update({k: v for k, v in (stored.get("metadata") or {}).items() if k in MEDIA_KEYS})
-    for key in ("qa", "qa_flag"):
+    for key in ("qa", "qa_flag", "body"):
         if key in stored:
             rec[key] = stored[key]
     return rec
@@ -185,6 +186,8 @@ def _stage(row: ManifestRow, rec: dict, stage: Path, settings: ImportSettings) -
                      settings.observer)
     rec["duration_s"] = m.duration_s
     rec["qa"], rec["qa_flag"] = m.qa, m.qa_flag
+    if (m.camera or {}).get("body_preset"):  # the human body shown, with its licence and citation
+        rec["body"] = load_body(m.camera["body_preset"]).record()
     meta.update(action="render", n_frames=m.n_frames, fps=rs.fps, camera=m.camera, render=rs.content_dict(),
                 motion=m.motion_metadata, **{"import": m.import_row})
     files = {f"clips/{clip_id}.mp4": m.mp4}

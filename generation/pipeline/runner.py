@@ -150,6 +150,7 @@ def render_job(job: Job, record: dict, clips_dir: str, records_dir: str) -> dict
     record["metadata"]["n_frames"] = result.n_frames
     record["metadata"]["fps"] = result.fps
     record["metadata"]["camera"] = _json_safe(result.camera)  # rule (fixed/follow), figure height fractions
+    record["body"] = _json_safe(result.body)  # the human body shown, its licence and citation (None otherwise)
     t_qa = time.perf_counter()
     _add_qa(record, job, motion, result.camera)
     record["metadata"]["timing_s"] = {"generate": round(t_gen, 3), "qa": round(time.perf_counter() - t_qa, 3),
@@ -243,7 +244,7 @@ def _select_todo(batch: _Batch, jobs: list[Job], plan: Plan, media_prefix: str, 
         done = load_done_record(job.clip_id, batch.clips_dir, batch.records_dir, job.run_entry.render.webm)
         if done is not None:
             # Same files; refresh the plan-dependent fields (another plan may share this clip).
-            for key in ("duration_s",):
+            for key in ("duration_s", "body"):
                 rec[key] = done.get(key)
             rec["metadata"] = {**done.get("metadata", {}), **rec["metadata"]}
             if _stale_qa(done, job):

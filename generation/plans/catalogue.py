@@ -1,8 +1,9 @@
 """The clip catalogue file ``clips.csv`` (DESIGN.md "Interchange formats"): write, read, check against files.
 
 One row per clip, columns :data:`CLIP_COLUMNS`, the quality columns :data:`QA_COLUMNS`, then the provenance
-columns :data:`CLIP_PROVENANCE_COLUMNS` (title, licence, citation; files without the extra columns still read, their
-rows get blank cells); blank cells are missing values. ``clip_id`` is the
+columns :data:`CLIP_PROVENANCE_COLUMNS` (title, licence, citation) and the body column :data:`CLIP_BODY_COLUMNS` (the
+human body preset shown; files without the extra columns still read, their rows get blank cells); blank cells are
+missing values. ``clip_id`` is the
 clip's content hash, which is also the stem of its files ``clips/<clip_id>.mp4|.webm|.png``.
 """
 from __future__ import annotations
@@ -15,6 +16,7 @@ from pathlib import Path
 
 from generation.quality.checks import qa_columns
 from protocol.vocabulary import (
+    CLIP_BODY_COLUMNS,
     CLIP_COLUMNS,
     CLIP_FLOAT_COLUMNS,
     CLIP_INT_COLUMNS,
@@ -25,7 +27,7 @@ from protocol.vocabulary import (
     QA_FLOAT_COLUMNS,
 )
 
-ALL_COLUMNS = (*CLIP_COLUMNS, *QA_COLUMNS, *CLIP_PROVENANCE_COLUMNS)
+ALL_COLUMNS = (*CLIP_COLUMNS, *QA_COLUMNS, *CLIP_PROVENANCE_COLUMNS, *CLIP_BODY_COLUMNS)
 
 
 class CatalogueFormatError(ValueError):
@@ -84,7 +86,8 @@ def write_clips_csv(records: Iterable[dict], path: str | Path, merge: bool = Tru
 
     The quality columns come from a record's ``qa`` dict (:func:`generation.quality.qa_columns`) or, for rows
     read back from the file, from their own qa_ keys; title, licence and citation from the record's own keys, else
-    its ``metadata`` (captured data keeps its licence there).
+    its ``metadata`` (captured data keeps its licence there); ``body`` from the record's ``body`` dict (its
+    ``preset``) or, read back, the cell.
 
     With ``merge``, rows already in the file whose clip_id is not among ``records`` are kept (the
     catalogue collects every plan rendered into this media folder); rows with the same clip_id are
@@ -99,7 +102,9 @@ def write_clips_csv(records: Iterable[dict], path: str | Path, merge: bool = Tru
         qa = qa_columns(rec["qa"]) if isinstance(rec.get("qa"), dict) else {c: rec.get(c) for c in QA_COLUMNS}
         meta = rec.get("metadata") if isinstance(rec.get("metadata"), dict) else {}
         provenance = {c: rec.get(c) or meta.get(c) for c in CLIP_PROVENANCE_COLUMNS}
-        rows[str(rec["clip_id"])] = {**{c: rec.get(c) for c in CLIP_COLUMNS}, **qa, **provenance}
+        body = rec.get("body")
+        body = {"body": body.get("preset") if isinstance(body, dict) else body}
+        rows[str(rec["clip_id"])] = {**{c: rec.get(c) for c in CLIP_COLUMNS}, **qa, **provenance, **body}
     path.parent.mkdir(parents=True, exist_ok=True)
     tmp = path.with_name(f".{path.name}.tmp{os.getpid()}")
     with tmp.open("w", newline="", encoding="utf-8") as f:

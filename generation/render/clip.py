@@ -15,9 +15,11 @@ import numpy as np
 from generation.core.motion import Motion
 from protocol.vocabulary import GENDERS
 
+from .bodies import BY_GENDER, DEFAULT_PRESET, load_body
 from .body import head_top
 from .camera import body_outline, choose_cameras, facing_direction
 from .encode import VideoWriter, write_png_atomic
+from .human import HumanScene, human_figure, seat_fit
 from .scene import GROUND_MARGIN_M, SCENES, chair_boxes
 from .settings import RenderSettings
 
@@ -32,6 +34,7 @@ class RenderResult:
     n_frames: int
     fps: float
     camera: dict = field(default_factory=dict)  # rule ("fixed"/"follow"), figure height fractions, body
+    body: dict | None = None  # the human body shown: preset, parameters, height, source, licence, citation
 
     @property
     def camera_rule(self) -> str | None:
@@ -75,31 +78,56 @@ def figure_outline(skel, positions: np.ndarray, body: str) -> np.ndarray:
     return body_outline(positions, head_top(skel, positions), 0.06 * s)
 
 
-def plan_cameras(motion: Motion, positions: np.ndarray, settings: RenderSettings) -> tuple[list, dict, tuple]:
-    """Per-frame camera poses of a prepared clip without rendering: (poses, info, (skeleton, ground_y, chair)).
+def body_preset_for(motion: Motion, settings: RenderSettings) -> str:
+    """The human body preset of a clip: the settings' ``body_preset``, else the one of the Motion's gender
+    (metadata "gender" or "build", else its skeleton's build; seed 003: the agent's gender picks its body), else
+    the default preset."""
+    if settings.body_preset:
+        return settings.body_preset
+    gender = motion.metadata.get("gender") or motion.metadata.get("build") or motion.skeleton.build
+    return BY_GENDER.get(gender, DEFAULT_PRESET)
+
+
+def human_figure_for(motion: Motion, settings: RenderSettings):
+    """The posed human body of a prepared clip (:class:`generation.render.human.HumanFigure`)."""
+    return human_figure(motion, body_preset_for(motion, settings), settings.face, settings.skin_tone)
+
+
+def plan_cameras(motion: Motion, positions: np.ndarray, settings: RenderSettings, figure=None
+                 ) -> tuple[list, dict, tuple]:
+    """Per-frame camera poses of a prepared clip without rendering: (poses, info, (skeleton, ground_y, chair,
+    figure)), ``figure`` the posed human body or None.
 
     ``info`` holds the camera rule and the projected figure height fractions (``min_figure_fraction``...), the
-    body look and build, and ``seated``."""
+    body look and build (and the human body's ``body_preset``), and ``seated``. ``figure``: the clip's posed human
+    body (made here when the look is "human" and none is given)."""
     skel = body_skeleton(motion)
     s = skel.height / 1.75
     ground_y = float(positions[..., 1].min() - 0.03 * s)
     chair = None
     extra = None
     seated = is_seated(motion)
+    if settings.body == "human" and figure is None:
+        figure = human_figure_for(motion, settings)
     if seated:
         facing = facing_direction(motion.rotations[0, 0])
-        chair = chair_boxes(positions, skel, facing, ground_y)
+        seat = None
+        if figure is not None:
+            seat = seat_fit(figure, facing)
+        chair = chair_boxes(positions, skel, facing, ground_y, seat)
         if settings.body != "points":
             extra = np.concatenate([np.stack([c + h * np.array(sgn) for sgn in ((1, 1, 1), (-1, -1, -1))])
                                     for c, h, _ in chair])
     root = positions[:, 0]
     extent = (root[:, 0].min() - GROUND_MARGIN_M, root[:, 0].max() + GROUND_MARGIN_M,
               root[:, 2].min() - GROUND_MARGIN_M, root[:, 2].max() + GROUND_MARGIN_M)
-    outline = figure_outline(skel, positions, settings.body)
+    outline = figure.outline if figure is not None else figure_outline(skel, positions, settings.body)
     cams, cam_info = choose_cameras(positions, motion.rotations[0, 0], outline, settings.fps, settings.width,
                                     settings.height, settings.camera, seated, extra)
     cam_info.update(body=settings.body, build=skel.build, seated=seated, extent=extent)
-    return cams, cam_info, (skel, ground_y, chair)
+    if figure is not None:
+        cam_info.update(body_preset=figure.body.name)
+    return cams, cam_info, (skel, ground_y, chair, figure)
 
 
 def anti_aliasing_for(setting: str, cams: list, seated: bool = True) -> str:
@@ -115,11 +143,14 @@ def anti_aliasing_for(setting: str, cams: list, seated: bool = True) -> str:
 def build_scene(motion: Motion, positions: np.ndarray, settings: RenderSettings, info: dict | None = None):
     """The scene and per-frame camera poses for a prepared clip; ``info`` (when given) receives the camera
     rule and the projected figure height fractions."""
-    cams, cam_info, (skel, ground_y, chair) = plan_cameras(motion, positions, settings)
+    cams, cam_info, (skel, ground_y, chair, figure) = plan_cameras(motion, positions, settings)
     extent = cam_info.pop("extent")
     aa = anti_aliasing_for(settings.anti_aliasing, cams, cam_info["seated"])
     cam_info["anti_aliasing"] = aa
-    scene = SCENES[settings.body](skel, settings.width, settings.height, aa, extent, ground_y, chair)
+    if figure is not None:
+        scene = HumanScene(skel, settings.width, settings.height, aa, extent, ground_y, chair, figure=figure)
+    else:
+        scene = SCENES[settings.body](skel, settings.width, settings.height, aa, extent, ground_y, chair)
     if info is not None:
         info.update(cam_info)
     return scene, cams
@@ -136,7 +167,7 @@ def _frames(clip: Motion, positions: np.ndarray, settings: RenderSettings, patch
             if not use_patches and cams[t] is not last_cam:
                 scene.set_camera(cams[t])
                 last_cam = cams[t]
-            scene.set_pose(positions[t])
+            scene.set_frame(t, positions[t])
             yield scene.frame_patch(t) if use_patches else scene.frame()
     finally:
         scene.close()
@@ -213,8 +244,11 @@ def render_clip(motion: Motion, out_dir: str | Path, name: str, settings: Render
     finally:
         frames.close()  # closes the offscreen window
     write_png_atomic(poster, out_dir / f"{name}.png")
+    body = None
+    if info.get("body_preset"):
+        body = load_body(info["body_preset"]).record()
     return RenderResult(out_dir / f"{name}.mp4", out_dir / f"{name}.webm" if settings.webm else None,
-                        out_dir / f"{name}.png", n, settings.fps, info)
+                        out_dir / f"{name}.png", n, settings.fps, info, body)
 
 
 def clip_files_complete(out_dir: str | Path, name: str, webm: bool) -> bool:

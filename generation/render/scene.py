@@ -61,21 +61,23 @@ def bone_matrices(start: np.ndarray, end: np.ndarray, radius: float | np.ndarray
     return m
 
 
-def chair_boxes(positions: np.ndarray, skeleton: Skeleton, facing: np.ndarray, ground_y: float) -> list[tuple]:
+def chair_boxes(positions: np.ndarray, skeleton: Skeleton, facing: np.ndarray, ground_y: float,
+                seat: tuple[float, float] | None = None) -> list[tuple]:
     """Boxes (centre (3,), half-sizes (3,) in the chair frame, yaw rotation) of a simple chair under a seated body.
 
     The seat top sits just under the lowest hip position over the clip, the backrest behind the
-    pelvis, four legs down to the ground. Metres.
+    pelvis, four legs down to the ground. Metres. ``seat``: (seat top height, backrest distance behind the
+    root) fitted to a body's mesh instead (:func:`generation.render.human.seat_fit`).
     """
     s = skeleton.height / 1.75
     hips = [j for j, n in enumerate(skeleton.joints) if n.endswith("_hip")]
     hip_y = positions[:, hips, 1].min()
     root = positions[0, 0]
-    seat_top = hip_y - 0.07 * s
+    seat_top = hip_y - 0.07 * s if seat is None else seat[0]
     seat_th = 0.04 * s
     right = np.cross(facing, np.array([0.0, 1.0, 0.0]))  # body's right
     # The backrest sits just behind the pelvis (a seated back touches it), the seat reaches toward the knees.
-    half_w, depth_back, depth_front = 0.23 * s, 0.13 * s, 0.30 * s
+    half_w, depth_back, depth_front = 0.23 * s, (0.13 * s if seat is None else seat[1] + 0.005), 0.30 * s
     centre_z = (depth_front - depth_back) / 2
     boxes = []
 
@@ -232,6 +234,11 @@ class StickFigureScene:
         self.shadow.user_matrix = np.array([[rs, 0, 0, root[0]], [0, 1, 0, self.ground_y + 0.001],
                                             [0, 0, rs, root[2]], [0, 0, 0, 1.0]])
 
+    def set_frame(self, t: int, positions: np.ndarray) -> None:
+        """Move the figure to frame ``t`` of the clip, whose joint positions are ``positions`` (J, 3) metres (a
+        figure posed ahead of time, the human body, uses ``t``; the others the positions)."""
+        self.set_pose(positions)
+
     def frame(self) -> np.ndarray:
         """Render and return the current image, (height, width, 3) uint8."""
         if not self._primed:
@@ -340,7 +347,7 @@ class StickFigureScene:
             for actor in figure:
                 actor.visibility = True
         else:
-            self.set_pose(positions[0])
+            self.set_frame(0, positions[0])
             self._background = self._render_full()
         self.plotter.render_window.SetSize(*self._patch_size)
         return True

