@@ -180,6 +180,8 @@ def calibrate(clips: list, base: Motion, m: int = 100) -> dict:
         factors, reached = calibrate_theme(base, theme, train)
         visual = generated_measures(base, theme, "visual")
         calibrated = _intensities(theme, factors)
+        alone = [generated_measures(base, theme, _intensities(theme, np.eye(len(groups))[i]))[i]
+                 for i in range(len(groups))]  # each group's own change at its visual intensity
         rows = []
         for f in THEMES[theme]:
             g = groups.index((f.part, f.axis, f.kind))
@@ -188,7 +190,7 @@ def calibrate(clips: list, base: Motion, m: int = 100) -> dict:
         group_rows = [{"part": p, "axis": a, "kind": k, "measure": "mean offset" if k == "tilt" else "peak-to-peak",
                        "real_train": float(train[i]), "real_heldout": float(heldout[i]),
                        "visual_w1": float(visual[i]), "calibrated_w1": float(reached[i]),
-                       "expert_sign_agrees": bool(train[i] * visual[i] > 0)}
+                       "expert_sign_agrees": bool(train[i] * alone[i] > 0)}
                       for i, (p, a, k) in enumerate(groups)]
         themes[theme] = {"features": rows, "groups": group_rows,
                          "sources": {"train": train_info, "heldout": held_info}}
