@@ -6,8 +6,9 @@ Measures (machine: 2-core shared CPU; about 1 min):
 2. The neutral base (:func:`generation.rbf.real_neutral.load_cycle`): speed, arm swing (wrist fore-aft peak-to-peak
    relative to the pelvis) and bounce (pelvis vertical peak-to-peak), all / height, against the steady cycles of
    every real normal walk; the observers' reading of the base walk beside the held-out real normal takes.
-3. Per theme and weight (-0.7, 0.4, 0.7, 1.0), with the ``visual`` and the ``calibrated`` intensities: the theme
-   scale's reading of the styled walk (4 cycles, 30 fps, feet planted), beside the held-out real takes of that style.
+3. Per theme and weight (-0.7, 0.4, 0.7, 1.0), with the ``visual`` and the ``calibrated`` intensities of the expert
+   features and with the data-driven features (``features: data``): the theme scale's reading of the styled walk (4
+   cycles, 30 fps, feet planted), beside the held-out real takes of that style.
 4. Feature differences per Table III group (:mod:`generation.rbf.calibrate`): real style minus normal (train and
    held-out takes) beside the generated edit minus the base at w = 1, visual and calibrated.
 
@@ -34,7 +35,7 @@ from generation.rbf.stylise import neutral_walk, stylise
 from generation.rbf.themes import CALIBRATED_PATH, THEME_NAMES
 
 WEIGHTS = (-0.7, 0.4, 0.7, 1.0)
-SETS = ("visual", "calibrated")
+SETS = ("visual", "calibrated", "data")  # expert features at two intensity sets; the data-driven features
 
 
 def energy_measures(positions: np.ndarray, joints: tuple, stride: float, duration: float) -> dict:
@@ -63,6 +64,22 @@ def base_section(obs, clips, base) -> dict:
     return {"measures": mine, "real_normal_cycles": len(rows), "real_range": real, "readings": readings}
 
 
+def cross_dataset_section(clips) -> dict:
+    """Energy and gender scales trained on dataset 2's training takes, reading every dataset-1 take of their classes
+    (other actors, other sessions): {scale: {class: {"takes", "recall"}}}."""
+    from generation.quality.style_observer import StyleObserver, scale_clips
+
+    out = {}
+    for scale in ("energy", "gender"):
+        o = StyleObserver.fit([c for c in clips if c.dataset == "bandai-namco-2"], scale)
+        rows = [(k, o.read(c.motion)["top"]) for c, k in scale_clips(clips, scale) if c.dataset == "bandai-namco-1"
+                and c.motion.num_frames >= 60]
+        out[scale] = {k: {"takes": sum(1 for kk, _ in rows if kk == k),
+                          "recall": float(np.mean([t == k for kk, t in rows if kk == k]))}
+                      for k in o.classes if any(kk == k for kk, _ in rows)}
+    return out
+
+
 def reading_section(obs, clips, base) -> dict:
     held = obs.heldout(clips)
     out = {}
@@ -74,7 +91,8 @@ def reading_section(obs, clips, base) -> dict:
         for name in SETS:
             entry[name] = {}
             for w in WEIGHTS:
-                r = obs.read_theme(stylise(base, theme, w, 10, n_cycles=4, fps=30.0, intensities=name), theme)
+                kw = {"features": "data"} if name == "data" else {"intensities": name}
+                r = obs.read_theme(stylise(base, theme, w, 10, n_cycles=4, fps=30.0, **kw), theme)
                 entry[name][str(w)] = {"p_target": r["p_target"], "top": r["top"]}
         out[theme] = entry
     return out
@@ -147,6 +165,12 @@ def render(res: dict) -> str:
     for scale, h in res["observers"].items():
         for k in h["recall"]:
             lines.append(f"| {scale} | {k} | {h['takes'][k]} | {_f(h['recall'][k])} | {_f(h['mean_p'][k])} |")
+    lines += ["", "Held out by dataset: the energy and gender scales trained on dataset 2 only, reading dataset 1's "
+              "takes (another actor; takes of at least 2 s):", "", "| scale | class | dataset-1 takes | recall |",
+              "|---|---|---|---|"]
+    for scale, classes in res["cross_dataset"].items():
+        for k, v in classes.items():
+            lines.append(f"| {scale} | {k} | {v['takes']} | {v['recall']:.2f} |")
     b = res["base"]
     lines += ["", f"Neutral base against {b['real_normal_cycles']} steady cycles of the real normal walks (/ height):",
               "", "| measure | base | real min | real median | real max | inside |", "|---|---|---|---|---|---|"]
@@ -192,6 +216,7 @@ def main(argv=None) -> int:
     held = obs.heldout(clips)
     res = {"date": "2026-12-06", "machine": "2-core shared CPU, no GPU", "corpus": args.corpus,
            "observers": {s: {k: h[k] for k in ("recall", "takes", "mean_p")} for s, h in held.items()},
+           "cross_dataset": cross_dataset_section(clips),
            "base": base_section(obs, clips, base), "readings": reading_section(obs, clips, base),
            "features": feature_section(base)}
     res["seconds"] = time.time() - t0
