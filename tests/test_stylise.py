@@ -226,9 +226,11 @@ def test_left_right_swings_are_mirrored_versions(neutral):
 @pytest.mark.parametrize("theme", THEME_NAMES)
 def test_bone_lengths_kept_within_1mm(neutral, theme):
     for w in (1.3, -0.7):
-        out = stylise(neutral, theme, w, 10, n_cycles=2)
+        out = stylise(neutral, theme, w, 10, n_cycles=2, intensities="visual")  # edits large enough to stretch
         assert bone_length_error(out.positions(), neutral.skeleton) < 1e-3
         assert out.metadata["bone_length_error_before_m"] > 5e-3  # the Cartesian edit did stretch bones
+        calibrated = stylise(neutral, theme, w, 10, n_cycles=2)
+        assert bone_length_error(calibrated.positions(), neutral.skeleton) < 1e-3
         assert out.metadata["bone_length_error_after_m"] < 1e-3
         feet = out.positions()[:, [3, 4, 7, 8], 1]
         assert feet.min() > -2e-3  # no foot through the floor

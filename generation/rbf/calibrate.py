@@ -8,7 +8,8 @@ arXiv:2306.08861, CC BY-NC 4.0; straight walks):
    "Shoulders: increased swing along Z" rows are one group). A group's measure on one cycle (m, J, 3) in walker
    heights, walker's frame (:func:`group_measure`): for each joint of the part its trajectory on the axis (relative to
    the pelvis; the pelvis itself as it is), then for a posture feature the cycle mean (times the side's sign for
-   "R along +X, L along -X" rows) and for a movement feature the peak-to-peak; averaged over the part's joints.
+   "R along +X, L along -X" rows) and for a movement feature the peak-to-peak; averaged over the part's joints and
+   the joints that follow them on that axis (:func:`_group_sides`: a shoulder's swing along Z carries the arm).
 2. **Real difference** (:func:`real_differences`): per dataset, the mean over the themed takes of the per-take mean
    of per-cycle measures (steady cycles, :func:`generation.rbf.real_neutral.steady_cycles`) minus the same for the
    same dataset's normal walks (the corpus has no actor ids; a dataset's takes come from its own actors), averaged
@@ -29,11 +30,13 @@ from __future__ import annotations
 import numpy as np
 
 from generation.core.motion import Motion
+from generation.core.skeleton import GAIT_JOINTS, gait_skeleton
 from protocol.vocabulary import CAPTURE_THEMES
 
 from .real_neutral import steady_cycles
 from .themes import BODY_PARTS, THEME_NAMES, THEMES, Feature
 
+MODELLED = frozenset(j for joints in BODY_PARTS.values() for j in joints)  # the paper's 18 joints
 MAX_FACTOR = 6.0  # no calibrated amplitude more than 6x the visual one (keeps a walk a walk)
 MEASURE_FLOOR = 0.005  # heights (9 mm at 1.75 m): residuals of smaller real differences count as this large
 MAX_EVALUATIONS = 200
@@ -46,12 +49,24 @@ def theme_groups(theme: str) -> list[tuple[str, str, str]]:
 
 
 def _group_sides(theme: str, group: tuple[str, str, str]) -> dict[str, int]:
-    """joint -> sign used by a posture measure (side signs of "R along +X, L along -X" rows, else +1)."""
+    """joint -> sign of a group's measure: the part's joints (per-side sign for "R along +X, L along -X" rows, else
+    +1) and the joints that follow them on that axis when the edit is applied (their children without an edit of
+    their own on that axis in this theme, transitively; not the pelvis's children: see
+    :func:`generation.rbf.stylise.rbf_displacement`), so the measure covers what the feature moves: a shoulder's
+    swing along Z carries the arm."""
     feats = [f for f in THEMES[theme] if (f.part, f.axis, f.kind) == group]
     f: Feature = feats[0]
     if f.kind == "tilt" and f.side_signs:
-        return {j: s for j, s in f.joint_signs()}
-    return {j: 1 for j in BODY_PARTS[f.part]}
+        signs = {j: s for j, s in f.joint_signs()}
+    else:
+        signs = {j: 1 for j in BODY_PARTS[f.part]}
+    edited = {(j, g.axis) for g in THEMES[theme] for j in BODY_PARTS[g.part]}
+    names, parents = GAIT_JOINTS, gait_skeleton().parents
+    for j, p in enumerate(parents):
+        if p > 0 and names[p] in signs and names[j] not in signs and names[j] in MODELLED \
+                and (names[j], f.axis) not in edited:
+            signs[names[j]] = signs[names[p]]
+    return signs
 
 
 def group_measure(positions: np.ndarray, joints: tuple[str, ...], theme: str, group: tuple[str, str, str]) -> float:
