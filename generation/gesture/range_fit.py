@@ -16,13 +16,16 @@ its metadata (``real_range``).
 """
 from __future__ import annotations
 
+import json
+from pathlib import Path
+
 import numpy as np
 
 from generation.core.motion import Motion
 from generation.core.quaternion import np_qconj, np_qfix, np_qmul, np_qnormalize
 from protocol.vocabulary import GESTURE_VAD
 
-from .real_stats import motion_stats
+from .real_stats import RANGES_FILE, motion_stats
 
 RANGE_STATS = ("wrist_mean", "wrist_p90", "reach_mean", "reach_p90")
 MIN_FACTOR, MAX_FACTOR = 0.25, 3.0
@@ -106,10 +109,9 @@ def fit_to_range(motion: Motion, bounds: dict) -> tuple[Motion, dict]:
 
 def fit_closest_range(motion: Motion, emotion: str, ranges: dict | None = None) -> Motion:
     """:func:`fit_to_range` against the real range of :func:`closest_captured` (``emotion``); the record, the
-    reference emotion and the ranges' licence go into ``metadata["real_range"]``."""
-    from .real_range import load_ranges
-
-    data = ranges or load_ranges()
+    reference emotion and the ranges' licence go into ``metadata["real_range"]``. ``ranges``: the content of
+    :data:`generation.gesture.real_stats.RANGES_FILE` (default: read from it)."""
+    data = ranges or read_ranges()
     captured = [k for k in data["ranges"] if k != "all"]
     ref = closest_captured(emotion, captured)
     out, record = fit_to_range(motion, data["ranges"][ref])
@@ -117,6 +119,19 @@ def fit_closest_range(motion: Motion, emotion: str, ranges: dict | None = None) 
     out.metadata["real_range"] = {"reference_emotion": ref, **record, "licence": data.get("licence"),
                                   "citation": data.get("citation")}
     return out
+
+
+def read_ranges(path: str | Path = RANGES_FILE) -> dict:
+    """The shipped real ranges ({"ranges": {emotion or "all": {stat: [min, max]}}, "licence", ...}), read without
+    torch (:func:`generation.gesture.real_range.load_ranges` is the training loss's reader)."""
+    path = Path(path)
+    if not path.is_file():
+        raise FileNotFoundError(f"{path}: no real gesture ranges (python -m generation.quality.real_gestures "
+                                "--write-ranges writes them from the real corpus)")
+    data = json.loads(path.read_text(encoding="utf-8"))
+    if "all" not in data.get("ranges", {}):
+        raise ValueError(f"{path}: expected an object with 'ranges' holding at least 'all'")
+    return data
 
 
 def _pick(stats: dict) -> dict:

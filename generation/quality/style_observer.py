@@ -27,6 +27,7 @@ import numpy as np
 
 from generation.core.motion import Motion
 from generation.core.skeleton import GAIT_JOINTS
+from generation.mocap.real_corpus import DEFAULT_PATH, load_real_corpus
 
 from .real_observer import window_descriptors
 
@@ -149,8 +150,6 @@ class StyleObservers:
 def train_style_observers(corpus_path: str | Path | None = None) -> tuple[StyleObservers, list]:
     """Style observers trained on the corpus's walks (default :data:`generation.mocap.real_corpus.DEFAULT_PATH`);
     returns them and the corpus's gait walks (for their held-out takes)."""
-    from generation.mocap.real_corpus import DEFAULT_PATH, load_real_corpus
-
     path = Path(corpus_path) if corpus_path is not None else DEFAULT_PATH
     if not path.is_file():
         raise FileNotFoundError(f"real corpus {path} not found; build it as docs/corpus.md says")

@@ -18,9 +18,11 @@ from pathlib import Path
 from generation.core.skeleton import GAIT_JOINTS
 from generation.mocap.real_corpus import load_real_corpus, real_corpus_path
 
+from .calibrate import calibrate, save_calibration
 from .data_features import SHIPPED_PATH as FEATURES_PATH
 from .data_features import fit_data_features, save_data_features
-from .real_neutral import SHIPPED_PATH, build_real_neutral
+from .real_neutral import SHIPPED_PATH, build_real_neutral, load_cycle
+from .themes import CALIBRATED_PATH
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -43,10 +45,6 @@ def main(argv: list[str] | None = None) -> int:
               f"{md['dtw_spread']['after']:.5f} heights -> {args.out or SHIPPED_PATH}")
         return 0
     if args.command == "calibrate":
-        from .calibrate import calibrate, save_calibration
-        from .real_neutral import load_cycle
-        from .themes import CALIBRATED_PATH
-
         data = calibrate(load_real_corpus(args.corpus, skeleton="gait", contents=["walk"]), load_cycle())
         save_calibration(data, args.out or CALIBRATED_PATH)
         for theme, entry in data["themes"].items():

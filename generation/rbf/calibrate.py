@@ -27,13 +27,18 @@ the w = 1 difference reached.
 """
 from __future__ import annotations
 
+import json
+from pathlib import Path
+
 import numpy as np
 
 from generation.core.motion import Motion
 from generation.core.skeleton import GAIT_JOINTS, gait_skeleton
 from protocol.vocabulary import CAPTURE_THEMES
 
+from .data_features import _rounded
 from .real_neutral import steady_cycles
+from .stylise import stylised_cycle
 from .themes import BODY_PARTS, THEME_NAMES, THEMES, Feature
 
 MODELLED = frozenset(j for joints in BODY_PARTS.values() for j in joints)  # the paper's 18 joints
@@ -150,8 +155,6 @@ def _intensities(theme: str, factors: np.ndarray) -> dict[int, float]:
 
 def generated_measures(base: Motion, theme: str, intensities, weight: float = 1.0) -> np.ndarray:
     """(G,) group measures of the stylised cycle minus the base's, heights (skeleton fit, no foot planting)."""
-    from .stylise import stylised_cycle
-
     out = stylised_cycle(base, theme, weight, len(THEMES[theme]), intensities=intensities)
     joints = tuple(base.skeleton.joints)
     h = base.skeleton.height
@@ -220,11 +223,6 @@ def calibrate(clips: list, base: Motion, m: int = 100) -> dict:
 
 def save_calibration(data: dict, path) -> None:
     """Write :func:`calibrate`'s dict as JSON (floats rounded to 6 decimals)."""
-    import json
-    from pathlib import Path
-
-    from .data_features import _rounded
-
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     path.write_text(json.dumps(_rounded(data), indent=1) + "\n", encoding="utf-8")

@@ -36,7 +36,7 @@ from generation.core.skeleton import Skeleton
 
 from .basis import CYCLE_FRAMES, rbf_sum, shape_params, swing_params
 from .data_features import data_rbfs, load_data_features
-from .themes import AXES, BODY_PARTS, INTENSITY_SETS, THEME_NAMES, theme_features
+from .themes import AXES, BODY_PARTS, INTENSITY_SETS, THEME_NAMES, calibration_provenance, theme_features
 
 _MODELLED = frozenset(name for joints in BODY_PARTS.values() for name in joints)
 PAPER_WEIGHTS = (0.4, 0.7, 1.0, 1.3)  # Fig. 7
@@ -510,8 +510,6 @@ def stylise(neutral_cycle: Motion, theme: str, weight: float, n_features: int, s
         metadata["excluded_ranks"] = sorted(exclude)
     metadata.update(base_provenance(base_meta))
     if features == "expert" and intensities == "calibrated" and "licence" not in metadata:
-        from .themes import calibration_provenance
-
         metadata.update(calibration_provenance())
     if features == "data" and "licence" not in metadata:
 

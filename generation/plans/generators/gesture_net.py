@@ -9,6 +9,7 @@ from pathlib import Path
 from generation.core.motion import Motion
 from generation.core.splits import SPLITS
 from generation.gesture.config import gesture_seconds
+from generation.gesture.range_fit import fit_closest_range
 from protocol.vocabulary import GENDERS, GESTURE_TASKS, HANDEDNESS
 
 from .fields import FieldError, choice, gesture_label, number, text
@@ -69,11 +70,7 @@ def make_gesture_net(entry, context: MakeContext) -> Motion:
     inp: GestureNetInputs = entry.inputs
     motion = generate_gesture(inp.sentence, inp.task, inp.emotion_label, inp.gender, inp.handedness, fps=context.fps,
                               seed=entry.seed, noise=inp.noise)
-    if inp.real_range == "off":
-        return motion
-    from generation.gesture.range_fit import fit_closest_range
-
-    return fit_closest_range(motion, inp.emotion_label)
+    return motion if inp.real_range == "off" else fit_closest_range(motion, inp.emotion_label)
 
 
 SPEC = register(GeneratorSpec(
