@@ -152,6 +152,9 @@ def contact_sheet(obs, clips, base, path: Path, n_poses: int = 5) -> None:
                  "5 phases, pelvis-centred (stick figures; blue = left, red = right)", fontsize=10)
     fig.savefig(path, bbox_inches="tight")
     plt.close(fig)
+    from PIL import Image
+
+    Image.open(path).convert("RGB").quantize(32).save(path, optimize=True)  # few colours: a fraction of the bytes
 
 
 def _f(x, d=2):
