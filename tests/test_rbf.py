@@ -143,7 +143,8 @@ def test_six_themes_with_ten_features_in_table_order():
 
 def test_first_n_features():
     for n in (1, 4, 7, 10):
-        assert theme_features("sad", n) == THEMES["sad"][:n]
+        assert theme_features("sad", n, "visual") == THEMES["sad"][:n]
+        assert [f.rank for f in theme_features("sad", n)] == [f.rank for f in THEMES["sad"][:n]]
     with pytest.raises(ValueError, match="n_features"):
         theme_features("sad", 11)
     with pytest.raises(ValueError, match="unknown theme"):

@@ -1,4 +1,5 @@
-"""Foot planting of the RBF-styled walks and of the chained captured source walks (quality gate thresholds)."""
+"""Foot planting of the RBF-styled walks (the visual intensities, whose large foot edits slide unplanted) and of the
+chained captured source walks (quality gate thresholds)."""
 import numpy as np
 import pytest
 
@@ -22,8 +23,8 @@ def _leg_joints(skeleton) -> set[int]:
 
 
 def test_tired_seven_features_is_planted_and_above_the_floor(neutral):
-    raw = stylise(neutral, "tired", 1.0, 7, fps=FPS, plant=False)
-    planted = stylise(neutral, "tired", 1.0, 7, fps=FPS)
+    raw = stylise(neutral, "tired", 1.0, 7, fps=FPS, intensities="visual", plant=False)
+    planted = stylise(neutral, "tired", 1.0, 7, fps=FPS, intensities="visual")
     before, after = motion_metrics(raw), motion_metrics(planted)
     assert before["foot_skate_cm_s"] > QA_THRESHOLDS["foot_skate_cm_s"]      # the styliser alone slides (~26)
     assert after["foot_skate_cm_s"] < 0.2 * QA_THRESHOLDS["foot_skate_cm_s"]
@@ -38,13 +39,13 @@ def test_planting_keeps_the_upper_body_features(neutral):
     """Only hips, knees and ankles (and the root height, by < 1 cm) change: every feature of the upper body
     keeps its displacement from the neutral walk."""
     base = neutral_walk(neutral, fps=FPS, plant=False).positions()
-    raw = stylise(neutral, "tired", 1.0, 7, fps=FPS, plant=False)
-    planted = stylise(neutral, "tired", 1.0, 7, fps=FPS)
+    raw = stylise(neutral, "tired", 1.0, 7, fps=FPS, intensities="visual", plant=False)
+    planted = stylise(neutral, "tired", 1.0, 7, fps=FPS, intensities="visual")
     sk = raw.skeleton
     legs_ = _leg_joints(sk)
     p_raw, p_planted = raw.positions(), planted.positions()
     checked = 0
-    for feature in theme_features("tired", 7):
+    for feature in theme_features("tired", 7, "visual"):
         joints = [sk.index(n) for n in BODY_PARTS[feature.part]]
         if set(joints) & legs_:
             continue
@@ -55,8 +56,8 @@ def test_planting_keeps_the_upper_body_features(neutral):
 
 
 def test_masculine_inverted_no_longer_sinks_into_the_floor(neutral):
-    raw = motion_metrics(stylise(neutral, "masculine", -0.7, 10, fps=FPS, plant=False))
-    out = motion_metrics(stylise(neutral, "masculine", -0.7, 10, fps=FPS))
+    raw = motion_metrics(stylise(neutral, "masculine", -0.7, 10, fps=FPS, intensities="visual", plant=False))
+    out = motion_metrics(stylise(neutral, "masculine", -0.7, 10, fps=FPS, intensities="visual"))
     assert raw["penetration_cm"] > QA_THRESHOLDS["penetration_cm"]           # 2.5 cm before
     assert out["penetration_cm"] <= QA_THRESHOLDS["penetration_cm"]
     assert out["foot_skate_cm_s"] < QA_THRESHOLDS["foot_skate_cm_s"]

@@ -170,8 +170,9 @@ def test_displacement_scales_linearly_with_weight(neutral):
         r = stylised_cycle(neutral, "happy", w, 10)
         np.testing.assert_allclose(r["Y"] - r["P"], w * base["S"], atol=1e-12)
     # after putting the edit back on the skeleton the displacement stays close to linear for small weights
-    d1 = stylised_cycle(neutral, "sad", 0.1, 10)["positions"] - stylised_cycle(neutral, "sad", 0.0, 10)["positions"]
-    d2 = stylised_cycle(neutral, "sad", 0.2, 10)["positions"] - stylised_cycle(neutral, "sad", 0.0, 10)["positions"]
+    def edit(w):
+        return stylised_cycle(neutral, "sad", w, 10, intensities="visual")["positions"]
+    d1, d2 = edit(0.1) - edit(0.0), edit(0.2) - edit(0.0)
     assert np.abs(d2 - 2 * d1).max() < 0.1 * np.abs(d2).max()
 
 
@@ -225,9 +226,11 @@ def test_left_right_swings_are_mirrored_versions(neutral):
 @pytest.mark.parametrize("theme", THEME_NAMES)
 def test_bone_lengths_kept_within_1mm(neutral, theme):
     for w in (1.3, -0.7):
-        out = stylise(neutral, theme, w, 10, n_cycles=2)
+        out = stylise(neutral, theme, w, 10, n_cycles=2, intensities="visual")  # edits large enough to stretch
         assert bone_length_error(out.positions(), neutral.skeleton) < 1e-3
         assert out.metadata["bone_length_error_before_m"] > 5e-3  # the Cartesian edit did stretch bones
+        calibrated = stylise(neutral, theme, w, 10, n_cycles=2)
+        assert bone_length_error(calibrated.positions(), neutral.skeleton) < 1e-3
         assert out.metadata["bone_length_error_after_m"] < 1e-3
         feet = out.positions()[:, [3, 4, 7, 8], 1]
         assert feet.min() > -2e-3  # no foot through the floor

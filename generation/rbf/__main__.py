@@ -2,9 +2,11 @@
 
     python -m generation.rbf neutral  [--corpus CORPUS] [--out generation/data/rbf/neutral_real.npz]
     python -m generation.rbf features [--corpus CORPUS] [--out generation/data/rbf/data_features.json]
+    python -m generation.rbf calibrate [--corpus CORPUS] [--out generation/data/rbf/calibrated_intensities.json]
 
 CORPUS is the real-capture corpus (``python -m generation.mocap dataset bandai-namco DIR --out CORPUS``; default
-$REAL_CORPUS, else ``var/mocap/bandai-namco.npz``). Both read the train split only.
+$REAL_CORPUS, else ``var/mocap/bandai-namco.npz``). ``neutral`` and ``features`` read the train split only;
+``calibrate`` fits on the train split and records the held-out (val, test) differences beside the fit.
 """
 from __future__ import annotations
 
@@ -16,16 +18,19 @@ from pathlib import Path
 from generation.core.skeleton import GAIT_JOINTS
 from generation.mocap.real_corpus import load_real_corpus, real_corpus_path
 
+from .calibrate import calibrate, save_calibration
 from .data_features import SHIPPED_PATH as FEATURES_PATH
 from .data_features import fit_data_features, save_data_features
-from .real_neutral import SHIPPED_PATH, build_real_neutral
+from .real_neutral import SHIPPED_PATH, build_real_neutral, load_cycle
+from .themes import CALIBRATED_PATH
 
 
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog="python -m generation.rbf", description=__doc__.splitlines()[0])
     sub = parser.add_subparsers(dest="command", required=True)
     for name, help_ in (("neutral", "average real normal-walk cycles into the neutral base cycle"),
-                        ("features", "fit data-driven RBF features per theme to real themed walks")):
+                        ("features", "fit data-driven RBF features per theme to real themed walks"),
+                        ("calibrate", "calibrate the expert features' intensities on real themed walks")):
         p = sub.add_parser(name, help=help_)
         p.add_argument("--corpus", type=Path, default=real_corpus_path(os.environ),
                        help="real-capture corpus .npz (default: $REAL_CORPUS, else var/mocap/bandai-namco.npz)")
@@ -39,8 +44,12 @@ def main(argv: list[str] | None = None) -> int:
               f"stride {md['stride_m'][2]:.3f} m, DTW spread {md['dtw_spread']['before']:.5f} -> "
               f"{md['dtw_spread']['after']:.5f} heights -> {args.out or SHIPPED_PATH}")
         return 0
-
-
+    if args.command == "calibrate":
+        data = calibrate(load_real_corpus(args.corpus, skeleton="gait", contents=["walk"]), load_cycle())
+        save_calibration(data, args.out or CALIBRATED_PATH)
+        for theme, entry in data["themes"].items():
+            print(f"{theme}: factors {[round(r['factor'], 2) for r in entry['features']]}")
+        return 0
     clips = load_real_corpus(args.corpus, skeleton="gait", split="train", contents=["walk"])
     features = fit_data_features(clips, GAIT_JOINTS)
     save_data_features(features, args.out or FEATURES_PATH)

@@ -22,6 +22,8 @@ Pipeline (shapes: m cycle frames, J joints):
 """
 from __future__ import annotations
 
+from collections.abc import Mapping
+
 import numpy as np
 import torch
 
@@ -34,7 +36,7 @@ from generation.core.skeleton import Skeleton
 
 from .basis import CYCLE_FRAMES, rbf_sum, shape_params, swing_params
 from .data_features import data_rbfs, load_data_features
-from .themes import AXES, BODY_PARTS, THEME_NAMES, theme_features
+from .themes import AXES, BODY_PARTS, INTENSITY_SETS, THEME_NAMES, calibration_provenance, theme_features
 
 _MODELLED = frozenset(name for joints in BODY_PARTS.values() for name in joints)
 PAPER_WEIGHTS = (0.4, 0.7, 1.0, 1.3)  # Fig. 7
@@ -97,7 +99,8 @@ def walker_frame_positions(neutral: Motion) -> tuple[np.ndarray, np.ndarray]:
 # Secondary features S
 # --------------------------------------------------------------------------------------------------
 def theme_rbfs(P: np.ndarray, skeleton: Skeleton, theme: str, n_features: int,
-               height: float | None = None, exclude: tuple[int, ...] = ()) -> dict[tuple[str, str], np.ndarray]:
+               height: float | None = None, exclude: tuple[int, ...] = (),
+               intensities: str | Mapping[int, float] = "calibrated") -> dict[tuple[str, str], np.ndarray]:
     """RBF parameters per degree of freedom for the first ``n_features`` of a theme.
 
     Args:
@@ -107,6 +110,8 @@ def theme_rbfs(P: np.ndarray, skeleton: Skeleton, theme: str, n_features: int,
         n_features: how many of Table III's features, in frequency order (0..10).
         height: walker height in metres for de-normalising intensities (default ``skeleton.height``).
         exclude: Table III ranks (1..10) to leave out of the first ``n_features`` (for ablations).
+        intensities: ``calibrated`` (default), ``visual`` or {rank: intensity}
+            (:func:`generation.rbf.themes.theme_features`).
 
     Returns:
         {(joint name, axis "X"|"Y"|"Z"): (M, 3) rows (alpha metres, mu frames, sigma2 frames^2)}, M <= 3.
@@ -116,7 +121,7 @@ def theme_rbfs(P: np.ndarray, skeleton: Skeleton, theme: str, n_features: int,
     m = P.shape[0]
     root = skeleton.index("root")
     dofs: dict[tuple[str, str], np.ndarray] = {}
-    for feat in theme_features(theme, n_features):
+    for feat in theme_features(theme, n_features, intensities):
         if feat.rank in exclude:
             continue
         for joint, sign in feat.joint_signs():
@@ -137,7 +142,8 @@ def theme_rbfs(P: np.ndarray, skeleton: Skeleton, theme: str, n_features: int,
 
 def theme_displacement(P: np.ndarray, skeleton: Skeleton, theme: str, n_features: int,
                        height: float | None = None, propagate: bool = True,
-                       exclude: tuple[int, ...] = ()) -> np.ndarray:
+                       exclude: tuple[int, ...] = (),
+                       intensities: str | Mapping[int, float] = "calibrated") -> np.ndarray:
     """Secondary features S of the first ``n_features``: (m, J, 3) metres, for weight 1 (linear in the RBFs).
 
     The paper moved each marker independently (its bones stretched). With exact bone lengths an isolated knee
@@ -147,7 +153,8 @@ def theme_displacement(P: np.ndarray, skeleton: Skeleton, theme: str, n_features
     per-marker displacement. The root's (pelvis) edits are not passed on, as that would only translate the
     body. Without ``propagate`` only joints outside the paper's model (toes, hand tips) follow their parent.
     """
-    return rbf_displacement(P, skeleton, theme_rbfs(P, skeleton, theme, n_features, height, exclude), propagate)
+    return rbf_displacement(P, skeleton, theme_rbfs(P, skeleton, theme, n_features, height, exclude, intensities),
+                            propagate)
 
 
 def rbf_displacement(P: np.ndarray, skeleton: Skeleton, dofs: dict[tuple[str, str], np.ndarray],
@@ -379,7 +386,8 @@ def warp_and_repeat_cycle(rotations: np.ndarray, root: np.ndarray, stride: np.nd
 # Public entry point
 # --------------------------------------------------------------------------------------------------
 def stylised_cycle(neutral_cycle: Motion, theme: str, weight: float, n_features: int,
-                   keep_ground: bool = True, features: str = "expert", exclude: tuple[int, ...] = ()) -> dict:
+                   keep_ground: bool = True, features: str = "expert", exclude: tuple[int, ...] = (),
+                   intensities: str | Mapping[int, float] = "calibrated") -> dict:
     """One stylised cycle on the skeleton, with the intermediate arrays.
 
     Returns a dict with ``P`` (m, J, 3) neutral walker-frame positions, ``S`` (m, J, 3) secondary
@@ -391,7 +399,9 @@ def stylised_cycle(neutral_cycle: Motion, theme: str, weight: float, n_features:
 
     ``features``: "expert" (Table III, :func:`theme_displacement`) or "data" (RBFs fitted to real themed walks,
     :func:`generation.rbf.data_features.data_rbfs`, applied to their own DOFs without propagation). ``exclude``:
-    expert features (Table III ranks) to leave out, for ablations.
+    expert features (Table III ranks) to leave out, for ablations. ``intensities``: the expert features'
+    amplitudes, ``calibrated`` (default) or ``visual`` (:data:`generation.rbf.themes.INTENSITY_SETS`) or
+    {rank: intensity}.
     """
     if features not in FEATURE_SOURCES:
         raise ValueError(f"features must be one of {list(FEATURE_SOURCES)}, got {features!r}")
@@ -402,7 +412,7 @@ def stylised_cycle(neutral_cycle: Motion, theme: str, weight: float, n_features:
     skel = neutral_cycle.skeleton
     P, progression = walker_frame_positions(neutral_cycle)
     if features == "expert":
-        S = theme_displacement(P, skel, theme, n_features, exclude=exclude)
+        S = theme_displacement(P, skel, theme, n_features, exclude=exclude, intensities=intensities)
     else:
 
         S = rbf_displacement(P, skel, data_rbfs(theme, n_features, skel.height, P.shape[0]), propagate=False)
@@ -438,7 +448,7 @@ def keep_feet_above_ground(Y: np.ndarray, P: np.ndarray, skeleton: Skeleton) -> 
 
 def stylise(neutral_cycle: Motion, theme: str, weight: float, n_features: int, speed: float = 1.0,
             n_cycles: int = 4, fps: float = 30.0, keep_ground: bool = True, plant: bool = True,
-            features: str = "expert", exclude: tuple[int, ...] = ()) -> Motion:
+            features: str = "expert", exclude: tuple[int, ...] = (), intensities: str = "calibrated") -> Motion:
     """Apply a seed 004 theme to a neutral walk cycle and walk it along a straight line.
 
     Args:
@@ -456,6 +466,8 @@ def stylise(neutral_cycle: Motion, theme: str, weight: float, n_features: int, s
             shortens the ankle swing while the body keeps the neutral stride), so without it they slide.
         features: "expert" (Table III) or "data" (fitted to real themed walks; see :func:`stylised_cycle`).
         exclude: expert features (Table III ranks) to leave out (ablations; recorded in the metadata when given).
+        intensities: the expert features' amplitudes: ``calibrated`` (default; w = 1 reproduces real actors'
+            style differences) or ``visual`` (the earlier hand-sized set), :data:`generation.rbf.themes.INTENSITY_SETS`.
 
     Returns:
         Motion on the neutral cycle's skeleton, round(n_cycles * cycle duration / speed * fps) frames, with
@@ -469,7 +481,10 @@ def stylise(neutral_cycle: Motion, theme: str, weight: float, n_features: int, s
         raise ValueError(f"fps must be positive, got {fps!r}")
     if isinstance(n_cycles, bool) or not isinstance(n_cycles, int) or n_cycles < 1:
         raise ValueError(f"n_cycles must be a positive integer, got {n_cycles!r}")
-    result = stylised_cycle(neutral_cycle, theme, weight, n_features, keep_ground, features, tuple(exclude))
+    if intensities not in INTENSITY_SETS:
+        raise ValueError(f"intensities must be one of {list(INTENSITY_SETS)}, got {intensities!r}")
+    result = stylised_cycle(neutral_cycle, theme, weight, n_features, keep_ground, features, tuple(exclude),
+                            intensities)
     stride = cycle_stride(neutral_cycle)
     rotations, root = warp_and_repeat_cycle(result["rotations"], result["root"], stride, neutral_cycle.duration,
                                             speed, n_cycles, fps)
@@ -489,9 +504,13 @@ def stylise(neutral_cycle: Motion, theme: str, weight: float, n_features: int, s
         "fit_residual_max_m": result["residual"],
         "ground_lift_max_m": result["ground_lift"],
     }
+    if features == "expert":
+        metadata["intensities"] = intensities
     if exclude:
         metadata["excluded_ranks"] = sorted(exclude)
     metadata.update(base_provenance(base_meta))
+    if features == "expert" and intensities == "calibrated" and "licence" not in metadata:
+        metadata.update(calibration_provenance())
     if features == "data" and "licence" not in metadata:
 
         data = load_data_features()

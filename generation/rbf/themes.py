@@ -19,7 +19,11 @@ move outward; sad and tired heads tilt along -Y (down) and +Z (forward)). That i
 """
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+import json
+from collections.abc import Mapping
+from dataclasses import dataclass, field, replace
+from functools import lru_cache
+from pathlib import Path
 
 from protocol.vocabulary import THEMES as THEME_NAMES  # the six theme names; THEMES below is Table III by theme
 
@@ -57,7 +61,9 @@ class Feature:
             -1 decreased.
         side_signs: tilts given per side ("R along +X, L along -X"): {"left": s, "right": s}; overrides sign.
         shape: Fig. 4 type (1 for tilts; 2, 3 or 4 for swings). Our choice where Fig. 5 is not legible.
-        intensity: amplitude / walker height (dimensionless, > 0). Our choice (Fig. 5 is a heat map).
+        intensity: amplitude / walker height (dimensionless, >= 0). ``THEMES`` holds our visual choice (Fig. 5 is
+            a heat map); :func:`theme_features` gives the calibrated ones by default (0 where real actors do not
+            move that way).
     """
 
     rank: int
@@ -83,8 +89,8 @@ class Feature:
             raise ValueError(f"{where}: a swing (movement) feature is shape 2, 3 or 4, got {self.shape}")
         if self.sign not in (-1, 1):
             raise ValueError(f"{where}: sign must be +1 or -1, got {self.sign}")
-        if not self.intensity > 0:
-            raise ValueError(f"{where}: intensity must be positive, got {self.intensity}")
+        if not self.intensity >= 0:
+            raise ValueError(f"{where}: intensity must be a non-negative number, got {self.intensity}")
         if self.side_signs and set(self.side_signs) != {"left", "right"}:
             raise ValueError(f"{where}: side_signs needs 'left' and 'right', got {sorted(self.side_signs)}")
 
@@ -232,13 +238,68 @@ TABLE_III: dict[str, tuple[str, ...]] = {
                   "Elbows: increased swing along Z"),
 }
 
-def theme_features(theme: str, n_features: int | None = None) -> tuple[Feature, ...]:
-    """The first ``n_features`` (1..10, default all) features of a theme, in Table III order."""
+#: Named sets of intensities: ``visual`` (our choice, sized to be visible in a stick figure at w = 0.7; the numbers
+#: of ``THEMES``) and ``calibrated`` (fitted so that w = 1 reproduces real actors' style differences,
+#: :mod:`generation.rbf.calibrate`, stored in :data:`CALIBRATED_PATH`). The first is the default.
+INTENSITY_SETS = ("calibrated", "visual")
+CALIBRATED_PATH = Path(__file__).resolve().parents[1] / "data" / "rbf" / "calibrated_intensities.json"
+
+
+@lru_cache(maxsize=4)
+def _calibrated_file(path: str) -> dict:
+    p = Path(path)
+    if not p.is_file():
+        raise FileNotFoundError(f"calibrated RBF intensities {p} not found; build them with "
+                                "`python -m generation.rbf calibrate`")
+    data = json.loads(p.read_text(encoding="utf-8"))
+    for theme in THEMES:
+        rows = data.get("themes", {}).get(theme, {}).get("features")
+        if not rows or sorted(r["rank"] for r in rows) != list(range(1, len(THEMES[theme]) + 1)):
+            raise ValueError(f"{p}: theme {theme!r} needs one calibrated intensity per Table III rank")
+        for r in rows:
+            if not (isinstance(r.get("calibrated"), (int, float)) and r["calibrated"] >= 0):
+                raise ValueError(f"{p}: theme {theme!r} rank {r.get('rank')}: calibrated intensity must be >= 0")
+    return data
+
+
+def calibrated_intensities(path: str | Path = CALIBRATED_PATH) -> dict[str, dict[int, float]]:
+    """{theme: {Table III rank: calibrated intensity (x height)}} from the shipped file (or ``path``)."""
+    data = _calibrated_file(str(path))
+    return {t: {int(r["rank"]): float(r["calibrated"]) for r in data["themes"][t]["features"]} for t in THEMES}
+
+
+def calibration_provenance(path: str | Path = CALIBRATED_PATH) -> dict:
+    """{licence, citation} of the real capture the calibrated intensities were fitted on."""
+    data = _calibrated_file(str(path))
+    return {"licence": data["licence"], "citation": data["citation"]}
+
+
+def theme_features(theme: str, n_features: int | None = None,
+                   intensities: str | Mapping[int, float] = "calibrated") -> tuple[Feature, ...]:
+    """The first ``n_features`` (1..10, default all) features of a theme, in Table III order.
+
+    ``intensities``: a name of :data:`INTENSITY_SETS` (``visual`` gives ``THEMES`` unchanged), or a mapping
+    {rank: intensity} overriding the visual ones (ranks not named keep theirs; used by the calibration).
+    """
     if theme not in THEMES:
         raise ValueError(f"unknown theme {theme!r}; expected one of {list(THEME_NAMES)}")
     feats = THEMES[theme]
+    if isinstance(intensities, str):
+        if intensities not in INTENSITY_SETS:
+            raise ValueError(f"intensities must be one of {list(INTENSITY_SETS)}, got {intensities!r}")
+        if intensities == "calibrated":
+            feats = _with_intensities(feats, calibrated_intensities()[theme])
+    else:
+        feats = _with_intensities(feats, intensities)
     if n_features is None:
         return feats
     if isinstance(n_features, bool) or not isinstance(n_features, int) or not 0 <= n_features <= len(feats):
         raise ValueError(f"n_features must be an integer in 0..{len(feats)}, got {n_features!r}")
     return feats[:n_features]
+
+
+def _with_intensities(feats: tuple[Feature, ...], by_rank: Mapping[int, float]) -> tuple[Feature, ...]:
+    unknown = set(by_rank) - {f.rank for f in feats}
+    if unknown:
+        raise ValueError(f"intensities for unknown Table III ranks {sorted(unknown)}")
+    return tuple(replace(f, intensity=float(by_rank[f.rank])) if f.rank in by_rank else f for f in feats)

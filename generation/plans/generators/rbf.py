@@ -12,14 +12,18 @@ from .neutral_walk import RBF_BASES, base_cycle
 from .registry import GeneratorSpec, InputContext, MakeContext, PlanInputs, register
 
 RBF_FEATURES = ("expert", "data")
+RBF_INTENSITIES = ("calibrated", "visual")  # generation.rbf.themes.INTENSITY_SETS (torch-free here)
 
 
 @dataclass(frozen=True)
 class RbfInputs(PlanInputs):
     """A ``theme`` at ``weight`` (-3..3; the paper uses 0.4, 0.7, 1.0, 1.3 and -0.7) with its first
-    ``n_features`` features, over ``n_cycles`` of the ``base`` cycle at ``speed``."""
+    ``n_features`` features, over ``n_cycles`` of the ``base`` cycle at ``speed``; the expert features'
+    ``intensities`` are ``calibrated`` (default: w = 1 reproduces real actors' style differences) or ``visual``
+    (the earlier hand-sized set, for rerendering earlier studies)."""
 
-    PLAN_FIELDS = frozenset({"theme", "weight", "n_features", "n_cycles", "speed", "base", "features"})
+    PLAN_FIELDS = frozenset({"theme", "weight", "n_features", "n_cycles", "speed", "base", "features",
+                             "intensities"})
 
     theme: str
     weight: float
@@ -28,6 +32,7 @@ class RbfInputs(PlanInputs):
     speed: float = 1.0
     base: str = "real"
     features: str = "expert"
+    intensities: str = "calibrated"
 
     @classmethod
     def parse(cls, raw: dict, context: InputContext) -> RbfInputs:
@@ -40,7 +45,8 @@ class RbfInputs(PlanInputs):
                    integer("n_features", raw.get("n_features", 10), 1, 10),
                    integer("n_cycles", raw.get("n_cycles", 3), 1, 50), number("speed", raw.get("speed", 1.0), 0.2, 3.0),
                    choice("base", raw.get("base", RBF_BASES[0]), RBF_BASES),
-                   choice("features", raw.get("features", RBF_FEATURES[0]), RBF_FEATURES))
+                   choice("features", raw.get("features", RBF_FEATURES[0]), RBF_FEATURES),
+                   choice("intensities", raw.get("intensities", RBF_INTENSITIES[0]), RBF_INTENSITIES))
 
     def intent(self, modality: str) -> dict:
         return {**super().intent(modality), "theme": self.theme, "weight": self.weight, "n_features": self.n_features}
@@ -51,7 +57,7 @@ def make_rbf(entry, context: MakeContext) -> Motion:
 
     inp: RbfInputs = entry.inputs
     motion = stylise(base_cycle(inp.base), inp.theme, inp.weight, inp.n_features, speed=inp.speed,
-                     n_cycles=inp.n_cycles, fps=context.fps, features=inp.features)
+                     n_cycles=inp.n_cycles, fps=context.fps, features=inp.features, intensities=inp.intensities)
     motion.metadata["base"] = inp.base
     return motion
 
