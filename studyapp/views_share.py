@@ -6,17 +6,15 @@ from __future__ import annotations
 from datetime import UTC, datetime
 
 from django.http import Http404
-from django.shortcuts import redirect, render
+from django.shortcuts import render
 from django.urls import reverse
 from django.views.decorators.cache import never_cache
 from django.views.decorators.http import require_http_methods
 
 from .forms import ConsentForm
 from .i18n import activate_study_language
-from .questions import AnswerError, clean_answers
 from .sharing import PreviewLinkError, study_of_token
-from .views import item_context, item_questions
-from .views_staff import _preview_plan, _preview_seed
+from .views_staff import _preview_plan, _preview_seed, preview_page
 
 
 def _study(token: str):
@@ -48,18 +46,6 @@ def shared_preview_item(request, token: str, n: int):
     if n < 1 or n > len(flat):
         return render(request, "studyapp/shared_preview_done.html", {"study": study, "preview": True,
                                                                       "again_url": again})
-    section, it, position = flat[n - 1]
     here = reverse("studyapp:shared_preview_item", args=[token, n]) + f"?seed={seed}"
-    error = ""
-    if request.method == "POST":
-        try:
-            clean_answers(item_questions(section, it.clip, it.options, it.kind, it.instructed), request.POST)
-            return redirect(reverse("studyapp:shared_preview_item", args=[token, n + 1]) + f"?seed={seed}")
-        except AnswerError as exc:
-            error = str(exc)
-    nxt = flat[n][1].clip if n < len(flat) else None
-    ctx = item_context(section, it.clip, n, len(flat), nxt, it.options,
-                       request.POST if request.method == "POST" else None, kind=it.kind, instructed=it.instructed)
-    ctx.update({"study": study, "preview": True, "seed": seed, "error": error, "first_of_section": position == 0,
-                "form_action": here})
-    return render(request, "studyapp/item.html", ctx, status=400 if error else 200)
+    after = reverse("studyapp:shared_preview_item", args=[token, n + 1]) + f"?seed={seed}"
+    return preview_page(request, study, flat, n, seed, here, after, {})

@@ -131,19 +131,27 @@ def preview_item(request, study_id: int, n: int):
         return redirect(reverse("admin:studyapp_study_change", args=[study.pk]))
     if n < 1 or n > len(flat):
         return render(request, "studyapp/done.html", {"study": study, "preview": True, "seed": seed})
+    page = reverse("studyapp:preview_item", args=[study.pk, n]) + f"?seed={seed}"
+    after = reverse("studyapp:preview_item", args=[study.pk, n + 1]) + f"?seed={seed}"
+    return preview_page(request, study, flat, n, seed, page, after, {"clip_label": _preview_label(flat[n - 1][1])})
+
+
+def preview_page(request, study, flat: list, n: int, seed: int, page_url: str, next_url: str, extra: dict):
+    """Clip page n (1-based) of a preview plan ``flat``: answers posted to ``page_url`` are checked like a
+    participant's and never stored; valid ones go on to ``next_url``, invalid ones show the page again (400)."""
     section, it, position = flat[n - 1]
     error = ""
     if request.method == "POST":
         try:
             clean_answers(item_questions(section, it.clip, it.options, it.kind, it.instructed), request.POST)
-            return redirect(reverse("studyapp:preview_item", args=[study.pk, n + 1]) + f"?seed={seed}")
+            return redirect(next_url)
         except AnswerError as exc:
             error = str(exc)
     nxt = flat[n][1].clip if n < len(flat) else None
     ctx = item_context(section, it.clip, n, len(flat), nxt, it.options,
                        request.POST if request.method == "POST" else None, kind=it.kind, instructed=it.instructed)
     ctx.update({"study": study, "preview": True, "seed": seed, "error": error, "first_of_section": position == 0,
-                "clip_label": _preview_label(it)})
+                "form_action": page_url, **extra})
     return render(request, "studyapp/item.html", ctx, status=400 if error else 200)
 
 

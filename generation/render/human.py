@@ -16,7 +16,7 @@ from generation.core.motion import Motion
 from .bodies import Body, load_body
 from .bodies.retarget import fit_rig, pose_transforms
 from .bodies.skinning import Skinner, posed_heads
-from .scene import MANNEQUIN_SHADOW_COLOUR, StickFigureScene
+from .scene import MANNEQUIN_SHADOW_COLOUR, SHADOW_RIM_POINTS, StickFigureScene
 
 #: Muted clothing colours that carry no emotion (no saturated reds, yellows or blues), by region.
 REGION_COLOURS = {"top": (0.47, 0.50, 0.55), "trousers": (0.29, 0.30, 0.33), "shoes": (0.17, 0.16, 0.16),
@@ -210,8 +210,6 @@ class HumanScene(StickFigureScene):
         centres = [pts]
         radii = [np.full(pts.shape[1], 0.02)]
         if shadow:
-            angles = np.linspace(0, 2 * np.pi, 12, endpoint=False)
-            ring = np.stack([np.cos(angles), np.zeros_like(angles), np.sin(angles)], 1) * self.shadow_radius
-            centres.append(positions[:, :1] * np.array([1, 0, 1]) + np.array([0, self.ground_y, 0]) + ring[None])
-            radii.append(np.full(len(angles), 0.01))
+            centres.append(self._shadow_rim(positions))
+            radii.append(np.full(SHADOW_RIM_POINTS, 0.01))
         return np.concatenate(centres, axis=1), np.concatenate(radii)

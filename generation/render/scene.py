@@ -28,6 +28,10 @@ GROUND_MARGIN_M = 25.0  # the floor reaches this far beyond the root's path: its
 GRID_MARGIN_M = 8.0
 
 
+SHADOW_RIM_POINTS = 12
+"""Points on the floor shadow's rim that framing keeps in view."""
+
+
 def _side_colour(name: str) -> tuple[float, float, float]:
     if name.startswith("left_"):
         return LEFT_COLOUR
@@ -272,11 +276,15 @@ class StickFigureScene:
             centres.append(head[:, None])
             radii.append(np.array([self.joint_radius[self.head] + 0.01]))
         if shadow:
-            angles = np.linspace(0, 2 * np.pi, 12, endpoint=False)
-            ring = np.stack([np.cos(angles), np.zeros_like(angles), np.sin(angles)], 1) * self.shadow_radius
-            centres.append(positions[:, :1] * np.array([1, 0, 1]) + np.array([0, self.ground_y, 0]) + ring[None])
-            radii.append(np.full(len(angles), 0.01))
+            centres.append(self._shadow_rim(positions))
+            radii.append(np.full(SHADOW_RIM_POINTS, 0.01))
         return np.concatenate(centres, axis=1), np.concatenate(radii)
+
+    def _shadow_rim(self, positions: np.ndarray) -> np.ndarray:
+        """(T, SHADOW_RIM_POINTS, 3) points on the rim of the floor shadow under the root of ``positions`` (T, J, 3)."""
+        angles = np.linspace(0, 2 * np.pi, SHADOW_RIM_POINTS, endpoint=False)
+        ring = np.stack([np.cos(angles), np.zeros_like(angles), np.sin(angles)], 1) * self.shadow_radius
+        return positions[:, :1] * np.array([1, 0, 1]) + np.array([0, self.ground_y, 0]) + ring[None]
 
     def _screen_boxes(self, centres: np.ndarray, radii: np.ndarray, pose: CameraPose, W: int, H: int):
         """Per-frame pixel boxes (lo (T, 2), hi (T, 2)) around spheres, or None if one is behind the camera."""
