@@ -6,7 +6,7 @@ import pytest
 
 from analysis import figures
 from analysis.io import load_study
-from analysis.report import _make_figures, build_report
+from analysis.report import build_report, make_figures
 from analysis.simulate import write_study
 
 TOLERANCE_PX = 1.0
@@ -60,8 +60,8 @@ def every_figure(tmp_path_factory):
     paths = write_study(str(src), 24, seed=9)
     data = load_study(paths["responses"], paths["clips"], paths["participants"])
     _, tables, extras = build_report(data)
-    return {**_make_figures(tables, extras),
-            **{f"{name} (small study)": fig for name, fig in _make_figures(_small(tables), extras).items()
+    return {**make_figures(tables, extras),
+            **{f"{name} (small study)": fig for name, fig in make_figures(_small(tables), extras).items()
                if name in SMALL}}
 
 
