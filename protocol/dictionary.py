@@ -74,6 +74,8 @@ _CLIPS = {
               "string", "", ""),
     "licence": ("Licence of what the clip was made from (captured or imported material)", "string", "", ""),
     "citation": ("How to cite what the clip was made from", "string", "", ""),
+    "body": ("The human body preset the clip shows (generation/data/bodies; blank: another figure or an imported "
+             "video); a study may vary it as a factor", "string", "", ""),
 }
 
 _RESPONSES = {

@@ -39,7 +39,7 @@ from .vocabulary import (
 
 TEXT_FIELDS: dict[str, tuple[str, ...] | None] = {
     "clip_id": None, "plan": None, "modality": CLIP_MODALITIES, "origin": ORIGINS, "emotion_label": GESTURE_EMOTIONS,
-    "theme": CLIP_THEMES, "sections": SECTION_TYPES}
+    "theme": CLIP_THEMES, "sections": SECTION_TYPES, "body": None}
 """Catalogue text fields a pool may filter on -> the protocol vocabulary of their values (None: free text)."""
 
 NUMBER_FIELDS = (*GAIT_EMOTIONS, *FINAL_EMOTION_COLUMNS, *VAD_DIMENSIONS, "weight", "duration_s")

@@ -229,6 +229,9 @@ CLIP_BODY_COLUMNS = ("body",)
 """Optional extra column of clips.csv after the provenance columns: the human body preset the clip shows
 (``generation/data/bodies/<preset>.npz``; blank for the mannequin, stick and point-light looks). The clip's record
 keeps the body's parameters, licence and citation (``record["body"]``)."""
+BODY_MAX_LENGTH = 60
+"""The longest body preset name a clip record may carry (characters)."""
+
 
 CLIP_FLOAT_COLUMNS = (*GAIT_EMOTIONS, *FINAL_EMOTION_COLUMNS, *VAD_DIMENSIONS, "weight", "duration_s")
 CLIP_INT_COLUMNS = ("n_features",)

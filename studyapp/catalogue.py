@@ -19,6 +19,7 @@ from django.db.models import QuerySet
 from protocol.pools import NORMS_RULE
 from protocol.titles import clip_titles
 from protocol.vocabulary import (
+    BODY_MAX_LENGTH,
     CLIP_FLOAT_COLUMNS,
     CLIP_MODALITIES,
     CLIP_THEMES,
@@ -106,8 +107,20 @@ def clean_record(rec: dict, index: int = 0) -> dict:
     for name in ("licence", "citation"):
         value = rec.get(name, metadata.get(name))
         out[name] = "" if _blank(value) else str(value).strip()
+    out["body"] = _body(rec, where)
     out["qa"], out["qa_flag"] = _qa(rec, where)
     return out
+
+
+def _body(rec: dict, where: str) -> str:
+    """The body preset a clip record shows: ``body`` as the renderer records it (a dict with ``preset``) or as
+    clips.csv writes it (the preset's name); "" for the other figures."""
+    body = rec.get("body")
+    name = body.get("preset") if isinstance(body, dict) else body
+    name = "" if _blank(name) else str(name).strip()
+    if len(name) > BODY_MAX_LENGTH:
+        raise CatalogueError(f"{where}: field 'body' is longer than {BODY_MAX_LENGTH} characters")
+    return name
 
 
 def _qa(rec: dict, where: str) -> tuple[dict, str]:

@@ -41,6 +41,7 @@ from protocol.pools import NORMS_RULE
 from protocol.vocabulary import (
     ASSIGNMENT_COLUMNS,
     ATTENTION_CHECK,
+    CLIP_BODY_COLUMNS,
     CLIP_COLUMNS,
     CLIP_PROVENANCE_COLUMNS,
     PARTICIPANT_COLUMNS,
@@ -136,7 +137,7 @@ def study_clips(study: Study):
 #: The study's clips.csv: the public columns, then the clip's readable title (protocol.titles) and the licence and
 #: citation of what it was made from (blank where the catalogue has none), which travel with the clips into every
 #: report and reuse.
-EXPORT_CLIP_COLUMNS = (*CLIP_COLUMNS, *CLIP_PROVENANCE_COLUMNS)
+EXPORT_CLIP_COLUMNS = (*CLIP_COLUMNS, *CLIP_PROVENANCE_COLUMNS, *CLIP_BODY_COLUMNS)
 
 
 def clip_rows(study: Study) -> Iterator[list]:

@@ -17,7 +17,7 @@ from django.utils import timezone
 from protocol.dictionary import PILOT_PREFIX
 from protocol.pools import errors_by_field, validate_section
 from protocol.titles import TITLE_MAX_LENGTH
-from protocol.vocabulary import ATTENTION_CHECK, CLIP_MODALITIES, ORIGINS
+from protocol.vocabulary import ATTENTION_CHECK, BODY_MAX_LENGTH, CLIP_MODALITIES, ORIGINS
 
 from .permissions import STUDY_PERMISSIONS
 from .questions import section_type_choices
@@ -59,6 +59,9 @@ class Clip(models.Model):
     # A readable label for staff pages and exports (protocol.titles: generator, condition, variant); never shown
     # to participants.
     title = models.CharField(max_length=TITLE_MAX_LENGTH, blank=True)
+    body = models.CharField(max_length=BODY_MAX_LENGTH, blank=True,
+                            help_text="The human body preset the clip shows (blank: a mannequin, stick figure or "
+                                      "point-lights, or an imported video)")
     modality = models.CharField(max_length=10, choices=[(m, m) for m in CLIP_MODALITIES])
     origin = models.CharField(max_length=10, choices=[(o, o) for o in ORIGINS])
     happy = models.FloatField(null=True, blank=True)

@@ -159,7 +159,7 @@ def test_exports_match_design_formats(staff, study):
     assert likert == set(LIKERT_FEATURES)
     assert {x["participant_id"] for x in rows} == {p1.public_id, p2.public_id}
     clips = read_csv(staff.get(reverse("studyapp:export_csv", args=[study.pk, "clips"])))
-    assert tuple(clips[0]) == (*CLIP_COLUMNS, "title", "licence", "citation")       # public columns, then provenance
+    assert tuple(clips[0]) == (*CLIP_COLUMNS, "title", "licence", "citation", "body")  # public, provenance, body
     assert {x["clip_id"] for x in rows} <= {c["clip_id"] for c in clips}
     tr = next(c for c in clips if c["clip_id"].startswith("gait_tr_"))
     assert tr["final_happy"] != "" and next(c for c in clips if c["clip_id"] == "gait_gen_00")["final_happy"] == ""
