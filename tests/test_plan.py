@@ -226,3 +226,17 @@ def test_demo_source_walks_are_real_capture_with_their_licence():
     meta = make_motion(sources[0]).metadata
     assert meta["captured"] is True and meta["synthetic"] is False
     assert meta["licence"] == "CC BY-NC 4.0" and "arXiv:2306.08861" in meta["citation"] and meta["take"]
+
+
+def test_a_plan_crosses_its_entries_with_bodies():
+    from generation.plans.schema import PlanError, validate_plan
+
+    walk = {"id": "w", "generator": "procedural_walk", "emotion": "happy"}
+    plan = validate_plan({"name": "bodies", "bodies": ["female", "male"],
+                          "clips": [walk, {**walk, "id": "v", "bodies": ["female-older"], "seed": 3}]})
+    assert [(e.id, e.render.body, e.render.body_preset) for e in plan.entries] == [
+        ("w-female", "human", "female"), ("w-male", "human", "male"), ("v-female-older", "human", "female-older")]
+    with pytest.raises(PlanError, match="'bodies'"):
+        validate_plan({"name": "bodies", "bodies": ["female", "female"], "clips": [walk]})
+    with pytest.raises(PlanError, match="unknown body preset"):
+        validate_plan({"name": "bodies", "bodies": ["giant"], "clips": [walk]})

@@ -5,6 +5,7 @@ A plan is a YAML (or JSON) file::
     name: demo
     description: ...
     render: {width: 640, height: 480, fps: 30, duration_s: 10}   # defaults for every clip
+    bodies: [female, male]   # optional: every entry once per human body preset (an entry's own `bodies` wins)
     qa: {foot_skate_cm_s: 5, jerk: null}   # optional: thresholds (protocol.vocabulary.QA_THRESHOLDS; null = off)
     clips:
       - id: happy_straight          # unique within the plan; never shown to participants
@@ -172,11 +173,33 @@ def _validate_entry(i: int, raw, plan_render: RenderSettings) -> ClipEntry:
     return ClipEntry(i, entry_id, modality, gen, origin, inputs, seed, fallback, loop, sections, pair, render, note)
 
 
+def cross_bodies(clips: list, plan_bodies, source: str) -> list:
+    """Raw plan entries crossed with human bodies: an entry with ``bodies: [female, male]`` (or, without its own,
+    the plan's top-level ``bodies``) becomes one entry per body preset, ``id`` suffixed with ``-<preset>`` and
+    ``render: {body: human, body_preset: <preset>}``; other entries stay as they are. PlanError for a list that is
+    not one of distinct names (an unknown preset is refused with the entry's render settings)."""
+    out = []
+    for i, raw in enumerate(clips, start=1):
+        bodies = raw.get("bodies", plan_bodies) if isinstance(raw, dict) else None
+        if bodies is None:
+            out.append(raw)
+            continue
+        if (not isinstance(bodies, list) or not bodies or len(set(map(str, bodies))) != len(bodies)
+                or not all(isinstance(b, str) and b.strip() for b in bodies)):
+            raise PlanError(f"{source}: entry {i}: field 'bodies': expected a list of distinct body preset names, "
+                            f"got {bodies!r}")
+        base = {k: v for k, v in raw.items() if k != "bodies"}
+        for body in bodies:
+            render = {**(base.get("render") or {}), "body": "human", "body_preset": body.strip()}
+            out.append({**base, "id": f"{base.get('id')}-{body.strip()}", "render": render})
+    return out
+
+
 def validate_plan(data, source: str = "<plan>") -> Plan:
     """A :class:`Plan` from parsed YAML/JSON, or PlanError naming the entry and field."""
     if not isinstance(data, dict):
         raise PlanError(f"{source}: a plan must be a mapping with 'name' and 'clips', got {type(data).__name__}")
-    unknown = set(data) - {"name", "description", "render", "clips", "meta", "qa"}
+    unknown = set(data) - {"name", "description", "render", "clips", "meta", "qa", "bodies"}
     if unknown:
         raise PlanError(f"{source}: unknown top-level field(s) {sorted(unknown)}")
     name = data.get("name")
@@ -189,6 +212,7 @@ def validate_plan(data, source: str = "<plan>") -> Plan:
     clips = data.get("clips")
     if not isinstance(clips, list) or not clips:
         raise PlanError(f"{source}: field 'clips': expected a non-empty list of entries")
+    clips = cross_bodies(clips, data.get("bodies"), source)
     entries = [_validate_entry(i, raw, render) for i, raw in enumerate(clips, start=1)]
     seen: dict[str, ClipEntry] = {}
     for e in entries:
