@@ -175,7 +175,8 @@ def firefox():
     with socket.socket() as probe:
         probe.bind(("127.0.0.1", 0))
         port = probe.getsockname()[1]
-    client = Marionette(bin=browser, headless=True, port=port, startup_timeout=120)
+    log = Path(tempfile.mkdtemp(prefix="gecko-")) / "gecko.log"     # not the working directory's gecko.log
+    client = Marionette(bin=browser, headless=True, port=port, startup_timeout=120, gecko_log=str(log))
     client.start_session()
     client.set_window_rect(width=BROWSER_WINDOW[0], height=BROWSER_WINDOW[1])
     browser_api = MarionetteBrowser(client)
