@@ -11,6 +11,7 @@ from django.urls import reverse
 
 from analysis.io import read_clips, read_participants, read_responses
 from protocol.vocabulary import (
+    CLIP_BODY_COLUMNS,
     CLIP_COLUMNS,
     CLIP_PROVENANCE_COLUMNS,
     MULTI_SELECT_KINDS,
@@ -80,7 +81,8 @@ def test_demo_study_round_trip(settings, tmp_path):
     def header(kind: str) -> tuple[str, ...]:
         return tuple(paths[kind].read_text(encoding="utf-8").splitlines()[0].split(","))
 
-    assert header("clips") == (*CLIP_COLUMNS, *CLIP_PROVENANCE_COLUMNS) and header("responses") == RESPONSE_COLUMNS
+    assert header("clips") == (*CLIP_COLUMNS, *CLIP_PROVENANCE_COLUMNS, *CLIP_BODY_COLUMNS)
+    assert header("responses") == RESPONSE_COLUMNS
     assert header("participants")[:len(PARTICIPANT_COLUMNS)] == PARTICIPANT_COLUMNS
     assert not clips.attrs.get("ignored_columns") and not responses.attrs.get("ignored_columns")
     assert len(responses) == Response.objects.count() > 0
