@@ -144,9 +144,12 @@ def _progress(job: str) -> dict:
 
 
 @pytest.mark.django_db
-def test_a_render_killed_midway_is_shown_failed_and_resumes_without_rendering_finished_clips(staff, settings):
+def test_a_render_killed_midway_is_shown_failed_and_resumes_without_rendering_finished_clips(staff, settings,
+                                                                                           monkeypatch):
+    # The detached job runs on its own SQLite database in DATA_DIR (the test database is not reachable from
+    # another process); under PostgreSQL, DATABASE_URL names an unmigrated server database, so the job goes without.
+    monkeypatch.delenv("DATABASE_URL", raising=False)
     env = dict(os.environ, DATA_DIR=str(settings.DATA_DIR), MEDIA_ROOT=str(settings.MEDIA_ROOT))
-    env.pop("DATABASE_URL", None)
     Path(settings.DATA_DIR).mkdir(parents=True)
     subprocess.run([sys.executable, "manage.py", "migrate", "-v", "0"], cwd=settings.BASE_DIR, env=env, check=True)
     data, plan = build_plan(StimulusSet(name="killed", generator="procedural_walk", conditions=["happy", "sad"],
