@@ -18,7 +18,6 @@ import http.client
 import json
 import os
 import secrets
-import socket
 import statistics
 import subprocess
 import sys
@@ -29,6 +28,8 @@ from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
 import psutil
+
+from benchmarks.local_server import free_port, wait_for_server
 
 ROOT = Path(__file__).resolve().parent.parent
 MiB = 1024 * 1024
@@ -45,12 +46,6 @@ c = Client()
 c.force_login(user)
 print(Clip.objects.get().media_key, c.cookies["sessionid"].value)
 """
-
-
-def free_port() -> int:
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return s.getsockname()[1]
 
 
 def synthetic_video(path: Path, size: int) -> None:
@@ -112,15 +107,7 @@ def run(code: Path, size: int, readers: int, workers: int) -> dict:
                                   env=env, cwd=code, stdout=subprocess.DEVNULL, stderr=log.open("wb"))
         try:
             proc = psutil.Process(server.pid)
-            deadline = time.monotonic() + 60
-            while True:
-                try:
-                    with socket.create_connection(("127.0.0.1", port), timeout=1):
-                        break
-                except OSError:
-                    if time.monotonic() > deadline or server.poll() is not None:
-                        raise SystemExit(f"the server did not start: {log.read_text()[-2000:]}") from None
-                    time.sleep(0.2)
+            wait_for_server(server, port, log)
             path = f"/m/{key}.mp4"
             for _ in range(workers * 2):                  # warm every worker (imports, first request)
                 read_range(port, path, cookie, size - 1024)

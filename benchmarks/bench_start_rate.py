@@ -19,7 +19,6 @@ import json
 import os
 import re
 import secrets
-import socket
 import statistics
 import subprocess
 import sys
@@ -28,17 +27,13 @@ import time
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
+from benchmarks.local_server import free_port, wait_for_server
+
 ROOT = Path(__file__).resolve().parent.parent
 SETUP = """
 from studyapp.presets import create_study_from_preset
 create_study_from_preset("rbf_thms2016", "rate", plan="test", status="open")
 """
-
-
-def free_port() -> int:
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return s.getsockname()[1]
 
 
 def start(port: int, address: str, pid: str) -> tuple[int, float]:
@@ -99,15 +94,7 @@ def main(argv=None) -> None:
                                    "-w", str(args.workers), "-b", f"127.0.0.1:{port}"], env=env, cwd=ROOT,
                                   stdout=subprocess.DEVNULL, stderr=log.open("wb"))
         try:
-            deadline = time.monotonic() + 60
-            while True:
-                try:
-                    with socket.create_connection(("127.0.0.1", port), timeout=1):
-                        break
-                except OSError:
-                    if time.monotonic() > deadline or server.poll() is not None:
-                        raise SystemExit(f"the server did not start: {log.read_text()[-2000:]}") from None
-                    time.sleep(0.2)
+            wait_for_server(server, port, log)
             gap = args.prolific_seconds / args.prolific
             t0 = time.perf_counter()
 
