@@ -24,7 +24,8 @@ from generation.gait.train import (
     splice_histories,
     train,
 )
-from generation.gait.weights import TrainingData, is_real
+from generation.gait.upgrade_weights import upgrade_weights
+from generation.gait.weights import NAMED_WEIGHTS, TrainingData, is_real, weights_path
 
 torch.set_num_threads(1)
 pytest_plugins = ("gait_fixtures",)   # the tiny_data and tiny_net fixtures
@@ -143,6 +144,12 @@ def test_weights_files_say_what_they_were_trained_on_and_old_files_still_load(ti
         torch.save({**payload, "format": "gait_net/2", "trained_on": trained_on}, old)
         net = load_model(old)
         assert net.training_data.kind == kind and net.info["trained_on"] == trained_on
+        assert upgrade_weights(old) and not upgrade_weights(old)      # rewritten once, then already current
+        upgraded = torch.load(old, weights_only=False)
+        assert upgraded["format"] == "gait_net/3" and upgraded["training_data"]["kind"] == kind
+        assert all(torch.equal(a, b) for a, b in zip(net.model.state_dict().values(),
+                                                     load_model(old).model.state_dict().values()))
+        assert load_model(old).training_data == net.training_data and load_model(old).info == net.info
     with pytest.raises(ValueError, match="training data kind"):
         TrainingData("synthetic", "x")
     with pytest.raises(ValueError, match="do not say what they are"):
@@ -189,3 +196,11 @@ def test_fine_tuning_starts_from_a_weights_file(tiny_data, tmp_path):
     with pytest.raises(ValueError, match="architecture"):
         train(GaitNetConfig.tiny(epochs=1, gru_hidden=16), tiny_data, tmp_path / "c.pt", tmp_path / "c.ckpt",
               progress=False, log=lambda *_: None, init=tmp_path / "a.pt")
+
+
+@pytest.mark.parametrize("name", sorted(NAMED_WEIGHTS))
+def test_shipped_gait_weights_carry_their_typed_training_record(name):
+    payload = torch.load(weights_path(name), map_location="cpu", weights_only=False)
+    assert payload["format"] == "gait_net/3"
+    record = TrainingData.from_record(payload["training_data"])
+    assert record.kind == name and record.description == payload["trained_on"] and record.datasets

@@ -107,9 +107,10 @@ class TrainingData:
 
 def training_data_of(payload: dict) -> TrainingData:
     """The training data of a weights file's payload: its ``training_data`` record (format gait_net/3). A file of
-    format gait_net/2 has only the prose ``trained_on`` and the ``corpus`` record; it is read here, once: a
+    format gait_net/2 has only the prose ``trained_on`` and the ``corpus`` record; it is read here and nowhere else: a
     ``trained_on`` that begins "real capture" is real capture of the corpus's ``stage``, anything else the
-    procedural corpus."""
+    procedural corpus. ``python -m generation.gait.upgrade_weights FILE`` writes such a file again with its record
+    (the shipped weights were, keeping their weights bit for bit)."""
     if payload.get("format") != "gait_net/2":
         return TrainingData.from_record(payload["training_data"])
     corpus = payload.get("corpus")
