@@ -19,7 +19,7 @@ from django.core.management import call_command
 from django.db import connections
 from django.urls import reverse
 
-from studyapp import background
+from studyapp import background, render_jobs
 from studyapp.models import Clip, Participant, Study
 from studyapp.testing import wait_for
 from tests.test_e2e_norming import simulated_participant
@@ -47,18 +47,25 @@ def threaded_jobs(monkeypatch) -> dict:
 
     def launch(cmd, folder, log_name, pid_name):
         args = cmd[cmd.index("generate_clips") + 1:]
-        shared = connections["default"]     # the test server's one connection to the in-memory database
-        shared.inc_thread_sharing()
+        # SQLite's in-memory test database is reachable only through the test server's own connection; a
+        # PostgreSQL one is a real database, and its pooled connections must not cross threads
+        shared = connections["default"] if connections["default"].vendor == "sqlite" else None
+        if shared is not None:
+            shared.inc_thread_sharing()
 
         def run():
-            connections["default"] = shared
+            if shared is not None:
+                connections["default"] = shared
             with open(Path(folder) / log_name, "a") as log:
                 try:
                     call_command("generate_clips", *args, stdout=log, stderr=log)
                 except Exception as exc:  # noqa: BLE001 - the job's log says what failed, as the real one does
                     log.write(f"{exc}\n")
                 finally:
-                    shared.dec_thread_sharing()
+                    if shared is not None:
+                        shared.dec_thread_sharing()
+                    else:
+                        connections["default"].close()
 
         threads[str(folder)] = thread = threading.Thread(target=run, daemon=True)
         thread.start()
@@ -141,7 +148,11 @@ def test_from_a_preset_to_a_piloted_shared_and_cloned_study(chromium, live_serve
         d.get(status_url)         # as the page's own refresh does every 3 s
         return False
 
-    wait_for(driver, finished, timeout=60, what="the render's page to say it is done")
+    try:
+        wait_for(driver, finished, timeout=60, what="the render's page to say it is done")
+    except AssertionError as exc:
+        state = render_jobs.render_state(status_url.rstrip("/").rsplit("/", 1)[-1])
+        raise AssertionError(f"{exc}; the render is {state.status}, its log ends:\n{state.log[-1500:]}") from None
     render_s = time.perf_counter() - render_started
     assert Clip.objects.filter(plan="gaits-mini").count() == 14
     assert driver.find_element(By.ID, "render-sheet").is_displayed()
