@@ -6,7 +6,8 @@ percentile, m) of :func:`generation.gesture.real_stats.motion_stats`, against th
 (``generation/data/gesture_real_ranges.json``: Bandai Namco dataset 1 seated gestures, CC BY-NC 4.0) of the captured
 emotion closest in valence-arousal-dominance (``protocol.vocabulary.GESTURE_VAD``, Euclidean) to the clip's emotion:
 **before** = the network's output (``real_range: off``), **after** = with the default ``real_range: closest``
-(:mod:`generation.gesture.range_fit`: the amplitude about the mean pose scaled into the range where one factor can).
+(:mod:`generation.gesture.range_fit`: the upper arms swung forward or back and the amplitude about the mean pose
+scaled, by the smallest change that gets the clip into the range).
 
     OMP_NUM_THREADS=1 python -m benchmarks.bench_gesture_closest_range \
         [--json docs/benchmarks/gesture_closest_range.json]
@@ -44,22 +45,25 @@ def plan_rows(plans=("demo", "seed003")) -> list[dict]:
             inside_before = {k: ranges[ref][k][0] <= rec["before"][k] <= ranges[ref][k][1] for k in STATS}
             inside = {k: ranges[ref][k][0] <= rec["after"][k] <= ranges[ref][k][1] for k in STATS}
             rows.append({"plan": plan, "id": e.id, "emotion": e.inputs["emotion_label"], "closest_captured": ref,
-                         "factor": rec["factor"], "before": rec["before"], "stats": rec["after"],
+                         "factor": rec["factor"], "shoulder_flexion_deg": rec.get("shoulder_flexion_deg", 0.0),
+                         "before": rec["before"], "stats": rec["after"],
                          "inside_before": inside_before, "inside": inside})
     return rows
 
 
 def render(rows: list[dict], ranges: dict) -> str:
-    lines = ["| plan | clip | emotion | closest captured | amplitude factor | " + " | ".join(STATS) + " |",
-             "|---|---|---|---|---|" + "---|" * len(STATS)]
+    lines = ["| plan | clip | emotion | closest captured | amplitude factor | shoulders forward (deg) | "
+             + " | ".join(STATS) + " |", "|---|---|---|---|---|---|" + "---|" * len(STATS)]
     for r in rows:
         cells = []
         for k in STATS:
             lo, hi = ranges[r["closest_captured"]][k]
             mark = "" if r["inside"][k] else " **out**"
-            was = "" if r["factor"] == 1.0 else f" (was {r['before'][k]:.3f})"
+            changed = r["factor"] != 1.0 or r["shoulder_flexion_deg"] != 0.0
+            was = f" (was {r['before'][k]:.3f})" if changed else ""
             cells.append(f"{r['stats'][k]:.3f}{was} [{lo:.3f}, {hi:.3f}]{mark}")
         lines.append(f"| {r['plan']} | {r['id']} | {r['emotion']} | {r['closest_captured']} | {r['factor']:.2f} | "
+                     f"{r['shoulder_flexion_deg']:+.0f} | "
                      + " | ".join(cells) + " |")
     n = len(rows)
     inside_all = sum(all(r["inside"].values()) for r in rows)

@@ -3,7 +3,8 @@
 Rows: afraid, ashamed, sad, angry, joyous, proud, neutral. Columns: the real seated ``bye`` take of the closest
 captured emotion (Bandai Namco dataset 1, CC BY-NC 4.0), the network's gesture of one sentence with that emotion
 (``real_range: off``) and the same fitted into the real range (``real_range: closest``,
-:mod:`generation.gesture.range_fit`). Each tile: the frame of the fastest wrist movement over ghosts of the clip
+:mod:`generation.gesture.range_fit`: the amplitude factor and the shoulder angle in the caption).
+Each tile: the frame of the fastest wrist movement over ghosts of the clip
 (:func:`benchmarks.bench_gesture.onion_skin`), upper body; the caption gives wrist speed (mean / 90th percentile,
 m/s) and reach (90th percentile, m).
 
@@ -73,7 +74,8 @@ def main(argv=None) -> int:
             tile(raw, f"raw_{emo}", f"{emo}: network")
             fitted = fit_closest_range(raw, emo)
             rec = fitted.metadata["real_range"]
-            tile(fitted, f"fit_{emo}", f"{emo}: fitted x{rec['factor']:.2f} ({'inside' if rec['inside'] else 'not'})")
+            tile(fitted, f"fit_{emo}", f"{emo}: fitted x{rec['factor']:.2f}, shoulders "
+                 f"{rec.get('shoulder_flexion_deg', 0.0):+.0f} deg ({'inside' if rec['inside'] else 'not'})")
         contact_sheet(tiles, labels, a.out, columns=3, thumb_width=300)
     Image.open(a.out).quantize(96).save(a.out, optimize=True)
     print("wrote", a.out)

@@ -29,7 +29,7 @@ REAL_RANGE = ("closest", "off")
 class GestureNetInputs(PlanInputs):
     """The spoken ``sentence``, the ``task``, the ``emotion_label``, the agent's build and handedness, latent
     ``noise`` (0..1), optionally the corpus split the sentence comes from, and ``real_range`` (``closest``: the
-    amplitude fitted into the real captured range of the closest captured emotion, or ``off``)."""
+    amplitude and shoulder posture fitted into the real captured range of the closest captured emotion, or ``off``)."""
 
     PLAN_FIELDS = frozenset({"sentence", "task", "emotion_label", "gender", "handedness", "noise", "sentence_split",
                              "real_range"})
