@@ -208,7 +208,8 @@ class Study(models.Model):
 
 
 class Section(models.Model):
-    """A block of clips with one question set; `order` fixes the position in the study."""
+    """A block of clips with one question set, or an instruction or break page (a page type: no clips, no
+    questions; studyapp.section_pages); `order` fixes the position in the study."""
 
     study = models.ForeignKey(Study, on_delete=models.CASCADE, related_name="sections")
     order = models.PositiveIntegerField(default=0)
@@ -240,7 +241,9 @@ class Section(models.Model):
                   'or {"practice_clip": "<clip_id>"}')
     counterbalance = models.BooleanField(
         default=True, help_text="Rotates with the other rotating sections when the study counterbalances its "
-                                "section order; untick to pin this section to its place (e.g. a final section)")
+                                "section order; untick to pin this section to its place (e.g. a final section). "
+                                "An instruction or break page travels with the section that follows it (its own "
+                                "tick is not used); a page after the last section stays last")
 
     class Meta:
         ordering = ["study", "order", "id"]
@@ -307,6 +310,9 @@ class Participant(models.Model):
     n_items = models.PositiveIntegerField(default=0, editable=False)
     # Consented while the study was in pilot mode (Study.pilot): public_id starts with PILOT_PREFIX.
     pilot = models.BooleanField(default=False, editable=False, db_index=True)
+    # The instruction and break pages this participant is given, fixed at start in the order taken
+    # (studyapp.section_pages): section pk, the clip number they come before, when first shown and when continued.
+    pages = models.JSONField(default=list, blank=True, editable=False)
 
     class Meta:
         constraints = [
