@@ -20,7 +20,7 @@ from protocol.section_types.pages import BREAK
 from . import section_pages
 from .assignment import current_step
 from .models import Participant, Section
-from .views import SESSION_KEY, _participant, _remember, step_url
+from .views import SESSION_KEY, _participant, _remember, mark_completed, step_url
 
 
 def page_wording(section: Section) -> tuple[str, str]:
@@ -47,6 +47,14 @@ def _render_page(request, participant: Participant, section: Section, n: int, st
         "percent": int(round(100 * done / max(total, 1)))}, status=status)
 
 
+def _onwards(participant: Participant):
+    """A redirect to the participant's step after a page; the end of the study is recorded when it ends here."""
+    step = current_step(participant)
+    if step.kind == "done":
+        mark_completed(participant)
+    return redirect(step_url(participant.token, step))
+
+
 @never_cache
 @require_http_methods(["GET", "HEAD", "POST"])
 def page(request, token: str, n: int):
@@ -59,7 +67,7 @@ def page(request, token: str, n: int):
     section = Section.objects.filter(pk=record.get("section"), study_id=participant.study_id).first()
     if section is None:            # the page was deleted from the study after this participant started
         section_pages.record(participant, n, "continued_at")
-        return redirect(step_url(token, current_step(participant)))
+        return _onwards(participant)
     if request.method == "POST":
         left = section_pages.wait_left(section, record)
         if left > 0:
@@ -68,7 +76,7 @@ def page(request, token: str, n: int):
                 "seconds": math.ceil(left)})
         section_pages.record(participant, n, "shown_at")         # a Continue without a display (no script)
         section_pages.record(participant, n, "continued_at")
-        return redirect(step_url(token, current_step(participant)))
+        return _onwards(participant)
     if request.method != "HEAD":
         section_pages.record(participant, n, "shown_at")
         if request.session.get(SESSION_KEY, {}).get(participant.study.slug) != participant.token:
