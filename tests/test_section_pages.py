@@ -318,3 +318,12 @@ def test_section_form_names_a_pool_on_a_page(study):
                        instance=Section(study=study))
     assert not form.is_valid()
     assert "leave its pool empty" in " ".join(form.errors.get("pool", []))
+
+
+def test_a_german_study_shows_its_pages_in_german(client, study):
+    Study.objects.filter(pk=study.pk).update(language="de")
+    p = reach_break(client, study)
+    html = client.get(page_url(p, 2)).content.decode()
+    assert "Kurze Pause" in html and "Sie können in 30 Sekunden weitermachen." in html and ">Weiter<" in html
+    r = client.post(page_url(p, 2))
+    assert r.status_code == 400 and "Bitte ruhen Sie sich noch etwas aus" in r.content.decode()
