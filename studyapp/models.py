@@ -16,6 +16,7 @@ from django.utils import timezone
 
 from protocol.dictionary import PILOT_PREFIX
 from protocol.pools import errors_by_field, validate_section
+from protocol.section_types import is_page_type
 from protocol.titles import TITLE_MAX_LENGTH
 from protocol.vocabulary import ATTENTION_CHECK, BODY_MAX_LENGTH, CLIP_MODALITIES, ORIGINS
 
@@ -260,7 +261,10 @@ class Section(models.Model):
         errors: dict[str, list[str]] = dict(self.protocol_errors())
         if self.reuse_section_id:
             other = self.reuse_section
-            if other.study_id != self.study_id:
+            if is_page_type(self.section_type) or is_page_type(other.section_type):
+                errors["reuse_section"] = ["An instruction or break page has no clips: it can neither reuse "
+                                           "another section's clips nor be reused."]
+            elif other.study_id != self.study_id:
                 errors["reuse_section"] = ["The reused section must belong to the same study."]
             elif (other.order, other.pk or 0) >= (self.order, self.pk or 10**12):
                 errors["reuse_section"] = ["The reused section must come before this one."]

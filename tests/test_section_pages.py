@@ -327,3 +327,16 @@ def test_a_german_study_shows_its_pages_in_german(client, study):
     assert "Kurze Pause" in html and "Sie können in 30 Sekunden weitermachen." in html and ">Weiter<" in html
     r = client.post(page_url(p, 2))
     assert r.status_code == 400 and "Bitte ruhen Sie sich noch etwas aus" in r.content.decode()
+
+
+def test_a_page_neither_reuses_nor_is_reused(study):
+    from django.core.exceptions import ValidationError
+
+    page = study.sections.get(order=2)
+    later = study.sections.get(order=3)
+    later.reuse_section = page
+    with pytest.raises(ValidationError, match="neither reuse"):
+        later.full_clean()
+    page.reuse_section = study.sections.get(order=1)
+    with pytest.raises(ValidationError, match="neither reuse"):
+        page.full_clean()
