@@ -74,17 +74,16 @@ def wait_left(section: Section, record: dict, now: datetime | None = None) -> fl
 
 def record(participant: Participant, n: int, field: str, now: datetime | None = None) -> bool:
     """Set ``field`` (shown_at or continued_at) of page n to ``now`` once: under the participant's row lock, so
-    two requests never both write it. Returns False when it was set already or there is no page n."""
-    stamp = (now or timezone.now()).isoformat()
+    two requests never both write it; the participant's last activity too (a long break is not abandonment).
+    Returns False when it was set already or there is no page n."""
+    now = now or timezone.now()
+    stamp = now.isoformat()
     with transaction.atomic():
         pages = (Participant.objects.select_for_update().filter(pk=participant.pk)
                  .values_list("pages", flat=True).first())
         if not pages or not 1 <= n <= len(pages) or pages[n - 1].get(field):
             return False
         pages[n - 1] = {**pages[n - 1], field: stamp}
-        updates = {"pages": pages}
-        if field == "continued_at":
-            updates["last_active_at"] = now or timezone.now()
-        Participant.objects.filter(pk=participant.pk).update(**updates)
+        Participant.objects.filter(pk=participant.pk).update(pages=pages, last_active_at=now)
     participant.pages = pages
     return True
