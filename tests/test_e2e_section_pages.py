@@ -83,3 +83,43 @@ def test_break_and_instruction_pages_in_chromium(chromium, live_server, settings
     rows = list(csv.DictReader(io.StringIO("".join(stream_csv(study, "pages")))))
     assert [r["section_type"] for r in rows] == ["break_page", "instruction_page"]
     assert float(rows[0]["seconds"]) >= WAIT_S and all(r["continued_at"] for r in rows)
+
+
+def test_a_researcher_adds_a_break_page_in_the_admin_in_chromium(chromium, live_server, settings, tmp_path):
+    """The study's admin page: a new section of type break_page shows its wait field and hides the clip pool and
+    the practice and check fields (static/studyapp/admin_pool.js); saved, it is a break page with that wait."""
+    from django.contrib.auth.models import User
+    from selenium.webdriver.common.by import By
+    from selenium.webdriver.support.ui import Select
+
+    settings.MEDIA_ROOT = tmp_path / "media"
+    make_catalogue(settings.MEDIA_ROOT)
+    study = Study.objects.create(slug="paged-admin", title="Paged study")
+    Section.objects.create(study=study, order=1, section_type="emotion_choice", clips_per_participant=2,
+                           pool={"modality": "gait"})
+    User.objects.create_superuser("researcher", "r@example.org", "pages-pw-12345")
+    driver = chromium
+    driver.get(live_server.url + "/admin/login/")
+    driver.find_element(By.ID, "id_username").send_keys("researcher")
+    driver.find_element(By.ID, "id_password").send_keys("pages-pw-12345")
+    driver.find_element(By.CSS_SELECTOR, "input[type=submit]").click()
+    wait_for(driver, lambda d: "/admin/login/" not in d.current_url, what="admin login")
+    driver.get(live_server.url + reverse("admin:studyapp_study_change", args=[study.pk]))
+    driver.execute_script("document.querySelector('#sections-group .add-row a').click()")
+    row = wait_for(driver, lambda d: d.find_element(By.ID, "sections-1"), what="a new section form")
+    Select(row.find_element(By.NAME, "sections-1-section_type")).select_by_value("break_page")
+    driver.execute_script("arguments[0].dispatchEvent(new Event('change', {bubbles: true}))",
+                          row.find_element(By.NAME, "sections-1-section_type"))
+    wait_for(driver, lambda d: d.find_element(By.NAME, "sections-1-opt_wait_seconds").is_displayed(),
+             what="the break's wait field")
+    assert not row.find_element(By.NAME, "sections-1-pool_plan").is_displayed()
+    assert not row.find_element(By.NAME, "sections-1-opt_practice").is_displayed()
+    row.find_element(By.NAME, "sections-1-order").clear()
+    row.find_element(By.NAME, "sections-1-order").send_keys("2")
+    row.find_element(By.NAME, "sections-1-title").send_keys("Rest a moment")
+    row.find_element(By.NAME, "sections-1-opt_wait_seconds").send_keys("20")
+    driver.find_element(By.CSS_SELECTOR, "input[name=_continue]").click()
+    wait_for(driver, lambda d: Section.objects.filter(study=study, order=2).exists(), what="the saved page")
+    page = Section.objects.get(study=study, order=2)
+    assert (page.section_type, page.title, page.options, page.pool) == ("break_page", "Rest a moment",
+                                                                        {"wait_seconds": 20}, {})
