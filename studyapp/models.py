@@ -220,9 +220,11 @@ class Section(models.Model):
                                       "to participants")
     title = models.CharField(max_length=200, blank=True,
                              help_text="The heading participants see on its clip pages, in their words (blank: plain "
-                                       "words for the section type, e.g. \"How does this walk look?\")")
+                                       "words for the section type, e.g. \"How does this walk look?\"); of an "
+                                       "instruction or break page: its title")
     instructions = models.TextField(blank=True, help_text="What participants are asked to do, shown above the clip "
-                                                          "(blank: the section type's plain-words default)")
+                                                          "(blank: the section type's plain-words default); of an "
+                                                          "instruction or break page: its text")
     pool = models.JSONField(
         default=dict, blank=True,
         help_text='Clip pool as catalogue filters, e.g. {"modality": "gait", "origin": "generated", '
