@@ -340,3 +340,23 @@ def test_a_page_neither_reuses_nor_is_reused(study):
     page.reuse_section = study.sections.get(order=1)
     with pytest.raises(ValidationError, match="neither reuse"):
         page.full_clean()
+
+
+def test_a_page_first_and_a_page_before_the_feedback(client, settings, tmp_path):
+    settings.MEDIA_ROOT = tmp_path / "media"
+    make_catalogue(settings.MEDIA_ROOT)
+    s = Study.objects.create(slug="framed", title="Framed", status=Study.Status.OPEN, ask_demographics=True,
+                             feedback_questions=[{"key": "comments", "text": "Anything else?", "kind": "text"}])
+    add_sections(s, ("instruction_page", {"title": "Welcome"}), ("emotion_choice", GAIT),
+                 ("instruction_page", {"title": "Nearly there"}))
+    r = client.post(reverse("studyapp:study_entry", args=[s.slug]), {"consent": "on"})
+    p = Participant.objects.get(token=r["Location"].rstrip("/").split("/")[-1])
+    assert client.get(reverse("studyapp:resume", args=[p.token]))["Location"].endswith("/about-you/")
+    client.post(reverse("studyapp:demographics", args=[p.token]), {"gender": "female", "age_group": "25-34"})
+    assert client.get(reverse("studyapp:resume", args=[p.token]))["Location"] == page_url(p, 1)
+    assert "Welcome" in client.get(page_url(p, 1)).content.decode()
+    assert client.post(page_url(p, 1))["Location"] == reverse("studyapp:item", args=[p.token, 1])
+    answer(client, p, 1)
+    assert answer(client, p, 2)["Location"] == page_url(p, 2)
+    assert client.get(reverse("studyapp:feedback", args=[p.token]))["Location"].endswith(f"/p/{p.token}/")
+    assert client.post(page_url(p, 2))["Location"] == reverse("studyapp:feedback", args=[p.token])
