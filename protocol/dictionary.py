@@ -11,6 +11,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
 
+from .section_types import page_types
 from .vocabulary import (
     ANSWER_QUESTIONS,
     ATTENTION_CHECK,
@@ -124,6 +125,17 @@ _VIEWING = {
     "shows": ("How often the page was displayed (1 + reloads)", *_COUNT),
 }
 
+_PAGES = {
+    "page": ("The page's number among this participant's instruction and break pages, in the order taken",
+             "integer", "", "1-based"),
+    "section_type": ("The kind of page: an instruction page or a break", "string",
+                     tuple(t.name for t in page_types()), ""),
+    "section_order": ("The page's order number in the study (Section.order)", "integer", "", ""),
+    "shown_at": ("When the page was first shown (blank: not yet)", *_TIME),
+    "continued_at": ("When the participant pressed Continue (blank: not yet)", *_TIME),
+    "seconds": ("From the page's first display to Continue (blank: not yet)", "number", "", "seconds"),
+}
+
 FILE_DOCS: dict[str, tuple[str, dict]] = {
     "responses.csv": ("One row per answer: participant, section type, clip, question", _RESPONSES),
     "clips.csv": ("One row per clip the study shows or may show: what it is meant to express", _CLIPS),
@@ -131,6 +143,8 @@ FILE_DOCS: dict[str, tuple[str, dict]] = {
                          _PARTICIPANTS),
     "assignments.csv": ("One row per clip page a participant was given (practice items left out)", _ASSIGNMENTS),
     "viewing.csv": ("One row per answered clip page: how the clip was watched", _VIEWING),
+    "pages.csv": ("One row per instruction or break page a participant was given: when it was shown and left",
+                  _PAGES),
 }
 """File name -> (what one row is, its own columns' entries); participant_id, clip_id and section_type are shared."""
 

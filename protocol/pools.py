@@ -16,7 +16,7 @@ import math
 from typing import NamedTuple
 
 from .norming import NORMING_OPTION
-from .section_types import find_section_type
+from .section_types import find_section_type, is_page_type, section_type_names
 from .section_types.checks import count_error as _count_error
 from .section_types.checks import is_int as _is_int
 from .section_types.gesture_emotion import DEFAULT_OPTIONS as DEFAULT_GESTURE_OPTIONS  # noqa: F401 - the editor reads it here
@@ -91,9 +91,9 @@ SUB_POOLS = HALVES
 """Sub-pools a section type may declare (``SectionType.sub_pools``, naturalness): extra filters for its generated
 and its source clips."""
 
-SECTION_OPTIONS = TypeMapView(lambda t: t.option_keys, keep=lambda t: bool(t.options))
+SECTION_OPTIONS = TypeMapView(lambda t: t.option_keys, keep=lambda t: bool(t.options), pages=True)
 """section_type -> the option keys it understands besides COMMON_OPTIONS (a live view of the section-type
-registry)."""
+registry; a page type's, e.g. break_page's ``wait_seconds``, too: a page takes only its own)."""
 
 PLAYER_CONTROLS = ("replay-only", "full", "none")
 """``controls`` option: play/pause and replay only (no seek bar, no speed menu; the default), the browser's full
@@ -394,12 +394,36 @@ def options_errors(section_type: str, options, clips_per_participant: int | None
     return _messages(options_problems(section_type, options, clips_per_participant))
 
 
+def page_problems(section_type: str, pool, options) -> list[SectionError]:
+    """Everything wrong with a page section (instruction or break page, ``protocol.section_types.pages``): it shows
+    no clips, so its pool must be empty, and it takes only its own options (no player, practice or checks)."""
+    errors = []
+    if pool not in (None, {}):
+        errors.append(SectionError("pool", f"a {section_type} shows no clips: leave its pool empty (got {pool!r})"))
+    if options in (None, {}):
+        return errors
+    if not isinstance(options, dict):
+        return errors + [SectionError("options", f"the options must be a JSON object, got {type(options).__name__}")]
+    own = SECTION_OPTIONS.get(section_type, ())
+    listed = f"options: {', '.join(own)}" if own else "it takes no options"
+    errors += [SectionError("options", f"unknown option {key!r} for {section_type} sections ({listed})", (key,))
+               for key in options if key not in own]
+    spec = find_section_type(section_type)
+    if spec is not None and spec.check_options is not None:
+        errors += [SectionError("options", msg, keys) for keys, msg in spec.check_options(options, None)]
+    return errors
+
+
 def validate_section(section_type: str, pool, options, clips_per_participant: int | None = None
                      ) -> list[SectionError]:
     """Everything wrong with a section's type, pool, options and clip count ([] when nothing), each error with its
-    Section field and the JSON keys it is about (:class:`SectionError`)."""
+    Section field and the JSON keys it is about (:class:`SectionError`). A page type (instruction or break page)
+    is checked by :func:`page_problems`; its clip count is not used."""
+    if is_page_type(section_type):
+        return page_problems(section_type, pool, options)
     if section_type not in SECTION_TYPES:
-        return [SectionError("section_type", f"{section_type!r} is not a section type ({', '.join(SECTION_TYPES)})")]
+        names = ", ".join(section_type_names(pages=True))
+        return [SectionError("section_type", f"{section_type!r} is not a section type ({names})")]
     errors = [SectionError("pool", msg, keys) for keys, msg in pool_problems(pool, section_type)]
     errors += [SectionError("options", msg, keys)
                for keys, msg in options_problems(section_type, options, clips_per_participant)]

@@ -369,3 +369,8 @@ VIEWING_COLUMNS_V1 = ("participant_id", "clip_id", "section_type", *VIEWING_FIEL
 VIEWING_COLUMNS = ("participant_id", "clip_id", "section_type", *VIEWING_FIELDS, *VIEWING_SERVER_FIELDS)
 """viewing.csv, in order: one row per answered clip page (practice items left out). ``record`` says what the server
 made of it; with ``missing`` or ``no_script`` every browser field is blank."""
+
+PAGE_COLUMNS = ("participant_id", "page", "section_type", "section_order", "shown_at", "continued_at", "seconds")
+"""pages.csv, in order: one row per instruction or break page a participant was given (protocol.section_types.pages):
+its number among the participant's pages (1-based, in the order taken), its type and section order number, when it
+was first shown and when the participant continued (blank: not yet), and the seconds between the two."""

@@ -18,6 +18,7 @@ from django.urls import path, reverse
 from django.utils.html import format_html, format_html_join
 
 from protocol.pools import SUB_POOLS
+from protocol.section_types import page_types
 
 from . import (
     admin_clip_qa,
@@ -46,6 +47,10 @@ RAW_JSON_HELP = ("The pool and options as JSON (protocol.pools). The fields abov
                  "<code>happy__gt</code>); it wins when the fields above are left as they were.")
 
 
+NOT_ON_PAGES = [f"not-{t.name}" for t in page_types()]
+"""Fieldset classes hiding a fieldset for the instruction and break pages (no clips: static/studyapp/admin_pool.js)."""
+
+
 def section_fieldsets() -> list:
     """The section form: main settings, the clip pool's fields with the live count, the naturalness halves, the
     options of each section type (the page shows those of the chosen type) and the raw JSON (collapsed)."""
@@ -62,12 +67,13 @@ def section_fieldsets() -> list:
     common = pool_editor.COMMON_OPTION_FIELDS
     return [
         (None, {"fields": main}),
-        ("Clip pool", {"fields": pool, "classes": ["pool-editor"],
+        ("Clip pool", {"fields": pool, "classes": ["pool-editor", *NOT_ON_PAGES],
                        "description": "Which catalogue clips this section draws from; blank or none ticked: any."}),
         (f"{section_type_label(pool_editor.SUB_POOL_SECTION_TYPE)}: generated and source halves",
          {"fields": halves, "classes": [f"only-{pool_editor.SUB_POOL_SECTION_TYPE}"]}),
         *option_sets,
-        ("Practice and attention checks", {"fields": [tuple(common[i:i + 2]) for i in range(0, len(common), 2)]}),
+        ("Practice and attention checks", {"fields": [tuple(common[i:i + 2]) for i in range(0, len(common), 2)],
+                                           "classes": NOT_ON_PAGES}),
         ("Advanced: raw JSON", {"fields": ["pool", "options"], "classes": ["collapse"], "description": RAW_JSON_HELP}),
     ]
 

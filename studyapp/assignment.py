@@ -10,7 +10,8 @@ Rules (seed 000 section 6.1, seed 003 section 6.1, seed 004 section V):
   whose source clip is also shown (seed 003);
 - gesture_emotion records four options: the intended emotion and three others drawn from the 11 categories;
 - practice items and attention checks (studyapp.trial_extras) and the counterbalanced section order
-  (studyapp.counterbalance) are fixed at the start too.
+  (studyapp.counterbalance) are fixed at the start too, and so are the instruction and break pages
+  (studyapp.section_pages: sections without clips, recorded on the participant, each before the clip it precedes).
 
 Concurrency: a start plans without any lock: pools from a per-study cache (studyapp.pool_cache), the
 balancing counts from SectionClipCount (one row per section and pool clip) read plainly. Its transaction then
@@ -41,10 +42,11 @@ from protocol.norming import clip_order, cyclic_block, ratings_per_clip
 from protocol.pools import SUB_POOLS
 from protocol.section_types import get_section_type
 
-from .counterbalance import SectionInfo, section_order
+from .counterbalance import SectionInfo, attach_pages, section_order
 from .models import Assignment, Clip, Participant, Section, SectionClipCount, Study, StudyCounter
 from .page_reads import open_assignments
 from .pool_cache import SectionPool, load_section_pool, section_pools
+from .section_pages import due_page, is_page, page_records
 from .trial_extras import PlannedItem, gesture_options, with_extras
 
 __all__ = ["PlannedItem", "Step", "StudyUnavailable", "active_count", "check_open", "current_step",
@@ -172,12 +174,14 @@ def read_counts(sections: list[Section], lock: bool = False) -> dict[int, dict[i
 def plan_study(study: Study, seed: int, balanced: bool = True, sections: list[Section] | None = None,
                pools: dict[int, SectionPool] | None = None, counts: dict[int, dict[int, int]] | None = None,
                extras: bool = False) -> list[tuple[Section, list[PlannedItem]]]:
-    """Plan every section of `study` for a participant with `seed`, in the study's order (no writes).
+    """Plan every section of `study` for a participant with `seed`, in the study's order (no writes); the
+    instruction and break pages are left out (they have no clips).
 
     balanced: use the balancing counts (previews pass False); sections/pools/counts: already loaded ones (the
     start passes them; otherwise they are queried); extras: add practice items and attention checks.
     """
-    sections = sections if sections is not None else list(study.sections.order_by("order", "id"))
+    sections = [s for s in (sections if sections is not None else study.sections.order_by("order", "id"))
+                if not is_page(s)]          # instruction and break pages show no clips
     pools = pools if pools is not None else {s.pk: load_section_pool(s) for s in sections}
     if counts is None:
         counts = read_counts(sections) if balanced else {}
@@ -251,12 +255,16 @@ def next_arrival(study_id: int) -> int:
 
 def participant_order(study: Study, sections: list[Section]) -> list[Section]:
     """The sections in the order this (next) participant takes them: the study's order, or a Williams row of the
-    rotating sections by arrival index when the study counterbalances (studyapp.counterbalance)."""
-    infos = [SectionInfo(s.pk, s.counterbalance, s.reuse_section_id) for s in sections]
-    if not study.counterbalance_sections or sum(s.counterbalance for s in sections) < 2:
+    rotating sections by arrival index when the study counterbalances (studyapp.counterbalance). Instruction and
+    break pages do not rotate themselves: each travels with the section that follows it (``attach_pages``)."""
+    pages = {s.pk for s in sections if is_page(s)}
+    rotating = [s for s in sections if s.pk not in pages]
+    infos = [SectionInfo(s.pk, s.counterbalance, s.reuse_section_id) for s in rotating]
+    if not study.counterbalance_sections or sum(s.counterbalance for s in rotating) < 2:
         return list(sections)
     by_pk = {s.pk: s for s in sections}
-    return [by_pk[pk] for pk in section_order(infos, next_arrival(study.pk))]
+    order = section_order(infos, next_arrival(study.pk))
+    return [by_pk[pk] for pk in attach_pages(order, [s.pk for s in sections], pages)]
 
 
 def _assignment_rows(participant: Participant, plan: list[tuple[Section, list[PlannedItem]]],
@@ -265,7 +273,7 @@ def _assignment_rows(participant: Participant, plan: list[tuple[Section, list[Pl
     by_section = {section.pk: items for section, items in plan}
     rows, seq = [], 0
     for section in order:
-        for position, it in enumerate(by_section[section.pk]):
+        for position, it in enumerate(by_section.get(section.pk, ())):     # a page has no clips
             seq += 1
             rows.append(Assignment(participant=participant, section=section, position=position, clip=it.clip,
                                    options=it.options, seq=seq, kind=it.kind, instructed=it.instructed))
@@ -289,13 +297,14 @@ def _start(participant: Participant) -> bool:
         return False
     study = p.study
     check_open(study)
-    sections = list(study.sections.order_by("order", "id"))
+    every = list(study.sections.order_by("order", "id"))
+    sections = [s for s in every if not is_page(s)]       # the sections with clips; pages only take a place
     pools = section_pools(study.pk, sections)
     balanced = [s for s in sections if not s.reuse_section_id]
     counts = read_counts(balanced)
     _ensure_count_rows(balanced, pools, counts)
     plan = plan_study(study, p.seed, sections=sections, pools=pools, counts=counts, extras=True)
-    order = participant_order(study, sections)
+    order = participant_order(study, every)
 
     def fresh_plan():
         """In the transaction: lock the counts; plan again only if they changed since planning."""
@@ -377,7 +386,9 @@ def _commit_start(p: Participant, study: Study, fresh_plan, order: list[Section]
         if not claimed:
             return False
         plan = fresh_plan()
-        Participant.objects.filter(pk=p.pk).update(n_items=sum(len(items) for _, items in plan))
+        Participant.objects.filter(pk=p.pk).update(
+            n_items=sum(len(items) for _, items in plan),
+            pages=page_records(order, {section.pk: len(items) for section, items in plan}))
         _count_trials(plan)
         Assignment.objects.bulk_create(_assignment_rows(p, plan, order))
         if study.max_participants:
@@ -398,10 +409,11 @@ def _count_trials(plan: list[tuple[Section, list[PlannedItem]]]) -> None:
 
 @dataclass
 class Step:
-    """Where a participant is: kind in demographics | start | item | feedback | done."""
+    """Where a participant is: kind in demographics | start | item | page | feedback | done."""
     kind: str
     assignment: Assignment | None = None
-    index: int = 0          # 1-based number of this clip among all of the participant's clips (Assignment.seq)
+    index: int = 0          # 1-based number of this clip among all of the participant's clips (Assignment.seq);
+    #                         of a page: its number among the participant's pages (studyapp.section_pages)
     total: int = 0
     next_assignment: Assignment | None = None     # the clip after this one (preloaded by the page), if asked for
 
@@ -414,7 +426,8 @@ def open_items(participant: Participant, n: int = 1) -> list[Assignment]:
 
 def current_step(participant: Participant, lookahead: bool = False) -> Step:
     """The participant's next page, computed from the database only (so reloads and restarts resume): at most one
-    query (the first unanswered assignment; with lookahead the one after it too). The total is the stored
+    query (the first unanswered assignment; with lookahead the one after it too). An instruction or break page due
+    before that clip comes first (Participant.pages, read with the participant). The total is the stored
     Participant.n_items."""
     study = participant.study
     if study.ask_demographics and not participant.demographics_done:
@@ -423,6 +436,9 @@ def current_step(participant: Participant, lookahead: bool = False) -> Step:
         return Step("start")
     total = participant.n_items
     items = open_items(participant, 2 if lookahead else 1)
+    page = due_page(participant.pages, items[0].seq if items else None)
+    if page is not None:
+        return Step("page", None, page, total)
     if items:
         return Step("item", items[0], items[0].seq, total, items[1] if len(items) > 1 else None)
     if study.feedback_questions and not participant.feedback_done:

@@ -9,7 +9,7 @@ the same clips can take spares too; the planner then gives fewer checks, never a
 from __future__ import annotations
 
 from protocol.pools import PoolError
-from protocol.section_types import find_section_type
+from protocol.section_types import find_section_type, page_types
 
 from .catalogue import section_queryset
 from .models import Clip, Section
@@ -69,7 +69,8 @@ def _rating_section(section: Section, clip: Clip) -> Section | None:
     """Another section of the study whose pool holds ``clip`` (participants may rate it there), if any."""
     if not section.study_id:
         return None
-    others = Section.objects.filter(study_id=section.study_id, reuse_section__isnull=True).exclude(pk=section.pk)
+    others = (Section.objects.filter(study_id=section.study_id, reuse_section__isnull=True).exclude(pk=section.pk)
+              .exclude(section_type__in=[t.name for t in page_types()]))     # a page rates no clip
     return next((s for s in others.order_by("order", "id") if _in_pool(s, clip)), None)
 
 

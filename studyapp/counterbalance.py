@@ -12,6 +12,10 @@ that: (1) a rotating section that reuses a rotating section moves with it as one
 after its source, in study order), so the square rotates units, not single sections; (2) if a pinned section and
 a rotating one are linked by reuse and the rotation would put the source after the reusing section, the reusing
 section is moved to just after its source (the only change to the square's order).
+
+Instruction and break pages (protocol.section_types.pages) are not conditions: they are left out of the square and
+each travels with the section that follows it in the study's order (``attach_pages``); pages after the last
+section stay at the end.
 """
 from __future__ import annotations
 
@@ -91,3 +95,17 @@ def _reuse_after_source(order: list[int], sections: Sequence[SectionInfo]) -> li
         if not moved:
             break
     return order
+
+
+def attach_pages(order: Sequence[int], study_order: Sequence[int], pages: set[int] | frozenset[int]) -> list[int]:
+    """``order`` (the pks of the question-bearing sections, in the participant's order) with the page sections put
+    back: each page right before the section that follows it in ``study_order`` (several pages before one section
+    keep their study order), the pages after the last section at the end."""
+    leading: dict[int, list[int]] = {}
+    waiting: list[int] = []
+    for pk in study_order:
+        if pk in pages:
+            waiting.append(pk)
+        else:
+            leading[pk], waiting = waiting, []
+    return [pk for section in order for pk in (*leading.get(section, ()), section)] + waiting

@@ -4,6 +4,7 @@ duration, computed from what the participant will get rather than typed in.
     seconds = sum over sections of  items x (mean clip duration of the section's pool + PAGE_SECONDS
                                               + questions x ANSWER_SECONDS_PER_QUESTION)
               + practice items and attention checks (each a clip page like a trial's)
+              + READING_SECONDS per instruction page + (its wait + PAGE_SECONDS) per break page
               + DEMOGRAPHICS_SECONDS (when asked) + FEEDBACK_SECONDS_PER_QUESTION x feedback questions
     minutes = ceil(seconds / 60)
 
@@ -16,6 +17,8 @@ import math
 from dataclasses import dataclass
 
 from protocol.norming import ratings_per_clip
+from protocol.section_types import is_page_type
+from protocol.section_types.pages import BREAK, wait_seconds
 from protocol.vocabulary import SECTION_QUESTIONS, section_questions
 
 from .models import Section, Study
@@ -29,6 +32,8 @@ PAGE_SECONDS = 3.0
 DEFAULT_CLIP_SECONDS = 5.0
 """Duration assumed for a clip whose duration is not in the catalogue (s)."""
 DEMOGRAPHICS_SECONDS = 30.0
+READING_SECONDS = 20.0
+"""Time to read an instruction page and continue (s)."""
 FEEDBACK_SECONDS_PER_QUESTION = 15.0
 
 
@@ -75,10 +80,19 @@ def section_times(sections: list[Section], pools: dict[int, SectionPool]) -> lis
     return [out[s.pk] for s in sections]
 
 
+def page_seconds(section: Section) -> float:
+    """The time an instruction page (READING_SECONDS) or a break page (its wait + PAGE_SECONDS) takes (s)."""
+    if section.section_type == BREAK.name:
+        return wait_seconds(section.options) + PAGE_SECONDS
+    return READING_SECONDS
+
+
 def expected_seconds(study: Study) -> float:
     """The formula of the module docstring, in seconds."""
     sections = list(study.sections.order_by("order", "id"))
-    total = sum(t.seconds for t in section_times(sections, section_pools(study.pk, sections)))
+    questions = [s for s in sections if not is_page_type(s.section_type)]
+    total = sum(t.seconds for t in section_times(questions, section_pools(study.pk, questions)))
+    total += sum(page_seconds(s) for s in sections if is_page_type(s.section_type))
     if study.ask_demographics:
         total += DEMOGRAPHICS_SECONDS
     return total + FEEDBACK_SECONDS_PER_QUESTION * len(study.feedback_questions or [])

@@ -24,6 +24,9 @@ section_type ``attention_check`` (protocol.vocabulary.ATTENTION_CHECK) and quest
 participants.csv counts them per participant (``attention_passed``, ``attention_total``). Its ``section_order``
 column lists the ``order`` numbers (Section.order, as in assignments.csv's section_order) of the sections in the
 order the participant took them, joined by ';' (empty for a participant who has not started).
+
+pages.csv (PAGE_COLUMNS) has one row per instruction or break page a participant was given (studyapp.section_pages):
+when it was first shown, when the participant continued and the seconds between (blank: not yet).
 """
 from __future__ import annotations
 
@@ -44,6 +47,7 @@ from protocol.vocabulary import (
     CLIP_BODY_COLUMNS,
     CLIP_COLUMNS,
     CLIP_PROVENANCE_COLUMNS,
+    PAGE_COLUMNS,
     PARTICIPANT_COLUMNS,
     RESPONSE_COLUMNS,
     VIEWING_COLUMNS,
@@ -55,13 +59,14 @@ from protocol.vocabulary import (
 from .models import Assignment, Clip, Participant, Response, Study
 from .pool_filters import filtered_clips
 from .privacy import pseudonym
+from .section_pages import when
 
 WITHDRAWN = Participant.Status.WITHDRAWN
 
-__all__ = ["ASSIGNMENT_COLUMNS", "CLIP_COLUMNS", "EXPORT_CLIP_COLUMNS", "EXPORT_KINDS", "PARTICIPANT_COLUMNS",
-           "RESPONSE_COLUMNS", "VIEWING_COLUMNS", "run_report", "stream_csv", "write_study_csvs"]
+__all__ = ["ASSIGNMENT_COLUMNS", "CLIP_COLUMNS", "EXPORT_CLIP_COLUMNS", "EXPORT_KINDS", "PAGE_COLUMNS",
+           "PARTICIPANT_COLUMNS", "RESPONSE_COLUMNS", "VIEWING_COLUMNS", "run_report", "stream_csv", "write_study_csvs"]
 
-EXPORT_KINDS = ("responses", "clips", "participants", "assignments", "viewing")
+EXPORT_KINDS = ("responses", "clips", "participants", "assignments", "viewing", "pages")
 """The CSV exports, each written as ``<kind>.csv``."""
 
 CHUNK = 2000
@@ -199,6 +204,19 @@ def viewing_rows(study: Study, include_pilot: bool = True) -> Iterator[list]:
                *(record.get(f) for f in VIEWING_SERVER_FIELDS)]
 
 
+def page_rows(study: Study, include_pilot: bool = True) -> Iterator[list]:
+    """One row per instruction or break page of each participant (Participant.pages, in the order taken): id, page
+    number, section type and order, first display, Continue and the seconds between (blank where not yet)."""
+    sections = {pk: (stype, order) for pk, stype, order in study.sections.values_list("pk", "section_type", "order")}
+    people = _without_pilots(study.participants.exclude(status=WITHDRAWN), include_pilot, "pilot")
+    for pid, pages in people.order_by("id").values_list("public_id", "pages").iterator(chunk_size=CHUNK):
+        for n, record in enumerate(pages or [], start=1):
+            stype, order = sections.get(record.get("section"), ("", ""))
+            shown, continued = when(record.get("shown_at")), when(record.get("continued_at"))
+            seconds = round((continued - shown).total_seconds(), 3) if shown and continued else ""
+            yield [pid, n, stype, order, _iso(shown), _iso(continued), seconds]
+
+
 def stream_csv(study: Study, kind: str, include_pilot: bool = True) -> Iterator[str]:
     """Lines of `kind` in EXPORT_KINDS; ``include_pilot=False`` leaves the pilot participants out."""
     if kind == "responses":
@@ -211,12 +229,14 @@ def stream_csv(study: Study, kind: str, include_pilot: bool = True) -> Iterator[
         return csv_lines(ASSIGNMENT_COLUMNS, assignment_rows(study, include_pilot))
     if kind == "viewing":
         return csv_lines(VIEWING_COLUMNS, viewing_rows(study, include_pilot))
+    if kind == "pages":
+        return csv_lines(PAGE_COLUMNS, page_rows(study, include_pilot))
     raise ValueError(f"unknown export {kind!r}; choose {', '.join(EXPORT_KINDS)}")
 
 
 def write_study_csvs(study: Study, out_dir: str | Path, include_pilot: bool = True) -> dict[str, Path]:
-    """Write responses.csv, clips.csv, participants.csv (DESIGN.md), assignments.csv and viewing.csv into out_dir
-    (the pilot participants left out unless ``include_pilot``); returns their paths by kind."""
+    """Write responses.csv, clips.csv, participants.csv (DESIGN.md), assignments.csv, viewing.csv and pages.csv
+    into out_dir (the pilot participants left out unless ``include_pilot``); returns their paths by kind."""
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     paths = {}

@@ -16,6 +16,7 @@ from django.utils import timezone
 
 from protocol.dictionary import PILOT_PREFIX
 from protocol.pools import errors_by_field, validate_section
+from protocol.section_types import is_page_type
 from protocol.titles import TITLE_MAX_LENGTH
 from protocol.vocabulary import ATTENTION_CHECK, BODY_MAX_LENGTH, CLIP_MODALITIES, ORIGINS
 
@@ -208,7 +209,8 @@ class Study(models.Model):
 
 
 class Section(models.Model):
-    """A block of clips with one question set; `order` fixes the position in the study."""
+    """A block of clips with one question set, or an instruction or break page (a page type: no clips, no
+    questions; studyapp.section_pages); `order` fixes the position in the study."""
 
     study = models.ForeignKey(Study, on_delete=models.CASCADE, related_name="sections")
     order = models.PositiveIntegerField(default=0)
@@ -218,9 +220,11 @@ class Section(models.Model):
                                       "to participants")
     title = models.CharField(max_length=200, blank=True,
                              help_text="The heading participants see on its clip pages, in their words (blank: plain "
-                                       "words for the section type, e.g. \"How does this walk look?\")")
+                                       "words for the section type, e.g. \"How does this walk look?\"); of an "
+                                       "instruction or break page: its title")
     instructions = models.TextField(blank=True, help_text="What participants are asked to do, shown above the clip "
-                                                          "(blank: the section type's plain-words default)")
+                                                          "(blank: the section type's plain-words default); of an "
+                                                          "instruction or break page: its text")
     pool = models.JSONField(
         default=dict, blank=True,
         help_text='Clip pool as catalogue filters, e.g. {"modality": "gait", "origin": "generated", '
@@ -240,7 +244,9 @@ class Section(models.Model):
                   'or {"practice_clip": "<clip_id>"}')
     counterbalance = models.BooleanField(
         default=True, help_text="Rotates with the other rotating sections when the study counterbalances its "
-                                "section order; untick to pin this section to its place (e.g. a final section)")
+                                "section order; untick to pin this section to its place (e.g. a final section). "
+                                "An instruction or break page travels with the section that follows it (its own "
+                                "tick is not used); a page after the last section stays last")
 
     class Meta:
         ordering = ["study", "order", "id"]
@@ -257,7 +263,10 @@ class Section(models.Model):
         errors: dict[str, list[str]] = dict(self.protocol_errors())
         if self.reuse_section_id:
             other = self.reuse_section
-            if other.study_id != self.study_id:
+            if is_page_type(self.section_type) or is_page_type(other.section_type):
+                errors["reuse_section"] = ["An instruction or break page has no clips: it can neither reuse "
+                                           "another section's clips nor be reused."]
+            elif other.study_id != self.study_id:
                 errors["reuse_section"] = ["The reused section must belong to the same study."]
             elif (other.order, other.pk or 0) >= (self.order, self.pk or 10**12):
                 errors["reuse_section"] = ["The reused section must come before this one."]
@@ -307,6 +316,9 @@ class Participant(models.Model):
     n_items = models.PositiveIntegerField(default=0, editable=False)
     # Consented while the study was in pilot mode (Study.pilot): public_id starts with PILOT_PREFIX.
     pilot = models.BooleanField(default=False, editable=False, db_index=True)
+    # The instruction and break pages this participant is given, fixed at start in the order taken
+    # (studyapp.section_pages): section pk, the clip number they come before, when first shown and when continued.
+    pages = models.JSONField(default=list, blank=True, editable=False)
 
     class Meta:
         constraints = [

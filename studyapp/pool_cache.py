@@ -17,6 +17,7 @@ from django.core.cache import cache
 from django.db.models import Count, Max, Q
 
 from protocol.pools import SUB_POOLS
+from protocol.section_types import is_page_type
 from protocol.vocabulary import SECTION_MODALITY
 
 from .catalogue import pool_queryset, section_queryset
@@ -68,7 +69,9 @@ def dedicated_check_clip(section: Section) -> Clip | None:
 
 def load_section_pool(section: Section) -> SectionPool:
     """Query one section's pool (no cache). A reusing section has no pool of its own (its checks draw on the
-    reused section's)."""
+    reused section's). An instruction or break page has none."""
+    if is_page_type(section.section_type):
+        return SectionPool()
     if section.reuse_section_id:
         return SectionPool(check_clip=dedicated_check_clip(section))
     clips = list(light(section_queryset(section.section_type, section.pool)).order_by("clip_id"))

@@ -39,6 +39,7 @@ from protocol.pools import (
     validate_section,
 )
 from protocol.section_types import find_section_type, registered
+from protocol.section_types.pages import BREAK, DEFAULT_WAIT_SECONDS, MAX_WAIT_SECONDS, WAIT_OPTION
 from protocol.vocabulary import (
     CLIP_MODALITIES,
     CLIP_THEMES,
@@ -559,6 +560,10 @@ def _option_specs() -> dict[str, list[ChoiceSpec]]:
                       f"2 to {n}, the intended emotion among them; blank: {DEFAULT_GESTURE_OPTIONS}",
                       forms.IntegerField, min_value=2, max_value=n),
             ChoiceSpec(o + "categories", "categories", GESTURE_EMOTIONS, "Emotions offered", f"none ticked: all {n}")],
+        BREAK.name: [
+            ValueSpec(o + WAIT_OPTION, WAIT_OPTION, "Wait before Continue (seconds)",
+                      f"Continue is enabled this long after the page is first shown (the server checks it too); "
+                      f"blank: {DEFAULT_WAIT_SECONDS}", forms.IntegerField, min_value=0, max_value=MAX_WAIT_SECONDS)],
     }
     return {stype: [s for s in group if s.key in SECTION_OPTIONS.get(stype, ())] for stype, group in specs.items()}
 

@@ -119,8 +119,9 @@ INTENSITY_ANCHORS = {"1": _("very weak"), "3": _("moderate"), "5": _("very stron
 
 def section_type_choices() -> list[tuple[str, str]]:
     """(section type, admin label) for every registered section type (protocol.section_types), in the protocol's
-    order. Read afresh on each call: a model or form field given the function sees types registered later."""
-    return [(t.name, t.label) for t in registered()]
+    order, the instruction and break pages last. Read afresh on each call: a model or form field given the function
+    sees types registered later."""
+    return [(t.name, t.label) for t in registered(pages=True)]
 
 
 def wording_of(section_type: str) -> SectionWording:

@@ -2,7 +2,7 @@
 clip media under /m/, researcher pages (staff only) under /staff/."""
 from django.urls import path
 
-from . import views, views_norming, views_share, views_staff
+from . import views, views_norming, views_pages, views_share, views_staff
 
 app_name = "studyapp"
 
@@ -13,6 +13,7 @@ urlpatterns = [
     path("p/<str:token>/about-you/", views.demographics, name="demographics"),
     path("p/<str:token>/clip/<int:n>/", views.item, name="item"),
     path("p/<str:token>/clip/<int:n>/playback", views.playback, name="playback"),
+    path("p/<str:token>/page/<int:n>/", views_pages.page, name="page"),
     path("p/<str:token>/feedback/", views.feedback, name="feedback"),
     path("p/<str:token>/done/", views.done, name="done"),
     path("m/<str:key>.<str:ext>", views.media, name="media"),

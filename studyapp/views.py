@@ -38,6 +38,7 @@ from .page_notes import page_note
 from .page_reads import participant_by_token
 from .permissions import has_staff_permission
 from .questions import AnswerError, clean_answers, questions_for
+from .section_pages import due_page
 from .section_wording import participant_wording
 from .viewing import (
     MAX_COUNT,
@@ -251,6 +252,8 @@ def resume(request, token: str):
         return redirect("studyapp:demographics", token=token)
     if step.kind == "item":
         return redirect("studyapp:item", token=token, n=step.index)
+    if step.kind == "page":
+        return redirect("studyapp:page", token=token, n=step.index)
     if step.kind == "feedback":
         return redirect("studyapp:feedback", token=token)
     mark_completed(participant)
@@ -327,18 +330,23 @@ def client_ms(raw, server_ms: int) -> int | None:
 
 
 def step_url(token: str, step) -> str:
-    """The URL of a participant's step (the clip page, feedback or done), without going through /resume."""
-    if step.kind == "item":
-        return reverse("studyapp:item", kwargs={"token": token, "n": step.index})
+    """The URL of a participant's step (the clip page, an instruction or break page, feedback or done), without
+    going through /resume."""
+    if step.kind in ("item", "page"):
+        return reverse(f"studyapp:{step.kind}", kwargs={"token": token, "n": step.index})
     if step.kind in ("feedback", "done"):
         return reverse(f"studyapp:{step.kind}", kwargs={"token": token})
     return reverse("studyapp:resume", kwargs={"token": token})
 
 
 def _after_answer_url(participant: Participant, n: int) -> str:
-    """Where the answer to clip n sends the participant: clip n + 1, or the feedback page, or the end (the
-    participant is then marked completed). No query unless the study ends here."""
+    """Where the answer to clip n sends the participant: an instruction or break page due before clip n + 1, or
+    clip n + 1, or the feedback page, or the end (the participant is then marked completed). No query unless the
+    study ends here."""
     token = participant.token
+    page = due_page(participant.pages, n + 1 if n < participant.n_items else None)
+    if page is not None:
+        return reverse("studyapp:page", kwargs={"token": token, "n": page})
     if n < participant.n_items:
         return reverse("studyapp:item", kwargs={"token": token, "n": n + 1})
     if participant.study.feedback_questions and not participant.feedback_done:

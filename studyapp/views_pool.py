@@ -29,6 +29,7 @@ from django.http import JsonResponse
 from django.views.decorators.cache import never_cache
 
 from protocol.pools import SUB_POOLS, pool_errors
+from protocol.section_types import is_page_type
 from protocol.vocabulary import ORIGINS
 
 from .admin_norms import norms_table
@@ -48,13 +49,17 @@ HALVES = tuple(name for name in SUB_POOLS if name in ORIGINS)
 @dataclass
 class PoolCount:
     """Clips (not retired) a pool matches: ``total`` (None when the pool cannot be counted, ``errors`` say why)
-    and, for a naturalness section, ``by_origin``: its generated and source halves with their sub-pools."""
+    and, for a naturalness section, ``by_origin``: its generated and source halves with their sub-pools.
+    ``page``: the section is an instruction or break page, which shows no clips."""
 
     total: int | None
     by_origin: dict[str, int] = field(default_factory=dict)
     errors: list[str] = field(default_factory=list)
+    page: bool = False
 
     def summary(self) -> str:
+        if self.page:
+            return "an instruction or break page shows no clips (leave the pool empty)"
         if self.total is None:
             return "the pool cannot be counted: " + "; ".join(self.errors)
         one = self.total == 1
@@ -65,7 +70,7 @@ class PoolCount:
 
     def warnings(self, clips_per_participant: int | None, options: dict | None) -> list[str]:
         """Where the pool is too small for what a participant is shown (earlier sections may use some clips)."""
-        if self.total is None:
+        if self.total is None or self.page:
             return []
         if self.total == 0:
             return ["no clip matches: this section would show nothing"]
@@ -82,6 +87,8 @@ class PoolCount:
 def count_pool(section_type: str | None, pool, reader=None) -> PoolCount:
     """Count the clips of a pool (studyapp.catalogue.pool_queryset); problems come back as errors, never raised.
     ``reader``: the user asking, whose studies alone a norms rule may read (None: the site, for a saved pool)."""
+    if is_page_type(section_type):
+        return PoolCount(0, page=True)
     errors = pool_errors(pool, section_type)
     if errors:
         return PoolCount(None, errors=errors)
@@ -107,8 +114,9 @@ def count_pool(section_type: str | None, pool, reader=None) -> PoolCount:
 
 
 def pool_sample(section_type: str | None, pool, n: int = SAMPLE_SIZE) -> list[ClipCell]:
-    """The first ``n`` clips (by title, then id) a valid pool matches; [] when it cannot be counted."""
-    if pool_errors(pool, section_type):
+    """The first ``n`` clips (by title, then id) a valid pool matches; [] when it cannot be counted (or for a
+    page, which shows none)."""
+    if is_page_type(section_type) or pool_errors(pool, section_type):
         return []
     try:
         clips = section_queryset(section_type, pool or {}).order_by("title", "clip_id")[:n]

@@ -19,6 +19,7 @@ from protocol.dictionary import DictionaryError, dictionary_rows
 from protocol.vocabulary import (
     ANSWER_QUESTIONS,
     ASSIGNMENT_COLUMNS,
+    PAGE_COLUMNS,
     PARTICIPANT_COLUMNS,
     RESPONSE_COLUMNS,
     VIEWING_COLUMNS,
@@ -32,7 +33,7 @@ from tests.test_pilots_sharing import take_part
 
 PROTOCOL_FILES = {"responses.csv": RESPONSE_COLUMNS, "clips.csv": EXPORT_CLIP_COLUMNS,
                   "participants.csv": PARTICIPANT_COLUMNS, "assignments.csv": ASSIGNMENT_COLUMNS,
-                  "viewing.csv": VIEWING_COLUMNS}
+                  "viewing.csv": VIEWING_COLUMNS, "pages.csv": PAGE_COLUMNS}
 
 
 def test_every_protocol_column_has_an_entry_and_a_new_one_fails():

@@ -108,4 +108,6 @@ def test_wording_covers_exactly_the_protocol():
     assert set(WORDING) == set(SECTION_TYPES)
     for stype, wording in WORDING.items():
         assert set(wording.questions) == set(SECTION_QUESTIONS[stype]) and get_section_type(stype).label
-    assert [value for value, _ in Section._meta.get_field("section_type").choices] == list(SECTION_TYPES)
+    # the admin offers the question-bearing types, then the instruction and break pages (no wording of this kind)
+    assert [value for value, _ in Section._meta.get_field("section_type").choices] == [
+        *SECTION_TYPES, "instruction_page", "break_page"]

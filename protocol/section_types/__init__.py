@@ -2,7 +2,8 @@
 
 ``docs/section_types.md`` lists them with their questions, options, clip needs and analyses; it is written from the
 registry (``python -m protocol.section_types``), so the registry is the one place a section type is described. The
-order of the imports below is the protocol's order (the admin's choices, the docs).
+order of the imports below is the protocol's order (the admin's choices, the docs); the page types
+(instruction and break pages, :mod:`.pages`) come last.
 """
 from .registry import (  # noqa: I001 - the registry first: the type modules import the vocabulary, which reads it
     Ask,
@@ -13,6 +14,8 @@ from .registry import (  # noqa: I001 - the registry first: the type modules imp
     UnknownSectionTypeError,
     find_section_type,
     get_section_type,
+    is_page_type,
+    page_types,
     register,
     registered,
     section_type_names,
@@ -27,7 +30,9 @@ from . import (  # noqa: F401 - importing a section type's module registers it
     neutral_validation,
     theme_rating,
     theme_inversion,
+    pages,
 )
 
 __all__ = ["Ask", "ClipNeed", "Found", "OptionSpec", "SectionType", "UnknownSectionTypeError", "find_section_type",
-           "get_section_type", "register", "registered", "section_type_names", "unregister"]
+           "get_section_type", "is_page_type", "page_types", "register", "registered", "section_type_names",
+           "unregister"]

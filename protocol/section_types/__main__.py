@@ -12,7 +12,7 @@ from pathlib import Path
 from protocol.pools import COMMON_OPTIONS
 from protocol.vocabulary import INTEGER_RANGES, NORMING_QUESTIONS, answer_values
 
-from . import registered
+from . import page_types, registered
 from .registry import SectionType
 
 
@@ -68,7 +68,20 @@ def render_page() -> str:
                      f"{f'`{spec.demographics}`' if spec.demographics else 'none'}.")
         lines += [f"- Feeds: {', '.join(f'`{a}`' for a in spec.analyses) or 'nothing'}; figures: "
                   f"{', '.join(f'`{f}`' for f in spec.figures) or 'none'}.", ""]
-    return "\n".join(lines)
+    return "\n".join(lines + _page_lines())
+
+
+def _page_lines() -> list[str]:
+    """The page types (instruction and break pages): no clips, no questions; left out of the table above."""
+    lines = ["## Pages between sections", "",
+             "A page type is a section without clips or questions that a participant reads and continues from "
+             "(docs/study.md, \"Instruction and break pages\"). It takes no pool and none of the options of every "
+             "section; under counterbalancing it travels with the section after it; pages.csv records when each "
+             "participant saw it and continued.", ""]
+    for spec in page_types():
+        options = "; ".join(f"`{o.key}` ({o.doc})" for o in spec.options) or "none"
+        lines += [f"- `{spec.name}`: {spec.label}. Module `{spec.module}`. {spec.summary} Options: {options}."]
+    return lines + [""]
 
 
 def main(argv=None) -> int:

@@ -13,6 +13,13 @@ here, its participant wording (``studyapp.questions.register_wording``) and its 
                          questions=(Ask("arousal", AROUSAL),), simulator="1..3, higher for angry walks",
                          analyses=("arousal_means",)))
 
+A *page* type (``page=True``: an instruction page, a break) is a section that shows no clip and asks nothing: the
+participant reads it and continues. It is registered here so the admin offers it and ``protocol.pools`` checks its
+options, but every list of question-bearing types leaves it out: :func:`registered`, :func:`section_type_names` and
+the live views (``protocol.vocabulary.SECTION_TYPES``, ``SECTION_QUESTIONS``, ...) hold the question types only, so
+the analysis, the simulator, pools and the answer exports never meet one; :func:`page_types` lists the pages and
+``registered(pages=True)`` every type.
+
 Shaped after the generator registry (``generation.plans.generators.registry``). Plain Python: imports nothing of the
 project, so ``protocol.vocabulary`` can import it.
 """
@@ -80,6 +87,8 @@ class SectionType:
         demographics: the label question whose answers are compared across gender and age group ("": none).
         analyses: the report tables (``analysis.report`` keys) its answers feed.
         figures: the report figures its answers feed.
+        page: a page between sections (no clip, no question; the participant continues): no questions, no
+            modality, no analyses; left out of every list of question-bearing types.
     """
 
     name: str
@@ -100,6 +109,7 @@ class SectionType:
     analyses: tuple[str, ...] = ()
     figures: tuple[str, ...] = ()
     module: str = ""
+    page: bool = False
 
     @property
     def question_kinds(self) -> dict[str, str]:
@@ -133,7 +143,9 @@ def register(spec: SectionType) -> SectionType:
         raise ValueError(f"section type {spec.name!r} is registered already (by {_REGISTRY[spec.name].module})")
     if not spec.name.isidentifier() or len(spec.name) > 30:
         raise ValueError(f"section type {spec.name!r}: the name must be an identifier of at most 30 characters")
-    if not spec.questions:
+    if spec.page:
+        _check_page(spec)
+    elif not spec.questions:
         raise ValueError(f"section type {spec.name!r}: give at least one question")
     keys = [ask.key for ask in spec.questions]
     if len(set(keys)) != len(keys):
@@ -146,6 +158,16 @@ def register(spec: SectionType) -> SectionType:
         raise ValueError(f"section type {spec.name!r}: drawn choices need exactly one question")
     _REGISTRY[spec.name] = spec
     return spec
+
+
+def _check_page(spec: SectionType) -> None:
+    """ValueError when a page type declares what only a question-bearing type has."""
+    extra = [what for what, there in (("questions", spec.questions), ("a modality", spec.modality),
+                                      ("analyses", spec.analyses or spec.figures), ("norming", spec.norming),
+                                      ("sub-pools", spec.sub_pools), ("drawn choices", spec.drawn_choices),
+                                      ("clip needs", spec.clip_need), ("agreement", spec.agreement)) if there]
+    if extra:
+        raise ValueError(f"section type {spec.name!r} is a page: it takes no {', '.join(extra)}")
 
 
 def unregister(name: str) -> None:
@@ -166,25 +188,43 @@ def find_section_type(name: str | None) -> SectionType | None:
     return _REGISTRY.get(name or "")
 
 
-def section_type_names() -> tuple[str, ...]:
-    """Registered section type names, in registration order."""
-    return tuple(_REGISTRY)
+def section_type_names(pages: bool = False) -> tuple[str, ...]:
+    """Registered section type names, in registration order: the question-bearing ones (``pages``: every one)."""
+    return tuple(t.name for t in registered(pages))
 
 
-def registered() -> tuple[SectionType, ...]:
-    """Every declaration, in registration order (the protocol's order)."""
-    return tuple(_REGISTRY.values())
+def registered(pages: bool = False) -> tuple[SectionType, ...]:
+    """The declarations in registration order (the protocol's order): the question-bearing types, or with ``pages``
+    every type, the page types included."""
+    return tuple(t for t in _REGISTRY.values() if pages or not t.page)
+
+
+def page_types() -> tuple[SectionType, ...]:
+    """The page types (instruction and break pages), in registration order."""
+    return tuple(t for t in _REGISTRY.values() if t.page)
+
+
+def is_page_type(name: str | None) -> bool:
+    """Whether ``name`` is a registered page type (an unknown name is not)."""
+    spec = _REGISTRY.get(name or "")
+    return spec is not None and spec.page
 
 
 # ---- live views: the vocabulary's old names, always reading the registry as it is now --------------------------------
-class NamesView(Sequence):
-    """A read-only tuple-like view of the registered names that pass ``keep`` (all when None)."""
+def _kept(keep: Callable[[SectionType], bool] | None, pages: bool) -> Iterator[SectionType]:
+    """The registered types that pass ``keep`` (all when None), page types only when ``pages``."""
+    return (t for t in _REGISTRY.values() if (pages or not t.page) and (keep is None or keep(t)))
 
-    def __init__(self, keep: Callable[[SectionType], bool] | None = None):
-        self._keep = keep
+
+class NamesView(Sequence):
+    """A read-only tuple-like view of the registered question-bearing names that pass ``keep`` (all when None);
+    ``pages``: the page types too."""
+
+    def __init__(self, keep: Callable[[SectionType], bool] | None = None, pages: bool = False):
+        self._keep, self._pages = keep, pages
 
     def _names(self) -> tuple[str, ...]:
-        return tuple(t.name for t in _REGISTRY.values() if self._keep is None or self._keep(t))
+        return tuple(t.name for t in _kept(self._keep, self._pages))
 
     def __getitem__(self, i):
         return self._names()[i]
@@ -233,13 +273,15 @@ class LiveTuple(Sequence):
 
 
 class TypeMapView(Mapping):
-    """A read-only mapping view: registered name (passing ``keep``) -> ``value(section type)``."""
+    """A read-only mapping view: registered question-bearing name (passing ``keep``) -> ``value(section type)``;
+    ``pages``: the page types too."""
 
-    def __init__(self, value: Callable[[SectionType], object], keep: Callable[[SectionType], bool] | None = None):
-        self._value, self._keep = value, keep
+    def __init__(self, value: Callable[[SectionType], object], keep: Callable[[SectionType], bool] | None = None,
+                 pages: bool = False):
+        self._value, self._keep, self._pages = value, keep, pages
 
     def _types(self) -> dict[str, SectionType]:
-        return {n: t for n, t in _REGISTRY.items() if self._keep is None or self._keep(t)}
+        return {t.name: t for t in _kept(self._keep, self._pages)}
 
     def __getitem__(self, name: str):
         types = self._types()

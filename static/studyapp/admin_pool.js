@@ -1,7 +1,7 @@
 /* The admin's pool editor (studyapp.pool_editor, studyapp.views_pool).
 
    For every section form on a study's admin page: show only the fieldsets of the chosen section type (classes
-   "only-<type>"), and while the researcher edits, ask the staff-only count endpoint how many catalogue clips the
+   "only-<type>"; a fieldset of class "not-<type>" is hidden for that type), and while the researcher edits, ask the staff-only count endpoint how many catalogue clips the
    pool matches; its summary, warnings and field errors replace the "matching clips" line. The endpoint gets the
    section's fields as the form would post them, plus touched_pool / touched_options when a structured field of
    that group differs from what the page showed (the server's own rule on save: the raw JSON wins only when they
@@ -48,6 +48,9 @@
     var type = select ? select.value : "";
     row.querySelectorAll("fieldset[class*='only-']").forEach(function (fs) {
       fs.hidden = !fs.classList.contains("only-" + type);
+    });
+    row.querySelectorAll("fieldset[class*='not-']").forEach(function (fs) {   // e.g. no clip pool on a page
+      fs.hidden = fs.classList.contains("not-" + type) && !fs.querySelector(".errorlist");  // errors stay seen
     });
   }
 

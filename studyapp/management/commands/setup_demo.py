@@ -4,6 +4,7 @@ superuser and so sees every study anyway)."""
 from django.contrib.auth import get_user_model
 from django.core.management.base import BaseCommand, CommandError
 
+from protocol.section_types import is_page_type
 from studyapp.catalogue import section_queryset
 from studyapp.models import Clip, Study
 from studyapp.presets import create_study_from_preset
@@ -42,7 +43,7 @@ class Command(BaseCommand):
             study.owners.add(owner_user)
             self.stdout.write(f"  owner: {owner_user.username}")
         for section in study.sections.order_by("order"):
-            if section.reuse_section_id:
+            if section.reuse_section_id or is_page_type(section.section_type):
                 continue
             n = section_queryset(section.section_type, section.pool).count()
             if n == 0:
