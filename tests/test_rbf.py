@@ -147,9 +147,8 @@ def test_first_n_features():
         assert [f.rank for f in theme_features("sad", n, "calibrated")] == [f.rank for f in THEMES["sad"][:n]]
         # the default (extended) set adds our own rows only to the full set: the first-n study stays Table III's
         ours = [f.rank for f in theme_features("sad", n)]
-        assert ours == [f.rank for f in THEMES["sad"][:n]] + ([11] if n == 10 else [])
-    assert [f.source for f in theme_features("sad")] == ["table_iii"] * 10 + ["ours"]
-    assert [f.source for f in theme_features("happy")] == ["table_iii"] * 10
+        assert ours == [f.rank for f in THEMES["sad"][:n]] + ([11, 12, 13] if n == 10 else [])
+    assert [f.source for f in theme_features("sad")] == ["table_iii"] * 10 + ["ours"] * 3
     with pytest.raises(ValueError, match="n_features"):
         theme_features("sad", 11)
     with pytest.raises(ValueError, match="unknown theme"):

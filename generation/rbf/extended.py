@@ -15,10 +15,11 @@ over the datasets with the theme.
 
 1. **Rows** (:func:`extend_theme`): for each group, the gain of its rows alone at their visual intensity on the real
    neutral base at w = 1 (after the skeleton fit), and the factor = real difference / gain, in [0,
-   :data:`MAX_FACTOR`]; 0 where real actors move against the row's sign (the row is kept, at zero). Then
+   :data:`MAX_FACTOR`] (a decreased swing at most to no swing, :func:`_decrease_caps`); 0 where real actors move
+   against the row's sign (the row is kept, at zero). Then
    :data:`REFINE_STEPS` rescalings of each group by real / reached with all rows on (rows interact: a forward neck
    carries the head); a group whose measure then moves against the real sign (a decreased swing pushed past zero
-   swings the other way) is halved instead. Energetic's
+   swings the other way) is halved instead, and held at zero if it still does after the last step. Energetic's
    "Shoulders: increased swing along Y" is held at 0 (:data:`HELD_AT_ZERO`): without clavicles a shoulder bob
    moves the whole chest, a shrug artefact that made energetic walks read tired.
 2. **Tempo** (a lever of ours): the real style's walking speed over the same dataset's normal speed, minus 1 (per
@@ -42,7 +43,8 @@ from generation.core.motion import Motion
 from . import calibrate as C
 from .data_features import _rounded
 from .real_neutral import steady_cycles
-from .themes import THEME_NAMES, Feature, all_features
+from .stylise import walker_frame_positions
+from .themes import BODY_PARTS, THEME_NAMES, Feature, all_features
 
 MAX_FACTOR = 10.0
 #: (theme, Table III rank) rows held at zero, with the reason (module docstring).
@@ -72,19 +74,45 @@ def group_gains(base: Motion, theme: str) -> np.ndarray:
     return gains
 
 
+def _decrease_caps(base: Motion, theme: str, feats: tuple[Feature, ...], groups: list) -> np.ndarray:
+    """(G,) largest factor per group: :data:`MAX_FACTOR`, and for a decreased swing the factor whose amplitude
+    equals half the smallest neutral peak-to-peak of the group's joints on that axis (relative to the pelvis): a
+    swing cannot shrink below none; pushed further it swings the other way (a shoulder swing decreased past zero
+    twists the chest against the step)."""
+    P, _ = walker_frame_positions(base)
+    joints = tuple(base.skeleton.joints)
+    root, h = joints.index("root"), base.skeleton.height
+    caps = np.full(len(groups), MAX_FACTOR)
+    for f in feats:
+        if f.kind != "swing" or f.sign > 0 or f.intensity <= 0:
+            continue
+        a = "XYZ".index(f.axis)
+        half = min(np.ptp(P[:, joints.index(j), a] - (0 if joints.index(j) == root else P[:, root, a])) / 2
+                   for j in BODY_PARTS[f.part]) / h
+        g = groups.index((f.part, f.axis, f.kind))
+        caps[g] = min(caps[g], half / f.intensity)
+    return caps
+
+
 def extend_theme(base: Motion, theme: str, target: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Factors (G,) on the visual intensities of ``theme``'s rows (Table III and ours) sized from ``target`` (G,)
     real differences in heights; returns the factors, the gains and the w = 1 measures reached with all rows."""
     feats = all_features(theme)
+    groups = C.theme_groups(theme, feats)
     gains = group_gains(base, theme)
+    cap = _decrease_caps(base, theme, feats, groups)
     factors = np.where((np.abs(gains) > MIN_GAIN) & (target * gains > 0),
-                       np.clip(target / np.where(np.abs(gains) > MIN_GAIN, gains, 1.0), 0.0, MAX_FACTOR), 0.0)
+                       np.clip(target / np.where(np.abs(gains) > MIN_GAIN, gains, 1.0), 0.0, cap), 0.0)
     reached = C.generated_measures(base, theme, _by_rank(theme, factors, feats), 1.0, feats)
     for _ in range(REFINE_STEPS):  # rows of one theme interact (a forward neck carries the head): rescale each group
         ok = (factors > 0) & (reached * target > 0) & (np.abs(reached) > MIN_GAIN)
-        factors = np.where(ok, np.clip(factors * target / np.where(ok, reached, 1.0), 0.0, MAX_FACTOR), factors)
+        factors = np.where(ok, np.clip(factors * target / np.where(ok, reached, 1.0), 0.0, cap), factors)
         # a decreased swing pushed past zero swings the other way (the measure's sign flips): halve it
         factors = np.where((factors > 0) & (reached * target < 0), 0.5 * factors, factors)
+        reached = C.generated_measures(base, theme, _by_rank(theme, factors, feats), 1.0, feats)
+    wrong = (factors > 0) & (reached * target < 0)
+    if wrong.any():  # still against the real sign after refining: held at zero
+        factors = np.where(wrong, 0.0, factors)
         reached = C.generated_measures(base, theme, _by_rank(theme, factors, feats), 1.0, feats)
     return factors, gains, reached
 

@@ -32,6 +32,7 @@ from generation.core.features import np_gait_affective_features
 from generation.core.motion import Motion
 from generation.core.skeleton import GAIT_JOINTS
 from generation.core.windows import windows
+from generation.mocap.real_corpus import DEFAULT_PATH, load_real_corpus
 
 WINDOW_S = 2.0
 HOP_S = 0.5
@@ -265,8 +266,6 @@ def train_observers(corpus_path: str | Path | None = None, normalise: str = "wal
     Raises:
         FileNotFoundError: without the corpus (build it as docs/corpus.md says).
     """
-    from generation.mocap.real_corpus import DEFAULT_PATH, load_real_corpus
-
     path = Path(corpus_path) if corpus_path is not None else DEFAULT_PATH
     if not path.is_file():
         raise FileNotFoundError(f"real corpus {path} not found; build it as docs/corpus.md says")

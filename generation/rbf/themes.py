@@ -242,15 +242,32 @@ TABLE_III: dict[str, tuple[str, ...]] = {
                   "Elbows: increased swing along Z"),
 }
 
+def _ours(rank, part, axis, kind, sign, shape=1, intensity=0.01):
+    return Feature(rank, part, axis, kind, sign, shape, intensity, source="ours")
+
+
 #: Rows of our own (``source="ours"``), not in Table III: levers the real styled walks use and the experts' ten
 #: rows lack (docs/rbf.md). Used only by the ``extended`` set and only with all of a theme's features
 #: (``n_features`` = 10), so the paper's first-n study (n = 1, 4, 7, 10 of Table III) is unchanged below 10.
 #: Their intensities here are placeholders; the ``extended`` file sizes them from real data.
 OURS: dict[str, tuple[Feature, ...]] = {
-    # real energetic (active) walks carry the hands higher, forearms raised (data features: wrists Y first)
-    "energetic": (Feature(11, "wrists", "Y", "tilt", +1, 1, 0.02, source="ours"),),
-    # real sad walks barely swing the arms (data features: wrists Z first, -0.10 to -0.21 heights)
-    "sad": (Feature(11, "wrists", "Z", "swing", -1, 4, 0.02, source="ours"),),
+    # each row: the real style's largest differences from normal walks that no Table III row of the theme holds
+    # (Bandai Namco train takes, docs/benchmarks/rbf.md); sized by the extended set like the experts' rows
+    "happy": (_ours(11, "hip", "Y", "swing", +1, 3),),                  # more bounce (pelvis up and down each step)
+    "sad": (_ours(11, "wrists", "Z", "swing", -1, 4),                   # arms barely swing
+            _ours(12, "ankles", "Z", "swing", -1, 4),                   # short steps
+            _ours(13, "torso_u", "Z", "tilt", +1)),                     # chest forward
+    "energetic": (_ours(11, "wrists", "Y", "tilt", +1),                 # hands carried higher
+                  _ours(12, "elbows", "Y", "tilt", +1),                 # forearms raised
+                  _ours(13, "torso_l", "Z", "tilt", +1),                # leaning into the walk
+                  _ours(14, "knees", "Z", "swing", +1, 4)),             # longer knee swing
+    "tired": (_ours(11, "shoulders", "Z", "tilt", +1),                  # shoulders rounded forward
+              _ours(12, "head", "X", "swing", +1, 4),                   # head sways side to side
+              _ours(13, "head", "Z", "swing", +1, 3)),                  # head nods with each step
+    "feminine": (_ours(11, "torso_u", "Z", "tilt", -1),                 # upright chest
+                 _ours(12, "elbows", "Z", "tilt", -1)),                 # elbows kept back, close to the body
+    "masculine": (_ours(11, "head", "Z", "tilt", +1),                   # head forward
+                  _ours(12, "knees", "Z", "swing", +1, 4)),             # longer knee swing
 }
 
 #: Named sets of intensities: ``extended`` (the default: sized from real style-vs-normal differences of Bandai
