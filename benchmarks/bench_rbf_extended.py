@@ -4,9 +4,9 @@ Measures (machine: 2-core shared CPU; about 2-3 min):
 1. The walker-normalised observers (:mod:`generation.rbf.observer`, trained on the training takes of the Bandai
    Namco walks): held-out recall per scale and class (val and test takes), and held out by dataset (trained on one
    dataset's takes, reading the other's, each relative to its own dataset's normal walks).
-2. Per theme and weight (-0.7, 0.4, 0.7, 1.0; ten features): p(theme) and the top class of the styled walk read
-   relative to the neutral walk (the plan's walk: 3 cycles at 25 fps), with the ``calibrated`` intensities (the
-   default before) and the ``extended`` ones (the default after), beside the held-out real takes of the style.
+2. Per theme and weight (-0.7, 0 (the base), 0.4, 0.7, 1.0; ten features): p(theme) and the top class of the styled
+   walk read relative to the neutral walk (the plan's walk: 3 cycles at 25 fps), with the ``calibrated`` intensities
+   (the default before) and the ``extended`` ones (the default after), beside the held-out real takes of the style.
 3. The built-in ``seed004`` plan's 16 walks per theme (w 0.4, 0.7, 1.0, 1.3 x 1, 4, 7, 10 features): how many read
    as the theme, before and after.
 4. Feature differences per group of the theme's rows (Table III and ours): real style minus normal (train and
@@ -32,7 +32,7 @@ from generation.rbf.real_neutral import load_cycle
 from generation.rbf.stylise import neutral_walk, stylise
 from generation.rbf.themes import CALIBRATED_PATH, EXTENDED_PATH, THEME_NAMES, all_features
 
-WEIGHTS = (-0.7, 0.4, 0.7, 1.0)
+WEIGHTS = (-0.7, 0.0, 0.4, 0.7, 1.0)  # 0: the neutral walk itself
 SETS = ("calibrated", "extended")  # before, after
 PLAN_WEIGHTS = (0.4, 0.7, 1.0, 1.3)
 PLAN_COUNTS = (1, 4, 7, 10)
