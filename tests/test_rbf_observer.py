@@ -80,3 +80,21 @@ def test_heldout_recall_on_real_walks_is_above_chance():
         k = len(O.SCALES[scale])
         for cls, recall in held[scale]["recall"].items():
             assert recall is not None and recall > 1.0 / k, (scale, cls, held[scale]["recall"])
+
+
+@pytest.mark.slow
+@pytest.mark.skipif(not DEFAULT_PATH.is_file(), reason="real corpus not built (docs/corpus.md)")
+def test_extended_walks_read_as_their_theme_at_full_weight():
+    """With the extended intensities, happy, tired and feminine at w = 1 (ten features) are read as their style
+    relative to the neutral walk, and every theme's p(theme) rises from w = 0.4 to 1.0 (docs/benchmarks/rbf.md)."""
+    from generation.rbf.real_neutral import load_cycle
+    from generation.rbf.stylise import neutral_walk, stylise
+
+    obs, _ = O.train_observers(DEFAULT_PATH)
+    base = load_cycle()
+    ref = O.reference_descriptor(neutral_walk(base, n_cycles=3, fps=25.0))
+    for theme in O.THEME_SCALE:
+        low, full = (obs.read_theme(stylise(base, theme, w, 10, n_cycles=3, fps=25.0), theme, ref) for w in (0.4, 1.0))
+        assert full["p_target"] > low["p_target"], theme
+        if theme in ("happy", "tired", "feminine"):
+            assert full["top"] == O.THEME_SCALE[theme][1], (theme, full)
