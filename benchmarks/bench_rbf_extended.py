@@ -111,8 +111,9 @@ def render(res: dict) -> str:
     for scale, h in res["observers"].items():
         for k in h["recall"]:
             lines.append(f"| {scale} | {k} | {h['takes'][k]} | {_f(h['recall'][k])} | {_f(h['mean_p'][k])} |")
-    lines += ["", "Held out by dataset (other actors, other sessions): trained on all takes of one dataset, reading "
-              "every take of at least 2 s of the other:", "", "| scale | trained -> read | class | takes | recall |",
+    lines += ["", "Held out by dataset (another recording with its own actors; the corpus has no actor ids): trained "
+              "on all takes of one dataset, reading every take of at least 2 s of the other:", "",
+              "| scale | trained -> read | class | takes | recall |",
               "|---|---|---|---|---|"]
     for scale, runs in res["cross_dataset"].items():
         for run, classes in runs.items():
