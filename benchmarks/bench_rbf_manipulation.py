@@ -130,8 +130,8 @@ def contact_sheet(obs, clips, base, path: Path, n_poses: int = 5) -> None:
                     and steady_cycles(c.motion, 100, c.name))
         real_pos = steady_cycles(real.motion, 100, real.name)[0].positions[:-1] * h
         poses = {"base": stylised_cycle(base, theme, 0.0, 10)["positions"], "real held-out take": real_pos,
-                 "calibrated w = 0.7": stylised_cycle(base, theme, 0.7, 10)["positions"],
-                 "calibrated w = 1.0": stylised_cycle(base, theme, 1.0, 10)["positions"],
+                 "calibrated w = 0.7": stylised_cycle(base, theme, 0.7, 10, intensities="calibrated")["positions"],
+                 "calibrated w = 1.0": stylised_cycle(base, theme, 1.0, 10, intensities="calibrated")["positions"],
                  "visual w = 1.0": stylised_cycle(base, theme, 1.0, 10, intensities="visual")["positions"]}
         for col, label in enumerate(cols):
             ax = axes[row, col]

@@ -2,10 +2,11 @@
 
 One PNG per theme, ``docs/img/rbf_manip_<theme>.png``: rows = the neutral base walk, a held-out real take of the
 style (Bandai Namco, CC BY-NC 4.0), the calibrated edit at w = 0.7 and 1.0, the visual edit at w = 1.0; columns = 5
-moments 0.25 s apart (about one stride).
+moments 0.25 s apart (about one stride). With ``--extended``, ``docs/img/rbf_extended_<theme>.png``: the base, the
+real take, the extended edit (the default) at w = 0.7 and 1.0 and the calibrated edit (the old default) at w = 1.0.
 
     OMP_NUM_THREADS=1 python -m benchmarks.rbf_manipulation_sheets [--corpus var/mocap/bandai-namco.npz] \
-        [--out docs/img] [--themes happy sad]
+        [--out docs/img] [--themes happy sad] [--extended]
 
 About 40 s per theme on the 2-core machine (25 offscreen renders).
 """
@@ -26,15 +27,21 @@ from generation.render.offscreen import prepare_render_process
 TIMES = [0.5 + 0.25 * k for k in range(5)]
 
 
-def theme_rows(base, clips, theme: str) -> list[tuple[str, object]]:
-    """(label, motion) rows of one theme's sheet."""
+def theme_rows(base, clips, theme: str, extended: bool = False) -> list[tuple[str, object]]:
+    """(label, motion) rows of one theme's sheet (``extended``: the extended set's sheet)."""
     real = next(c for c in sorted(clips, key=lambda c: (c.dataset, c.take))
                 if c.split != "train" and c.style in theme_styles(theme) and c.motion.num_frames >= 60)
     kw = {"n_cycles": 3, "fps": 30.0}
+    if extended:
+        return [("base (real average)", neutral_walk(base, **kw)),
+                (f"REAL {real.style} {real.dataset[-1]}/{real.take}", real.motion),
+                (f"{theme} extended w0.7", stylise(base, theme, 0.7, 10, intensities="extended", **kw)),
+                (f"{theme} extended w1.0", stylise(base, theme, 1.0, 10, intensities="extended", **kw)),
+                (f"{theme} calibrated w1.0", stylise(base, theme, 1.0, 10, intensities="calibrated", **kw))]
     return [("base (real average)", neutral_walk(base, **kw)),
             (f"REAL {real.style} {real.dataset[-1]}/{real.take}", real.motion),
-            (f"{theme} calibrated w0.7", stylise(base, theme, 0.7, 10, **kw)),
-            (f"{theme} calibrated w1.0", stylise(base, theme, 1.0, 10, **kw)),
+            (f"{theme} calibrated w0.7", stylise(base, theme, 0.7, 10, intensities="calibrated", **kw)),
+            (f"{theme} calibrated w1.0", stylise(base, theme, 1.0, 10, intensities="calibrated", **kw)),
             (f"{theme} visual w1.0", stylise(base, theme, 1.0, 10, intensities="visual", **kw))]
 
 
@@ -67,11 +74,13 @@ def main(argv=None) -> int:
     ap.add_argument("--corpus", type=Path, default=DEFAULT_PATH)
     ap.add_argument("--out", type=Path, default=Path("docs/img"))
     ap.add_argument("--themes", nargs="*", default=list(THEME_NAMES), choices=list(THEME_NAMES))
+    ap.add_argument("--extended", action="store_true", help="the extended set's sheets (rbf_extended_<theme>.png)")
     a = ap.parse_args(argv)
     clips = load_real_corpus(a.corpus, skeleton="gait", contents=["walk"])
     base = load_cycle()
     for theme in a.themes:
-        print("wrote", write_sheet(theme_rows(base, clips, theme), a.out / f"rbf_manip_{theme}.png"))
+        name = f"rbf_extended_{theme}.png" if a.extended else f"rbf_manip_{theme}.png"
+        print("wrote", write_sheet(theme_rows(base, clips, theme, a.extended), a.out / name))
     return 0
 
 

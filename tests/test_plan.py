@@ -172,6 +172,10 @@ def test_generator_version_follows_the_generator_code():
     assert "humanoid3d_walk.txt" in captured  # data files count too
     assert clipgen.generator_version("rbf").startswith(get_generator("rbf").version + "+src")
     assert clipgen.source_digest("rbf") != clipgen.source_digest("captured")
+    # a data folder named after a package counts only for the generators that import it
+    assert {"extended_intensities.json", "neutral_real.npz"} <= rbf
+    for generator in ("gait_net", "gesture_net", "captured", "procedural_gesture"):
+        assert not any("rbf" in p.parts[-2:-1] for p in clipgen.source_files(generator)), generator
 
 
 def test_seed003_generates_gestures_from_held_out_sentences():

@@ -144,7 +144,11 @@ def test_six_themes_with_ten_features_in_table_order():
 def test_first_n_features():
     for n in (1, 4, 7, 10):
         assert theme_features("sad", n, "visual") == THEMES["sad"][:n]
-        assert [f.rank for f in theme_features("sad", n)] == [f.rank for f in THEMES["sad"][:n]]
+        assert [f.rank for f in theme_features("sad", n, "calibrated")] == [f.rank for f in THEMES["sad"][:n]]
+        # the default (extended) set adds our own rows only to the full set: the first-n study stays Table III's
+        ours = [f.rank for f in theme_features("sad", n)]
+        assert ours == [f.rank for f in THEMES["sad"][:n]] + ([11, 12, 13] if n == 10 else [])
+    assert [f.source for f in theme_features("sad")] == ["table_iii"] * 10 + ["ours"] * 3
     with pytest.raises(ValueError, match="n_features"):
         theme_features("sad", 11)
     with pytest.raises(ValueError, match="unknown theme"):

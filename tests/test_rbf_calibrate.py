@@ -48,11 +48,12 @@ def test_visual_set_is_the_old_numbers_exactly(base):
     assert clip.metadata["intensities"] == "visual"
 
 
-def test_calibrated_is_the_default_and_carries_the_licence(base):
-    out = stylise(base, "tired", 1.0, 10, n_cycles=1, plant=False)
+def test_calibrated_is_selectable_and_carries_the_licence(base):
+    # no longer the default (extended is, tests/test_rbf_extended.py); still selectable by name
+    out = stylise(base, "tired", 1.0, 10, n_cycles=1, plant=False, intensities="calibrated")
     assert out.metadata["intensities"] == "calibrated" and out.metadata["licence"] == "CC BY-NC 4.0"
     cal = calibrated_intensities()["tired"]
-    assert [f.intensity for f in theme_features("tired")] == [cal[r] for r in range(1, 11)]
+    assert [f.intensity for f in theme_features("tired", None, "calibrated")] == [cal[r] for r in range(1, 11)]
     with pytest.raises(ValueError, match="intensities"):
         stylise(base, "tired", 1.0, 10, intensities="louder")
 

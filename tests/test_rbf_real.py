@@ -147,7 +147,7 @@ def test_data_features_style_the_real_base(base):
 def test_comparison_of_expert_features_with_themselves(base):
     P, _ = walker_frame_positions(base)
     h = base.skeleton.height
-    dofs = theme_rbfs(P, base.skeleton, "happy", 10)
+    dofs = theme_rbfs(P, base.skeleton, "happy", 10, intensities="calibrated")  # compare_theme's set: Table III's rows
     rows = sorted({(DF.PART_OF[j], a) for j, a in dofs})
     as_data = {"cycle_frames": 100, "themes": {"happy": {"features": [list(r) for r in rows], "dofs": [
         {"joint": j, "axis": a, "part": DF.PART_OF[j], "rbfs": (p * [1 / h, 1, 1]).tolist()}
@@ -193,6 +193,8 @@ def test_excluding_expert_features(base):
     masculine = theme_rbfs(P, skel, "masculine", 10)
     without = theme_rbfs(P, skel, "masculine", 10, exclude=(5,))  # Ankles: increased swing along Y
     assert set(masculine) - set(without) == {("left_heel", "Y"), ("right_heel", "Y")}
-    assert theme_rbfs(P, skel, "masculine", 10, exclude=tuple(range(1, 11))) == {}
+    assert theme_rbfs(P, skel, "masculine", 10, exclude=tuple(range(1, 11)), intensities="calibrated") == {}
+    # the default (extended) set's own rows (ranks 11 and up) are excluded by rank too
+    assert theme_rbfs(P, skel, "masculine", 10, exclude=tuple(range(1, 13))) == {}
     clip = stylise(base, "masculine", 1.0, 10, n_cycles=2, fps=30.0, exclude=(5,))
     assert clip.metadata["excluded_ranks"] == [5]

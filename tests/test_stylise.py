@@ -266,8 +266,9 @@ def test_horn_rotation_recovers_a_rotation():
 
 # ---- timing, path, metadata, errors ------------------------------------------------------------------
 def test_speed_warps_time_uniformly_and_walks_forward(neutral):
-    slow = stylise(neutral, "tired", 0.7, 10, speed=1.0, n_cycles=4, fps=30.0)
-    fast = stylise(neutral, "tired", 0.7, 10, speed=1.25, n_cycles=4, fps=30.0)
+    # the calibrated set: the default (extended) set changes tempo with the weight too (next test)
+    slow = stylise(neutral, "tired", 0.7, 10, speed=1.0, n_cycles=4, fps=30.0, intensities="calibrated")
+    fast = stylise(neutral, "tired", 0.7, 10, speed=1.25, n_cycles=4, fps=30.0, intensities="calibrated")
     assert slow.num_frames == round(4 * neutral.duration * 30.0)
     assert fast.num_frames == round(4 * neutral.duration / 1.25 * 30.0)
     stride = neutral.metadata["stride_m"][2]
@@ -282,6 +283,23 @@ def test_speed_warps_time_uniformly_and_walks_forward(neutral):
     sparse = stylise(neutral, "tired", 0.7, 10, speed=1.0, n_cycles=4, fps=24.0, plant=False)
     assert sparse.num_frames == fast.num_frames
     np.testing.assert_allclose(fast.positions(), sparse.positions(), atol=1e-9)
+
+
+def test_extended_set_changes_tempo_with_the_weight(neutral):
+    """The extended set's tempo (a lever of ours): the cycle plays max(0.5, 1 + w * tempo) times faster, only with
+    all ten features; the same poses otherwise (a uniform time warp)."""
+    from generation.rbf.themes import extended_tempo
+
+    tempo = extended_tempo("energetic")
+    assert tempo > 0 > extended_tempo("sad")
+    for w in (-0.7, 0.7):
+        clip = stylise(neutral, "energetic", w, 10, n_cycles=4, fps=30.0)
+        assert clip.metadata["tempo"] == pytest.approx(1 + w * tempo)
+        assert clip.num_frames == round(4 * neutral.duration / (1 + w * tempo) * 30.0)
+    assert "tempo" not in stylise(neutral, "energetic", 0.7, 7, n_cycles=4).metadata
+    assert "tempo" not in stylise(neutral, "energetic", 0.0, 10, n_cycles=4).metadata
+    slow = stylise(neutral, "sad", 1.3, 10, n_cycles=1)
+    assert slow.metadata["tempo"] == 0.5
 
 
 def test_neutral_walk_equals_weight_zero(neutral):

@@ -90,7 +90,10 @@ def _module_file(module: str) -> Path:
 def source_files(generator: str) -> list[Path]:
     """The files whose content a generator's output depends on: the module that declares it, its required modules
     and everything they import from the project (followed transitively), this file, and the small data files
-    under ``generation/data`` (weights apart; they have their own digest)."""
+    under ``generation/data`` (weights apart; they have their own digest). A data folder named after a package of
+    ``generation`` (``data/rbf``, ``data/mocap``, ...) counts only for generators whose code imports that package,
+    so new RBF intensities re-render the RBF clips and leave the gait and gesture networks' clip ids alone; every
+    other data file counts for all."""
     spec = get_generator(generator)
     todo = [_module_file(m) for m in (spec.module, *spec.requires)]
     seen: set[Path] = set()
@@ -102,8 +105,16 @@ def source_files(generator: str) -> list[Path]:
         todo.extend(_imported_files(path) - seen)
     seen.add(Path(__file__).resolve())
     data = PACKAGE_DIR / "data"
+    root = PACKAGE_DIR.resolve()
+    packages = {d.name for d in root.iterdir() if (d / "__init__.py").is_file()}
+    imported = {p.relative_to(root).parts[0] for p in seen if p.is_relative_to(root)}
+
+    def counts(p: Path) -> bool:
+        folder = p.relative_to(data).parts[0] if len(p.relative_to(data).parts) > 1 else ""
+        return folder not in packages or folder in imported
+
     return sorted(seen) + sorted(p.resolve() for p in data.rglob("*") if p.is_file() and "weights" not in p.parts
-                                 and p.stat().st_size < 5_000_000)
+                                 and p.stat().st_size < 5_000_000 and counts(p))
 
 
 @functools.cache

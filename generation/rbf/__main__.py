@@ -3,10 +3,11 @@
     python -m generation.rbf neutral  [--corpus CORPUS] [--out generation/data/rbf/neutral_real.npz]
     python -m generation.rbf features [--corpus CORPUS] [--out generation/data/rbf/data_features.json]
     python -m generation.rbf calibrate [--corpus CORPUS] [--out generation/data/rbf/calibrated_intensities.json]
+    python -m generation.rbf extend [--corpus CORPUS] [--out generation/data/rbf/extended_intensities.json]
 
 CORPUS is the real-capture corpus (``python -m generation.mocap dataset bandai-namco DIR --out CORPUS``; default
 $REAL_CORPUS, else ``var/mocap/bandai-namco.npz``). ``neutral`` and ``features`` read the train split only;
-``calibrate`` fits on the train split and records the held-out (val, test) differences beside the fit.
+``calibrate`` and ``extend`` size on the train split and record the held-out (val, test) differences beside it.
 """
 from __future__ import annotations
 
@@ -21,8 +22,9 @@ from generation.mocap.real_corpus import load_real_corpus, real_corpus_path
 from .calibrate import calibrate, save_calibration
 from .data_features import SHIPPED_PATH as FEATURES_PATH
 from .data_features import fit_data_features, save_data_features
+from .extended import extend, save_extended
 from .real_neutral import SHIPPED_PATH, build_real_neutral, load_cycle
-from .themes import CALIBRATED_PATH
+from .themes import CALIBRATED_PATH, EXTENDED_PATH
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -30,7 +32,8 @@ def main(argv: list[str] | None = None) -> int:
     sub = parser.add_subparsers(dest="command", required=True)
     for name, help_ in (("neutral", "average real normal-walk cycles into the neutral base cycle"),
                         ("features", "fit data-driven RBF features per theme to real themed walks"),
-                        ("calibrate", "calibrate the expert features' intensities on real themed walks")):
+                        ("calibrate", "calibrate the expert features' intensities on real themed walks"),
+                        ("extend", "size the extended intensity set (with our rows and tempo) on real themed walks")):
         p = sub.add_parser(name, help=help_)
         p.add_argument("--corpus", type=Path, default=real_corpus_path(os.environ),
                        help="real-capture corpus .npz (default: $REAL_CORPUS, else var/mocap/bandai-namco.npz)")
@@ -49,6 +52,13 @@ def main(argv: list[str] | None = None) -> int:
         save_calibration(data, args.out or CALIBRATED_PATH)
         for theme, entry in data["themes"].items():
             print(f"{theme}: factors {[round(r['factor'], 2) for r in entry['features']]}")
+        return 0
+    if args.command == "extend":
+        data = extend(load_real_corpus(args.corpus, skeleton="gait", contents=["walk"]), load_cycle())
+        save_extended(data, args.out or EXTENDED_PATH)
+        for theme, entry in data["themes"].items():
+            print(f"{theme}: factors {[round(r['factor'], 2) for r in entry['features']]}, "
+                  f"tempo {entry['tempo']['per_weight']:+.3f}")
         return 0
     clips = load_real_corpus(args.corpus, skeleton="gait", split="train", contents=["walk"])
     features = fit_data_features(clips, GAIT_JOINTS)

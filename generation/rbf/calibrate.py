@@ -48,24 +48,25 @@ MAX_EVALUATIONS = 200
 HELDOUT_SPLITS = ("val", "test")
 
 
-def theme_groups(theme: str) -> list[tuple[str, str, str]]:
-    """(part, axis, kind) groups of a theme's Table III rows, in first-rank order."""
-    return list(dict.fromkeys((f.part, f.axis, f.kind) for f in THEMES[theme]))
+def theme_groups(theme: str, feats: tuple[Feature, ...] | None = None) -> list[tuple[str, str, str]]:
+    """(part, axis, kind) groups of a theme's Table III rows (or of ``feats``), in first-rank order."""
+    return list(dict.fromkeys((f.part, f.axis, f.kind) for f in (THEMES[theme] if feats is None else feats)))
 
 
-def _group_sides(theme: str, group: tuple[str, str, str]) -> dict[str, int]:
+def _group_sides(theme: str, group: tuple[str, str, str], feats: tuple[Feature, ...] | None = None
+                 ) -> dict[str, int]:
     """joint -> sign of a group's measure: the part's joints (per-side sign for "R along +X, L along -X" rows, else
     +1) and the joints that follow them on that axis when the edit is applied (their children without an edit of
     their own on that axis in this theme, transitively; not the pelvis's children: see
     :func:`generation.rbf.stylise.rbf_displacement`), so the measure covers what the feature moves: a shoulder's
     swing along Z carries the arm."""
-    feats = [f for f in THEMES[theme] if (f.part, f.axis, f.kind) == group]
-    f: Feature = feats[0]
+    rows = THEMES[theme] if feats is None else feats
+    f: Feature = [g for g in rows if (g.part, g.axis, g.kind) == group][0]
     if f.kind == "tilt" and f.side_signs:
         signs = {j: s for j, s in f.joint_signs()}
     else:
         signs = {j: 1 for j in BODY_PARTS[f.part]}
-    edited = {(j, g.axis) for g in THEMES[theme] for j in BODY_PARTS[g.part]}
+    edited = {(j, g.axis) for g in rows for j in BODY_PARTS[g.part]}
     names, parents = GAIT_JOINTS, gait_skeleton().parents
     for j, p in enumerate(parents):
         if p > 0 and names[p] in signs and names[j] not in signs and names[j] in MODELLED \
@@ -74,35 +75,38 @@ def _group_sides(theme: str, group: tuple[str, str, str]) -> dict[str, int]:
     return signs
 
 
-def group_measure(positions: np.ndarray, joints: tuple[str, ...], theme: str, group: tuple[str, str, str]) -> float:
+def group_measure(positions: np.ndarray, joints: tuple[str, ...], theme: str, group: tuple[str, str, str],
+                  feats: tuple[Feature, ...] | None = None) -> float:
     """A group's measure on one cycle (see the module docstring), in walker heights.
 
     Args:
         positions: (m, J, 3) one cycle in the walker's frame divided by the walker's height.
         joints: joint names in ``positions``' order.
+        feats: the theme's rows (default Table III's; :mod:`generation.rbf.extended` adds ours).
     """
     part, axis, kind = group
     a = "XYZ".index(axis)
     root = joints.index("root")
     values = []
-    for joint, sign in _group_sides(theme, group).items():
+    for joint, sign in _group_sides(theme, group, feats).items():
         j = joints.index(joint)
         traj = positions[:, j, a] if j == root else positions[:, j, a] - positions[:, root, a]
         values.append(sign * float(traj.mean()) if kind == "tilt" else float(np.ptp(traj)))
     return float(np.mean(values))
 
 
-def theme_measures(positions: np.ndarray, joints: tuple[str, ...], theme: str) -> np.ndarray:
+def theme_measures(positions: np.ndarray, joints: tuple[str, ...], theme: str,
+                   feats: tuple[Feature, ...] | None = None) -> np.ndarray:
     """(G,) measures of all of a theme's groups (:func:`theme_groups` order) on one cycle (m, J, 3) in heights."""
-    return np.array([group_measure(positions, joints, theme, g) for g in theme_groups(theme)])
+    return np.array([group_measure(positions, joints, theme, g, feats) for g in theme_groups(theme, feats)])
 
 
-def _take_measures(clip, theme: str, m: int) -> np.ndarray | None:
+def _take_measures(clip, theme: str, m: int, feats: tuple[Feature, ...] | None = None) -> np.ndarray | None:
     cycles = steady_cycles(clip.motion, m, clip.name)
     if not cycles:
         return None
     joints = tuple(clip.motion.skeleton.joints)
-    return np.mean([theme_measures(c.positions[:-1], joints, theme) for c in cycles], axis=0)
+    return np.mean([theme_measures(c.positions[:-1], joints, theme, feats) for c in cycles], axis=0)
 
 
 def theme_styles(theme: str) -> tuple[str, ...]:
@@ -110,11 +114,13 @@ def theme_styles(theme: str) -> tuple[str, ...]:
     return tuple(s for s, t in CAPTURE_THEMES.items() if t == theme)
 
 
-def real_differences(clips: list, theme: str, splits: tuple[str, ...], m: int = 100) -> tuple[np.ndarray, list[dict]]:
+def real_differences(clips: list, theme: str, splits: tuple[str, ...], m: int = 100,
+                     feats: tuple[Feature, ...] | None = None) -> tuple[np.ndarray, list[dict]]:
     """(G,) real style-minus-normal differences of ``theme``'s group measures on the takes of ``splits``.
 
     Args:
         clips: CorpusClips (gait skeleton, straight walks) of both datasets, any split.
+        feats: the theme's rows (default Table III's).
 
     Returns:
         the differences (mean over datasets that have the theme in ``splits``) and per dataset {dataset, styles,
@@ -128,12 +134,12 @@ def real_differences(clips: list, theme: str, splits: tuple[str, ...], m: int = 
     diffs, info = [], []
     for dataset in sorted({c.dataset for c in clips}):
         mine = [c for c in clips if c.dataset == dataset and c.split in splits and c.content == "walk"]
-        themed = [v for v in (_take_measures(c, theme, m) for c in mine if c.style in styles) if v is not None]
-        normal = [v for v in (_take_measures(c, theme, m) for c in mine if c.style == "normal") if v is not None]
+        themed = [v for v in (_take_measures(c, theme, m, feats) for c in mine if c.style in styles) if v is not None]
+        normal = [v for v in (_take_measures(c, theme, m, feats) for c in mine if c.style == "normal") if v is not None]
         normal_splits = list(splits)
         if themed and not normal:
             # dataset 1's one held-out normal take is 1 s long (no cycle): its actor's other normal take stands in
-            normal = [v for v in (_take_measures(c, theme, m) for c in clips if c.dataset == dataset
+            normal = [v for v in (_take_measures(c, theme, m, feats) for c in clips if c.dataset == dataset
                                   and c.content == "walk" and c.style == "normal") if v is not None]
             normal_splits = sorted({c.split for c in clips if c.dataset == dataset and c.style == "normal"})
         if not themed or not normal:
@@ -153,12 +159,15 @@ def _intensities(theme: str, factors: np.ndarray) -> dict[int, float]:
     return {f.rank: f.intensity * float(factors[groups.index((f.part, f.axis, f.kind))]) for f in THEMES[theme]}
 
 
-def generated_measures(base: Motion, theme: str, intensities, weight: float = 1.0) -> np.ndarray:
-    """(G,) group measures of the stylised cycle minus the base's, heights (skeleton fit, no foot planting)."""
+def generated_measures(base: Motion, theme: str, intensities, weight: float = 1.0,
+                       feats: tuple[Feature, ...] | None = None) -> np.ndarray:
+    """(G,) group measures of the stylised cycle minus the base's, heights (skeleton fit, no foot planting);
+    ``feats``: whose groups to measure (default Table III's)."""
     out = stylised_cycle(base, theme, weight, len(THEMES[theme]), intensities=intensities)
     joints = tuple(base.skeleton.joints)
     h = base.skeleton.height
-    return theme_measures(out["positions"] / h, joints, theme) - theme_measures(out["P"] / h, joints, theme)
+    return (theme_measures(out["positions"] / h, joints, theme, feats)
+            - theme_measures(out["P"] / h, joints, theme, feats))
 
 
 def calibrate_theme(base: Motion, theme: str, target: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -42,7 +42,8 @@ def _peak(y: np.ndarray) -> tuple[int, float]:
     return k, float(y[k])
 
 
-def compare_theme(neutral: Motion, theme: str, data: dict | None = None, n_data: int = 10) -> dict:
+def compare_theme(neutral: Motion, theme: str, data: dict | None = None, n_data: int = 10,
+                  intensities: str = "calibrated") -> dict:
     """Per-DOF comparison of a theme's expert features (all ten) with its first ``n_data`` data-driven features.
 
     Returns {"rows": [per DOF dict, largest first], "expert_features": [(part, axis)], "data_features":
@@ -52,7 +53,7 @@ def compare_theme(neutral: Motion, theme: str, data: dict | None = None, n_data:
     skel = neutral.skeleton
     P, _ = walker_frame_positions(neutral)
     m, h = P.shape[0], skel.height
-    expert = _curves(theme_rbfs(P, skel, theme, 10), m, h)
+    expert = _curves(theme_rbfs(P, skel, theme, 10, intensities=intensities), m, h)
     found = _curves(data_rbfs(theme, n_data, h, m, data), m, h)
     rows = []
     for key in sorted(set(expert) | set(found), key=lambda k: (k[0], AXES[k[1]])):
@@ -74,7 +75,7 @@ def compare_theme(neutral: Motion, theme: str, data: dict | None = None, n_data:
                 row["corr"] = float(np.corrcoef(e, d)[0, 1])
         rows.append(row)
     rows.sort(key=lambda r: -max(abs(r["expert_peak"] or 0.0), abs(r["data_peak"] or 0.0)))
-    expert_rows = list(dict.fromkeys((f.part, f.axis) for f in theme_features(theme)))
+    expert_rows = list(dict.fromkeys((f.part, f.axis) for f in theme_features(theme, None, intensities)))
     data_rows = [tuple(k) for k in data["themes"][theme]["features"][:n_data]]
     shared = [r for r in rows if r["sign_agree"] is not None]
     ratios = [r["ratio"] for r in shared]

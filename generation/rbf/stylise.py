@@ -36,7 +36,17 @@ from generation.core.skeleton import Skeleton
 
 from .basis import CYCLE_FRAMES, rbf_sum, shape_params, swing_params
 from .data_features import data_rbfs, load_data_features
-from .themes import AXES, BODY_PARTS, INTENSITY_SETS, THEME_NAMES, calibration_provenance, theme_features
+from .themes import (
+    AXES,
+    BODY_PARTS,
+    DEFAULT_INTENSITIES,
+    INTENSITY_SETS,
+    THEME_NAMES,
+    calibration_provenance,
+    extended_provenance,
+    extended_tempo,
+    theme_features,
+)
 
 _MODELLED = frozenset(name for joints in BODY_PARTS.values() for name in joints)
 PAPER_WEIGHTS = (0.4, 0.7, 1.0, 1.3)  # Fig. 7
@@ -100,7 +110,7 @@ def walker_frame_positions(neutral: Motion) -> tuple[np.ndarray, np.ndarray]:
 # --------------------------------------------------------------------------------------------------
 def theme_rbfs(P: np.ndarray, skeleton: Skeleton, theme: str, n_features: int,
                height: float | None = None, exclude: tuple[int, ...] = (),
-               intensities: str | Mapping[int, float] = "calibrated") -> dict[tuple[str, str], np.ndarray]:
+               intensities: str | Mapping[int, float] = DEFAULT_INTENSITIES) -> dict[tuple[str, str], np.ndarray]:
     """RBF parameters per degree of freedom for the first ``n_features`` of a theme.
 
     Args:
@@ -110,7 +120,7 @@ def theme_rbfs(P: np.ndarray, skeleton: Skeleton, theme: str, n_features: int,
         n_features: how many of Table III's features, in frequency order (0..10).
         height: walker height in metres for de-normalising intensities (default ``skeleton.height``).
         exclude: Table III ranks (1..10) to leave out of the first ``n_features`` (for ablations).
-        intensities: ``calibrated`` (default), ``visual`` or {rank: intensity}
+        intensities: ``extended`` (default), ``calibrated``, ``visual`` or {rank: intensity}
             (:func:`generation.rbf.themes.theme_features`).
 
     Returns:
@@ -143,7 +153,7 @@ def theme_rbfs(P: np.ndarray, skeleton: Skeleton, theme: str, n_features: int,
 def theme_displacement(P: np.ndarray, skeleton: Skeleton, theme: str, n_features: int,
                        height: float | None = None, propagate: bool = True,
                        exclude: tuple[int, ...] = (),
-                       intensities: str | Mapping[int, float] = "calibrated") -> np.ndarray:
+                       intensities: str | Mapping[int, float] = DEFAULT_INTENSITIES) -> np.ndarray:
     """Secondary features S of the first ``n_features``: (m, J, 3) metres, for weight 1 (linear in the RBFs).
 
     The paper moved each marker independently (its bones stretched). With exact bone lengths an isolated knee
@@ -387,7 +397,7 @@ def warp_and_repeat_cycle(rotations: np.ndarray, root: np.ndarray, stride: np.nd
 # --------------------------------------------------------------------------------------------------
 def stylised_cycle(neutral_cycle: Motion, theme: str, weight: float, n_features: int,
                    keep_ground: bool = True, features: str = "expert", exclude: tuple[int, ...] = (),
-                   intensities: str | Mapping[int, float] = "calibrated") -> dict:
+                   intensities: str | Mapping[int, float] = DEFAULT_INTENSITIES) -> dict:
     """One stylised cycle on the skeleton, with the intermediate arrays.
 
     Returns a dict with ``P`` (m, J, 3) neutral walker-frame positions, ``S`` (m, J, 3) secondary
@@ -400,8 +410,8 @@ def stylised_cycle(neutral_cycle: Motion, theme: str, weight: float, n_features:
     ``features``: "expert" (Table III, :func:`theme_displacement`) or "data" (RBFs fitted to real themed walks,
     :func:`generation.rbf.data_features.data_rbfs`, applied to their own DOFs without propagation). ``exclude``:
     expert features (Table III ranks) to leave out, for ablations. ``intensities``: the expert features'
-    amplitudes, ``calibrated`` (default) or ``visual`` (:data:`generation.rbf.themes.INTENSITY_SETS`) or
-    {rank: intensity}.
+    amplitudes, ``extended`` (default), ``calibrated`` or ``visual`` (:data:`generation.rbf.themes.INTENSITY_SETS`)
+    or {rank: intensity}.
     """
     if features not in FEATURE_SOURCES:
         raise ValueError(f"features must be one of {list(FEATURE_SOURCES)}, got {features!r}")
@@ -448,7 +458,7 @@ def keep_feet_above_ground(Y: np.ndarray, P: np.ndarray, skeleton: Skeleton) -> 
 
 def stylise(neutral_cycle: Motion, theme: str, weight: float, n_features: int, speed: float = 1.0,
             n_cycles: int = 4, fps: float = 30.0, keep_ground: bool = True, plant: bool = True,
-            features: str = "expert", exclude: tuple[int, ...] = (), intensities: str = "calibrated") -> Motion:
+            features: str = "expert", exclude: tuple[int, ...] = (), intensities: str = DEFAULT_INTENSITIES) -> Motion:
     """Apply a seed 004 theme to a neutral walk cycle and walk it along a straight line.
 
     Args:
@@ -466,8 +476,11 @@ def stylise(neutral_cycle: Motion, theme: str, weight: float, n_features: int, s
             shortens the ankle swing while the body keeps the neutral stride), so without it they slide.
         features: "expert" (Table III) or "data" (fitted to real themed walks; see :func:`stylised_cycle`).
         exclude: expert features (Table III ranks) to leave out (ablations; recorded in the metadata when given).
-        intensities: the expert features' amplitudes: ``calibrated`` (default; w = 1 reproduces real actors'
-            style differences) or ``visual`` (the earlier hand-sized set), :data:`generation.rbf.themes.INTENSITY_SETS`.
+        intensities: the expert features' amplitudes, :data:`generation.rbf.themes.INTENSITY_SETS`: ``extended``
+            (default; sized from real style-vs-normal differences, with our rows and, with all ten features, the
+            theme's tempo: the cycle is played max(0.5, 1 + weight * tempo) times faster on top of ``speed``),
+            ``calibrated`` (w = 1 reproduces real actors' style differences, factors capped at 6x) or ``visual``
+            (the earlier hand-sized set).
 
     Returns:
         Motion on the neutral cycle's skeleton, round(n_cycles * cycle duration / speed * fps) frames, with
@@ -486,8 +499,11 @@ def stylise(neutral_cycle: Motion, theme: str, weight: float, n_features: int, s
     result = stylised_cycle(neutral_cycle, theme, weight, n_features, keep_ground, features, tuple(exclude),
                             intensities)
     stride = cycle_stride(neutral_cycle)
+    tempo = 1.0
+    if features == "expert" and intensities == "extended" and n_features == len(theme_features(theme, None, "visual")):
+        tempo = max(0.5, 1.0 + float(weight) * extended_tempo(theme))
     rotations, root = warp_and_repeat_cycle(result["rotations"], result["root"], stride, neutral_cycle.duration,
-                                            speed, n_cycles, fps)
+                                            speed * tempo, n_cycles, fps)
     base_meta = neutral_cycle.metadata
     metadata = {
         "origin": "generated",
@@ -506,11 +522,15 @@ def stylise(neutral_cycle: Motion, theme: str, weight: float, n_features: int, s
     }
     if features == "expert":
         metadata["intensities"] = intensities
+    if tempo != 1.0:
+        metadata["tempo"] = tempo
     if exclude:
         metadata["excluded_ranks"] = sorted(exclude)
     metadata.update(base_provenance(base_meta))
     if features == "expert" and intensities == "calibrated" and "licence" not in metadata:
         metadata.update(calibration_provenance())
+    if features == "expert" and intensities == "extended" and "licence" not in metadata:
+        metadata.update(extended_provenance())
     if features == "data" and "licence" not in metadata:
 
         data = load_data_features()

@@ -60,10 +60,11 @@ class Feature:
         sign: tilt: +1/-1 direction along the axis for every joint of the part; swing: +1 increased,
             -1 decreased.
         side_signs: tilts given per side ("R along +X, L along -X"): {"left": s, "right": s}; overrides sign.
+        source: ``table_iii`` (the experts' rows) or ``ours`` (a row we added, :data:`OURS`; ranks 11 and up).
         shape: Fig. 4 type (1 for tilts; 2, 3 or 4 for swings). Our choice where Fig. 5 is not legible.
         intensity: amplitude / walker height (dimensionless, >= 0). ``THEMES`` holds our visual choice (Fig. 5 is
-            a heat map); :func:`theme_features` gives the calibrated ones by default (0 where real actors do not
-            move that way).
+            a heat map); :func:`theme_features` gives the ``extended`` ones by default (sized from real data; 0
+            where real actors do not move that way).
     """
 
     rank: int
@@ -74,6 +75,7 @@ class Feature:
     shape: int
     intensity: float
     side_signs: dict = field(default_factory=dict)
+    source: str = "table_iii"
 
     def __post_init__(self):
         where = f"feature {self.rank} ({self.part})"
@@ -91,6 +93,8 @@ class Feature:
             raise ValueError(f"{where}: sign must be +1 or -1, got {self.sign}")
         if not self.intensity >= 0:
             raise ValueError(f"{where}: intensity must be a non-negative number, got {self.intensity}")
+        if self.source not in ("table_iii", "ours"):
+            raise ValueError(f"{where}: source must be 'table_iii' or 'ours', got {self.source!r}")
         if self.side_signs and set(self.side_signs) != {"left", "right"}:
             raise ValueError(f"{where}: side_signs needs 'left' and 'right', got {sorted(self.side_signs)}")
 
@@ -238,11 +242,88 @@ TABLE_III: dict[str, tuple[str, ...]] = {
                   "Elbows: increased swing along Z"),
 }
 
-#: Named sets of intensities: ``visual`` (our choice, sized to be visible in a stick figure at w = 0.7; the numbers
-#: of ``THEMES``) and ``calibrated`` (fitted so that w = 1 reproduces real actors' style differences,
-#: :mod:`generation.rbf.calibrate`, stored in :data:`CALIBRATED_PATH`). The first is the default.
-INTENSITY_SETS = ("calibrated", "visual")
+def _ours(rank, part, axis, kind, sign, shape=1, intensity=0.01):
+    return Feature(rank, part, axis, kind, sign, shape, intensity, source="ours")
+
+
+#: Rows of our own (``source="ours"``), not in Table III: levers the real styled walks use and the experts' ten
+#: rows lack (docs/rbf.md). Used only by the ``extended`` set and only with all of a theme's features
+#: (``n_features`` = 10), so the paper's first-n study (n = 1, 4, 7, 10 of Table III) is unchanged below 10.
+#: Their intensities here are placeholders; the ``extended`` file sizes them from real data.
+OURS: dict[str, tuple[Feature, ...]] = {
+    # each row: the real style's largest differences from normal walks that no Table III row of the theme holds
+    # (Bandai Namco train takes, docs/benchmarks/rbf.md); sized by the extended set like the experts' rows
+    "happy": (_ours(11, "hip", "Y", "swing", +1, 3),),                  # more bounce (pelvis up and down each step)
+    "sad": (_ours(11, "wrists", "Z", "swing", -1, 4),                   # arms barely swing
+            _ours(12, "ankles", "Z", "swing", -1, 4),                   # short steps
+            _ours(13, "torso_u", "Z", "tilt", +1)),                     # chest forward
+    "energetic": (_ours(11, "wrists", "Y", "tilt", +1),                 # hands carried higher
+                  _ours(12, "elbows", "Y", "tilt", +1),                 # forearms raised
+                  _ours(13, "torso_l", "Z", "tilt", +1),                # leaning into the walk
+                  _ours(14, "knees", "Z", "swing", +1, 4)),             # longer knee swing
+    "tired": (_ours(11, "shoulders", "Z", "tilt", +1),                  # shoulders rounded forward
+              _ours(12, "head", "X", "swing", +1, 4),                   # head sways side to side
+              _ours(13, "head", "Z", "swing", +1, 3)),                  # head nods with each step
+    "feminine": (_ours(11, "torso_u", "Z", "tilt", -1),                 # upright chest
+                 _ours(12, "elbows", "Z", "tilt", -1)),                 # elbows kept back, close to the body
+    "masculine": (_ours(11, "head", "Z", "tilt", +1),                   # head forward
+                  _ours(12, "knees", "Z", "swing", +1, 4)),             # longer knee swing
+}
+
+#: Named sets of intensities: ``extended`` (the default: sized from real style-vs-normal differences of Bandai
+#: Namco walks, with our rows and a tempo lever, :mod:`generation.rbf.extended`, stored in :data:`EXTENDED_PATH`),
+#: ``calibrated`` (fitted so that w = 1 reproduces real actors' style differences with factors capped at 6x the
+#: visual ones, :mod:`generation.rbf.calibrate`, :data:`CALIBRATED_PATH`) and ``visual`` (our choice, sized to
+#: be visible in a stick figure at w = 0.7; the numbers of ``THEMES``). The first is the default.
+INTENSITY_SETS = ("extended", "calibrated", "visual")
+DEFAULT_INTENSITIES = INTENSITY_SETS[0]
 CALIBRATED_PATH = Path(__file__).resolve().parents[1] / "data" / "rbf" / "calibrated_intensities.json"
+EXTENDED_PATH = Path(__file__).resolve().parents[1] / "data" / "rbf" / "extended_intensities.json"
+
+
+def all_features(theme: str) -> tuple[Feature, ...]:
+    """Table III's rows of ``theme`` followed by our own (:data:`OURS`)."""
+    return THEMES[theme] + OURS.get(theme, ())
+
+
+@lru_cache(maxsize=4)
+def _extended_file(path: str) -> dict:
+    p = Path(path)
+    if not p.is_file():
+        raise FileNotFoundError(f"extended RBF intensities {p} not found; build them with "
+                                "`python -m generation.rbf extend`")
+    data = json.loads(p.read_text(encoding="utf-8"))
+    for theme in THEMES:
+        entry = data.get("themes", {}).get(theme, {})
+        rows = entry.get("features")
+        if not rows or sorted(r["rank"] for r in rows) != [f.rank for f in all_features(theme)]:
+            raise ValueError(f"{p}: theme {theme!r} needs one extended intensity per rank (Table III and ours)")
+        for r in rows:
+            if not (isinstance(r.get("extended"), (int, float)) and r["extended"] >= 0):
+                raise ValueError(f"{p}: theme {theme!r} rank {r.get('rank')}: extended intensity must be >= 0")
+        if not isinstance(entry.get("tempo", {}).get("per_weight"), (int, float)):
+            raise ValueError(f"{p}: theme {theme!r} needs tempo.per_weight (a number)")
+    return data
+
+
+def extended_intensities(path: str | Path = EXTENDED_PATH) -> dict[str, dict[int, float]]:
+    """{theme: {rank: extended intensity (x height)}} from the shipped file (or ``path``); ranks 11+ are ours."""
+    data = _extended_file(str(path))
+    return {t: {int(r["rank"]): float(r["extended"]) for r in data["themes"][t]["features"]} for t in THEMES}
+
+
+def extended_tempo(theme: str, path: str | Path = EXTENDED_PATH) -> float:
+    """Cadence change per unit weight of the ``extended`` set (a row of ours): the walk is played
+    max(0.5, 1 + w * tempo) times faster (real style-vs-normal cadence ratio - 1, :mod:`generation.rbf.extended`)."""
+    if theme not in THEMES:
+        raise ValueError(f"unknown theme {theme!r}; expected one of {list(THEME_NAMES)}")
+    return float(_extended_file(str(path))["themes"][theme]["tempo"]["per_weight"])
+
+
+def extended_provenance(path: str | Path = EXTENDED_PATH) -> dict:
+    """{licence, citation} of the real capture the extended intensities were sized on."""
+    data = _extended_file(str(path))
+    return {"licence": data["licence"], "citation": data["citation"]}
 
 
 @lru_cache(maxsize=4)
@@ -275,27 +356,36 @@ def calibration_provenance(path: str | Path = CALIBRATED_PATH) -> dict:
 
 
 def theme_features(theme: str, n_features: int | None = None,
-                   intensities: str | Mapping[int, float] = "calibrated") -> tuple[Feature, ...]:
+                   intensities: str | Mapping[int, float] = DEFAULT_INTENSITIES) -> tuple[Feature, ...]:
     """The first ``n_features`` (1..10, default all) features of a theme, in Table III order.
 
-    ``intensities``: a name of :data:`INTENSITY_SETS` (``visual`` gives ``THEMES`` unchanged), or a mapping
-    {rank: intensity} overriding the visual ones (ranks not named keep theirs; used by the calibration).
+    ``intensities``: a name of :data:`INTENSITY_SETS` (``visual`` gives ``THEMES`` unchanged; ``extended`` adds our
+    rows, :data:`OURS`, when all ten Table III rows are asked for), or a mapping {rank: intensity} overriding the
+    visual ones (ranks not named keep theirs; ranks of our rows add those rows; used by the fits).
     """
     if theme not in THEMES:
         raise ValueError(f"unknown theme {theme!r}; expected one of {list(THEME_NAMES)}")
     feats = THEMES[theme]
+    ours = ()
     if isinstance(intensities, str):
         if intensities not in INTENSITY_SETS:
             raise ValueError(f"intensities must be one of {list(INTENSITY_SETS)}, got {intensities!r}")
         if intensities == "calibrated":
             feats = _with_intensities(feats, calibrated_intensities()[theme])
+        elif intensities == "extended":
+            by_rank = extended_intensities()[theme]
+            feats = _with_intensities(feats, {r: v for r, v in by_rank.items() if r <= len(feats)})
+            ours = _with_intensities(OURS.get(theme, ()), {r: v for r, v in by_rank.items() if r > len(feats)})
     else:
-        feats = _with_intensities(feats, intensities)
+        own = {f.rank for f in OURS.get(theme, ())}
+        ours = tuple(f for f in _with_intensities(OURS.get(theme, ()), {r: v for r, v in intensities.items()
+                                                                         if r in own}) if f.rank in intensities)
+        feats = _with_intensities(feats, {r: v for r, v in intensities.items() if r not in own})
     if n_features is None:
-        return feats
+        return feats + ours
     if isinstance(n_features, bool) or not isinstance(n_features, int) or not 0 <= n_features <= len(feats):
         raise ValueError(f"n_features must be an integer in 0..{len(feats)}, got {n_features!r}")
-    return feats[:n_features]
+    return feats[:n_features] + (ours if n_features == len(feats) else ())
 
 
 def _with_intensities(feats: tuple[Feature, ...], by_rank: Mapping[int, float]) -> tuple[Feature, ...]:

@@ -12,15 +12,16 @@ from .neutral_walk import RBF_BASES, base_cycle
 from .registry import GeneratorSpec, InputContext, MakeContext, PlanInputs, register
 
 RBF_FEATURES = ("expert", "data")
-RBF_INTENSITIES = ("calibrated", "visual")  # generation.rbf.themes.INTENSITY_SETS (torch-free here)
+RBF_INTENSITIES = ("extended", "calibrated", "visual")  # generation.rbf.themes.INTENSITY_SETS (torch-free here)
 
 
 @dataclass(frozen=True)
 class RbfInputs(PlanInputs):
     """A ``theme`` at ``weight`` (-3..3; the paper uses 0.4, 0.7, 1.0, 1.3 and -0.7) with its first
     ``n_features`` features, over ``n_cycles`` of the ``base`` cycle at ``speed``; the expert features'
-    ``intensities`` are ``calibrated`` (default: w = 1 reproduces real actors' style differences) or ``visual``
-    (the earlier hand-sized set, for rerendering earlier studies)."""
+    ``intensities`` are ``extended`` (default: each row sized from real style differences, with our rows and the
+    theme's tempo), ``calibrated`` (the 2026-12-06 default: w = 1 reproduces real actors' style differences, factors
+    capped) or ``visual`` (the earlier hand-sized set); the last two rerender earlier studies."""
 
     PLAN_FIELDS = frozenset({"theme", "weight", "n_features", "n_cycles", "speed", "base", "features",
                              "intensities"})
@@ -32,7 +33,7 @@ class RbfInputs(PlanInputs):
     speed: float = 1.0
     base: str = "real"
     features: str = "expert"
-    intensities: str = "calibrated"
+    intensities: str = "extended"
 
     @classmethod
     def parse(cls, raw: dict, context: InputContext) -> RbfInputs:

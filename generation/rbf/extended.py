@@ -1,0 +1,194 @@
+"""The ``extended`` intensity set of seed 004's expert features: every row sized from real style differences.
+
+Why: with the ``visual`` and ``calibrated`` sets, observers trained on real styled walks read nearly every styled walk
+as its unstyled base (docs/benchmarks/rbf.md). The calibrated set fits all rows of a theme together with factors
+capped at 6x our visual numbers, and zeroes or caps rows to offset one another; the real differences are larger
+(data-driven features fitted to real themed walks are 1.0-2.0x the experts'). Here each row is sized on its own
+from what real actors do, and two levers the experts' ten rows lack are added as rows of our own
+(:data:`generation.rbf.themes.OURS`, ``source: ours``) plus a tempo.
+
+Data: the straight walks of the Bandai Namco Research Motion Dataset 1 and 2 (Kobayashi et al. 2023,
+arXiv:2306.08861, CC BY-NC 4.0), **training split** only; measures as :mod:`generation.rbf.calibrate` (per body part
+x axis x kind of a theme's rows, in walker heights: posture = mean offset relative to the pelvis, movement = change
+of the peak-to-peak), real difference = per dataset the themed takes minus the same dataset's normal takes, averaged
+over the datasets with the theme.
+
+1. **Rows** (:func:`extend_theme`): for each group, the gain of its rows alone at their visual intensity on the real
+   neutral base at w = 1 (after the skeleton fit), and the factor = real difference / gain, in [0,
+   :data:`MAX_FACTOR`] (a decreased swing at most to no swing, :func:`_decrease_caps`); 0 where real actors move
+   against the row's sign (the row is kept, at zero). Then
+   :data:`REFINE_STEPS` rescalings of each group by real / reached with all rows on (rows interact: a forward neck
+   carries the head); a group whose measure then moves against the real sign (a decreased swing pushed past zero
+   swings the other way) is halved instead, and held at zero if it still does after the last step. Energetic's
+   "Shoulders: increased swing along Y" is held at 0 (:data:`HELD_AT_ZERO`): without clavicles a shoulder bob
+   moves the whole chest, a shrug artefact that made energetic walks read tired.
+2. **Tempo** (a lever of ours): the real style's walking speed over the same dataset's normal speed, minus 1 (per
+   cycle: stride / duration), applied by :func:`generation.rbf.stylise.stylise` as a cadence change of
+   max(0.5, 1 + w * tempo) with all ten features. Real styles change stride and cadence together; we change cadence
+   only (the base's stride is kept so the feet stay planted), so the speed, which observers read, matches.
+
+:func:`extend` gives the JSON of :data:`generation.rbf.themes.EXTENDED_PATH` with the data's licence and citation,
+every row's visual and extended intensity and source, per group the training and held-out real differences and
+the w = 1 change reached, and the tempo with its per-dataset speeds.
+"""
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+
+from generation.core.motion import Motion
+
+from . import calibrate as C
+from .data_features import _rounded
+from .real_neutral import steady_cycles
+from .stylise import walker_frame_positions
+from .themes import BODY_PARTS, THEME_NAMES, Feature, all_features
+
+MAX_FACTOR = 10.0
+#: (theme, Table III rank) rows held at zero, with the reason (module docstring).
+HELD_AT_ZERO = {("energetic", 5): "no clavicles: a shoulder bob moves the whole chest (read as tired)"}
+REFINE_STEPS = 5
+MIN_GAIN = 1e-4  # heights: a group whose rows move their own measure less than this cannot be sized (factor 0)
+
+
+def _by_rank(theme: str, factors: np.ndarray, feats: tuple[Feature, ...]) -> dict[int, float]:
+    groups = C.theme_groups(theme, feats)
+    out = {f.rank: f.intensity * float(factors[groups.index((f.part, f.axis, f.kind))]) for f in feats}
+    for (t, rank) in HELD_AT_ZERO:
+        if t == theme:
+            out[rank] = 0.0
+    return out
+
+
+def group_gains(base: Motion, theme: str) -> np.ndarray:
+    """(G,) each group's own measure change at w = 1 with only its rows on, at their visual intensities."""
+    feats = all_features(theme)
+    groups = C.theme_groups(theme, feats)
+    gains = np.zeros(len(groups))
+    for i in range(len(groups)):
+        one = np.zeros(len(groups))
+        one[i] = 1.0
+        gains[i] = C.generated_measures(base, theme, _by_rank(theme, one, feats), 1.0, feats)[i]
+    return gains
+
+
+def _decrease_caps(base: Motion, theme: str, feats: tuple[Feature, ...], groups: list) -> np.ndarray:
+    """(G,) largest factor per group: :data:`MAX_FACTOR`, and for a decreased swing the factor whose amplitude
+    equals half the smallest neutral peak-to-peak of the group's joints on that axis (relative to the pelvis): a
+    swing cannot shrink below none; pushed further it swings the other way (a shoulder swing decreased past zero
+    twists the chest against the step)."""
+    P, _ = walker_frame_positions(base)
+    joints = tuple(base.skeleton.joints)
+    root, h = joints.index("root"), base.skeleton.height
+    caps = np.full(len(groups), MAX_FACTOR)
+    for f in feats:
+        if f.kind != "swing" or f.sign > 0 or f.intensity <= 0:
+            continue
+        a = "XYZ".index(f.axis)
+        half = min(np.ptp(P[:, joints.index(j), a] - (0 if joints.index(j) == root else P[:, root, a])) / 2
+                   for j in BODY_PARTS[f.part]) / h
+        g = groups.index((f.part, f.axis, f.kind))
+        caps[g] = min(caps[g], half / f.intensity)
+    return caps
+
+
+def extend_theme(base: Motion, theme: str, target: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Factors (G,) on the visual intensities of ``theme``'s rows (Table III and ours) sized from ``target`` (G,)
+    real differences in heights; returns the factors, the gains and the w = 1 measures reached with all rows."""
+    feats = all_features(theme)
+    groups = C.theme_groups(theme, feats)
+    gains = group_gains(base, theme)
+    cap = _decrease_caps(base, theme, feats, groups)
+    factors = np.where((np.abs(gains) > MIN_GAIN) & (target * gains > 0),
+                       np.clip(target / np.where(np.abs(gains) > MIN_GAIN, gains, 1.0), 0.0, cap), 0.0)
+    reached = C.generated_measures(base, theme, _by_rank(theme, factors, feats), 1.0, feats)
+    for _ in range(REFINE_STEPS):  # rows of one theme interact (a forward neck carries the head): rescale each group
+        ok = (factors > 0) & (reached * target > 0) & (np.abs(reached) > MIN_GAIN)
+        factors = np.where(ok, np.clip(factors * target / np.where(ok, reached, 1.0), 0.0, cap), factors)
+        # a decreased swing pushed past zero swings the other way (the measure's sign flips): halve it
+        factors = np.where((factors > 0) & (reached * target < 0), 0.5 * factors, factors)
+        reached = C.generated_measures(base, theme, _by_rank(theme, factors, feats), 1.0, feats)
+    wrong = (factors > 0) & (reached * target < 0)
+    if wrong.any():  # still against the real sign after refining: held at zero
+        factors = np.where(wrong, 0.0, factors)
+        reached = C.generated_measures(base, theme, _by_rank(theme, factors, feats), 1.0, feats)
+    return factors, gains, reached
+
+
+def real_tempo(clips: list, theme: str, splits: tuple[str, ...] = ("train",), m: int = 100) -> dict:
+    """Real walking speed, stride and cadence of ``theme``'s takes relative to the same dataset's normal takes.
+
+    Returns {"per_weight": mean over datasets of speed ratio - 1, "datasets": [{dataset, speed_ratio, stride_ratio,
+    cadence_ratio, takes, normal_takes}]}; speeds per take are the mean over its steady cycles of stride / duration
+    (heights per second).
+    """
+    styles = C.theme_styles(theme)
+
+    def take(c):
+        cycles = steady_cycles(c.motion, m, c.name)
+        if not cycles:
+            return None
+        return (np.mean([cy.stride for cy in cycles]), np.mean([cy.duration_s for cy in cycles]))
+
+    rows = []
+    for dataset in sorted({c.dataset for c in clips}):
+        mine = [c for c in clips if c.dataset == dataset and c.split in splits and c.content == "walk"]
+        themed = [v for v in (take(c) for c in mine if c.style in styles) if v is not None]
+        normal = [v for v in (take(c) for c in mine if c.style == "normal") if v is not None]
+        if not themed or not normal:
+            continue
+        (s_t, d_t), (s_n, d_n) = np.mean(themed, axis=0), np.mean(normal, axis=0)
+        rows.append({"dataset": dataset, "speed_ratio": float((s_t / d_t) / (s_n / d_n)),
+                     "stride_ratio": float(s_t / s_n), "cadence_ratio": float(d_n / d_t),
+                     "takes": len(themed), "normal_takes": len(normal)})
+    if not rows:
+        raise ValueError(f"no dataset has {theme} and normal walks in splits {list(splits)}")
+    return {"per_weight": float(np.mean([r["speed_ratio"] for r in rows]) - 1.0), "datasets": rows}
+
+
+def extend(clips: list, base: Motion, m: int = 100) -> dict:
+    """The ``extended`` set of all six themes: the JSON-ready dict of :data:`generation.rbf.themes.EXTENDED_PATH`."""
+    first = clips[0].motion.metadata if clips else {}
+    themes = {}
+    for theme in THEME_NAMES:
+        feats = all_features(theme)
+        groups = C.theme_groups(theme, feats)
+        train, train_info = C.real_differences(clips, theme, ("train",), m, feats)
+        heldout, held_info = C.real_differences(clips, theme, C.HELDOUT_SPLITS, m, feats)
+        factors, gains, reached = extend_theme(base, theme, train)
+        by_rank = _by_rank(theme, factors, feats)
+        rows = [{"rank": f.rank, "feature": f.describe(), "source": f.source,
+                 "group": groups.index((f.part, f.axis, f.kind)), "visual": f.intensity, "extended": by_rank[f.rank],
+                 "factor": float(factors[groups.index((f.part, f.axis, f.kind))]),
+                 **({"held_at_zero": HELD_AT_ZERO[(theme, f.rank)]} if (theme, f.rank) in HELD_AT_ZERO else {})}
+                for f in feats]
+        group_rows = [{"part": p, "axis": a, "kind": k, "measure": "mean offset" if k == "tilt" else "peak-to-peak",
+                       "real_train": float(train[i]), "real_heldout": float(heldout[i]), "gain_alone": float(gains[i]),
+                       "extended_w1": float(reached[i]), "expert_sign_agrees": bool(train[i] * gains[i] > 0)}
+                      for i, (p, a, k) in enumerate(groups)]
+        tempo = real_tempo(clips, theme, ("train",), m)
+        tempo["source"] = "ours"
+        tempo["applied_as"] = "cadence: the cycle played max(0.5, 1 + w * per_weight) times faster, stride kept"
+        themes[theme] = {"features": rows, "groups": group_rows, "tempo": tempo,
+                         "sources": {"train": train_info, "heldout": held_info}}
+    return {"method": "generation.rbf.extended: each body part x axis x kind group of a theme's rows (Table III and "
+                      "ours) sized on its own so that w = 1 moves its measure by the real style-minus-normal "
+                      "difference (train split); 0 against the real sign; factor cap "
+                      f"{MAX_FACTOR:g}; plus a tempo (real speed ratio) applied as cadence",
+            "units": "intensity: amplitude / walker height; measures: walker heights",
+            "base": base.metadata.get("generator", "") + (" (real)" if base.metadata.get("captured_base") else ""),
+            "max_factor": MAX_FACTOR, "fit_split": "train", "check_splits": list(C.HELDOUT_SPLITS),
+            "data": "Bandai Namco Research Motion Dataset 1 and 2, straight walks (content walk), train split; "
+                    "real-capture corpus built as docs/corpus.md says",
+            "licence": first.get("licence", "CC BY-NC 4.0"), "citation": first.get("citation", ""),
+            "dataset_url": first.get("source_url", ""), "themes": themes}
+
+
+def save_extended(data: dict, path) -> None:
+    """Write :func:`extend`'s dict as JSON (floats rounded to 6 decimals)."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    path.write_text(json.dumps(_rounded(data), indent=1) + "\n", encoding="utf-8")
+

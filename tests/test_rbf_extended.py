@@ -1,0 +1,86 @@
+"""The ``extended`` intensity set (generation/rbf/extended.py, generation/data/rbf/extended_intensities.json): sized
+from real style-vs-normal differences of Bandai Namco walks (CC BY-NC 4.0, Kobayashi et al. 2023), the default."""
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+from generation.mocap.real_corpus import DEFAULT_PATH, load_real_corpus
+from generation.rbf import calibrate as C
+from generation.rbf import extended as E
+from generation.rbf.real_neutral import load_cycle
+from generation.rbf.stylise import stylise
+from generation.rbf.themes import EXTENDED_PATH, OURS, THEME_NAMES, THEMES, all_features, theme_features
+
+
+@pytest.fixture(scope="module")
+def base():
+    return load_cycle()
+
+
+@pytest.fixture(scope="module")
+def shipped():
+    return json.loads(EXTENDED_PATH.read_text(encoding="utf-8"))
+
+
+def test_shipped_file_names_its_data_and_keeps_the_experts_rows(shipped):
+    assert shipped["licence"] == "CC BY-NC 4.0" and "arXiv:2306.08861" in shipped["citation"]
+    assert "Bandai Namco" in shipped["data"] and shipped["fit_split"] == "train"
+    for theme in THEME_NAMES:
+        entry = shipped["themes"][theme]
+        rows = entry["features"]
+        assert [r["feature"] for r in rows] == [f.describe() for f in all_features(theme)]
+        assert [r["source"] for r in rows] == ["table_iii"] * 10 + ["ours"] * len(OURS.get(theme, ()))
+        assert [r["visual"] for r in rows[:10]] == [f.intensity for f in THEMES[theme]]
+        assert all(0 <= r["extended"] <= E.MAX_FACTOR * r["visual"] + 1e-9 for r in rows)
+        # a row whose real actors move the other way is kept at zero, never flipped
+        for r in rows:
+            g = entry["groups"][r["group"]]
+            if not g["expert_sign_agrees"]:
+                assert r["extended"] == 0.0, (theme, r["feature"])
+        assert entry["tempo"]["source"] == "ours" and entry["tempo"]["datasets"]
+    held = next(r for r in shipped["themes"]["energetic"]["features"] if r["rank"] == 5)
+    assert held["extended"] == 0.0 and "clavicles" in held["held_at_zero"]
+
+
+def test_extended_is_the_default_with_the_licence(base):
+    out = stylise(base, "sad", 1.0, 10, n_cycles=1, plant=False)
+    assert out.metadata["intensities"] == "extended" and out.metadata["licence"] == "CC BY-NC 4.0"
+    assert [f.rank for f in theme_features("sad")] == list(range(1, 14))
+
+
+def test_w1_reaches_the_real_difference(base, shipped):
+    """The file is current (the w = 1 measures it records are what the code makes), and wherever the real actors
+    move a group the experts' way by more than 0.5 cm, the w = 1 edit moves it the same way and, summed over those
+    groups, within 25 % of the real amount."""
+    for theme in THEME_NAMES:
+        groups = shipped["themes"][theme]["groups"]
+        by_rank = {r["rank"]: r["extended"] for r in shipped["themes"][theme]["features"]}
+        reached = C.generated_measures(base, theme, by_rank, 1.0, all_features(theme))
+        np.testing.assert_allclose(reached, [g["extended_w1"] for g in groups], atol=1e-5)
+        real = np.array([g["real_train"] for g in groups])
+        mask = np.array([g["expert_sign_agrees"] for g in groups]) & (np.abs(real) > 0.003)
+        assert np.abs(reached[mask] - real[mask]).sum() <= 0.25 * np.abs(real[mask]).sum(), theme
+
+
+def test_sizing_reaches_a_reachable_target(base):
+    """Targets made by the visual rows at w = 0.5 are reached where they are larger than 0.3 % of the height."""
+    feats = all_features("feminine")
+    target = C.generated_measures(base, "feminine", {f.rank: f.intensity * 0.5 for f in feats}, 1.0, feats)
+    factors, gains, reached = E.extend_theme(base, "feminine", target)
+    big = np.abs(target) > 0.003  # (a group whose target the other rows' side effects make is not sized by itself)
+    assert big.sum() >= 6
+    np.testing.assert_allclose(reached[big], target[big], atol=2e-3)
+
+
+@pytest.mark.slow
+@pytest.mark.skipif(not DEFAULT_PATH.is_file(), reason="real corpus not built (docs/corpus.md)")
+def test_rebuild_on_the_corpus_matches_the_shipped_file(shipped):
+    clips = load_real_corpus(DEFAULT_PATH, skeleton="gait", contents=["walk"])
+    for theme in ("energetic", "sad"):
+        train, _ = C.real_differences(clips, theme, ("train",), 100, all_features(theme))
+        np.testing.assert_allclose(train, [g["real_train"] for g in shipped["themes"][theme]["groups"]], atol=1e-5)
+        tempo = shipped["themes"][theme]["tempo"]["per_weight"]
+        assert E.real_tempo(clips, theme)["per_weight"] == pytest.approx(tempo, abs=1e-5)
