@@ -144,9 +144,10 @@ class StudyStepsMixin:
         """Save; for the sections, warn about each other section whose clips per participant the save changed."""
         if formset.model is not Section or not change:
             return super().save_formset(request, form, formset, change)
-        before = section_impact.clips_given(section_impact.study_sections(form.instance))
+        saved = section_impact.study_sections(form.instance)
+        before = section_impact.clips_given(saved)
         super().save_formset(request, form, formset, change)
-        changed = {obj.pk for obj, _fields in formset.changed_objects} | {obj.pk for obj in formset.new_objects}
         sections = section_impact.study_sections(form.instance)
+        changed = section_impact.changed_sections(saved, sections)
         for impact in section_impact.impacts(before, section_impact.clips_given(sections), sections, changed):
             self.message_user(request, impact.message(), messages.WARNING)

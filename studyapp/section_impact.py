@@ -29,6 +29,22 @@ def study_sections(study) -> list[Section]:
     return list(Section.objects.filter(study=study).order_by("order", "id"))
 
 
+PLAN_FIELDS = ("order", "section_type", "pool", "options", "clips_per_participant", "reuse_section_id",
+               "randomize_order")
+"""The section fields a participant's plan reads (what a save must change to change what sections give)."""
+
+
+def plan_inputs(sections: list[Section]) -> dict[int, tuple]:
+    """Section pk -> the values of its PLAN_FIELDS, to tell which sections a save changed."""
+    return {s.pk: tuple(getattr(s, name) for name in PLAN_FIELDS) for s in sections}
+
+
+def changed_sections(before: list[Section], after: list[Section]) -> set[int]:
+    """The pks of the sections of ``after`` that are new or whose plan inputs differ from ``before``."""
+    old = plan_inputs(before)
+    return {pk for pk, values in plan_inputs(after).items() if old.get(pk) != values}
+
+
 def clips_given(sections: list[Section], seeds=SEEDS) -> dict[int, int] | None:
     """Section pk -> the fewest clips a participant gets there over the planned ``seeds`` (practice items and
     attention checks not counted), ``sections`` taken in the order given. None when the study cannot be planned
