@@ -63,9 +63,9 @@ def section_fieldsets() -> list:
             ("pool_transition", "pool_rbf"), ("pool_include_flagged", "pool_keep_advisory", "pool_observer_advisory")]
     halves = [tuple(name for name in pool_editor.SUB_POOL_FIELDS if name.startswith(f"pool_{sub}_"))
               for sub in SUB_POOLS]
-    option_sets = [(f"{section_type_label(stype)}{study_steps.SECTION_OPTIONS_SUFFIX}", {
-        "fields": [tuple(names[i:i + 3]) for i in range(0, len(names), 3)], "classes": [f"only-{stype}"]})
-        for stype, names in pool_editor.OPTION_FIELDS.items() if names]
+    option_sets = [(f"{' / '.join(section_type_label(t) for t in types)}{study_steps.SECTION_OPTIONS_SUFFIX}", {
+        "fields": [tuple(names[i:i + 3]) for i in range(0, len(names), 3)],
+        "classes": [f"only-{t}" for t in types]}) for types, names in pool_editor.OPTION_GROUPS]
     common = pool_editor.COMMON_OPTION_FIELDS
     return [
         (study_steps.SECTION_MAIN, {"fields": main}),
