@@ -39,7 +39,8 @@ class FirstStepChangeList(ChangeList):
 
 class SectionStepsMixin:
     """For the section inline: the fieldsets of the page's step, adding only where the type is chosen, and the
-    clips each section gives a participant (measured once per page: the inline admin lives for one request)."""
+    clips each section gives a participant, for the note beside each pool (measured once per page that shows the
+    pools: the inline admin lives for one request)."""
 
     clips_given: dict[int, int] | None = None
 
@@ -58,7 +59,8 @@ class SectionStepsMixin:
         step = study_steps.page_step(request, obj)
         if step is not None and not step.adds_sections:
             kwargs["widgets"] = {**kwargs.get("widgets", {}), "section_type": HiddenInput}
-        if obj is not None and obj.pk is not None:
+        shows_pool = step is None or study_steps.SECTION_POOL in step.section_fieldsets
+        if shows_pool and obj is not None and obj.pk is not None:
             self.clips_given = section_impact.clips_given(section_impact.study_sections(obj))
         return super().get_formset(request, obj, **kwargs)
 
