@@ -23,6 +23,7 @@ from .pool_editor import PoolEditorFields
 from .presets import preset_choices
 from .questions import section_type_choices
 from .redirects import check_completion_url
+from .section_order import move_refusal
 
 GENDERS = [("female", _("Female")), ("male", _("Male")), ("non-binary", _("Non-binary / another gender")),
            ("undisclosed", _("Prefer not to say"))]
@@ -163,10 +164,19 @@ class SectionForm(PartialModelForm, PoolEditorFields):
             if not self.shows(name):
                 data[name] = self.value_of(data, name)
         pool_editor.resolve_section_json(self, data, pool_editor.touched_groups(self.changed_data))
+        self._check_order_change()
         if self.shows("pool"):
             self._check_norms_reader(data)
             self._check_norms_source(data)
         return data
+
+    def _check_order_change(self) -> None:
+        """A saved section's order is not typed anew once participants take part: the same rule as the move
+        buttons (studyapp.section_order), as an error on the order field."""
+        if self.instance.pk and self.shows("order") and "order" in self.changed_data:
+            refusal = move_refusal(self.instance.study)
+            if refusal:
+                self.add_error("order", refusal)
 
     def _post_clean(self):
         """After the model's own checks: an error on the options when the section's attention checks would find no

@@ -12,6 +12,8 @@ as if the researcher had typed it. A move is refused, with a sentence that says 
 - the section reuses the clips of the section it would pass, or that section reuses its clips (a reused section
   must come first: Section.clean, studyapp.counterbalance);
 - there is no neighbour on that side.
+
+The section form refuses a typed change of ``order`` by the same first rule (:func:`move_refusal`).
 """
 from __future__ import annotations
 

@@ -142,3 +142,17 @@ def test_only_those_who_may_change_the_study_move(study):
 def test_a_section_of_another_study_is_not_found(admin_client, study):
     other = create_study_from_preset("gait_ismar2020", "other", plan="test")
     assert admin_client.post(move_url(study, other.sections.last(), "up")).status_code == 404
+
+
+def test_a_typed_order_change_is_refused_the_same_way(admin_client, study):
+    from studyapp.testing import admin_form_data
+
+    Participant.objects.create(study=study)
+    url = reverse("admin:studyapp_study_change", args=[study.pk]) + "?step=sections"
+    data = admin_form_data(admin_client.get(url))
+    data["sections-0-order"], data["sections-1-order"] = "2", "1"
+    r = admin_client.post(url, data)
+    assert r.status_code == 200
+    errors = r.context["inline_admin_formsets"][0].formset.forms[0].errors
+    assert "cannot be reordered: 1 participant has taken part" in str(errors["order"])
+    assert types(study)[:2] == ["emotion_choice", "emotion_transition"]
