@@ -26,11 +26,14 @@ from . import (
     clip_display,
     clip_import,
     pool_editor,
+    section_impact,
     study_fields,
+    study_steps,
     views_pool,
     views_staff,
 )
 from .admin_norms import norms_table
+from .admin_steps import SectionStepsMixin, StudyStepsMixin
 from .forms import ClipImportForm, SectionForm, StudyAdminForm
 from .models import Assignment, Clip, Participant, Response, Section, Study
 from .norming import design_rows, open_errors
@@ -42,7 +45,9 @@ COMPACT = {models.JSONField: {"widget": Textarea(attrs={"rows": 2, "cols": 90})}
            models.TextField: {"widget": Textarea(attrs={"rows": 3, "cols": 90})}}
 
 
-RAW_JSON_HELP = ("The pool and options as JSON (protocol.pools). The fields above win as soon as one of them is "
+RAW_STUDY_JSON_HELP = ("The fields above win as soon as one of them is edited; this JSON wins when they are left as "
+                       "they were (paste a study's JSON here to import it).")
+RAW_JSON_HELP = ("As JSON (protocol.pools). The fields above win as soon as one of them is "
                  "edited, and this JSON then only adds the keys they cannot show (e.g. <code>plan__startswith</code>, "
                  "<code>happy__gt</code>); it wins when the fields above are left as they were.")
 
@@ -52,29 +57,35 @@ NOT_ON_PAGES = [f"not-{t.name}" for t in page_types()]
 
 
 def section_fieldsets() -> list:
-    """The section form: main settings, the clip pool's fields with the live count, the naturalness halves, the
-    options of each section type (the page shows those of the chosen type) and the raw JSON (collapsed)."""
-    main = [("order", "section_type", "name"), "title", "instructions", ("clips_per_participant", "reuse_section"),
+    """The section form: the section itself, its clips per participant, the clip pool's fields with the live count,
+    the naturalness halves, the options of each section type (the page shows those of the chosen type), practice
+    and attention checks, and the raw JSON of the pool and of the options (collapsed). The study page's steps
+    (studyapp.study_steps) show these by title: sections and options on one step, clips on another."""
+    main = [("order", "section_type", "name"), "title", "instructions",
             ("randomize_order", "require_full_play", "loop", "counterbalance")]
     pool = ["matching_clips", ("pool_modality", "pool_origin"), "pool_plan", "pool_emotion_label", "pool_theme",
             ("pool_weight_sign", "pool_weight_min", "pool_weight_max"), ("pool_n_features_min", "pool_n_features_max"),
             ("pool_transition", "pool_rbf"), ("pool_include_flagged", "pool_keep_advisory", "pool_observer_advisory")]
     halves = [tuple(name for name in pool_editor.SUB_POOL_FIELDS if name.startswith(f"pool_{sub}_"))
               for sub in SUB_POOLS]
-    option_sets = [(f"{section_type_label(stype)}: options", {
-        "fields": [tuple(names[i:i + 3]) for i in range(0, len(names), 3)], "classes": [f"only-{stype}"]})
-        for stype, names in pool_editor.OPTION_FIELDS.items() if names]
+    option_sets = [(f"{' / '.join(section_type_label(t) for t in types)}{study_steps.SECTION_OPTIONS_SUFFIX}", {
+        "fields": [tuple(names[i:i + 3]) for i in range(0, len(names), 3)],
+        "classes": [f"only-{t}" for t in types]}) for types, names in pool_editor.OPTION_GROUPS]
     common = pool_editor.COMMON_OPTION_FIELDS
     return [
-        (None, {"fields": main}),
-        ("Clip pool", {"fields": pool, "classes": ["pool-editor", *NOT_ON_PAGES],
-                       "description": "Which catalogue clips this section draws from; blank or none ticked: any."}),
-        (f"{section_type_label(pool_editor.SUB_POOL_SECTION_TYPE)}: generated and source halves",
+        (study_steps.SECTION_MAIN, {"fields": main}),
+        (study_steps.SECTION_CLIPS, {"fields": [("clips_per_participant", "reuse_section")]}),
+        (study_steps.SECTION_POOL, {"fields": pool, "classes": ["pool-editor", *NOT_ON_PAGES],
+                                    "description": "Which catalogue clips this section draws from; blank or none "
+                                                   "ticked: any."}),
+        (f"{section_type_label(pool_editor.SUB_POOL_SECTION_TYPE)}{study_steps.SECTION_HALVES_SUFFIX}",
          {"fields": halves, "classes": [f"only-{pool_editor.SUB_POOL_SECTION_TYPE}"]}),
         *option_sets,
-        ("Practice and attention checks", {"fields": [tuple(common[i:i + 2]) for i in range(0, len(common), 2)],
-                                           "classes": NOT_ON_PAGES}),
-        ("Advanced: raw JSON", {"fields": ["pool", "options"], "classes": ["collapse"], "description": RAW_JSON_HELP}),
+        (study_steps.SECTION_PRACTICE, {"fields": [tuple(common[i:i + 2]) for i in range(0, len(common), 2)],
+                                        "classes": ["collapse", *NOT_ON_PAGES]}),
+        (study_steps.SECTION_RAW_POOL, {"fields": ["pool"], "classes": ["collapse"], "description": RAW_JSON_HELP}),
+        (study_steps.SECTION_RAW_OPTIONS, {"fields": ["options"], "classes": ["collapse"],
+                                           "description": RAW_JSON_HELP}),
     ]
 
 
@@ -82,11 +93,15 @@ def section_type_label(section_type: str) -> str:
     return dict(section_type_choices()).get(section_type, section_type)
 
 
-def pool_notes(section: Section) -> tuple[str, list[str]]:
-    """(summary, warnings) of a section's pool against the catalogue (never raises)."""
+def pool_notes(section: Section, given: dict[int, int] | None = None) -> tuple[str, list[str]]:
+    """(summary, warnings) of a section's pool against the catalogue (never raises). ``given``: the clips each
+    section gives a participant (studyapp.section_impact.clips_given), to say when earlier sections leave this
+    one fewer clips than it shows."""
     counted = count_pool(section.section_type or None, section.pool)
     warnings = counted.warnings(section.clips_per_participant, section.options)
-    return counted.summary(), ([views_pool.REUSED] if section.reuse_section_id else []) + warnings
+    short = section_impact.short_of(section, given, counted.total)
+    return counted.summary(), ([views_pool.REUSED] if section.reuse_section_id else []) + warnings + (
+        [short] if short else [])
 
 
 class StudyScopedAdmin(admin.ModelAdmin):
@@ -129,7 +144,7 @@ class StudyScopedAdmin(admin.ModelAdmin):
         return super().formfield_for_foreignkey(db_field, request, **kwargs)
 
 
-class SectionInline(admin.StackedInline):
+class SectionInline(SectionStepsMixin, admin.StackedInline):
     model = Section
     form = SectionForm
     formfield_overrides = COMPACT
@@ -157,7 +172,7 @@ class SectionInline(admin.StackedInline):
 
     @admin.display(description="matching clips")
     def matching_clips(self, section):
-        summary, warnings = pool_notes(section)
+        summary, warnings = pool_notes(section, self.clips_given)
         sample = [] if section.reuse_section_id else views_pool.pool_sample(section.section_type or None,
                                                                              section.pool)
         return format_html('<span class="pool-count" data-url="{}" aria-live="polite">{}</span>'
@@ -171,7 +186,7 @@ class SectionInline(admin.StackedInline):
 
 
 @admin.register(Study)
-class StudyAdmin(StudyScopedAdmin):
+class StudyAdmin(StudyStepsMixin, StudyScopedAdmin):
     list_display = ["title", "slug", "status", "preset", "n_started", "n_completed", "links"]
     list_filter = ["status", "preset"]
     search_fields = ["title", "slug"]
@@ -180,6 +195,10 @@ class StudyAdmin(StudyScopedAdmin):
     actions = ["open_studies", "close_studies"]
     readonly_fields = ["links", "preset", "created_at", "norming_design"]
     form = StudyAdminForm
+
+    class Media:
+        css = {"all": ["studyapp/admin_steps.css"]}
+
     fieldsets = [
         (None, {"fields": ["title", "slug", "status", "listed_publicly", "preset", "links"]}),
         ("Participant data", {"fields": ["export_external_ids"],
@@ -204,10 +223,10 @@ class StudyAdmin(StudyScopedAdmin):
                                  for i in range(0, len(study_fields.RULE_FIELDS), 2)],
                       "description": "Exclusion rules the analysis report applies (checked by analysis.exclusion); "
                                      "the raw exports stay unchanged. Blank: the defaults."}),
-        ("Advanced: feedback questions and exclusion rules as JSON", {
-            "fields": ["feedback_questions", "exclusion_rules"], "classes": ["collapse"],
-            "description": "The fields above win as soon as one of them is edited; this JSON wins when they are "
-                           "left as they were (paste a study's JSON here to import it)."}),
+        ("Advanced: feedback questions as JSON", {"fields": ["feedback_questions"], "classes": ["collapse"],
+                                                  "description": RAW_STUDY_JSON_HELP}),
+        ("Advanced: exclusion rules as JSON", {"fields": ["exclusion_rules"], "classes": ["collapse"],
+                                               "description": RAW_STUDY_JSON_HELP}),
         ("Access", {"fields": ["owners", "collaborators"],
                     "description": "Who may see, preview, export and analyse this study (superusers see every "
                                    "study). Only owners and superusers change this; whoever creates a study owns "

@@ -18,10 +18,12 @@ from .inputs import refuse_control_characters, refuse_control_characters_in_text
 from .models import Clip, Section, Study
 from .norming import open_errors
 from .norms_rule import NormsSourceError, check_reader, load_norms, norms_rules, norms_sources
+from .partial_forms import PartialModelForm
 from .pool_editor import PoolEditorFields
 from .presets import preset_choices
 from .questions import section_type_choices
 from .redirects import check_completion_url
+from .section_order import move_refusal
 
 GENDERS = [("female", _("Female")), ("male", _("Male")), ("non-binary", _("Non-binary / another gender")),
            ("undisclosed", _("Prefer not to say"))]
@@ -109,7 +111,7 @@ class SharePreviewForm(forms.Form):
     days = forms.IntegerField(min_value=1, max_value=90, initial=14, label="Valid for (days)")
 
 
-class SectionForm(forms.ModelForm, PoolEditorFields):
+class SectionForm(PartialModelForm, PoolEditorFields):
     """A section in the admin: the pool and options as structured fields (studyapp.pool_editor) with the raw JSON
     as an advanced field. The raw JSON wins only when none of its group's structured fields was edited (their
     initial values are read from the saved JSON); otherwise the fields win and the raw JSON adds only the keys
@@ -120,7 +122,13 @@ class SectionForm(forms.ModelForm, PoolEditorFields):
 
     ``reader``: the user saving (the admin passes it). A norms rule (the pool's or a sub-pool's) whose source this
     save adds may name only a study of theirs (studyapp.norms_rule.check_reader); a source already saved stays as
-    it is, so a collaborator can still save a section a superuser pointed at another study's norms."""
+    it is, so a collaborator can still save a section a superuser pointed at another study's norms.
+
+    On a step of the study page the form holds only that step's fields (studyapp.partial_forms); the pool and
+    options are still checked against the section's type and count, the saved values standing in for the fields
+    the step does not show."""
+
+    CHECKED_TOGETHER = ("section_type", "clips_per_participant", "pool", "options")
 
     class Meta:
         model = Section
@@ -152,10 +160,23 @@ class SectionForm(forms.ModelForm, PoolEditorFields):
 
     def clean(self):
         data = super().clean()
+        for name in self.CHECKED_TOGETHER:
+            if not self.shows(name):
+                data[name] = self.value_of(data, name)
         pool_editor.resolve_section_json(self, data, pool_editor.touched_groups(self.changed_data))
-        self._check_norms_reader(data)
-        self._check_norms_source(data)
+        self._check_order_change()
+        if self.shows("pool"):
+            self._check_norms_reader(data)
+            self._check_norms_source(data)
         return data
+
+    def _check_order_change(self) -> None:
+        """A saved section's order is not typed anew once participants take part: the same rule as the move
+        buttons (studyapp.section_order), as an error on the order field."""
+        if self.instance.pk and self.shows("order") and "order" in self.changed_data:
+            refusal = move_refusal(self.instance.study)
+            if refusal:
+                self.add_error("order", refusal)
 
     def _post_clean(self):
         """After the model's own checks: an error on the options when the section's attention checks would find no
@@ -163,7 +184,7 @@ class SectionForm(forms.ModelForm, PoolEditorFields):
         super()._post_clean()
         if not self.has_error("options") and not self.has_error("pool"):
             for problem in check_clip_problems(self.instance):
-                self.add_error("options", problem)
+                self.add_error("options" if self.shows("options") else None, problem)
 
     def _check_norms_source(self, data: dict) -> None:
         """An error on the pool when a norms rule of its tree (its own or a sub-pool's) gives no norms (an unknown
@@ -212,7 +233,7 @@ class SectionPreviewForm(PoolEditorFields):
         return data
 
 
-class StudyAdminForm(forms.ModelForm):
+class StudyAdminForm(PartialModelForm):
     """A study in the admin; the exclusion rules are checked by the analysis library (analysis.exclusion), the
     completion URL must be http(s) (studyapp.redirects)."""
 

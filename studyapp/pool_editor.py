@@ -25,21 +25,22 @@ from __future__ import annotations
 from django import forms
 from django.utils.html import format_html, format_html_join
 
+from protocol.norming import DEFAULT_RATINGS_PER_CLIP, NORMING_OPTION
 from protocol.pools import (
     COMMON_OPTIONS,
     DEFAULT_GESTURE_OPTIONS,
     DEFAULT_PLAYER_CONTROLS,
     INCLUDE_FLAGGED,
     KEEP_ADVISORY,
+    MAX_RATINGS_PER_CLIP,
     MAX_REPLAYS_LIMIT,
     OBSERVER_ADVISORY,
     PLAYER_CONTROLS,
-    SECTION_OPTIONS,
     SUB_POOLS,
     validate_section,
 )
 from protocol.section_types import find_section_type, registered
-from protocol.section_types.pages import BREAK, DEFAULT_WAIT_SECONDS, MAX_WAIT_SECONDS, WAIT_OPTION
+from protocol.section_types.pages import DEFAULT_WAIT_SECONDS, MAX_WAIT_SECONDS, WAIT_OPTION
 from protocol.vocabulary import (
     CLIP_MODALITIES,
     CLIP_THEMES,
@@ -475,6 +476,48 @@ class AttentionSpec(ChoiceSpec):
         return {}
 
 
+class NormingSpec(ChoiceSpec):
+    """``norming`` (protocol.norming): ``{"ratings_per_clip": K}`` as a check box and K; ticked with K blank is
+    ``{}`` (the default K). A K alone ticks the box."""
+
+    def __init__(self, field: str):
+        super().__init__(field, NORMING_OPTION, (), "Norming section")
+        self.k = f"{field}_ratings_per_clip"
+
+    def form_fields(self) -> dict[str, forms.Field]:
+        return {
+            self.field: forms.BooleanField(
+                required=False, label="Norming section",
+                help_text="every clip of the pool is rated by K participants, each rating M (the clips per "
+                          "participant), in a balanced design; intensity and naturalness are asked after the "
+                          "section's own questions (protocol.norming)"),
+            self.k: forms.IntegerField(
+                required=False, min_value=1, max_value=MAX_RATINGS_PER_CLIP, label="Ratings per clip (K)",
+                help_text=f"blank: {DEFAULT_RATINGS_PER_CLIP}; the study's participant limit must give every clip "
+                          "K ratings before it opens")}
+
+    def read(self, data: dict) -> tuple[dict, dict]:
+        config = data.get(self.key)
+        if not isinstance(config, dict) or set(config) - {"ratings_per_clip"}:
+            return {}, data
+        k = config.get("ratings_per_clip")
+        if k is not None and not (_is_int(k) and 1 <= k <= MAX_RATINGS_PER_CLIP):
+            return {}, data
+        values = {self.field: True, **({self.k: k} if k is not None else {})}
+        return values, {key: v for key, v in data.items() if key != self.key}
+
+    def write(self, values: dict) -> dict:
+        k = values.get(self.k)
+        if not values.get(self.field) and k is None:
+            return {}
+        return {self.key: {} if k is None else {"ratings_per_clip": k}}
+
+    def owner(self, keys: tuple[str, ...]) -> str | None:
+        if f"{self.key}.ratings_per_clip" in keys:
+            return self.k
+        return self.field if self.key in keys or any(k.startswith(f"{self.key}.") for k in keys) else None
+
+
 def read_specs(specs: list[ChoiceSpec], data: dict) -> tuple[dict, dict]:
     """(field values, leftover) of ``data`` under ``specs``, each taking the keys it can show."""
     values, rest = {}, dict(data)
@@ -543,29 +586,41 @@ def _sub_pool_specs() -> list[SubPoolSpec]:
     return [SubPoolSpec(name, inner(name)) for name in SUB_POOLS]
 
 
-def _option_specs() -> dict[str, list[ChoiceSpec]]:
+def _option_key_specs() -> dict[str, ChoiceSpec]:
+    """Option key -> its spec: the form fields of every option a section type declares (protocol.section_types'
+    ``options``). A declared key missing here is edited in the raw JSON only (tests/test_option_fields.py fails)."""
     o, n = OPTIONS_PREFIX, len(GESTURE_EMOTIONS)
-    specs = {
-        "naturalness": [
-            AnchorsSpec(o + "anchor"),
-            ValueSpec(o + "question", "question", "Question", "blank: the default question", forms.CharField,
-                      max_length=500),
-            ValueSpec(o + "n_generated", "n_generated", "Generated clips per participant",
-                      "with the next: how each participant's clips split; their sum is the clips per participant",
-                      forms.IntegerField, min_value=0, max_value=N_FEATURES_MAX),
-            ValueSpec(o + "n_source", "n_source", "Source clips per participant", "", forms.IntegerField,
-                      min_value=0, max_value=N_FEATURES_MAX)],
-        "gesture_emotion": [
-            ValueSpec(o + "n_options", "n_options", "Answer options shown",
-                      f"2 to {n}, the intended emotion among them; blank: {DEFAULT_GESTURE_OPTIONS}",
-                      forms.IntegerField, min_value=2, max_value=n),
-            ChoiceSpec(o + "categories", "categories", GESTURE_EMOTIONS, "Emotions offered", f"none ticked: all {n}")],
-        BREAK.name: [
-            ValueSpec(o + WAIT_OPTION, WAIT_OPTION, "Wait before Continue (seconds)",
-                      f"Continue is enabled this long after the page is first shown (the server checks it too); "
-                      f"blank: {DEFAULT_WAIT_SECONDS}", forms.IntegerField, min_value=0, max_value=MAX_WAIT_SECONDS)],
+    return {
+        "anchors": AnchorsSpec(o + "anchor"),
+        "question": ValueSpec(o + "question", "question", "Question", "blank: the default question", forms.CharField,
+                              max_length=500),
+        "n_generated": ValueSpec(o + "n_generated", "n_generated", "Generated clips per participant",
+                                 "with the next: how each participant's clips split; their sum is the clips per "
+                                 "participant", forms.IntegerField, min_value=0, max_value=N_FEATURES_MAX),
+        "n_source": ValueSpec(o + "n_source", "n_source", "Source clips per participant",
+                              "the captured clips each participant sees; blank: half the clips per participant",
+                              forms.IntegerField, min_value=0, max_value=N_FEATURES_MAX),
+        "n_options": ValueSpec(o + "n_options", "n_options", "Answer options shown",
+                               f"2 to {n}, the intended emotion among them; blank: {DEFAULT_GESTURE_OPTIONS}",
+                               forms.IntegerField, min_value=2, max_value=n),
+        "categories": ChoiceSpec(o + "categories", "categories", GESTURE_EMOTIONS, "Emotions offered",
+                                 f"none ticked: all {n}"),
+        NORMING_OPTION: NormingSpec(o + NORMING_OPTION),
+        WAIT_OPTION: ValueSpec(o + WAIT_OPTION, WAIT_OPTION, "Wait before Continue (seconds)",
+                               f"Continue is enabled this long after the page is first shown (the server checks it "
+                               f"too); blank: {DEFAULT_WAIT_SECONDS}", forms.IntegerField, min_value=0,
+                               max_value=MAX_WAIT_SECONDS),
     }
-    return {stype: [s for s in group if s.key in SECTION_OPTIONS.get(stype, ())] for stype, group in specs.items()}
+
+
+OPTION_KEY_SPECS = _option_key_specs()
+
+
+def _option_specs() -> dict[str, list[ChoiceSpec]]:
+    """Section type -> the specs of the options its declaration takes, in declaration order (the types registered
+    when this module is imported)."""
+    return {t.name: [OPTION_KEY_SPECS[key] for key in t.option_keys if key in OPTION_KEY_SPECS]
+            for t in registered(pages=True) if t.options}
 
 
 def _common_option_specs() -> list[ChoiceSpec]:
@@ -589,7 +644,9 @@ MAIN_POOL_SPECS = _main_pool_specs()
 SUB_POOL_SPECS = _sub_pool_specs()
 COMMON_OPTION_SPECS = _common_option_specs()
 OPTION_SPECS = _option_specs()
-ALL_OPTION_SPECS = [*COMMON_OPTION_SPECS, *(spec for group in OPTION_SPECS.values() for spec in group)]
+TYPE_OPTION_SPECS = list({id(spec): spec for group in OPTION_SPECS.values() for spec in group}.values())
+"""Every section type's own option specs, each once (``norming`` is taken by several types)."""
+ALL_OPTION_SPECS = [*COMMON_OPTION_SPECS, *TYPE_OPTION_SPECS]
 
 
 def _names(specs) -> list[str]:
@@ -601,6 +658,19 @@ SUB_POOL_FIELDS = _names(SUB_POOL_SPECS)
 POOL_FIELDS = MAIN_POOL_FIELDS + SUB_POOL_FIELDS
 OPTION_FIELDS = {stype: _names(specs) for stype, specs in OPTION_SPECS.items()}
 """section type -> the fields of its own options (COMMON_OPTION_FIELDS: every type's)."""
+
+
+def _option_groups() -> list[tuple[tuple[str, ...], list[str]]]:
+    """The option fieldsets of the section form: (the section types that take them, their fields); an option
+    several types take (``norming``) is one group for all of them, so each field is on the page once."""
+    groups: dict[tuple[str, ...], list[str]] = {}
+    for spec in TYPE_OPTION_SPECS:
+        types = tuple(stype for stype, specs in OPTION_SPECS.items() if spec in specs)
+        groups.setdefault(types, []).extend(spec.form_fields())
+    return list(groups.items())
+
+
+OPTION_GROUPS = _option_groups()
 COMMON_OPTION_FIELDS = _names(COMMON_OPTION_SPECS)
 ALL_OPTION_FIELDS = _names(ALL_OPTION_SPECS)
 

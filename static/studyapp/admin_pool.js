@@ -44,7 +44,7 @@
   }
 
   function showType(row) {
-    var select = row.querySelector("select[name$='-section_type']");
+    var select = row.querySelector("select[name$='-section_type'], input[type='hidden'][name$='-section_type']");
     var type = select ? select.value : "";
     row.querySelectorAll("fieldset[class*='only-']").forEach(function (fs) {
       fs.hidden = !fs.classList.contains("only-" + type);
