@@ -75,7 +75,8 @@ class SectionDesign:
 
     @property
     def mixed_naturalness(self) -> bool:
-        """A naturalness section that mixes given numbers of generated and source clips (studyapp.assignment)."""
+        """A naturalness section that mixes given numbers of generated and source clips
+        (studyapp.participant.assignment)."""
         return bool(get_section_type(self.section_type).sub_pools) and (bool(self.sub_pools)
                                                                         or "n_source" in self.options)
 
@@ -191,7 +192,7 @@ def pool_mask(clips: pd.DataFrame, pool: dict | None) -> np.ndarray:
 
 # ---- presets -> design ---------------------------------------------------------------------------------------------
 def _section(spec: dict, order: int, preset: str, plan: str, clips: pd.DataFrame, offset: int) -> SectionDesign:
-    """One preset section (with the preset's plan as pool filter, as studyapp.presets.preset_sections does)."""
+    """One preset section (with the preset's plan as pool filter, as studyapp.staff.presets.preset_sections does)."""
     where = f"preset {preset!r}, section {order - offset} ({spec['section_type']})"
     if "reuse" in spec:
         return SectionDesign(order, preset, spec["section_type"], np.zeros(0, int), 0, offset + spec["reuse"],

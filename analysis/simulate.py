@@ -6,8 +6,8 @@ Nothing here is data from people. Participant ids start with ``sim-``, clip ids 
 The design comes from study presets and their plans (:mod:`analysis.design`): ``simulate_study(n, presets=("demo",))``
 simulates the demo study on the demo plan's clips; the default is the three papers' studies one after the other
 (:data:`analysis.design.PAPER_PRESETS`: seed 000's gait study on plan seed000, seed 003's gesture study on seed003,
-seed 004's RBF study on seed004). Every section is drawn as the study app assigns it (studyapp.assignment): the
-preset's clips per participant from its pool (0 = all), no clip twice for one participant except in a section that
+seed 004's RBF study on seed004). Every section is drawn as the study app assigns it (studyapp.participant.assignment):
+the preset's clips per participant from its pool (0 = all), no clip twice for one participant except in a section that
 reuses another's clips, naturalness mixing the given numbers of generated and source clips and never a generated clip
 whose source is shown, gesture_emotion offering the intended and ``n_options - 1`` other categories. Assignment is
 uniformly random rather than balanced.
@@ -146,7 +146,7 @@ def _naturalness_pick(rng, sec: SectionDesign, design: StudyDesign, used: np.nda
 def _drawn_options(rng, sec: SectionDesign, design: StudyDesign, shown: _Shown) -> _Shown:
     """Offered categories of each item of a section with drawn choices (gesture_emotion): the intended (the clip's
     emotion_label, else neutral) and ``n_options - 1`` others of the section's categories, in random order
-    (studyapp.assignment)."""
+    (studyapp.participant.assignment)."""
     intended = design.clips["emotion_label"].fillna("").astype(str).to_numpy()[shown.clip]
     intended = np.where(intended == "", "neutral", intended)
     cats = sec.categories()

@@ -37,7 +37,7 @@ MiB = 1024 * 1024
 SETUP = """
 from django.contrib.auth.models import User
 from django.test import Client
-from studyapp.catalogue import upsert_clips
+from studyapp.data.catalogue import upsert_clips
 from studyapp.models import Clip
 upsert_clips([{"clip_id": "synthetic_500mb", "modality": "other", "origin": "imported",
                "video": "clips/synthetic_500mb.mp4", "metadata": {"synthetic": True}}])

@@ -1,4 +1,4 @@
-"""What the participant pages' two reads in plain SQL (studyapp.page_reads) save on the answer path's CPU.
+"""What the participant pages' two reads in plain SQL (studyapp.participant.page_reads) save on the answer path's CPU.
 
 Same set-up as ``bench_study_load.py --in-process-only`` (scratch PostgreSQL database or SQLite, synthetic catalogue,
 demo study, Django test client, url-encoded POSTs): participants are taken through the study in-process, and each
@@ -32,7 +32,7 @@ KINDS = ("answer POST", "clip page")      # take_study's names of the answer POS
 def queryset_reads() -> tuple:
     """(participant_by_token, open_assignments) as ORM querysets, compiled to SQL on each call."""
     from studyapp.models import Assignment, Participant
-    from studyapp.page_reads import ASSIGNMENT_FIELDS, CLIP_FIELDS
+    from studyapp.participant.page_reads import ASSIGNMENT_FIELDS, CLIP_FIELDS
 
     only = (*ASSIGNMENT_FIELDS, "section", "clip", *(f"clip__{f}" for f in CLIP_FIELDS))
 
@@ -47,7 +47,7 @@ def queryset_reads() -> tuple:
 
 
 def shipped_reads() -> tuple:
-    from studyapp.page_reads import open_assignments, participant_by_token
+    from studyapp.participant.page_reads import open_assignments, participant_by_token
 
     return participant_by_token, open_assignments
 
@@ -58,7 +58,7 @@ MODES = {"plain_sql": shipped_reads, "queryset": queryset_reads}
 
 def use(reads: tuple) -> None:
     """Make the study app's views and assignment code call these two reads."""
-    from studyapp import assignment, views
+    from studyapp.participant import assignment, views
 
     views.participant_by_token, assignment.open_assignments = reads
 

@@ -1,5 +1,5 @@
-"""How long ``studyapp.reports.start_build`` takes to return (the staff page's "build the report" click), while the
-detached ``manage.py build_report`` it spawns runs on.
+"""How long ``studyapp.staff.reports.start_build`` takes to return (the staff page's "build the report" click), while
+the detached ``manage.py build_report`` it spawns runs on.
 
 A scratch SQLite database in a temporary DATA_DIR (synthetic catalogue, the demo study with a few finished
 synthetic participants); each round starts a build of a new data version (one more answer each time), records the
@@ -29,7 +29,7 @@ def main(argv=None) -> dict:
     from benchmarks.bench_record import record
 
     study = load.setup_django(f"sqlite:///{data / 'db.sqlite3'}", data / "media")
-    from studyapp import reports
+    from studyapp.staff import reports
 
     start_ms, build_s = [], []
     for i in range(args.rounds):

@@ -37,7 +37,7 @@ SERVERS = {
 }
 
 SETUP = """
-from studyapp.presets import create_study_from_preset
+from studyapp.staff.presets import create_study_from_preset
 from studyapp.testing import make_catalogue
 from django.conf import settings
 make_catalogue(settings.MEDIA_ROOT)

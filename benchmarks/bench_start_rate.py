@@ -1,5 +1,5 @@
-"""Start rate limit (studyapp.start_throttle) against the demo's server configuration: 200 Prolific-like starts in
-one minute, each from its own address, and a scripted flood of starts from one address.
+"""Start rate limit (studyapp.participant.start_throttle) against the demo's server configuration: 200 Prolific-like
+starts in one minute, each from its own address, and a scripted flood of starts from one address.
 
 Starts gunicorn ``studyapp.asgi:application -k asgi`` (2 workers, TRUSTED_PROXY_COUNT=1 as behind nginx, the default
 START_RATE_BURST / START_RATE_INTERVAL_S unless given) on a scratch SQLite database with an open study. A start is
@@ -31,7 +31,7 @@ from benchmarks.local_server import free_port, wait_for_server
 
 ROOT = Path(__file__).resolve().parent.parent
 SETUP = """
-from studyapp.presets import create_study_from_preset
+from studyapp.staff.presets import create_study_from_preset
 create_study_from_preset("rbf_thms2016", "rate", plan="test", status="open")
 """
 

@@ -19,8 +19,8 @@ and starts gunicorn (gthread workers). Then:
 Pages are parsed generically (the post form with the most fields; radios/checkboxes take their first value, hidden
 fields are kept, redirects are followed whatever their target), so the driver does not depend on the exact page
 sequence. An answer POST is acknowledged by a redirect or, as the clip page's form asks for it
-(studyapp.views.INLINE_NEXT_FIELD), by the next clip page itself, whose form action is then the page's URL (as the
-browser's study.js does). The locust driver (benchmarks/locustfile.py: gevent users, so the generator is not the
+(studyapp.participant.views.INLINE_NEXT_FIELD), by the next clip page itself, whose form action is then the page's URL
+(as the browser's study.js does). The locust driver (benchmarks/locustfile.py: gevent users, so the generator is not the
 bottleneck) is the default; --driver threads runs one Python thread per participant with `requests`.
 
 Reports answers per second (answer POSTs accepted / wall time, and answers stored / wall time), p50/p99 latency
@@ -211,8 +211,8 @@ def _answer_clip(http, page: Page, action: str, data: dict, n: int, rec: dict, a
             rec["errors"].append(f"clip {n}: HTTP {status} {_snippet(text)}")
     rec["answer_posts"] += 1
     if status == 200:
-        # The next clip page came as the answer (studyapp.views.INLINE_NEXT_FIELD); like the browser's script,
-        # take its form's action as the page's URL.
+        # The next clip page came as the answer (studyapp.participant.views.INLINE_NEXT_FIELD); like the browser's
+        # script, take its form's action as the page's URL.
         next_action, _data, _questions = fill_form(text, action)
         if next_action is None or not CLIP_RE.search(next_action):
             rec["errors"].append(f"clip {n}: HTTP 200 without a next clip page: {_snippet(text)}")
@@ -285,7 +285,7 @@ def setup_django(db_url: str, media_root: Path):
 
     call_command("migrate", verbosity=0)
     from studyapp.models import Study
-    from studyapp.presets import create_study_from_preset
+    from studyapp.staff.presets import create_study_from_preset
     from studyapp.testing import make_catalogue
 
     synthetic_media = bytes((i * 131 + 7) % 256 for i in range(2 * 1024 * 1024))
@@ -304,7 +304,7 @@ def media_urls(n: int = 4) -> list[str]:
 
 def media_session() -> str:
     """The session key of a staff account that may see the catalogue: the media viewers are no participants, and
-    clips need a session that may see them (studyapp.views.media_allowed)."""
+    clips need a session that may see them (studyapp.participant.views.media_allowed)."""
     from django.contrib.auth import BACKEND_SESSION_KEY, HASH_SESSION_KEY, SESSION_KEY, get_user_model
     from django.contrib.sessions.backends.db import SessionStore
 
@@ -718,7 +718,7 @@ def database_checks(study, records: list[dict]) -> dict:
     from django.db import connection
     from django.db.models import Count, Exists, OuterRef
 
-    from studyapp.export import stream_csv
+    from studyapp.data.export import stream_csv
     from studyapp.models import Assignment, Participant, Response
 
     connection.close()

@@ -52,7 +52,7 @@ def make_study():
     from django.conf import settings
 
     from studyapp.models import Study
-    from studyapp.presets import create_study_from_preset
+    from studyapp.staff.presets import create_study_from_preset
     from studyapp.testing import make_catalogue
 
     make_catalogue(Path(settings.MEDIA_ROOT))
@@ -64,8 +64,8 @@ def make_study():
 
 def add_crowd(study, n: int) -> None:
     """n - 1 started participants with the assignments of one real start, bulk-inserted."""
-    from studyapp.assignment import start_participant
     from studyapp.models import Assignment, Participant
+    from studyapp.participant.assignment import start_participant
 
     template = Participant.objects.create(study=study, demographics_done=True)
     start_participant(template)
@@ -87,8 +87,8 @@ def answer_cost(study, n_clips: int = 3) -> dict:
     from django.test.utils import CaptureQueriesContext
     from django.urls import reverse
 
-    from studyapp.assignment import current_step
     from studyapp.models import Participant
+    from studyapp.participant.assignment import current_step
     from studyapp.questions import questions_for
 
     client = Client()
@@ -133,8 +133,8 @@ def release_together(work, items, threads: int, gate: threading.Event) -> float:
 def concurrent_starts(study, n: int, threads: int) -> dict:
     from django.db import connection
 
-    from studyapp.assignment import start_participant
     from studyapp.models import Participant
+    from studyapp.participant.assignment import start_participant
 
     people = [Participant.objects.create(study=study, demographics_done=True) for _ in range(n)]
     gate = threading.Event()

@@ -60,7 +60,7 @@ candidates are rated precisely because an observer's reading is a weak judge); o
 SWITCHES = (INCLUDE_FLAGGED, KEEP_ADVISORY, OBSERVER_ADVISORY)
 NORMS_RULE = "norms"
 """Pool rule admitting only clips whose per-clip norms pass: ``{"from": <study slug or clip_norms.csv path>,
-"min_ratings": 10, "min_intended_share": 0.5, "max_entropy_bits": 1.5}`` (studyapp.norms_rule applies it)."""
+"min_ratings": 10, "min_intended_share": 0.5, "max_entropy_bits": 1.5}`` (studyapp.data.norms_rule applies it)."""
 NORMS_FIELDS = {"from": None, "min_ratings": (int, 1, 1_000_000), "min_intended_share": (float, 0.0, 1.0),
                 "max_entropy_bits": (float, 0.0, 64.0)}
 """Fields of the norms rule -> (type, lowest, highest); ``from`` is text."""
@@ -105,9 +105,10 @@ unlimited; 0: played once)."""
 MAX_REPLAYS_LIMIT = 100
 
 COMMON_OPTIONS = ("attention_checks", "practice", "practice_clip", *PLAYER_OPTIONS)
-"""Options of every section type (studyapp.trial_extras): attention checks, a practice item, the clip player."""
+"""Options of every section type (studyapp.participant.trial_extras): attention checks, a practice item, the clip
+player."""
 ATTENTION_KEYS = ("count", "answer", "positions", "question", "clip")
-"""``clip``: the clip_id of a dedicated check clip, one no participant rates (studyapp.trial_extras)."""
+"""``clip``: the clip_id of a dedicated check clip, one no participant rates (studyapp.participant.trial_extras)."""
 
 
 class SectionError(NamedTuple):
@@ -218,7 +219,7 @@ def pool_problems(pool, section_type: str | None = None, sub_pools: bool = True)
 
 
 def _norms_rule_problems(rule) -> Found:
-    """Problems of a pool's ``norms`` rule as written (the source itself is checked by studyapp.norms_rule)."""
+    """Problems of a pool's ``norms`` rule as written (the source itself is checked by studyapp.data.norms_rule)."""
     example = '{"from": "my-pilot", "min_ratings": 10, "min_intended_share": 0.5}'
     if not isinstance(rule, dict):
         return [(("norms",), f"'norms' must be an object like {example}, got {rule!r}")]
@@ -257,7 +258,7 @@ def pool_lookups(pool: dict | None) -> list[tuple[str, dict]]:
         raise PoolError({"pool": errors})
     calls = []
     for key, value in (pool or {}).items():
-        if key in SUB_POOLS or key in SWITCHES or key == NORMS_RULE:   # NORMS_RULE: studyapp.norms_rule
+        if key in SUB_POOLS or key in SWITCHES or key == NORMS_RULE:   # NORMS_RULE: studyapp.data.norms_rule
             continue
         if key == "transition":
             calls.append(("filter", {f"{FINAL_EMOTION_COLUMNS[0]}__isnull": not value}))

@@ -1,6 +1,6 @@
 """Study presets as plain data: one per paper's web study, and a demo with every section type. No Django.
 
-``studyapp.presets`` turns a preset into Study + Section rows (the researcher then edits them in the admin); the
+``studyapp.staff.presets`` turns a preset into Study + Section rows (the researcher then edits them in the admin); the
 synthetic-study simulator (``analysis.design``) reads the same sections to simulate a study of that preset. Each
 section: ``section_type``, ``name`` (the researchers' name for it, never shown to participants), ``title`` and
 ``instructions`` (what participants see: plain words, never the researchers' terms such as "theme" or "inversion"),

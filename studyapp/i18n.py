@@ -126,12 +126,12 @@ _MARKED_FOR_EXTRACTION = (
     pgettext_lazy("theme adjective", "sad"), pgettext_lazy("theme adjective", "energetic"),
     pgettext_lazy("theme adjective", "tired"), pgettext_lazy("theme adjective", "feminine"),
     pgettext_lazy("theme adjective", "masculine"),
-    # preset defaults copied into studies (studyapp/presets.py)
+    # preset defaults copied into studies (studyapp/staff/presets.py)
     gettext_noop("How natural do the gestures look?"),
     gettext_noop("Were you distracted by the camera during the study?"),
     gettext_noop("Were you distracted by the lack of facial expressions?"),
     gettext_noop("Any other comments (optional)?"),
-    # messages of studyapp/assignment.py and studyapp/views.py, translated where they are shown
+    # messages of studyapp/participant/assignment.py and studyapp/participant/views.py, translated where they are shown
     gettext_noop("This study is closed and is not accepting participants. Thank you for your interest."),
     gettext_noop("This study is full: it has all the participants it needs. Thank you for your interest."),
     gettext_noop("This Prolific ID has already started this study in another browser, with a different "

@@ -210,7 +210,7 @@ class Study(models.Model):
 
 class Section(models.Model):
     """A block of clips with one question set, or an instruction or break page (a page type: no clips, no
-    questions; studyapp.section_pages); `order` fixes the position in the study."""
+    questions; studyapp.data.section_pages); `order` fixes the position in the study."""
 
     study = models.ForeignKey(Study, on_delete=models.CASCADE, related_name="sections")
     order = models.PositiveIntegerField(default=0)
@@ -302,7 +302,8 @@ class Participant(models.Model):
     last_active_at = models.DateTimeField(null=True, blank=True)
     completed_at = models.DateTimeField(null=True, blank=True)
     user_agent = models.CharField(max_length=300, blank=True)
-    # The browser window and kind of device at consent (studyapp.device_check): CSS pixels, null when not reported.
+    # The browser window and kind of device at consent (studyapp.participant.device_check): CSS pixels, null when not
+    # reported.
     viewport_width = models.PositiveSmallIntegerField(null=True, blank=True, editable=False)
     viewport_height = models.PositiveSmallIntegerField(null=True, blank=True, editable=False)
     device_kind = models.CharField(max_length=10, blank=True, default="", editable=False,
@@ -317,7 +318,7 @@ class Participant(models.Model):
     # Consented while the study was in pilot mode (Study.pilot): public_id starts with PILOT_PREFIX.
     pilot = models.BooleanField(default=False, editable=False, db_index=True)
     # The instruction and break pages this participant is given, fixed at start in the order taken
-    # (studyapp.section_pages): section pk, the clip number they come before, when first shown and when continued.
+    # (studyapp.data.section_pages): section pk, the clip number they come before, when first shown and when continued.
     pages = models.JSONField(default=list, blank=True, editable=False)
 
     class Meta:
@@ -361,17 +362,19 @@ class Assignment(models.Model):
     kind = models.CharField(max_length=20, choices=Kind.choices, default=Kind.TRIAL, blank=True)
     # Attention check: the answer the participant is told to give (Section.options["attention_checks"]["answer"]).
     instructed = models.CharField(max_length=40, blank=True, default="")
-    # How the clip was watched before the answer (studyapp.viewing): protocol.vocabulary.VIEWING_FIELDS -> int or null;
-    # null when the browser sent no record. Exported as viewing.csv.
+    # How the clip was watched before the answer (studyapp.participant.viewing): protocol.vocabulary.VIEWING_FIELDS ->
+    # int or null; null when the browser sent no record. Exported as viewing.csv.
     viewing = models.JSONField(null=True, blank=True, editable=False)
-    # The clip's playback as the player reported it while the page was open (studyapp.viewing.record_playback), kept
-    # across reloads so a reload neither restarts the count nor resets max_replays: plays started, the ms from
-    # shown_at to the clip's first end (null: not yet), how often the page was displayed, and the counts of the
-    # displays left without an answer (studyapp.viewing.CARRIED_FIELDS -> int), added to the answer's record.
+    # The clip's playback as the player reported it while the page was open
+    # (studyapp.participant.viewing.record_playback), kept across reloads so a reload neither restarts the count nor
+    # resets max_replays: plays started, the ms from shown_at to the clip's first end (null: not yet), how often the
+    # page was displayed, and the counts of the displays left without an answer
+    # (studyapp.participant.viewing.CARRIED_FIELDS -> int), added to the answer's record.
     plays = models.PositiveIntegerField(default=0, editable=False)
     play_ended_ms = models.PositiveIntegerField(null=True, blank=True, editable=False)
     shows = models.PositiveIntegerField(default=0, editable=False)
-    # when this session's player first fetched the clip (studyapp.views.media): the viewing record's server evidence
+    # when this session's player first fetched the clip (studyapp.participant.views.media): the viewing record's server
+    # evidence
     fetched_at = models.DateTimeField(null=True, blank=True, editable=False)
     carried = models.JSONField(default=dict, blank=True, editable=False)
 

@@ -14,7 +14,7 @@ from django.http import Http404
 
 EXPORT_PERMISSION = "studyapp.export_participant_data"
 """Download a study's CSV exports and analysis report (participant data; external ids pseudonymised unless the
-study asks for them: studyapp.privacy)."""
+study asks for them: studyapp.data.privacy)."""
 
 STUDY_PERMISSIONS = [
     ("export_participant_data", "Can download participant data (CSV exports and analysis reports)"),

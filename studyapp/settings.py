@@ -24,7 +24,7 @@ Variables (all optional for the demo):
     TRUSTED_PROXY_COUNT   reverse proxies in front of the app whose X-Forwarded-For is trusted for the client
                       address of the login throttle (default: 1 with PRODUCTION=1, the nginx recipe; else 0)
     START_RATE_BURST  new participants one client address may start at once (default 6; 0 turns the limit off)
-    START_RATE_INTERVAL_S then one more every this many seconds (default 20; studyapp.start_throttle)
+    START_RATE_INTERVAL_S then one more every this many seconds (default 20; studyapp.participant.start_throttle)
     QA_GAIT_OBSERVER  the quality gate's gait observer for plans that name none: real (default), real-perceived
                       or synthetic
     REAL_CORPUS       the Bandai Namco real-capture corpus the real gait observers are trained on (default:

@@ -1,12 +1,12 @@
 """Model signals: a participant deleted or withdrawn leaves no stored report behind
-(studyapp.reports.forget_reports)."""
+(studyapp.staff.reports.forget_reports)."""
 from __future__ import annotations
 
 from django.db.models.signals import post_delete, post_save, pre_save
 from django.dispatch import receiver
 
 from .models import Participant, Study
-from .reports import forget_reports
+from .staff.reports import forget_reports
 
 
 @receiver(pre_save, sender=Participant)

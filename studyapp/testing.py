@@ -16,8 +16,8 @@ from django import forms
 
 from protocol.vocabulary import GAIT_EMOTIONS, GESTURE_EMOTIONS, NEUTRAL_THEME, THEMES
 
-from .catalogue import upsert_clips
-from .forms import SectionForm
+from .admin.forms import SectionForm
+from .data.catalogue import upsert_clips
 
 GAIT_VECTORS = [   # in protocol.vocabulary.GAIT_EMOTIONS order; GAIT_VECTORS[3] is pure neutral
     (1, 0, 0, 0), (0, 1, 0, 0), (0, 0, 1, 0), (0, 0, 0, 1), (0.5, 0, 0, 0.5), (0, 0.5, 0.5, 0),

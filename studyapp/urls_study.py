@@ -2,7 +2,9 @@
 clip media under /m/, researcher pages (staff only) under /staff/."""
 from django.urls import path
 
-from . import views, views_norming, views_pages, views_share, views_staff
+from .participant import views, views_pages
+from .staff import views as views_staff
+from .staff import views_norming, views_share
 
 app_name = "studyapp"
 

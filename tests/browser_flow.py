@@ -4,15 +4,15 @@ small part of the WebDriver API that Selenium's Chromium and WebKitGTK drivers a
 script, so the three browsers are driven the same way.
 
 The test's database tells the flow which section each page belongs to and what an attention check instructs (the
-page itself does not show either to a script, studyapp.page_notes); everything else is read from the page.
+page itself does not show either to a script, studyapp.participant.page_notes); everything else is read from the page.
 """
 from __future__ import annotations
 
 import time
 from dataclasses import dataclass, field
 
-from studyapp.assignment import current_step
 from studyapp.models import Participant, Study
+from studyapp.participant.assignment import current_step
 
 PAGE_TIMEOUT_S = 30.0
 

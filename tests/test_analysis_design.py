@@ -52,7 +52,7 @@ def test_simulated_participants_follow_the_design(preset):
     asked = set(zip(sim.responses["section_type"], sim.responses["question"]))
     assert asked == {(s.section_type, q) for s in d.sections for q in SECTION_QUESTIONS[s.section_type]}
     # no clip twice for one participant, except the reusing section; a naturalness section never shows a generated
-    # clip and its source together (studyapp.assignment)
+    # clip and its source together (studyapp.participant.assignment)
     a = sim.assignments.merge(pd.DataFrame({"section_order": [s.order for s in d.sections],
                                             "reuse": [s.reuse is not None for s in d.sections]}))
     assert not a[~a["reuse"]].duplicated(["participant_id", "clip_id"]).any()

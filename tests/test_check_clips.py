@@ -7,11 +7,11 @@ import pytest
 from protocol.pools import options_errors
 from protocol.presets import PRESETS
 from protocol.vocabulary import ATTENTION_CHECK
-from studyapp.assignment import start_participant
-from studyapp.catalogue import pool_queryset
-from studyapp.check_clips import check_clip_problems
+from studyapp.data.catalogue import pool_queryset
+from studyapp.data.check_clips import check_clip_problems
 from studyapp.models import Clip, Participant, Study
-from studyapp.presets import create_study_from_preset
+from studyapp.participant.assignment import start_participant
+from studyapp.staff.presets import create_study_from_preset
 from studyapp.testing import make_catalogue, section_form_errors
 
 pytestmark = pytest.mark.django_db

@@ -8,10 +8,10 @@ import io
 import pytest
 
 from analysis.io import load_study
-from studyapp.catalogue import CatalogueError, pool_queryset, upsert_clips
-from studyapp.export import stream_csv
+from studyapp.data.catalogue import CatalogueError, pool_queryset, upsert_clips
+from studyapp.data.export import stream_csv
 from studyapp.models import Clip
-from studyapp.presets import create_study_from_preset
+from studyapp.staff.presets import create_study_from_preset
 from studyapp.testing import make_catalogue
 
 pytestmark = pytest.mark.django_db

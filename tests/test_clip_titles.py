@@ -8,7 +8,7 @@ import pytest
 from django.apps import apps as django_apps
 
 from protocol.titles import TITLE_MAX_LENGTH, clip_title, clip_titles, condition_label, emotion_mix
-from studyapp.catalogue import upsert_clips
+from studyapp.data.catalogue import upsert_clips
 from studyapp.models import Clip
 
 
@@ -112,9 +112,9 @@ def test_the_clip_list_is_paginated_with_thumbnails_the_security_policy_allows(s
 def test_progress_and_pool_editor_show_titles_and_posters(staff, catalogue):
     from django.urls import reverse
 
-    from studyapp.assignment import start_participant
     from studyapp.models import Participant, Study
-    from studyapp.presets import create_study_from_preset
+    from studyapp.participant.assignment import start_participant
+    from studyapp.staff.presets import create_study_from_preset
 
     study = create_study_from_preset("gait_ismar2020", "titled", plan="test", status=Study.Status.OPEN)
     start_participant(Participant.objects.create(study=study, demographics_done=True))

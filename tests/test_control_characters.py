@@ -8,11 +8,11 @@ from django.contrib.auth.models import User
 from django.test import Client
 from django.urls import reverse
 
-from studyapp.assignment import current_step
-from studyapp.forms import ConsentForm, FeedbackForm
 from studyapp.inputs import has_control_character
 from studyapp.models import Participant, Response, Study
-from studyapp.viewing import SCRIPT_FIELD, VIEWING_FORM_FIELDS
+from studyapp.participant.assignment import current_step
+from studyapp.participant.forms import ConsentForm, FeedbackForm
+from studyapp.participant.viewing import SCRIPT_FIELD, VIEWING_FORM_FIELDS
 from tests.test_study_flow import answer_for, consent, demographics
 
 pytestmark = pytest.mark.django_db
@@ -26,7 +26,7 @@ def bad(text: str, control: str) -> str:
 
 @pytest.fixture
 def study(settings, tmp_path):
-    from studyapp.presets import create_study_from_preset
+    from studyapp.staff.presets import create_study_from_preset
     from studyapp.testing import make_catalogue
 
     settings.MEDIA_ROOT = tmp_path / "media"

@@ -1,6 +1,6 @@
 """Data a reviewer can read: every export carries a data dictionary written from the protocol's definitions
 (protocol.dictionary) and a Psych-DS dataset_description.json; the progress page shows the completion funnel,
-median times and answers per day (studyapp.progress_stats)."""
+median times and answers per day (studyapp.staff.progress_stats)."""
 from __future__ import annotations
 
 import csv
@@ -24,10 +24,10 @@ from protocol.vocabulary import (
     RESPONSE_COLUMNS,
     VIEWING_COLUMNS,
 )
-from studyapp.export import EXPORT_CLIP_COLUMNS, EXPORT_KINDS, write_data_package
+from studyapp.data.export import EXPORT_CLIP_COLUMNS, EXPORT_KINDS, write_data_package
 from studyapp.models import Assignment, Participant, Study
-from studyapp.presets import create_study_from_preset
-from studyapp.progress_stats import progress_stats
+from studyapp.staff.presets import create_study_from_preset
+from studyapp.staff.progress_stats import progress_stats
 from studyapp.testing import make_catalogue
 from tests.test_pilots_sharing import take_part
 

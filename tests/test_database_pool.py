@@ -87,7 +87,7 @@ OTHER_DATABASE_FAULTS = [lambda: OperationalError("no such table: studyapp_parti
 
 @pytest.mark.parametrize("error", NO_CONNECTION)
 def test_no_connection_is_a_503_with_retry_after(monkeypatch, settings, error):
-    from studyapp import views
+    from studyapp.participant import views
 
     settings.DEBUG = False
 
@@ -120,7 +120,7 @@ def test_a_failure_in_middleware_is_a_503_too(monkeypatch, settings):
 
 @pytest.mark.parametrize("error", [lambda: ZeroDivisionError("division by zero"), *OTHER_DATABASE_FAULTS])
 def test_other_errors_stay_a_plain_500(monkeypatch, settings, error):
-    from studyapp import views
+    from studyapp.participant import views
 
     settings.DEBUG = False
 

@@ -7,9 +7,9 @@ from django.core.exceptions import ValidationError
 from django.test import Client
 from django.urls import reverse
 
-from studyapp.device_check import device_record, kind_from_user_agent, min_viewport, refusal
 from studyapp.models import Participant, Study
-from studyapp.presets import create_study_from_preset
+from studyapp.participant.device_check import device_record, kind_from_user_agent, min_viewport, refusal
+from studyapp.staff.presets import create_study_from_preset
 from studyapp.testing import make_catalogue
 
 pytestmark = pytest.mark.django_db

@@ -10,9 +10,9 @@ import pytest
 from browser_flow import take_study
 
 from protocol.vocabulary import ATTENTION_CHECK, SECTION_QUESTIONS, SECTION_TYPES
-from studyapp.device_check import MP4_TYPE
 from studyapp.models import Participant, Response, Study
-from studyapp.presets import create_study_from_preset
+from studyapp.participant.device_check import MP4_TYPE
+from studyapp.staff.presets import create_study_from_preset
 from studyapp.testing import make_catalogue, wide_clip
 
 pytestmark = [pytest.mark.browser, pytest.mark.slow, pytest.mark.django_db(transaction=True)]

@@ -13,7 +13,7 @@ import pytest
 from django.urls import reverse
 
 from studyapp.models import Participant, Response, Study
-from studyapp.presets import create_study_from_preset
+from studyapp.staff.presets import create_study_from_preset
 from studyapp.testing import make_catalogue, wait_for
 from tests.test_e2e_keyboard_a11y import CLIP_SECONDS, press, wide_test_clip
 

@@ -26,9 +26,9 @@ import pytest
 from django.urls import reverse
 
 from protocol.vocabulary import ATTENTION_CHECK, SECTION_QUESTIONS, SECTION_TYPES, answer_values
-from studyapp.export import stream_csv
+from studyapp.data.export import stream_csv
 from studyapp.models import Assignment, Participant, Response, Study
-from studyapp.presets import create_study_from_preset
+from studyapp.staff.presets import create_study_from_preset
 from studyapp.testing import make_catalogue, wait_for
 
 pytestmark = [pytest.mark.browser, pytest.mark.slow, pytest.mark.django_db(transaction=True)]

@@ -14,7 +14,7 @@ from django.urls import reverse
 
 from protocol.vocabulary import SECTION_TYPES
 from studyapp.models import Participant, Study
-from studyapp.presets import create_study_from_preset
+from studyapp.staff.presets import create_study_from_preset
 from studyapp.testing import make_catalogue, wide_clip
 
 pytestmark = [pytest.mark.browser, pytest.mark.slow, pytest.mark.django_db(transaction=True)]

@@ -16,7 +16,7 @@ from django.urls import reverse
 
 from protocol.vocabulary import ATTENTION_CHECK, CLIP_NORMS_COLUMNS, GAIT_EMOTIONS
 from studyapp.models import Clip, Participant, Response, Study
-from studyapp.presets import create_study_from_preset
+from studyapp.staff.presets import create_study_from_preset
 from studyapp.testing import consent_and_demographics, make_catalogue, tiny_mp4, wait_for
 
 pytestmark = [pytest.mark.browser, pytest.mark.slow, pytest.mark.django_db(transaction=True)]
@@ -69,7 +69,7 @@ def simulated_participant(study: Study, external_id: str) -> None:
     instructed answer on attention checks, else the first choice of every question."""
     from django.test import Client
 
-    from studyapp.assignment import current_step
+    from studyapp.participant.assignment import current_step
     from studyapp.questions import questions_for
 
     client = Client()

@@ -16,7 +16,7 @@ from pathlib import Path
 import pytest
 from django.urls import reverse
 
-from studyapp.export import stream_csv
+from studyapp.data.export import stream_csv
 from studyapp.models import Participant, Section, Study
 from studyapp.testing import consent_and_demographics, make_catalogue, tiny_mp4, wait_for
 from tests.test_e2e_study import pick_answers

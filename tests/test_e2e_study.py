@@ -19,10 +19,10 @@ import pytest
 from django.urls import reverse
 
 from protocol.vocabulary import SECTION_TYPES
-from studyapp.export import stream_csv
+from studyapp.data.export import stream_csv
 from studyapp.models import Participant, Response, Study
-from studyapp.presets import create_study_from_preset
 from studyapp.questions import questions_for
+from studyapp.staff.presets import create_study_from_preset
 from studyapp.testing import consent_and_demographics, make_catalogue, tiny_mp4, wait_for
 
 pytestmark = [pytest.mark.browser, pytest.mark.slow, pytest.mark.django_db(transaction=True)]

@@ -1,14 +1,14 @@
 """The study admin page in steps, in headless Chromium: from the study list to the first step, along the step bar
 (each step's page short, the clips step showing a naturalness section's halves), moving a section, and saving a
-step without losing the others (studyapp.study_steps, studyapp.admin_steps)."""
+step without losing the others (studyapp.admin.study_steps, studyapp.admin.steps)."""
 from __future__ import annotations
 
 import pytest
 from django.contrib.auth.models import User
 from django.urls import reverse
 
-from studyapp import study_steps
-from studyapp.presets import create_study_from_preset
+from studyapp.admin import study_steps
+from studyapp.staff.presets import create_study_from_preset
 from studyapp.testing import make_catalogue, wait_for
 
 pytestmark = [pytest.mark.browser, pytest.mark.slow, pytest.mark.django_db(transaction=True)]

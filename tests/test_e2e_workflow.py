@@ -19,7 +19,7 @@ from django.core.management import call_command
 from django.db import connections
 from django.urls import reverse
 
-from studyapp import background, render_jobs
+from studyapp.data import background, render_jobs
 from studyapp.models import Clip, Participant, Study
 from studyapp.testing import wait_for
 from tests.test_e2e_norming import simulated_participant

@@ -17,11 +17,11 @@ from django.utils import translation
 from django.utils.translation.template import templatize
 
 from protocol.vocabulary import LABEL_CHOICES, SECTION_QUESTIONS, answer_values
-from studyapp.export import stream_csv
+from studyapp.data.export import stream_csv
 from studyapp.i18n import activate_study_language, answer_label, label_msgids, likert_texts
 from studyapp.models import Participant, Response, Study
-from studyapp.presets import create_study_from_preset
 from studyapp.questions import AnswerError, questions_for
+from studyapp.staff.presets import create_study_from_preset
 from studyapp.testing import make_catalogue
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -105,7 +105,7 @@ def python_msgids_from_source(source: str) -> set[tuple[str | None, str]]:
 
 def all_marked() -> set[tuple[str | None, str]]:
     marked = set()
-    for path in sorted((ROOT / "studyapp").glob("*.py")):
+    for path in sorted((ROOT / "studyapp").rglob("*.py")):
         marked |= python_msgids(path)
     for path in PARTICIPANT_TEMPLATES:
         marked |= template_msgids(path)
@@ -152,7 +152,7 @@ def test_messages_other_modules_show_are_in_the_catalogue():
     module constants) are translated where they are shown, so they need msgids."""
     po = read_po(PO)
     texts = set()
-    for name in ("assignment.py", "views.py"):
+    for name in ("participant/assignment.py", "participant/views.py"):
         tree = ast.parse((ROOT / "studyapp" / name).read_text(encoding="utf-8"))
         constants = {t.id: _literal(node.value) for node in tree.body if isinstance(node, ast.Assign)
                      for t in node.targets if isinstance(t, ast.Name)}

@@ -106,7 +106,7 @@ def _files(media: Path) -> set[str]:
 
 @pytest.mark.django_db
 def test_good_rows_become_first_class_clips(media, lab):
-    from studyapp.catalogue import pool_queryset
+    from studyapp.data.catalogue import pool_queryset
     from studyapp.models import Clip
 
     out = run(write_manifest(lab, GOOD), *TINY)
@@ -310,7 +310,7 @@ def test_a_dry_run_says_a_long_take_will_be_cut(lab):
 
 @pytest.mark.django_db
 def test_a_failing_catalogue_step_undoes_the_row(media, lab, monkeypatch):
-    from studyapp import catalogue
+    from studyapp.data import catalogue
     from studyapp.models import Clip
 
     run(write_manifest(lab, GOOD[1:2]))
@@ -393,7 +393,7 @@ def staff(db):
 @pytest.fixture
 def inline_jobs(monkeypatch):
     """Run the import job in this process (the admin starts it detached; the test waits for nothing)."""
-    from studyapp import clip_import
+    from studyapp.data import clip_import
 
     def launch(cmd, job):
         assert cmd[2] == "import_clips" and cmd[1].endswith("manage.py")
@@ -596,7 +596,7 @@ def test_other_clips_only_in_sections_that_take_either_modality():
 def test_zip_members_that_leave_the_upload_are_refused(tmp_path):
     import zipfile
 
-    from studyapp.clip_import import UploadError, unpack_zip
+    from studyapp.data.clip_import import UploadError, unpack_zip
 
     archive = tmp_path / "a.zip"
     with zipfile.ZipFile(archive, "w") as zf:
@@ -627,7 +627,7 @@ def test_staging_left_by_a_killed_import_is_removed(tmp_path):
 
 @pytest.mark.django_db
 def test_a_collection_too_long_for_the_plan_field_is_refused_not_cut(media, lab):
-    from studyapp.clip_import import UploadError, collection_name
+    from studyapp.data.clip_import import UploadError, collection_name
 
     with pytest.raises(CommandError, match="too long"):
         call_command("import_clips", str(write_manifest(lab, GOOD[:1])), "--name", "x" * 200, stdout=io.StringIO())

@@ -17,9 +17,9 @@ from django.utils import timezone
 
 from analysis.io import load_study
 from protocol.vocabulary import ATTENTION_CHECK
-from studyapp import norms_rule
-from studyapp.assignment import current_step
+from studyapp.data import norms_rule
 from studyapp.models import Assignment, Clip, Participant, Response, Section, Study
+from studyapp.participant.assignment import current_step
 from studyapp.questions import questions_for
 from studyapp.testing import section_form_errors
 from tests.test_import_clips import make_video, media, read_report, run, write_manifest  # noqa: F401 - fixture
@@ -94,9 +94,9 @@ def test_imported_walks_in_a_norming_study_get_norms(media, tmp_path):  # noqa: 
     """A norming study (the preset) of two imported walks: every SIMULATED participant rates both; the per-clip
     norms, as the pool rule ``norms`` reads them from the study (exports, exclusion rules, analysis.norms), count
     each participant's rating of each clip, and a pool's norms rule admits the walks by them."""
-    from studyapp.catalogue import pool_queryset
-    from studyapp.norming import open_errors
-    from studyapp.presets import create_study_from_preset
+    from studyapp.data.catalogue import pool_queryset
+    from studyapp.data.norming import open_errors
+    from studyapp.staff.presets import create_study_from_preset
 
     walks = import_walks(tmp_path)
     study = create_study_from_preset("norming", "norming-imported", plan=PLAN)
@@ -153,7 +153,7 @@ def test_a_study_export_lists_imported_clips_with_origin_licence_and_citation(me
     from django.contrib.auth.models import User
 
     from analysis.naturalness import naturalness
-    from studyapp.catalogue import pool_queryset
+    from studyapp.data.catalogue import pool_queryset
     from studyapp.testing import make_catalogue
 
     make_catalogue(media, n_gait=2, n_transition=0, n_gait_source=0, n_gesture=0)

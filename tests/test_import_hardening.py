@@ -15,7 +15,7 @@ from django.core.files.uploadedfile import SimpleUploadedFile
 from django.urls import reverse
 
 from generation.imports.probe import VideoProbeError, probe_video
-from studyapp import clip_import
+from studyapp.data import clip_import
 from tests import test_import_clips as base
 from tests.test_import_clips import BVH, GOOD, make_video, read_report, run, write_manifest
 

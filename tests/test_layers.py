@@ -154,18 +154,33 @@ def test_generation_reads_no_study_design():
     assert not found, "generation must not import the study design (presets, pools, norming):\n" + "\n".join(found)
 
 
+def _import_nodes(path: Path) -> list[ast.Import | ast.ImportFrom]:
+    """The import statements of a file in imports_of's order (one entry per name of a plain import)."""
+    found: list = []
+
+    def visit(node: ast.AST) -> None:
+        for child in ast.iter_child_nodes(node):
+            if isinstance(child, ast.Import):
+                found.extend([child] * len(child.names))
+            elif isinstance(child, ast.ImportFrom):
+                found.append(child)
+            visit(child)
+
+    visit(ast.parse(path.read_text()))
+    return found
+
+
 def studyapp_module_cycles(root: Path = ROOT) -> list[list[str]]:
     """Import cycles between the modules of studyapp (function-local imports included), each as a closed path."""
     graph: dict[str, set[str]] = {}
     for path in sorted((root / "studyapp").rglob("*.py")):
         if "migrations" not in path.parts:
-            package = module_name(path, root).rpartition(".")[0] if path.name != "__init__.py" \
-                else module_name(path, root)
-            siblings = {f"{package}.{alias.name}" for node in ast.walk(ast.parse(path.read_text()))
-                        if isinstance(node, ast.ImportFrom) and node.level == 1 and node.module is None
-                        for alias in node.names}          # from . import a, b: the modules a and b
+            siblings = {f"{target}.{alias.name}" for (target, _line, _local), node
+                        in zip(imports_of(path, root), _import_nodes(path), strict=True)
+                        if isinstance(node, ast.ImportFrom) for alias in node.names}   # from . import a: module a
             graph[module_name(path, root)] = {m for m, _line, _local in imports_of(path, root)} | siblings
-    graph = {m: {d for d in deps if d in graph and d != m} for m, deps in graph.items()}
+    graph = {m: {d for d in deps if d in graph and d != m and not m.startswith(d + ".")}
+             for m, deps in graph.items()}          # a module's own packages run before it: no cycle
     found, state, stack = [], {}, []
 
     def visit(module: str) -> None:

@@ -13,8 +13,8 @@ from django.test import Client, RequestFactory
 from django.utils import timezone
 
 from studyapp.login_throttle import client_ip
-from studyapp.presets import create_study_from_preset
 from studyapp.settings import env_int
+from studyapp.staff.presets import create_study_from_preset
 from studyapp.testing import make_catalogue
 
 pytestmark = pytest.mark.django_db

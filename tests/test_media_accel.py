@@ -5,7 +5,7 @@ from __future__ import annotations
 import pytest
 from django.urls import reverse
 
-from studyapp.catalogue import upsert_clips
+from studyapp.data.catalogue import upsert_clips
 from studyapp.models import Clip
 from studyapp.testing import write_media
 
@@ -16,7 +16,8 @@ PAYLOAD = bytes(range(256)) * 8
 
 @pytest.fixture
 def client(admin_client):
-    """Clip media need a session that may see the clip (studyapp.views.media_allowed): here a superuser's."""
+    """Clip media need a session that may see the clip (studyapp.participant.views.media_allowed): here a
+    superuser's."""
     return admin_client
 
 

@@ -13,10 +13,10 @@ from django.contrib.auth.models import User
 from django.test import AsyncClient, Client
 from django.urls import reverse
 
-from studyapp import streaming
-from studyapp.catalogue import upsert_clips
+from studyapp.data.catalogue import upsert_clips
 from studyapp.models import Clip, Participant, Study
-from studyapp.presets import create_study_from_preset
+from studyapp.participant import streaming
+from studyapp.staff.presets import create_study_from_preset
 from studyapp.testing import write_media
 
 pytestmark = pytest.mark.django_db

@@ -31,14 +31,14 @@ import django, sys
 django.setup()
 from django.core.management import call_command
 call_command("migrate", verbosity=0)
-from studyapp.catalogue import upsert_clips
+from studyapp.data.catalogue import upsert_clips
 from studyapp.models import Clip
 from studyapp.testing import write_media
 from django.conf import settings
 rel = write_media(settings.MEDIA_ROOT, bytes.fromhex(sys.stdin.read().strip()))
 upsert_clips([{"clip_id": "gait_synthetic_nginx", "modality": "gait", "origin": "generated", "video": rel,
                "happy": 1, "sad": 0, "angry": 0, "neutral": 0}])
-# clips need a session that may see them (studyapp.views.media_allowed): a superuser's
+# clips need a session that may see them (studyapp.participant.views.media_allowed): a superuser's
 from django.contrib.auth import BACKEND_SESSION_KEY, HASH_SESSION_KEY, SESSION_KEY, get_user_model
 from django.contrib.sessions.backends.db import SessionStore
 user = get_user_model().objects.create_superuser("nginx-test", password="pw-nginx-test-1")

@@ -17,13 +17,13 @@ from analysis.norms import clip_norms
 from analysis.norms_simulate import expected_shares, true_perception
 from protocol.norming import required_participants
 from protocol.vocabulary import ATTENTION_CHECK, GESTURE_EMOTIONS
-from studyapp.admin import StudyAdmin
-from studyapp.assignment import current_step
-from studyapp.export import stream_csv
+from studyapp.admin.model_admins import StudyAdmin
+from studyapp.data.export import stream_csv
+from studyapp.data.norming import design_rows, open_errors
 from studyapp.models import Assignment, Participant, Response, Study
-from studyapp.norming import design_rows, open_errors
-from studyapp.presets import create_study_from_preset
+from studyapp.participant.assignment import current_step
 from studyapp.questions import questions_for
+from studyapp.staff.presets import create_study_from_preset
 from studyapp.testing import admin_form_data, make_catalogue
 
 pytestmark = pytest.mark.django_db
@@ -133,7 +133,7 @@ def test_concurrent_starts_follow_the_design(settings, tmp_path):
 
     from django.db import connection
 
-    from studyapp.assignment import start_participant
+    from studyapp.participant.assignment import start_participant
     if connection.vendor != "postgresql":
         pytest.skip("concurrency test needs PostgreSQL (set DATABASE_URL)")
     settings.MEDIA_ROOT = tmp_path / "media"

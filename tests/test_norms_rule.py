@@ -12,11 +12,11 @@ from django.urls import reverse
 
 from protocol.pools import pool_errors
 from protocol.vocabulary import CLIP_NORMS_COLUMNS, GAIT_EMOTIONS
-from studyapp import norms_rule
-from studyapp.admin_norms import norms_table
-from studyapp.catalogue import CatalogueError, pool_queryset
+from studyapp.admin.norms import norms_table
+from studyapp.data import norms_rule
+from studyapp.data.catalogue import CatalogueError, pool_queryset
 from studyapp.models import Clip, Participant, Response, Section, Study
-from studyapp.presets import create_study_from_preset
+from studyapp.staff.presets import create_study_from_preset
 from studyapp.testing import make_catalogue
 from studyapp.testing import section_form_errors as section_errors
 

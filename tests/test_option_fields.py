@@ -1,8 +1,8 @@
-"""Section options as form fields (studyapp.pool_editor): every option a registered section type declares
+"""Section options as form fields (studyapp.admin.pool_editor): every option a registered section type declares
 (protocol.section_types) and every option of all sections has form fields with help text, and every JSON option
 round-trips through the form for every registered section type (JSON -> fields -> the form's cleaned options is
 the same JSON), so JSON stays importable and exportable. The study's feedback questions and exclusion rules are
-form fields too (studyapp.study_fields)."""
+form fields too (studyapp.admin.study_fields)."""
 from __future__ import annotations
 
 import json
@@ -13,10 +13,10 @@ from django.urls import reverse
 from protocol.pools import COMMON_OPTIONS, validate_section
 from protocol.section_types import registered
 from protocol.vocabulary import GESTURE_EMOTIONS, answer_values
-from studyapp import pool_editor as pe
-from studyapp.admin import section_fieldsets
-from studyapp.forms import SectionPreviewForm
-from studyapp.presets import create_study_from_preset
+from studyapp.admin import pool_editor as pe
+from studyapp.admin.forms import SectionPreviewForm
+from studyapp.admin.model_admins import section_fieldsets
+from studyapp.staff.presets import create_study_from_preset
 from studyapp.testing import admin_form_data, make_catalogue
 
 EXAMPLES: dict[str, list[dict]] = {

@@ -1,4 +1,4 @@
-"""studyapp.page_reads: the participant pages' two plain-SQL reads give what the ORM querysets give."""
+"""studyapp.participant.page_reads: the participant pages' two plain-SQL reads give what the ORM querysets give."""
 from __future__ import annotations
 
 import threading
@@ -7,10 +7,10 @@ import pytest
 from django.db import connection
 from django.test.utils import CaptureQueriesContext
 
-from studyapp.assignment import open_items, start_participant
 from studyapp.models import Assignment, Participant, Study
-from studyapp.page_reads import ASSIGNMENT_FIELDS, CLIP_FIELDS, open_assignments, participant_by_token
-from studyapp.presets import create_study_from_preset
+from studyapp.participant.assignment import open_items, start_participant
+from studyapp.participant.page_reads import ASSIGNMENT_FIELDS, CLIP_FIELDS, open_assignments, participant_by_token
+from studyapp.staff.presets import create_study_from_preset
 from studyapp.testing import make_catalogue
 
 pytestmark = pytest.mark.django_db

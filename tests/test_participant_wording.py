@@ -13,9 +13,9 @@ from django.utils import translation
 from protocol.presets import PRESETS
 from protocol.vocabulary import OPPOSITE_THEME, SECTION_TYPES, THEMES
 from studyapp.models import Participant, Study
-from studyapp.presets import create_study_from_preset
+from studyapp.participant.section_wording import DEFAULT_WORDING, RESEARCHER_TERMS
 from studyapp.questions import questions_for
-from studyapp.section_wording import DEFAULT_WORDING, RESEARCHER_TERMS
+from studyapp.staff.presets import create_study_from_preset
 from studyapp.testing import make_catalogue
 
 NUMBERS = {"one": 1, "two": 2, "three": 3, "four": 4, "five": 5, "six": 6, "seven": 7, "eight": 8, "nine": 9}

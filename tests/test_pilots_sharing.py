@@ -1,6 +1,6 @@
-"""Pilots and sharing (studyapp.study_clone, studyapp.pilots, studyapp.sharing, studyapp.views_share): clone a
-study, run a pilot whose participants stay apart and can be deleted, share a signed preview link that needs no
-account and stores nothing, and the Prolific URL with its placeholders."""
+"""Pilots and sharing (studyapp.staff.study_clone, studyapp.staff.pilots, studyapp.staff.sharing,
+studyapp.staff.views_share): clone a study, run a pilot whose participants stay apart and can be deleted, share a signed
+preview link that needs no account and stores nothing, and the Prolific URL with its placeholders."""
 from __future__ import annotations
 
 import csv
@@ -12,17 +12,17 @@ from django.contrib.sessions.models import Session
 from django.test import Client
 from django.urls import reverse
 
-from studyapp.assignment import current_step, start_participant
-from studyapp.export import write_study_csvs
+from studyapp.data.export import write_study_csvs
 from studyapp.models import Assignment, Participant, Response, SectionClipCount, Study
-from studyapp.pilots import delete_pilot_data
-from studyapp.presets import create_study_from_preset
+from studyapp.participant.assignment import current_step, start_participant
+from studyapp.participant.views import save_answers
 from studyapp.questions import questions_for
-from studyapp.reports import data_version
-from studyapp.sharing import preview_token
-from studyapp.study_clone import clone_study
+from studyapp.staff.pilots import delete_pilot_data
+from studyapp.staff.presets import create_study_from_preset
+from studyapp.staff.reports import data_version
+from studyapp.staff.sharing import preview_token
+from studyapp.staff.study_clone import clone_study
 from studyapp.testing import make_catalogue
-from studyapp.views import save_answers
 
 pytestmark = pytest.mark.django_db
 

@@ -1,5 +1,5 @@
-"""The admin's pool editor: form fields <-> pool/options JSON (studyapp.pool_editor), the staff-only live count
-(studyapp.views_pool), saving sections through the admin with fields or raw JSON, the study form's new fields,
+"""The admin's pool editor: form fields <-> pool/options JSON (studyapp.admin.pool_editor), the staff-only live count
+(studyapp.admin.views_pool), saving sections through the admin with fields or raw JSON, the study form's new fields,
 and (browser, slow) the count updating in headless Chromium as a field changes."""
 from __future__ import annotations
 
@@ -12,13 +12,13 @@ from django.test import Client
 from django.urls import reverse
 
 from protocol.vocabulary import CLIP_THEMES, GESTURE_EMOTIONS, MODALITIES, ORIGINS
-from studyapp import pool_editor as pe
-from studyapp.catalogue import pool_queryset
-from studyapp.forms import SectionForm, SectionPreviewForm
+from studyapp.admin import pool_editor as pe
+from studyapp.admin.forms import SectionForm, SectionPreviewForm
+from studyapp.admin.views_pool import HALVES
+from studyapp.data.catalogue import pool_queryset
 from studyapp.models import Clip, Section, Study
-from studyapp.presets import create_study_from_preset
+from studyapp.staff.presets import create_study_from_preset
 from studyapp.testing import admin_form_data, make_catalogue
-from studyapp.views_pool import HALVES
 
 COUNT_URL = "admin:studyapp_pool_count"
 
@@ -357,7 +357,7 @@ def test_exclusion_rules_checked_by_the_analysis_library(admin_client, study):
 
 
 def test_exclusion_rules_are_checked_by_the_analysis_library(admin_client, study, monkeypatch):
-    from studyapp import forms
+    from studyapp.admin import forms
 
     monkeypatch.setattr(forms, "rule_errors", lambda rules: [f"fake: {key!r} refused" for key in rules])
     r = change(admin_client, study, {"exclusion_rules": json.dumps({"anything": 1})})
@@ -449,8 +449,8 @@ def screenshot(driver, path: str) -> None:
 def test_a_section_draws_only_the_modality_it_shows(catalogue):
     """A gait section whose pool names no modality never draws gestures (nor imported `other` videos); its count
     says the same; naturalness sections take either modality."""
-    from studyapp.catalogue import section_queryset
-    from studyapp.views_pool import count_pool
+    from studyapp.admin.views_pool import count_pool
+    from studyapp.data.catalogue import section_queryset
 
     assert Clip.objects.filter(modality="gesture").exists() and Clip.objects.filter(modality="gait").exists()
     gait = section_queryset("emotion_choice", {})

@@ -16,13 +16,13 @@ from django.test import Client
 from django.urls import reverse
 from test_study_admin import finish
 
-from studyapp import reports
-from studyapp.export import stream_csv
+from studyapp.data.export import stream_csv
+from studyapp.data.privacy import PURGED_NAME, pseudonym
 from studyapp.models import Participant, Response, Study
 from studyapp.permissions import RESEARCHER_GROUP
-from studyapp.presets import create_study_from_preset
-from studyapp.privacy import PURGED_NAME, pseudonym
-from studyapp.reports import forget_reports
+from studyapp.staff import reports
+from studyapp.staff.presets import create_study_from_preset
+from studyapp.staff.reports import forget_reports
 from studyapp.testing import make_catalogue
 
 pytestmark = pytest.mark.django_db

@@ -1,5 +1,5 @@
 """Round trip of the study protocol: the demo study, answered by participants through the real pages, exported by
-studyapp.export and read back by analysis.io without a single problem; every section type, question and answer of
+studyapp.data.export and read back by analysis.io without a single problem; every section type, question and answer of
 the export lies inside protocol.vocabulary's vocabularies."""
 from __future__ import annotations
 
@@ -21,11 +21,11 @@ from protocol.vocabulary import (
     SECTION_TYPES,
     answer_values,
 )
-from studyapp.assignment import current_step
-from studyapp.export import write_study_csvs
+from studyapp.data.export import write_study_csvs
 from studyapp.models import Participant, Response, Study
-from studyapp.presets import create_study_from_preset
+from studyapp.participant.assignment import current_step
 from studyapp.questions import questions_for
+from studyapp.staff.presets import create_study_from_preset
 from studyapp.testing import make_catalogue
 
 pytestmark = pytest.mark.django_db

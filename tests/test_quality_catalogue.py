@@ -11,7 +11,7 @@ from django.core.management import call_command
 
 from generation.plans.catalogue import read_clips_csv
 from protocol.pools import pool_errors
-from studyapp.catalogue import CatalogueError, pool_queryset, upsert_clips
+from studyapp.data.catalogue import CatalogueError, pool_queryset, upsert_clips
 from studyapp.models import Clip
 
 
@@ -75,7 +75,7 @@ def test_unknown_check_in_a_record_is_refused():
 def test_admin_filter_passed_flagged_and_per_check(rf):
     from django.contrib.admin.sites import site
 
-    from studyapp.admin_clip_qa import QualityFlagFilter, quality_flag
+    from studyapp.admin.clip_qa import QualityFlagFilter, quality_flag
 
     upsert_clips([rec("good"), rec("sunk", "penetration"), rec("both", "penetration;jerk"), rec("j", "jerk")])
     admin_obj = site._registry[Clip]
@@ -97,7 +97,7 @@ def test_admin_filter_passed_flagged_and_per_check(rf):
 def test_admin_observer_column_shows_label_probability_and_gesture_arousal():
     from django.contrib.admin.sites import site
 
-    from studyapp.admin_clip_qa import observer_reading
+    from studyapp.admin.clip_qa import observer_reading
 
     gait, gesture, blank = Clip(qa={"observed": "sad", "observed_p": 0.8123}), Clip(
         qa={"observed": "afraid", "observed_p": 0.55, "observed_arousal": 0.712}), Clip(qa={"observed": None})
@@ -181,7 +181,7 @@ def test_run_plan_on_a_dask_cluster_then_resumes_locally(tmp_path):
 
 
 def test_contact_sheet_caption_names_failed_checks():
-    from studyapp.catalogue import clip_label
+    from studyapp.data.catalogue import clip_label
 
     meta = {"entry_id": "walk_sunk", "generator": "procedural_walk"}
     assert clip_label({"clip_id": "x", "origin": "generated", "metadata": meta, "qa_flag": "penetration;jerk"}) == \

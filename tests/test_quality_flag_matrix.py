@@ -11,9 +11,9 @@ from django.test import Client
 from django.urls import reverse
 
 from protocol.vocabulary import QA_ADVISORY_CHECKS, QA_CHECKS
-from studyapp.assignment import start_participant
-from studyapp.catalogue import upsert_clips
+from studyapp.data.catalogue import upsert_clips
 from studyapp.models import Assignment, Participant, Section, Study
+from studyapp.participant.assignment import start_participant
 
 SWITCHES = {"none": {}, "keep_advisory": {"keep_advisory": True}, "observer_advisory": {"observer_advisory": True},
             "include_flagged": {"include_flagged": True}}
@@ -79,7 +79,7 @@ def test_flag_matrix_editor_count_matches_a_participants_clips(catalogue, staff,
 
 @pytest.mark.parametrize("flag", [f for f in FLAGS if f])
 def test_unticked_include_flagged_keeps_each_flag_kind_out(catalogue, flag):
-    from studyapp.catalogue import pool_queryset
+    from studyapp.data.catalogue import pool_queryset
     ids = set(pool_queryset({"plan": "matrix"}).values_list("clip_id", flat=True))
     assert ids == {"clip_00"}
     kept = set(pool_queryset({"plan": "matrix", "keep_advisory": True}).values_list("clip_id", flat=True))

@@ -101,12 +101,12 @@ def test_chained_captured_source_walk_is_planted_and_labelled():
 @pytest.mark.django_db
 def test_sub_pools_keep_the_flagged_clips_their_section_pool_includes():
     """A naturalness section whose pool includes flagged clips (e.g. a sliding source walk) keeps them in its
-    source/generated sub-pools: a sub-pool only narrows the section's pool (studyapp.pool_cache)."""
+    source/generated sub-pools: a sub-pool only narrows the section's pool (studyapp.data.pool_cache)."""
     from protocol.pools import INCLUDE_FLAGGED, SUB_POOLS
-    from studyapp.catalogue import upsert_clips
+    from studyapp.admin.pool_editor import SUB_POOL_SECTION_TYPE
+    from studyapp.data.catalogue import upsert_clips
+    from studyapp.data.pool_cache import load_section_pool
     from studyapp.models import Section
-    from studyapp.pool_cache import load_section_pool
-    from studyapp.pool_editor import SUB_POOL_SECTION_TYPE
 
     generated, source = SUB_POOLS
 

@@ -1,4 +1,4 @@
-"""Report zips built outside the request (studyapp.reports, manage.py build_report): the button returns at once,
+"""Report zips built outside the request (studyapp.staff.reports, manage.py build_report): the button returns at once,
 one build per data version at a time, the finished zip is reused until the data change, failures are shown."""
 from __future__ import annotations
 
@@ -19,9 +19,9 @@ from django.urls import reverse
 # The team's helper that takes a participant through a study with library calls (no HTTP).
 from test_study_admin import finish
 
-from studyapp import reports
 from studyapp.models import Participant, Response
-from studyapp.presets import create_study_from_preset
+from studyapp.staff import reports
+from studyapp.staff.presets import create_study_from_preset
 from studyapp.testing import make_catalogue
 
 pytestmark = pytest.mark.django_db
@@ -219,6 +219,6 @@ def test_progress_page_offers_a_build_and_reports_a_start_failure(gait_study, st
     def refuse(study):
         raise PermissionError("[Errno 13] Permission denied: '/srv/studies/reports'")
 
-    monkeypatch.setattr("studyapp.views_staff.start_build", refuse)
+    monkeypatch.setattr("studyapp.staff.views.start_build", refuse)
     r = staff.post(reverse("studyapp:report_zip", args=[gait_study.pk]), follow=True)
     assert r.status_code == 200 and "Could not start the report build" in r.content.decode()

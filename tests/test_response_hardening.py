@@ -8,10 +8,10 @@ from django.core.exceptions import ValidationError
 from django.test import Client
 from django.urls import reverse
 
-from studyapp.assignment import current_step, start_participant
-from studyapp.export import safe_cell
+from studyapp.data.export import safe_cell
 from studyapp.models import Assignment, Participant, Study
-from studyapp.presets import create_study_from_preset
+from studyapp.participant.assignment import current_step, start_participant
+from studyapp.staff.presets import create_study_from_preset
 from studyapp.testing import admin_form_data, make_catalogue
 
 pytestmark = pytest.mark.django_db

@@ -1,11 +1,11 @@
-"""What a save of one section does to the clips other sections give (studyapp.section_impact): the measure, the
+"""What a save of one section does to the clips other sections give (studyapp.admin.section_impact): the measure, the
 warning after a save that names the other section and the change, and the note beside that section's pool."""
 from __future__ import annotations
 
 import pytest
 from django.urls import reverse
 
-from studyapp import section_impact
+from studyapp.admin import section_impact
 from studyapp.models import Section, Study
 from studyapp.testing import admin_form_data, make_catalogue
 

@@ -1,4 +1,4 @@
-"""Moving sections up and down on the study page's sections step (studyapp.section_order, studyapp.admin_steps):
+"""Moving sections up and down on the study page's sections step (studyapp.admin.section_order, studyapp.admin.steps):
 the swap, what is refused and why, POST with CSRF and change permission only, and the order assignment reads."""
 from __future__ import annotations
 
@@ -7,10 +7,10 @@ from django.contrib.auth.models import Permission, User
 from django.test import Client
 from django.urls import reverse
 
-from studyapp import section_order
-from studyapp.assignment import participant_order
+from studyapp.admin import section_order
 from studyapp.models import Participant, Section
-from studyapp.presets import create_study_from_preset
+from studyapp.participant.assignment import participant_order
+from studyapp.staff.presets import create_study_from_preset
 from studyapp.testing import make_catalogue
 
 pytestmark = pytest.mark.django_db

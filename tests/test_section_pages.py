@@ -18,12 +18,12 @@ import protocol.vocabulary as P
 from protocol.pools import validate_section
 from protocol.section_types import is_page_type, page_types, registered, section_type_names
 from protocol.section_types.pages import MAX_WAIT_SECONDS
-from studyapp.assignment import current_step, plan_study
-from studyapp.counterbalance import attach_pages
-from studyapp.duration import READING_SECONDS, expected_seconds
-from studyapp.export import stream_csv
-from studyapp.forms import SectionForm
+from studyapp.admin.forms import SectionForm
+from studyapp.data.export import stream_csv
 from studyapp.models import Participant, Response, Section, Study
+from studyapp.participant.assignment import current_step, plan_study
+from studyapp.participant.counterbalance import attach_pages
+from studyapp.participant.duration import READING_SECONDS, expected_seconds
 from studyapp.questions import section_type_choices
 from studyapp.testing import admin_form_data, make_catalogue
 from tests.test_study_flow import answer_for

@@ -22,10 +22,10 @@ from analysis.simulate import simulate_design
 from protocol import section_types
 from protocol.section_types.__main__ import render_page
 from protocol.vocabulary import GAIT_EMOTIONS, SECTION_TYPES
-from studyapp.assignment import current_step
-from studyapp.export import write_study_csvs
+from studyapp.data.export import write_study_csvs
 from studyapp.models import Participant, Response, Study
-from studyapp.presets import create_study_from_preset
+from studyapp.participant.assignment import current_step
+from studyapp.staff.presets import create_study_from_preset
 from studyapp.testing import admin_form_data, make_catalogue
 
 DECLARATION = '''

@@ -28,12 +28,12 @@ from django.test import Client
 from django.urls import reverse
 from django.utils import timezone
 
-from studyapp.assignment import current_step
-from studyapp.export import safe_cell, stream_csv
+from studyapp.data.export import safe_cell, stream_csv
 from studyapp.models import Assignment, Clip, Participant, Response, Study
-from studyapp.presets import create_study_from_preset
+from studyapp.participant.assignment import current_step
 from studyapp.questions import questions_for
 from studyapp.security import CONTENT_SECURITY_POLICY, RedactTokensFilter, redact
+from studyapp.staff.presets import create_study_from_preset
 from studyapp.testing import make_catalogue, write_media
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -222,7 +222,7 @@ def test_exports_neutralise_participant_text_but_keep_negative_ratings(study):
 def test_the_documented_quoting_is_what_exports_do():
     """docs/study.md's rule, checked on the exporter: its example comes out as documented, every listed first
     character is quoted, plain numbers are not, and removing the one leading quote gives the typed text back."""
-    from studyapp.export import safe_cell
+    from studyapp.data.export import safe_cell
 
     doc = (ROOT / "docs" / "study.md").read_text()
     example = re.search(r"`(=HYPERLINK\(\"x\"\))` is exported as\s+`([^`]+)`", doc)
@@ -378,7 +378,7 @@ def test_shipped_gunicorn_command_keeps_tokens_out_of_the_logs_and_debug_off(tmp
 # ---- clip revalidation -------------------------------------------------------------------------------------
 
 def test_clip_etag_and_304(admin_client, settings, tmp_path):
-    client = admin_client              # a session that may see the clip (studyapp.views.media_allowed)
+    client = admin_client              # a session that may see the clip (studyapp.participant.views.media_allowed)
     settings.MEDIA_ROOT = tmp_path / "media"
     rel = write_media(settings.MEDIA_ROOT, b"0123456789" * 100)
     clip = Clip.objects.create(clip_id="c1", modality="gait", origin="generated", video=rel)

@@ -14,10 +14,10 @@ from analysis.design import design_from_presets
 from analysis.io import read_clips, read_participants, read_responses
 from analysis.simulate import simulate_design
 from protocol.vocabulary import CLIP_COLUMNS, GESTURE_EMOTIONS, MULTI_SELECT_KINDS, SECTION_QUESTIONS, answer_values
-from studyapp.catalogue import upsert_clips
-from studyapp.export import run_report, write_study_csvs
+from studyapp.data.catalogue import upsert_clips
+from studyapp.data.export import run_report, write_study_csvs
 from studyapp.models import Study
-from studyapp.presets import create_study_from_preset
+from studyapp.staff.presets import create_study_from_preset
 from studyapp.testing import write_media
 
 pytestmark = pytest.mark.django_db

@@ -9,7 +9,7 @@ from django.urls import reverse
 
 from studyapp.models import Study
 from studyapp.permissions import EXPORT_PERMISSION, RESEARCHER_GROUP, RESEARCHER_PERMISSIONS
-from studyapp.presets import create_study_from_preset
+from studyapp.staff.presets import create_study_from_preset
 from studyapp.testing import make_catalogue
 
 pytestmark = pytest.mark.django_db

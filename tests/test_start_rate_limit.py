@@ -1,6 +1,6 @@
 """Starting participants: a Prolific-like burst (200 addresses in one minute) all admitted, a scripted flood from
-one address slowed with 429 + Retry-After (studyapp.start_throttle), the session key renewed at consent, and a
-stale started participant's place freed by the default abandon time."""
+one address slowed with 429 + Retry-After (studyapp.participant.start_throttle), the session key renewed at consent, and
+a stale started participant's place freed by the default abandon time."""
 from __future__ import annotations
 
 import time
@@ -10,9 +10,9 @@ from django.core.cache import cache
 from django.test import Client
 from django.urls import reverse
 
-from studyapp import start_throttle
 from studyapp.models import DEFAULT_ABANDON_MINUTES, Participant, Study
-from studyapp.presets import create_study_from_preset
+from studyapp.participant import start_throttle
+from studyapp.staff.presets import create_study_from_preset
 
 pytestmark = pytest.mark.django_db
 

@@ -1,4 +1,4 @@
-"""Stimulus sets from the admin (generation.plans.stimulus_set, studyapp.admin_stimuli, studyapp.render_jobs): the
+"""Stimulus sets from the admin (generation.plans.stimulus_set, studyapp.admin.stimuli, studyapp.data.render_jobs): the
 form's plan is the command line's plan (same clip ids), renders run as background jobs that outlive their process,
 and a render killed mid-way resumes without rendering a finished clip again."""
 from __future__ import annotations
@@ -29,7 +29,7 @@ from generation.plans.stimulus_set import (
     parse_condition,
     plan_yaml,
 )
-from studyapp import background, render_jobs
+from studyapp.data import background, render_jobs
 from studyapp.models import Clip
 
 TINY = {"width": "96", "height": "64", "fps": "8", "duration_s": "1", "camera": "fixed", "body": "stick"}

@@ -10,10 +10,10 @@ from django.contrib.auth.models import Group, User
 from django.test import Client
 from django.urls import reverse
 
-from studyapp.export import EXPORT_KINDS
+from studyapp.data.export import EXPORT_KINDS
 from studyapp.models import Clip, Participant, Response, Section, Study
 from studyapp.permissions import RESEARCHER_GROUP, can_access_study, studies_for
-from studyapp.presets import create_study_from_preset
+from studyapp.staff.presets import create_study_from_preset
 from studyapp.testing import admin_form_data, make_catalogue
 
 pytestmark = pytest.mark.django_db
@@ -85,7 +85,7 @@ def test_who_sees_which_study(labs):
 
 @pytest.mark.parametrize("who", ["alice", "bob"])
 def test_staff_pages_of_another_labs_study_are_404(labs, who, monkeypatch):
-    from studyapp import views_staff
+    from studyapp.staff import views as views_staff
 
     monkeypatch.setattr(views_staff, "start_build", lambda study: pytest.fail("a build of another lab's study"))
     c = client_of(labs[who])
@@ -97,7 +97,7 @@ def test_staff_pages_of_another_labs_study_are_404(labs, who, monkeypatch):
 
 @pytest.mark.parametrize("who", ["alice", "bob", "root"])
 def test_staff_pages_of_ones_own_study_open(labs, who, monkeypatch):
-    from studyapp import views_staff
+    from studyapp.staff import views as views_staff
 
     monkeypatch.setattr(views_staff, "start_build", lambda study: type("S", (), {"status": "building"})())
     c = client_of(labs[who])
@@ -105,7 +105,7 @@ def test_staff_pages_of_ones_own_study_open(labs, who, monkeypatch):
         r = getattr(c, method)(url)
         assert r.status_code in (200, 302), (who, method, url, r.status_code)
     export = c.get(reverse("studyapp:export_csv", args=[labs["ours"].pk, "participants"]))
-    from studyapp.privacy import pseudonym
+    from studyapp.data.privacy import pseudonym
     assert pseudonym(labs["ours"].pk, "PID-ours").encode() in b"".join(export.streaming_content)
     if who == "root":
         for method, url in staff_pages(labs["theirs"]):
@@ -226,7 +226,7 @@ def live_sub_pool_norms(c: Client, source: str) -> dict:
 
 
 def test_a_sub_pools_norms_rule_is_checked_like_the_pools_own(labs, monkeypatch):
-    from studyapp import norms_rule
+    from studyapp.data import norms_rule
 
     read = []
     monkeypatch.setattr(norms_rule, "load_norms", lambda source: read.append(source) or {})

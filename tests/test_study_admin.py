@@ -13,12 +13,12 @@ from django.test import Client
 from django.urls import reverse
 
 from protocol.vocabulary import CLIP_COLUMNS, LIKERT_FEATURES, PARTICIPANT_COLUMNS, RESPONSE_COLUMNS
-from studyapp.assignment import current_step, start_participant
 from studyapp.models import Participant, Response, Study
-from studyapp.presets import create_study_from_preset
+from studyapp.participant.assignment import current_step, start_participant
+from studyapp.participant.views import save_answers
 from studyapp.questions import questions_for
+from studyapp.staff.presets import create_study_from_preset
 from studyapp.testing import admin_form_data, make_catalogue
-from studyapp.views import save_answers
 
 pytestmark = pytest.mark.django_db
 
@@ -165,7 +165,7 @@ def test_exports_match_design_formats(staff, study):
     assert tr["final_happy"] != "" and next(c for c in clips if c["clip_id"] == "gait_gen_00")["final_happy"] == ""
     people = read_csv(staff.get(reverse("studyapp:export_csv", args=[study.pk, "participants"])))
     assert tuple(people[0])[:len(PARTICIPANT_COLUMNS)] == PARTICIPANT_COLUMNS and "distracted_camera" in people[0]
-    from studyapp.privacy import pseudonym
+    from studyapp.data.privacy import pseudonym
     assert "PID1" not in {x["external_id"] for x in people}          # pseudonymised by default
     row = next(x for x in people if x["external_id"] == pseudonym(study.pk, "PID1"))
     assert row["gender"] == "female" and row["status"] == "completed" and row["started_at"]

@@ -8,9 +8,9 @@ import pytest
 from django.db import connection
 
 from protocol.vocabulary import SECTION_TYPES
-from studyapp.assignment import StudyUnavailable, plan_study, start_participant
 from studyapp.models import Assignment, Participant, Section, Study
-from studyapp.presets import PRESETS, create_study_from_preset
+from studyapp.participant.assignment import StudyUnavailable, plan_study, start_participant
+from studyapp.staff.presets import PRESETS, create_study_from_preset
 from studyapp.testing import make_catalogue
 
 pytestmark = pytest.mark.django_db

@@ -6,7 +6,7 @@ from django.contrib.auth.models import User
 from django.test import Client
 from django.urls import reverse
 
-from studyapp.presets import create_study_from_preset
+from studyapp.staff.presets import create_study_from_preset
 
 pytestmark = pytest.mark.django_db
 

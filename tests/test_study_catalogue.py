@@ -3,7 +3,7 @@ from __future__ import annotations
 
 import pytest
 
-from studyapp.catalogue import CatalogueError, pool_queryset, retire_superseded, upsert_clips
+from studyapp.data.catalogue import CatalogueError, pool_queryset, retire_superseded, upsert_clips
 from studyapp.models import Clip
 
 pytestmark = pytest.mark.django_db
@@ -86,7 +86,7 @@ def test_superseded_renders_are_retired_and_left_out_of_pools():
 
 def test_presets_draw_clips_of_their_own_plan_only():
     """A demo clip in the same catalogue never enters a paper preset's pools, and the demo keeps to its own."""
-    from studyapp.presets import PRESET_PLANS, PRESETS, create_study_from_preset
+    from studyapp.staff.presets import PRESET_PLANS, PRESETS, create_study_from_preset
 
     assert set(PRESET_PLANS) == set(PRESETS)
     upsert_clips([rec(clip_id="demo_walk", plan="demo"), rec(clip_id="paper_walk", plan="seed000"),

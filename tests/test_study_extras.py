@@ -12,22 +12,22 @@ from django.test import Client
 from django.urls import reverse
 
 from protocol.vocabulary import ATTENTION_CHECK, ATTENTION_COLUMNS, PARTICIPANT_COLUMNS, SECTION_QUESTIONS
-from studyapp.assignment import current_step, start_participant
-from studyapp.catalogue import pool_queryset
-from studyapp.counterbalance import williams_rows
-from studyapp.duration import (
+from studyapp.data.catalogue import pool_queryset
+from studyapp.data.export import stream_csv
+from studyapp.models import Assignment, Clip, Participant, Response, Study
+from studyapp.participant.assignment import current_step, start_participant
+from studyapp.participant.counterbalance import williams_rows
+from studyapp.participant.duration import (
     ANSWER_SECONDS_PER_QUESTION,
     DEMOGRAPHICS_SECONDS,
     FEEDBACK_SECONDS_PER_QUESTION,
     PAGE_SECONDS,
     expected_minutes,
 )
-from studyapp.export import stream_csv
-from studyapp.models import Assignment, Clip, Participant, Response, Study
-from studyapp.presets import create_study_from_preset
+from studyapp.participant.views import item_questions
 from studyapp.questions import questions_for
+from studyapp.staff.presets import create_study_from_preset
 from studyapp.testing import make_catalogue
-from studyapp.views import item_questions
 
 pytestmark = pytest.mark.django_db
 
@@ -334,10 +334,10 @@ def test_admin_participant_page_lists_seq_kind_and_instructed_answer(study, staf
 
 
 def test_presets_do_not_hard_code_a_duration():
-    """The consent page computes the duration (studyapp.duration); preset texts must not state another."""
+    """The consent page computes the duration (studyapp.participant.duration); preset texts must not state another."""
     import re
 
-    from studyapp.presets import PRESETS
+    from studyapp.staff.presets import PRESETS
 
     for key, preset in PRESETS.items():
         texts = [preset.get("introduction", ""), preset.get("consent_text", "")]

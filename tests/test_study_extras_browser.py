@@ -12,9 +12,9 @@ import pytest
 from django.urls import reverse
 
 from protocol.vocabulary import ATTENTION_CHECK
-from studyapp.duration import expected_minutes
 from studyapp.models import Assignment, Participant, Response, Study
-from studyapp.presets import create_study_from_preset
+from studyapp.participant.duration import expected_minutes
+from studyapp.staff.presets import create_study_from_preset
 from studyapp.testing import consent_and_demographics, make_catalogue, tiny_mp4, wait_for
 
 pytestmark = [pytest.mark.browser, pytest.mark.slow, pytest.mark.django_db(transaction=True)]

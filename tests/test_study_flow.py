@@ -10,10 +10,10 @@ from django.urls import reverse
 from django.utils import timezone
 
 from protocol.vocabulary import SECTION_TYPES
-from studyapp.assignment import current_step
 from studyapp.models import Assignment, Participant, Response, Study
-from studyapp.presets import create_study_from_preset
+from studyapp.participant.assignment import current_step
 from studyapp.questions import questions_for
+from studyapp.staff.presets import create_study_from_preset
 from studyapp.testing import make_catalogue
 
 pytestmark = pytest.mark.django_db

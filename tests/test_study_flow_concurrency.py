@@ -18,9 +18,9 @@ from django.test import Client
 from django.test.utils import CaptureQueriesContext
 from django.urls import reverse
 
-from studyapp import assignment
 from studyapp.models import Assignment, Participant, SectionClipCount, Study
-from studyapp.presets import create_study_from_preset
+from studyapp.participant import assignment
+from studyapp.staff.presets import create_study_from_preset
 from studyapp.testing import make_catalogue
 
 

@@ -20,12 +20,12 @@ from django.test import Client
 from django.test.utils import CaptureQueriesContext
 from django.urls import reverse
 
-from studyapp.assignment import current_step, start_participant
 from studyapp.models import Assignment, Participant, Response, SectionClipCount, Study
-from studyapp.presets import create_study_from_preset
+from studyapp.participant.assignment import current_step, start_participant
+from studyapp.participant.views import INLINE_NEXT_FIELD
 from studyapp.questions import questions_for
+from studyapp.staff.presets import create_study_from_preset
 from studyapp.testing import make_catalogue
-from studyapp.views import INLINE_NEXT_FIELD
 
 pytestmark = pytest.mark.django_db
 

@@ -6,9 +6,9 @@ import pytest
 
 from generation.pipeline import runner as batch
 from generation.plans.schema import load_plan
-from studyapp.assignment import plan_study
-from studyapp.catalogue import upsert_clips
-from studyapp.presets import create_study_from_preset
+from studyapp.data.catalogue import upsert_clips
+from studyapp.participant.assignment import plan_study
+from studyapp.staff.presets import create_study_from_preset
 
 pytestmark = pytest.mark.django_db
 

@@ -17,9 +17,9 @@ import pytest
 from django.urls import reverse
 
 from protocol.vocabulary import VIEWING_COLUMNS
-from studyapp.export import stream_csv
+from studyapp.data.export import stream_csv
 from studyapp.models import Participant, Study
-from studyapp.presets import create_study_from_preset
+from studyapp.staff.presets import create_study_from_preset
 from studyapp.testing import consent_and_demographics, make_catalogue, tiny_mp4, wait_for
 
 pytestmark = [pytest.mark.browser, pytest.mark.slow, pytest.mark.django_db(transaction=True)]

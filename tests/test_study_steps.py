@@ -1,4 +1,4 @@
-"""The study admin page in steps (studyapp.study_steps, studyapp.admin_steps): every fieldset belongs to a step,
+"""The study admin page in steps (studyapp.admin.study_steps, studyapp.admin.steps): every fieldset belongs to a step,
 each step shows only its parts, saving a step keeps the other steps' fields, and the step bar and links."""
 from __future__ import annotations
 
@@ -7,10 +7,10 @@ from django.contrib.admin.sites import site
 from django.contrib.admin.utils import flatten_fieldsets
 from django.urls import reverse
 
-from studyapp import study_steps
-from studyapp.admin import StudyAdmin, section_fieldsets
+from studyapp.admin import study_steps
+from studyapp.admin.model_admins import StudyAdmin, section_fieldsets
 from studyapp.models import Section, Study
-from studyapp.presets import create_study_from_preset
+from studyapp.staff.presets import create_study_from_preset
 from studyapp.testing import admin_form_data, make_catalogue
 
 FEEDBACK = [{"key": "distracted", "text": "Were you distracted?", "kind": "yesno"}]
@@ -21,7 +21,7 @@ RULES = {"min_rt_fraction": 0.3, "min_straight": 6}
 
 def test_every_study_fieldset_belongs_to_a_step():
     for title, _options in StudyAdmin.fieldsets:
-        assert study_steps.steps_of(title), f"the study fieldset {title!r} is on no step (studyapp.study_steps)"
+        assert study_steps.steps_of(title), f"the study fieldset {title!r} is on no step (studyapp.admin.study_steps)"
 
 
 def test_every_section_fieldset_belongs_to_a_step():

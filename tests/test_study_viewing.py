@@ -13,10 +13,10 @@ from django.urls import reverse
 
 from protocol.pools import options_errors, player_errors
 from protocol.vocabulary import VIEWING_COLUMNS, VIEWING_FIELDS
-from studyapp.assignment import current_step
-from studyapp.export import stream_csv
+from studyapp.data.export import stream_csv
 from studyapp.models import Assignment, Participant, Study
-from studyapp.viewing import MAX_COUNT, SCRIPT_FIELD, carried_counts, field_name, max_plays, parse_viewing
+from studyapp.participant.assignment import current_step
+from studyapp.participant.viewing import MAX_COUNT, SCRIPT_FIELD, carried_counts, field_name, max_plays, parse_viewing
 from tests import test_study_flow as flow
 from tests.test_study_flow import answer_for, consent, cur, demographics
 
@@ -60,7 +60,7 @@ def test_bad_player_options_name_the_key(options, words):
                                            ("naturalness", {"controls": "none", "max_replays": 0}),
                                            ("gesture_emotion", {"controls": "replay-only"})])
 def test_pool_editor_shows_and_writes_the_player_options(stype, options):
-    from studyapp import pool_editor as pe
+    from studyapp.admin import pool_editor as pe
 
     values, leftover = pe.options_to_fields(options)
     assert leftover == {} and values[pe.OPTIONS_PREFIX + "controls"] == options["controls"]

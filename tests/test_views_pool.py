@@ -1,4 +1,4 @@
-"""What the pool editor's live count answers (studyapp.views_pool): counts by origin, sub-pools narrowing their
+"""What the pool editor's live count answers (studyapp.admin.views_pool): counts by origin, sub-pools narrowing their
 half, warnings for pools too small, errors instead of exceptions. Who may ask is tests/test_staff_permissions.py's
 subject; the editor's fields are tests/test_pool_editor.py's."""
 from __future__ import annotations
@@ -10,9 +10,9 @@ from django.contrib.auth.models import User
 from django.test import Client
 from django.urls import reverse
 
+from studyapp.admin.views_pool import REUSED, PoolCount, count_pool
 from studyapp.models import Clip
 from studyapp.testing import make_catalogue
-from studyapp.views_pool import REUSED, PoolCount, count_pool
 
 pytestmark = pytest.mark.django_db
 

@@ -1,4 +1,4 @@
-"""What the researcher pages do (studyapp.views_staff): create from a preset, preview without recording anything,
+"""What the researcher pages do (studyapp.staff.views): create from a preset, preview without recording anything,
 progress counts, CSV exports. Who may open them is tests/test_staff_permissions.py's subject."""
 from __future__ import annotations
 
@@ -12,9 +12,9 @@ from django.test import Client
 from django.urls import reverse
 
 from protocol.presets import PRESETS
-from studyapp.assignment import start_participant
 from studyapp.models import Assignment, Participant, Response, Study
-from studyapp.presets import create_study_from_preset
+from studyapp.participant.assignment import start_participant
+from studyapp.staff.presets import create_study_from_preset
 from studyapp.testing import make_catalogue
 
 pytestmark = pytest.mark.django_db
@@ -88,6 +88,6 @@ def test_exports_stream_the_public_csvs_and_refuse_unknown_kinds(staff, study):
     r = staff.get(reverse("studyapp:export_csv", args=[study.pk, "participants"]))
     assert r.status_code == 200 and r["Content-Disposition"] == 'attachment; filename="staffed-participants.csv"'
     rows = list(csv.DictReader(io.StringIO(b"".join(r.streaming_content).decode())))
-    from studyapp.privacy import pseudonym
+    from studyapp.data.privacy import pseudonym
     assert [row["external_id"] for row in rows] == [pseudonym(study.pk, "prolific-1")]
     assert staff.get(reverse("studyapp:export_csv", args=[study.pk, "passwords"])).status_code == 404

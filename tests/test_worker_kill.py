@@ -38,11 +38,11 @@ KILLS = 4
 SETUP = """
 import json
 from django.conf import settings
-from studyapp.assignment import start_participant
+from studyapp.participant.assignment import start_participant
 from studyapp.models import Participant
-from studyapp.presets import create_study_from_preset
+from studyapp.staff.presets import create_study_from_preset
 from studyapp.testing import make_catalogue
-from studyapp.views import item_questions
+from studyapp.participant.views import item_questions
 make_catalogue(settings.MEDIA_ROOT)
 study = create_study_from_preset("demo", "demo", plan="test", status="open")
 study.sections.update(require_full_play=False)

@@ -3,8 +3,8 @@ nothing: an instruction page shows its title and text until the participant cont
 participant to rest and enables Continue only after ``wait_seconds`` (the server refuses an earlier continue too).
 
 A page is a Section like any other (it has an ``order``); under counterbalancing it travels with the section that
-follows it (``studyapp.counterbalance.attach_pages``). When and how long each participant spent on each page is
-exported as pages.csv (``protocol.vocabulary.PAGE_COLUMNS``).
+follows it (``studyapp.participant.counterbalance.attach_pages``). When and how long each participant spent on each page
+is exported as pages.csv (``protocol.vocabulary.PAGE_COLUMNS``).
 """
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-/* The admin's pool editor (studyapp.pool_editor, studyapp.views_pool).
+/* The admin's pool editor (studyapp.admin.pool_editor, studyapp.admin.views_pool).
 
    For every section form on a study's admin page: show only the fieldsets of the chosen section type (classes
    "only-<type>"; a fieldset of class "not-<type>" is hidden for that type), and while the researcher edits, ask the staff-only count endpoint how many catalogue clips the
@@ -70,7 +70,7 @@
   }
 
   function clipCell(c) {
-    /* one matching clip as studyapp.clip_display draws it: poster thumbnail, title, id */
+    /* one matching clip as studyapp.data.clip_display draws it: poster thumbnail, title, id */
     var li = document.createElement("li"), cell = document.createElement("span"), thumb;
     cell.className = "clip-cell";
     if (c.thumb_url) {
@@ -119,7 +119,7 @@
     }
     var norms = row.querySelector(".norms-slot");
     if (norms && status === 200) {
-      norms.innerHTML = body.norms_html || "";     // escaped by the server (studyapp.admin_norms)
+      norms.innerHTML = body.norms_html || "";     // escaped by the server (studyapp.admin.norms)
     }
     if (json && body.pool) {
       json.textContent = "pool " + (body.used && body.used.pool === "fields" ? "(from the fields)" : "(raw JSON)")

@@ -2,7 +2,7 @@
    player (the study's minimum), the browser can play none of the clip formats, or the study does not admit this
    kind of device (phone, tablet), and keeps the start button disabled meanwhile (checked again when the window is
    resized or the device turned). The viewport and the kind go with the consent form (hidden fields), and the
-   server checks them again and records them (studyapp.device_check). The limits and sentences come from data
+   server checks them again and records them (studyapp.participant.device_check). The limits and sentences come from data
    attributes of #device-check that the server wrote in the study's language; without JS the server alone checks
    the kind, from the User-Agent. */
 (function () {

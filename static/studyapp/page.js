@@ -1,4 +1,4 @@
-/* Instruction and break pages (templates/studyapp/page.html, studyapp/views_pages.py). On a break page the Continue
+/* Instruction and break pages (templates/studyapp/page.html, studyapp/participant/views_pages.py). On a break page the Continue
    button stays disabled until the wait has passed, counting down the seconds the server wrote into
    #page-wait's data-wait-left (the time left since the page's first display, so a reload continues the count);
    the sentences come from its data attributes, in the study's language. The server refuses an early Continue

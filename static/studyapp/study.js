@@ -97,7 +97,7 @@
         .catch(function () { /* the answer's own record still goes with the form */ });
     }
     // Left without an answer (a reload, the back button): this display's counts go to the server, which adds
-    // them to the answer's record (studyapp.viewing.CARRIED_FIELDS).
+    // them to the answer's record (studyapp.participant.viewing.CARRIED_FIELDS).
     window.addEventListener("pagehide", function () {
       if (answered || !playbackUrl || !navigator.sendBeacon || !window.FormData) { return; }
       closeTimers();

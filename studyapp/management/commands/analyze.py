@@ -1,7 +1,7 @@
 """Export a study's CSVs and write the analysis report (analysis.report.write_report) into --out."""
 from django.core.management.base import BaseCommand, CommandError
 
-from studyapp.export import run_report
+from studyapp.data.export import run_report
 from studyapp.management.cli import study_by_slug
 
 

@@ -1,4 +1,4 @@
-"""Build a study's analysis-report zip into REPORTS_DIR/<study id>/<data version>/ (studyapp.reports).
+"""Build a study's analysis-report zip into REPORTS_DIR/<study id>/<data version>/ (studyapp.staff.reports).
 
 The staff "Build report" button runs this as a detached process with --data-version and --lock-fd (the lock it took
 for the version). Run by hand it computes the current data version and takes the lock itself:
@@ -11,8 +11,8 @@ import os
 
 from django.core.management.base import BaseCommand, CommandError
 
-from studyapp import reports
 from studyapp.models import Study
+from studyapp.staff import reports
 
 
 def find_study(ref: str) -> Study:

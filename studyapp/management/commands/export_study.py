@@ -1,7 +1,7 @@
 """Write a study's responses.csv, clips.csv and participants.csv (DESIGN.md formats) into a folder."""
 from django.core.management.base import BaseCommand
 
-from studyapp.export import write_study_csvs
+from studyapp.data.export import write_study_csvs
 from studyapp.management.cli import study_by_slug
 
 

@@ -33,7 +33,7 @@ from generation.quality.checks import QAThresholdError, gait_observer_kind
 from generation.render import contact_sheet, prepare_render_process
 from protocol.coverage import coverage_lines, presets_of_plan
 from protocol.titles import clip_titles
-from studyapp.catalogue import clip_label, retire_superseded, upsert_clips
+from studyapp.data.catalogue import clip_label, retire_superseded, upsert_clips
 
 
 def _require_migrated_database() -> None:

@@ -24,8 +24,8 @@ from generation.imports.run import REPORT_NAME, RowRefused
 from generation.imports.video import VideoLimits
 from generation.render.offscreen import prepare_render_process
 from generation.render.settings import RenderSettings, RenderSettingsError
-from studyapp.catalogue import retire_replaced, upsert_clips
-from studyapp.clip_import import UploadError, collection_plan
+from studyapp.data.catalogue import retire_replaced, upsert_clips
+from studyapp.data.clip_import import UploadError, collection_plan
 from studyapp.models import Clip
 
 from .generate_clips import _require_migrated_database

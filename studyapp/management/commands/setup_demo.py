@@ -5,9 +5,9 @@ from django.contrib.auth import get_user_model
 from django.core.management.base import BaseCommand, CommandError
 
 from protocol.section_types import is_page_type
-from studyapp.catalogue import section_queryset
+from studyapp.data.catalogue import section_queryset
 from studyapp.models import Clip, Study
-from studyapp.presets import create_study_from_preset
+from studyapp.staff.presets import create_study_from_preset
 
 
 class Command(BaseCommand):
