@@ -112,3 +112,15 @@ def test_a_design_without_an_answer_model_is_refused_before_drawing():
             simulate_design(3, broken)
     finally:
         st.unregister(toy.name)
+
+
+def test_no_branch_on_a_section_type_name_outside_the_types_own_modules():
+    """A type's behaviour lives in its declaration: code elsewhere asks the registry, never compares names."""
+    import re
+
+    root = Path(__file__).resolve().parents[1]
+    branch = re.compile(r"section_type\s*(==|!=)|section_type\s+(not\s+)?in\s+\(\s*['\"]")
+    found = [f"{path.relative_to(root)}:{n}" for package in ("studyapp", "analysis", "generation", "protocol")
+             for path in sorted((root / package).rglob("*.py")) if "section_types" not in path.parts
+             for n, line in enumerate(path.read_text(encoding="utf-8").splitlines(), 1) if branch.search(line)]
+    assert not found, f"branches on a section type's name outside protocol/section_types: {found}"

@@ -46,3 +46,8 @@ BREAK = register(SectionType(
     options=(OptionSpec(WAIT_OPTION, f"seconds before Continue is enabled, 0..{MAX_WAIT_SECONDS} (default "
                                      f"{DEFAULT_WAIT_SECONDS})"),),
     check_options=check_break_options, page=True, module=__name__))
+
+
+def makes_wait(section_type: str | None) -> bool:
+    """Whether a page of this type holds Continue back for a wait (a break page) rather than showing text only."""
+    return section_type == BREAK.name

@@ -21,7 +21,7 @@ from django.utils import timezone
 from django.utils.dateparse import parse_datetime
 
 from protocol.section_types import is_page_type
-from protocol.section_types.pages import BREAK, wait_seconds
+from protocol.section_types.pages import makes_wait, wait_seconds
 
 from ..models import Participant, Section
 
@@ -63,7 +63,7 @@ def when(value) -> datetime | None:
 def wait_left(section: Section, record: dict, now: datetime | None = None) -> float:
     """Seconds until a break page may be continued (0 for an instruction page, or once the wait has passed); the
     full wait when the page has not been shown yet."""
-    if section.section_type != BREAK.name:
+    if not makes_wait(section.section_type):
         return 0.0
     wait = wait_seconds(section.options)
     shown = when(record.get("shown_at"))

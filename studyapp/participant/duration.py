@@ -18,7 +18,7 @@ from dataclasses import dataclass
 
 from protocol.norming import ratings_per_clip
 from protocol.section_types import is_page_type
-from protocol.section_types.pages import BREAK, wait_seconds
+from protocol.section_types.pages import makes_wait, wait_seconds
 from protocol.vocabulary import SECTION_QUESTIONS, section_questions
 
 from ..data.pool_cache import SectionPool, section_pools
@@ -82,7 +82,7 @@ def section_times(sections: list[Section], pools: dict[int, SectionPool]) -> lis
 
 def page_seconds(section: Section) -> float:
     """The time an instruction page (READING_SECONDS) or a break page (its wait + PAGE_SECONDS) takes (s)."""
-    if section.section_type == BREAK.name:
+    if makes_wait(section.section_type):
         return wait_seconds(section.options) + PAGE_SECONDS
     return READING_SECONDS
 

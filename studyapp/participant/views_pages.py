@@ -15,7 +15,7 @@ from django.utils.translation import gettext
 from django.views.decorators.cache import never_cache
 from django.views.decorators.http import require_http_methods
 
-from protocol.section_types.pages import BREAK
+from protocol.section_types.pages import makes_wait
 
 from ..data import section_pages
 from ..models import Participant, Section
@@ -25,7 +25,7 @@ from .views import SESSION_KEY, _participant, _remember, mark_completed, step_ur
 
 def page_wording(section: Section) -> tuple[str, str]:
     """(title, text) of a page: the section's own, else the plain words of its kind."""
-    if section.section_type == BREAK.name:
+    if makes_wait(section.section_type):
         title = section.title or gettext("Short break")
         text = section.instructions or gettext(
             "Take a short rest before the next part of the study: look away from the screen, stretch, relax.")
@@ -43,7 +43,7 @@ def _render_page(request, participant: Participant, section: Section, n: int, st
     left = math.ceil(section_pages.wait_left(section, record))
     return render(request, "studyapp/page.html", {
         "participant": participant, "study": participant.study, "section": section, "title": title, "text": text,
-        "is_break": section.section_type == BREAK.name, "wait_left": left, "error": error, "n": n,
+        "is_break": makes_wait(section.section_type), "wait_left": left, "error": error, "n": n,
         "percent": int(round(100 * done / max(total, 1)))}, status=status)
 
 
