@@ -28,7 +28,8 @@ from pathlib import Path
 
 import numpy as np
 
-from generation.quality.style_observer import NEUTRAL_CLASS, THEME_SCALE, train_style_observers
+from generation.mocap.style_scales import NEUTRAL_CLASS, THEME_SCALE
+from generation.quality.style_observer import train_style_observers
 from generation.rbf import calibrate as C
 from generation.rbf.real_neutral import load_cycle, steady_cycles
 from generation.rbf.stylise import neutral_walk, stylise

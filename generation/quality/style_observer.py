@@ -28,21 +28,10 @@ import numpy as np
 from generation.core.motion import Motion
 from generation.core.skeleton import GAIT_JOINTS
 from generation.mocap.real_corpus import DEFAULT_PATH, load_real_corpus
+from generation.mocap.style_scales import SCALE_DATASETS, SCALES, THEME_SCALE
 
 from .real_observer import window_descriptors
 
-#: scale -> {class: corpus styles}; dataset restriction in :data:`SCALE_DATASETS`.
-SCALES: dict[str, dict[str, tuple[str, ...]]] = {
-    "energy": {"energetic": ("active",), "normal": ("normal",), "tired": ("tired", "exhausted")},
-    "gender": {"feminine": ("feminine",), "normal": ("normal",), "masculine": ("masculinity", "masculine")},
-    "emotion": {"happy": ("happy",), "sad": ("sad",), "angry": ("angry",), "neutral": ("normal",)},
-}
-SCALE_DATASETS = {"energy": ("bandai-namco-1", "bandai-namco-2"), "gender": ("bandai-namco-1", "bandai-namco-2"),
-                  "emotion": ("bandai-namco-1",)}
-#: seed 004 theme -> (scale, class on that scale)
-THEME_SCALE = {"happy": ("emotion", "happy"), "sad": ("emotion", "sad"), "energetic": ("energy", "energetic"),
-               "tired": ("energy", "tired"), "feminine": ("gender", "feminine"), "masculine": ("gender", "masculine")}
-NEUTRAL_CLASS = {"energy": "normal", "gender": "normal", "emotion": "neutral"}
 REGULARISATION_C = 0.1
 
 

@@ -17,8 +17,8 @@ Training data: the straight walks of the Bandai Namco Research Motion Dataset 1 
 arXiv:2306.08861, CC BY-NC 4.0), training split only (held out by take, :func:`generation.mocap.bandai_namco.
 split_for`). The corpus has no actor ids; a dataset's takes come from its own three actors, so the walker's
 reference for a real take is the mean of its dataset's **training** normal walks (never a held-out take).
-Scales and classes as :data:`generation.quality.style_observer.SCALES` (repeated here: ``rbf`` sits below
-``quality``). :meth:`RbfStyleObserver.heldout` reports the held-out recall (val and test takes) that belongs
+Scales and classes: :mod:`generation.mocap.style_scales`, shared with :mod:`generation.quality.style_observer`.
+:meth:`RbfStyleObserver.heldout` reports the held-out recall (val and test takes) that belongs
 beside every reading.
 """
 from __future__ import annotations
@@ -33,6 +33,7 @@ from generation.core.motion import Motion
 from generation.core.skeleton import GAIT_JOINTS
 from generation.core.windows import windows
 from generation.mocap.real_corpus import DEFAULT_PATH, load_real_corpus
+from generation.mocap.style_scales import SCALE_DATASETS, SCALES, THEME_SCALE
 
 WINDOW_S = 2.0
 HOP_S = 0.5
@@ -40,18 +41,6 @@ FEATURE_CLIP = 10.0
 REGULARISATION_C = 0.1
 NORMALISE = ("walker", "none")
 
-#: scale -> {class: corpus styles}
-SCALES: dict[str, dict[str, tuple[str, ...]]] = {
-    "energy": {"energetic": ("active",), "normal": ("normal",), "tired": ("tired", "exhausted")},
-    "gender": {"feminine": ("feminine",), "normal": ("normal",), "masculine": ("masculinity", "masculine")},
-    "emotion": {"happy": ("happy",), "sad": ("sad",), "angry": ("angry",), "neutral": ("normal",)},
-}
-SCALE_DATASETS = {"energy": ("bandai-namco-1", "bandai-namco-2"), "gender": ("bandai-namco-1", "bandai-namco-2"),
-                  "emotion": ("bandai-namco-1",)}
-#: seed 004 theme -> (scale, class on that scale)
-THEME_SCALE = {"happy": ("emotion", "happy"), "sad": ("emotion", "sad"), "energetic": ("energy", "energetic"),
-               "tired": ("energy", "tired"), "feminine": ("gender", "feminine"), "masculine": ("gender", "masculine")}
-NEUTRAL_CLASS = {"energy": "normal", "gender": "normal", "emotion": "neutral"}
 
 _J = {name: i for i, name in enumerate(GAIT_JOINTS)}
 
