@@ -26,12 +26,14 @@ from django.views.decorators.http import require_http_methods
 from generation.plans.schema import PlanError, load_plan
 from generation.render import contact_sheet
 from protocol.presets import PRESET_PLANS
+from protocol.section_types.pages import makes_wait, wait_seconds
 from protocol.vocabulary import ATTENTION_CHECK
 
 from ..data.catalogue import clip_label
 from ..data.clip_display import clip_cells
 from ..data.export import EXPORT_KINDS, csv_lines, stream_csv, write_data_package
 from ..data.privacy import PAYMENT_COLUMNS, PAYMENT_PERMISSION, payment_rows
+from ..data.section_pages import is_page
 from ..i18n import activate_study_language
 from ..models import Assignment, Clip, Participant, Response, Study
 from ..participant.assignment import plan_study
@@ -39,6 +41,7 @@ from ..participant.forms import ConsentForm
 from ..participant.media import media_path
 from ..participant.streaming import body, file_body
 from ..participant.views import item_context, item_questions
+from ..participant.views_pages import page_wording
 from ..permissions import EXPORT_PERMISSION, staff_permission_required, study_of
 from ..questions import AnswerError, clean_answers
 from .forms import CloneStudyForm, PresetStudyForm, SharePreviewForm
@@ -86,11 +89,18 @@ def render_offer(preset: str):
 
 
 def _preview_plan(study: Study, seed: int):
-    """The preview participant's pages: (section, PlannedItem, position in section), practice items and attention
-    checks included, sections in the study's order (a counterbalanced study rotates them per participant)."""
+    """The preview participant's steps in the study's order (a counterbalanced study rotates the sections per
+    participant; the preview does not): (section, PlannedItem, position in section) for each clip page, practice
+    items and attention checks included, and (section, None, 0) for each instruction or break page at its place."""
+    sections = list(study.sections.order_by("order", "id"))
+    planned = {section.pk: items for section, items in
+               plan_study(study, seed, balanced=False, sections=sections, extras=True)}
     flat = []
-    for section, items in plan_study(study, seed, balanced=False, extras=True):
-        flat += [(section, it, i) for i, it in enumerate(items)]
+    for section in sections:
+        if is_page(section):
+            flat.append((section, None, 0))
+        else:
+            flat += [(section, it, i) for i, it in enumerate(planned.get(section.pk, []))]
     return flat
 
 
@@ -122,25 +132,32 @@ def preview_start(request, study_id: int):
 @staff_permission_required("studyapp.view_study")
 @require_http_methods(["GET", "POST"])
 def preview_item(request, study_id: int, n: int):
-    """Clip n of a preview participant with the given seed. Answers are validated, never stored."""
+    """Step n of a preview participant with the given seed: a clip page (answers are validated, never stored) or an
+    instruction or break page, in the study's order."""
     study = study_of(request, study_id)
     activate_study_language(study)     # the preview shows the pages as participants see them
     seed = _preview_seed(request)
     flat = _preview_plan(study, seed)
-    if not flat:
+    if not any(it for _, it, _ in flat):
         messages.warning(request, "No section of this study has clips: the catalogue has none matching the pools.")
         return redirect(reverse("admin:studyapp_study_change", args=[study.pk]))
     if n < 1 or n > len(flat):
         return render(request, "studyapp/done.html", {"study": study, "preview": True, "seed": seed})
     page = reverse("studyapp:preview_item", args=[study.pk, n]) + f"?seed={seed}"
     after = reverse("studyapp:preview_item", args=[study.pk, n + 1]) + f"?seed={seed}"
-    return preview_page(request, study, flat, n, seed, page, after, {"clip_label": _preview_label(flat[n - 1][1])})
+    it = flat[n - 1][1]
+    return preview_page(request, study, flat, n, seed, page, after, {"clip_label": _preview_label(it) if it else ""})
 
 
 def preview_page(request, study, flat: list, n: int, seed: int, page_url: str, next_url: str, extra: dict):
-    """Clip page n (1-based) of a preview plan ``flat``: answers posted to ``page_url`` are checked like a
-    participant's and never stored; valid ones go on to ``next_url``, invalid ones show the page again (400)."""
+    """Step n (1-based) of a preview plan ``flat`` (_preview_plan): a clip page, whose answers posted to
+    ``page_url`` are checked like a participant's and never stored (valid ones go on to ``next_url``, invalid ones
+    show the page again, 400), or an instruction or break page (preview_section_page)."""
     section, it, position = flat[n - 1]
+    clips = [step for step in flat if step[1] is not None]
+    index = sum(1 for step in flat[:n] if step[1] is not None)          # the clip's number, as participants see it
+    if it is None:
+        return preview_section_page(request, study, section, seed, next_url, index, len(clips), extra)
     error = ""
     if request.method == "POST":
         try:
@@ -148,12 +165,25 @@ def preview_page(request, study, flat: list, n: int, seed: int, page_url: str, n
             return redirect(next_url)
         except AnswerError as exc:
             error = str(exc)
-    nxt = flat[n][1].clip if n < len(flat) else None
-    ctx = item_context(section, it.clip, n, len(flat), nxt, it.options,
+    nxt = clips[index][1].clip if index < len(clips) else None
+    ctx = item_context(section, it.clip, index, len(clips), nxt, it.options,
                        request.POST if request.method == "POST" else None, kind=it.kind, instructed=it.instructed)
     ctx.update({"study": study, "preview": True, "seed": seed, "error": error, "first_of_section": position == 0,
                 "form_action": page_url, **extra})
     return render(request, "studyapp/item.html", ctx, status=400 if error else 200)
+
+
+def preview_section_page(request, study, section, seed: int, next_url: str, done: int, total: int, extra: dict):
+    """An instruction or break page in a preview, with the participant's template and wording: Continue (a POST)
+    goes on to ``next_url`` and records nothing. A break page's Continue is enabled at once; the page says how long
+    participants wait (templates/studyapp/page.html)."""
+    if request.method == "POST":
+        return redirect(next_url)
+    title, text = page_wording(section)
+    return render(request, "studyapp/page.html", {
+        "study": study, "section": section, "title": title, "text": text, "preview": True, "seed": seed,
+        "is_break": makes_wait(section.section_type), "wait_left": 0, "wait_seconds": wait_seconds(section.options),
+        "error": "", "percent": int(round(100 * done / max(total, 1))), **extra})
 
 
 @staff_permission_required("studyapp.view_study")
