@@ -193,7 +193,7 @@ def test_the_real_detached_command_runs(tmp_path):
         "from django.core.management import call_command\n"
         "call_command('migrate', verbosity=0)\n"
         "from studyapp.models import Study\n"
-        "from studyapp import reports\n"
+        "from studyapp.staff import reports\n"
         "study = Study.objects.create(slug='empty', title='synthetic empty study')\n"
         "state = reports.start_build(study)\n"
         "print('first', state.status)\n"
