@@ -7,7 +7,7 @@ cd "$(dirname "$0")/.."
 PYTHON="${PYTHON:-python3}"
 VENV="${VENV:-.venv}"
 SYSTEM_PACKAGES=(chromium chromium-driver libegl1 libgl1-mesa-dri)
-# Best effort: the other browsers participants use, for the browser tests (tests/test_e2e_browsers.py skips a
+# Best effort: the other browsers participants use, for the browser tests (tests/studyapp/participant/test_e2e_browsers.py skips a
 # browser that is missing): WebKitGTK (Safari's engine) with its WebDriver, GStreamer's H.264 decoder and a virtual
 # X display, and Firefox ESR (driven through Marionette, PyPI marionette-driver).
 OPTIONAL_PACKAGES=(webkit2gtk-driver gstreamer1.0-libav xvfb firefox-esr)

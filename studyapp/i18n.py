@@ -12,7 +12,7 @@ entered; text that is one of this app's defaults (e.g. the naturalness anchors a
 options) has a msgid and is translated.
 
 The msgids of the protocol's display strings are marked below (`_MARKED_FOR_EXTRACTION`) so that `makemessages`
-finds them; tests/test_i18n.py checks that every protocol value and every marked string has a German msgstr.
+finds them; tests/studyapp/test_i18n.py checks that every protocol value and every marked string has a German msgstr.
 """
 from __future__ import annotations
 

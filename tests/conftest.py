@@ -51,7 +51,8 @@ def _single_threaded_torch():
 @pytest.fixture(autouse=True)
 def _start_rate_limit_off(settings):
     """Tests start many participants from one address (127.0.0.1): the start rate limit
-    (studyapp.participant.start_throttle) is off unless a test turns it on (tests/test_start_rate_limit.py)."""
+    (studyapp.participant.start_throttle) is off unless a test turns it on
+    (tests/studyapp/participant/test_start_rate_limit.py)."""
     settings.START_RATE_BURST = 0
 
 

@@ -588,7 +588,8 @@ def _sub_pool_specs() -> list[SubPoolSpec]:
 
 def _option_key_specs() -> dict[str, ChoiceSpec]:
     """Option key -> its spec: the form fields of every option a section type declares (protocol.section_types'
-    ``options``). A declared key missing here is edited in the raw JSON only (tests/test_option_fields.py fails)."""
+    ``options``). A declared key missing here is edited in the raw JSON only (tests/studyapp/admin/test_option_fields.py
+    fails)."""
     o, n = OPTIONS_PREFIX, len(GESTURE_EMOTIONS)
     return {
         "anchors": AnchorsSpec(o + "anchor"),

@@ -6,8 +6,8 @@ the page shows every step at once (the page as it always was: saved links and sc
 keep working). StudyAdmin and its SectionInline ask this module which fieldsets to show, so the form of a step
 holds only that step's fields, and Django leaves every other field of the study as it is saved.
 
-``STEPS`` is the one table; ``tests/test_study_steps.py`` fails when a fieldset of StudyAdmin or of the section form
-belongs to no step, so a new fieldset cannot silently vanish from the stepped pages.
+``STEPS`` is the one table; ``tests/studyapp/admin/test_study_steps.py`` fails when a fieldset of StudyAdmin or of the
+section form belongs to no step, so a new fieldset cannot silently vanish from the stepped pages.
 """
 from __future__ import annotations
 

@@ -7,7 +7,7 @@ SQL"). Here the SQL text is written once per process from the models' field list
 ``connection.cursor()``, and the rows become model instances through ``Model.from_db`` (the public constructor
 QuerySet iteration uses), with related objects set through their foreign-key attributes. Only documented model
 APIs are used (``_meta.concrete_fields``, ``Field.column``/``attname``, ``JSONField.from_db_value``), so a Django
-upgrade cannot change what these functions return without tests/test_page_reads.py noticing.
+upgrade cannot change what these functions return without tests/studyapp/participant/test_page_reads.py noticing.
 
 Values come back as the ORM gives them on PostgreSQL and SQLite: JSON decoded, booleans as bool, datetimes aware
 (SQLite returns text and integers for those, PostgreSQL native types).

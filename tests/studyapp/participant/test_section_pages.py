@@ -26,7 +26,7 @@ from studyapp.participant.counterbalance import attach_pages
 from studyapp.participant.duration import READING_SECONDS, expected_seconds
 from studyapp.questions import section_type_choices
 from studyapp.testing import admin_form_data, make_catalogue
-from tests.test_study_flow import answer_for
+from tests.studyapp.participant.test_study_flow import answer_for
 
 pytestmark = pytest.mark.django_db
 

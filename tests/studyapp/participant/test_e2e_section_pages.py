@@ -19,7 +19,7 @@ from django.urls import reverse
 from studyapp.data.export import stream_csv
 from studyapp.models import Participant, Section, Study
 from studyapp.testing import consent_and_demographics, make_catalogue, tiny_mp4, wait_for
-from tests.test_e2e_study import pick_answers
+from tests.studyapp.participant.test_e2e_study import pick_answers
 
 pytestmark = [pytest.mark.browser, pytest.mark.slow, pytest.mark.django_db(transaction=True)]
 

@@ -18,7 +18,7 @@ from django.urls import reverse
 
 from studyapp.models import Clip, Participant, Response, Section, Study
 from studyapp.testing import consent_and_demographics, wait_for
-from tests.test_import_clips import GOOD, lab, write_manifest  # noqa: F401 - the lab fixture
+from tests.studyapp.data.test_import_clips import GOOD, lab, write_manifest  # noqa: F401 - the lab fixture
 
 pytestmark = [pytest.mark.browser, pytest.mark.slow, pytest.mark.django_db(transaction=True)]
 

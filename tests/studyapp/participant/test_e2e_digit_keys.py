@@ -15,7 +15,7 @@ from django.urls import reverse
 from studyapp.models import Participant, Response, Study
 from studyapp.staff.presets import create_study_from_preset
 from studyapp.testing import make_catalogue, wait_for
-from tests.test_e2e_keyboard_a11y import CLIP_SECONDS, press, wide_test_clip
+from tests.studyapp.participant.test_e2e_keyboard_a11y import CLIP_SECONDS, press, wide_test_clip
 
 pytestmark = [pytest.mark.browser, pytest.mark.slow, pytest.mark.django_db(transaction=True)]
 

@@ -29,7 +29,7 @@ from studyapp.models import Assignment, Participant, Study
 from studyapp.staff.presets import create_study_from_preset
 from studyapp.staff.progress_stats import progress_stats
 from studyapp.testing import make_catalogue
-from tests.test_pilots_sharing import take_part
+from tests.studyapp.staff.test_pilots_sharing import take_part
 
 PROTOCOL_FILES = {"responses.csv": RESPONSE_COLUMNS, "clips.csv": EXPORT_CLIP_COLUMNS,
                   "participants.csv": PARTICIPANT_COLUMNS, "assignments.csv": ASSIGNMENT_COLUMNS,

@@ -17,8 +17,8 @@ from studyapp.data.export import stream_csv
 from studyapp.models import Assignment, Participant, Study
 from studyapp.participant.assignment import current_step
 from studyapp.participant.viewing import MAX_COUNT, SCRIPT_FIELD, carried_counts, field_name, max_plays, parse_viewing
-from tests import test_study_flow as flow
-from tests.test_study_flow import answer_for, consent, cur, demographics
+from tests.studyapp.participant import test_study_flow as flow
+from tests.studyapp.participant.test_study_flow import answer_for, consent, cur, demographics
 
 GOOD_RECORD = {"first_play_ms": 120, "ended_ms": 2400, "plays": 2, "pauses": 1, "seeks": 3, "stalls": 1,
                "stall_ms": 250, "hidden": 1}

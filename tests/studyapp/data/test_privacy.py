@@ -14,7 +14,6 @@ from django.contrib.auth.models import Group, Permission, User
 from django.core.management import call_command
 from django.test import Client
 from django.urls import reverse
-from test_study_admin import finish
 
 from studyapp.data.export import stream_csv
 from studyapp.data.privacy import PURGED_NAME, pseudonym
@@ -24,6 +23,7 @@ from studyapp.staff import reports
 from studyapp.staff.presets import create_study_from_preset
 from studyapp.staff.reports import forget_reports
 from studyapp.testing import make_catalogue
+from tests.studyapp.staff.test_study_admin import finish
 
 pytestmark = pytest.mark.django_db
 

@@ -434,7 +434,8 @@ def screenshot(driver, path: str) -> None:
     from pathlib import Path
 
     from selenium.webdriver.common.by import By
-    from test_e2e_study import full_shot
+
+    from tests.studyapp.participant.test_e2e_study import full_shot
 
     toggle = driver.find_elements(By.ID, "toggle-nav-sidebar")
     if toggle and toggle[0].is_displayed():

@@ -1,5 +1,6 @@
 """Clip media behind nginx: with settings.MEDIA_ACCEL_REDIRECT the app checks the opaque key and answers with an
-empty X-Accel-Redirect response; without it the app streams the bytes itself (tests/test_study_media.py)."""
+empty X-Accel-Redirect response; without it the app streams the bytes itself
+(tests/studyapp/participant/test_study_media.py)."""
 from __future__ import annotations
 
 import pytest

@@ -33,7 +33,7 @@ from studyapp.testing import make_catalogue, wait_for
 
 pytestmark = [pytest.mark.browser, pytest.mark.slow, pytest.mark.django_db(transaction=True)]
 
-AXE_DIR = Path(__file__).resolve().parent / "vendor" / "axe-core-4.14.1"
+AXE_DIR = Path(__file__).resolve().parents[2] / "vendor" / "axe-core-4.14.1"
 AXE_SHA256 = "29348999450cdf2849a8e70b7912fc2da85a849da39c0d0d5394f51d4a9ed95c"
 BLOCKING_IMPACTS = ("serious", "critical")
 PHONE, DESKTOP = (360, 740), (1366, 768)

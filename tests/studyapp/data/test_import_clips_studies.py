@@ -2,7 +2,8 @@
 participant pages (Django test client), normed per clip, and a study's exports listing imported clips with their
 origin, licence and citation beside generated ones.
 
-The videos are tiny synthetic test patterns made with the bundled ffmpeg (tests/test_import_clips.make_video).
+The videos are tiny synthetic test patterns made with the bundled ffmpeg
+(tests/studyapp/data/test_import_clips.make_video).
 """
 from __future__ import annotations
 
@@ -22,7 +23,7 @@ from studyapp.models import Assignment, Clip, Participant, Response, Section, St
 from studyapp.participant.assignment import current_step
 from studyapp.questions import questions_for
 from studyapp.testing import section_form_errors
-from tests.test_import_clips import make_video, media, read_report, run, write_manifest  # noqa: F401 - fixture
+from tests.studyapp.data.test_import_clips import make_video, media, read_report, run, write_manifest  # noqa: F401 - fixture
 
 pytestmark = pytest.mark.django_db
 

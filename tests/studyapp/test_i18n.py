@@ -24,7 +24,7 @@ from studyapp.questions import AnswerError, questions_for
 from studyapp.staff.presets import create_study_from_preset
 from studyapp.testing import make_catalogue
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 PO = ROOT / "locale" / "de" / "LC_MESSAGES" / "django.po"
 MO = PO.with_suffix(".mo")
 PARTICIPANT_TEMPLATES = sorted((ROOT / "templates" / "studyapp").glob("*.html"))

@@ -36,7 +36,7 @@ from studyapp.security import CONTENT_SECURITY_POLICY, RedactTokensFilter, redac
 from studyapp.staff.presets import create_study_from_preset
 from studyapp.testing import make_catalogue, write_media
 
-ROOT = Path(__file__).resolve().parent.parent
+ROOT = Path(__file__).resolve().parents[2]
 pytestmark = pytest.mark.django_db
 TRIPLE = {"PROLIFIC_PID": "5f1e2d3c4b5a69788796a5b4", "STUDY_ID": "stud-42", "SESSION_ID": "sess-77"}
 

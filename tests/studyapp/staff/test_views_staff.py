@@ -1,5 +1,5 @@
 """What the researcher pages do (studyapp.staff.views): create from a preset, preview without recording anything,
-progress counts, CSV exports. Who may open them is tests/test_staff_permissions.py's subject."""
+progress counts, CSV exports. Who may open them is tests/studyapp/staff/test_staff_permissions.py's subject."""
 from __future__ import annotations
 
 import csv

@@ -16,7 +16,7 @@ from studyapp.models import Section, Study
 from studyapp.staff.presets import PRESETS, create_study_from_preset
 from studyapp.testing import admin_form_data, make_catalogue
 
-ROOT = Path(__file__).resolve().parent.parent
+ROOT = Path(__file__).resolve().parents[3]
 
 
 def test_pools_module_imports_no_django():

@@ -3,7 +3,8 @@ refused, not followed to a video outside the upload), a BVH over the size limit 
 every malformed zip is a clear error on the upload page (never a 500) and leaves no folder, and the upload folder
 is removed when the job ends (imported, failed or dry run).
 
-The videos are synthetic test patterns made with the bundled ffmpeg (tests/test_import_clips.make_video)."""
+The videos are synthetic test patterns made with the bundled ffmpeg
+(tests/studyapp/data/test_import_clips.make_video)."""
 from __future__ import annotations
 
 import struct
@@ -16,8 +17,8 @@ from django.urls import reverse
 
 from generation.imports.probe import VideoProbeError, probe_video
 from studyapp.data import clip_import
-from tests import test_import_clips as base
-from tests.test_import_clips import BVH, GOOD, make_video, read_report, run, write_manifest
+from tests.studyapp.data import test_import_clips as base
+from tests.studyapp.data.test_import_clips import BVH, GOOD, make_video, read_report, run, write_manifest
 
 media, lab, staff, inline_jobs = base.media, base.lab, base.staff, base.inline_jobs      # shared fixtures
 

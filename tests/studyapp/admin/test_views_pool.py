@@ -1,6 +1,7 @@
 """What the pool editor's live count answers (studyapp.admin.views_pool): counts by origin, sub-pools narrowing their
-half, warnings for pools too small, errors instead of exceptions. Who may ask is tests/test_staff_permissions.py's
-subject; the editor's fields are tests/test_pool_editor.py's."""
+half, warnings for pools too small, errors instead of exceptions. Who may ask is
+tests/studyapp/staff/test_staff_permissions.py's subject; the editor's fields are
+tests/studyapp/admin/test_pool_editor.py's."""
 from __future__ import annotations
 
 import json

@@ -8,7 +8,6 @@ import io
 
 import pandas as pd
 import pytest
-from test_protocol_roundtrip import take_part
 
 from analysis.design import design_from_presets
 from analysis.io import read_clips, read_participants, read_responses
@@ -19,6 +18,7 @@ from studyapp.data.export import run_report, write_study_csvs
 from studyapp.models import Study
 from studyapp.staff.presets import create_study_from_preset
 from studyapp.testing import write_media
+from tests.studyapp.data.test_protocol_roundtrip import take_part
 
 pytestmark = pytest.mark.django_db
 

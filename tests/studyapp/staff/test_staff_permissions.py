@@ -43,7 +43,8 @@ def pages(study) -> list[tuple[str, str, set[int]]]:
 
 
 def staff_client(username: str, *perms: str) -> Client:
-    """A staff member holding ``perms`` who owns every study there is (per-study access: tests/test_study_access.py)."""
+    """A staff member holding ``perms`` who owns every study there is (per-study access:
+    tests/studyapp/staff/test_study_access.py)."""
     user = User.objects.create_user(username, password="pw-" + username + "-1", is_staff=True)
     for study in Study.objects.all():
         study.owners.add(user)

@@ -127,8 +127,8 @@ def test_balanced_over_participants_and_positions(norming):
 
 @pytest.mark.django_db(transaction=True)
 def test_concurrent_starts_follow_the_design(settings, tmp_path):
-    """Participants starting at once (threads; PostgreSQL only, as tests/test_study_assignment.py) still get the
-    design: every clip the same number of times, no clip twice for one participant."""
+    """Participants starting at once (threads; PostgreSQL only, as tests/studyapp/participant/test_study_assignment.py)
+    still get the design: every clip the same number of times, no clip twice for one participant."""
     import threading
 
     from django.db import connection

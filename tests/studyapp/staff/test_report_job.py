@@ -16,17 +16,17 @@ from django.core.management import CommandError, call_command
 from django.test import Client
 from django.urls import reverse
 
-# The team's helper that takes a participant through a study with library calls (no HTTP).
-from test_study_admin import finish
-
 from studyapp.models import Participant, Response
 from studyapp.staff import reports
 from studyapp.staff.presets import create_study_from_preset
 from studyapp.testing import make_catalogue
 
+# The team's helper that takes a participant through a study with library calls (no HTTP).
+from tests.studyapp.staff.test_study_admin import finish
+
 pytestmark = pytest.mark.django_db
 
-ROOT = Path(__file__).resolve().parent.parent
+ROOT = Path(__file__).resolve().parents[3]
 # A stand-in build that holds the inherited lock until its gate file exists (or 60 s pass), and writes no zip.
 GATED = "import os, sys, time\nend = time.time() + 60\nwhile not os.path.exists(sys.argv[1]) and time.time() < end:\n" \
         "    time.sleep(0.05)"

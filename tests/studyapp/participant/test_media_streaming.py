@@ -118,9 +118,9 @@ def test_a_range_reads_only_its_range_and_the_first_block_comes_before_the_rest(
 
 def test_exports_and_the_report_stream_under_asgi(settings, tmp_path, root):
     from django.core.management import call_command
-    from test_study_admin import finish
 
     from studyapp.testing import make_catalogue
+    from tests.studyapp.staff.test_study_admin import finish
 
     settings.MEDIA_ROOT = tmp_path / "media"
     settings.REPORTS_DIR = tmp_path / "reports"

@@ -13,7 +13,7 @@ from studyapp.models import Participant, Response, Study
 from studyapp.participant.assignment import current_step
 from studyapp.participant.forms import ConsentForm, FeedbackForm
 from studyapp.participant.viewing import SCRIPT_FIELD, VIEWING_FORM_FIELDS
-from tests.test_study_flow import answer_for, consent, demographics
+from tests.studyapp.participant.test_study_flow import answer_for, consent, demographics
 
 pytestmark = pytest.mark.django_db
 

@@ -22,7 +22,7 @@ from generation.imports.manifest import MANIFEST_COLUMNS
 from generation.imports.run import REPORT_COLUMNS
 from generation.plans.catalogue import read_clips_csv
 
-REPO = Path(__file__).resolve().parents[1]
+REPO = Path(__file__).resolve().parents[3]
 BVH = (REPO / "generation/data/mocap/bandai-namco/Bandai-Namco-Research-Motiondataset-1/data"
        / "dataset-1_walk_happy_001.bvh")
 BANDAI_LICENCE = "CC BY-NC 4.0"

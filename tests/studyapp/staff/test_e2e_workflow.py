@@ -4,7 +4,7 @@ point the study's pools at it, share a preview link and open it in a browser wit
 participants, delete the pilot data, clone the study and open the clone.
 
 The render jobs run here as threads of the test server instead of detached processes: the test database lives in
-this process's memory, out of reach of another process (tests/test_stimulus_sets.py runs the real detached
+this process's memory, out of reach of another process (tests/studyapp/data/test_stimulus_sets.py runs the real detached
 process, kills it and resumes it). STUDY_SCREENSHOTS=<folder> saves the pages at 1366x768 as workflow_*.png."""
 from __future__ import annotations
 
@@ -22,7 +22,7 @@ from django.urls import reverse
 from studyapp.data import background, render_jobs
 from studyapp.models import Clip, Participant, Study
 from studyapp.testing import wait_for
-from tests.test_e2e_norming import simulated_participant
+from tests.studyapp.participant.test_e2e_norming import simulated_participant
 
 pytestmark = [pytest.mark.browser, pytest.mark.slow, pytest.mark.django_db(transaction=True)]
 
