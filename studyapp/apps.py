@@ -3,6 +3,7 @@ from django.apps import AppConfig
 
 class StudyAppConfig(AppConfig):
     """The studyapp Django app, listed as "Perceptual studies" in the admin."""
+
     name = "studyapp"
     verbose_name = "Perceptual studies"
     default_auto_field = "django.db.models.BigAutoField"

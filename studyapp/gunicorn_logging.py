@@ -17,6 +17,7 @@ URL_ATOMS = ("r", "U", "q", "f", "{referer}i", "{origin}i")
 
 class RedactingLogger(Logger):
     """gunicorn's logger with the participant credentials redacted from the access and error logs."""
+
     def setup(self, cfg):
         """Set up gunicorn's logs and add one RedactTokensFilter to each (not a second on a reload)."""
         super().setup(cfg)

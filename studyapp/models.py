@@ -112,6 +112,7 @@ class Clip(models.Model):
 
     class Meta:
         """Clips listed by clip id."""
+
         ordering = ["clip_id"]
 
     def __str__(self) -> str:
@@ -119,15 +120,17 @@ class Clip(models.Model):
 
     @property
     def is_transition(self) -> bool:
-        """True for a clip that moves between two emotions (it has a final happiness value)."""
+        """True for a transition clip: one with final emotion values (``final_happy`` set)."""
         return self.final_happy is not None
 
 
 class Study(models.Model):
     """A study: its participant-facing texts and settings, its sections (Section) and participants, and who may manage
     it (owners) or see it (collaborators)."""
+
     class Status(models.TextChoices):
         """Draft (being set up), open (taking participants) or closed."""
+
         DRAFT = "draft", "Draft"
         OPEN = "open", "Open"
         CLOSED = "closed", "Closed"
@@ -198,6 +201,7 @@ class Study(models.Model):
 
     class Meta:
         """Newest first; the study permissions of studyapp.permissions beside Django's own."""
+
         verbose_name_plural = "studies"
         ordering = ["-created_at"]
         permissions = STUDY_PERMISSIONS
@@ -261,6 +265,7 @@ class Section(models.Model):
 
     class Meta:
         """A study's sections in their order."""
+
         ordering = ["study", "order", "id"]
 
     def __str__(self) -> str:
@@ -295,8 +300,10 @@ class Section(models.Model):
 class Participant(models.Model):
     """One person taking a study, from consent on: the unguessable token of their URL, the public id of the exports, the
     external (Prolific) id, the seed of their clip plan, their status and their instruction and break pages."""
+
     class Status(models.TextChoices):
         """Where the participant stands: consented, started (clips assigned), completed or withdrawn."""
+
         CONSENTED = "consented", "Consented"
         STARTED = "started", "Started"
         COMPLETED = "completed", "Completed"
@@ -341,6 +348,7 @@ class Participant(models.Model):
 
     class Meta:
         """One participant per external id and per consent key in a study (blank ones exempt)."""
+
         constraints = [
             models.UniqueConstraint(fields=["study", "external_id"], condition=~models.Q(external_id=""),
                                     name="unique_external_id_per_study"),
@@ -367,6 +375,7 @@ class Assignment(models.Model):
 
     class Kind(models.TextChoices):
         """What an assignment is: a trial (exported), a practice item (never exported) or an attention check."""
+
         TRIAL = "", "Trial"
         PRACTICE = "practice", "Practice (never exported)"
         ATTENTION = ATTENTION_CHECK, "Attention check"
@@ -401,6 +410,7 @@ class Assignment(models.Model):
     class Meta:
         """A participant's pages by seq; one assignment per slot, per trial clip of a section and per seq, and an index
         for the first unanswered page."""
+
         ordering = ["participant", "seq"]
         constraints = [
             models.UniqueConstraint(fields=["participant", "section", "position"], name="unique_assignment_slot"),
@@ -418,6 +428,7 @@ class Assignment(models.Model):
 class Response(models.Model):
     """One answer of a participant to one question about one clip of a section, with the time it took (ms); a row of
     responses.csv."""
+
     participant = models.ForeignKey(Participant, on_delete=models.CASCADE, related_name="responses")
     section = models.ForeignKey(Section, on_delete=models.CASCADE, related_name="responses")
     clip = models.ForeignKey(Clip, on_delete=models.PROTECT, related_name="responses")
@@ -431,6 +442,7 @@ class Response(models.Model):
 
     class Meta:
         """Answers in the order given; one per participant, section, clip and question."""
+
         ordering = ["id"]
         constraints = [
             models.UniqueConstraint(fields=["participant", "section", "clip", "question"],
@@ -448,6 +460,7 @@ class SectionClipCount(models.Model):
 
     class Meta:
         """One count per section and clip."""
+
         constraints = [models.UniqueConstraint(fields=["section", "clip"], name="unique_section_clip_count")]
 
 

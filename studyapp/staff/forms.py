@@ -9,6 +9,7 @@ from .presets import preset_choices
 
 class PresetStudyForm(forms.Form):
     """The "New study from preset" page's form: a preset, the new study's slug (not yet taken) and an optional title."""
+
     preset = forms.ChoiceField(choices=preset_choices)
     slug = forms.SlugField(max_length=80, help_text="Used in the participant URL /s/<slug>/")
     title = forms.CharField(max_length=200, required=False, help_text="Leave blank for the preset's title")
@@ -23,6 +24,7 @@ class PresetStudyForm(forms.Form):
 
 class CloneStudyForm(forms.Form):
     """The clone page's form: the copy's slug (not yet taken) and title."""
+
     slug = forms.SlugField(max_length=80, help_text="The copy's participant URL /s/<slug>/")
     title = forms.CharField(max_length=200)
 
@@ -36,4 +38,5 @@ class CloneStudyForm(forms.Form):
 
 class SharePreviewForm(forms.Form):
     """The progress page's "share a preview" form: how many days (1 to 90) the signed link stays valid."""
+
     days = forms.IntegerField(min_value=1, max_value=90, initial=14, label="Valid for (days)")

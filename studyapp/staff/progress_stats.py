@@ -47,6 +47,7 @@ class Funnel:
 class SectionTime:
     """One section's row of the progress page: the median time a participant spent in it (s; None when nobody finished
     it) over ``n`` timed participants."""
+
     section_id: int
     label: str
     median_s: float | None
@@ -57,6 +58,7 @@ class SectionTime:
 class ProgressStats:
     """Everything the progress page charts: the funnel, the median time per participant (s) over ``n_timed``
     participants, the time per section and (date, answers) per day."""
+
     funnel: Funnel
     median_participant_s: float | None
     n_timed: int

@@ -8,6 +8,7 @@ from studyapp.management.cli import study_by_slug
 class Command(BaseCommand):
     """``manage.py analyze STUDY --out DIR``: the study's CSV exports and the papers' statistics (report.json, tables,
     figures, report.html) in one folder."""
+
     help = "Run the statistics of the papers on STUDY (slug): report.json, tables, figures, report.html in --out."
 
     def add_arguments(self, parser):

@@ -9,6 +9,7 @@ from generation.procedural.corpus import DEFAULT_DIR, build_and_save
 
 class Command(BaseCommand):
     """``manage.py build_corpus``: the synthetic gait corpus (and with --gestures the demo gesture corpus) on disk."""
+
     help = ("Build the synthetic (procedural, simulated-annotator) gait training corpus "
             "var/corpus/gait_corpus_synthetic.npz; the same as `python -m generation.procedural.corpus`.")
 

@@ -27,6 +27,7 @@ def find_study(ref: str) -> Study:
 class Command(BaseCommand):
     """``manage.py build_report STUDY``: the analysis-report zip of a study's current data, as the staff "Build report"
     button starts it."""
+
     help = "Build STUDY's analysis report zip for its current data (kept in REPORTS_DIR until the data change)."
 
     def add_arguments(self, parser):

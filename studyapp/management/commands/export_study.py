@@ -7,6 +7,7 @@ from studyapp.management.cli import study_by_slug
 
 class Command(BaseCommand):
     """``manage.py export_study STUDY --out DIR``: responses.csv, clips.csv and participants.csv of one study."""
+
     help = "Export responses.csv, clips.csv and participants.csv of STUDY (its slug) into --out."
 
     def add_arguments(self, parser):

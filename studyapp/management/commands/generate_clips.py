@@ -51,6 +51,7 @@ def _require_migrated_database() -> None:
 class Command(BaseCommand):
     """``manage.py generate_clips --plan PLAN``: render a stimulus plan's clips, catalogue them in clips.csv and as Clip
     rows, and report their quality flags and the presets' coverage."""
+
     help = "Render the clips of a stimulus plan (built-in name or YAML/JSON file) and catalogue them."
 
     def add_arguments(self, parser):

@@ -85,6 +85,7 @@ def _render_size(text: str | None) -> dict:
 class Command(BaseCommand):
     """``manage.py import_clips MANIFEST.csv``: a researcher's own videos and motion files into the catalogue, with a
     per-row report."""
+
     help = "Import videos and motion files named in a manifest CSV as clips with origin 'imported'."
 
     def add_arguments(self, parser):

@@ -12,6 +12,7 @@ from studyapp.staff.presets import create_study_from_preset
 
 class Command(BaseCommand):
     """``manage.py setup_demo``: the open, publicly listed demo study built from a preset, with its participant URL."""
+
     help = "Create the demo study (every section type) from the clips in the database and print its URL."
 
     def add_arguments(self, parser):

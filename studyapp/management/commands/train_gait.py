@@ -15,6 +15,7 @@ from studyapp.management.cli import mirror_arguments, mirrored_namespace
 class Command(BaseCommand):
     """``manage.py train_gait``: train the seed 000 gait network with the options of ``python -m
     generation.gait.train``."""
+
     help = ("Train the seed 000 emotive gait network on the synthetic gait corpus; the same options as "
             "`python -m generation.gait.train` (--config small|paper, --device auto|cpu|cuda[:N], --amp).")
 

@@ -19,6 +19,7 @@ from studyapp.management.cli import mirror_arguments, mirrored_namespace
 class Command(BaseCommand):
     """``manage.py train_gesture``: train the seed 003 gesture network with the options of ``python -m
     generation.gesture.train``."""
+
     help = ("Train the seed 003 gesture network on the synthetic sentence/procedural-gesture corpus; "
             "the same options as `python -m generation.gesture.train` (--config small|paper, "
             "--device auto|cpu|cuda[:N], --amp).")
