@@ -475,7 +475,7 @@ class AssignmentInline(admin.TabularInline):
 
 @admin.register(Participant)
 class ParticipantAdmin(StudyScopedAdmin):
-    """Participants of the user's studies, read-only apart from their status; deleting or withdrawing one says whether
+    """Participants of the user's studies, their record mostly read-only; deleting or withdrawing one says whether
     stored analysis reports with their data were deleted."""
 
     study_field = "study"
