@@ -16,13 +16,17 @@ URL_ATOMS = ("r", "U", "q", "f", "{referer}i", "{origin}i")
 
 
 class RedactingLogger(Logger):
+    """gunicorn's logger with the participant credentials redacted from the access and error logs."""
+
     def setup(self, cfg):
+        """Set up gunicorn's logs and add one RedactTokensFilter to each (not a second on a reload)."""
         super().setup(cfg)
         for log in (self.error_log, self.access_log):
             if not any(isinstance(f, RedactTokensFilter) for f in log.filters):
                 log.addFilter(RedactTokensFilter())
 
     def atoms(self, resp, req, environ, request_time):
+        """The access log's atoms with every URL-bearing one (URL_ATOMS) passed through studyapp.security.redact."""
         atoms = super().atoms(resp, req, environ, request_time)
         for key in URL_ATOMS:
             if isinstance(atoms.get(key), str):

@@ -42,6 +42,8 @@ class ThrottledLoginBackend(AxesStandaloneBackend):
     throttle and is passed on to the next backend unchanged."""
 
     def authenticate(self, request, username=None, password=None, **kwargs):
+        """django-axes' check for a login through a request; None (the next backend decides) for one without a
+        request."""
         if request is None:
             return None
         return super().authenticate(request, username=username, password=password, **kwargs)

@@ -42,14 +42,17 @@ def new_public_id() -> str:
 
 
 def new_media_key() -> str:
+    """The default Clip.media_key: 32 random hex digits that name the clip's media URL without revealing its id."""
     return secrets.token_hex(16)
 
 
 def new_seed() -> int:
+    """The default Participant.seed: a random integer in [0, 2**31 - 1) that fixes the participant's clip plan."""
     return secrets.randbelow(2**31 - 1)
 
 
 def new_completion_code() -> str:
+    """The default Study.completion_code: 8 random upper-case hex digits, filled into the completion URL's {code}."""
     return secrets.token_hex(4).upper()
 
 
@@ -108,6 +111,8 @@ class Clip(models.Model):
     updated_at = models.DateTimeField(auto_now=True)
 
     class Meta:
+        """Clips listed by clip id."""
+
         ordering = ["clip_id"]
 
     def __str__(self) -> str:
@@ -115,11 +120,17 @@ class Clip(models.Model):
 
     @property
     def is_transition(self) -> bool:
+        """True for a transition clip: one with final emotion values (``final_happy`` set)."""
         return self.final_happy is not None
 
 
 class Study(models.Model):
+    """A study: its participant-facing texts and settings, its sections (Section) and participants, and who may manage
+    it (owners) or see it (collaborators)."""
+
     class Status(models.TextChoices):
+        """Draft (being set up), open (taking participants) or closed."""
+
         DRAFT = "draft", "Draft"
         OPEN = "open", "Open"
         CLOSED = "closed", "Closed"
@@ -189,6 +200,8 @@ class Study(models.Model):
     created_at = models.DateTimeField(auto_now_add=True)
 
     class Meta:
+        """Newest first; the study permissions of studyapp.permissions beside Django's own."""
+
         verbose_name_plural = "studies"
         ordering = ["-created_at"]
         permissions = STUDY_PERMISSIONS
@@ -197,6 +210,8 @@ class Study(models.Model):
         return self.title
 
     def clean(self):
+        """Refuse a completion redirect that is not a safe http(s) URL, as an error on that field of the study's admin
+        page."""
         try:
             check_completion_url(self.completion_redirect)
         except ValidationError as exc:
@@ -249,6 +264,8 @@ class Section(models.Model):
                                 "tick is not used); a page after the last section stays last")
 
     class Meta:
+        """A study's sections in their order."""
+
         ordering = ["study", "order", "id"]
 
     def __str__(self) -> str:
@@ -260,6 +277,9 @@ class Section(models.Model):
                                                 self.clips_per_participant))
 
     def clean(self):
+        """Check the section on its admin form: the pool, options and clip count (protocol_errors), that a reused
+        section is an earlier clip section of the same study (no page type on either side), and that a named practice
+        clip exists. Raises ValidationError keyed by field."""
         errors: dict[str, list[str]] = dict(self.protocol_errors())
         if self.reuse_section_id:
             other = self.reuse_section
@@ -278,7 +298,12 @@ class Section(models.Model):
 
 
 class Participant(models.Model):
+    """One person taking a study, from consent on: the unguessable token of their URL, the public id of the exports, the
+    external (Prolific) id, the seed of their clip plan, their status and their instruction and break pages."""
+
     class Status(models.TextChoices):
+        """Where the participant stands: consented, started (clips assigned), completed or withdrawn."""
+
         CONSENTED = "consented", "Consented"
         STARTED = "started", "Started"
         COMPLETED = "completed", "Completed"
@@ -322,6 +347,8 @@ class Participant(models.Model):
     pages = models.JSONField(default=list, blank=True, editable=False)
 
     class Meta:
+        """One participant per external id and per consent key in a study (blank ones exempt)."""
+
         constraints = [
             models.UniqueConstraint(fields=["study", "external_id"], condition=~models.Q(external_id=""),
                                     name="unique_external_id_per_study"),
@@ -347,6 +374,8 @@ class Assignment(models.Model):
     participant's clip pages 1..n over the whole study in the order they are shown (the URL's clip number)."""
 
     class Kind(models.TextChoices):
+        """What an assignment is: a trial (exported), a practice item (never exported) or an attention check."""
+
         TRIAL = "", "Trial"
         PRACTICE = "practice", "Practice (never exported)"
         ATTENTION = ATTENTION_CHECK, "Attention check"
@@ -379,6 +408,9 @@ class Assignment(models.Model):
     carried = models.JSONField(default=dict, blank=True, editable=False)
 
     class Meta:
+        """A participant's pages by seq; one assignment per slot, per trial clip of a section and per seq, and an index
+        for the first unanswered page."""
+
         ordering = ["participant", "seq"]
         constraints = [
             models.UniqueConstraint(fields=["participant", "section", "position"], name="unique_assignment_slot"),
@@ -394,6 +426,9 @@ class Assignment(models.Model):
 
 
 class Response(models.Model):
+    """One answer of a participant to one question about one clip of a section, with the time it took (ms); a row of
+    responses.csv."""
+
     participant = models.ForeignKey(Participant, on_delete=models.CASCADE, related_name="responses")
     section = models.ForeignKey(Section, on_delete=models.CASCADE, related_name="responses")
     clip = models.ForeignKey(Clip, on_delete=models.PROTECT, related_name="responses")
@@ -406,6 +441,8 @@ class Response(models.Model):
     created_at = models.DateTimeField(auto_now_add=True)
 
     class Meta:
+        """Answers in the order given; one per participant, section, clip and question."""
+
         ordering = ["id"]
         constraints = [
             models.UniqueConstraint(fields=["participant", "section", "clip", "question"],
@@ -422,6 +459,8 @@ class SectionClipCount(models.Model):
     n = models.PositiveIntegerField(default=0)
 
     class Meta:
+        """One count per section and clip."""
+
         constraints = [models.UniqueConstraint(fields=["section", "clip"], name="unique_section_clip_count")]
 
 

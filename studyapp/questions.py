@@ -148,6 +148,9 @@ class AnswerError(ValueError):
 
 @dataclass(frozen=True)
 class Question:
+    """One question of a clip page: ``key`` (the responses.csv column), its text, how it is shown (``kind``: multi,
+    single or scale), the allowed (value, label) choices, a help text and the answer kind of its declaration."""
+
     key: str                       # the `question` column of responses.csv
     text: str
     kind: str                      # how it is shown: "multi" | "single" | "scale"

@@ -59,6 +59,7 @@ class RedactTokensFilter(logging.Filter):
     """Rewrites a record's message (and string arguments) with `redact`; never drops a record."""
 
     def filter(self, record: logging.LogRecord) -> bool:
+        """Redact the record's message and string arguments in place; always True (the record is kept)."""
         if isinstance(record.msg, str):
             record.msg = redact(record.msg)
         if isinstance(record.args, tuple):

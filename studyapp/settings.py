@@ -42,6 +42,8 @@ BASE_DIR = Path(__file__).resolve().parent.parent
 
 
 def env_bool(name: str, default: bool = False) -> bool:
+    """The environment variable as a boolean: 1, true, yes or on (any case) are True; unset or blank gives
+    ``default``."""
     value = os.environ.get(name)
     if value is None or value == "":
         return default
@@ -49,6 +51,8 @@ def env_bool(name: str, default: bool = False) -> bool:
 
 
 def env_int(name: str, default: int, minimum: int = 0) -> int:
+    """The environment variable as a whole number of at least ``minimum`` (``default`` when unset or blank);
+    ImproperlyConfigured for anything else, so a bad setting stops the start-up."""
     raw = os.environ.get(name, "").strip()
     if not raw:
         return default
@@ -64,6 +68,7 @@ def env_int(name: str, default: int, minimum: int = 0) -> int:
 
 
 def env_list(name: str, default: str) -> list[str]:
+    """The environment variable (else ``default``) as a comma-separated list, items stripped, empty ones dropped."""
     return [item.strip() for item in os.environ.get(name, default).split(",") if item.strip()]
 
 

@@ -29,6 +29,7 @@ UNAVAILABLE_TEXT = ("The study server is busy right now. Please wait a few secon
 @never_cache
 @require_safe
 def healthz(request):
+    """/healthz: "ok" as plain text for GET or HEAD, never cached, without touching the database or the session."""
     return HttpResponse("ok", content_type="text/plain; charset=utf-8")
 
 
@@ -76,6 +77,7 @@ def database_unavailable(exc: BaseException | None) -> bool:
 
 
 def unavailable_response() -> HttpResponse:
+    """The 503 page of a database outage: UNAVAILABLE_TEXT with Retry-After (RETRY_AFTER_S seconds) and no-store."""
     response = HttpResponse(UNAVAILABLE_TEXT, status=503, content_type="text/plain; charset=utf-8")
     response["Retry-After"] = str(RETRY_AFTER_S)
     response["Cache-Control"] = "no-store"

@@ -17,10 +17,13 @@ class QualityFlagFilter(admin.SimpleListFilter):
     parameter_name = "qa"
 
     def lookups(self, request, model_admin):
+        """The filter's choices in the clip list's sidebar: passed, flagged (any check), and failed for each check."""
         return [(PASSED, "passed"), (FLAGGED, "flagged (any check)"),
                 *[(check, f"failed: {check.replace('_', ' ')}") for check in QA_CHECKS]]
 
     def queryset(self, request, queryset: QuerySet) -> QuerySet:
+        """The clips of the chosen choice (all for none or an unknown one); a check matches only as a whole name in the
+        ';'-joined ``qa_flag``."""
         value = self.value()
         if value == PASSED:
             return queryset.filter(qa_flag="")

@@ -43,6 +43,8 @@ class SectionForm(PartialModelForm, PoolEditorFields):
     CHECKED_TOGETHER = ("section_type", "clips_per_participant", "pool", "options")
 
     class Meta:
+        """Every field of Section."""
+
         model = Section
         fields = "__all__"
 
@@ -71,6 +73,9 @@ class SectionForm(PartialModelForm, PoolEditorFields):
         field.queryset = earlier.order_by("order", "id")
 
     def clean(self):
+        """Fill in the saved type, count, pool and options for fields this step does not show, settle the pool and
+        options from the structured fields or the raw JSON (pool_editor.resolve_section_json), refuse an order change
+        once participants take part, and check the norms rules the pool names."""
         data = super().clean()
         for name in self.CHECKED_TOGETHER:
             if not self.shows(name):
@@ -139,6 +144,7 @@ class SectionPreviewForm(PoolEditorFields):
     touched_options = forms.BooleanField(required=False)
 
     def clean(self):
+        """The pool and options the page's fields mean, settled as on save, each problem on its field."""
         data = super().clean()
         touched = {"pool": bool(data.get("touched_pool")), "options": bool(data.get("touched_options"))}
         pool_editor.resolve_section_json(self, data, touched)
@@ -150,6 +156,8 @@ class StudyAdminForm(PartialModelForm):
     completion URL must be http(s) (studyapp.redirects)."""
 
     class Meta:
+        """Every field of Study."""
+
         model = Study
         fields = "__all__"
 
@@ -158,6 +166,7 @@ class StudyAdminForm(PartialModelForm):
         study_fields.set_initial(self)
 
     def clean_completion_redirect(self):
+        """The completion URL, stripped; refused unless it is http(s) (blank allowed)."""
         value = (self.cleaned_data.get("completion_redirect") or "").strip()
         check_completion_url(value)
         return value
@@ -180,6 +189,8 @@ class StudyAdminForm(PartialModelForm):
         return data
 
     def clean_exclusion_rules(self):
+        """The raw exclusion rules JSON (blank: {}), refused with the analysis library's messages when a rule is unknown
+        or out of range."""
         rules = self.cleaned_data.get("exclusion_rules")
         rules = {} if rules is None else rules
         errors = rule_errors(rules)
@@ -193,6 +204,8 @@ StudyAdminForm.declared_fields.update(study_fields.declared_fields())
 
 
 class MultipleFileInput(forms.ClearableFileInput):
+    """A file input that lets the browser select several files."""
+
     allow_multiple_selected = True
 
 
@@ -204,6 +217,7 @@ class MultipleFileField(forms.FileField):
         super().__init__(*args, **kwargs)
 
     def clean(self, data, initial=None):
+        """The uploaded files as a list, each checked like one file; empty slots are dropped."""
         if isinstance(data, (list, tuple)):
             return [super(MultipleFileField, self).clean(d, initial) for d in data if d]
         return [super().clean(data, initial)] if data else []
@@ -228,6 +242,7 @@ class ClipImportForm(forms.Form):
     dry_run = forms.BooleanField(required=False, help_text="Only check every row; import nothing.")
 
     def clean(self):
+        """Requires a manifest (a .csv) or a zip; a blank collection is named after the uploaded file."""
         data = super().clean()
         if not data.get("manifest") and not data.get("archive"):
             raise forms.ValidationError("Upload a manifest with its files, or a zip of them.")

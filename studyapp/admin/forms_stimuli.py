@@ -19,10 +19,15 @@ RENDER_FIELDS = ("width", "height", "fps", "duration_s", "camera", "body")
 
 
 def generator_choices() -> list[tuple[str, str]]:
+    """(name, "name: summary") of every registered generator, the form's generator choices."""
     return [(spec.name, f"{spec.name.replace('_', ' ')}: {spec.summary}") for spec in registered()]
 
 
 class StimulusSetForm(forms.Form):
+    """The stimuli page's "new stimulus set" form: a plan name, a generator and its conditions, variants and first seed,
+    fields every clip shares, the render settings (size in px, fps, duration in s, camera, body), the intended section
+    types and the fallback switch. A valid form holds the built plan in ``plan_data`` and ``plan``."""
+
     name = forms.SlugField(max_length=60, help_text="The plan's name: its clips are catalogued under it (pool "
                                                     "filter <code>plan</code>). Lower-case letters, digits, - and _.")
     description = forms.CharField(required=False, max_length=300)
@@ -53,6 +58,7 @@ class StimulusSetForm(forms.Form):
         help_text="e.g. the procedural walk while the gait network's weights are missing; recorded per clip.")
 
     def clean_shared(self) -> dict:
+        """The "fields of every clip" box as a dict (blank: {}); refused unless it is a YAML mapping."""
         text = self.cleaned_data.get("shared", "").strip()
         if not text:
             return {}
@@ -65,6 +71,7 @@ class StimulusSetForm(forms.Form):
         return data
 
     def clean_name(self) -> str:
+        """The plan name in lower case; refused when a built-in plan has it."""
         name = self.cleaned_data["name"].lower()
         if name in builtin_plans():
             raise forms.ValidationError(f"{name!r} is a built-in plan: render it from the list of built-in plans, "
@@ -72,6 +79,8 @@ class StimulusSetForm(forms.Form):
         return name
 
     def clean(self):
+        """Build the plan from the fields (generation.plans.stimulus_set.build_plan); what the plan schema refuses
+        becomes an error on the field at fault (a render setting, the generator's field) or on the form."""
         data = super().clean()
         if self.errors:
             return data

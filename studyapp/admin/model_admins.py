@@ -83,6 +83,7 @@ def section_fieldsets() -> list:
 
 
 def section_type_label(section_type: str) -> str:
+    """The readable label of a section type, as its choice shows it (the name itself for an unknown type)."""
     return dict(section_type_choices()).get(section_type, section_type)
 
 
@@ -113,6 +114,7 @@ class StudyScopedAdmin(admin.ModelAdmin):
         return value.pk
 
     def get_queryset(self, request):
+        """The rows of the user's studies only (every row for a superuser): the admin list and every lookup by id."""
         queryset = super().get_queryset(request)
         if request.user.is_superuser:
             return queryset
@@ -123,21 +125,28 @@ class StudyScopedAdmin(admin.ModelAdmin):
         return obj is None or request.user.is_superuser or can_access_study(request.user, self._study_pk(obj))
 
     def has_view_permission(self, request, obj=None):
+        """Django's view permission, and for a row access to its study."""
         return super().has_view_permission(request, obj) and self._may(request, obj)
 
     def has_change_permission(self, request, obj=None):
+        """Django's change permission, and for a row access to its study."""
         return super().has_change_permission(request, obj) and self._may(request, obj)
 
     def has_delete_permission(self, request, obj=None):
+        """Django's delete permission, and for a row access to its study."""
         return super().has_delete_permission(request, obj) and self._may(request, obj)
 
     def formfield_for_foreignkey(self, db_field, request, **kwargs):
+        """A study drop-down offers only the user's studies."""
         if db_field.related_model is Study:
             kwargs["queryset"] = studies_for(request.user)
         return super().formfield_for_foreignkey(db_field, request, **kwargs)
 
 
 class SectionInline(SectionStepsMixin, admin.StackedInline):
+    """The study page's sections, one stacked form each (section_fieldsets), with the pool editor and its live count of
+    matching clips."""
+
     model = Section
     form = SectionForm
     formfield_overrides = COMPACT
@@ -148,14 +157,19 @@ class SectionInline(SectionStepsMixin, admin.StackedInline):
     fieldsets = section_fieldsets()
 
     class Media:
+        """The pool editor's script and styles and the clip cells' stylesheet."""
+
         js = ["studyapp/admin_pool.js"]
         css = {"all": ["studyapp/admin_pool.css", clip_display.STYLESHEET]}
 
     def get_formset(self, request, obj=None, **kwargs):
+        """The sections' formset, remembering on the request which study they belong to (for the reused-section
+        choices)."""
         request.studyapp_section_study = obj          # the study whose sections a reused section may be
         return super().get_formset(request, obj, **kwargs)
 
     def formfield_for_foreignkey(self, db_field, request, **kwargs):
+        """"Reuse section" offers only sections of the study being edited (none on a new study), never another lab's."""
         if db_field.name == "reuse_section":
             # only this study's sections (each form narrows to the earlier ones: SectionForm); never another lab's
             study = getattr(request, "studyapp_section_study", None)
@@ -165,6 +179,8 @@ class SectionInline(SectionStepsMixin, admin.StackedInline):
 
     @admin.display(description="matching clips")
     def matching_clips(self, section):
+        """The read-only "matching clips" cell: the pool's count (refreshed live from the pool-count URL), its warnings,
+        a sample of matching clips, the saved pool JSON and the norms table of a norms rule."""
         summary, warnings = pool_notes(section, self.clips_given)
         sample = [] if section.reuse_section_id else views_pool.pool_sample(section.section_type or None,
                                                                              section.pool)
@@ -180,6 +196,9 @@ class SectionInline(SectionStepsMixin, admin.StackedInline):
 
 @admin.register(Study)
 class StudyAdmin(StudyStepsMixin, StudyScopedAdmin):
+    """The study admin: the list with participant counts and links to the staff pages, the study page in steps with its
+    sections inline, the open and close actions, and the owners and collaborators who may see the study."""
+
     list_display = ["title", "slug", "status", "preset", "n_started", "n_completed", "links"]
     list_filter = ["status", "preset"]
     search_fields = ["title", "slug"]
@@ -190,6 +209,8 @@ class StudyAdmin(StudyStepsMixin, StudyScopedAdmin):
     form = StudyAdminForm
 
     class Media:
+        """The stylesheet of the study page's steps."""
+
         css = {"all": ["studyapp/admin_steps.css"]}
 
     fieldsets = [
@@ -227,6 +248,8 @@ class StudyAdmin(StudyStepsMixin, StudyScopedAdmin):
     ]
 
     def get_readonly_fields(self, request, obj=None):
+        """Owners and collaborators are read-only for anyone who may not manage the study's access (only superusers on a
+        new study)."""
         fields = list(super().get_readonly_fields(request, obj))
         may_manage = request.user.is_superuser if obj is None else can_manage_study_access(request.user, obj)
         if not may_manage:
@@ -234,17 +257,20 @@ class StudyAdmin(StudyStepsMixin, StudyScopedAdmin):
         return fields
 
     def formfield_for_manytomany(self, db_field, request, **kwargs):
+        """Owners and collaborators are chosen among active staff accounts, by username."""
         if db_field.name in ("owners", "collaborators"):
             kwargs["queryset"] = db_field.related_model.objects.filter(is_staff=True, is_active=True).order_by(
                 "username")
         return super().formfield_for_manytomany(db_field, request, **kwargs)
 
     def save_related(self, request, form, formsets, change):
+        """Save the sections and access lists; whoever creates a study becomes an owner."""
         super().save_related(request, form, formsets, change)
         if not change:
             form.instance.owners.add(request.user)
 
     def get_urls(self):
+        """The admin's URLs plus "new from preset" and the pool editor's live count (pool-count/)."""
         custom = [path("new-from-preset/", self.admin_site.admin_view(views_staff.create_from_preset),
                        name="studyapp_study_from_preset"),
                   # staff check inside: answers 403 JSON (not a login redirect) to anyone else
@@ -271,14 +297,18 @@ class StudyAdmin(StudyStepsMixin, StudyScopedAdmin):
 
     @admin.display(description="started")
     def n_started(self, obj):
+        """The list's "started" column: participants who started or completed."""
         return obj.participants.filter(status__in=["started", "completed"]).count()
 
     @admin.display(description="completed")
     def n_completed(self, obj):
+        """The list's "completed" column."""
         return obj.participants.filter(status="completed").count()
 
     @admin.display(description="study pages")
     def links(self, obj):
+        """The "study pages" cell: participant link, preview, progress, clone, the three CSV exports and report.zip ("-"
+        before the study is saved)."""
         if not obj.pk:
             return "-"
         return format_html(
@@ -295,6 +325,8 @@ class StudyAdmin(StudyStepsMixin, StudyScopedAdmin):
 
     @admin.action(description="Open the selected studies to participants")
     def open_studies(self, request, queryset):
+        """The list action "Open": opens each selected study whose checks pass (studyapp.data.norming.open_errors; the
+        others are named with their errors), ends its pilot mode and warns where pilot data remain."""
         refused = {}
         for study in queryset:
             errors = open_errors(study)
@@ -313,6 +345,8 @@ class StudyAdmin(StudyStepsMixin, StudyScopedAdmin):
 
     @admin.display(description="norming design")
     def norming_design(self, obj):
+        """The read-only "norming design" table: per norming section C, M, K, the participants needed and planned and
+        whether every clip gets K ratings, with a link to the norming monitor ("-" without norming sections)."""
         rows = design_rows(obj) if obj.pk else []
         if not rows:
             return "-"
@@ -329,12 +363,16 @@ class StudyAdmin(StudyStepsMixin, StudyScopedAdmin):
 
     @admin.action(description="Close the selected studies (no new participants)")
     def close_studies(self, request, queryset):
+        """The list action "Close": no new participants for the selected studies."""
         n = queryset.update(status=Study.Status.CLOSED)
         self.message_user(request, f"Closed {n} stud{'y' if n == 1 else 'ies'}.", messages.SUCCESS)
 
 
 @admin.register(Clip)
 class ClipAdmin(admin.ModelAdmin):
+    """The shared clip catalogue: posters, titles, quality flags and observer readings, the stimuli page (render a plan)
+    and the clip import, and a contact sheet of selected clips."""
+
     list_display = ["thumbnail", "title_or_id", "modality", "origin", "emotion_label", "theme", "weight",
                     "n_features", "duration_s", "plan", admin_clip_qa.quality_flag, admin_clip_qa.observer_reading]
     list_display_links = ["title_or_id"]
@@ -346,9 +384,13 @@ class ClipAdmin(admin.ModelAdmin):
     list_per_page = 25
 
     class Media:
+        """The clip cells' stylesheet."""
+
         css = {"all": [clip_display.STYLESHEET]}
 
     def get_urls(self):
+        """The admin's URLs plus the stimuli page, its render jobs with their plan and contact sheet, the import and its
+        status page."""
         def wrap(view):
             return self.admin_site.admin_view(lambda request, *args, **kwargs: view(request, self, *args, **kwargs))
 
@@ -384,6 +426,8 @@ class ClipAdmin(admin.ModelAdmin):
         return TemplateResponse(request, "admin/studyapp/clip/import.html", context)
 
     def import_status_view(self, request, job):
+        """The status page of clip import ``job`` (needs the clip add permission): its state and the per-row report; 404
+        for an unknown job."""
         if not self.has_add_permission(request):
             raise PermissionDenied
         try:
@@ -396,14 +440,17 @@ class ClipAdmin(admin.ModelAdmin):
 
     @admin.display(description="poster")
     def thumbnail(self, clip):
+        """The list's "poster" cell."""
         return clip_display.clip_cell(clip).thumb()
 
     @admin.display(description="clip", ordering="title")
     def title_or_id(self, clip):
+        """The list's "clip" cell: the title (or the clip id) above the clip id."""
         return format_html('{}<br><code class="clip-id">{}</code>', clip.title or clip.clip_id, clip.clip_id)
 
     @admin.display(description="poster and video")
     def preview(self, clip):
+        """The change page's player: the clip's MP4 with its poster, looping as the clip does."""
         poster = reverse("studyapp:media", args=[clip.media_key, "png"]) if clip.poster else ""
         return format_html('<video src="{}" poster="{}" controls preload="metadata" {} style="max-width:480px">'
                            "</video>", reverse("studyapp:media", args=[clip.media_key, "mp4"]), poster,
@@ -411,10 +458,13 @@ class ClipAdmin(admin.ModelAdmin):
 
     @admin.action(description="Download a contact sheet (PNG) of the selected clips")
     def download_contact_sheet(self, request, queryset):
+        """The list action: a PNG contact sheet of the selected clips' posters."""
         return views_staff.contact_sheet_response(request, queryset)
 
 
 class AssignmentInline(admin.TabularInline):
+    """A participant's clip pages, read-only, in the order they are shown."""
+
     model = Assignment
     extra = 0
     can_delete = False
@@ -425,6 +475,9 @@ class AssignmentInline(admin.TabularInline):
 
 @admin.register(Participant)
 class ParticipantAdmin(StudyScopedAdmin):
+    """Participants of the user's studies, their record mostly read-only; deleting or withdrawing one says whether
+    stored analysis reports with their data were deleted."""
+
     study_field = "study"
     list_display = ["public_id", "study", "status", "external_id", "gender", "age_group", "started_at",
                     "completed_at"]
@@ -437,6 +490,7 @@ class ParticipantAdmin(StudyScopedAdmin):
     inlines = [AssignmentInline]
 
     def has_add_permission(self, request):
+        """Never: participants come from the consent page."""
         return False              # participants come from the consent page only
 
     def _say_reports_forgotten(self, request, participants) -> None:
@@ -450,15 +504,18 @@ class ParticipantAdmin(StudyScopedAdmin):
                                    "the database on each download and no longer include them.")
 
     def save_model(self, request, obj, form, change):
+        """Save; a change to withdrawn says which stored analysis reports held the participant's data."""
         super().save_model(request, obj, form, change)
         if "status" in form.changed_data and obj.status == Participant.Status.WITHDRAWN:
             self._say_reports_forgotten(request, [obj])
 
     def delete_model(self, request, obj):
+        """Delete the participant (answers and assignments with them) and say which stored reports went too."""
         super().delete_model(request, obj)
         self._say_reports_forgotten(request, [obj])
 
     def delete_queryset(self, request, queryset):
+        """The list's delete action: each participant deleted on its own, so each one's study forgets its reports."""
         gone = list(queryset.select_related("study"))
         for participant in gone:               # one by one: each deletion forgets its study's reports
             participant.delete()
@@ -471,15 +528,19 @@ PARTICIPANT_DELETE_VIEWS = ("studyapp_participant_delete", "studyapp_participant
 
 @admin.register(Response)
 class ResponseAdmin(StudyScopedAdmin):
+    """Answers of the user's studies, read-only; deleted only with their participant."""
+
     study_field = "section__study"
     list_display = ["participant", "section", "clip", "question", "answer", "response_ms", "created_at"]
     list_filter = [("section__study", admin.RelatedOnlyFieldListFilter), "section__section_type", "question"]
     search_fields = ["participant__public_id", "clip__clip_id"]
 
     def has_add_permission(self, request):
+        """Never: answers come from participants."""
         return False              # answers come from participants only
 
     def has_change_permission(self, request, obj=None):
+        """Never: an answer is kept as given."""
         return False
 
     def has_delete_permission(self, request, obj=None):
@@ -490,6 +551,7 @@ class ResponseAdmin(StudyScopedAdmin):
         return whole and super().has_delete_permission(request, obj)
 
     def formfield_for_foreignkey(self, db_field, request, **kwargs):
+        """Participant and section drop-downs offer only those of the user's studies."""
         if db_field.name == "participant":
             kwargs["queryset"] = Participant.objects.filter(study__in=studies_for(request.user).values("pk"))
         elif db_field.name == "section":

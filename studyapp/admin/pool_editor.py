@@ -81,9 +81,11 @@ class ChoiceListWidget(forms.CheckboxSelectMultiple):
     """Check boxes whose value may also be given as one comma-separated string (``gait,gesture``)."""
 
     def format_value(self, value):
+        """The ticked values, from a list or one comma-separated string."""
         return super().format_value(split_choices(value))
 
     def value_from_datadict(self, data, files, name):
+        """The posted values as a list, from several check boxes or one comma-separated string."""
         return split_choices(data.getlist(name) if hasattr(data, "getlist") else data.get(name))
 
 
@@ -98,16 +100,20 @@ class ChoiceListField(forms.MultipleChoiceField):
         self.vocabulary = tuple(vocabulary)
 
     def prepare_value(self, value):
+        """The value as one comma-separated string, the form the page posts back."""
         return ",".join(split_choices(value))
 
     def to_python(self, value):
+        """The posted value as a list of strings."""
         return split_choices(value)
 
     def clean(self, value):
+        """The chosen values in the vocabulary's order, each once; an unknown value is a field error."""
         chosen = set(super().clean(value))
         return [v for v in self.vocabulary if v in chosen]
 
     def has_changed(self, initial, data):
+        """Whether the set of values differs from the initial one (order and spelling, list or string, do not count)."""
         return set(split_choices(initial)) != set(split_choices(data))
 
 
@@ -119,6 +125,7 @@ class DatalistInput(forms.TextInput):
         self.suggestions = list(suggestions)
 
     def render(self, name, value, attrs=None, renderer=None):
+        """The text box with its ``<datalist>`` of suggestions, linked by the box's id."""
         list_id = f"{(attrs or {}).get('id', name)}_suggestions"
         box = super().render(name, value, {**(attrs or {}), "list": list_id}, renderer)
         options = format_html_join("", '<option value="{}">', ((s,) for s in self.suggestions))
@@ -137,6 +144,7 @@ class ChoiceSpec:
         self.field, self.key, self.vocabulary, self.label, self.help = field, key, tuple(vocabulary), label, help_text
 
     def form_fields(self) -> dict[str, forms.Field]:
+        """The spec's form fields by name: here one check-box list of the vocabulary."""
         return {self.field: ChoiceListField(self.vocabulary, label=self.label, help_text=self.help)}
 
     def _values(self, value) -> list[str] | None:
@@ -147,6 +155,8 @@ class ChoiceSpec:
         return None
 
     def read(self, data: dict) -> tuple[dict, dict]:
+        """(field values, the data without the keys taken): ``key`` or a list in ``key__in`` whose values are all of the
+        vocabulary, each once; anything else stays in the leftover."""
         for key in (self.key, f"{self.key}__in"):
             if key.endswith("__in") and not isinstance(data.get(key), list):
                 continue
@@ -155,6 +165,8 @@ class ChoiceSpec:
         return {}, data
 
     def write(self, values: dict) -> dict:
+        """The JSON fragment of the ticked values: one value as a string, several as a list in the vocabulary's order,
+        none as nothing."""
         chosen = [v for v in self.vocabulary if v in (values.get(self.field) or [])]
         if not chosen:
             return {}
@@ -165,6 +177,7 @@ class ChoiceSpec:
         return self.field if self.key in keys or f"{self.key}__in" in keys else None
 
     def check(self, values: dict) -> dict[str, str]:
+        """Problems between the spec's own fields (field -> message); none for a single field."""
         return {}
 
 
@@ -176,6 +189,7 @@ class TextListSpec(ChoiceSpec):
         self.suggestions = tuple(suggestions)
 
     def form_fields(self) -> dict[str, forms.Field]:
+        """One text box with the suggestions as a datalist."""
         return {self.field: forms.CharField(required=False, max_length=1000, label=self.label, help_text=self.help,
                                             widget=DatalistInput(self.suggestions))}
 
@@ -187,6 +201,8 @@ class TextListSpec(ChoiceSpec):
         return None
 
     def write(self, values: dict) -> dict:
+        """The comma-separated words as ``key``: one as a string, several as a list (duplicates dropped), none as
+        nothing."""
         chosen = list(dict.fromkeys(split_choices(values.get(self.field) or "")))
         if not chosen:
             return {}
@@ -197,15 +213,18 @@ class TristateSpec(ChoiceSpec):
     """A boolean shorthand (``transition``, ``rbf``): yes, no or any."""
 
     def form_fields(self) -> dict[str, forms.Field]:
+        """One any / yes / no drop-down."""
         return {self.field: forms.ChoiceField(choices=TRISTATE, required=False, label=self.label,
                                               help_text=self.help)}
 
     def read(self, data: dict) -> tuple[dict, dict]:
+        """Takes ``key`` when it is a boolean: yes for true, no for false."""
         if isinstance(data.get(self.key), bool):
             return {self.field: "yes" if data[self.key] else "no"}, {k: v for k, v in data.items() if k != self.key}
         return {}, data
 
     def write(self, values: dict) -> dict:
+        """``key: true`` or ``false`` for yes or no; nothing for any."""
         value = values.get(self.field) or ANY
         return {} if value == ANY else {self.key: value == "yes"}
 
@@ -214,11 +233,13 @@ class SignSpec(ChoiceSpec):
     """``weight`` compared with 0: ``weight__gt: 0``, ``weight__lt: 0`` or ``weight: 0``."""
 
     def form_fields(self) -> dict[str, forms.Field]:
+        """One drop-down of the signs (any, positive, negative, zero)."""
         choices = [(ANY, "any"), *((name, label) for name, (_, label) in SIGNS.items())]
         return {self.field: forms.ChoiceField(choices=choices, required=False, label=self.label,
                                               help_text=self.help)}
 
     def read(self, data: dict) -> tuple[dict, dict]:
+        """Takes the first of ``key__gt``, ``key__lt`` or ``key`` that compares with exactly 0."""
         for name, (lookup, _) in SIGNS.items():
             key = self.key + lookup
             if _is_number(data.get(key)) and data[key] == 0:
@@ -226,10 +247,12 @@ class SignSpec(ChoiceSpec):
         return {}, data
 
     def write(self, values: dict) -> dict:
+        """The sign's comparison with 0 (e.g. ``weight__gt: 0``); nothing for any."""
         name = values.get(self.field) or ANY
         return {} if name == ANY else {self.key + SIGNS[name][0]: 0}
 
     def owner(self, keys: tuple[str, ...]) -> str | None:
+        """The field, for an error about any of the sign's keys."""
         return self.field if any(self.key + lookup in keys for lookup, _ in SIGNS.values()) else None
 
 
@@ -243,6 +266,7 @@ class RangeSpec(ChoiceSpec):
         self.low, self.high = f"{field}_min", f"{field}_max"
 
     def form_fields(self) -> dict[str, forms.Field]:
+        """The "from" and "to" fields: whole numbers 0 to N_FEATURES_MAX, or numbers within +-WEIGHT_LIMIT."""
         def make(label):
             if self.integer:
                 return forms.IntegerField(required=False, min_value=0, max_value=N_FEATURES_MAX, label=label,
@@ -255,6 +279,8 @@ class RangeSpec(ChoiceSpec):
         return _is_int(value) if self.integer else _is_number(value)
 
     def read(self, data: dict) -> tuple[dict, dict]:
+        """Takes ``key__gte`` and ``key__lte`` (or an exact ``key`` alone, as both ends) when they are numbers of the
+        right kind."""
         gte, lte, values = f"{self.key}__gte", f"{self.key}__lte", {}
         if self.exact and self._ok(data.get(self.key)) and gte not in data and lte not in data:
             values = {self.low: data[self.key], self.high: data[self.key]}
@@ -265,6 +291,8 @@ class RangeSpec(ChoiceSpec):
         return values, {k: v for k, v in data.items() if k not in taken}
 
     def write(self, values: dict) -> dict:
+        """The range as ``key__gte`` / ``key__lte`` (blank ends left out), or ``key`` when exact and both ends are
+        equal."""
         low, high = values.get(self.low), values.get(self.high)
         if self.exact and low is not None and low == high:
             return {self.key: low}
@@ -272,11 +300,13 @@ class RangeSpec(ChoiceSpec):
         return {k: v for k, v in out.items() if v is not None}
 
     def owner(self, keys: tuple[str, ...]) -> str | None:
+        """"to" for an error about ``key__lte``, "from" for ``key__gte`` or ``key``."""
         if f"{self.key}__lte" in keys:
             return self.high
         return self.low if f"{self.key}__gte" in keys or self.key in keys else None
 
     def check(self, values: dict) -> dict[str, str]:
+        """An error on "to" when the range is upside down (from > to)."""
         low, high = values.get(self.low), values.get(self.high)
         if low is not None and high is not None and low > high:
             return {self.high: f"{high:g} is below {self.label.lower()} from ({low:g})"}
@@ -287,14 +317,17 @@ class FlagSpec(ChoiceSpec):
     """A switch that only means something when on (``include_flagged: true``, ``practice: true``): a check box."""
 
     def form_fields(self) -> dict[str, forms.Field]:
+        """One check box."""
         return {self.field: forms.BooleanField(required=False, label=self.label, help_text=self.help)}
 
     def read(self, data: dict) -> tuple[dict, dict]:
+        """Takes ``key`` only when it is exactly true (false is the default and stays in the leftover)."""
         if data.get(self.key) is True:
             return {self.field: True}, {k: v for k, v in data.items() if k != self.key}
         return {}, data
 
     def write(self, values: dict) -> dict:
+        """``key: true`` when ticked, nothing otherwise."""
         return {self.key: True} if values.get(self.field) else {}
 
 
@@ -307,16 +340,19 @@ class SelectSpec(ChoiceSpec):
         self.default = default
 
     def form_fields(self) -> dict[str, forms.Field]:
+        """One drop-down of the vocabulary whose blank choice names the default."""
         choices = [("", f"default ({self.default})"), *((v, v) for v in self.vocabulary)]
         return {self.field: forms.ChoiceField(choices=choices, required=False, label=self.label,
                                               help_text=self.help)}
 
     def read(self, data: dict) -> tuple[dict, dict]:
+        """Takes ``key`` when it is one value of the vocabulary."""
         if isinstance(data.get(self.key), str) and data[self.key] in self.vocabulary:
             return {self.field: data[self.key]}, {k: v for k, v in data.items() if k != self.key}
         return {}, data
 
     def write(self, values: dict) -> dict:
+        """``key: value``, or nothing for the blank (default) choice."""
         value = values.get(self.field)
         return {self.key: value} if value else {}
 
@@ -329,9 +365,12 @@ class SubPoolSpec(ChoiceSpec):
         self.inner = inner
 
     def form_fields(self) -> dict[str, forms.Field]:
+        """The inner specs' fields, all on the page."""
         return {name: field for spec in self.inner for name, field in spec.form_fields().items()}
 
     def read(self, data: dict) -> tuple[dict, dict]:
+        """Reads ``pool[name]`` with the inner specs; the sub-pool's leftover keys stay under its name in the
+        leftover."""
         sub = data.get(self.key)
         if not isinstance(sub, dict) or not sub:
             return {}, data
@@ -340,14 +379,17 @@ class SubPoolSpec(ChoiceSpec):
         return values, ({**remaining, self.key: rest} if rest else remaining)
 
     def write(self, values: dict) -> dict:
+        """``{name: {...}}`` of the inner specs' values, nothing when they are all blank."""
         sub = write_specs(self.inner, values)
         return {self.key: sub} if sub else {}
 
     def owner(self, keys: tuple[str, ...]) -> str | None:
+        """The inner field of an error about ``name.<key>``, or None."""
         inner = tuple(k.removeprefix(f"{self.key}.") for k in keys if k.startswith(f"{self.key}."))
         return next((field for spec in self.inner if (field := spec.owner(inner))), None) if inner else None
 
     def check(self, values: dict) -> dict[str, str]:
+        """The inner specs' problems, together."""
         return {k: v for spec in self.inner for k, v in spec.check(values).items()}
 
 
@@ -358,11 +400,13 @@ class AnchorsSpec(ChoiceSpec):
         super().__init__(field, "anchors", answer_values(NATURALNESS), "Anchor")
 
     def form_fields(self) -> dict[str, forms.Field]:
+        """One text box per value of the naturalness scale, ``<field>_<value>``."""
         return {f"{self.field}_{v}": forms.CharField(
             required=False, max_length=300, label=f"Label of {v}",
             help_text="all blank: the default gait anchors" if i == 0 else "") for i, v in enumerate(self.vocabulary)}
 
     def read(self, data: dict) -> tuple[dict, dict]:
+        """Takes ``anchors`` when every key is a scale value and every label a non-blank, unpadded string."""
         anchors = data.get(self.key)
         if not isinstance(anchors, dict) or not anchors or not all(
                 k in self.vocabulary and isinstance(v, str) and v.strip() == v and v for k, v in anchors.items()):
@@ -371,10 +415,12 @@ class AnchorsSpec(ChoiceSpec):
                 {k: v for k, v in data.items() if k != self.key})
 
     def write(self, values: dict) -> dict:
+        """``anchors`` of the filled-in labels, nothing when all are blank."""
         anchors = {v: values[f"{self.field}_{v}"] for v in self.vocabulary if values.get(f"{self.field}_{v}")}
         return {self.key: anchors} if anchors else {}
 
     def owner(self, keys: tuple[str, ...]) -> str | None:
+        """The label box of the scale value an error names (``anchors.<value>``), else the first one."""
         value = next((k.removeprefix(f"{self.key}.") for k in keys if k.startswith(f"{self.key}.")), None)
         if value in self.vocabulary:
             return f"{self.field}_{value}"
@@ -389,6 +435,7 @@ class ValueSpec(ChoiceSpec):
         self.field_class, self.field_kwargs = field_class, field_kwargs
 
     def form_fields(self) -> dict[str, forms.Field]:
+        """One field of the spec's field class and arguments, not required."""
         return {self.field: self.field_class(required=False, label=self.label, help_text=self.help,
                                              **self.field_kwargs)}
 
@@ -399,11 +446,14 @@ class ValueSpec(ChoiceSpec):
         return isinstance(value, str) and value.strip() == value and value != ""
 
     def read(self, data: dict) -> tuple[dict, dict]:
+        """Takes ``key`` when the field could show it: an integer within the field's bounds, or a non-blank unpadded
+        string."""
         if self.key in data and self._accepts(data[self.key]):
             return {self.field: data[self.key]}, {k: v for k, v in data.items() if k != self.key}
         return {}, data
 
     def write(self, values: dict) -> dict:
+        """``key: value``, nothing when blank."""
         value = values.get(self.field)
         return {} if value is None or value == "" else {self.key: value}
 
@@ -419,6 +469,7 @@ class AttentionSpec(ChoiceSpec):
         super().__init__(field, "attention_checks", (), "Attention checks")
 
     def form_fields(self) -> dict[str, forms.Field]:
+        """The instructed answer, count (1 to 100), positions, question and check clip fields."""
         f = self.field
         return {
             f"{f}_answer": forms.CharField(required=False, max_length=40, label="Attention check: instructed answer",
@@ -440,6 +491,7 @@ class AttentionSpec(ChoiceSpec):
         return [int(p) for p in parts] if all(p.isdigit() and int(p) >= 1 for p in parts) else None
 
     def read(self, data: dict) -> tuple[dict, dict]:
+        """Takes ``attention_checks`` when every part is known and well-formed; a list of positions shows as "3, 7"."""
         config = data.get(self.key)
         if not isinstance(config, dict) or not config or set(config) - set(self.PARTS):
             return {}, data
@@ -457,6 +509,8 @@ class AttentionSpec(ChoiceSpec):
         return values, {k: v for k, v in data.items() if k != self.key}
 
     def write(self, values: dict) -> dict:
+        """``attention_checks`` of the filled-in parts, positions as "random" or a list of places; nothing when all are
+        blank."""
         config = {k: values.get(f"{self.field}_{k}") for k in self.PARTS}
         positions = (config["positions"] or "").strip()
         config["positions"] = "random" if positions == "random" else (self._places(positions) if positions else None)
@@ -464,12 +518,14 @@ class AttentionSpec(ChoiceSpec):
         return {self.key: config} if config else {}
 
     def owner(self, keys: tuple[str, ...]) -> str | None:
+        """The part's field an error about ``attention_checks.<part>`` names, the answer field for the whole config."""
         parts = [k.removeprefix(f"{self.key}.") for k in keys if k == self.key or k.startswith(f"{self.key}.")]
         if not parts:
             return None
         return f"{self.field}_{next((p for p in parts if p in self.PARTS), 'answer')}"
 
     def check(self, values: dict) -> dict[str, str]:
+        """An error on the positions field unless it says random or lists whole numbers from 1."""
         positions = (values.get(f"{self.field}_positions") or "").strip()
         if positions and positions != "random" and self._places(positions) is None:
             return {f"{self.field}_positions": "write random, or whole numbers from 1 separated by commas"}
@@ -485,6 +541,7 @@ class NormingSpec(ChoiceSpec):
         self.k = f"{field}_ratings_per_clip"
 
     def form_fields(self) -> dict[str, forms.Field]:
+        """The "Norming section" check box and the ratings per clip (K, 1 to MAX_RATINGS_PER_CLIP)."""
         return {
             self.field: forms.BooleanField(
                 required=False, label="Norming section",
@@ -497,6 +554,8 @@ class NormingSpec(ChoiceSpec):
                           "K ratings before it opens")}
 
     def read(self, data: dict) -> tuple[dict, dict]:
+        """Takes ``norming`` when it is an object holding at most a valid ``ratings_per_clip``: the box ticked, K filled
+        in."""
         config = data.get(self.key)
         if not isinstance(config, dict) or set(config) - {"ratings_per_clip"}:
             return {}, data
@@ -507,12 +566,14 @@ class NormingSpec(ChoiceSpec):
         return values, {key: v for key, v in data.items() if key != self.key}
 
     def write(self, values: dict) -> dict:
+        """``norming: {}`` when ticked without K, ``{"ratings_per_clip": K}`` when K is given, nothing otherwise."""
         k = values.get(self.k)
         if not values.get(self.field) and k is None:
             return {}
         return {self.key: {} if k is None else {"ratings_per_clip": k}}
 
     def owner(self, keys: tuple[str, ...]) -> str | None:
+        """K for an error about ``norming.ratings_per_clip``, the check box for the rest of ``norming``."""
         if f"{self.key}.ratings_per_clip" in keys:
             return self.k
         return self.field if self.key in keys or any(k.startswith(f"{self.key}.") for k in keys) else None
@@ -528,6 +589,7 @@ def read_specs(specs: list[ChoiceSpec], data: dict) -> tuple[dict, dict]:
 
 
 def write_specs(specs: list[ChoiceSpec], values: dict) -> dict:
+    """The JSON every spec writes from the field values, merged in the specs' order."""
     out = {}
     for spec in specs:
         out.update(spec.write(values))

@@ -74,12 +74,15 @@ class Impact:
     changed: tuple[Section, ...]
 
     def why(self) -> str:
+        """Why the section's clips changed: it reuses an edited section's clips, or its pool overlaps another's."""
         reused = next((s for s in self.changed if s.pk == self.section.reuse_section_id), None)
         if reused is not None:
             return f"it shows the clips {describe(reused)} gives"
         return "its pool shares clips with another section, and a participant never sees a clip twice"
 
     def message(self, verb: str = "Saving") -> str:
+        """The admin message of this impact, e.g. "Saving section 2 changes what section 3 gives each participant: 6
+        clips before, 4 now (...)"."""
         names = ", ".join(describe(s) for s in self.changed) or "this change"
         return (f"{verb} {names} changes what {describe(self.section)} gives each participant: {self.before} "
                 f"clip{'' if self.before == 1 else 's'} before, {self.after} now ({self.why()}).")

@@ -34,6 +34,7 @@ class FirstStepChangeList(ChangeList):
     """The study list, whose links open a study at its first step."""
 
     def url_for_result(self, result):
+        """The row's change URL at the first step of the study page."""
         return f"{super().url_for_result(result)}?{study_steps.STEP_PARAM}={study_steps.STEPS[0].key}"
 
 
@@ -45,6 +46,8 @@ class SectionStepsMixin:
     clips_given: dict[int, int] | None = None
 
     def get_fieldsets(self, request, obj=None):
+        """The section fieldsets of the page's step (all without a step); the section type is added where the step's
+        fieldsets lack it, so the checks and the page's script know it."""
         fieldsets = super().get_fieldsets(request, obj)
         step = study_steps.page_step(request, obj)
         if step is None:
@@ -56,6 +59,8 @@ class SectionStepsMixin:
         return chosen
 
     def get_formset(self, request, obj=None, **kwargs):
+        """The section formset of the step: the type hidden on steps that do not add sections, and the clips each
+        section gives measured when the step shows the pools."""
         step = study_steps.page_step(request, obj)
         if step is not None and not step.adds_sections:
             kwargs["widgets"] = {**kwargs.get("widgets", {}), "section_type": HiddenInput}
@@ -69,9 +74,11 @@ class SectionStepsMixin:
         return step is None or step.adds_sections
 
     def has_add_permission(self, request, obj=None):
+        """Sections are added only on the step that adds sections (or the page without steps)."""
         return self._adds_here(request, obj) and super().has_add_permission(request, obj)
 
     def has_delete_permission(self, request, obj=None):
+        """Sections are deleted only on the step that adds sections (or the page without steps)."""
         return self._adds_here(request, obj) and super().has_delete_permission(request, obj)
 
 
@@ -80,18 +87,23 @@ class StudyStepsMixin:
     context, the move view, and the impact warnings after a save of sections."""
 
     def get_fieldsets(self, request, obj=None):
+        """The study fieldsets of the page's step (all without a step)."""
         fieldsets = super().get_fieldsets(request, obj)
         step = study_steps.page_step(request, obj)
         return fieldsets if step is None else study_steps.step_fieldsets(fieldsets, step.fieldsets)
 
     def get_inlines(self, request, obj):
+        """The section inline only on steps that show section fieldsets (and the page without steps)."""
         step = study_steps.page_step(request, obj)
         return super().get_inlines(request, obj) if step is None or step.section_fieldsets else []
 
     def get_changelist(self, request, **kwargs):
+        """The study list whose links open the first step."""
         return FirstStepChangeList
 
     def change_view(self, request, object_id, form_url="", extra_context=None):
+        """The study page at the ``?step=`` step with the step bar and, on the sections step, the order buttons; an
+        unknown step is an error message and a redirect to the whole page."""
         try:
             step = study_steps.request_step(request)
         except study_steps.UnknownStepError as exc:
@@ -113,6 +125,7 @@ class StudyStepsMixin:
         return {"rows": rows, "may_move": may, "refusal": section_order.move_refusal(study) if may else ""}
 
     def get_urls(self):
+        """The admin's URLs plus the section move view."""
         move = path("<path:object_id>/sections/<int:section_id>/move/<str:direction>/",
                     self.admin_site.admin_view(self.move_section_view), name="studyapp_study_move_section")
         return [move, *super().get_urls()]

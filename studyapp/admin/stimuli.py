@@ -47,6 +47,8 @@ def _past_records() -> list[dict]:
 
 
 def builtin_rows(past: list[dict]) -> list[BuiltinPlan]:
+    """The stimuli page's list of built-in plans (unloadable or empty ones left out), with the expected render time (s)
+    from ``past`` clip records."""
     rows = []
     for name in builtin_plans():
         try:

@@ -16,10 +16,12 @@ KEY_RE = re.compile(r"^[a-z][a-z0-9_]{0,39}$")
 
 
 def feedback_names(i: int) -> tuple[str, str, str]:
+    """The key, text and kind field names of feedback row ``i``."""
     return f"feedback_{i}_key", f"feedback_{i}_text", f"feedback_{i}_kind"
 
 
 def rule_name(key: str) -> str:
+    """The form field of exclusion rule ``key``."""
     return f"rule_{key}"
 
 
@@ -61,6 +63,7 @@ def set_initial(form: forms.Form) -> None:
 
 
 def touched(form: forms.Form, names) -> bool:
+    """Whether any of the named fields was changed on the page (then the fields, not the raw JSON, are saved)."""
     return any(name in form.changed_data for name in names)
 
 

@@ -58,6 +58,8 @@ class PoolCount:
     page: bool = False
 
     def summary(self) -> str:
+        """The count as the section form shows it, e.g. "12 clips in the catalogue match (generated 6, source 6)", or
+        why there is none."""
         if self.page:
             return "an instruction or break page shows no clips (leave the pool empty)"
         if self.total is None:

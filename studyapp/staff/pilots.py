@@ -11,6 +11,7 @@ from ..models import Assignment, Participant, SectionClipCount, Study
 
 
 def pilot_count(study: Study) -> int:
+    """How many participants of the study consented in pilot mode (shown on the progress page)."""
     return Participant.objects.filter(study=study, pilot=True).count()
 
 

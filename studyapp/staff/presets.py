@@ -20,6 +20,7 @@ _OWN_PLAN = object()
 
 
 def preset_choices() -> list[tuple[str, str]]:
+    """(key, title) of every preset, the choices of the "New study from preset" form."""
     return [(key, value["title"]) for key, value in PRESETS.items()]
 
 

@@ -35,6 +35,8 @@ class Funnel:
 
     @property
     def steps(self) -> list[tuple[str, int]]:
+        """The funnel's rows for the progress page: (label, participants) for consented, started and completed, then one
+        "excluded: <rule>" row per exclusion rule of the current report."""
         out = [("consented", self.consented), ("started", self.started), ("completed", self.completed)]
         if self.excluded:
             out += [(f"excluded: {rule.replace('_', ' ')}", n) for rule, n in self.excluded.items()]
@@ -43,6 +45,9 @@ class Funnel:
 
 @dataclass
 class SectionTime:
+    """One section's row of the progress page: the median time a participant spent in it (s; None when nobody finished
+    it) over ``n`` timed participants."""
+
     section_id: int
     label: str
     median_s: float | None
@@ -51,6 +56,9 @@ class SectionTime:
 
 @dataclass
 class ProgressStats:
+    """Everything the progress page charts: the funnel, the median time per participant (s) over ``n_timed``
+    participants, the time per section and (date, answers) per day."""
+
     funnel: Funnel
     median_participant_s: float | None
     n_timed: int
@@ -59,6 +67,7 @@ class ProgressStats:
 
     @property
     def max_per_day(self) -> int:
+        """The most answers on one day (0 without any), the scale of the per-day chart."""
         return max((n for _, n in self.per_day), default=0)
 
 

@@ -70,10 +70,12 @@ class ReportState:
 
     @property
     def started(self) -> datetime | None:
+        """When the running build started, as an aware UTC datetime (None when unknown or not running)."""
         return datetime.fromtimestamp(self.started_at, UTC) if self.started_at else None
 
     @property
     def finished(self) -> datetime | None:
+        """When the zip was written, as an aware UTC datetime (None unless ready)."""
         return datetime.fromtimestamp(self.finished_at, UTC) if self.finished_at else None
 
 
@@ -94,6 +96,8 @@ def data_version(study: Study) -> str:
 
 
 def version_dir(study_id: int, version: str) -> Path:
+    """The folder of a study's report for one data version, REPORTS_DIR/<study id>/<version>; ValueError for a version
+    that is not hex digits, so no path can leave REPORTS_DIR."""
     if not version or not all(c in "0123456789abcdef" for c in version):
         raise ValueError(f"not a data version: {version!r}")
     return Path(settings.REPORTS_DIR) / str(int(study_id)) / version
@@ -160,6 +164,8 @@ def report_state(study: Study, version: str | None = None) -> ReportState:
 
 
 def build_command(study_id: int, version: str, lock_fd: int) -> list[str]:
+    """The argv of the detached ``manage.py build_report`` run for this version, handed the already locked
+    ``lock_fd``."""
     return [sys.executable, str(MANAGE_PY), "build_report", str(study_id), "--data-version", version,
             "--lock-fd", str(lock_fd)]
 

@@ -56,6 +56,8 @@ from .study_clone import clone_study
 @staff_permission_required("studyapp.add_study")
 @require_http_methods(["GET", "POST"])
 def create_from_preset(request):
+    """The "New study from preset" page (studyapp.add_study): creates a draft study owned by the researcher, offers to
+    render the preset's plan when clips are missing and opens the study's admin page."""
     form = PresetStudyForm(request.POST or None)
     if request.method == "POST" and form.is_valid():
         d = form.cleaned_data
@@ -122,6 +124,8 @@ def _preview_seed(request) -> int:
 
 @staff_permission_required("studyapp.view_study")
 def preview_start(request, study_id: int):
+    """The preview's consent page (studyapp.view_study), in the study's language, for a preview participant with the
+    ?seed= seed."""
     study = study_of(request, study_id)
     activate_study_language(study)     # the preview shows the pages as participants see them
     seed = _preview_seed(request)
@@ -188,6 +192,8 @@ def preview_section_page(request, study, section, seed: int, next_url: str, done
 
 @staff_permission_required("studyapp.view_study")
 def progress(request, study_id: int):
+    """The study's progress page (studyapp.view_study): participants by status, the funnel and times, per-section clip
+    assignments and answers, the report's state, the participant and Prolific links and the pilot count."""
     study = study_of(request, study_id)
     counts = {row["status"]: row["n"] for row in study.participants.values("status").annotate(n=Count("id"))}
     sections = []
@@ -262,6 +268,8 @@ def share_preview(request, study_id: int):
 
 @staff_permission_required(EXPORT_PERMISSION)
 def export_csv(request, study_id: int, kind: str):
+    """One CSV export of the study (``kind`` one of EXPORT_KINDS, else 404), streamed as a download; needs the export
+    permission."""
     study = study_of(request, study_id)
     if kind not in EXPORT_KINDS:
         raise Http404("unknown export")

@@ -12,6 +12,8 @@ from ..permissions import staff_permission_required, study_of
 
 @staff_permission_required("studyapp.view_study")
 def norming_monitor(request, study_id: int):
+    """The norming monitor page (studyapp.view_study): per norming section its design and each clip's ratings so far,
+    with how many clips are still below K."""
     study = study_of(request, study_id)
     sections = []
     for row in design_rows(study):

@@ -26,6 +26,8 @@ def _study(token: str):
 
 @never_cache
 def shared_preview(request, token: str):
+    """The shared preview's consent page for a valid link (else 404), in the study's language, saying when the link
+    expires."""
     study, expires = _study(token)
     activate_study_language(study)
     seed = _preview_seed(request)
@@ -38,6 +40,8 @@ def shared_preview(request, token: str):
 @never_cache
 @require_http_methods(["GET", "POST"])
 def shared_preview_item(request, token: str, n: int):
+    """Clip page n of the shared preview, answers checked and never stored; past the last page a done page offers a run
+    with the next seed."""
     study, _ = _study(token)
     activate_study_language(study)
     seed = _preview_seed(request)

@@ -6,13 +6,19 @@ from studyapp.management.cli import study_by_slug
 
 
 class Command(BaseCommand):
+    """``manage.py analyze STUDY --out DIR``: the study's CSV exports and the papers' statistics (report.json, tables,
+    figures, report.html) in one folder."""
+
     help = "Run the statistics of the papers on STUDY (slug): report.json, tables, figures, report.html in --out."
 
     def add_arguments(self, parser):
+        """STUDY (slug) and the required --out folder."""
         parser.add_argument("study", help="study slug")
         parser.add_argument("--out", required=True, help="output folder (created if missing)")
 
     def handle(self, *args, study, out, **options):
+        """Write the exports and the report into --out and list what the report holds; a missing analysis library or
+        exports that do not validate end the command with an error naming the CSV folder."""
         obj = study_by_slug(study)
         try:
             result = run_report(obj, out)

@@ -16,6 +16,7 @@ from studyapp.staff import reports
 
 
 def find_study(ref: str) -> Study:
+    """The study whose id (all digits) or slug is ``ref``; CommandError when there is none."""
     study = (Study.objects.filter(pk=int(ref)).first() if ref.isdigit() else None) or \
         Study.objects.filter(slug=ref).first()
     if study is None:
@@ -24,9 +25,13 @@ def find_study(ref: str) -> Study:
 
 
 class Command(BaseCommand):
+    """``manage.py build_report STUDY``: the analysis-report zip of a study's current data, as the staff "Build report"
+    button starts it."""
+
     help = "Build STUDY's analysis report zip for its current data (kept in REPORTS_DIR until the data change)."
 
     def add_arguments(self, parser):
+        """STUDY (id or slug), --data-version and --lock-fd (passed by the staff page's detached run) and --force."""
         parser.add_argument("study", help="study id or slug")
         parser.add_argument("--data-version", default="", help="data version to build (default: the current one)")
         parser.add_argument("--lock-fd", type=int, default=-1,
@@ -34,6 +39,9 @@ class Command(BaseCommand):
         parser.add_argument("--force", action="store_true", help="rebuild even when the zip exists")
 
     def handle(self, *args, study, data_version, lock_fd, force, **options):
+        """Build the zip for the data version unless it already exists (or --force), holding the version's build lock,
+        taken here when no --lock-fd was passed and closed at the end; a failed build reports the error the build left
+        behind."""
         obj = find_study(study)
         version = data_version or reports.data_version(obj)
         folder = reports.version_dir(obj.pk, version)

@@ -49,9 +49,15 @@ def _require_migrated_database() -> None:
 
 
 class Command(BaseCommand):
+    """``manage.py generate_clips --plan PLAN``: render a stimulus plan's clips, catalogue them in clips.csv and as Clip
+    rows, and report their quality flags and the presets' coverage."""
+
     help = "Render the clips of a stimulus plan (built-in name or YAML/JSON file) and catalogue them."
 
     def add_arguments(self, parser):
+        """The plan (built-in name or file) and the render options: workers or a Dask scheduler, WebM, a limit, the
+        torch device of the network generators, a contact sheet, a progress file for the admin's render jobs, and
+        --no-db."""
         parser.add_argument("--plan", required=True, help="built-in plan (demo, seed000, seed003, seed004) or a file")
         parser.add_argument("--workers", type=int, default=1, help="worker processes (default 1)")
         parser.add_argument("--webm", action="store_true", help="also write VP9 WebM files")
@@ -74,6 +80,9 @@ class Command(BaseCommand):
                                  "of local worker processes")
 
     def handle(self, *args, **opts):
+        """Validate the options and the plan, render what is missing, write clips.csv and (unless --no-db) upsert the
+        Clip rows and retire clips the plan no longer makes; then print the counts, the quality summary and each
+        preset's coverage. Ends with CommandError when any clip failed, after cataloguing the others."""
         if opts["workers"] < 1:
             raise CommandError(f"--workers must be at least 1, got {opts['workers']}")
         if opts["limit"] is not None and opts["limit"] < 1:
@@ -169,12 +178,16 @@ class ProgressFile:
         self.write()
 
     def write(self) -> None:
+        """Replace the JSON file with the current state (through a temporary file and a rename, so a reader never sees
+        half of it), stamping ``updated`` (Unix seconds)."""
         self.state["updated"] = time.time()
         tmp = self.path.with_name(f".{self.path.name}.tmp{os.getpid()}")
         tmp.write_text(json.dumps(self.state), encoding="utf-8")
         os.replace(tmp, self.path)
 
     def event(self, kind: str, info: dict) -> None:
+        """Count a runner event: ``plan`` sets the totals, ``done`` and ``fail`` add one and log a line; other events
+        are ignored."""
         if kind == "plan":
             self.state.update(total=info["total"], todo=info["todo"], skipped=info["skipped"])
         elif kind == "done":
@@ -189,6 +202,7 @@ class ProgressFile:
         self.write()
 
     def finish(self, rendered: int, skipped: int, failed: int, clip_ids: list[str]) -> None:
+        """Store the final counts and the catalogued clip ids and mark the render finished."""
         self.state.update(done=rendered, skipped=skipped, failed=failed, finished=True, clip_ids=clip_ids)
         self.write()
 

@@ -83,9 +83,15 @@ def _render_size(text: str | None) -> dict:
 
 
 class Command(BaseCommand):
+    """``manage.py import_clips MANIFEST.csv``: a researcher's own videos and motion files into the catalogue, with a
+    per-row report."""
+
     help = "Import videos and motion files named in a manifest CSV as clips with origin 'imported'."
 
     def add_arguments(self, parser):
+        """The manifest, --dry-run and --report, the video limits (seconds, MiB), audio and WebM delivery, the
+        collection name, the render size and observer of motion files, ffmpeg threads and the upload folder to remove
+        afterwards."""
         parser.add_argument("manifest", help="the manifest CSV (paths in it are relative to its folder)")
         parser.add_argument("--dry-run", action="store_true", help="check every row, write nothing")
         parser.add_argument("--report", default=None, help=f"where the report goes (default: {REPORT_NAME} beside "
@@ -111,6 +117,7 @@ class Command(BaseCommand):
                                  "whether it imported, failed or was a dry run")
 
     def handle(self, *args, **opts):
+        """Run the import; the --remove-after folder (which must hold the manifest) is removed whatever the outcome."""
         folder = Path(opts["remove_after"]).resolve() if opts.get("remove_after") else None
         if folder is not None and not Path(opts["manifest"]).resolve().is_relative_to(folder):
             raise CommandError(f"--remove-after {folder}: the manifest is not inside it")

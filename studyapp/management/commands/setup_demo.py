@@ -11,15 +11,20 @@ from studyapp.staff.presets import create_study_from_preset
 
 
 class Command(BaseCommand):
+    """``manage.py setup_demo``: the open, publicly listed demo study built from a preset, with its participant URL."""
+
     help = "Create the demo study (every section type) from the clips in the database and print its URL."
 
     def add_arguments(self, parser):
+        """--slug, --base-url of the printed link, --preset and --owner (a username)."""
         parser.add_argument("--slug", default="demo")
         parser.add_argument("--base-url", default="http://127.0.0.1:8000")
         parser.add_argument("--preset", default="demo", help="preset to build the study from (default: demo)")
         parser.add_argument("--owner", default="", help="username of an account to make an owner of the study")
 
     def handle(self, *args, slug, base_url, preset, owner="", **options):
+        """Create the study from the preset, or reopen the existing one, add the owner and print each section's pool
+        size (warning about empty pools) and the participant URL. Requires a non-empty clip catalogue."""
         owner_user = None
         if owner:
             owner_user = get_user_model().objects.filter(username=owner).first()

@@ -17,16 +17,23 @@ from studyapp.management.cli import mirror_arguments, mirrored_namespace
 
 
 class Command(BaseCommand):
+    """``manage.py train_gesture``: train the seed 003 gesture network with the options of ``python -m
+    generation.gesture.train``."""
+
     help = ("Train the seed 003 gesture network on the synthetic sentence/procedural-gesture corpus; "
             "the same options as `python -m generation.gesture.train` (--config small|paper, "
             "--device auto|cpu|cuda[:N], --amp).")
 
     def add_arguments(self, parser):
+        """The library parser's options, mirrored, plus --corpus (an imported gesture corpus to train on)."""
         mirror_arguments(parser, build_parser())
         parser.add_argument("--corpus", help="train on an imported gesture corpus (python -m generation.mocap corpus "
                                              "--skeleton gesture) instead of the synthetic one")
 
     def handle(self, *args, **options):
+        """Train on the synthetic corpus, the rated clips' soft labels (--soft-labels, motions from MEDIA_ROOT/motions
+        by default) or an imported corpus (--corpus; not with --soft-labels), and print epochs, seconds, device, best
+        selection score and where the weights went."""
         ns = mirrored_namespace(build_parser(), options)
         if ns.motions is None:
             ns.motions = Path(settings.MEDIA_ROOT) / "motions"
