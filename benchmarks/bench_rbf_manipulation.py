@@ -68,7 +68,8 @@ def base_section(obs, clips, base) -> dict:
 def cross_dataset_section(clips) -> dict:
     """Energy and gender scales trained on dataset 2's training takes, reading every dataset-1 take of their classes
     (other actors, other sessions): {scale: {class: {"takes", "recall"}}}."""
-    from generation.quality.style_observer import StyleObserver, scale_clips
+    from generation.mocap.style_scales import scale_clips
+    from generation.quality.style_observer import StyleObserver
 
     out = {}
     for scale in ("energy", "gender"):

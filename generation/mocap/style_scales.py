@@ -1,9 +1,12 @@
 """The style scales of the real Bandai Namco walks (Kobayashi et al. 2023, arXiv:2306.08861, CC BY-NC 4.0) on which
 seed 004's themes are judged: each scale's classes and the corpus styles that make them, the datasets that hold
-them, and where each theme sits on its scale. Read by the style observers of ``generation.quality`` and
-``generation.rbf`` alike, so both judge a theme against the same real walks.
+them, and where each theme sits on its scale; which real walks belong to a scale (:func:`scale_clips`) and how a
+scale's held-out readings add up per class (:func:`class_recall`). Read by the style observers of
+``generation.quality`` and ``generation.rbf`` alike, so both judge a theme against the same real walks.
 """
 from __future__ import annotations
+
+import numpy as np
 
 #: scale -> {class: corpus styles}
 SCALES: dict[str, dict[str, tuple[str, ...]]] = {
@@ -19,3 +22,27 @@ THEME_SCALE = {"happy": ("emotion", "happy"), "sad": ("emotion", "sad"), "energe
                "tired": ("energy", "tired"), "feminine": ("gender", "feminine"), "masculine": ("gender", "masculine")}
 #: scale -> its unstyled class
 NEUTRAL_CLASS = {"energy": "normal", "gender": "normal", "emotion": "neutral"}
+
+
+def scale_clips(clips: list, scale: str, datasets: tuple[str, ...] | None = None) -> list[tuple[object, str]]:
+    """(clip, class) for the straight walks of ``clips`` in ``datasets`` (default :data:`SCALE_DATASETS`) that
+    belong to one of ``scale``'s classes."""
+    if scale not in SCALES:
+        raise ValueError(f"unknown style scale {scale!r}; expected one of {sorted(SCALES)}")
+    style_class = {s: k for k, styles in SCALES[scale].items() for s in styles}
+    datasets = SCALE_DATASETS[scale] if datasets is None else datasets
+    return [(c, style_class[c.style]) for c in clips
+            if c.content == "walk" and c.dataset in datasets and c.style in style_class]
+
+
+def class_recall(rows: list[dict], classes) -> dict:
+    """Per class of ``classes``, from readings ``rows`` ({"class", "top", "p": {class: probability}, ...}):
+    {"recall": {class: share of its rows read as it, None without rows}, "takes": {class: n},
+    "mean_p": {class: mean probability of the own class, None without rows}, "rows": rows}."""
+    recall, takes, mean_p = {}, {}, {}
+    for k in classes:
+        mine = [r for r in rows if r["class"] == k]
+        takes[k] = len(mine)
+        recall[k] = (sum(r["top"] == k for r in mine) / len(mine)) if mine else None
+        mean_p[k] = float(np.mean([r["p"][k] for r in mine])) if mine else None
+    return {"recall": recall, "takes": takes, "mean_p": mean_p, "rows": rows}

@@ -28,20 +28,11 @@ import numpy as np
 from generation.core.motion import Motion
 from generation.core.skeleton import GAIT_JOINTS
 from generation.mocap.real_corpus import DEFAULT_PATH, load_real_corpus
-from generation.mocap.style_scales import SCALE_DATASETS, SCALES, THEME_SCALE
+from generation.mocap.style_scales import SCALES, THEME_SCALE, class_recall, scale_clips
 
 from .real_observer import window_descriptors
 
 REGULARISATION_C = 0.1
-
-
-def scale_clips(clips: list, scale: str) -> list[tuple[object, str]]:
-    """(clip, class) for the straight walks of ``clips`` that belong to one of ``scale``'s classes."""
-    if scale not in SCALES:
-        raise ValueError(f"unknown style scale {scale!r}; expected one of {sorted(SCALES)}")
-    style_class = {s: k for k, styles in SCALES[scale].items() for s in styles}
-    return [(c, style_class[c.style]) for c in clips
-            if c.content == "walk" and c.dataset in SCALE_DATASETS[scale] and c.style in style_class]
 
 
 @dataclass
@@ -107,13 +98,7 @@ class StyleObserver:
                 continue
             r = self.read(clip.motion)
             rows.append({"name": clip.name, "dataset": clip.dataset, "class": k, "top": r["top"], "p": r["p"]})
-        recall, takes, mean_p = {}, {}, {}
-        for k in self.classes:
-            mine = [r for r in rows if r["class"] == k]
-            takes[k] = len(mine)
-            recall[k] = (sum(r["top"] == k for r in mine) / len(mine)) if mine else None
-            mean_p[k] = float(np.mean([r["p"][k] for r in mine])) if mine else None
-        return {"recall": recall, "takes": takes, "mean_p": mean_p, "rows": rows}
+        return class_recall(rows, self.classes)
 
 
 class StyleObservers:

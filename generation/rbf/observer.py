@@ -33,7 +33,7 @@ from generation.core.motion import Motion
 from generation.core.skeleton import GAIT_JOINTS
 from generation.core.windows import windows
 from generation.mocap.real_corpus import DEFAULT_PATH, load_real_corpus
-from generation.mocap.style_scales import SCALE_DATASETS, SCALES, THEME_SCALE
+from generation.mocap.style_scales import SCALES, THEME_SCALE, class_recall, scale_clips
 
 WINDOW_S = 2.0
 HOP_S = 0.5
@@ -98,17 +98,6 @@ def reference_descriptor(reference: Motion | list[Motion]) -> np.ndarray:
     if not motions:
         raise ValueError("style observer: an empty reference")
     return np.mean([window_descriptors(m).mean(0) for m in motions], axis=0)
-
-
-def scale_clips(clips: list, scale: str, datasets: tuple[str, ...] | None = None) -> list[tuple[object, str]]:
-    """(clip, class) for the straight walks of ``clips`` in ``datasets`` (default :data:`SCALE_DATASETS`) that
-    belong to one of ``scale``'s classes."""
-    if scale not in SCALES:
-        raise ValueError(f"unknown style scale {scale!r}; expected one of {sorted(SCALES)}")
-    style_class = {s: k for k, styles in SCALES[scale].items() for s in styles}
-    datasets = SCALE_DATASETS[scale] if datasets is None else datasets
-    return [(c, style_class[c.style]) for c in clips
-            if c.content == "walk" and c.dataset in datasets and c.style in style_class]
 
 
 def dataset_references(clips: list, splits: tuple[str, ...] = ("train",)) -> dict[str, np.ndarray]:
@@ -216,13 +205,7 @@ class RbfStyleObserver:
                 continue
             r = self.read(clip.motion, refs.get(clip.dataset))
             rows.append({"name": clip.name, "dataset": clip.dataset, "class": k, "top": r["top"], "p": r["p"]})
-        recall, takes, mean_p = {}, {}, {}
-        for k in self.classes:
-            mine = [r for r in rows if r["class"] == k]
-            takes[k] = len(mine)
-            recall[k] = (sum(r["top"] == k for r in mine) / len(mine)) if mine else None
-            mean_p[k] = float(np.mean([r["p"][k] for r in mine])) if mine else None
-        return {"recall": recall, "takes": takes, "mean_p": mean_p, "rows": rows}
+        return class_recall(rows, self.classes)
 
 
 class RbfStyleObservers:
