@@ -22,10 +22,10 @@ from __future__ import annotations
 
 import argparse
 import json
-import re
 import time
 from pathlib import Path
 
+from benchmarks.doc_tables import write_marked
 from generation.rbf import calibrate as C
 from generation.rbf import observer as O
 from generation.rbf.real_neutral import load_cycle
@@ -170,11 +170,7 @@ def main(argv=None) -> int:
     text = render(res)
     print(text)
     if args.doc:
-        doc = Path(args.doc).read_text(encoding="utf-8")
-        pattern = re.compile(r"(<!-- extended -->\n).*?(<!-- /extended -->)", re.S)
-        if not pattern.search(doc):
-            raise SystemExit(f"{args.doc}: no <!-- extended --> ... <!-- /extended --> markers")
-        Path(args.doc).write_text(pattern.sub(lambda m: m.group(1) + text + "\n" + m.group(2), doc), encoding="utf-8")
+        write_marked(args.doc, "extended", text)
     return 0
 
 

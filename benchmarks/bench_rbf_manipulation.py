@@ -22,12 +22,12 @@ from __future__ import annotations
 
 import argparse
 import json
-import re
 import time
 from pathlib import Path
 
 import numpy as np
 
+from benchmarks.doc_tables import write_marked
 from generation.mocap.style_scales import NEUTRAL_CLASS, THEME_SCALE
 from generation.quality.style_observer import train_style_observers
 from generation.rbf import calibrate as C
@@ -231,11 +231,7 @@ def main(argv=None) -> int:
     text = render(res)
     print(text)
     if args.doc:
-        doc = Path(args.doc).read_text(encoding="utf-8")
-        pattern = re.compile(r"(<!-- manipulation -->\n).*?(<!-- /manipulation -->)", re.S)
-        if not pattern.search(doc):
-            raise SystemExit(f"{args.doc}: no <!-- manipulation --> ... <!-- /manipulation --> markers")
-        Path(args.doc).write_text(pattern.sub(lambda m: m.group(1) + text + "\n" + m.group(2), doc), encoding="utf-8")
+        write_marked(args.doc, "manipulation", text)
     return 0
 
 

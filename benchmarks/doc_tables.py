@@ -45,7 +45,7 @@ from benchmarks.doc_renderers.common import EMOTIONS, Renderer, table
 from benchmarks.doc_renderers.gait_real import GAIT_REAL_SUBSETS
 
 __all__ = ["BLOCK_RE", "DOCS", "EMOTIONS", "FILES", "GAIT_REAL_SUBSETS", "TABLES", "area_files", "fill_doc", "main",
-           "render_tables", "table", "update_doc", "write_results"]
+           "render_tables", "table", "update_doc", "write_marked", "write_results"]
 
 DOCS = Path(__file__).resolve().parent.parent / "docs" / "benchmarks"
 BLOCK_RE = re.compile(r"(<!-- table: (?P<name>[\w.]+) -->\n)(?P<body>.*?)(<!-- /table -->)", re.S)
@@ -101,6 +101,18 @@ def update_doc(area: str, results_path: Path | None = None, doc_path: Path | Non
     text, done = fill_doc(doc_path.read_text(), tables)
     doc_path.write_text(text)
     return done
+
+
+def write_marked(doc_path: str | Path, marker: str, text: str) -> None:
+    """Replace what stands between ``<!-- marker -->`` and ``<!-- /marker -->`` in the page ``doc_path`` with
+    ``text`` (a section a benchmark writes whole, narrative beside it kept); SystemExit naming the page when the
+    markers are missing."""
+    doc_path = Path(doc_path)
+    doc = doc_path.read_text(encoding="utf-8")
+    pattern = re.compile(rf"(<!-- {re.escape(marker)} -->\n).*?(<!-- /{re.escape(marker)} -->)", re.S)
+    if not pattern.search(doc):
+        raise SystemExit(f"{doc_path}: no <!-- {marker} --> ... <!-- /{marker} --> markers")
+    doc_path.write_text(pattern.sub(lambda m: m.group(1) + text + "\n" + m.group(2), doc), encoding="utf-8")
 
 
 def write_results(area: str, out: Path, results: dict, seconds: float, default=float) -> None:
