@@ -74,7 +74,8 @@ def home(request):
     return render(request, "studyapp/home.html", {"studies": studies})
 
 
-def _remember(request, participant: Participant) -> None:
+def remember_participant(request, participant: Participant) -> None:
+    """Keep the participant's token in the session under its study's slug, so that the study's link resumes it."""
     tokens = dict(request.session.get(SESSION_KEY, {}))
     tokens[participant.study.slug] = participant.token
     request.session[SESSION_KEY] = tokens
@@ -160,7 +161,7 @@ def study_entry(request, slug: str):
                 _store_missing_ids(existing, params)
                 return redirect("studyapp:resume", token=existing.token)
             if prolific_match(existing, params):
-                _remember(request, existing)
+                remember_participant(request, existing)
                 return redirect("studyapp:resume", token=existing.token)
             return _prolific_conflict(request, study)
     if mine is not None and not pid:
@@ -202,7 +203,7 @@ def study_entry(request, slug: str):
                 if participant is None:
                     return _prolific_conflict(request, study)
             request.session.cycle_key()      # a session planted before consent does not carry over to the answers
-            _remember(request, participant)
+            remember_participant(request, participant)
             _retire_consent_key(request, study)
             return redirect("studyapp:resume", token=participant.token)
     else:
@@ -228,7 +229,7 @@ def _store_missing_ids(participant: Participant, params: dict[str, str]) -> None
         Participant.objects.filter(pk=participant.pk).update(**updates)
 
 
-def _participant(token: str) -> Participant:
+def participant_or_404(token: str) -> Participant:
     """The participant of a URL token with its study (404 if none), the study's language activated."""
     participant = participant_by_token(token)
     if participant is None:
@@ -240,7 +241,7 @@ def _participant(token: str) -> Participant:
 @never_cache
 def resume(request, token: str):
     """Send the participant to the page where they are (computed from the database)."""
-    participant = _participant(token)
+    participant = participant_or_404(token)
     step = current_step(participant)
     if step.kind == "start":
         try:
@@ -263,7 +264,7 @@ def resume(request, token: str):
 @never_cache
 @require_http_methods(["GET", "HEAD", "POST"])
 def demographics(request, token: str):
-    participant = _participant(token)
+    participant = participant_or_404(token)
     if participant.demographics_done:
         return redirect("studyapp:resume", token=token)
     form = DemographicsForm(request.POST or None)
@@ -377,7 +378,7 @@ def item(request, token: str, n: int):
     to the next clip (or the feedback / end page): the next clip page itself when the form asked for it
     (INLINE_NEXT_FIELD), else a redirect. A constant number of indexed queries: the participant, its first
     unanswered assignments, and on GET the one UPDATE of shown_at when first shown."""
-    participant = _participant(token)
+    participant = participant_or_404(token)
     step = current_step(participant, lookahead=request.method != "POST")
     if step.kind != "item" or step.index != n:
         if request.method == "POST" and (step.kind != "item" or n < step.index):
@@ -438,7 +439,7 @@ def _show_item(request, participant: Participant, step):
         else:
             Assignment.objects.filter(pk=assignment.pk).update(shows=F("shows") + 1)
         if request.session.get(SESSION_KEY, {}).get(participant.study.slug) != participant.token:
-            _remember(request, participant)
+            remember_participant(request, participant)
     return _render_item(request, participant, step, posted=None)
 
 
@@ -497,7 +498,7 @@ def playback(request, token: str, n: int):
     counts of a display being left without an answer (a reload) on clip page n, kept on the assignment while it is
     unanswered: a reload then keeps the plays (max_replays holds), the end and the counts. 204; 400 for an unknown
     event; 404 when page n is not the participant's current page."""
-    participant = _participant(token)
+    participant = participant_or_404(token)
     event = request.POST.get("event", "")
     if event not in PLAYBACK_EVENTS:
         return HttpResponse(status=400)
@@ -525,7 +526,7 @@ def playback(request, token: str, n: int):
 @never_cache
 @require_http_methods(["GET", "HEAD", "POST"])
 def feedback(request, token: str):
-    participant = _participant(token)
+    participant = participant_or_404(token)
     step = current_step(participant)
     if step.kind != "feedback":
         return redirect("studyapp:resume", token=token)
@@ -541,7 +542,7 @@ def feedback(request, token: str):
 
 @never_cache
 def done(request, token: str):
-    participant = _participant(token)
+    participant = participant_or_404(token)
     if current_step(participant).kind != "done":
         return redirect("studyapp:resume", token=token)
     mark_completed(participant)      # writes only for a participant who finished before this was recorded

@@ -20,7 +20,7 @@ from protocol.section_types.pages import makes_wait
 from ..data import section_pages
 from ..models import Participant, Section
 from .assignment import current_step
-from .views import SESSION_KEY, _participant, _remember, mark_completed, step_url
+from .views import SESSION_KEY, mark_completed, participant_or_404, remember_participant, step_url
 
 
 def page_wording(section: Section) -> tuple[str, str]:
@@ -59,7 +59,7 @@ def _onwards(participant: Participant):
 @require_http_methods(["GET", "HEAD", "POST"])
 def page(request, token: str, n: int):
     """Instruction or break page n of the participant: show it, or continue from it (see the module docstring)."""
-    participant = _participant(token)
+    participant = participant_or_404(token)
     step = current_step(participant)
     if step.kind != "page" or step.index != n:
         return redirect(step_url(token, step))
@@ -80,5 +80,5 @@ def page(request, token: str, n: int):
     if request.method != "HEAD":
         section_pages.record(participant, n, "shown_at")
         if request.session.get(SESSION_KEY, {}).get(participant.study.slug) != participant.token:
-            _remember(request, participant)
+            remember_participant(request, participant)
     return _render_page(request, participant, section, n)
