@@ -1,4 +1,5 @@
-"""End to end in headless Chromium: a break page between sections counts down under the Content-Security-Policy
+"""End to end in the participants' browsers (Chromium, WebKit, Firefox ESR; a missing one is skipped with the reason):
+a break page between sections counts down under the Content-Security-Policy
 (static/studyapp/page.js), enables Continue only after its wait, and an instruction page survives a reload; the
 participant goes on to the next section and ends on the completion page, and pages.csv has both pages.
 
@@ -14,21 +15,23 @@ import time
 from pathlib import Path
 
 import pytest
+from browser_flow import PAGE_TIMEOUT_S, answer_page, click, consent_and_demographics, path_of, wait
 from django.urls import reverse
 
 from studyapp.data.export import stream_csv
 from studyapp.models import Participant, Section, Study
-from studyapp.testing import consent_and_demographics, make_catalogue, tiny_mp4, wait_for
-from tests.studyapp.participant.test_e2e_study import pick_answers
+from studyapp.testing import make_catalogue, tiny_mp4, wait_for
+from tests.studyapp.participant.test_e2e_browsers import BROWSERS
+
+ENABLED = "var b = document.getElementById('next'); return b && !b.disabled"
 
 pytestmark = [pytest.mark.browser, pytest.mark.slow, pytest.mark.django_db(transaction=True)]
 
 WAIT_S = 4
 
 
-def test_break_and_instruction_pages_in_chromium(chromium, live_server, settings, tmp_path):
-    from selenium.webdriver.common.by import By
-
+@pytest.mark.parametrize("browser", BROWSERS)
+def test_break_and_instruction_pages(browser, request, live_server, settings, tmp_path):
     settings.MEDIA_ROOT = tmp_path / "media"
     video = tiny_mp4(tmp_path / "clip.mp4", seconds=1.0, size=160)
     make_catalogue(settings.MEDIA_ROOT, video_bytes=video.read_bytes(), duration_s=1.0)
@@ -44,40 +47,40 @@ def test_break_and_instruction_pages_in_chromium(chromium, live_server, settings
     Section.objects.create(study=study, order=4, section_type="affect_likert", clips_per_participant=1,
                            pool={"modality": "gait", "origin": "generated", "transition": False},
                            require_full_play=False)
-    driver = chromium
+    driver = request.getfixturevalue(browser)
     driver.get(live_server.url + reverse("studyapp:study_entry", args=[study.slug]) + "?PROLIFIC_PID=e2e-pages")
     consent_and_demographics(driver)
     participant = Participant.objects.get(external_id="e2e-pages")
-    wait_for(driver, lambda d: d.find_element(By.ID, "next").is_enabled(), what="answers enabled")
-    pick_answers(driver)
-    driver.find_element(By.ID, "next").click()
-    wait_for(driver, lambda d: "/page/1/" in d.current_url, what="the break page")
-    button = driver.find_element(By.ID, "continue")
-    assert not button.is_enabled()                  # page.js runs under the CSP: it holds Continue back
-    note = driver.find_element(By.ID, "page-wait").text
+    wait(driver, ENABLED, what="answers enabled")
+    answer_page(driver)
+    wait(driver, "return location.pathname.indexOf('/page/1/') >= 0", what="the break page")
+    # page.js runs under the CSP: it holds Continue back and counts down
+    assert driver.execute_script("return document.getElementById('continue').disabled")
+    note = driver.execute_script("return document.getElementById('page-wait').textContent")
     assert "You can continue in" in note, note
-    if os.environ.get("STUDY_SCREENSHOTS"):
+    if os.environ.get("STUDY_SCREENSHOTS") and browser == "chromium":
         driver.set_window_size(1366, 768)
         chrome = driver.execute_script("return [window.outerWidth - window.innerWidth, "
                                        "window.outerHeight - window.innerHeight]")
         driver.set_window_size(1366 + chrome[0], 768 + chrome[1])        # a 1366x768 viewport
         time.sleep(0.3)
         driver.save_screenshot(str(Path(os.environ["STUDY_SCREENSHOTS"]) / "study_break_page.png"))
-    wait_for(driver, lambda d: d.find_element(By.ID, "continue").is_enabled(), timeout=WAIT_S + 10,
-             what="Continue enabled")
-    assert driver.find_element(By.ID, "page-wait").text == "You can continue now."
-    driver.find_element(By.ID, "continue").click()
-    wait_for(driver, lambda d: "/page/2/" in d.current_url, what="the instruction page")
+    wait(driver, "return !document.getElementById('continue').disabled", timeout=WAIT_S + 10,
+         what="Continue enabled")
+    assert driver.execute_script("return document.getElementById('page-wait').textContent.trim()") == \
+        "You can continue now."
+    click(driver, "#continue")
+    wait(driver, "return location.pathname.indexOf('/page/2/') >= 0", what="the instruction page")
     driver.refresh()
-    wait_for(driver, lambda d: d.find_element(By.CSS_SELECTOR, "h1.page-title").text == "The last part",
-             what="the same instruction page after a reload")
-    assert "/page/2/" in driver.current_url and driver.find_element(By.ID, "continue").is_enabled()
-    driver.find_element(By.ID, "continue").click()
-    wait_for(driver, lambda d: "/clip/2/" in d.current_url, what="the clip after the pages")
-    wait_for(driver, lambda d: d.find_element(By.ID, "next").is_enabled(), what="answers enabled")
-    pick_answers(driver)
-    driver.find_element(By.ID, "next").click()
-    wait_for(driver, lambda d: "/done/" in d.current_url, what="the completion page")
+    wait(driver, "var h = document.querySelector('h1.page-title'); return h && h.textContent.trim() === arguments[0]",
+         PAGE_TIMEOUT_S, "the same instruction page after a reload", "The last part")
+    assert "/page/2/" in path_of(driver)
+    assert not driver.execute_script("return document.getElementById('continue').disabled")
+    click(driver, "#continue")
+    wait(driver, "return location.pathname.indexOf('/clip/2/') >= 0", what="the clip after the pages")
+    wait(driver, ENABLED, what="answers enabled")
+    answer_page(driver)
+    wait(driver, "return location.pathname.indexOf('/done/') >= 0", what="the completion page")
     participant.refresh_from_db()
     assert participant.status == Participant.Status.COMPLETED
     rows = list(csv.DictReader(io.StringIO("".join(stream_csv(study, "pages")))))
