@@ -3,6 +3,10 @@ seed 004's themes are judged: each scale's classes and the corpus styles that ma
 them, and where each theme sits on its scale; which real walks belong to a scale (:func:`scale_clips`) and how a
 scale's held-out readings add up per class (:func:`class_recall`). Read by the style observers of
 ``generation.quality`` and ``generation.rbf`` alike, so both judge a theme against the same real walks.
+
+The emotion scale's classes are also those of the BML walks of Emotion-Gait (:mod:`generation.mocap.emotion_gait_bml`,
+dataset ``emotion-gait-bml``, styles happy, sad, angry and neutral = the acted emotion; research use with citation),
+whose clips carry a second label, the annotators' majority ``perceived_label`` (``labels="perceived"``).
 """
 from __future__ import annotations
 
@@ -12,8 +16,12 @@ import numpy as np
 SCALES: dict[str, dict[str, tuple[str, ...]]] = {
     "energy": {"energetic": ("active",), "normal": ("normal",), "tired": ("tired", "exhausted")},
     "gender": {"feminine": ("feminine",), "normal": ("normal",), "masculine": ("masculinity", "masculine")},
-    "emotion": {"happy": ("happy",), "sad": ("sad",), "angry": ("angry",), "neutral": ("normal",)},
+    "emotion": {"happy": ("happy",), "sad": ("sad",), "angry": ("angry",), "neutral": ("normal", "neutral")},
 }
+#: corpus styles of a walker's unstyled walk (Bandai Namco "normal", BML "neutral")
+NEUTRAL_STYLES = ("normal", "neutral")
+#: which label of a clip names its class: the corpus style (acted) or the BML annotators' majority (perceived)
+LABELS = ("acted", "perceived")
 #: scale -> the corpus datasets whose walks it is trained on (dataset 2 has no emotion styles)
 SCALE_DATASETS = {"energy": ("bandai-namco-1", "bandai-namco-2"), "gender": ("bandai-namco-1", "bandai-namco-2"),
                   "emotion": ("bandai-namco-1",)}
@@ -24,15 +32,32 @@ THEME_SCALE = {"happy": ("emotion", "happy"), "sad": ("emotion", "sad"), "energe
 NEUTRAL_CLASS = {"energy": "normal", "gender": "normal", "emotion": "neutral"}
 
 
-def scale_clips(clips: list, scale: str, datasets: tuple[str, ...] | None = None) -> list[tuple[object, str]]:
+def clip_style(clip, labels: str = "acted") -> str:
+    """The style that names a clip's class: its corpus style (``acted``), or with ``labels="perceived"`` the
+    ``perceived_label`` of its Motion's metadata where it has one (BML clips; others keep their acted style)."""
+    if labels not in LABELS:
+        raise ValueError(f"labels must be one of {list(LABELS)}, got {labels!r}")
+    if labels == "perceived":
+        return (getattr(clip.motion, "metadata", None) or {}).get("perceived_label", clip.style)
+    return clip.style
+
+
+def scale_clips(clips: list, scale: str, datasets: tuple[str, ...] | None = None, labels: str = "acted"
+                ) -> list[tuple[object, str]]:
     """(clip, class) for the straight walks of ``clips`` in ``datasets`` (default :data:`SCALE_DATASETS`) that
-    belong to one of ``scale``'s classes."""
+    belong to one of ``scale``'s classes, by :func:`clip_style` of ``labels``."""
     if scale not in SCALES:
         raise ValueError(f"unknown style scale {scale!r}; expected one of {sorted(SCALES)}")
     style_class = {s: k for k, styles in SCALES[scale].items() for s in styles}
+    if labels not in LABELS:
+        raise ValueError(f"labels must be one of {list(LABELS)}, got {labels!r}")
     datasets = SCALE_DATASETS[scale] if datasets is None else datasets
-    return [(c, style_class[c.style]) for c in clips
-            if c.content == "walk" and c.dataset in datasets and c.style in style_class]
+    out = []
+    for c in clips:
+        style = clip_style(c, labels) if c.content == "walk" and c.dataset in datasets else None
+        if style in style_class:
+            out.append((c, style_class[style]))
+    return out
 
 
 def class_recall(rows: list[dict], classes) -> dict:

@@ -37,6 +37,8 @@ from generation.core.skeleton import GAIT_JOINTS, gait_skeleton
 from protocol.vocabulary import CAPTURE_THEMES
 
 from .data_features import _rounded
+from .neutral_base import NormalisedCycle, normalise_cycle
+from .observer import walker_of
 from .real_neutral import steady_cycles
 from .stylise import stylised_cycle
 from .themes import BODY_PARTS, THEME_NAMES, THEMES, Feature
@@ -152,6 +154,56 @@ def real_differences(clips: list, theme: str, splits: tuple[str, ...], m: int = 
     if not diffs:
         raise ValueError(f"no dataset has {theme} (styles {list(styles)}) and normal walks in splits {list(splits)}")
     return np.mean(diffs, axis=0), info
+
+
+def clip_cycles(clip, m: int = 100) -> tuple[list[NormalisedCycle], str]:
+    """A clip's cycles and how they were cut: its steady cycles (``steady``); else, for a clip that is one cycle
+    repeated (metadata ``loop_period_frames`` p, the BML walks), the frames 0..p as one cycle with its midpoint as
+    the right strike (``loop``; tilt means and swing peak-to-peaks do not depend on where the cycle starts); else
+    ([], ``none``)."""
+    cycles = steady_cycles(clip.motion, m, clip.name)
+    if cycles:
+        return cycles, "steady"
+    p = int(clip.motion.metadata.get("loop_period_frames") or 0)
+    if 2 <= p < clip.motion.num_frames:
+        motion = clip.motion
+        return [normalise_cycle(motion.positions(), motion.skeleton, motion.fps, (0, p // 2, p), m, clip.name)], "loop"
+    return [], "none"
+
+
+def walker_differences(clips: list, theme: str, styles: tuple[str, ...], neutral: tuple[str, ...] = ("neutral",),
+                       m: int = 100, feats: tuple[Feature, ...] | None = None) -> list[dict]:
+    """Per walker (:func:`generation.rbf.observer.walker_of`) with walks of ``styles`` and of ``neutral``: its
+    styled minus its own neutral walks, on ``theme``'s group measures and tempo (cycles: :func:`clip_cycles`).
+
+    Returns [{"walker", "difference": (G,) list, walker heights, "speed_ratio", "stride_ratio", "cadence_ratio"
+    (styled / neutral; speed = stride / duration, cadence = 1 / duration), "cycles": {clip name: how cut}}], sorted
+    by walker.
+    """
+    per: dict[str, dict[str, list]] = {}
+    for c in clips:
+        if c.content != "walk" or c.style not in styles + neutral:
+            continue
+        cycles, how = clip_cycles(c, m)
+        if not cycles:
+            continue
+        joints = tuple(c.motion.skeleton.joints)
+        measures = np.mean([theme_measures(cy.positions[:-1], joints, theme, feats) for cy in cycles], axis=0)
+        gait = (np.mean([cy.stride for cy in cycles]), np.mean([cy.duration_s for cy in cycles]))
+        key = "styled" if c.style in styles else "neutral"
+        per.setdefault(walker_of(c), {"styled": [], "neutral": [], "cycles": {}})
+        per[walker_of(c)][key].append((measures, gait))
+        per[walker_of(c)]["cycles"][c.name] = how
+    out = []
+    for walker in sorted(per):
+        d = per[walker]
+        if not d["styled"] or not d["neutral"]:
+            continue
+        (s_t, d_t), (s_n, d_n) = (np.mean([g for _, g in d[k]], axis=0) for k in ("styled", "neutral"))
+        diff = np.mean([x for x, _ in d["styled"]], axis=0) - np.mean([x for x, _ in d["neutral"]], axis=0)
+        out.append({"walker": walker, "difference": diff.tolist(), "speed_ratio": float((s_t / d_t) / (s_n / d_n)),
+                    "stride_ratio": float(s_t / s_n), "cadence_ratio": float(d_n / d_t), "cycles": d["cycles"]})
+    return out
 
 
 def _intensities(theme: str, factors: np.ndarray) -> dict[int, float]:
