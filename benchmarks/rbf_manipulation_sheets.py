@@ -4,9 +4,12 @@ One PNG per theme, ``docs/img/rbf_manip_<theme>.png``: rows = the neutral base w
 style (Bandai Namco, CC BY-NC 4.0), the calibrated edit at w = 0.7 and 1.0, the visual edit at w = 1.0; columns = 5
 moments 0.25 s apart (about one stride). With ``--extended``, ``docs/img/rbf_extended_<theme>.png``: the base, the
 real take, the extended edit (the default) at w = 0.7 and 1.0 and the calibrated edit (the old default) at w = 1.0.
+With ``--actors``, ``docs/img/rbf_actors_<theme>.png``: the base and the extended edit at w = 1.0 beside real walks of
+the style by several actors: Bandai takes of the style from both datasets (held-out first) and, for happy and sad,
+BML actors' walks of that emotion (``--bml``; research use with citation, docs/mocap.md).
 
     OMP_NUM_THREADS=1 python -m benchmarks.rbf_manipulation_sheets [--corpus var/mocap/bandai-namco.npz] \
-        [--out docs/img] [--themes happy sad] [--extended]
+        [--out docs/img] [--themes happy sad] [--extended | --actors [--bml var/mocap/emotion-gait-bml.npz]]
 
 About 40 s per theme on the 2-core machine (25 offscreen renders).
 """
@@ -17,7 +20,7 @@ import tempfile
 import warnings
 from pathlib import Path
 
-from generation.mocap.real_corpus import DEFAULT_PATH, load_real_corpus
+from generation.mocap.real_corpus import DEFAULT_BML_PATH, DEFAULT_PATH, load_real_corpus
 from generation.rbf.calibrate import theme_styles
 from generation.rbf.real_neutral import load_cycle
 from generation.rbf.stylise import neutral_walk, stylise
@@ -43,6 +46,27 @@ def theme_rows(base, clips, theme: str, extended: bool = False) -> list[tuple[st
             (f"{theme} calibrated w0.7", stylise(base, theme, 0.7, 10, intensities="calibrated", **kw)),
             (f"{theme} calibrated w1.0", stylise(base, theme, 1.0, 10, intensities="calibrated", **kw)),
             (f"{theme} visual w1.0", stylise(base, theme, 1.0, 10, intensities="visual", **kw))]
+
+
+def actor_rows(base, clips, bml, theme: str, n_real: int = 4) -> list[tuple[str, object]]:
+    """(label, motion) rows of one theme's sheet beside several actors: the base, the extended edit at w = 1.0,
+    then up to ``n_real`` real walks of the style: for happy and sad, BML actors (every seventh performer, so the
+    rows are different people) and one Bandai take; otherwise Bandai takes alternating between the datasets."""
+    kw = {"n_cycles": 3, "fps": 30.0}
+    rows = [("base (real average)", neutral_walk(base, **kw)),
+            (f"{theme} extended w1.0", stylise(base, theme, 1.0, 10, **kw))]
+    takes = sorted((c for c in clips if c.style in theme_styles(theme) and c.motion.num_frames >= 60),
+                   key=lambda c: (c.split == "train", c.take, c.dataset))
+    by_dataset = [[c for c in takes if c.dataset == d] for d in sorted({c.dataset for c in takes})]
+    bandai = [c for group in zip(*by_dataset) for c in group] if len(by_dataset) > 1 else takes
+    bandai += [c for c in takes if c not in bandai]
+    emotion = [c for c in bml if c.style == theme]
+    actors = sorted(emotion, key=lambda c: c.motion.metadata.get("performer", c.name))[::7]
+    real = [(f"REAL BML {c.motion.metadata.get('performer', c.name).removeprefix('BML_')} {theme}", c.motion)
+            for c in actors]
+    real = real[:n_real - 1] if bandai else real[:n_real]
+    real += [(f"REAL {c.style} {c.dataset[-1]}/{c.take}", c.motion) for c in bandai[:n_real - len(real)]]
+    return rows + real
 
 
 def write_sheet(rows, path: Path) -> Path:
@@ -74,10 +98,20 @@ def main(argv=None) -> int:
     ap.add_argument("--corpus", type=Path, default=DEFAULT_PATH)
     ap.add_argument("--out", type=Path, default=Path("docs/img"))
     ap.add_argument("--themes", nargs="*", default=list(THEME_NAMES), choices=list(THEME_NAMES))
-    ap.add_argument("--extended", action="store_true", help="the extended set's sheets (rbf_extended_<theme>.png)")
+    kind = ap.add_mutually_exclusive_group()
+    kind.add_argument("--extended", action="store_true", help="the extended set's sheets (rbf_extended_<theme>.png)")
+    kind.add_argument("--actors", action="store_true",
+                      help="the extended edit beside real walks by several actors (rbf_actors_<theme>.png)")
+    ap.add_argument("--bml", type=Path, default=DEFAULT_BML_PATH,
+                    help="the BML walks for happy and sad with --actors (skipped when the file is missing)")
     a = ap.parse_args(argv)
     clips = load_real_corpus(a.corpus, skeleton="gait", contents=["walk"])
     base = load_cycle()
+    if a.actors:
+        bml = load_real_corpus(a.bml, skeleton="gait") if a.bml.is_file() else []
+        for theme in a.themes:
+            print("wrote", write_sheet(actor_rows(base, clips, bml, theme), a.out / f"rbf_actors_{theme}.png"))
+        return 0
     for theme in a.themes:
         name = f"rbf_extended_{theme}.png" if a.extended else f"rbf_manip_{theme}.png"
         print("wrote", write_sheet(theme_rows(base, clips, theme, a.extended), a.out / name))
