@@ -242,8 +242,8 @@ TABLE_III: dict[str, tuple[str, ...]] = {
                   "Elbows: increased swing along Z"),
 }
 
-def _ours(rank, part, axis, kind, sign, shape=1, intensity=0.01):
-    return Feature(rank, part, axis, kind, sign, shape, intensity, source="ours")
+def _ours(rank, part, axis, kind, sign, shape=1, intensity=0.01, sides=None):
+    return Feature(rank, part, axis, kind, sign, shape, intensity, dict(sides or {}), source="ours")
 
 
 #: Rows of our own (``source="ours"``), not in Table III: levers the real styled walks use and the experts' ten
@@ -252,7 +252,10 @@ def _ours(rank, part, axis, kind, sign, shape=1, intensity=0.01):
 #: Their intensities here are placeholders; the ``extended`` file sizes them from real data.
 OURS: dict[str, tuple[Feature, ...]] = {
     # each row: the real style's largest differences from normal walks that no Table III row of the theme holds
-    # (Bandai Namco train takes, docs/benchmarks/rbf.md); sized by the extended set like the experts' rows
+    # (Bandai Namco train takes, docs/benchmarks/rbf.md); sized by the extended set like the experts' rows.
+    # Energetic 15-16, tired 14, feminine 13-15 and masculine 13-14 were chosen by effect size d (style minus
+    # normal over the between-take spread, the same sign in both datasets; generation.rbf.row_effects, the "rows"
+    # section of docs/benchmarks/rbf.md); their comments give d and the real difference in walker heights
     "happy": (_ours(11, "hip", "Y", "swing", +1, 3),),                  # more bounce (pelvis up and down each step)
     "sad": (_ours(11, "wrists", "Z", "swing", -1, 4),                   # arms barely swing
             _ours(12, "ankles", "Z", "swing", -1, 4),                   # short steps
@@ -260,14 +263,22 @@ OURS: dict[str, tuple[Feature, ...]] = {
     "energetic": (_ours(11, "wrists", "Y", "tilt", +1),                 # hands carried higher
                   _ours(12, "elbows", "Y", "tilt", +1),                 # forearms raised
                   _ours(13, "torso_l", "Z", "tilt", +1),                # leaning into the walk
-                  _ours(14, "knees", "Z", "swing", +1, 4)),             # longer knee swing
+                  _ours(14, "knees", "Z", "swing", +1, 4),              # longer knee swing
+                  _ours(15, "wrists", "Y", "swing", +1, 4),             # hands pump up and down (d +3.8, 7.7 % h)
+                  _ours(16, "ankles", "Y", "swing", +1, 2)),            # feet lifted higher (d +7.7, 2.3 % h)
     "tired": (_ours(11, "shoulders", "Z", "tilt", +1),                  # shoulders rounded forward
               _ours(12, "head", "X", "swing", +1, 4),                   # head sways side to side
-              _ours(13, "head", "Z", "swing", +1, 3)),                  # head nods with each step
+              _ours(13, "head", "Z", "swing", +1, 3),                   # head nods with each step
+              _ours(14, "wrists", "X", "tilt", +1, sides=INWARD)),      # hands nearer the midline (d -4.6, 1.3 % h)
     "feminine": (_ours(11, "torso_u", "Z", "tilt", -1),                 # upright chest
-                 _ours(12, "elbows", "Z", "tilt", -1)),                 # elbows kept back, close to the body
+                 _ours(12, "elbows", "Z", "tilt", -1),                  # elbows kept back, close to the body
+                 _ours(13, "wrists", "X", "tilt", +1, sides=OUTWARD),   # hands held out from the hips (d +11, 3.3 % h)
+                 _ours(14, "shoulders", "Z", "swing", +1, 4),           # shoulder line turns more (d +11, 2.1 % h)
+                 _ours(15, "head", "X", "swing", +1, 4)),               # head sways side to side (d +2.9, 0.5 % h)
     "masculine": (_ours(11, "head", "Z", "tilt", +1),                   # head forward
-                  _ours(12, "knees", "Z", "swing", +1, 4)),             # longer knee swing
+                  _ours(12, "knees", "Z", "swing", +1, 4),              # longer knee swing
+                  _ours(13, "hip", "Y", "swing", +1, 3),                # more bounce (d +2.8, 1.1 % h)
+                  _ours(14, "wrists", "Y", "tilt", +1)),                # hands higher, elbows bent (d +1.9, 1.4 % h)
 }
 
 #: Named sets of intensities: ``extended`` (the default: sized from real style-vs-normal differences of Bandai
