@@ -46,7 +46,7 @@ def _feats_with(theme: str, group: tuple[str, str, str]) -> tuple[Feature, ...]:
     return feats + (candidate_feature(*group),)
 
 
-def _group_sign(theme: str, group: tuple[str, str, str]) -> int:
+def group_sign(theme: str, group: tuple[str, str, str]) -> int:
     """+1, or -1 where the theme's own row on ``group`` is measured inward (its side signs point to the midline),
     so that every group's number reads as +axis / outward / more swing."""
     feats = _feats_with(theme, group)
@@ -60,7 +60,7 @@ def take_measures(clips: list, theme: str, groups: list, m: int = 100) -> dict[s
     """{clip name: (G,) mean over the take's steady cycles of each group's measure, heights} for the walk takes of
     ``clips``; takes without a steady cycle are left out."""
     feats = {g: _feats_with(theme, g) for g in groups}
-    signs = np.array([_group_sign(theme, g) for g in groups])
+    signs = np.array([group_sign(theme, g) for g in groups])
     out = {}
     for c in clips:
         cycles = steady_cycles(c.motion, m, c.name)
