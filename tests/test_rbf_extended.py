@@ -84,3 +84,56 @@ def test_rebuild_on_the_corpus_matches_the_shipped_file(shipped):
         np.testing.assert_allclose(train, [g["real_train"] for g in shipped["themes"][theme]["groups"]], atol=1e-5)
         tempo = shipped["themes"][theme]["tempo"]["per_weight"]
         assert E.real_tempo(clips, theme)["per_weight"] == pytest.approx(tempo, abs=1e-5)
+
+
+def _row_direction(f) -> int:
+    """+1 where the row's group measure grows in the row's direction (side-signed tilts measure that way), else the
+    row's sign."""
+    return 1 if (f.kind == "tilt" and f.side_signs) else f.sign
+
+
+def test_rows_of_ours_follow_the_real_difference_in_every_dataset(shipped):
+    """Each row of ours moves its group the way the real style does in every dataset with the theme (train takes);
+    sad's chest-forward row, measured against its sign, is the one row of ours held at zero."""
+    for theme, rows in OURS.items():
+        entry = shipped["themes"][theme]
+        by_rank = {r["rank"]: r for r in entry["features"]}
+        for f in rows:
+            r = by_rank[f.rank]
+            assert f.source == "ours" and r["source"] == "ours" and f.rank > len(THEMES[theme])
+            g = r["group"]
+            per_dataset = [d["difference"][g] * _row_direction(f) for d in entry["sources"]["train"]]
+            agrees = entry["groups"][g]["real_train"] * _row_direction(f) > 0 and all(d > 0 for d in per_dataset)
+            if (theme, f.rank) == ("sad", 13):
+                assert not agrees and r["extended"] == 0.0
+            else:
+                assert per_dataset and agrees, (theme, f.describe())
+
+
+def test_candidate_groups_cover_every_part_axis_and_kind():
+    from generation.rbf.row_effects import all_groups, candidate_feature
+
+    groups = all_groups()
+    assert len(groups) == len(set(groups)) == 66
+    wide = candidate_feature("wrists", "X", "tilt")
+    assert dict(wide.joint_signs()) == {"left_hand": 1, "right_hand": -1}  # outward: left is +x
+    assert candidate_feature("hip", "Y", "swing").sign == 1
+
+
+@pytest.mark.slow
+@pytest.mark.skipif(not DEFAULT_PATH.is_file(), reason="real corpus not built (docs/corpus.md)")
+def test_row_effects_match_the_shipped_differences_of_the_rows_of_ours(shipped):
+    """The effect-size scan measures a row's group as the extended set does: its difference is the shipped one
+    (in the scan's sign convention), both datasets agree, and the effect is at least one between-take sd."""
+    from generation.rbf.row_effects import group_effects, group_sign
+
+    clips = load_real_corpus(DEFAULT_PATH, skeleton="gait", contents=["walk"])
+    for theme in ("energetic", "feminine", "masculine", "tired"):
+        rows = [f for f in OURS[theme] if f.rank >= {"energetic": 15, "tired": 14}.get(theme, 13)]
+        groups = [(f.part, f.axis, f.kind) for f in rows]
+        effects = group_effects(clips, theme, groups=groups)
+        entry = shipped["themes"][theme]
+        for g, e in zip(groups, effects):
+            real = next(x["real_train"] for x in entry["groups"] if (x["part"], x["axis"], x["kind"]) == g)
+            assert e["difference"] == pytest.approx(group_sign(theme, g) * real, abs=1e-5), (theme, g)
+            assert e["consistent"] and abs(e["effect"]) >= 1.0, (theme, g)
