@@ -37,7 +37,10 @@ REJECTED = {
               "ankles X tilt": "stance knee 41.7 deg at w = 1.3",
               "thighs X tilt": "stance knee 41.5 deg at w = 1.3",
               "hip Y tilt": "stance knee 42.5-47.8 deg at w = 0.4-1.3 (tried beside the knees X row)",
-              "hip Y swing": "p(tired) at w = 1 0.71 -> 0.56; inverted walk's stance knee 41.2 deg"},
+              "hip Y swing": "p(tired) at w = 1 0.71 -> 0.56; inverted walk's stance knee 41.2 deg",
+              "head Y swing": "d +1.3 in dataset 2's 16 takes (the mean d comes from dataset 1's one take); more head "
+                              "motion where the observers already see too much; the chest's fore-aft rock (d +2.5 "
+                              "and +3.4) taken instead"},
     "feminine": {"neck X swing": "the head rides on the neck: the head-to-shoulder angle did not change; head X "
                                  "swing carries the sway"},
 }

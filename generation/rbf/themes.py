@@ -253,7 +253,7 @@ def _ours(rank, part, axis, kind, sign, shape=1, intensity=0.01, sides=None):
 OURS: dict[str, tuple[Feature, ...]] = {
     # each row: the real style's largest differences from normal walks that no Table III row of the theme holds
     # (Bandai Namco train takes, docs/benchmarks/rbf.md); sized by the extended set like the experts' rows.
-    # Energetic 15-16, tired 14, feminine 13-15 and masculine 13-14 were chosen by effect size d (style minus
+    # Energetic 15-16, tired 14-15, feminine 13-15 and masculine 13-14 were chosen by effect size d (style minus
     # normal over the between-take spread, the same sign in both datasets; generation.rbf.row_effects, the "rows"
     # section of docs/benchmarks/rbf.md); their comments give d and the real difference in walker heights
     "happy": (_ours(11, "hip", "Y", "swing", +1, 3),),                  # more bounce (pelvis up and down each step)
@@ -269,7 +269,8 @@ OURS: dict[str, tuple[Feature, ...]] = {
     "tired": (_ours(11, "shoulders", "Z", "tilt", +1),                  # shoulders rounded forward
               _ours(12, "head", "X", "swing", +1, 4),                   # head sways side to side
               _ours(13, "head", "Z", "swing", +1, 3),                   # head nods with each step
-              _ours(14, "wrists", "X", "tilt", +1, sides=INWARD)),      # hands nearer the midline (d -4.6, 1.3 % h)
+              _ours(14, "wrists", "X", "tilt", +1, sides=INWARD),       # hands nearer the midline (d -4.6, 1.3 % h)
+              _ours(15, "torso_u", "Z", "swing", +1, 4)),               # chest rocks fore and aft (d +3.0, 0.7 % h)
     "feminine": (_ours(11, "torso_u", "Z", "tilt", -1),                 # upright chest
                  _ours(12, "elbows", "Z", "tilt", -1),                  # elbows kept back, close to the body
                  _ours(13, "wrists", "X", "tilt", +1, sides=OUTWARD),   # hands held out from the hips (d +11, 3.3 % h)
