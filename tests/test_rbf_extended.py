@@ -138,8 +138,9 @@ def _stride_only(base, scale: float, progression: bool = True):
 def test_stride_lever_keeps_feet_planted_and_bones(base, scale):
     """The stride lever alone (no features, no foot planting afterwards): feet slide no more than the base walk's
     own (unplanted: 0.06 m/s mean over contact frames) plus 0.02 m/s; without scaling the progression the same legs
-    slide by about |1 - s| x the walking speed (0.2 m/s and more). Bone lengths exact; the heels reach their targets (under 5 mm)
-    and no leg is straighter than the base's straightest (1 mm): the pelvis moves down for a longer stride."""
+    slide by about |1 - s| x the walking speed (0.2 m/s and more). Bone lengths exact; the heels reach their targets
+    (under 5 mm) and no leg is straighter than the base's straightest (1 mm): the pelvis moves down for a longer
+    stride and up for a shorter one."""
     own = foot_skate(neutral_walk(base, n_cycles=6, fps=30.0, plant=False).positions(), 30.0, base.skeleton)
     walk, r = _stride_only(base, scale)
     slide = foot_skate(walk.positions(), 30.0, base.skeleton)["mean_m_s"]
