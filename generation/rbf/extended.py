@@ -279,18 +279,19 @@ def extend(clips: list, base: Motion, m: int = 100, bml_clips: list | None = Non
             themes[theme]["sized_on"] = [bandai_source(s, first) if s != BML_DATASET else BML_SOURCE
                                          for s in train_per]
             themes[theme]["target"] = "mean over sources, each weighing the same"
+    pooled = [t for t in themes if "sized_on" in themes[t]]
     return {"method": "generation.rbf.extended: each body part x axis x kind group of a theme's rows (Table III and "
                       "ours) sized on its own so that w = 1 moves its measure by the real style-minus-normal "
-                      "difference (train split; the mean over the sources that hold the theme); 0 against the real "
-                      f"sign; factor cap {MAX_FACTOR:g}; plus a tempo (real speed ratio) applied as cadence",
+                      "difference (train split" + ("; the mean over the sources that hold the theme" if pooled else "")
+                      + f"); 0 against the real sign; factor cap {MAX_FACTOR:g}; plus a tempo (real speed ratio) "
+                      "applied as cadence",
             "units": "intensity: amplitude / walker height; measures: walker heights",
             "base": base.metadata.get("generator", "") + (" (real)" if base.metadata.get("captured_base") else ""),
             "max_factor": MAX_FACTOR, "fit_split": "train", "check_splits": list(C.HELDOUT_SPLITS),
             "data": "Bandai Namco Research Motion Dataset 1 and 2, straight walks (content walk), train split; "
                     "real-capture corpus built as docs/corpus.md says"
-                    + (f"; for {' and '.join(t for t in themes if 'sized_on' in themes[t])} also the BML walks of "
-                       "Emotion-Gait, training actors (the theme's sized_on lists its sources with licences and "
-                       "citations)" if any("sized_on" in e for e in themes.values()) else ""),
+                    + (f"; for {' and '.join(pooled)} also the BML walks of Emotion-Gait, training actors (the "
+                       "theme's sized_on lists its sources with licences and citations)" if pooled else ""),
             "licence": first.get("licence", "CC BY-NC 4.0"), "citation": first.get("citation", ""),
             "dataset_url": first.get("source_url", ""), "themes": themes}
 

@@ -40,10 +40,13 @@ from .themes import (
     AXES,
     BODY_PARTS,
     DEFAULT_INTENSITIES,
+    EXTENDED_SETS,
     INTENSITY_SETS,
+    POOLED_PATH,
     THEME_NAMES,
     calibration_provenance,
     extended_provenance,
+    extended_sources,
     extended_tempo,
     theme_features,
 )
@@ -479,8 +482,9 @@ def stylise(neutral_cycle: Motion, theme: str, weight: float, n_features: int, s
         intensities: the expert features' amplitudes, :data:`generation.rbf.themes.INTENSITY_SETS`: ``extended``
             (default; sized from real style-vs-normal differences, with our rows and, with all ten features, the
             theme's tempo: the cycle is played max(0.5, 1 + weight * tempo) times faster on top of ``speed``),
-            ``calibrated`` (w = 1 reproduces real actors' style differences, factors capped at 6x) or ``visual``
-            (the earlier hand-sized set).
+            ``calibrated`` (w = 1 reproduces real actors' style differences, factors capped at 6x), ``visual``
+            (the earlier hand-sized set) or ``pooled`` (as ``extended``, happy and sad sized on Bandai Namco and the
+            BML walks of Emotion-Gait; metadata ``intensity_sources`` names both with their licences).
 
     Returns:
         Motion on the neutral cycle's skeleton, round(n_cycles * cycle duration / speed * fps) frames, with
@@ -500,8 +504,9 @@ def stylise(neutral_cycle: Motion, theme: str, weight: float, n_features: int, s
                             intensities)
     stride = cycle_stride(neutral_cycle)
     tempo = 1.0
-    if features == "expert" and intensities == "extended" and n_features == len(theme_features(theme, None, "visual")):
-        tempo = max(0.5, 1.0 + float(weight) * extended_tempo(theme))
+    if features == "expert" and intensities in EXTENDED_SETS \
+            and n_features == len(theme_features(theme, None, "visual")):
+        tempo = max(0.5, 1.0 + float(weight) * extended_tempo(theme, EXTENDED_SETS[intensities]))
     rotations, root = warp_and_repeat_cycle(result["rotations"], result["root"], stride, neutral_cycle.duration,
                                             speed * tempo, n_cycles, fps)
     base_meta = neutral_cycle.metadata
@@ -529,8 +534,10 @@ def stylise(neutral_cycle: Motion, theme: str, weight: float, n_features: int, s
     metadata.update(base_provenance(base_meta))
     if features == "expert" and intensities == "calibrated" and "licence" not in metadata:
         metadata.update(calibration_provenance())
-    if features == "expert" and intensities == "extended" and "licence" not in metadata:
-        metadata.update(extended_provenance())
+    if features == "expert" and intensities in EXTENDED_SETS and "licence" not in metadata:
+        metadata.update(extended_provenance(EXTENDED_SETS[intensities]))
+    if features == "expert" and intensities == "pooled" and extended_sources(theme, POOLED_PATH):
+        metadata["intensity_sources"] = extended_sources(theme, POOLED_PATH)
     if features == "data" and "licence" not in metadata:
 
         data = load_data_features()
