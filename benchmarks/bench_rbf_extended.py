@@ -10,8 +10,8 @@ Measures (machine: 2-core shared CPU; about 2-3 min):
 3. The built-in ``seed004`` plan's 16 walks per theme (w 0.4, 0.7, 1.0, 1.3 x 1, 4, 7, 10 features): how many read
    as the theme, before and after.
 4. Feature differences per group of the theme's rows (Table III and ours): real style minus normal (train and
-   held-out takes) beside the generated w = 1 edit minus the base, calibrated and extended; and the tempo (real
-   speed ratio vs the extended walk's).
+   held-out takes) beside the generated w = 1 edit minus the base, calibrated and extended; and the stride and
+   cadence levers (real ratios vs the extended walk's at w = 1, measured on the walk's own steady cycles).
 
     OMP_NUM_THREADS=1 python -m benchmarks.bench_rbf_extended [--corpus var/mocap/bandai-namco.npz] \
         [--json docs/benchmarks/rbf_extended.json] [--doc docs/benchmarks/rbf.md]
@@ -28,7 +28,7 @@ from pathlib import Path
 from benchmarks.doc_tables import write_marked
 from generation.rbf import calibrate as C
 from generation.rbf import observer as O
-from generation.rbf.real_neutral import load_cycle
+from generation.rbf.real_neutral import load_cycle, steady_cycles
 from generation.rbf.stylise import neutral_walk, stylise
 from generation.rbf.themes import CALIBRATED_PATH, EXTENDED_PATH, THEME_NAMES, all_features
 
@@ -37,6 +37,7 @@ SETS = ("calibrated", "extended")  # before, after
 PLAN_WEIGHTS = (0.4, 0.7, 1.0, 1.3)
 PLAN_COUNTS = (1, 4, 7, 10)
 WALK = {"n_cycles": 3, "fps": 25.0}  # the seed004 plan's walks
+GAIT_WALK = {"n_cycles": 6, "fps": 25.0}  # long enough for several steady cycles
 
 
 def cross_dataset(clips) -> dict:
@@ -76,6 +77,20 @@ def readings(obs, held, base, reference) -> dict:
     return out
 
 
+def walk_gait(motion) -> tuple[float, float]:
+    """Mean stride (heights per cycle) and duration (s) of a walk's steady cycles, cut at its own left heel strikes
+    (as :func:`generation.rbf.extended.real_tempo` measures the real takes)."""
+    cycles = steady_cycles(motion, 100, "bench")
+    return sum(c.stride for c in cycles) / len(cycles), sum(c.duration_s for c in cycles) / len(cycles)
+
+
+def generated_gait(base, theme: str, w: float = 1.0) -> dict:
+    """The extended walk's stride, cadence and speed at weight ``w`` (ten features) over the neutral walk's."""
+    stride0, dur0 = walk_gait(neutral_walk(base, **GAIT_WALK))
+    stride, dur = walk_gait(stylise(base, theme, w, 10, **GAIT_WALK))
+    return {"stride": stride / stride0, "cadence": dur0 / dur, "speed": stride / stride0 * dur0 / dur}
+
+
 def features(base) -> dict:
     cal = json.loads(CALIBRATED_PATH.read_text(encoding="utf-8"))["themes"]
     ext = json.loads(EXTENDED_PATH.read_text(encoding="utf-8"))["themes"]
@@ -92,8 +107,12 @@ def features(base) -> dict:
                          "real_train": gx["real_train"], "real_heldout": gx["real_heldout"],
                          "calibrated_w1": float(c_w1[i]), "extended_w1": float(e_w1[i])})
         t = ext[theme]["tempo"]
-        out[theme] = {"groups": rows, "tempo": {"real_speed_ratio": [d["speed_ratio"] for d in t["datasets"]],
-                                                "per_weight": t["per_weight"]}}
+        out[theme] = {"groups": rows, "tempo": {
+            "real_speed_ratio": [d["speed_ratio"] for d in t["datasets"]],
+            "real_stride_ratio": [d["stride_ratio"] for d in t["datasets"]],
+            "real_cadence_ratio": [d["cadence_ratio"] for d in t["datasets"]],
+            "per_weight": t["per_weight"], "stride_per_weight": t["stride_per_weight"],
+            "cadence_per_weight": t["cadence_per_weight"], "generated_w1": generated_gait(base, theme)}}
         assert len(cal[theme]["groups"]) <= len(rows)
     return out
 
@@ -139,14 +158,19 @@ def render(res: dict) -> str:
         for r in entry["groups"]:
             lines.append(f"| {theme} | {r['group']} | {r['real_train']:+.4f} | {r['real_heldout']:+.4f} | "
                          f"{r['calibrated_w1']:+.4f} | {r['extended_w1']:+.4f} |")
-    lines += ["", "Tempo (ours; real speed of the style / the same dataset's normal speed, train takes; the extended "
-              "walk plays max(0.5, 1 + w x tempo) times faster):", "",
-              "| theme | real speed ratio per dataset | tempo per unit weight | extended speed at w = 1 |",
-              "|---|---|---|---|"]
+    lines += ["", "Stride and cadence (levers of ours; real style / the same dataset's normal walks, train takes, per "
+              "dataset; the extended walk's stride is scaled by max(0.5, 1 + w x stride) and its cadence by "
+              "max(0.5, 1 + w x cadence), per unit weight the mean real ratio - 1); the extended walk at w = 1 "
+              "measured on its own steady cycles (6 cycles, contacts detected on the walk) over the neutral walk's:",
+              "", "| theme | real stride ratio | real cadence ratio | real speed ratio | stride / cadence per unit "
+              "weight | w = 1 stride | w = 1 cadence | w = 1 speed |", "|---|---|---|---|---|---|---|---|"]
     for theme, entry in res["features"].items():
-        t = entry["tempo"]
-        lines.append(f"| {theme} | {', '.join(f'{x:.2f}' for x in t['real_speed_ratio'])} | {t['per_weight']:+.3f} | "
-                     f"{max(0.5, 1 + t['per_weight']):.2f} |")
+        t, g = entry["tempo"], entry["tempo"]["generated_w1"]
+        lines.append(f"| {theme} | {', '.join(f'{x:.2f}' for x in t['real_stride_ratio'])} | "
+                     f"{', '.join(f'{x:.2f}' for x in t['real_cadence_ratio'])} | "
+                     f"{', '.join(f'{x:.2f}' for x in t['real_speed_ratio'])} | "
+                     f"{t['stride_per_weight']:+.3f} / {t['cadence_per_weight']:+.3f} | {g['stride']:.2f} | "
+                     f"{g['cadence']:.2f} | {g['speed']:.2f} |")
     return "\n".join(lines)
 
 

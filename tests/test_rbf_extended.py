@@ -7,11 +7,19 @@ import json
 import numpy as np
 import pytest
 
+from generation.core.features import foot_skate
 from generation.mocap.real_corpus import DEFAULT_PATH, load_real_corpus
 from generation.rbf import calibrate as C
 from generation.rbf import extended as E
-from generation.rbf.real_neutral import load_cycle
-from generation.rbf.stylise import stylise
+from generation.rbf.real_neutral import load_cycle, steady_cycles
+from generation.rbf.stylise import (
+    bone_length_error,
+    cycle_stride,
+    neutral_walk,
+    stylise,
+    stylised_cycle,
+    warp_and_repeat_cycle,
+)
 from generation.rbf.themes import EXTENDED_PATH, OURS, THEME_NAMES, THEMES, all_features, theme_features
 
 
@@ -40,7 +48,11 @@ def test_shipped_file_names_its_data_and_keeps_the_experts_rows(shipped):
             g = entry["groups"][r["group"]]
             if not g["expert_sign_agrees"]:
                 assert r["extended"] == 0.0, (theme, r["feature"])
-        assert entry["tempo"]["source"] == "ours" and entry["tempo"]["datasets"]
+        tempo = entry["tempo"]
+        assert tempo["source"] == "ours" and tempo["datasets"]
+        for key in ("stride", "cadence"):
+            real = np.mean([d[f"{key}_ratio"] for d in tempo["datasets"]]) - 1
+            assert tempo[f"{key}_per_weight"] == pytest.approx(real, abs=1e-5)
     held = next(r for r in shipped["themes"]["energetic"]["features"] if r["rank"] == 5)
     assert held["extended"] == 0.0 and "clavicles" in held["held_at_zero"]
 
@@ -83,4 +95,65 @@ def test_rebuild_on_the_corpus_matches_the_shipped_file(shipped):
         train, _ = C.real_differences(clips, theme, ("train",), 100, all_features(theme))
         np.testing.assert_allclose(train, [g["real_train"] for g in shipped["themes"][theme]["groups"]], atol=1e-5)
         tempo = shipped["themes"][theme]["tempo"]["per_weight"]
-        assert E.real_tempo(clips, theme)["per_weight"] == pytest.approx(tempo, abs=1e-5)
+        real = E.real_tempo(clips, theme)
+        assert real["per_weight"] == pytest.approx(tempo, abs=1e-5)
+        for key in ("stride_per_weight", "cadence_per_weight"):
+            assert real[key] == pytest.approx(shipped["themes"][theme]["tempo"][key], abs=1e-5)
+
+
+def _gait(motion) -> tuple[float, float]:
+    """Mean stride (root advance per cycle, heights) and cycle duration (s) over the steady cycles cut at the
+    walk's own left heel strikes, as the real ratios are measured (:func:`generation.rbf.extended.real_tempo`)."""
+    cycles = steady_cycles(motion, 100, "test")
+    assert len(cycles) >= 3
+    return float(np.mean([c.stride for c in cycles])), float(np.mean([c.duration_s for c in cycles]))
+
+
+@pytest.mark.parametrize("theme, w", [("sad", 1.0), ("energetic", 1.0), ("masculine", 1.0), ("sad", -0.7)])
+def test_stylised_walk_has_the_levers_stride_and_cadence(base, shipped, theme, w):
+    """Measured on the walk (contacts detected on it), stride / the base walk's stride is the stride factor and
+    cadence / the base's the cadence factor within 3 %; at w = 1 that is the real style's ratios."""
+    tempo = shipped["themes"][theme]["tempo"]
+    s, c = 1 + w * tempo["stride_per_weight"], 1 + w * tempo["cadence_per_weight"]
+    stride0, dur0 = _gait(neutral_walk(base, n_cycles=6, plant=False))
+    clip = stylise(base, theme, w, 10, n_cycles=6)
+    assert clip.metadata["stride_scale"] == pytest.approx(s) and clip.metadata["cadence_scale"] == pytest.approx(c)
+    stride, dur = _gait(clip)
+    assert stride / stride0 == pytest.approx(s, rel=0.03)
+    assert dur0 / dur == pytest.approx(c, rel=0.03)
+
+
+def _stride_only(base, scale: float, progression: bool = True):
+    """The base cycle with only the stride lever (no features), walked 6 cycles at its own cadence, unplanted."""
+    from generation.core.motion import Motion
+
+    r = stylised_cycle(base, "sad", 0.0, 10, stride_scale=scale)
+    stride = cycle_stride(base) * (scale if progression else 1.0)
+    root = r["root"] if progression else r["root"] - (scale - 1) * (r["root"] - r["root"][:1])
+    rot, root = warp_and_repeat_cycle(r["rotations"], root, stride, base.duration, 1.0, 6, 30.0)
+    return Motion(base.skeleton, rot, root, 30.0, {}), r
+
+
+@pytest.mark.parametrize("scale", [0.71, 1.2])
+def test_stride_lever_keeps_feet_planted_and_bones(base, scale):
+    """The stride lever alone (no features, no foot planting afterwards): feet slide no more than the base walk's
+    own (unplanted: 0.06 m/s mean over contact frames) plus 0.02 m/s; without scaling the progression the same legs
+    slide by about |1 - s| x the walking speed (0.2 m/s and more). Bone lengths exact; the heels reach their targets
+    (under 5 mm) and no leg is straighter than the base's straightest (1 mm): the pelvis moves down for a longer
+    stride and up for a shorter one."""
+    own = foot_skate(neutral_walk(base, n_cycles=6, fps=30.0, plant=False).positions(), 30.0, base.skeleton)
+    walk, r = _stride_only(base, scale)
+    slide = foot_skate(walk.positions(), 30.0, base.skeleton)["mean_m_s"]
+    assert slide <= own["mean_m_s"] + 0.02
+    skid = foot_skate(_stride_only(base, scale, progression=False)[0].positions(), 30.0, base.skeleton)["mean_m_s"]
+    assert skid > own["mean_m_s"] + 0.1
+    assert bone_length_error(walk.positions(), base.skeleton) < 1e-4
+    heels = [base.skeleton.index(n) for n in ("left_heel", "right_heel")]
+    hips = [base.skeleton.index(n) for n in ("left_hip", "right_hip")]
+    assert np.linalg.norm(r["positions"][:, heels] - r["target"][:, heels], axis=-1).max() < 5e-3
+    leg = np.linalg.norm(r["positions"][:, heels] - r["positions"][:, hips], axis=-1).max(axis=0)
+    assert np.all(leg <= np.linalg.norm(r["P"][:, heels] - r["P"][:, hips], axis=-1).max(axis=0) + 1e-3)
+    if scale > 1:
+        assert r["pelvis_shift"].min() < -0.01  # a longer stride lowers the pelvis
+    else:
+        assert r["pelvis_shift"].max() > 0.01  # a shorter one raises it (the knees keep the base's flexion)

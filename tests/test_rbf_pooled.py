@@ -48,8 +48,9 @@ def test_happy_and_sad_targets_are_the_mean_of_both_sources(pooled):
         assert any(abs(g["real_train_sources"][BANDAI] - g["real_train_sources"][BML]) > 0.01 for g in entry["groups"])
         tempo = entry["tempo"]
         assert [d["dataset"] for d in tempo["datasets"]] == [BANDAI, BML]
-        assert tempo["per_weight"] == pytest.approx(np.mean([d["speed_ratio"] for d in tempo["datasets"]]) - 1,
-                                                    abs=2e-6)
+        for key, ratio in (("per_weight", "speed_ratio"), ("stride_per_weight", "stride_ratio"),
+                           ("cadence_per_weight", "cadence_ratio")):
+            assert tempo[key] == pytest.approx(np.mean([d[ratio] for d in tempo["datasets"]]) - 1, abs=2e-6), key
 
 
 def test_bml_sizes_on_training_actors_and_checks_on_the_others(pooled):
@@ -70,11 +71,14 @@ def test_other_themes_and_the_default_set_are_bandai_alone(pooled, extended):
 
 def test_pooled_is_selectable_with_its_tempo_and_sources(pooled):
     out = stylise(load_cycle(), "sad", 1.0, 10, intensities="pooled", n_cycles=1, plant=False)
+    tempo = pooled["themes"]["sad"]["tempo"]
     assert out.metadata["intensities"] == "pooled"
-    assert out.metadata["tempo"] == pytest.approx(max(0.5, 1 + pooled["themes"]["sad"]["tempo"]["per_weight"]))
+    assert out.metadata["stride_scale"] == pytest.approx(max(0.5, 1 + tempo["stride_per_weight"]))
+    assert out.metadata["cadence_scale"] == pytest.approx(max(0.5, 1 + tempo["cadence_per_weight"]))
     assert sorted(out.metadata["intensity_sources"]) == [BANDAI, BML]
     default = stylise(load_cycle(), "sad", 1.0, 10, n_cycles=1, plant=False)
-    assert "intensity_sources" not in default.metadata and default.metadata["tempo"] != out.metadata["tempo"]
+    assert "intensity_sources" not in default.metadata
+    assert default.metadata["cadence_scale"] != out.metadata["cadence_scale"]
 
 
 def test_pooled_file_is_current(pooled):
@@ -130,5 +134,6 @@ def test_rebuild_on_the_corpora_matches_the_shipped_file(pooled):
     for theme in POOLED_THEMES:
         train, _, _ = E.source_differences(clips, bml, theme, ("train",), 100, all_features(theme))
         np.testing.assert_allclose(train, [g["real_train"] for g in pooled["themes"][theme]["groups"]], atol=1e-5)
-        tempo = E.pooled_tempo(clips, bml, theme)["per_weight"]
-        assert tempo == pytest.approx(pooled["themes"][theme]["tempo"]["per_weight"], abs=1e-5)
+        tempo = E.pooled_tempo(clips, bml, theme)
+        for key in ("per_weight", "stride_per_weight", "cadence_per_weight"):
+            assert tempo[key] == pytest.approx(pooled["themes"][theme]["tempo"][key], abs=1e-5), key

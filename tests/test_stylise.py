@@ -285,21 +285,26 @@ def test_speed_warps_time_uniformly_and_walks_forward(neutral):
     np.testing.assert_allclose(fast.positions(), sparse.positions(), atol=1e-9)
 
 
-def test_extended_set_changes_tempo_with_the_weight(neutral):
-    """The extended set's tempo (a lever of ours): the cycle plays max(0.5, 1 + w * tempo) times faster, only with
-    all ten features; the same poses otherwise (a uniform time warp)."""
-    from generation.rbf.themes import extended_tempo
+def test_extended_set_changes_stride_and_cadence_with_the_weight(neutral):
+    """The extended set's stride and cadence (levers of ours): s = max(0.5, 1 + w * stride), c = max(0.5, 1 + w *
+    cadence), only with all ten features; the cycle plays c times faster and walks s times further per cycle."""
+    from generation.rbf.themes import extended_stride_cadence
 
-    tempo = extended_tempo("energetic")
-    assert tempo > 0 > extended_tempo("sad")
+    stride, cadence = extended_stride_cadence("energetic")
+    assert stride > 0 and cadence > 0 and extended_stride_cadence("sad")[0] < 0 > extended_stride_cadence("sad")[1]
     for w in (-0.7, 0.7):
-        clip = stylise(neutral, "energetic", w, 10, n_cycles=4, fps=30.0)
-        assert clip.metadata["tempo"] == pytest.approx(1 + w * tempo)
-        assert clip.num_frames == round(4 * neutral.duration / (1 + w * tempo) * 30.0)
-    assert "tempo" not in stylise(neutral, "energetic", 0.7, 7, n_cycles=4).metadata
-    assert "tempo" not in stylise(neutral, "energetic", 0.0, 10, n_cycles=4).metadata
-    slow = stylise(neutral, "sad", 1.3, 10, n_cycles=1)
-    assert slow.metadata["tempo"] == 0.5
+        clip = stylise(neutral, "energetic", w, 10, n_cycles=4, fps=30.0, plant=False)
+        assert clip.metadata["stride_scale"] == pytest.approx(1 + w * stride)
+        assert clip.metadata["cadence_scale"] == pytest.approx(1 + w * cadence)
+        assert clip.num_frames == round(4 * neutral.duration / (1 + w * cadence) * 30.0)
+        advance = clip.root_positions[-1, 2] - clip.root_positions[0, 2]
+        per_frame = (1 + w * stride) * neutral.metadata["stride_m"][2] * (1 + w * cadence) / (neutral.duration * 30)
+        assert advance == pytest.approx(per_frame * (clip.num_frames - 1), rel=0.02)
+    for kept in (stylise(neutral, "energetic", 0.7, 7, n_cycles=4), stylise(neutral, "energetic", 0.0, 10, n_cycles=4),
+                 stylise(neutral, "energetic", 0.7, 10, n_cycles=4, intensities="calibrated")):
+        assert "stride_scale" not in kept.metadata and "cadence_scale" not in kept.metadata
+    slow = stylise(neutral, "sad", 1.9, 10, n_cycles=1)
+    assert slow.metadata["stride_scale"] == 0.5 and slow.metadata["cadence_scale"] == 0.5
 
 
 def test_neutral_walk_equals_weight_zero(neutral):

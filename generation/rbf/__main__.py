@@ -39,7 +39,7 @@ def main(argv: list[str] | None = None) -> int:
     for name, help_ in (("neutral", "average real normal-walk cycles into the neutral base cycle"),
                         ("features", "fit data-driven RBF features per theme to real themed walks"),
                         ("calibrate", "calibrate the expert features' intensities on real themed walks"),
-                        ("extend", "size the extended intensity set (with our rows and tempo) on real themed walks")):
+                        ("extend", "size the extended intensity set (our rows, stride, cadence) on real themed walks")):
         p = sub.add_parser(name, help=help_)
         p.add_argument("--corpus", type=Path, default=real_corpus_path(os.environ),
                        help="real-capture corpus .npz (default: $REAL_CORPUS, else var/mocap/bandai-namco.npz)")
@@ -70,7 +70,8 @@ def main(argv: list[str] | None = None) -> int:
         save_extended(data, args.out or (POOLED_PATH if args.pooled else EXTENDED_PATH))
         for theme, entry in data["themes"].items():
             print(f"{theme}: factors {[round(r['factor'], 2) for r in entry['features']]}, "
-                  f"tempo {entry['tempo']['per_weight']:+.3f}")
+                  f"stride {entry['tempo']['stride_per_weight']:+.3f}, "
+                  f"cadence {entry['tempo']['cadence_per_weight']:+.3f}")
         return 0
     clips = load_real_corpus(args.corpus, skeleton="gait", split="train", contents=["walk"])
     features = fit_data_features(clips, GAIT_JOINTS)

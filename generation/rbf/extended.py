@@ -5,9 +5,9 @@ as its unstyled base (docs/benchmarks/rbf.md). The calibrated set fits all rows 
 capped at 6x our visual numbers, and zeroes or caps rows to offset one another; the real differences are larger
 (data-driven features fitted to real themed walks are 1.0-2.0x the experts'). Here each row is sized on its own
 from what real actors do, and two levers the experts' ten rows lack are added as rows of our own
-(:data:`generation.rbf.themes.OURS`, ``source: ours``) plus a tempo.
+(:data:`generation.rbf.themes.OURS`, ``source: ours``) plus a stride and a cadence lever.
 
-Data (**sources**, :data:`SOURCES`): the straight walks of the Bandai Namco Research Motion Dataset 1 and 2
+Data (**sources**): the straight walks of the Bandai Namco Research Motion Dataset 1 and 2
 (Kobayashi et al. 2023, arXiv:2306.08861, CC BY-NC 4.0), each dataset a source; and for the themes it has (happy,
 sad) the BML walks of Emotion-Gait (Ma, Paterson & Pollick 2006; Bhattacharya et al. AAAI 2020; research use with
 citation), :data:`BML_SOURCE`. **Training split** only: Bandai's training takes, BML's training actors (whole actors
@@ -28,16 +28,19 @@ actors, so neither alone decides the size.
    swings the other way) is halved instead, and held at zero if it still does after the last step. Energetic's
    "Shoulders: increased swing along Y" is held at 0 (:data:`HELD_AT_ZERO`): without clavicles a shoulder bob
    moves the whole chest, a shrug artefact that made energetic walks read tired.
-2. **Tempo** (a lever of ours): the real style's walking speed over the same source's normal speed (BML: the
-   mean over actors of the actor's ratio), averaged over the sources, minus 1 (per cycle: stride / duration),
-   applied by :func:`generation.rbf.stylise.stylise` as a cadence change of
-   max(0.5, 1 + w * tempo) with all ten features. Real styles change stride and cadence together; we change cadence
-   only (the base's stride is kept so the feet stay planted), so the speed, which observers read, matches.
+2. **Stride and cadence** (two levers of ours, the JSON's ``tempo`` block): the real style's stride (distance per
+   cycle) and cadence (cycles per second) over the same source's normal ones (BML: the mean over actors of the
+   actor's ratios), minus 1, averaged over the sources with the theme (``stride_per_weight``, ``cadence_per_weight``;
+   ``per_weight`` is the speed's, kept for reference). :func:`generation.rbf.stylise.stylise` applies them with all
+   ten features: the stride scaled by s(w) = max(0.5, 1 + w * stride_per_weight) (the legs' fore-aft offsets from the
+   pelvis and the progression per cycle, so a planted foot stays planted;
+   :func:`generation.rbf.stylise.scale_stride`) and the cycle played c(w) = max(0.5, 1 + w * cadence_per_weight)
+   times faster; w = 1 gives the real stride and cadence.
 
 :func:`extend` gives the JSON of :data:`generation.rbf.themes.EXTENDED_PATH` with the data's licence and citation,
-every row's visual and extended intensity and source, per group the training and held-out real differences (their
-mean over sources and per source) and the w = 1 change reached, the tempo with its per-source speeds, and per theme
-the sources it was sized on with their licences and citations.
+every row's visual and extended intensity and source, per group the training and held-out real differences (with
+BML: their mean over sources and per source) and the w = 1 change reached, the stride and cadence levers with their
+per-source ratios, and per pooled theme the sources it was sized on with their licences and citations.
 """
 from __future__ import annotations
 
@@ -137,9 +140,10 @@ def extend_theme(base: Motion, theme: str, target: np.ndarray) -> tuple[np.ndarr
 def real_tempo(clips: list, theme: str, splits: tuple[str, ...] = ("train",), m: int = 100) -> dict:
     """Real walking speed, stride and cadence of ``theme``'s takes relative to the same dataset's normal takes.
 
-    Returns {"per_weight": mean over datasets of speed ratio - 1, "datasets": [{dataset, speed_ratio, stride_ratio,
-    cadence_ratio, takes, normal_takes}]}; speeds per take are the mean over its steady cycles of stride / duration
-    (heights per second).
+    Returns {"per_weight": mean over datasets of speed ratio - 1, "stride_per_weight": of stride ratio - 1,
+    "cadence_per_weight": of cadence ratio - 1, "datasets": [{dataset, speed_ratio, stride_ratio, cadence_ratio,
+    takes, normal_takes}]}; per take the mean over its steady cycles of the stride (heights) and the duration
+    (seconds); cadence ratio = normal duration / themed duration.
     """
     styles = C.theme_styles(theme)
 
@@ -162,7 +166,9 @@ def real_tempo(clips: list, theme: str, splits: tuple[str, ...] = ("train",), m:
                      "takes": len(themed), "normal_takes": len(normal)})
     if not rows:
         raise ValueError(f"no dataset has {theme} and normal walks in splits {list(splits)}")
-    return {"per_weight": float(np.mean([r["speed_ratio"] for r in rows]) - 1.0), "datasets": rows}
+    return {"per_weight": float(np.mean([r["speed_ratio"] for r in rows]) - 1.0),
+            "stride_per_weight": float(np.mean([r["stride_ratio"] for r in rows]) - 1.0),
+            "cadence_per_weight": float(np.mean([r["cadence_ratio"] for r in rows]) - 1.0), "datasets": rows}
 
 
 def bml_source(clips: list, theme: str, splits: tuple[str, ...] = ("train",), m: int = 100,
@@ -222,8 +228,9 @@ def source_differences(clips: list, bml_clips: list | None, theme: str, splits: 
 def pooled_tempo(clips: list, bml_clips: list | None, theme: str, splits: tuple[str, ...] = ("train",),
                  m: int = 100) -> dict:
     """:func:`real_tempo` with BML as one more source where it holds the theme (its ratios: means over actors of
-    each actor's styled / neutral walk, :func:`bml_source`); ``per_weight`` = mean over sources of the speed
-    ratio - 1, each source weighing the same."""
+    each actor's styled / neutral walk, :func:`bml_source`); ``per_weight``, ``stride_per_weight`` and
+    ``cadence_per_weight`` = mean over sources of the speed, stride and cadence ratio - 1, each source weighing the
+    same."""
     tempo = real_tempo(clips, theme, splits, m)
     bml = bml_source(bml_clips, theme, splits, m) if bml_clips else None
     if bml is None:
@@ -231,7 +238,9 @@ def pooled_tempo(clips: list, bml_clips: list | None, theme: str, splits: tuple[
     tempo["datasets"].append({"dataset": BML_DATASET, "speed_ratio": bml["speed_ratio"],
                               "stride_ratio": bml["stride_ratio"], "cadence_ratio": bml["cadence_ratio"],
                               "walkers": len(bml["walkers"]), "splits": bml["splits"]})
-    tempo["per_weight"] = float(np.mean([r["speed_ratio"] for r in tempo["datasets"]]) - 1.0)
+    for key, ratio in (("per_weight", "speed_ratio"), ("stride_per_weight", "stride_ratio"),
+                       ("cadence_per_weight", "cadence_ratio")):
+        tempo[key] = float(np.mean([r[ratio] for r in tempo["datasets"]]) - 1.0)
     return tempo
 
 
@@ -272,7 +281,10 @@ def extend(clips: list, base: Motion, m: int = 100, bml_clips: list | None = Non
                       for i, (p, a, k) in enumerate(groups)]
         tempo = pooled_tempo(clips, bml_clips, theme, ("train",), m)
         tempo["source"] = "ours"
-        tempo["applied_as"] = "cadence: the cycle played max(0.5, 1 + w * per_weight) times faster, stride kept"
+        tempo["applied_as"] = ("with all ten features: stride scaled by max(0.5, 1 + w * stride_per_weight) (legs' "
+                               "fore-aft offsets from the pelvis and progression per cycle, feet planted, pelvis "
+                               "lowered where a leg cannot reach) and the cycle played max(0.5, 1 + w * "
+                               "cadence_per_weight) times faster; per_weight (speed) for reference")
         themes[theme] = {"features": rows, "groups": group_rows, "tempo": tempo,
                          "sources": {"train": train_info, "heldout": held_info}}
         if pooled:
@@ -283,8 +295,8 @@ def extend(clips: list, base: Motion, m: int = 100, bml_clips: list | None = Non
     return {"method": "generation.rbf.extended: each body part x axis x kind group of a theme's rows (Table III and "
                       "ours) sized on its own so that w = 1 moves its measure by the real style-minus-normal "
                       "difference (train split" + ("; the mean over the sources that hold the theme" if pooled else "")
-                      + f"); 0 against the real sign; factor cap {MAX_FACTOR:g}; plus a tempo (real speed ratio) "
-                      "applied as cadence",
+                      + f"); 0 against the real sign; factor cap {MAX_FACTOR:g}; plus stride and cadence levers "
+                      "(real stride and cadence ratios)",
             "units": "intensity: amplitude / walker height; measures: walker heights",
             "base": base.metadata.get("generator", "") + (" (real)" if base.metadata.get("captured_base") else ""),
             "max_factor": MAX_FACTOR, "fit_split": "train", "check_splits": list(C.HELDOUT_SPLITS),

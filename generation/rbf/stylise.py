@@ -19,6 +19,10 @@ Pipeline (shapes: m cycle frames, J joints):
    joints with several children (pelvis, chest) take the best rotation onto their children (Horn's
    quaternion method). Twist comes from the neutral motion. Bone lengths are then exact.
 5. Uniform time warping for speed (cycle duration / speed) and the cycle repeated n_cycles times along +z.
+
+With the ``extended`` (or ``pooled``) set and all ten features, two levers of ours (:func:`stride_cadence_scales`):
+the stride scaled by s (before step 4, :func:`scale_stride` and :func:`keep_leg_extension`; the progression per cycle by
+the same s) and the cadence by c (step 5).
 """
 from __future__ import annotations
 
@@ -47,7 +51,7 @@ from .themes import (
     calibration_provenance,
     extended_provenance,
     extended_sources,
-    extended_tempo,
+    extended_stride_cadence,
     theme_features,
 )
 
@@ -56,6 +60,14 @@ PAPER_WEIGHTS = (0.4, 0.7, 1.0, 1.3)  # Fig. 7
 PAPER_FEATURE_COUNTS = (1, 4, 7, 10)  # Fig. 7
 INVERSION_WEIGHT = -0.7  # Fig. 8
 FEATURE_SOURCES = ("expert", "data")  # Table III's expert features, or RBFs fitted to real themed walks
+
+#: (hip, knee, heel, toe) of each leg of the gait skeleton: what a stride change moves.
+STRIDE_LEGS = (("left_hip", "left_knee", "left_heel", "left_toe"),
+               ("right_hip", "right_knee", "right_heel", "right_toe"))
+#: The straightest a leg may be after a stride change: hip-to-heel distance / (thigh + shin) at most this
+#: (:func:`keep_leg_extension`).
+MAX_LEG_EXTENSION = 0.995
+MIN_GAIT_SCALE = 0.5  # stride and cadence factors are at least this (a negative weight past -1 / ratio would stop)
 
 # Two-bone chains (root, middle, end) of the 21-joint gait skeleton solved analytically.
 GAIT_LIMB_CHAINS = (
@@ -196,6 +208,85 @@ def rbf_displacement(P: np.ndarray, skeleton: Skeleton, dofs: dict[tuple[str, st
             continue
         S[:, j, follow] = S[:, p, follow]
     return S
+
+
+# --------------------------------------------------------------------------------------------------
+# Stride and cadence (levers of ours, extended set)
+# --------------------------------------------------------------------------------------------------
+def stride_cadence_scales(theme: str, weight: float, n_features: int, features: str = "expert",
+                          intensities: str | Mapping[int, float] = DEFAULT_INTENSITIES) -> tuple[float, float]:
+    """(stride factor s, cadence factor c) of a styled walk, both 1 unless the ``extended`` (or ``pooled``) set's
+    expert features are all on (all ten of Table III): s = max(0.5, 1 + w * stride), c = max(0.5, 1 + w * cadence)
+    with the theme's real stride and cadence ratios minus 1 (:func:`generation.rbf.themes.extended_stride_cadence`), so
+    w = 1 gives the real style's stride and cadence relative to normal walking and a negative w inverts them."""
+    if not (features == "expert" and isinstance(intensities, str) and intensities in EXTENDED_SETS
+            and n_features == len(theme_features(theme, None, "visual"))):
+        return 1.0, 1.0
+    stride, cadence = extended_stride_cadence(theme, EXTENDED_SETS[intensities])
+    w = float(weight)
+    return max(MIN_GAIT_SCALE, 1.0 + w * stride), max(MIN_GAIT_SCALE, 1.0 + w * cadence)
+
+
+def scale_stride(Y: np.ndarray, skeleton: Skeleton, scale: float) -> np.ndarray:
+    """Walker-frame targets (m, J, 3) metres with the stride scaled by ``scale``: a copy.
+
+    The fore-aft (z) offsets of the hips and heels from the pelvis are scaled by ``scale`` and the pelvis' own
+    fore-aft surge about its cycle mean too (a uniform stretch of the legs along z about the pelvis' mean), so with
+    the progression per cycle scaled by the same factor a planted heel stays planted; the other joints (trunk,
+    arms, head) move with the pelvis. Knees follow their hip and toes their heel unscaled (the knee is solved by
+    the leg IK, so its bend direction is kept; the foot keeps its shape). Heights are unchanged
+    (:func:`keep_leg_extension` then moves the pelvis up or down to keep the legs' flexion).
+    """
+    out = Y.copy()
+    if scale == 1.0:
+        return out
+    root = skeleton.index("root")
+    z = Y[:, :, 2]
+    z0 = float(z[:, root].mean())
+    surge = (scale - 1.0) * (z[:, root] - z0)                           # (m,) the pelvis' own change
+    out[:, :, 2] = z + surge[:, None]
+    for hip, knee, heel, toe in STRIDE_LEGS:
+        for joint, follows in ((hip, knee), (heel, toe)):
+            j, f = skeleton.index(joint), skeleton.index(follows)
+            out[:, j, 2] = z0 + scale * (z[:, j] - z0)
+            out[:, f, 2] = z[:, f] + (out[:, j, 2] - z[:, j])
+    return out
+
+
+def _hip_height_shift(Y: np.ndarray, hip: int, heel: int, distance: np.ndarray) -> np.ndarray:
+    """(m,) metres the hip of targets ``Y`` (m, J, 3) must move up (negative: down) to stand ``distance`` (m,)
+    from its heel, the horizontal offset kept (0 height over the heel where the offset alone is longer)."""
+    d = Y[:, hip] - Y[:, heel]
+    rise = np.sqrt(np.maximum(distance * distance - d[:, 0] ** 2 - d[:, 2] ** 2, 0.0))
+    return rise - d[:, 1]
+
+
+def keep_leg_extension(Y: np.ndarray, P: np.ndarray, skeleton: Skeleton) -> tuple[np.ndarray, np.ndarray]:
+    """Raise or lower every joint but the feet so the legs reach their heels and keep about the base's flexion.
+
+    A stride change moves the heels fore-aft but not the pelvis' height. A longer stride would stretch a leg past
+    its length (the IK would lift the heel off its planted spot): where a leg's hip-to-heel distance in the targets
+    ``Y`` (m, J, 3) would exceed its straightest in the neutral cycle ``P`` (m, J, 3) (at most
+    :data:`MAX_LEG_EXTENSION` x (thigh + shin)), the pelvis is lowered until it does not, as real walkers' is with
+    long steps. A shorter stride would bend the stance knee more than the base's: the pelvis is raised, at most
+    until one leg is as straight as in the neutral cycle at that frame. The shift (per frame, the most both legs
+    allow) moves the pelvis, trunk, arms, hips and knees; heels and toes keep their targets. Returns the shifted
+    copy and the shift per frame (m,) metres (negative: lowered).
+    """
+    lower, raise_ = [], []
+    for hip, knee, heel, _ in STRIDE_LEGS:
+        h, k, e = skeleton.index(hip), skeleton.index(knee), skeleton.index(heel)
+        length = float(np.linalg.norm(skeleton.offsets[k]) + np.linalg.norm(skeleton.offsets[e]))
+        base = np.linalg.norm(P[:, e] - P[:, h], axis=-1)                                      # (m,)
+        reach = min(float(base.max()), MAX_LEG_EXTENSION * length)
+        lower.append(_hip_height_shift(Y, h, e, np.full(len(Y), reach)))
+        raise_.append(_hip_height_shift(Y, h, e, np.minimum(base, reach)))
+    shift = np.minimum(np.minimum(*lower), np.maximum(np.minimum(*raise_), 0.0))
+    out = Y.copy()
+    feet = [skeleton.index(n) for leg in STRIDE_LEGS for n in leg[2:]]
+    body = [j for j in range(skeleton.num_joints) if j not in feet]
+    out[:, body, 1] += shift[:, None]
+    return out, shift
 
 
 # --------------------------------------------------------------------------------------------------
@@ -400,22 +491,25 @@ def warp_and_repeat_cycle(rotations: np.ndarray, root: np.ndarray, stride: np.nd
 # --------------------------------------------------------------------------------------------------
 def stylised_cycle(neutral_cycle: Motion, theme: str, weight: float, n_features: int,
                    keep_ground: bool = True, features: str = "expert", exclude: tuple[int, ...] = (),
-                   intensities: str | Mapping[int, float] = DEFAULT_INTENSITIES) -> dict:
+                   intensities: str | Mapping[int, float] = DEFAULT_INTENSITIES, stride_scale: float = 1.0) -> dict:
     """One stylised cycle on the skeleton, with the intermediate arrays.
 
     Returns a dict with ``P`` (m, J, 3) neutral walker-frame positions, ``S`` (m, J, 3) secondary
-    features, ``Y`` = P + weight * S, ``rotations`` (m, J, 4) and ``root`` (m, 3) of the fitted cycle (root
-    with the progression added back), ``positions`` (m, J, 3) their forward kinematics in the walker's
-    frame, and the bone-length errors ``before`` (of Y) and ``after`` (of the fit), the largest
-    distance ``residual`` between fitted and edited positions and the largest ``ground_lift`` applied by
-    :func:`keep_feet_above_ground` (when ``keep_ground``), all metres.
+    features, ``Y`` = P + weight * S (with the stride scaled, :func:`scale_stride`), ``rotations`` (m, J, 4) and
+    ``root`` (m, 3) of the fitted cycle (root with the progression, times ``stride_scale``, added back),
+    ``positions`` (m, J, 3) their forward kinematics in the walker's frame, and the bone-length errors ``before``
+    (of Y) and ``after`` (of the fit), the largest distance ``residual`` between fitted and edited positions, the
+    largest ``ground_lift`` applied by :func:`keep_feet_above_ground` (when ``keep_ground``) and ``pelvis_shift``
+    (m,) of :func:`keep_leg_extension` (zeros with ``stride_scale`` 1), all metres.
 
     ``features``: "expert" (Table III, :func:`theme_displacement`) or "data" (RBFs fitted to real themed walks,
     :func:`generation.rbf.data_features.data_rbfs`, applied to their own DOFs without propagation). ``exclude``:
     expert features (Table III ranks) to leave out, for ablations. ``intensities``: the expert features'
     amplitudes, ``extended`` (default), ``calibrated`` or ``visual`` (:data:`generation.rbf.themes.INTENSITY_SETS`)
-    or {rank: intensity}.
+    or {rank: intensity}. ``stride_scale``: the stride factor s (:func:`stride_cadence_scales`; 1 keeps the base's).
     """
+    if not (stride_scale > 0 and np.isfinite(stride_scale)):
+        raise ValueError(f"stride_scale must be a positive number, got {stride_scale!r}")
     if features not in FEATURE_SOURCES:
         raise ValueError(f"features must be one of {list(FEATURE_SOURCES)}, got {features!r}")
     if not np.isfinite(weight):
@@ -429,15 +523,19 @@ def stylised_cycle(neutral_cycle: Motion, theme: str, weight: float, n_features:
     else:
 
         S = rbf_displacement(P, skel, data_rbfs(theme, n_features, skel.height, P.shape[0]), propagate=False)
-    Y = P + float(weight) * S
+    Y = scale_stride(P + float(weight) * S, skel, float(stride_scale))
     target, lifted = keep_feet_above_ground(Y, P, skel) if keep_ground else (Y, 0.0)
+    shift = np.zeros(len(P))
+    if stride_scale != 1.0:
+        target, shift = keep_leg_extension(target, P, skel)
     rotations, root = fit_to_skeleton(target, skel, neutral_cycle.rotations)
     fitted = np_forward_kinematics(rotations, root, skel)
     return {
-        "P": P, "S": S, "Y": Y, "target": target, "rotations": rotations, "root": root + progression,
-        "positions": fitted,
+        "P": P, "S": S, "Y": Y, "target": target, "rotations": rotations,
+        "root": root + float(stride_scale) * progression, "positions": fitted,
         "before": bone_length_error(Y, skel), "after": bone_length_error(fitted, skel),
         "residual": float(np.linalg.norm(fitted - Y, axis=-1).max()), "ground_lift": lifted,
+        "pelvis_shift": shift,
     }
 
 
@@ -481,7 +579,8 @@ def stylise(neutral_cycle: Motion, theme: str, weight: float, n_features: int, s
         exclude: expert features (Table III ranks) to leave out (ablations; recorded in the metadata when given).
         intensities: the expert features' amplitudes, :data:`generation.rbf.themes.INTENSITY_SETS`: ``extended``
             (default; sized from real style-vs-normal differences, with our rows and, with all ten features, the
-            theme's tempo: the cycle is played max(0.5, 1 + weight * tempo) times faster on top of ``speed``),
+            theme's stride and cadence, :func:`stride_cadence_scales`: the stride scaled by s with the feet
+            planted and the cycle played c times faster on top of ``speed``),
             ``calibrated`` (w = 1 reproduces real actors' style differences, factors capped at 6x), ``visual``
             (the earlier hand-sized set) or ``pooled`` (as ``extended``, happy and sad sized on Bandai Namco and the
             BML walks of Emotion-Gait; metadata ``intensity_sources`` names both with their licences).
@@ -489,7 +588,9 @@ def stylise(neutral_cycle: Motion, theme: str, weight: float, n_features: int, s
     Returns:
         Motion on the neutral cycle's skeleton, round(n_cycles * cycle duration / speed * fps) frames, with
         metadata origin, generator "rbf", theme, weight, n_features, speed, synthetic_base, the
-        bone-length errors before/after the fit (metres) and, when planted, ``foot_planting`` (True) and
+        bone-length errors before/after the fit (metres), ``stride_scale`` and ``cadence_scale`` (when the
+        levers change the walk; with ``pelvis_shift_m``, the range [min, max] of :func:`keep_leg_extension`'s
+        height change) and, when planted, ``foot_planting`` (True) and
         ``foot_cleanup`` (see :func:`generation.core.foot_contact.plant_feet`).
     """
     if not speed > 0 or not np.isfinite(speed):
@@ -500,15 +601,12 @@ def stylise(neutral_cycle: Motion, theme: str, weight: float, n_features: int, s
         raise ValueError(f"n_cycles must be a positive integer, got {n_cycles!r}")
     if intensities not in INTENSITY_SETS:
         raise ValueError(f"intensities must be one of {list(INTENSITY_SETS)}, got {intensities!r}")
+    stride_scale, cadence_scale = stride_cadence_scales(theme, weight, n_features, features, intensities)
     result = stylised_cycle(neutral_cycle, theme, weight, n_features, keep_ground, features, tuple(exclude),
-                            intensities)
-    stride = cycle_stride(neutral_cycle)
-    tempo = 1.0
-    if features == "expert" and intensities in EXTENDED_SETS \
-            and n_features == len(theme_features(theme, None, "visual")):
-        tempo = max(0.5, 1.0 + float(weight) * extended_tempo(theme, EXTENDED_SETS[intensities]))
+                            intensities, stride_scale)
+    stride = stride_scale * cycle_stride(neutral_cycle)
     rotations, root = warp_and_repeat_cycle(result["rotations"], result["root"], stride, neutral_cycle.duration,
-                                            speed * tempo, n_cycles, fps)
+                                            speed * cadence_scale, n_cycles, fps)
     base_meta = neutral_cycle.metadata
     metadata = {
         "origin": "generated",
@@ -527,8 +625,10 @@ def stylise(neutral_cycle: Motion, theme: str, weight: float, n_features: int, s
     }
     if features == "expert":
         metadata["intensities"] = intensities
-    if tempo != 1.0:
-        metadata["tempo"] = tempo
+    if (stride_scale, cadence_scale) != (1.0, 1.0):
+        metadata.update({"stride_scale": stride_scale, "cadence_scale": cadence_scale,
+                         "pelvis_shift_m": [float(result["pelvis_shift"].min()),
+                                            float(result["pelvis_shift"].max())]})
     if exclude:
         metadata["excluded_ranks"] = sorted(exclude)
     metadata.update(base_provenance(base_meta))
@@ -591,4 +691,5 @@ def neutral_walk(neutral_cycle: Motion, speed: float = 1.0, n_cycles: int = 4, f
 
 __all__ = ["neutral_walk", "plant_walk_feet", "stylise", "stylised_cycle", "theme_rbfs", "theme_displacement",
            "rbf_displacement", "FEATURE_SOURCES",
-           "fit_to_skeleton", "walker_frame_positions", "warp_and_repeat_cycle", "bone_length_error", "CYCLE_FRAMES"]
+           "fit_to_skeleton", "walker_frame_positions", "stride_cadence_scales", "scale_stride",
+           "keep_leg_extension", "warp_and_repeat_cycle", "bone_length_error", "CYCLE_FRAMES"]

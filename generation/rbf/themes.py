@@ -271,7 +271,8 @@ OURS: dict[str, tuple[Feature, ...]] = {
 }
 
 #: Named sets of intensities: ``extended`` (the default: sized from real style-vs-normal differences of Bandai
-#: Namco walks, with our rows and a tempo lever, :mod:`generation.rbf.extended`, stored in :data:`EXTENDED_PATH`),
+#: Namco walks, with our rows and stride and cadence levers, :mod:`generation.rbf.extended`, stored in
+#: :data:`EXTENDED_PATH`),
 #: ``calibrated`` (fitted so that w = 1 reproduces real actors' style differences with factors capped at 6x the
 #: visual ones, :mod:`generation.rbf.calibrate`, :data:`CALIBRATED_PATH`) and ``visual`` (our choice, sized to
 #: be visible in a stick figure at w = 0.7; the numbers of ``THEMES``). The first is the default. ``pooled`` is the
@@ -283,7 +284,7 @@ DEFAULT_INTENSITIES = INTENSITY_SETS[0]
 CALIBRATED_PATH = Path(__file__).resolve().parents[1] / "data" / "rbf" / "calibrated_intensities.json"
 EXTENDED_PATH = Path(__file__).resolve().parents[1] / "data" / "rbf" / "extended_intensities.json"
 POOLED_PATH = Path(__file__).resolve().parents[1] / "data" / "rbf" / "pooled_intensities.json"
-#: Intensity sets sized by :mod:`generation.rbf.extended` (our rows and a tempo) -> their files.
+#: Intensity sets sized by :mod:`generation.rbf.extended` (our rows, stride and cadence) -> their files.
 EXTENDED_SETS = {"extended": EXTENDED_PATH, "pooled": POOLED_PATH}
 
 
@@ -307,8 +308,10 @@ def _extended_file(path: str) -> dict:
         for r in rows:
             if not (isinstance(r.get("extended"), (int, float)) and r["extended"] >= 0):
                 raise ValueError(f"{p}: theme {theme!r} rank {r.get('rank')}: extended intensity must be >= 0")
-        if not isinstance(entry.get("tempo", {}).get("per_weight"), (int, float)):
-            raise ValueError(f"{p}: theme {theme!r} needs tempo.per_weight (a number)")
+        tempo = entry.get("tempo", {})
+        if not all(isinstance(tempo.get(k), (int, float)) for k in ("stride_per_weight", "cadence_per_weight")):
+            raise ValueError(f"{p}: theme {theme!r} needs tempo.stride_per_weight and tempo.cadence_per_weight "
+                             "(numbers); rebuild with `python -m generation.rbf extend`")
     return data
 
 
@@ -318,12 +321,16 @@ def extended_intensities(path: str | Path = EXTENDED_PATH) -> dict[str, dict[int
     return {t: {int(r["rank"]): float(r["extended"]) for r in data["themes"][t]["features"]} for t in THEMES}
 
 
-def extended_tempo(theme: str, path: str | Path = EXTENDED_PATH) -> float:
-    """Cadence change per unit weight of the ``extended`` set (a row of ours): the walk is played
-    max(0.5, 1 + w * tempo) times faster (real style-vs-normal cadence ratio - 1, :mod:`generation.rbf.extended`)."""
+def extended_stride_cadence(theme: str, path: str | Path = EXTENDED_PATH) -> tuple[float, float]:
+    """Stride and cadence change per unit weight of the ``extended`` set (levers of ours), (stride, cadence):
+    the real style-vs-normal stride ratio - 1 and cadence ratio - 1, each the mean over the datasets with the
+    theme (train takes, :mod:`generation.rbf.extended`). With all ten features the walk's stride is scaled by
+    max(0.5, 1 + w * stride) and its cadence by max(0.5, 1 + w * cadence)
+    (:func:`generation.rbf.stylise.stride_cadence_scales`)."""
     if theme not in THEMES:
         raise ValueError(f"unknown theme {theme!r}; expected one of {list(THEME_NAMES)}")
-    return float(_extended_file(str(path))["themes"][theme]["tempo"]["per_weight"])
+    tempo = _extended_file(str(path))["themes"][theme]["tempo"]
+    return float(tempo["stride_per_weight"]), float(tempo["cadence_per_weight"])
 
 
 def extended_provenance(path: str | Path = EXTENDED_PATH) -> dict:

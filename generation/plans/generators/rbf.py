@@ -20,9 +20,10 @@ class RbfInputs(PlanInputs):
     """A ``theme`` at ``weight`` (-3..3; the paper uses 0.4, 0.7, 1.0, 1.3 and -0.7) with its first
     ``n_features`` features, over ``n_cycles`` of the ``base`` cycle at ``speed``; the expert features'
     ``intensities`` are ``extended`` (default: each row sized from real style differences, with our rows and the
-    theme's tempo), ``calibrated`` (the 2026-12-06 default: w = 1 reproduces real actors' style differences, factors
-    capped) or ``visual`` (the earlier hand-sized set), which rerender earlier studies, or ``pooled`` (as
-    ``extended``, with happy and sad sized on Bandai Namco and the BML walks of Emotion-Gait together)."""
+    theme's real stride and cadence), ``calibrated`` (the 2026-12-06 default: w = 1 reproduces real actors' style
+    differences, factors capped) or ``visual`` (the earlier hand-sized set), which rerender earlier studies, or
+    ``pooled`` (as ``extended``, with happy and sad sized on Bandai Namco and the BML walks of Emotion-Gait
+    together)."""
 
     PLAN_FIELDS = frozenset({"theme", "weight", "n_features", "n_cycles", "speed", "base", "features",
                              "intensities"})
