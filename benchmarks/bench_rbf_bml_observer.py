@@ -143,7 +143,7 @@ def differences(clips) -> dict:
                       "tempo": {k: interval([p[k] for p in per]) for k in ("speed_ratio", "stride_ratio",
                                                                            "cadence_ratio")},
                       "bandai_tempo": ext[theme]["tempo"]["datasets"],
-                      "pooled_tempo": pooled[theme]["tempo"],
+                      "pooled_tempo": pooled[theme]["tempo"], "extended_tempo": ext[theme]["tempo"],
                       "cycles": {h: how.count(h) for h in sorted(set(how))}}
     return out
 
@@ -235,13 +235,16 @@ def render(res: dict) -> str:
                       for x in d["bandai_tempo"])
         lines.append(f"| {theme} | {d['actors']} | {_ci(t['speed_ratio'], 2, '')} | {_ci(t['stride_ratio'], 2, '')} "
                      f"| {_ci(t['cadence_ratio'], 2, '')} | {b} |")
-    lines += ["", "Pooled tempo (speed ratio per source, training split; per unit weight = their mean - 1):", "",
+    lines += ["", "Pooled stride and cadence levers (speed / stride / cadence ratio per source, training split; per "
+              "unit weight = their mean over sources - 1, stride / cadence, speed for reference):", "",
               "| theme | per source | extended per unit weight | pooled per unit weight |", "|---|---|---|---|"]
+    keys = ("stride_per_weight", "cadence_per_weight", "per_weight")
     for theme, d in res["differences"].items():
         p = d["pooled_tempo"]
-        per = "; ".join(f"{x['dataset']} {x['speed_ratio']:.2f}" for x in p["datasets"])
-        ext = np.mean([x["speed_ratio"] for x in d["bandai_tempo"]]) - 1
-        lines.append(f"| {theme} | {per} | {ext:+.3f} | {p['per_weight']:+.3f} |")
+        per = "; ".join(f"{x['dataset']} {x['speed_ratio']:.2f} / {x['stride_ratio']:.2f} / {x['cadence_ratio']:.2f}"
+                        for x in p["datasets"])
+        ext = " / ".join(f"{d['extended_tempo'][k]:+.3f}" for k in keys)
+        lines.append(f"| {theme} | {per} | {ext} | {' / '.join(f'{p[k]:+.3f}' for k in keys)} |")
     cuts = {k: sum(d["cycles"].get(k, 0) for d in res["differences"].values()) for k in ("steady", "loop", "none")}
     lines += ["", f"Cycles: {cuts['steady']} clip readings used steady cycles "
               "(`generation.rbf.real_neutral.steady_cycles`); the BML clips are about 2.5 s, and where no left-right-"
