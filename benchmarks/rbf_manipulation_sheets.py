@@ -4,8 +4,9 @@ One PNG per theme, ``docs/img/rbf_manip_<theme>.png``: rows = the neutral base w
 style (Bandai Namco, CC BY-NC 4.0), the calibrated edit at w = 0.7 and 1.0, the visual edit at w = 1.0; columns = 5
 moments 0.25 s apart (about one stride). With ``--extended``, ``docs/img/rbf_extended_<theme>.png``: the base, the
 real take, the extended edit (the default) at w = 0.7 and 1.0 and the calibrated edit (the old default) at w = 1.0.
-With ``--actors``, ``docs/img/rbf_actors_<theme>.png``: the base and the extended edit at w = 1.0 beside real walks of
-the style by several actors: Bandai takes of the style from both datasets (held-out first) and, for happy and sad,
+With ``--actors``, ``docs/img/rbf_actors_<theme>.png``: the base and the extended edit at w = 1.0 (for happy and sad
+also the pooled edit, sized on Bandai and BML together) beside real walks of the style by several actors: Bandai
+takes of the style from both datasets (held-out first) and, for happy and sad,
 BML actors' walks of that emotion (``--bml``; research use with citation, docs/mocap.md).
 
     OMP_NUM_THREADS=1 python -m benchmarks.rbf_manipulation_sheets [--corpus var/mocap/bandai-namco.npz] \
@@ -24,7 +25,7 @@ from generation.mocap.real_corpus import DEFAULT_BML_PATH, DEFAULT_PATH, load_re
 from generation.rbf.calibrate import theme_styles
 from generation.rbf.real_neutral import load_cycle
 from generation.rbf.stylise import neutral_walk, stylise
-from generation.rbf.themes import THEME_NAMES
+from generation.rbf.themes import POOLED_PATH, THEME_NAMES, extended_sources
 from generation.render.offscreen import prepare_render_process
 
 TIMES = [0.5 + 0.25 * k for k in range(5)]
@@ -49,12 +50,15 @@ def theme_rows(base, clips, theme: str, extended: bool = False) -> list[tuple[st
 
 
 def actor_rows(base, clips, bml, theme: str, n_real: int = 4) -> list[tuple[str, object]]:
-    """(label, motion) rows of one theme's sheet beside several actors: the base, the extended edit at w = 1.0,
-    then up to ``n_real`` real walks of the style: for happy and sad, BML actors (every seventh performer, so the
+    """(label, motion) rows of one theme's sheet beside several actors: the base, the extended edit at w = 1.0 (and
+    the pooled one where the pooled set sizes the theme on more than one source), then up to ``n_real`` real walks
+    of the style: for happy and sad, BML actors (every seventh performer, so the
     rows are different people) and one Bandai take; otherwise Bandai takes alternating between the datasets."""
     kw = {"n_cycles": 3, "fps": 30.0}
     rows = [("base (real average)", neutral_walk(base, **kw)),
             (f"{theme} extended w1.0", stylise(base, theme, 1.0, 10, **kw))]
+    if extended_sources(theme, POOLED_PATH):
+        rows.append((f"{theme} pooled w1.0", stylise(base, theme, 1.0, 10, intensities="pooled", **kw)))
     takes = sorted((c for c in clips if c.style in theme_styles(theme) and c.motion.num_frames >= 60),
                    key=lambda c: (c.split == "train", c.take, c.dataset))
     by_dataset = [[c for c in takes if c.dataset == d] for d in sorted({c.dataset for c in takes})]

@@ -4,10 +4,15 @@
     python -m generation.rbf features [--corpus CORPUS] [--out generation/data/rbf/data_features.json]
     python -m generation.rbf calibrate [--corpus CORPUS] [--out generation/data/rbf/calibrated_intensities.json]
     python -m generation.rbf extend [--corpus CORPUS] [--out generation/data/rbf/extended_intensities.json]
+    python -m generation.rbf extend --pooled [--corpus CORPUS] [--bml-corpus BML] \
+        [--out generation/data/rbf/pooled_intensities.json]
 
 CORPUS is the real-capture corpus (``python -m generation.mocap dataset bandai-namco DIR --out CORPUS``; default
 $REAL_CORPUS, else ``var/mocap/bandai-namco.npz``). ``neutral`` and ``features`` read the train split only;
 ``calibrate`` and ``extend`` size on the train split and record the held-out (val, test) differences beside it.
+``extend --pooled`` sizes happy and sad from the mean over two sources, each weighing the same: Bandai Namco and the
+BML walks of Emotion-Gait (``--bml-corpus``, default ``var/mocap/emotion-gait-bml.npz``, built as docs/mocap.md says;
+training actors); the ``pooled`` intensity set.
 """
 from __future__ import annotations
 
@@ -17,14 +22,15 @@ import sys
 from pathlib import Path
 
 from generation.core.skeleton import GAIT_JOINTS
-from generation.mocap.real_corpus import load_real_corpus, real_corpus_path
+from generation.mocap.real_corpus import DEFAULT_BML_PATH, load_real_corpus, real_corpus_path
 
 from .calibrate import calibrate, save_calibration
 from .data_features import SHIPPED_PATH as FEATURES_PATH
 from .data_features import fit_data_features, save_data_features
 from .extended import extend, save_extended
+from .observer import load_bml_walks
 from .real_neutral import SHIPPED_PATH, build_real_neutral, load_cycle
-from .themes import CALIBRATED_PATH, EXTENDED_PATH
+from .themes import CALIBRATED_PATH, EXTENDED_PATH, POOLED_PATH
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -38,6 +44,11 @@ def main(argv: list[str] | None = None) -> int:
         p.add_argument("--corpus", type=Path, default=real_corpus_path(os.environ),
                        help="real-capture corpus .npz (default: $REAL_CORPUS, else var/mocap/bandai-namco.npz)")
         p.add_argument("--out", default=None, help="output file (default: the shipped file in generation/data/rbf)")
+        if name == "extend":
+            p.add_argument("--pooled", action="store_true",
+                           help="size happy and sad on Bandai Namco and BML together (the pooled intensity set)")
+            p.add_argument("--bml-corpus", type=Path, default=DEFAULT_BML_PATH,
+                           help="BML walks of Emotion-Gait for --pooled (default var/mocap/emotion-gait-bml.npz)")
     args = parser.parse_args(argv)
     if args.command == "neutral":
 
@@ -54,8 +65,9 @@ def main(argv: list[str] | None = None) -> int:
             print(f"{theme}: factors {[round(r['factor'], 2) for r in entry['features']]}")
         return 0
     if args.command == "extend":
-        data = extend(load_real_corpus(args.corpus, skeleton="gait", contents=["walk"]), load_cycle())
-        save_extended(data, args.out or EXTENDED_PATH)
+        bml = load_bml_walks(args.bml_corpus) if args.pooled else None
+        data = extend(load_real_corpus(args.corpus, skeleton="gait", contents=["walk"]), load_cycle(), bml_clips=bml)
+        save_extended(data, args.out or (POOLED_PATH if args.pooled else EXTENDED_PATH))
         for theme, entry in data["themes"].items():
             print(f"{theme}: factors {[round(r['factor'], 2) for r in entry['features']]}, "
                   f"stride {entry['tempo']['stride_per_weight']:+.3f}, "

@@ -7,11 +7,17 @@ capped at 6x our visual numbers, and zeroes or caps rows to offset one another; 
 from what real actors do, and two levers the experts' ten rows lack are added as rows of our own
 (:data:`generation.rbf.themes.OURS`, ``source: ours``) plus a stride and a cadence lever.
 
-Data: the straight walks of the Bandai Namco Research Motion Dataset 1 and 2 (Kobayashi et al. 2023,
-arXiv:2306.08861, CC BY-NC 4.0), **training split** only; measures as :mod:`generation.rbf.calibrate` (per body part
+Data (**sources**): the straight walks of the Bandai Namco Research Motion Dataset 1 and 2
+(Kobayashi et al. 2023, arXiv:2306.08861, CC BY-NC 4.0), each dataset a source; and for the themes it has (happy,
+sad) the BML walks of Emotion-Gait (Ma, Paterson & Pollick 2006; Bhattacharya et al. AAAI 2020; research use with
+citation), :data:`BML_SOURCE`. **Training split** only: Bandai's training takes, BML's training actors (whole actors
+are held out, :mod:`generation.mocap.emotion_gait_bml`). Measures as :mod:`generation.rbf.calibrate` (per body part
 x axis x kind of a theme's rows, in walker heights: posture = mean offset relative to the pelvis, movement = change
-of the peak-to-peak), real difference = per dataset the themed takes minus the same dataset's normal takes, averaged
-over the datasets with the theme.
+of the peak-to-peak). Real difference per source (:func:`source_differences`): a Bandai dataset's themed takes minus
+the same dataset's normal takes; BML the mean over actors of each actor's emotion walk minus the same actor's neutral
+walk (:func:`generation.rbf.calibrate.walker_differences`). The target is the mean over the sources that hold the
+theme, each source weighing the same: Bandai dataset 1 has one happy and one sad training take, BML 21 training
+actors, so neither alone decides the size.
 
 1. **Rows** (:func:`extend_theme`): for each group, the gain of its rows alone at their visual intensity on the real
    neutral base at w = 1 (after the skeleton fit), and the factor = real difference / gain, in [0,
@@ -23,16 +29,18 @@ over the datasets with the theme.
    "Shoulders: increased swing along Y" is held at 0 (:data:`HELD_AT_ZERO`): without clavicles a shoulder bob
    moves the whole chest, a shrug artefact that made energetic walks read tired.
 2. **Stride and cadence** (two levers of ours, the JSON's ``tempo`` block): the real style's stride (distance per
-   cycle) and cadence (cycles per second) over the same dataset's normal ones, minus 1, averaged over the datasets
-   with the theme (``stride_per_weight``, ``cadence_per_weight``; ``per_weight`` is the speed's, kept for
-   reference). :func:`generation.rbf.stylise.stylise` applies them with all ten features: the stride scaled by
-   s(w) = max(0.5, 1 + w * stride_per_weight) (the legs' fore-aft offsets from the pelvis and the progression per
-   cycle, so a planted foot stays planted; :func:`generation.rbf.stylise.scale_stride`) and the cycle played
-   c(w) = max(0.5, 1 + w * cadence_per_weight) times faster; w = 1 gives the real stride and cadence.
+   cycle) and cadence (cycles per second) over the same source's normal ones (BML: the mean over actors of the
+   actor's ratios), minus 1, averaged over the sources with the theme (``stride_per_weight``, ``cadence_per_weight``;
+   ``per_weight`` is the speed's, kept for reference). :func:`generation.rbf.stylise.stylise` applies them with all
+   ten features: the stride scaled by s(w) = max(0.5, 1 + w * stride_per_weight) (the legs' fore-aft offsets from the
+   pelvis and the progression per cycle, so a planted foot stays planted;
+   :func:`generation.rbf.stylise.scale_stride`) and the cycle played c(w) = max(0.5, 1 + w * cadence_per_weight)
+   times faster; w = 1 gives the real stride and cadence.
 
 :func:`extend` gives the JSON of :data:`generation.rbf.themes.EXTENDED_PATH` with the data's licence and citation,
-every row's visual and extended intensity and source, per group the training and held-out real differences and
-the w = 1 change reached, and the stride and cadence levers with their per-dataset ratios.
+every row's visual and extended intensity and source, per group the training and held-out real differences (with
+BML: their mean over sources and per source) and the w = 1 change reached, the stride and cadence levers with their
+per-source ratios, and per pooled theme the sources it was sized on with their licences and citations.
 """
 from __future__ import annotations
 
@@ -42,6 +50,10 @@ from pathlib import Path
 import numpy as np
 
 from generation.core.motion import Motion
+from generation.mocap.emotion_gait_bml import CITATION as BML_CITATION
+from generation.mocap.emotion_gait_bml import DATASET as BML_DATASET
+from generation.mocap.emotion_gait_bml import LICENCE as BML_LICENCE
+from generation.mocap.emotion_gait_bml import SOURCE_URL as BML_URL
 
 from . import calibrate as C
 from .data_features import _rounded
@@ -54,6 +66,11 @@ MAX_FACTOR = 10.0
 HELD_AT_ZERO = {("energetic", 5): "no clavicles: a shoulder bob moves the whole chest (read as tired)"}
 REFINE_STEPS = 5
 MIN_GAIN = 1e-4  # heights: a group whose rows move their own measure less than this cannot be sized (factor 0)
+#: The BML walks of Emotion-Gait as a source: its name in the JSON, licence, citation and where it comes from.
+BML_SOURCE = {"source": BML_DATASET, "licence": BML_LICENCE, "citation": BML_CITATION, "dataset_url": BML_URL,
+              "what": "BML walks of Emotion-Gait: one walk per actor and acted emotion (happy, sad, angry, neutral); "
+                      "difference = mean over actors of emotion minus the same actor's neutral walk"}
+BML_NEUTRAL = ("neutral",)
 
 
 def _by_rank(theme: str, factors: np.ndarray, feats: tuple[Feature, ...]) -> dict[int, float]:
@@ -154,15 +171,100 @@ def real_tempo(clips: list, theme: str, splits: tuple[str, ...] = ("train",), m:
             "cadence_per_weight": float(np.mean([r["cadence_ratio"] for r in rows]) - 1.0), "datasets": rows}
 
 
-def extend(clips: list, base: Motion, m: int = 100) -> dict:
-    """The ``extended`` set of all six themes: the JSON-ready dict of :data:`generation.rbf.themes.EXTENDED_PATH`."""
+def bml_source(clips: list, theme: str, splits: tuple[str, ...] = ("train",), m: int = 100,
+               feats: tuple[Feature, ...] | None = None, all_if_none: bool = True) -> dict | None:
+    """BML's real difference for ``theme``: per actor (:func:`generation.rbf.observer.walker_of`) of ``splits`` its
+    emotion walk minus its own neutral walk (:func:`generation.rbf.calibrate.walker_differences`), averaged over
+    actors.
+
+    Args:
+        clips: the BML walks (:func:`generation.rbf.observer.load_bml_walks`), any split.
+        splits: whose actors count; when none of them has the theme and a neutral walk and ``all_if_none``, all
+            splits are used and ``splits`` in the result says so.
+
+    Returns:
+        None when the corpus has no walk of the theme; else {"dataset", "styles", "splits", "walkers": [names],
+        "difference": (G,) list in walker heights, "speed_ratio", "stride_ratio", "cadence_ratio" (means over actors
+        of styled / neutral), "per_walker": [{walker, difference, speed_ratio, stride_ratio, cadence_ratio}]}.
+    """
+    styles = tuple(s for s in C.theme_styles(theme) if any(c.style == s for c in clips))
+    if not styles:
+        return None
+    used = tuple(splits)
+    per = C.walker_differences([c for c in clips if c.split in used], theme, styles, BML_NEUTRAL, m, feats)
+    if not per and all_if_none:
+        used = tuple(sorted({c.split for c in clips}))
+        per = C.walker_differences(clips, theme, styles, BML_NEUTRAL, m, feats)
+    if not per:
+        return None
+    ratios = ("speed_ratio", "stride_ratio", "cadence_ratio")
+    return {"dataset": BML_DATASET, "styles": list(styles), "splits": list(used),
+            "walkers": [p["walker"] for p in per],
+            "difference": np.mean([p["difference"] for p in per], axis=0).tolist(),
+            **{k: float(np.mean([p[k] for p in per])) for k in ratios},
+            "per_walker": [{"walker": p["walker"], "difference": p["difference"], **{k: p[k] for k in ratios}}
+                           for p in per]}
+
+
+def source_differences(clips: list, bml_clips: list | None, theme: str, splits: tuple[str, ...], m: int = 100,
+                       feats: tuple[Feature, ...] | None = None) -> tuple[np.ndarray, dict[str, np.ndarray], list]:
+    """(G,) target of ``theme``: the mean over sources of their real differences (walker heights), each source
+    weighing the same; the Bandai datasets (:func:`generation.rbf.calibrate.real_differences`, per dataset) and,
+    where ``bml_clips`` hold the theme, BML (:func:`bml_source`).
+
+    Returns the target, {source: (G,) difference} and the per-source info (Bandai's per-dataset dicts, BML's
+    :func:`bml_source` without its per-walker rows). Without a BML source the target is
+    :func:`generation.rbf.calibrate.real_differences`' mean, unchanged.
+    """
+    bandai, info = C.real_differences(clips, theme, splits, m, feats)
+    bml = bml_source(bml_clips, theme, splits, m, feats, all_if_none=tuple(splits) == ("train",)) if bml_clips else None
+    per = {d["dataset"]: np.asarray(d["difference"]) for d in info}
+    if bml is None:
+        return bandai, per, info
+    per[BML_DATASET] = np.asarray(bml["difference"])
+    return np.mean(list(per.values()), axis=0), per, info + [{k: v for k, v in bml.items() if k != "per_walker"}]
+
+
+def pooled_tempo(clips: list, bml_clips: list | None, theme: str, splits: tuple[str, ...] = ("train",),
+                 m: int = 100) -> dict:
+    """:func:`real_tempo` with BML as one more source where it holds the theme (its ratios: means over actors of
+    each actor's styled / neutral walk, :func:`bml_source`); ``per_weight``, ``stride_per_weight`` and
+    ``cadence_per_weight`` = mean over sources of the speed, stride and cadence ratio - 1, each source weighing the
+    same."""
+    tempo = real_tempo(clips, theme, splits, m)
+    bml = bml_source(bml_clips, theme, splits, m) if bml_clips else None
+    if bml is None:
+        return tempo
+    tempo["datasets"].append({"dataset": BML_DATASET, "speed_ratio": bml["speed_ratio"],
+                              "stride_ratio": bml["stride_ratio"], "cadence_ratio": bml["cadence_ratio"],
+                              "walkers": len(bml["walkers"]), "splits": bml["splits"]})
+    for key, ratio in (("per_weight", "speed_ratio"), ("stride_per_weight", "stride_ratio"),
+                       ("cadence_per_weight", "cadence_ratio")):
+        tempo[key] = float(np.mean([r[ratio] for r in tempo["datasets"]]) - 1.0)
+    return tempo
+
+
+def bandai_source(dataset: str, metadata: dict) -> dict:
+    """Provenance of one Bandai Namco dataset as a source: {source, licence, citation, dataset_url, what}."""
+    return {"source": dataset, "licence": metadata.get("licence", "CC BY-NC 4.0"),
+            "citation": metadata.get("citation", ""), "dataset_url": metadata.get("source_url", ""),
+            "what": "Bandai Namco Research Motion Dataset straight walks; difference = the dataset's themed takes "
+                    "minus its normal takes (no actor ids)"}
+
+
+def extend(clips: list, base: Motion, m: int = 100, bml_clips: list | None = None) -> dict:
+    """The ``extended`` set of all six themes: the JSON-ready dict of :data:`generation.rbf.themes.EXTENDED_PATH`.
+
+    ``clips``: the Bandai Namco walks (gait skeleton); ``bml_clips``: the BML walks, a second source for the themes
+    they hold (None: Bandai alone, as before BML was added)."""
     first = clips[0].motion.metadata if clips else {}
     themes = {}
     for theme in THEME_NAMES:
         feats = all_features(theme)
         groups = C.theme_groups(theme, feats)
-        train, train_info = C.real_differences(clips, theme, ("train",), m, feats)
-        heldout, held_info = C.real_differences(clips, theme, C.HELDOUT_SPLITS, m, feats)
+        train, train_per, train_info = source_differences(clips, bml_clips, theme, ("train",), m, feats)
+        heldout, held_per, held_info = source_differences(clips, bml_clips, theme, C.HELDOUT_SPLITS, m, feats)
+        pooled = BML_DATASET in train_per
         factors, gains, reached = extend_theme(base, theme, train)
         by_rank = _by_rank(theme, factors, feats)
         rows = [{"rank": f.rank, "feature": f.describe(), "source": f.source,
@@ -171,10 +273,13 @@ def extend(clips: list, base: Motion, m: int = 100) -> dict:
                  **({"held_at_zero": HELD_AT_ZERO[(theme, f.rank)]} if (theme, f.rank) in HELD_AT_ZERO else {})}
                 for f in feats]
         group_rows = [{"part": p, "axis": a, "kind": k, "measure": "mean offset" if k == "tilt" else "peak-to-peak",
-                       "real_train": float(train[i]), "real_heldout": float(heldout[i]), "gain_alone": float(gains[i]),
+                       "real_train": float(train[i]), "real_heldout": float(heldout[i]),
+                       **({"real_train_sources": {s: float(d[i]) for s, d in train_per.items()},
+                           "real_heldout_sources": {s: float(d[i]) for s, d in held_per.items()}} if pooled else {}),
+                       "gain_alone": float(gains[i]),
                        "extended_w1": float(reached[i]), "expert_sign_agrees": bool(train[i] * gains[i] > 0)}
                       for i, (p, a, k) in enumerate(groups)]
-        tempo = real_tempo(clips, theme, ("train",), m)
+        tempo = pooled_tempo(clips, bml_clips, theme, ("train",), m)
         tempo["source"] = "ours"
         tempo["applied_as"] = ("with all ten features: stride scaled by max(0.5, 1 + w * stride_per_weight) (legs' "
                                "fore-aft offsets from the pelvis and progression per cycle, feet planted, pelvis "
@@ -182,15 +287,23 @@ def extend(clips: list, base: Motion, m: int = 100) -> dict:
                                "cadence_per_weight) times faster; per_weight (speed) for reference")
         themes[theme] = {"features": rows, "groups": group_rows, "tempo": tempo,
                          "sources": {"train": train_info, "heldout": held_info}}
+        if pooled:
+            themes[theme]["sized_on"] = [bandai_source(s, first) if s != BML_DATASET else BML_SOURCE
+                                         for s in train_per]
+            themes[theme]["target"] = "mean over sources, each weighing the same"
+    pooled = [t for t in themes if "sized_on" in themes[t]]
     return {"method": "generation.rbf.extended: each body part x axis x kind group of a theme's rows (Table III and "
                       "ours) sized on its own so that w = 1 moves its measure by the real style-minus-normal "
-                      "difference (train split); 0 against the real sign; factor cap "
-                      f"{MAX_FACTOR:g}; plus stride and cadence levers (real stride and cadence ratios)",
+                      "difference (train split" + ("; the mean over the sources that hold the theme" if pooled else "")
+                      + f"); 0 against the real sign; factor cap {MAX_FACTOR:g}; plus stride and cadence levers "
+                      "(real stride and cadence ratios)",
             "units": "intensity: amplitude / walker height; measures: walker heights",
             "base": base.metadata.get("generator", "") + (" (real)" if base.metadata.get("captured_base") else ""),
             "max_factor": MAX_FACTOR, "fit_split": "train", "check_splits": list(C.HELDOUT_SPLITS),
             "data": "Bandai Namco Research Motion Dataset 1 and 2, straight walks (content walk), train split; "
-                    "real-capture corpus built as docs/corpus.md says",
+                    "real-capture corpus built as docs/corpus.md says"
+                    + (f"; for {' and '.join(pooled)} also the BML walks of Emotion-Gait, training actors (the "
+                       "theme's sized_on lists its sources with licences and citations)" if pooled else ""),
             "licence": first.get("licence", "CC BY-NC 4.0"), "citation": first.get("citation", ""),
             "dataset_url": first.get("source_url", ""), "themes": themes}
 

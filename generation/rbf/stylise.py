@@ -20,8 +20,8 @@ Pipeline (shapes: m cycle frames, J joints):
    quaternion method). Twist comes from the neutral motion. Bone lengths are then exact.
 5. Uniform time warping for speed (cycle duration / speed) and the cycle repeated n_cycles times along +z.
 
-With the ``extended`` set and all ten features, two levers of ours (:func:`stride_cadence_scales`): the stride
-scaled by s (before step 4, :func:`scale_stride` and :func:`keep_leg_extension`; the progression per cycle by
+With the ``extended`` (or ``pooled``) set and all ten features, two levers of ours (:func:`stride_cadence_scales`):
+the stride scaled by s (before step 4, :func:`scale_stride` and :func:`keep_leg_extension`; the progression per cycle by
 the same s) and the cadence by c (step 5).
 """
 from __future__ import annotations
@@ -44,10 +44,13 @@ from .themes import (
     AXES,
     BODY_PARTS,
     DEFAULT_INTENSITIES,
+    EXTENDED_SETS,
     INTENSITY_SETS,
+    POOLED_PATH,
     THEME_NAMES,
     calibration_provenance,
     extended_provenance,
+    extended_sources,
     extended_stride_cadence,
     theme_features,
 )
@@ -212,14 +215,14 @@ def rbf_displacement(P: np.ndarray, skeleton: Skeleton, dofs: dict[tuple[str, st
 # --------------------------------------------------------------------------------------------------
 def stride_cadence_scales(theme: str, weight: float, n_features: int, features: str = "expert",
                           intensities: str | Mapping[int, float] = DEFAULT_INTENSITIES) -> tuple[float, float]:
-    """(stride factor s, cadence factor c) of a styled walk, both 1 unless the ``extended`` set's expert features
-    are all on (all ten of Table III): s = max(0.5, 1 + w * stride), c = max(0.5, 1 + w * cadence) with the
-    theme's real stride and cadence ratios minus 1 (:func:`generation.rbf.themes.extended_stride_cadence`), so
+    """(stride factor s, cadence factor c) of a styled walk, both 1 unless the ``extended`` (or ``pooled``) set's
+    expert features are all on (all ten of Table III): s = max(0.5, 1 + w * stride), c = max(0.5, 1 + w * cadence)
+    with the theme's real stride and cadence ratios minus 1 (:func:`generation.rbf.themes.extended_stride_cadence`), so
     w = 1 gives the real style's stride and cadence relative to normal walking and a negative w inverts them."""
-    if not (features == "expert" and isinstance(intensities, str) and intensities == "extended"
+    if not (features == "expert" and isinstance(intensities, str) and intensities in EXTENDED_SETS
             and n_features == len(theme_features(theme, None, "visual"))):
         return 1.0, 1.0
-    stride, cadence = extended_stride_cadence(theme)
+    stride, cadence = extended_stride_cadence(theme, EXTENDED_SETS[intensities])
     w = float(weight)
     return max(MIN_GAIT_SCALE, 1.0 + w * stride), max(MIN_GAIT_SCALE, 1.0 + w * cadence)
 
@@ -578,8 +581,9 @@ def stylise(neutral_cycle: Motion, theme: str, weight: float, n_features: int, s
             (default; sized from real style-vs-normal differences, with our rows and, with all ten features, the
             theme's stride and cadence, :func:`stride_cadence_scales`: the stride scaled by s with the feet
             planted and the cycle played c times faster on top of ``speed``),
-            ``calibrated`` (w = 1 reproduces real actors' style differences, factors capped at 6x) or ``visual``
-            (the earlier hand-sized set).
+            ``calibrated`` (w = 1 reproduces real actors' style differences, factors capped at 6x), ``visual``
+            (the earlier hand-sized set) or ``pooled`` (as ``extended``, happy and sad sized on Bandai Namco and the
+            BML walks of Emotion-Gait; metadata ``intensity_sources`` names both with their licences).
 
     Returns:
         Motion on the neutral cycle's skeleton, round(n_cycles * cycle duration / speed * fps) frames, with
@@ -630,8 +634,10 @@ def stylise(neutral_cycle: Motion, theme: str, weight: float, n_features: int, s
     metadata.update(base_provenance(base_meta))
     if features == "expert" and intensities == "calibrated" and "licence" not in metadata:
         metadata.update(calibration_provenance())
-    if features == "expert" and intensities == "extended" and "licence" not in metadata:
-        metadata.update(extended_provenance())
+    if features == "expert" and intensities in EXTENDED_SETS and "licence" not in metadata:
+        metadata.update(extended_provenance(EXTENDED_SETS[intensities]))
+    if features == "expert" and intensities == "pooled" and extended_sources(theme, POOLED_PATH):
+        metadata["intensity_sources"] = extended_sources(theme, POOLED_PATH)
     if features == "data" and "licence" not in metadata:
 
         data = load_data_features()

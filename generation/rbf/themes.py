@@ -287,11 +287,17 @@ OURS: dict[str, tuple[Feature, ...]] = {
 #: :data:`EXTENDED_PATH`),
 #: ``calibrated`` (fitted so that w = 1 reproduces real actors' style differences with factors capped at 6x the
 #: visual ones, :mod:`generation.rbf.calibrate`, :data:`CALIBRATED_PATH`) and ``visual`` (our choice, sized to
-#: be visible in a stick figure at w = 0.7; the numbers of ``THEMES``). The first is the default.
-INTENSITY_SETS = ("extended", "calibrated", "visual")
+#: be visible in a stick figure at w = 0.7; the numbers of ``THEMES``). The first is the default. ``pooled`` is the
+#: extended method with happy and sad sized from the mean over two sources (Bandai Namco dataset 1 and the BML walks
+#: of Emotion-Gait, :data:`POOLED_PATH`); the other themes as ``extended``. An option: observers read it less often as
+#: the theme than ``extended`` (docs/benchmarks/rbf.md).
+INTENSITY_SETS = ("extended", "calibrated", "visual", "pooled")
 DEFAULT_INTENSITIES = INTENSITY_SETS[0]
 CALIBRATED_PATH = Path(__file__).resolve().parents[1] / "data" / "rbf" / "calibrated_intensities.json"
 EXTENDED_PATH = Path(__file__).resolve().parents[1] / "data" / "rbf" / "extended_intensities.json"
+POOLED_PATH = Path(__file__).resolve().parents[1] / "data" / "rbf" / "pooled_intensities.json"
+#: Intensity sets sized by :mod:`generation.rbf.extended` (our rows, stride and cadence) -> their files.
+EXTENDED_SETS = {"extended": EXTENDED_PATH, "pooled": POOLED_PATH}
 
 
 def all_features(theme: str) -> tuple[Feature, ...]:
@@ -345,6 +351,13 @@ def extended_provenance(path: str | Path = EXTENDED_PATH) -> dict:
     return {"licence": data["licence"], "citation": data["citation"]}
 
 
+def extended_sources(theme: str, path: str | Path = EXTENDED_PATH) -> dict[str, str]:
+    """{source: licence} of the real capture ``theme``'s rows in ``path`` were sized on: the theme's ``sized_on``
+    where the file pools sources for it, else {} (the file's own licence covers it)."""
+    entry = _extended_file(str(path))["themes"][theme]
+    return {s["source"]: s["licence"] for s in entry.get("sized_on", [])}
+
+
 @lru_cache(maxsize=4)
 def _calibrated_file(path: str) -> dict:
     p = Path(path)
@@ -378,9 +391,9 @@ def theme_features(theme: str, n_features: int | None = None,
                    intensities: str | Mapping[int, float] = DEFAULT_INTENSITIES) -> tuple[Feature, ...]:
     """The first ``n_features`` (1..10, default all) features of a theme, in Table III order.
 
-    ``intensities``: a name of :data:`INTENSITY_SETS` (``visual`` gives ``THEMES`` unchanged; ``extended`` adds our
-    rows, :data:`OURS`, when all ten Table III rows are asked for), or a mapping {rank: intensity} overriding the
-    visual ones (ranks not named keep theirs; ranks of our rows add those rows; used by the fits).
+    ``intensities``: a name of :data:`INTENSITY_SETS` (``visual`` gives ``THEMES`` unchanged; ``extended`` and
+    ``pooled`` add our rows, :data:`OURS`, when all ten Table III rows are asked for), or a mapping {rank: intensity}
+    overriding the visual ones (ranks not named keep theirs; ranks of our rows add those rows; used by the fits).
     """
     if theme not in THEMES:
         raise ValueError(f"unknown theme {theme!r}; expected one of {list(THEME_NAMES)}")
@@ -391,8 +404,8 @@ def theme_features(theme: str, n_features: int | None = None,
             raise ValueError(f"intensities must be one of {list(INTENSITY_SETS)}, got {intensities!r}")
         if intensities == "calibrated":
             feats = _with_intensities(feats, calibrated_intensities()[theme])
-        elif intensities == "extended":
-            by_rank = extended_intensities()[theme]
+        elif intensities in EXTENDED_SETS:
+            by_rank = extended_intensities(EXTENDED_SETS[intensities])[theme]
             feats = _with_intensities(feats, {r: v for r, v in by_rank.items() if r <= len(feats)})
             ours = _with_intensities(OURS.get(theme, ()), {r: v for r, v in by_rank.items() if r > len(feats)})
     else:

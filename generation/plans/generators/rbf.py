@@ -12,7 +12,7 @@ from .neutral_walk import RBF_BASES, base_cycle
 from .registry import GeneratorSpec, InputContext, MakeContext, PlanInputs, register
 
 RBF_FEATURES = ("expert", "data")
-RBF_INTENSITIES = ("extended", "calibrated", "visual")  # generation.rbf.themes.INTENSITY_SETS (torch-free here)
+RBF_INTENSITIES = ("extended", "calibrated", "visual", "pooled")  # generation.rbf.themes.INTENSITY_SETS (torch-free)
 
 
 @dataclass(frozen=True)
@@ -21,7 +21,9 @@ class RbfInputs(PlanInputs):
     ``n_features`` features, over ``n_cycles`` of the ``base`` cycle at ``speed``; the expert features'
     ``intensities`` are ``extended`` (default: each row sized from real style differences, with our rows and the
     theme's real stride and cadence), ``calibrated`` (the 2026-12-06 default: w = 1 reproduces real actors' style
-    differences, factors capped) or ``visual`` (the earlier hand-sized set); the last two rerender earlier studies."""
+    differences, factors capped) or ``visual`` (the earlier hand-sized set), which rerender earlier studies, or
+    ``pooled`` (as ``extended``, with happy and sad sized on Bandai Namco and the BML walks of Emotion-Gait
+    together)."""
 
     PLAN_FIELDS = frozenset({"theme", "weight", "n_features", "n_cycles", "speed", "base", "features",
                              "intensities"})
