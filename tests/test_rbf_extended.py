@@ -70,7 +70,7 @@ def test_w1_reaches_the_real_difference(base, shipped):
     for theme in THEME_NAMES:
         groups = shipped["themes"][theme]["groups"]
         by_rank = {r["rank"]: r["extended"] for r in shipped["themes"][theme]["features"]}
-        reached = C.generated_measures(base, theme, by_rank, 1.0, all_features(theme))
+        reached = C.generated_measures(base, theme, by_rank, 1.0, all_features(theme), True)
         np.testing.assert_allclose(reached, [g["extended_w1"] for g in groups], atol=1e-5)
         real = np.array([g["real_train"] for g in groups])
         mask = np.array([g["expert_sign_agrees"] for g in groups]) & (np.abs(real) > 0.003)
@@ -80,7 +80,7 @@ def test_w1_reaches_the_real_difference(base, shipped):
 def test_sizing_reaches_a_reachable_target(base):
     """Targets made by the visual rows at w = 0.5 are reached where they are larger than 0.3 % of the height."""
     feats = all_features("feminine")
-    target = C.generated_measures(base, "feminine", {f.rank: f.intensity * 0.5 for f in feats}, 1.0, feats)
+    target = C.generated_measures(base, "feminine", {f.rank: f.intensity * 0.5 for f in feats}, 1.0, feats, True)
     factors, gains, reached = E.extend_theme(base, "feminine", target)
     big = np.abs(target) > 0.003  # (a group whose target the other rows' side effects make is not sized by itself)
     assert big.sum() >= 6
@@ -210,3 +210,31 @@ def test_row_effects_match_the_shipped_differences_of_the_rows_of_ours(shipped):
             real = next(x["real_train"] for x in entry["groups"] if (x["part"], x["axis"], x["kind"]) == g)
             assert e["difference"] == pytest.approx(group_sign(theme, g) * real, abs=1e-5), (theme, g)
             assert e["consistent"] and abs(e["effect"]) >= 1.0, (theme, g)
+
+
+def _mean_elbow_angle(positions: np.ndarray, joints: tuple[str, ...]) -> float:
+    """Mean over frames and both arms of the shoulder-elbow-hand angle, degrees (180: straight), positions (T, J, 3)."""
+    angles = []
+    for side in ("left", "right"):
+        s, e, h = (joints.index(f"{side}_{n}") for n in ("shoulder", "elbow", "hand"))
+        u, v = positions[:, s] - positions[:, e], positions[:, h] - positions[:, e]
+        cos = (u * v).sum(-1) / (np.linalg.norm(u, axis=-1) * np.linalg.norm(v, axis=-1))
+        angles.append(np.degrees(np.arccos(np.clip(cos, -1.0, 1.0))))
+    return float(np.mean(angles))
+
+
+#: The straightest real happy walk's mean elbow angle, rounded up: Bandai Namco dataset 1's happy training take
+#: (158.4 degrees; its test take 74 degrees, the 30 BML actors' happy walks 132 on average, at most about 150).
+REAL_HAPPY_ELBOW_MAX = 160.0
+
+
+def test_happy_walk_keeps_the_elbows_bent(base):
+    """The happy arm swing and raised hands swing the bent arm: at w = 0.7 and 1 the elbows stay as bent as in the
+    straightest real happy walk, and never lock straight (the plain fit stretched them to 180 degrees)."""
+    joints = tuple(base.skeleton.joints)
+    for w in (0.7, 1.0):
+        out = stylised_cycle(base, "happy", w, 10, stride_scale=1.0)
+        assert _mean_elbow_angle(out["positions"], joints) < REAL_HAPPY_ELBOW_MAX, w
+    held = next(r for r in json.loads(EXTENDED_PATH.read_text(encoding="utf-8"))["themes"]["happy"]["features"]
+                if r["rank"] == 11)
+    assert held["extended"] == 0.0 and "BML" in held["held_at_zero"]

@@ -86,7 +86,7 @@ def test_pooled_file_is_current(pooled):
     base = load_cycle()
     for theme in POOLED_THEMES:
         by_rank = {r["rank"]: r["extended"] for r in pooled["themes"][theme]["features"]}
-        reached = C.generated_measures(base, theme, by_rank, 1.0, all_features(theme))
+        reached = C.generated_measures(base, theme, by_rank, 1.0, all_features(theme), True)
         np.testing.assert_allclose(reached, [g["extended_w1"] for g in pooled["themes"][theme]["groups"]], atol=1e-5)
 
 

@@ -212,10 +212,11 @@ def _intensities(theme: str, factors: np.ndarray) -> dict[int, float]:
 
 
 def generated_measures(base: Motion, theme: str, intensities, weight: float = 1.0,
-                       feats: tuple[Feature, ...] | None = None) -> np.ndarray:
+                       feats: tuple[Feature, ...] | None = None, bent_arms: bool | None = None) -> np.ndarray:
     """(G,) group measures of the stylised cycle minus the base's, heights (skeleton fit, no foot planting);
-    ``feats``: whose groups to measure (default Table III's)."""
-    out = stylised_cycle(base, theme, weight, len(THEMES[theme]), intensities=intensities)
+    ``feats``: whose groups to measure (default Table III's); ``bent_arms``: as
+    :func:`generation.rbf.stylise.stylised_cycle` (default: with the ``extended`` and ``pooled`` sets)."""
+    out = stylised_cycle(base, theme, weight, len(THEMES[theme]), intensities=intensities, bent_arms=bent_arms)
     joints = tuple(base.skeleton.joints)
     h = base.skeleton.height
     return (theme_measures(out["positions"] / h, joints, theme, feats)

@@ -74,6 +74,9 @@ GAIT_LIMB_CHAINS = (
     ("left_hip", "left_knee", "left_heel"), ("right_hip", "right_knee", "right_heel"),
     ("left_shoulder", "left_elbow", "left_hand"), ("right_shoulder", "right_elbow", "right_hand"),
 )
+#: Root joints of the arm chains: with the ``extended`` and ``pooled`` sets the arms keep at least the base's elbow
+#: bend (:func:`keep_bend`).
+ARM_ROOTS = ("left_shoulder", "right_shoulder")
 
 
 # --------------------------------------------------------------------------------------------------
@@ -375,8 +378,22 @@ def global_rotations(motion_rotations: np.ndarray, root_positions: np.ndarray, s
     return g.numpy()
 
 
+def keep_bend(root: np.ndarray, end_target: np.ndarray, ref_root: np.ndarray, ref_end: np.ndarray) -> np.ndarray:
+    """(T, 3) end targets pulled towards ``root`` (T, 3) to at most the reference's root-to-end distance per frame.
+
+    The limb still points at its edited target but is no straighter than in the reference (``ref_root``,
+    ``ref_end``: (T, 3) the unedited positions), metres: a hand pushed out of the base's reach swings the bent arm
+    (the shoulder turns, the elbow keeps at least the base's flexion) instead of locking the elbow straight.
+    """
+    d = end_target - root
+    dist = np.linalg.norm(d, axis=-1, keepdims=True)
+    limit = np.linalg.norm(ref_end - ref_root, axis=-1, keepdims=True)
+    return root + d * np.minimum(1.0, limit / np.maximum(dist, 1e-12))
+
+
 def fit_to_skeleton(target: np.ndarray, skeleton: Skeleton, reference_rotations: np.ndarray,
-                    chains: tuple[tuple[str, str, str], ...] | None = None) -> tuple[np.ndarray, np.ndarray]:
+                    chains: tuple[tuple[str, str, str], ...] | None = None,
+                    bent: tuple[str, ...] = ()) -> tuple[np.ndarray, np.ndarray]:
     """Local rotations and root positions whose forward kinematics best follows edited positions.
 
     Bone lengths are exact by construction (the result is a skeletal motion). This is our local
@@ -390,6 +407,8 @@ def fit_to_skeleton(target: np.ndarray, skeleton: Skeleton, reference_rotations:
             reference itself.
         chains: (root, middle, end) joint names solved by two-bone IK; default :data:`GAIT_LIMB_CHAINS` when
             the skeleton has those joints, else none.
+        bent: root joints of chains whose end target is first pulled to at most the reference's root-to-end
+            distance (:func:`keep_bend`), e.g. :data:`ARM_ROOTS`: the middle joint keeps at least its reference bend.
 
     Returns:
         rotations (T, J, 4) local unit quaternions, root_positions (T, 3).
@@ -419,7 +438,10 @@ def fit_to_skeleton(target: np.ndarray, skeleton: Skeleton, reference_rotations:
             mid, end = chain_of[p]
             a = float(np.linalg.norm(offsets[mid]))
             hint = _bend_hint(ref_pos, target, p, mid, end, a)
-            goal[:, mid], goal[:, end] = _two_bone(pos[:, p], hint, target[:, end], a,
+            end_goal = target[:, end]
+            if skeleton.joints[p] in bent:
+                end_goal = keep_bend(pos[:, p], end_goal, ref_pos[:, p], ref_pos[:, end])
+            goal[:, mid], goal[:, end] = _two_bone(pos[:, p], hint, end_goal, a,
                                                   float(np.linalg.norm(offsets[end])))
         if p in chain_ends and len(kids[p]) == 1 and not kids[kids[p][0]]:
             # the foot (heel -> toe) or hand tip: keep the edited height of the tip (a planted toe stays on the
@@ -491,7 +513,8 @@ def warp_and_repeat_cycle(rotations: np.ndarray, root: np.ndarray, stride: np.nd
 # --------------------------------------------------------------------------------------------------
 def stylised_cycle(neutral_cycle: Motion, theme: str, weight: float, n_features: int,
                    keep_ground: bool = True, features: str = "expert", exclude: tuple[int, ...] = (),
-                   intensities: str | Mapping[int, float] = DEFAULT_INTENSITIES, stride_scale: float = 1.0) -> dict:
+                   intensities: str | Mapping[int, float] = DEFAULT_INTENSITIES, stride_scale: float = 1.0,
+                   bent_arms: bool | None = None) -> dict:
     """One stylised cycle on the skeleton, with the intermediate arrays.
 
     Returns a dict with ``P`` (m, J, 3) neutral walker-frame positions, ``S`` (m, J, 3) secondary
@@ -507,6 +530,8 @@ def stylised_cycle(neutral_cycle: Motion, theme: str, weight: float, n_features:
     expert features (Table III ranks) to leave out, for ablations. ``intensities``: the expert features'
     amplitudes, ``extended`` (default), ``calibrated`` or ``visual`` (:data:`generation.rbf.themes.INTENSITY_SETS`)
     or {rank: intensity}. ``stride_scale``: the stride factor s (:func:`stride_cadence_scales`; 1 keeps the base's).
+    ``bent_arms``: the arms keep at least the base's elbow bend (:func:`keep_bend`, :data:`ARM_ROOTS`); default
+    (None): with the expert features of the ``extended`` and ``pooled`` sets (:func:`uses_bent_arms`).
     """
     if not (stride_scale > 0 and np.isfinite(stride_scale)):
         raise ValueError(f"stride_scale must be a positive number, got {stride_scale!r}")
@@ -528,7 +553,8 @@ def stylised_cycle(neutral_cycle: Motion, theme: str, weight: float, n_features:
     shift = np.zeros(len(P))
     if stride_scale != 1.0:
         target, shift = keep_leg_extension(target, P, skel)
-    rotations, root = fit_to_skeleton(target, skel, neutral_cycle.rotations)
+    bent = ARM_ROOTS if (uses_bent_arms(features, intensities) if bent_arms is None else bent_arms) else ()
+    rotations, root = fit_to_skeleton(target, skel, neutral_cycle.rotations, bent=bent)
     fitted = np_forward_kinematics(rotations, root, skel)
     return {
         "P": P, "S": S, "Y": Y, "target": target, "rotations": rotations,
@@ -537,6 +563,12 @@ def stylised_cycle(neutral_cycle: Motion, theme: str, weight: float, n_features:
         "residual": float(np.linalg.norm(fitted - Y, axis=-1).max()), "ground_lift": lifted,
         "pelvis_shift": shift,
     }
+
+
+def uses_bent_arms(features: str, intensities: str | Mapping[int, float]) -> bool:
+    """Whether a styled walk keeps the base's elbow bend by default: the expert features of the ``extended`` or
+    ``pooled`` set (the ``calibrated`` and ``visual`` sets and data features keep the plain fit)."""
+    return features == "expert" and isinstance(intensities, str) and intensities in EXTENDED_SETS
 
 
 def keep_feet_above_ground(Y: np.ndarray, P: np.ndarray, skeleton: Skeleton) -> tuple[np.ndarray, float]:
@@ -690,6 +722,6 @@ def neutral_walk(neutral_cycle: Motion, speed: float = 1.0, n_cycles: int = 4, f
 
 
 __all__ = ["neutral_walk", "plant_walk_feet", "stylise", "stylised_cycle", "theme_rbfs", "theme_displacement",
-           "rbf_displacement", "FEATURE_SOURCES",
+           "rbf_displacement", "FEATURE_SOURCES", "keep_bend", "uses_bent_arms", "ARM_ROOTS",
            "fit_to_skeleton", "walker_frame_positions", "stride_cadence_scales", "scale_stride",
            "keep_leg_extension", "warp_and_repeat_cycle", "bone_length_error", "CYCLE_FRAMES"]
