@@ -235,6 +235,15 @@ def test_happy_walk_keeps_the_elbows_bent(base):
     for w in (0.7, 1.0):
         out = stylised_cycle(base, "happy", w, 10, stride_scale=1.0)
         assert _mean_elbow_angle(out["positions"], joints) < REAL_HAPPY_ELBOW_MAX, w
-    held = next(r for r in json.loads(EXTENDED_PATH.read_text(encoding="utf-8"))["themes"]["happy"]["features"]
-                if r["rank"] == 11)
-    assert held["extended"] == 0.0 and "BML" in held["held_at_zero"]
+
+
+def test_happy_bounce_is_sized_on_both_sources(shipped):
+    """The happy bounce (a row of ours) is sized on the mean of Bandai Namco's and BML's differences: BML's actors
+    hardly bounce more when happy, so its target is below Bandai's alone, and its BML difference is recorded."""
+    entry = shipped["themes"]["happy"]
+    row = next(r for r in entry["features"] if r["rank"] == 11)
+    assert "BML" in row["sized_on_both_sources"] and row["extended"] > 0.0
+    bandai = entry["sources"]["train"][0]["difference"][row["group"]]
+    bml = entry["bml_train_differences"]["hip Y swing"]
+    assert 0.0 <= bml < bandai
+    assert entry["groups"][row["group"]]["real_train"] == pytest.approx((bandai + bml) / 2, abs=1e-6)

@@ -48,7 +48,8 @@ def main(argv: list[str] | None = None) -> int:
             p.add_argument("--pooled", action="store_true",
                            help="size happy and sad on Bandai Namco and BML together (the pooled intensity set)")
             p.add_argument("--bml-corpus", type=Path, default=DEFAULT_BML_PATH,
-                           help="BML walks of Emotion-Gait for --pooled (default var/mocap/emotion-gait-bml.npz)")
+                           help="BML walks of Emotion-Gait for --pooled and the rows both sources size "
+                                "(default var/mocap/emotion-gait-bml.npz)")
     args = parser.parse_args(argv)
     if args.command == "neutral":
 
@@ -65,8 +66,9 @@ def main(argv: list[str] | None = None) -> int:
             print(f"{theme}: factors {[round(r['factor'], 2) for r in entry['features']]}")
         return 0
     if args.command == "extend":
-        bml = load_bml_walks(args.bml_corpus) if args.pooled else None
-        data = extend(load_real_corpus(args.corpus, skeleton="gait", contents=["walk"]), load_cycle(), bml_clips=bml)
+        bml = load_bml_walks(args.bml_corpus) if args.pooled or Path(args.bml_corpus).is_file() else None
+        data = extend(load_real_corpus(args.corpus, skeleton="gait", contents=["walk"]), load_cycle(), bml_clips=bml,
+                      pooled=args.pooled)
         save_extended(data, args.out or (POOLED_PATH if args.pooled else EXTENDED_PATH))
         for theme, entry in data["themes"].items():
             print(f"{theme}: factors {[round(r['factor'], 2) for r in entry['features']]}, "

@@ -28,8 +28,9 @@ actors, so neither alone decides the size.
    swings the other way) is halved instead, and held at zero if it still does after the last step. Energetic's
    "Shoulders: increased swing along Y" is held at 0 (:data:`HELD_AT_ZERO`): without clavicles a shoulder bob
    moves the whole chest, a shrug artefact that made energetic walks read tired. Happy's "Hip: increased swing along
-   Y" (a row of ours, the bounce) is held at 0 too: Bandai Namco dataset 1's happy takes bounce 4.2 % of the height
-   more than its normal ones, but the BML actors do not (mean +0.2 % h over 21 training actors, 12 of 21 higher).
+   Y" (a row of ours, the bounce) is sized on the mean over Bandai Namco and BML even in this set
+   (:data:`BOTH_SOURCES`): Bandai Namco dataset 1's one happy training take bounces 4.2 % of the height more than
+   its normal take, the BML actors hardly do (mean +0.2 % h over 21 training actors, 12 of 21 higher).
 2. **Stride and cadence** (two levers of ours, the JSON's ``tempo`` block): the real style's stride (distance per
    cycle) and cadence (cycles per second) over the same source's normal ones (BML: the mean over actors of the
    actor's ratios), minus 1, averaged over the sources with the theme (``stride_per_weight``, ``cadence_per_weight``;
@@ -65,9 +66,12 @@ from .themes import BODY_PARTS, THEME_NAMES, Feature, all_features
 
 MAX_FACTOR = 10.0
 #: (theme, Table III rank) rows held at zero, with the reason (module docstring).
-HELD_AT_ZERO = {("energetic", 5): "no clavicles: a shoulder bob moves the whole chest (read as tired)",
-                ("happy", 11): "bounce only in Bandai Namco's happy takes (+4.2 % of the height, dataset 1); the 21 "
-                               "BML training actors show none (mean +0.2 % h, sd 0.9 % h, 12 of 21 higher)"}
+HELD_AT_ZERO = {("energetic", 5): "no clavicles: a shoulder bob moves the whole chest (read as tired)"}
+#: (theme, rank of ours) rows the ``extended`` set sizes on the mean over Bandai Namco and BML (each source weighing
+#: the same, as the ``pooled`` set sizes every row), with the reason (module docstring).
+BOTH_SOURCES = {("happy", 11): "bounce: Bandai Namco dataset 1's one happy training take bounces +4.2 % of the "
+                               "height more than its normal take, the 21 BML training actors +0.2 % h (sd 0.9 % h, "
+                               "12 of 21 higher): one take alone does not size it"}
 REFINE_STEPS = 5
 MIN_GAIN = 1e-4  # heights: a group whose rows move their own measure less than this cannot be sized (factor 0)
 #: The BML walks of Emotion-Gait as a source: its name in the JSON, licence, citation and where it comes from.
@@ -256,25 +260,54 @@ def bandai_source(dataset: str, metadata: dict) -> dict:
                     "minus its normal takes (no actor ids)"}
 
 
-def extend(clips: list, base: Motion, m: int = 100, bml_clips: list | None = None) -> dict:
+def both_sources_target(clips: list, bml_clips: list | None, theme: str, feats: tuple[Feature, ...],
+                        target: np.ndarray, m: int = 100) -> tuple[np.ndarray, dict[str, float]]:
+    """``target`` (G,) heights with the groups of ``theme``'s :data:`BOTH_SOURCES` rows set to the mean of their
+    Bandai Namco (train) and BML (training actors) differences; also {group name: BML difference} of those groups
+    (unchanged target and {} without BML walks of the theme)."""
+    ranks = [rank for (t, rank) in BOTH_SOURCES if t == theme]
+    if not ranks or not bml_clips:
+        return target, {}
+    _, per, _ = source_differences(clips, bml_clips, theme, ("train",), m, feats)
+    if BML_DATASET not in per:
+        return target, {}
+    groups = C.theme_groups(theme, feats)
+    out, used = target.copy(), {}
+    for f in feats:
+        if f.rank in ranks:
+            g = groups.index((f.part, f.axis, f.kind))
+            out[g] = float(np.mean([d[g] for d in per.values()]))
+            used[f"{f.part} {f.axis} {f.kind}"] = float(per[BML_DATASET][g])
+    return out, used
+
+
+def extend(clips: list, base: Motion, m: int = 100, bml_clips: list | None = None, pooled: bool | None = None) -> dict:
     """The ``extended`` set of all six themes: the JSON-ready dict of :data:`generation.rbf.themes.EXTENDED_PATH`.
 
-    ``clips``: the Bandai Namco walks (gait skeleton); ``bml_clips``: the BML walks, a second source for the themes
-    they hold (None: Bandai alone, as before BML was added)."""
+    ``clips``: the Bandai Namco walks (gait skeleton); ``bml_clips``: the BML walks; ``pooled`` (default: when BML
+    walks are given): BML a second source of every row of the themes they hold (the ``pooled`` set); else Bandai
+    alone, BML only for the :data:`BOTH_SOURCES` rows (:func:`both_sources_target`)."""
+    pooled_set = bml_clips is not None if pooled is None else pooled
     first = clips[0].motion.metadata if clips else {}
     themes = {}
     for theme in THEME_NAMES:
         feats = all_features(theme)
         groups = C.theme_groups(theme, feats)
-        train, train_per, train_info = source_differences(clips, bml_clips, theme, ("train",), m, feats)
-        heldout, held_per, held_info = source_differences(clips, bml_clips, theme, C.HELDOUT_SPLITS, m, feats)
+        sources = bml_clips if pooled_set else None
+        train, train_per, train_info = source_differences(clips, sources, theme, ("train",), m, feats)
+        heldout, held_per, held_info = source_differences(clips, sources, theme, C.HELDOUT_SPLITS, m, feats)
+        both = {}
+        if not pooled_set:
+            train, both = both_sources_target(clips, bml_clips, theme, feats, train, m)
         pooled = BML_DATASET in train_per
         factors, gains, reached = extend_theme(base, theme, train)
         by_rank = _by_rank(theme, factors, feats)
         rows = [{"rank": f.rank, "feature": f.describe(), "source": f.source,
                  "group": groups.index((f.part, f.axis, f.kind)), "visual": f.intensity, "extended": by_rank[f.rank],
                  "factor": float(factors[groups.index((f.part, f.axis, f.kind))]),
-                 **({"held_at_zero": HELD_AT_ZERO[(theme, f.rank)]} if (theme, f.rank) in HELD_AT_ZERO else {})}
+                 **({"held_at_zero": HELD_AT_ZERO[(theme, f.rank)]} if (theme, f.rank) in HELD_AT_ZERO else {}),
+                 **({"sized_on_both_sources": BOTH_SOURCES[(theme, f.rank)]} if both and (theme, f.rank) in BOTH_SOURCES
+                    else {})}
                 for f in feats]
         group_rows = [{"part": p, "axis": a, "kind": k, "measure": "mean offset" if k == "tilt" else "peak-to-peak",
                        "real_train": float(train[i]), "real_heldout": float(heldout[i]),
@@ -283,7 +316,7 @@ def extend(clips: list, base: Motion, m: int = 100, bml_clips: list | None = Non
                        "gain_alone": float(gains[i]),
                        "extended_w1": float(reached[i]), "expert_sign_agrees": bool(train[i] * gains[i] > 0)}
                       for i, (p, a, k) in enumerate(groups)]
-        tempo = pooled_tempo(clips, bml_clips, theme, ("train",), m)
+        tempo = pooled_tempo(clips, sources, theme, ("train",), m)
         tempo["source"] = "ours"
         tempo["applied_as"] = ("with all ten features: stride scaled by max(0.5, 1 + w * stride_per_weight) (legs' "
                                "fore-aft offsets from the pelvis and progression per cycle, feet planted, pelvis "
@@ -291,6 +324,8 @@ def extend(clips: list, base: Motion, m: int = 100, bml_clips: list | None = Non
                                "cadence_per_weight) times faster; per_weight (speed) for reference")
         themes[theme] = {"features": rows, "groups": group_rows, "tempo": tempo,
                          "sources": {"train": train_info, "heldout": held_info}}
+        if both:
+            themes[theme]["bml_train_differences"] = both
         if pooled:
             themes[theme]["sized_on"] = [bandai_source(s, first) if s != BML_DATASET else BML_SOURCE
                                          for s in train_per]

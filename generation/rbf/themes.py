@@ -256,7 +256,7 @@ OURS: dict[str, tuple[Feature, ...]] = {
     # Energetic 15-16, tired 14-15, feminine 13-15 and masculine 13-14 were chosen by effect size d (style minus
     # normal over the between-take spread, the same sign in both datasets; generation.rbf.row_effects, the "rows"
     # section of docs/benchmarks/rbf.md); their comments give d and the real difference in walker heights
-    "happy": (_ours(11, "hip", "Y", "swing", +1, 3),                    # more bounce: held at 0 (extended.HELD_AT_ZERO)
+    "happy": (_ours(11, "hip", "Y", "swing", +1, 3),                    # more bounce (sized on Bandai and BML)
               _ours(12, "wrists", "Y", "tilt", +1)),                    # hands carried higher, elbows bent
     "sad": (_ours(11, "wrists", "Z", "swing", -1, 4),                   # arms barely swing
             _ours(12, "ankles", "Z", "swing", -1, 4),                   # short steps
