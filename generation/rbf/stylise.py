@@ -17,7 +17,9 @@ Pipeline (shapes: m cycle frames, J joints):
    reaches the edited heel/hand position when it is reachable, bending in the neutral bend plane turned by
    the knee/elbow edit; toes and hand tips keep their edited height; other bones keep the edited direction;
    joints with several children (pelvis, chest) take the best rotation onto their children (Horn's
-   quaternion method). Twist comes from the neutral motion. Bone lengths are then exact.
+   quaternion method). Twist comes from the neutral motion. Bone lengths are then exact. With the ``extended`` and
+   ``pooled`` sets the arms keep at least the base's elbow bend (:func:`keep_bend`): a hand target beyond the base's
+   reach swings the bent arm from the shoulder.
 5. Uniform time warping for speed (cycle duration / speed) and the cycle repeated n_cycles times along +z.
 
 With the ``extended`` (or ``pooled``) set and all ten features, two levers of ours (:func:`stride_cadence_scales`):
