@@ -35,7 +35,7 @@ from pathlib import Path
 import numpy as np
 
 from benchmarks.bench_rbf_extended import PLAN_COUNTS, PLAN_WEIGHTS, SETS, WALK, WEIGHTS
-from benchmarks.doc_tables import write_marked
+from benchmarks.doc_tables import publish_marked
 from generation.mocap.emotion_gait_bml import CITATION
 from generation.rbf import calibrate as C
 from generation.rbf import observer as O
@@ -273,11 +273,7 @@ def main(argv=None) -> int:
            "bandai_readings": bandai_readings(), "bandai_pooled": bandai_pooled(args.bandai_corpus, base, reference),
            "differences": differences(clips)}
     res["seconds"] = time.time() - t0
-    Path(args.json).write_text(json.dumps(res, indent=1) + "\n", encoding="utf-8")
-    text = render(res)
-    print(text)
-    if args.doc:
-        write_marked(args.doc, "bml-observer", text)
+    publish_marked(res, args.json, render(res), args.doc, "bml-observer")
     return 0
 
 

@@ -23,9 +23,8 @@ from __future__ import annotations
 import argparse
 import json
 import time
-from pathlib import Path
 
-from benchmarks.doc_tables import write_marked
+from benchmarks.doc_tables import publish_marked
 from generation.rbf import calibrate as C
 from generation.rbf import observer as O
 from generation.rbf.real_neutral import load_cycle, steady_cycles
@@ -190,11 +189,7 @@ def main(argv=None) -> int:
            "cross_dataset": cross_dataset(clips), "readings": readings(obs, held, base, reference),
            "features": features(base)}
     res["seconds"] = time.time() - t0
-    Path(args.json).write_text(json.dumps(res, indent=1) + "\n", encoding="utf-8")
-    text = render(res)
-    print(text)
-    if args.doc:
-        write_marked(args.doc, "extended", text)
+    publish_marked(res, args.json, render(res), args.doc, "extended")
     return 0
 
 

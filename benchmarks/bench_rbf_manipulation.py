@@ -27,7 +27,7 @@ from pathlib import Path
 
 import numpy as np
 
-from benchmarks.doc_tables import write_marked
+from benchmarks.doc_tables import publish_marked
 from generation.mocap.style_scales import NEUTRAL_CLASS, THEME_SCALE
 from generation.quality.style_observer import train_style_observers
 from generation.rbf import calibrate as C
@@ -227,11 +227,7 @@ def main(argv=None) -> int:
     res["seconds"] = time.time() - t0
     if args.sheet:
         contact_sheet(obs, clips, base, Path(args.sheet))
-    Path(args.json).write_text(json.dumps(res, indent=1) + "\n", encoding="utf-8")
-    text = render(res)
-    print(text)
-    if args.doc:
-        write_marked(args.doc, "manipulation", text)
+    publish_marked(res, args.json, render(res), args.doc, "manipulation")
     return 0
 
 

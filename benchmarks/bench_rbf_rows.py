@@ -17,9 +17,8 @@ from __future__ import annotations
 import argparse
 import json
 import time
-from pathlib import Path
 
-from benchmarks.doc_tables import write_marked
+from benchmarks.doc_tables import publish_marked
 from generation.mocap.real_corpus import load_real_corpus
 from generation.rbf.row_effects import group_effects, group_sign
 from generation.rbf.themes import EXTENDED_PATH, OURS
@@ -144,11 +143,7 @@ def main(argv=None) -> int:
         themes[theme] = {"effects": effects, "ours": theme_rows(effects, theme, extended)}
     res = {"date": time.strftime("%Y-%m-%d"), "machine": "2-core shared CPU, no GPU", "corpus": args.corpus,
            "themes": themes, "seconds": time.time() - t0}
-    Path(args.json).write_text(json.dumps(res, indent=1) + "\n", encoding="utf-8")
-    text = render(res, args.top)
-    print(text)
-    if args.doc:
-        write_marked(args.doc, "rows", text)
+    publish_marked(res, args.json, render(res, args.top), args.doc, "rows")
     return 0
 
 

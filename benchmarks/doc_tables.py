@@ -115,6 +115,15 @@ def write_marked(doc_path: str | Path, marker: str, text: str) -> None:
     doc_path.write_text(pattern.sub(lambda m: m.group(1) + text + "\n" + m.group(2), doc), encoding="utf-8")
 
 
+def publish_marked(results: dict, json_path: str | Path, text: str, doc_path: str | Path | None, marker: str) -> None:
+    """A benchmark's end: ``results`` as JSON to ``json_path``, its rendered ``text`` printed and, with ``doc_path``,
+    written between the page's ``marker`` markers (:func:`write_marked`)."""
+    Path(json_path).write_text(json.dumps(results, indent=1) + "\n", encoding="utf-8")
+    print(text)
+    if doc_path:
+        write_marked(doc_path, marker, text)
+
+
 def write_results(area: str, out: Path, results: dict, seconds: float, default=float) -> None:
     """Write a benchmark's ``results`` as JSON to ``out``; when ``out`` is the area's own JSON file, also render the
     area's tables into its doc (a run written elsewhere, e.g. a candidate's, leaves the docs alone)."""
