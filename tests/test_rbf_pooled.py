@@ -134,6 +134,6 @@ def test_rebuild_on_the_corpora_matches_the_shipped_file(pooled):
     for theme in POOLED_THEMES:
         train, _, _ = E.source_differences(clips, bml, theme, ("train",), 100, all_features(theme))
         np.testing.assert_allclose(train, [g["real_train"] for g in pooled["themes"][theme]["groups"]], atol=1e-5)
-        tempo = E.pooled_tempo(clips, bml, theme)
+        tempo = E.pooled_tempo(clips, E.bml_source(bml, theme, ("train",)), theme)
         for key in ("per_weight", "stride_per_weight", "cadence_per_weight"):
             assert tempo[key] == pytest.approx(pooled["themes"][theme]["tempo"][key], abs=1e-5), key

@@ -233,14 +233,13 @@ def source_differences(clips: list, bml_clips: list | None, theme: str, splits: 
     return np.mean(list(per.values()), axis=0), per, info + [{k: v for k, v in bml.items() if k != "per_walker"}]
 
 
-def pooled_tempo(clips: list, bml_clips: list | None, theme: str, splits: tuple[str, ...] = ("train",),
+def pooled_tempo(clips: list, bml: dict | None, theme: str, splits: tuple[str, ...] = ("train",),
                  m: int = 100) -> dict:
-    """:func:`real_tempo` with BML as one more source where it holds the theme (its ratios: means over actors of
-    each actor's styled / neutral walk, :func:`bml_source`); ``per_weight``, ``stride_per_weight`` and
-    ``cadence_per_weight`` = mean over sources of the speed, stride and cadence ratio - 1, each source weighing the
-    same."""
+    """:func:`real_tempo` with BML as one more source where it holds the theme: ``bml`` is its :func:`bml_source`
+    (ratios: means over actors of each actor's styled / neutral walk; None: Bandai alone); ``per_weight``,
+    ``stride_per_weight`` and ``cadence_per_weight`` = mean over sources of the speed, stride and cadence ratio - 1,
+    each source weighing the same."""
     tempo = real_tempo(clips, theme, splits, m)
-    bml = bml_source(bml_clips, theme, splits, m) if bml_clips else None
     if bml is None:
         return tempo
     tempo["datasets"].append({"dataset": BML_DATASET, "speed_ratio": bml["speed_ratio"],
@@ -316,7 +315,8 @@ def extend(clips: list, base: Motion, m: int = 100, bml_clips: list | None = Non
                        "gain_alone": float(gains[i]),
                        "extended_w1": float(reached[i]), "expert_sign_agrees": bool(train[i] * gains[i] > 0)}
                       for i, (p, a, k) in enumerate(groups)]
-        tempo = pooled_tempo(clips, sources, theme, ("train",), m)
+        bml_train = next((d for d in train_info if d["dataset"] == BML_DATASET), None)  # source_differences' BML
+        tempo = pooled_tempo(clips, bml_train, theme, ("train",), m)
         tempo["source"] = "ours"
         tempo["applied_as"] = ("with all ten features: stride scaled by max(0.5, 1 + w * stride_per_weight) (legs' "
                                "fore-aft offsets from the pelvis and progression per cycle, feet planted, pelvis "

@@ -224,8 +224,7 @@ def stride_cadence_scales(theme: str, weight: float, n_features: int, features: 
     expert features are all on (all ten of Table III): s = max(0.5, 1 + w * stride), c = max(0.5, 1 + w * cadence)
     with the theme's real stride and cadence ratios minus 1 (:func:`generation.rbf.themes.extended_stride_cadence`), so
     w = 1 gives the real style's stride and cadence relative to normal walking and a negative w inverts them."""
-    if not (features == "expert" and isinstance(intensities, str) and intensities in EXTENDED_SETS
-            and n_features == len(theme_features(theme, None, "visual"))):
+    if not (uses_bent_arms(features, intensities) and n_features == len(theme_features(theme, None, "visual"))):
         return 1.0, 1.0
     stride, cadence = extended_stride_cadence(theme, EXTENDED_SETS[intensities])
     w = float(weight)
@@ -569,7 +568,8 @@ def stylised_cycle(neutral_cycle: Motion, theme: str, weight: float, n_features:
 
 def uses_bent_arms(features: str, intensities: str | Mapping[int, float]) -> bool:
     """Whether a styled walk keeps the base's elbow bend by default: the expert features of the ``extended`` or
-    ``pooled`` set (the ``calibrated`` and ``visual`` sets and data features keep the plain fit)."""
+    ``pooled`` set (the ``calibrated`` and ``visual`` sets and data features keep the plain fit). The same sets,
+    with all ten features, carry the stride and cadence levers (:func:`stride_cadence_scales`)."""
     return features == "expert" and isinstance(intensities, str) and intensities in EXTENDED_SETS
 
 
@@ -670,8 +670,9 @@ def stylise(neutral_cycle: Motion, theme: str, weight: float, n_features: int, s
         metadata.update(calibration_provenance())
     if features == "expert" and intensities in EXTENDED_SETS and "licence" not in metadata:
         metadata.update(extended_provenance(EXTENDED_SETS[intensities]))
-    if features == "expert" and intensities == "pooled" and extended_sources(theme, POOLED_PATH):
-        metadata["intensity_sources"] = extended_sources(theme, POOLED_PATH)
+    sources = extended_sources(theme, POOLED_PATH) if features == "expert" and intensities == "pooled" else {}
+    if sources:
+        metadata["intensity_sources"] = sources
     if features == "data" and "licence" not in metadata:
 
         data = load_data_features()
